@@ -1,0 +1,85 @@
+#include "cli_common.hpp"
+
+#include <fmt/core.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+
+namespace fiblet::cli {
+
+int exit_code_for(Errc c) {
+    switch (c) {
+        case Errc::io: return kIo;
+        case Errc::tck_format:
+        case Errc::fft_format:
+        case Errc::invalid_input: return kBadInput;
+        case Errc::invalid_argument: return kUsage;
+        case Errc::exists: return kExists;
+        case Errc::unsupported: return kUnsupported;
+        case Errc::checksum: return kChecksum;
+        case Errc::interrupted: return 130;
+    }
+    return kInternal;
+}
+
+Progress::Progress(bool quiet) : enabled_(!quiet && ::isatty(STDERR_FILENO)) {}
+Progress::~Progress() { done(); }
+
+void Progress::update(const std::string& label, double fraction) {
+    if (!enabled_) return;
+    const int permille = int(std::lround(std::min(std::max(fraction, 0.0), 1.0) * 1000));
+    if (permille == last_permille_ && label == last_label_) return;
+    last_permille_ = permille, last_label_ = label;
+    fmt::print(stderr, "\r{:<40} {:5.1f}%", label, permille / 10.0);
+    std::fflush(stderr);
+}
+
+void Progress::done() {
+    if (enabled_ && last_permille_ >= 0) fmt::print(stderr, "\r{:<48}\r", "");
+    last_permille_ = -1;
+}
+
+std::string human_bytes(std::uint64_t b) {
+    if (b < 10000) return fmt::format("{} B", b);
+    if (b < 1'000'000) return fmt::format("{:.1f} kB", b / 1e3);
+    if (b < 10'000'000'000ull) return fmt::format("{:.2f} MB", b / 1e6);
+    return fmt::format("{:.2f} GB", b / 1e9);
+}
+
+std::string json_quote(const std::string& s) {
+    std::string out = "\"";
+    for (unsigned char ch : s) {
+        switch (ch) {
+            case '"': out += "\\\""; break;
+            case '\\': out += "\\\\"; break;
+            case '\n': out += "\\n"; break;
+            case '\t': out += "\\t"; break;
+            case '\r': out += "\\r"; break;
+            default:
+                if (ch < 0x20) out += fmt::format("\\u{:04x}", ch);
+                else out += char(ch);
+        }
+    }
+    return out + "\"";
+}
+
+Json& Json::num(const std::string& k, double v) {
+    return raw(k, std::isfinite(v) ? fmt::format("{:.9g}", v) : "null");
+}
+Json& Json::integer(const std::string& k, std::uint64_t v) { return raw(k, std::to_string(v)); }
+Json& Json::str(const std::string& k, const std::string& v) { return raw(k, json_quote(v)); }
+Json& Json::boolean(const std::string& k, bool v) { return raw(k, v ? "true" : "false"); }
+Json& Json::raw(const std::string& k, const std::string& r) {
+    fields_.emplace_back(k, r);
+    return *this;
+}
+
+std::string Json::render() const {
+    std::string out = "{";
+    for (std::size_t i = 0; i < fields_.size(); ++i)
+        out += (i ? ", " : "") + json_quote(fields_[i].first) + ": " + fields_[i].second;
+    return out + "}";
+}
+
+}  // namespace fiblet::cli

@@ -1,0 +1,65 @@
+// Shared helpers of the fiblet subcommands: exit codes, progress, JSON.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "fiblet/error.hpp"
+
+namespace fiblet::cli {
+
+// Exit codes (documented in README.md, "Exit codes").
+enum ExitCode : int {
+    kOk = 0,
+    kInternal = 1,     // a bug: unexpected exception
+    kUsage = 2,        // bad command line or option value
+    kIo = 3,           // cannot read/write a file
+    kBadInput = 4,     // malformed or inconsistent input file
+    kExists = 5,       // output exists, --force not given
+    kUnsupported = 6,  // valid input fiblet cannot handle
+    kChecksum = 7,     // integrity check failed
+};
+int exit_code_for(Errc c);
+
+// Progress on stderr, only when stderr is a terminal and not --quiet.
+class Progress {
+public:
+    explicit Progress(bool quiet);
+    ~Progress();
+    void update(const std::string& label, double fraction);
+    void done();
+
+private:
+    bool enabled_;
+    int last_permille_ = -1;
+    std::string last_label_;
+};
+
+std::string human_bytes(std::uint64_t bytes);
+
+// Minimal JSON object builder (values are numbers, strings, bools or nested
+// objects already rendered), keys in insertion order.
+class Json {
+public:
+    Json& num(const std::string& key, double v);
+    Json& integer(const std::string& key, std::uint64_t v);
+    Json& str(const std::string& key, const std::string& v);
+    Json& boolean(const std::string& key, bool v);
+    Json& raw(const std::string& key, const std::string& rendered);
+    std::string render() const;
+
+private:
+    std::vector<std::pair<std::string, std::string>> fields_;
+};
+std::string json_quote(const std::string& s);
+
+// Subcommand registration (one file each).
+void add_compress(CLI::App& app);
+void add_decompress(CLI::App& app);
+void add_stats(CLI::App& app);
+void add_info(CLI::App& app);
+
+}  // namespace fiblet::cli

@@ -1,0 +1,120 @@
+// fiblet compress IN.tck [IN2.tck ...] (-o OUT.fft | --output-dir DIR)
+#include <fmt/core.h>
+
+#include <filesystem>
+#include <optional>
+
+#include "cli_common.hpp"
+#include "fiblet/compress.hpp"
+
+namespace fiblet::cli {
+namespace {
+
+struct CompressArgs {
+    std::vector<std::string> inputs;
+    std::string output, output_dir;
+    std::optional<double> step;
+    bool force = false, quiet = false, json = false, allow_count_mismatch = false;
+};
+
+std::string output_for(const CompressArgs& a, const std::string& in) {
+    if (!a.output.empty()) return a.output;
+    std::filesystem::path p = std::filesystem::path(in).filename();
+    p.replace_extension(".fft");
+    return (a.output_dir.empty() ? std::filesystem::path(in).parent_path() / p : std::filesystem::path(a.output_dir) / p)
+        .string();
+}
+
+std::string describe_errors(const ErrorStats& e) {
+    return fmt::format("max {:.2f} µm, mean {:.2f} µm, p99 {:.2f} µm", e.max_mm() * 1e3, e.mean_mm() * 1e3,
+                       e.percentile_mm(99) * 1e3);
+}
+
+std::string report_json(const std::string& in, const std::string& out, const CompressReport& r) {
+    Json j;
+    j.str("input", in).str("output", out);
+    j.integer("fibers", r.header.fibers).integer("points", r.header.points).integer("blocks", r.header.blocks);
+    j.integer("input_bytes", r.input_bytes).integer("output_bytes", r.output_bytes);
+    j.num("ratio", r.output_bytes ? double(r.input_bytes) / double(r.output_bytes) : 0.0);
+    j.num("step_mm", r.step_mm).num("cap_ratio", r.header.ratio).boolean("resampled", r.resampled);
+    j.num("max_error_um", r.error.max_mm() * 1e3).num("mean_error_um", r.error.mean_mm() * 1e3);
+    if (r.resampled)
+        j.num("max_error_vs_original_um", r.error_vs_original.max_mm() * 1e3)
+            .num("mean_error_vs_original_um", r.error_vs_original.mean_mm() * 1e3);
+    j.num("seconds", r.seconds);
+    return j.render();
+}
+
+void run(const CompressArgs& a) {
+    if (a.inputs.size() > 1 && !a.output.empty())
+        throw Error(Errc::invalid_argument, "-o names one output: use --output-dir DIR for several inputs");
+    if (!a.output_dir.empty() && !std::filesystem::is_directory(a.output_dir))
+        throw Error(Errc::invalid_argument, a.output_dir + ": --output-dir is not a directory");
+    std::vector<std::string> json;
+    std::optional<Error> first_failure;
+    for (const std::string& in : a.inputs) {
+        const std::string out = output_for(a, in);
+        Progress progress(a.quiet);
+        CompressOptions o;
+        o.step_mm = a.step;
+        o.overwrite = a.force;
+        o.allow_count_mismatch = a.allow_count_mismatch;
+        const std::string name = std::filesystem::path(in).filename().string();
+        o.progress = [&](const char* phase, double f) { progress.update(name + ": " + phase, f); };
+        try {
+            const CompressReport r = compress_tck(in, out, o);
+            progress.done();
+            if (a.json) {
+                json.push_back(report_json(in, out, r));
+            } else if (!a.quiet) {
+                fmt::print("{} -> {}\n", in, out);
+                fmt::print("  {} fibers, {} points, {} blocks of {} points ({} B)\n", r.header.fibers,
+                           r.header.points, r.header.blocks, r.header.points_per_block, r.header.block_bytes());
+                fmt::print("  step {:.6g} mm{}, cap ratio {:.4f}\n", r.step_mm,
+                           r.resampled ? " (variable spacing in the input: resampled to this fixed step)" : "",
+                           r.header.ratio);
+                fmt::print("  {} -> {} ({:.2f}x smaller)\n", human_bytes(r.input_bytes), human_bytes(r.output_bytes),
+                           double(r.input_bytes) / double(r.output_bytes));
+                fmt::print("  error vs {}: {}\n", r.resampled ? "resampled points" : "input", describe_errors(r.error));
+                if (r.resampled)
+                    fmt::print("  error vs original polyline: {}\n", describe_errors(r.error_vs_original));
+                fmt::print("  {:.2f} s ({:.1f} M points/s)\n", r.seconds, r.header.points / r.seconds / 1e6);
+            }
+        } catch (const Error& e) {
+            progress.done();
+            fmt::print(stderr, "fiblet: error: {}\n", e.what());
+            if (!first_failure) first_failure = e;
+        }
+    }
+    if (a.json) {
+        if (a.inputs.size() == 1 && json.size() == 1) fmt::print("{}\n", json[0]);
+        else {
+            std::string all = "[";
+            for (std::size_t i = 0; i < json.size(); ++i) all += (i ? ",\n " : "") + json[i];
+            fmt::print("{}]\n", all);
+        }
+    }
+    if (first_failure) {
+        if (a.inputs.size() == 1) throw Error(first_failure->code(), "compression failed");
+        throw Error(first_failure->code(), "some inputs failed (see above)");
+    }
+}
+
+}  // namespace
+
+void add_compress(CLI::App& app) {
+    auto args = std::make_shared<CompressArgs>();
+    CLI::App* cmd = app.add_subcommand("compress", "Compress .tck tractograms into .fft fiblet files");
+    cmd->add_option("inputs", args->inputs, "Input .tck files")->required()->check(CLI::ExistingFile);
+    cmd->add_option("-o,--output", args->output, "Output .fft file (one input)");
+    cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs)");
+    cmd->add_option("--step", args->step, "Fixed step in mm (default: measured; variable spacing is resampled)");
+    cmd->add_flag("-f,--force", args->force, "Overwrite existing outputs");
+    cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
+    cmd->add_flag("--json", args->json, "Print the report as JSON");
+    cmd->add_flag("--allow-count-mismatch", args->allow_count_mismatch,
+                  "Accept a .tck whose count: header disagrees with its data");
+    cmd->callback([args] { run(*args); });
+}
+
+}  // namespace fiblet::cli

@@ -1,0 +1,100 @@
+// fiblet info FILE — the header of a .fft or .tck file.
+#include <fmt/core.h>
+
+#include <cstdio>
+#include <fstream>
+
+#include "cli_common.hpp"
+#include "fiblet/fft_file.hpp"
+#include "fiblet/tck.hpp"
+
+namespace fiblet::cli {
+namespace {
+
+struct InfoArgs {
+    std::string input;
+    bool json = false;
+};
+
+bool looks_like_tck(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    char magic[13] = {};
+    f.read(magic, 13);
+    return f.gcount() == 13 && std::string(magic, 13) == "mrtrix tracks";
+}
+
+std::string properties_json(const std::vector<std::pair<std::string, std::string>>& props) {
+    std::string out = "[";
+    for (std::size_t i = 0; i < props.size(); ++i)
+        out += (i ? ", " : "") + fmt::format("[{}, {}]", json_quote(props[i].first), json_quote(props[i].second));
+    return out + "]";
+}
+
+void print_properties(const std::vector<std::pair<std::string, std::string>>& props) {
+    for (const auto& [k, v] : props) fmt::print("  {:<22} {}\n", k + ":", v);
+}
+
+void info_tck(const InfoArgs& a) {
+    const TckHeader h = read_tck_header(a.input);
+    if (a.json) {
+        fmt::print("{}\n", Json{}
+                               .str("file", a.input)
+                               .str("format", "tck")
+                               .str("datatype", tck_datatype_name(h.datatype))
+                               .integer("data_offset", h.data_offset)
+                               .raw("properties", properties_json(h.properties))
+                               .render());
+        return;
+    }
+    fmt::print("{}: MRtrix3 tracks file, {}, data at byte {}\n", a.input, tck_datatype_name(h.datatype), h.data_offset);
+    print_properties(h.properties);
+}
+
+void info_fft(const InfoArgs& a) {
+    const FftFile f(a.input);
+    const FftHeader& h = f.header();
+    std::string chunks;
+    for (const auto& c : f.trailer()) chunks += (chunks.empty() ? "" : " ") + std::string(c.tag.data(), 4);
+    if (a.json) {
+        Json j;
+        j.str("file", a.input).str("format", "fft").integer("version", h.version);
+        j.integer("fibers", h.fibers).integer("points", h.points).integer("blocks", h.blocks);
+        j.integer("points_per_block", h.points_per_block).integer("block_bytes", h.block_bytes());
+        j.num("scaling_mm", h.scaling);
+        j.raw("offset_mm", fmt::format("[{:.9g}, {:.9g}, {:.9g}]", h.offset[0], h.offset[1], h.offset[2]));
+        j.num("ratio", h.ratio).num("step", h.step).num("step_mm", double(h.step) * h.scaling);
+        j.num("max_error_um", h.max_error_mm * 1e3).num("mean_error_um", h.mean_error_mm * 1e3);
+        j.integer("gpu_buffers", h.buffer_ends.size()).integer("file_bytes", f.file_size());
+        j.str("trailer_chunks", chunks);
+        j.raw("properties", properties_json(f.properties()));
+        fmt::print("{}\n", j.render());
+        return;
+    }
+    fmt::print("{}: fiblet .fft version {}, {}\n", a.input, h.version, human_bytes(f.file_size()));
+    fmt::print("  fibers                 {}\n  points                 {}\n", h.fibers, h.points);
+    fmt::print("  blocks                 {} x {} B ({} points each)\n", h.blocks, h.block_bytes(), h.points_per_block);
+    fmt::print("  step                   {:.6g} mm ({:.6g} normalized)\n", double(h.step) * h.scaling, h.step);
+    fmt::print("  cap ratio              {:.6g}\n", h.ratio);
+    fmt::print("  scaling, offset (mm)   {:.6g}, ({:.6g}, {:.6g}, {:.6g})\n", h.scaling, h.offset[0], h.offset[1],
+               h.offset[2]);
+    fmt::print("  recorded error         max {:.3f} µm, mean {:.3f} µm\n", h.max_error_mm * 1e3, h.mean_error_mm * 1e3);
+    fmt::print("  GPU buffers            {}\n", h.buffer_ends.size());
+    if (!chunks.empty()) fmt::print("  trailer chunks         {}\n", chunks);
+    const auto props = f.properties();
+    if (!props.empty()) {
+        fmt::print("  source .tck properties:\n");
+        print_properties(props);
+    }
+}
+
+}  // namespace
+
+void add_info(CLI::App& app) {
+    auto args = std::make_shared<InfoArgs>();
+    CLI::App* cmd = app.add_subcommand("info", "Print the header of a .fft or .tck file");
+    cmd->add_option("file", args->input, "A .fft or .tck file")->required()->check(CLI::ExistingFile);
+    cmd->add_flag("--json", args->json, "Print as JSON");
+    cmd->callback([args] { looks_like_tck(args->input) ? info_tck(*args) : info_fft(*args); });
+}
+
+}  // namespace fiblet::cli

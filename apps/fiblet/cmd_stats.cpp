@@ -1,0 +1,82 @@
+// fiblet stats IN.fft --reference IN.tck
+#include <fmt/core.h>
+
+#include "cli_common.hpp"
+#include "fiblet/compare.hpp"
+
+namespace fiblet::cli {
+namespace {
+
+struct StatsArgs {
+    std::string input, reference;
+    bool json = false, quiet = false, allow_count_mismatch = false;
+};
+
+std::string error_json(const ErrorStats& e) {
+    return Json{}
+        .num("max_um", e.max_mm() * 1e3)
+        .num("mean_um", e.mean_mm() * 1e3)
+        .num("rms_um", e.rms_mm() * 1e3)
+        .num("p50_um", e.percentile_mm(50) * 1e3)
+        .num("p95_um", e.percentile_mm(95) * 1e3)
+        .num("p99_um", e.percentile_mm(99) * 1e3)
+        .integer("worst_fiber", e.worst_fiber())
+        .integer("points", e.count())
+        .render();
+}
+
+void print_errors(const char* label, const ErrorStats& e) {
+    fmt::print("{:<22} max {:.3f}  mean {:.3f}  rms {:.3f}  p50 {:.2f}  p95 {:.2f}  p99 {:.2f}  (worst fiber {})\n",
+               label, e.max_mm() * 1e3, e.mean_mm() * 1e3, e.rms_mm() * 1e3, e.percentile_mm(50) * 1e3,
+               e.percentile_mm(95) * 1e3, e.percentile_mm(99) * 1e3, e.worst_fiber());
+}
+
+void run(const StatsArgs& a) {
+    const FftFile file(a.input);
+    Progress progress(a.quiet || a.json);
+    const Comparison c =
+        compare_to_reference(file, a.reference, a.allow_count_mismatch, [&](double f) { progress.update("stats", f); });
+    progress.done();
+    const FftHeader& h = file.header();
+    const double ratio = c.fft_bytes ? double(c.reference_bytes) / double(c.fft_bytes) : 0.0;
+    if (a.json) {
+        Json j;
+        j.str("file", a.input).str("reference", a.reference);
+        j.integer("fibers", c.fibers).integer("points", c.points).integer("blocks", c.blocks);
+        j.integer("fft_bytes", c.fft_bytes).integer("reference_bytes", c.reference_bytes).num("ratio", ratio);
+        j.num("bytes_per_point", c.points ? double(c.fft_bytes) / double(c.points) : 0.0);
+        j.boolean("resampled", c.resampled);
+        j.raw("error", error_json(c.error));
+        if (c.resampled) j.raw("error_vs_original", error_json(c.error_vs_original));
+        j.num("header_max_error_um", h.max_error_mm * 1e3).num("header_mean_error_um", h.mean_error_mm * 1e3);
+        fmt::print("{}\n", j.render());
+        return;
+    }
+    fmt::print("{}: {} fibers, {} points, {} blocks of {} points\n", a.input, c.fibers, c.points, c.blocks,
+               h.points_per_block);
+    fmt::print("size                   {} vs {} reference: {:.2f}x smaller, {:.3f} bytes/point\n",
+               human_bytes(c.fft_bytes), human_bytes(c.reference_bytes), ratio,
+               c.points ? double(c.fft_bytes) / double(c.points) : 0.0);
+    fmt::print("error (µm)\n");
+    print_errors(c.resampled ? "  vs resampled points" : "  vs reference", c.error);
+    if (c.resampled) print_errors("  vs original polyline", c.error_vs_original);
+    fmt::print("  recorded in header   max {:.3f}  mean {:.3f}\n", h.max_error_mm * 1e3, h.mean_error_mm * 1e3);
+}
+
+}  // namespace
+
+void add_stats(CLI::App& app) {
+    auto args = std::make_shared<StatsArgs>();
+    CLI::App* cmd = app.add_subcommand("stats", "Measure a .fft file against its source .tck");
+    cmd->add_option("input", args->input, "Input .fft file")->required()->check(CLI::ExistingFile);
+    cmd->add_option("-r,--reference", args->reference, "The .tck file it was made from")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cmd->add_flag("--json", args->json, "Print the report as JSON");
+    cmd->add_flag("-q,--quiet", args->quiet, "No progress display");
+    cmd->add_flag("--allow-count-mismatch", args->allow_count_mismatch,
+                  "Accept a reference whose count: header disagrees with its data");
+    cmd->callback([args] { run(*args); });
+}
+
+}  // namespace fiblet::cli

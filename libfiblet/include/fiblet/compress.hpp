@@ -1,0 +1,49 @@
+// fiblet — compressing a .tck file into a .fft file (the whole pipeline).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "fiblet/error_stats.hpp"
+#include "fiblet/fft_format.hpp"
+
+namespace fiblet {
+
+// What a first pass over a .tck learns about it.
+struct TckScan {
+    std::uint64_t fibers = 0, points = 0, segments = 0;
+    std::uint64_t empty_fibers = 0, single_point_fibers = 0;
+    std::array<double, 3> min{}, max{};  // bounding box, mm
+    double min_dot = 1;                  // smallest dot of consecutive unit segment directions
+    double step_mean = 0, step_min = 0, step_max = 0, step_median = 0;  // segment lengths, mm
+    std::optional<double> header_step;   // "step_size:" of the header
+    std::uint64_t off_step_segments = 0; // segments farther than the tolerance from the chosen step
+};
+
+struct CompressOptions {
+    std::optional<double> step_mm;            // overrides the measured step
+    std::uint32_t points_per_block = kDefaultPointsPerBlock;
+    double step_tolerance = 0.01;             // relative spacing deviation that triggers resampling
+    bool overwrite = false;
+    bool allow_count_mismatch = false;
+    // progress(phase, fraction in [0,1]); phases "scan", "resample-scan", "encode".
+    std::function<void(const char*, double)> progress;
+};
+
+struct CompressReport {
+    TckScan scan;
+    FftHeader header;
+    double step_mm = 0;
+    bool resampled = false;          // the input was resampled to the fixed step
+    ErrorStats error;                // decoded vs the encoded points (resampled ones if resampled)
+    ErrorStats error_vs_original;    // decoded vs the original polyline (only if resampled)
+    std::uint64_t input_bytes = 0, output_bytes = 0;
+    double seconds = 0;
+};
+
+// Compresses `tck_path` into `fft_path` (atomically; see AtomicOutputFile).
+CompressReport compress_tck(const std::string& tck_path, const std::string& fft_path, const CompressOptions& options);
+
+}  // namespace fiblet

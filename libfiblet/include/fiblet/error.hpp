@@ -1,0 +1,38 @@
+// fiblet — error reporting.
+//
+// Every failure the library can meet on bad input or a failing system call is
+// reported as a fiblet::Error carrying a category, so that callers (the CLI,
+// the Python module, a pipeline) can map it to an exit code without parsing
+// the message. Messages name the file and what is wrong with it.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace fiblet {
+
+enum class Errc : int {
+    io = 1,            // open/read/write/rename failed (errno text in the message)
+    tck_format = 2,    // malformed .tck header or data
+    fft_format = 3,    // malformed .fft header or data
+    invalid_input = 4, // well-formed file whose content cannot be encoded (NaN, ...)
+    invalid_argument = 5, // bad option value given by the caller
+    exists = 6,        // output exists and overwriting was not allowed
+    unsupported = 7,   // valid but not supported (e.g. an unknown datatype)
+    checksum = 8,      // integrity check failed
+    interrupted = 9,   // stopped by a signal
+};
+
+// Short stable name of a category ("tck_format", ...), for --json output.
+const char* errc_name(Errc c) noexcept;
+
+class Error : public std::runtime_error {
+public:
+    Error(Errc code, const std::string& message) : std::runtime_error(message), code_(code) {}
+    Errc code() const noexcept { return code_; }
+
+private:
+    Errc code_;
+};
+
+}  // namespace fiblet

@@ -1,0 +1,135 @@
+// fiblet — the .fft (Fiblets, version 2) file layout.
+//
+// See formats/fft.md for the full specification. Everything is little-endian
+// and unpadded:
+//   header   u8 version=2, u64 nbFibers, u64 nbPoints, u32 nbBlocks,
+//            u32 pointsPerBlock, f32 scaling, f32x3 offset, f32 ratio,
+//            f32 step (normalized units), f32 maxError (mm), f32 meanError (mm),
+//            u8 nbSSBOs, u64 x nbSSBOs (cumulative block count per GPU buffer)
+//   LUT      per fiber u32 x, u32 y (x = buffer << 16 | blocks, y = first block
+//            of the fiber inside its buffer)
+//   blocks   nbBlocks x blockSize bytes (76 for 60 points)
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "fiblet/geometry.hpp"
+
+namespace fiblet {
+
+inline constexpr std::uint8_t kFftVersion = 2;
+inline constexpr std::uint32_t kDefaultPointsPerBlock = 60;
+inline constexpr std::uint32_t kMaxPointsPerBlock = 63;  // 6-bit count in the flags byte
+inline constexpr std::size_t kFftFixedHeaderBytes = 1 + 8 + 8 + 4 + 4 + 4 * 8 + 1;  // up to the SSBO table
+
+// Byte offsets inside a block.
+inline constexpr std::size_t kBlockAnchorBytes = 12;  // two points, six unorm16
+inline constexpr std::size_t kBlockFiberIdOffset = 12;
+inline constexpr std::size_t kBlockFlagsOffset = 16;
+inline constexpr std::size_t kBlockIndexOffset = 17;
+inline constexpr std::size_t kBlockDirectionsOffset = 18;
+
+inline constexpr std::uint8_t kFlagNotFirst = 0x80;
+inline constexpr std::uint8_t kFlagNotLast = 0x40;
+inline constexpr std::uint8_t kFlagCountMask = 0x3f;
+
+// Block size for a number of points: points + 16 rounded up to 4 bytes.
+constexpr std::uint32_t fft_block_bytes(std::uint32_t points_per_block) {
+    return (points_per_block + 16 + 3) / 4 * 4;
+}
+
+// Largest number of blocks one GPU buffer holds (2^31 bytes / block size).
+constexpr std::uint64_t fft_max_blocks_per_buffer(std::uint32_t block_bytes) {
+    return (std::uint64_t{1} << 31) / block_bytes;
+}
+
+struct FftHeader {
+    std::uint8_t version = kFftVersion;
+    std::uint64_t fibers = 0;
+    std::uint64_t points = 0;
+    std::uint32_t blocks = 0;
+    std::uint32_t points_per_block = kDefaultPointsPerBlock;
+    float scaling = 1;                 // mm per normalized unit
+    std::array<float, 3> offset{};     // mm, added before scaling
+    float ratio = 1;                   // spherical-cap parameter of the direction code
+    float step = 0;                    // step length in normalized units
+    float max_error_mm = 0;
+    float mean_error_mm = 0;
+    std::vector<std::uint64_t> buffer_ends;  // cumulative block count at the end of each buffer
+
+    std::uint32_t block_bytes() const { return fft_block_bytes(points_per_block); }
+    float step_mm() const { return step * scaling; }
+    // Bytes before the fiber LUT / before the first block.
+    std::uint64_t lut_offset() const { return kFftFixedHeaderBytes + 8 * buffer_ends.size(); }
+    std::uint64_t blocks_offset() const { return lut_offset() + 8 * fibers; }
+    std::uint64_t file_bytes() const { return blocks_offset() + std::uint64_t{blocks} * block_bytes(); }
+
+    // Normalized <-> world coordinates.
+    Vec3f to_world(float nx, float ny, float nz) const {
+        return {(nx - 0.5f) * scaling - offset[0], (ny - 0.5f) * scaling - offset[1],
+                (nz - 0.5f) * scaling - offset[2]};
+    }
+};
+
+struct FiberLutEntry {
+    std::uint32_t x = 0;  // buffer index << 16 | number of blocks
+    std::uint32_t y = 0;  // first block inside the buffer
+
+    std::uint32_t buffer() const { return x >> 16; }
+    std::uint32_t block_count() const { return x & 0xffffu; }
+};
+
+// Serializes the header (fixed part + buffer table) into bytes.
+std::vector<std::uint8_t> serialize_fft_header(const FftHeader& h);
+
+// fiblet extension trailer (formats/fft.md, "Trailer"): optional chunks after
+// the last block, which readers of the original format never look at.
+// Layout: chunks { char tag[4]; u32 flags = 0; u64 size; u8 payload[size] },
+// then a 16-byte footer { u64 offset of the first chunk; "FIBLETX1" }.
+inline constexpr char kTrailerMagic[8] = {'F', 'I', 'B', 'L', 'E', 'T', 'X', '1'};
+inline constexpr std::size_t kTrailerFooterBytes = 16;
+struct TrailerChunk {
+    std::array<char, 4> tag{};
+    std::vector<std::uint8_t> payload;
+};
+// Serializes chunks + footer; `trailer_offset` is where the first chunk starts.
+std::vector<std::uint8_t> serialize_trailer(const std::vector<TrailerChunk>& chunks, std::uint64_t trailer_offset);
+
+// "PROP" chunk: the source .tck header properties, in order, each as two
+// strings (key, value), each string a u32 byte count then its bytes.
+inline constexpr std::array<char, 4> kPropertiesTag = {'P', 'R', 'O', 'P'};
+// "RSMP" chunk, present when the encoder resampled variable-step input to
+// the fixed step: payload f64 step in mm. Tells a comparison to resample the
+// reference the same way.
+inline constexpr std::array<char, 4> kResampledTag = {'R', 'S', 'M', 'P'};
+TrailerChunk make_properties_chunk(const std::vector<std::pair<std::string, std::string>>& properties);
+
+// Read-only view of one block's fields.
+struct BlockView {
+    const std::uint8_t* bytes;
+
+    std::uint8_t flags() const { return bytes[kBlockFlagsOffset]; }
+    std::uint32_t point_count() const { return flags() & kFlagCountMask; }
+    bool is_first() const { return !(flags() & kFlagNotFirst); }
+    bool is_last() const { return !(flags() & kFlagNotLast); }
+    std::uint32_t index_in_fiber() const { return bytes[kBlockIndexOffset]; }
+    std::uint32_t fiber_id() const {
+        return std::uint32_t{bytes[12]} << 24 | std::uint32_t{bytes[13]} << 16 | std::uint32_t{bytes[14]} << 8 |
+               bytes[15];
+    }
+    // Anchor k (0 or 1) in normalized coordinates, as six unorm16 values.
+    std::array<std::uint16_t, 6> anchor_words() const;
+    std::array<float, 6> anchors_normalized() const;
+    const std::uint8_t* directions() const { return bytes + kBlockDirectionsOffset; }
+};
+
+// unorm16 as GLSL packUnorm2x16 defines it: round(clamp(v, 0, 1) * 65535).
+std::uint16_t pack_unorm16(float v);
+inline float unpack_unorm16(std::uint16_t q) { return float(q) / 65535.0f; }
+
+}  // namespace fiblet

@@ -1,0 +1,28 @@
+// fiblet — fixed-step resampling of variable-step streamlines.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "fiblet/geometry.hpp"
+
+namespace fiblet {
+
+// Walks along the polyline from its first point and emits points on it whose
+// consecutive straight-line distances all equal `step` (the codec's model of
+// a streamline: a fixed chord length). The tail shorter than one step is
+// dropped (at most `step` of length). Points are appended to `out` (cleared
+// first). A streamline shorter than one step keeps only its first point.
+void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out);
+
+// Distance from a point to a polyline (a single point is a degenerate
+// polyline), in the units of the inputs: the exact minimum over all segments.
+double distance_to_polyline(Vec3f p, std::span<const Vec3f> polyline);
+
+// Same, searching only the segments [hint - window, hint + window] and
+// moving `hint` to the closest one: linear time for points visited in order
+// along the polyline (as decoded points of a resampled streamline are).
+double distance_to_polyline_near(Vec3f p, std::span<const Vec3f> polyline, std::size_t& hint,
+                                 std::size_t window = 16);
+
+}  // namespace fiblet

@@ -1,0 +1,25 @@
+// Internal: little-endian (de)serialization of fixed-size fields.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+namespace fiblet::detail {
+
+template <class T>
+void put_le(std::vector<std::uint8_t>& out, T value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    std::uint8_t raw[sizeof(T)];
+    std::memcpy(raw, &value, sizeof(T));  // hosts are little-endian (checked in CMake)
+    out.insert(out.end(), raw, raw + sizeof(T));
+}
+
+template <class T>
+T get_le(const std::uint8_t* p) {
+    T value;
+    std::memcpy(&value, p, sizeof(T));
+    return value;
+}
+
+}  // namespace fiblet::detail

@@ -1,0 +1,76 @@
+#include "fiblet/fft_format.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/bytes.hpp"
+
+namespace fiblet {
+using detail::put_le;
+
+std::uint16_t pack_unorm16(float v) {
+    const float c = std::clamp(v, 0.0f, 1.0f);  // NaN never reaches here: inputs are validated
+    return static_cast<std::uint16_t>(std::lround(c * 65535.0f));
+}
+
+std::vector<std::uint8_t> serialize_fft_header(const FftHeader& h) {
+    std::vector<std::uint8_t> out;
+    out.reserve(h.lut_offset());
+    put_le(out, h.version);
+    put_le(out, h.fibers);
+    put_le(out, h.points);
+    put_le(out, h.blocks);
+    put_le(out, h.points_per_block);
+    put_le(out, h.scaling);
+    for (float o : h.offset) put_le(out, o);
+    put_le(out, h.ratio);
+    put_le(out, h.step);
+    put_le(out, h.max_error_mm);
+    put_le(out, h.mean_error_mm);
+    put_le(out, static_cast<std::uint8_t>(h.buffer_ends.size()));
+    for (std::uint64_t e : h.buffer_ends) put_le(out, e);
+    return out;
+}
+
+std::vector<std::uint8_t> serialize_trailer(const std::vector<TrailerChunk>& chunks, std::uint64_t trailer_offset) {
+    std::vector<std::uint8_t> out;
+    for (const TrailerChunk& c : chunks) {
+        out.insert(out.end(), c.tag.begin(), c.tag.end());
+        put_le(out, std::uint32_t{0});
+        put_le(out, std::uint64_t{c.payload.size()});
+        out.insert(out.end(), c.payload.begin(), c.payload.end());
+    }
+    put_le(out, trailer_offset);
+    out.insert(out.end(), std::begin(kTrailerMagic), std::end(kTrailerMagic));
+    return out;
+}
+
+TrailerChunk make_properties_chunk(const std::vector<std::pair<std::string, std::string>>& properties) {
+    TrailerChunk c{kPropertiesTag, {}};
+    auto put_string = [&](const std::string& s) {
+        put_le(c.payload, std::uint32_t(s.size()));
+        c.payload.insert(c.payload.end(), s.begin(), s.end());
+    };
+    for (const auto& [k, v] : properties) put_string(k), put_string(v);
+    return c;
+}
+
+std::array<std::uint16_t, 6> BlockView::anchor_words() const {
+    // Word k holds the pair (a, b) as a | b << 16, stored most-significant byte first.
+    std::array<std::uint16_t, 6> q{};
+    for (int k = 0; k < 3; ++k) {
+        const std::uint8_t* w = bytes + 4 * k;
+        q[2 * k] = static_cast<std::uint16_t>(w[2] << 8 | w[3]);
+        q[2 * k + 1] = static_cast<std::uint16_t>(w[0] << 8 | w[1]);
+    }
+    return q;
+}
+
+std::array<float, 6> BlockView::anchors_normalized() const {
+    const auto q = anchor_words();
+    std::array<float, 6> v{};
+    for (int i = 0; i < 6; ++i) v[i] = unpack_unorm16(q[i]);
+    return v;
+}
+
+}  // namespace fiblet

@@ -1,0 +1,144 @@
+#include "fiblet/output_file.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <random>
+
+#include "fiblet/error.hpp"
+
+namespace fiblet {
+namespace {
+
+// Pending temporaries, removable from a signal handler: fixed slots of
+// NUL-terminated paths, published with an atomic flag.
+constexpr int kSlots = 64;
+constexpr std::size_t kPathMax = 4096;
+struct Slot {
+    std::atomic<bool> used{false};
+    std::atomic<bool> ready{false};
+    char path[kPathMax];
+};
+Slot g_slots[kSlots];
+
+int register_temporary(const std::string& path) {
+    if (path.size() >= kPathMax) return -1;
+    for (int i = 0; i < kSlots; ++i) {
+        bool expected = false;
+        if (g_slots[i].used.compare_exchange_strong(expected, true)) {
+            std::memcpy(g_slots[i].path, path.c_str(), path.size() + 1);
+            g_slots[i].ready.store(true);
+            return i;
+        }
+    }
+    return -1;  // more than kSlots outputs at once: still removed by the destructor
+}
+
+void unregister_temporary(int slot) {
+    if (slot < 0) return;
+    g_slots[slot].ready.store(false);
+    g_slots[slot].used.store(false);
+}
+
+std::string errno_text() { return std::strerror(errno); }
+
+bool path_exists(const std::string& p) { return ::access(p.c_str(), F_OK) == 0; }
+
+void handle_signal(int sig) {
+    remove_pending_outputs();
+    ::_exit(128 + sig);
+}
+
+}  // namespace
+
+void remove_pending_outputs() noexcept {
+    for (auto& s : g_slots)
+        if (s.ready.load()) ::unlink(s.path);
+}
+
+void install_signal_cleanup() {
+    struct sigaction sa {};
+    sa.sa_handler = handle_signal;
+    sigemptyset(&sa.sa_mask);
+    ::sigaction(SIGINT, &sa, nullptr);
+    ::sigaction(SIGTERM, &sa, nullptr);
+}
+
+AtomicOutputFile::AtomicOutputFile(const std::string& path, bool overwrite) : path_(path), overwrite_(overwrite) {
+    if (!overwrite && path_exists(path))
+        throw Error(Errc::exists, path + ": output exists (use --force to overwrite)");
+    std::random_device rd;
+    for (int attempt = 0; attempt < 16 && fd_ < 0; ++attempt) {
+        tmp_ = path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(rd() % 1000000);
+        fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+        if (fd_ < 0 && errno != EEXIST) break;
+    }
+    if (fd_ < 0) throw Error(Errc::io, path + ": cannot create output: " + errno_text());
+    registry_slot_ = register_temporary(tmp_);
+    buffer_.reserve(1u << 20);
+}
+
+AtomicOutputFile::~AtomicOutputFile() {
+    if (fd_ >= 0) ::close(fd_);
+    if (!committed_) ::unlink(tmp_.c_str());
+    unregister_temporary(registry_slot_);
+}
+
+void AtomicOutputFile::flush_buffer() {
+    const char* p = buffer_.data();
+    std::size_t left = buffer_.size();
+    while (left > 0) {
+        const ssize_t n = ::write(fd_, p, left);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            throw Error(Errc::io, path_ + ": write failed: " + errno_text());
+        }
+        p += n;
+        left -= std::size_t(n);
+    }
+    buffer_.clear();
+}
+
+void AtomicOutputFile::write(const void* data, std::size_t size) {
+    if (buffer_.size() + size > buffer_.capacity()) flush_buffer();
+    if (size >= buffer_.capacity()) {
+        buffer_.assign(static_cast<const char*>(data), size);
+        flush_buffer();
+    } else {
+        buffer_.append(static_cast<const char*>(data), size);
+    }
+    written_ += size;
+}
+
+void AtomicOutputFile::write_at(const void* data, std::size_t size, std::uint64_t offset) {
+    flush_buffer();
+    const char* p = static_cast<const char*>(data);
+    while (size > 0) {
+        const ssize_t n = ::pwrite(fd_, p, size, off_t(offset));
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            throw Error(Errc::io, path_ + ": write failed: " + errno_text());
+        }
+        p += n, size -= std::size_t(n), offset += std::uint64_t(n);
+    }
+}
+
+void AtomicOutputFile::commit() {
+    flush_buffer();
+    if (::fsync(fd_) != 0 && errno != EINVAL)
+        throw Error(Errc::io, path_ + ": sync failed: " + errno_text());
+    ::close(fd_);
+    fd_ = -1;
+    if (!overwrite_ && path_exists(path_))  // appeared while we were writing
+        throw Error(Errc::exists, path_ + ": output exists (use --force to overwrite)");
+    if (::rename(tmp_.c_str(), path_.c_str()) != 0)
+        throw Error(Errc::io, path_ + ": cannot rename temporary into place: " + errno_text());
+    committed_ = true;
+}
+
+}  // namespace fiblet

@@ -1,0 +1,263 @@
+// Streaming MRtrix3 .tck reader: reads the data section chunk by chunk with pread().
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+
+#include "fiblet/error.hpp"
+#include "fiblet/tck.hpp"
+
+namespace fiblet {
+namespace {
+
+static_assert(sizeof(Vec3f) == 12, "Vec3f must be three packed floats: points are memcpy'd from the file");
+
+constexpr std::uint32_t kExp32 = 0x7f800000u;  // all-ones exponent: Inf or NaN
+
+inline bool nonfinite_bits(std::uint32_t b) { return (b & kExp32) == kExp32; }
+
+enum class Kind { point, separator, end, bad };
+
+// A triplet is a point (all finite), a streamline separator (all NaN), the end of
+// the data (all Inf, either sign: MATLAB writes -Inf), or malformed.
+inline Kind classify(int n_nan, int n_inf) {
+    if (n_nan == 0 && n_inf == 0) return Kind::point;
+    if (n_nan == 3) return Kind::separator;
+    if (n_inf == 3) return Kind::end;
+    return Kind::bad;
+}
+
+template <class U>
+U load_swapped(const char* p, bool swap) {
+    U u;
+    std::memcpy(&u, p, sizeof(U));
+    if (swap) {
+        if constexpr (sizeof(U) == 4)
+            u = __builtin_bswap32(u);
+        else
+            u = __builtin_bswap64(u);
+    }
+    return u;
+}
+
+// Decodes one triplet of any datatype into doubles (float32 converts exactly).
+inline void decode_triplet(const char* p, TckDataType t, double out[3]) {
+    for (int i = 0; i < 3; ++i) {
+        switch (t) {
+            case TckDataType::float32le:
+            case TckDataType::float32be: {
+                const auto u = load_swapped<std::uint32_t>(p + 4 * i, t == TckDataType::float32be);
+                float f;
+                std::memcpy(&f, &u, 4);
+                out[i] = f;
+                break;
+            }
+            case TckDataType::float64le:
+            case TckDataType::float64be: {
+                const auto u = load_swapped<std::uint64_t>(p + 8 * i, t == TckDataType::float64be);
+                std::memcpy(&out[i], &u, 8);
+                break;
+            }
+        }
+    }
+}
+
+}  // namespace
+
+struct TckReader::Impl {
+    std::string path;
+    TckReadOptions options;
+    TckHeader header;
+    int fd = -1;
+    std::size_t triplet = 12;
+    std::uint64_t data_begin = 0, data_end = 0;
+    std::uint64_t next_read = 0;  // file offset of the next chunk
+    // Chunks are whole multiples of the triplet size, so only the last one can
+    // end inside a point: no triplet ever straddles two chunks.
+    std::unique_ptr<char[]> chunk;
+    std::size_t chunk_cap = 0, chunk_len = 0, chunk_pos = 0;
+    std::uint64_t streamlines = 0, points = 0;
+    bool at_end = false;  // end marker seen (or empty data section)
+
+    ~Impl() {
+        if (fd >= 0) ::close(fd);
+    }
+
+    std::uint64_t consumed() const { return (next_read - data_begin) - (chunk_len - chunk_pos); }
+    std::uint64_t file_pos() const { return data_begin + consumed(); }
+
+    [[noreturn]] void fail(const std::string& what) const {
+        throw Error(Errc::tck_format, path + ": invalid .tck data: " + what);
+    }
+
+    [[noreturn]] void fail_bad_triplet() const {
+        fail("NaN/Inf inside a coordinate at streamline " + std::to_string(streamlines + 1) + " (counting from 1)" +
+             ", byte " + std::to_string(file_pos()));
+    }
+
+    void check_count() const {
+        if (options.allow_count_mismatch) return;
+        const auto c = header.count();
+        if (c && *c != streamlines)
+            throw Error(Errc::tck_format, path + ": header says count: " + std::to_string(*c) + " but the data holds " +
+                                              std::to_string(streamlines) +
+                                              " streamlines (truncated or edited file? use allow_count_mismatch / "
+                                              "--allow-count-mismatch to read it anyway)");
+    }
+
+    // Reads the next chunk; false when the data section is exhausted.
+    bool refill() {
+        if (next_read >= data_end) return false;
+        if (!chunk) chunk.reset(new char[chunk_cap]);
+        const std::size_t want = std::size_t(std::min<std::uint64_t>(chunk_cap, data_end - next_read));
+        std::size_t got = 0;
+        while (got < want) {
+            const ssize_t n = ::pread(fd, chunk.get() + got, want - got, off_t(next_read + got));
+            if (n < 0) {
+                if (errno == EINTR) continue;
+                throw Error(Errc::io, path + ": read failed: " + std::strerror(errno));
+            }
+            if (n == 0) break;  // the file shrank under us: treat as its end
+            got += std::size_t(n);
+        }
+        if (got < want) data_end = next_read + got;
+        chunk_len = got;
+        chunk_pos = 0;
+        next_read += got;
+        return got > 0;
+    }
+
+    // Appends the run of finite float32le points at the cursor; stops at the first special triplet.
+    void scan_float32le(std::vector<Vec3f>& out) {
+        const char* p = chunk.get() + chunk_pos;
+        const std::size_t n = (chunk_len - chunk_pos) / 12;
+        std::size_t i = 0;
+        for (; i < n; ++i) {
+            std::uint32_t a, b, c;
+            std::memcpy(&a, p + 12 * i, 4);
+            std::memcpy(&b, p + 12 * i + 4, 4);
+            std::memcpy(&c, p + 12 * i + 8, 4);
+            if (nonfinite_bits(a) | nonfinite_bits(b) | nonfinite_bits(c)) break;
+        }
+        if (i == 0) return;
+        const std::size_t old = out.size();
+        out.resize(old + i);
+        std::memcpy(static_cast<void*>(out.data() + old), p, i * 12);
+        chunk_pos += i * 12;
+    }
+
+    // Classifies the triplet at the cursor; for a point, stores it in `v`.
+    Kind read_triplet(Vec3f& v) {
+        double d[3];
+        decode_triplet(chunk.get() + chunk_pos, header.datatype, d);
+        int n_nan = 0, n_inf = 0;
+        for (double x : d) n_nan += std::isnan(x), n_inf += std::isinf(x);
+        const Kind k = classify(n_nan, n_inf);
+        if (k == Kind::point) {
+            v = Vec3f{float(d[0]), float(d[1]), float(d[2])};
+            if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+                throw Error(Errc::invalid_input, path + ": coordinate beyond the float32 range at streamline " +
+                                                     std::to_string(streamlines + 1) + ", byte " +
+                                                     std::to_string(file_pos()));
+        }
+        return k;
+    }
+
+    bool next(std::vector<Vec3f>& out) {
+        out.clear();
+        if (at_end) {
+            check_count();
+            return false;
+        }
+        const bool fast = header.datatype == TckDataType::float32le;
+        for (;;) {
+            if (chunk_pos == chunk_len && !refill()) {
+                if (data_end == data_begin) {  // no data at all: a file with zero streamlines
+                    at_end = true;
+                    check_count();
+                    return false;
+                }
+                fail("no end-of-data marker (Inf triplet) after " + std::to_string(streamlines) +
+                     " streamlines (truncated?)");
+            }
+            if (chunk_len - chunk_pos < triplet)
+                fail("truncated in the middle of a point at streamline " + std::to_string(streamlines + 1) +
+                     " (counting from 1), byte " + std::to_string(file_pos()));
+            if (fast) {
+                scan_float32le(out);
+                if (chunk_len - chunk_pos < triplet) continue;  // run reached the end of the chunk
+            }
+            Vec3f v;
+            const Kind k = read_triplet(v);
+            if (k == Kind::bad) fail_bad_triplet();
+            chunk_pos += triplet;
+            switch (k) {
+                case Kind::point:
+                    out.push_back(v);
+                    break;
+                case Kind::separator:
+                    ++streamlines;
+                    points += out.size();
+                    return true;
+                case Kind::end:
+                    at_end = true;  // anything after the marker is ignored
+                    if (!out.empty()) {  // last streamline closed by the marker itself
+                        ++streamlines;
+                        points += out.size();
+                        return true;
+                    }
+                    check_count();
+                    return false;
+                case Kind::bad:
+                    break;
+            }
+        }
+    }
+
+    void rewind() {
+        next_read = data_begin;
+        chunk_len = chunk_pos = 0;
+        streamlines = points = 0;
+        at_end = false;
+    }
+};
+
+TckReader::TckReader(const std::string& path, TckReadOptions options) : impl_(std::make_unique<Impl>()) {
+    Impl& m = *impl_;
+    m.path = path;
+    m.options = options;
+    m.header = read_tck_header(path);
+    m.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (m.fd < 0) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
+    struct stat st {};
+    if (::fstat(m.fd, &st) != 0) throw Error(Errc::io, path + ": cannot stat: " + std::strerror(errno));
+    if (std::uint64_t(st.st_size) < m.header.data_offset)
+        throw Error(Errc::tck_format, path + ": invalid .tck header: data offset is past the end of the file");
+    m.triplet = 3 * std::size_t(tck_datatype_size(m.header.datatype));
+    m.data_begin = m.next_read = m.header.data_offset;
+    m.data_end = std::uint64_t(st.st_size);
+    std::size_t cap = std::max(m.triplet, options.chunk_bytes / m.triplet * m.triplet);
+    const std::uint64_t data = m.data_end - m.data_begin;
+    if (data < cap) cap = std::max<std::size_t>(m.triplet, std::size_t((data + m.triplet - 1) / m.triplet * m.triplet));
+    m.chunk_cap = cap;
+    ::posix_fadvise(m.fd, off_t(m.data_begin), 0, POSIX_FADV_SEQUENTIAL);
+}
+
+TckReader::~TckReader() = default;
+TckReader::TckReader(TckReader&&) noexcept = default;
+TckReader& TckReader::operator=(TckReader&&) noexcept = default;
+
+const TckHeader& TckReader::header() const { return impl_->header; }
+const std::string& TckReader::path() const { return impl_->path; }
+bool TckReader::next(std::vector<Vec3f>& points) { return impl_->next(points); }
+std::uint64_t TckReader::streamlines_read() const { return impl_->streamlines; }
+std::uint64_t TckReader::points_read() const { return impl_->points; }
+std::uint64_t TckReader::bytes_consumed() const { return impl_->consumed(); }
+std::uint64_t TckReader::data_bytes() const { return impl_->data_end - impl_->data_begin; }
+void TckReader::rewind() { impl_->rewind(); }
+
+}  // namespace fiblet

@@ -1,0 +1,139 @@
+// MRtrix3 .tck writer (Float32LE), through an AtomicOutputFile.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string_view>
+
+#include "fiblet/error.hpp"
+#include "fiblet/output_file.hpp"
+#include "fiblet/tck.hpp"
+
+namespace fiblet {
+namespace {
+
+static_assert(sizeof(Vec3f) == 12, "Vec3f must be three packed floats: points are written with memcpy");
+
+// MRtrix writes "count:" as 10 zero-padded digits; the field is patched in place at finish().
+constexpr int kCountDigits = 10;
+constexpr std::uint64_t kMaxCount = 9'999'999'999ull;
+// Data offset alignment (MRtrix pads its headers too; keeps the floats aligned).
+constexpr std::uint64_t kAlign = 16;
+
+int digits(std::uint64_t v) {
+    int d = 1;
+    while (v >= 10) v /= 10, ++d;
+    return d;
+}
+
+std::string zero_padded(std::uint64_t v, int width) {
+    std::string s = std::to_string(v);
+    return std::string(std::size_t(std::max(0, width - int(s.size()))), '0') + s;
+}
+
+bool owned_key(std::string_view k) { return k == "count" || k == "file" || k == "datatype" || k == "END"; }
+
+std::string_view trim(std::string_view s) {
+    while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r')) s.remove_prefix(1);
+    while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+    return s;
+}
+
+}  // namespace
+
+struct TckWriter::Impl {
+    AtomicOutputFile out;
+    std::uint64_t count = 0;
+    std::uint64_t count_field = 0;  // file offset of the count digits
+    bool finished = false;
+
+    Impl(const std::string& path, bool overwrite) : out(path, overwrite) {}
+
+    void check_open() const {
+        if (finished) throw Error(Errc::invalid_argument, out.path() + ": TckWriter used after finish()");
+    }
+
+    // Appends one streamline of n packed xyz float triplets and its NaN separator.
+    void append(const void* xyz, std::size_t n, bool finite) {
+        check_open();
+        // A NaN or Inf would be read back as a separator or the end of the data.
+        if (!finite)
+            throw Error(Errc::invalid_input, out.path() + ": non-finite coordinate in streamline " +
+                                                 std::to_string(count + 1) + " (counting from 1)");
+        if (count >= kMaxCount)
+            throw Error(Errc::unsupported, out.path() + ": more than " + std::to_string(kMaxCount) + " streamlines");
+        if (n > 0) out.write(xyz, n * sizeof(Vec3f));
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        const float sep[3] = {nan, nan, nan};
+        out.write(sep, sizeof sep);
+        ++count;
+    }
+};
+
+TckWriter::TckWriter(const std::string& path, const std::vector<std::pair<std::string, std::string>>& properties,
+                     bool overwrite)
+    : impl_(std::make_unique<Impl>(path, overwrite)) {
+    std::string h = "mrtrix tracks\n";
+    for (const auto& [key, value] : properties) {
+        const std::string_view k = trim(key);
+        if (owned_key(k)) continue;
+        // Such a key could not be read back as the same key.
+        if (k.empty() || k.find_first_of(":\n") != std::string_view::npos)
+            throw Error(Errc::invalid_argument, path + ": invalid .tck header key \"" + key + "\"");
+        // A multi-line value becomes repeated "key: line" entries, as MRtrix writes them.
+        std::string_view v = value;
+        for (;;) {
+            const std::size_t nl = v.find('\n');
+            h.append(k).append(": ").append(trim(v.substr(0, nl))).append("\n");
+            if (nl == std::string_view::npos) break;
+            v.remove_prefix(nl + 1);
+        }
+    }
+    h += "count: ";
+    impl_->count_field = h.size();
+    h += zero_padded(0, kCountDigits) + "\n";
+    h += "datatype: Float32LE\n";
+    h += "file: . ";
+    const std::size_t fixed = h.size() + std::string_view("\nEND\n").size();
+    // The offset's own digits count toward the header: take the fewest digits that fit.
+    std::uint64_t offset = 0;
+    for (int d = 1; d <= 20; ++d) {
+        const std::uint64_t candidate = (fixed + d + kAlign - 1) / kAlign * kAlign;
+        if (digits(candidate) == d) {
+            offset = candidate;
+            break;
+        }
+    }
+    h += std::to_string(offset) + "\nEND\n";
+    h.resize(offset, '\0');
+    impl_->out.write(h.data(), h.size());
+}
+
+TckWriter::~TckWriter() = default;
+
+void TckWriter::write(std::span<const Vec3f> streamline) {
+    bool finite = true;
+    for (const Vec3f& p : streamline) finite &= std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+    impl_->append(streamline.data(), streamline.size(), finite);
+}
+
+void TckWriter::write(const float* xyz, std::size_t n_points) {
+    bool finite = true;
+    for (std::size_t i = 0; i < 3 * n_points; ++i) finite &= std::isfinite(xyz[i]);
+    impl_->append(xyz, n_points, finite);
+}
+
+void TckWriter::finish() {
+    Impl& m = *impl_;
+    m.check_open();
+    const float inf = std::numeric_limits<float>::infinity();
+    const float end[3] = {inf, inf, inf};
+    m.out.write(end, sizeof end);
+    const std::string c = zero_padded(m.count, kCountDigits);
+    m.out.write_at(c.data(), c.size(), m.count_field);
+    m.finished = true;
+    m.out.commit();
+}
+
+std::uint64_t TckWriter::count() const { return impl_->count; }
+
+}  // namespace fiblet

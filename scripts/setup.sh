@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs fiblet's build and test dependencies from Debian's packages.
+# Idempotent: quick when everything is already installed.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake ninja-build pkg-config
+  libcli11-dev libeigen3-dev libfmt-dev libzstd-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libhwy-dev
+  python3 python3-numpy python3-nibabel python3-matplotlib
+  mrtrix3 zstd time
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}" >&2
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi

@@ -1,0 +1,61 @@
+// Small helpers shared by the tests: temporary directories, shared test data, raw files.
+#pragma once
+
+#include <stdlib.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <system_error>
+
+namespace fiblet::test {
+
+// A fresh directory under /tmp, removed with its contents on destruction.
+class TempDir {
+public:
+    TempDir() {
+        std::string tmpl = "/tmp/fiblet-test-XXXXXX";
+        if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
+        path_ = tmpl;
+    }
+    ~TempDir() {
+        std::error_code ec;
+        std::filesystem::remove_all(path_, ec);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+
+    const std::string& path() const { return path_; }
+    // Path of `name` inside the directory.
+    std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+private:
+    std::string path_;
+};
+
+// Directory of the shared test data (FIBLET_SHARED_DIR "/data").
+inline std::string shared_data_dir() { return std::string(FIBLET_SHARED_DIR) + "/data"; }
+
+// Path of a file of the shared test data, e.g. shared_data("conformance/simple.tck").
+inline std::string shared_data(const std::string& relpath) { return shared_data_dir() + "/" + relpath; }
+
+inline bool shared_data_available() { return std::filesystem::is_directory(shared_data_dir()); }
+
+// Writes `bytes` to `path` (replacing it).
+inline void write_file(const std::string& path, std::string_view bytes) {
+    std::ofstream f(path, std::ios::binary | std::ios::trunc);
+    f.write(bytes.data(), std::streamsize(bytes.size()));
+    if (!f) throw std::runtime_error("cannot write " + path);
+}
+
+// Whole content of `path`.
+inline std::string read_file(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) throw std::runtime_error("cannot read " + path);
+    return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+}  // namespace fiblet::test
