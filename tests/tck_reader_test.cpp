@@ -72,12 +72,6 @@ Streamlines read_all(const std::string& path, TckReadOptions options = {}) {
     return out;
 }
 
-std::size_t total_points(const Streamlines& s) {
-    std::size_t n = 0;
-    for (const auto& x : s) n += x.size();
-    return n;
-}
-
 // Order-sensitive hash of all coordinates' bits and of the streamline boundaries.
 std::uint64_t hash_points(TckReader& r) {
     std::uint64_t h = 1469598103934665603ull;

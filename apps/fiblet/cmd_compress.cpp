@@ -14,6 +14,7 @@ struct CompressArgs {
     std::vector<std::string> inputs;
     std::string output, output_dir;
     std::optional<double> step;
+    unsigned threads = 0;
     bool force = false, quiet = false, json = false, allow_count_mismatch = false;
 };
 
@@ -58,6 +59,7 @@ void run(const CompressArgs& a) {
         CompressOptions o;
         o.step_mm = a.step;
         o.overwrite = a.force;
+        o.threads = a.threads;
         o.allow_count_mismatch = a.allow_count_mismatch;
         const std::string name = std::filesystem::path(in).filename().string();
         o.progress = [&](const char* phase, double f) { progress.update(name + ": " + phase, f); };
@@ -109,6 +111,7 @@ void add_compress(CLI::App& app) {
     cmd->add_option("-o,--output", args->output, "Output .fft file (one input)");
     cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs)");
     cmd->add_option("--step", args->step, "Fixed step in mm (default: measured; variable spacing is resampled)");
+    cmd->add_option("-j,--threads", args->threads, "Encoding threads (default: all cores)");
     cmd->add_flag("-f,--force", args->force, "Overwrite existing outputs");
     cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
     cmd->add_flag("--json", args->json, "Print the report as JSON");

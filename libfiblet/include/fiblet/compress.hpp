@@ -1,6 +1,7 @@
 // fiblet — compressing a .tck file into a .fft file (the whole pipeline).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -26,6 +27,7 @@ struct CompressOptions {
     std::optional<double> step_mm;            // overrides the measured step
     std::uint32_t points_per_block = kDefaultPointsPerBlock;
     double step_tolerance = 0.01;             // relative spacing deviation that triggers resampling
+    unsigned threads = 0;                     // encoding threads; 0 = all cores
     bool overwrite = false;
     bool allow_count_mismatch = false;
     // progress(phase, fraction in [0,1]); phases "scan", "resample-scan", "encode".

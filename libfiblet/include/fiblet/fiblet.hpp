@@ -12,6 +12,7 @@
 //   compare.hpp        a .fft measured against its source .tck
 //   error_stats.hpp    max / mean / RMS / percentiles of position errors
 //   resample.hpp       fixed-step resampling, point-to-polyline distance
+//   view.hpp           camera, frustum, level of detail, block bounding spheres
 //   output_file.hpp    atomic outputs, cleanup on signals
 #pragma once
 
@@ -28,3 +29,4 @@
 #include "fiblet/output_file.hpp"
 #include "fiblet/resample.hpp"
 #include "fiblet/tck.hpp"
+#include "fiblet/view.hpp"

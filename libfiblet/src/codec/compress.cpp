@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <thread>
 
 #include "fiblet/encode.hpp"
 #include "fiblet/error.hpp"
@@ -211,29 +212,63 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         out.write(lut.data(), lut.size() * sizeof(FiberLutEntry));
     }
     reader.rewind();
-    std::vector<std::uint8_t> block_bytes;
-    std::vector<Vec3f> decoded;
-    std::size_t hint = 0;
-    for (std::uint32_t f = 0; reader.next(fiber); ++f) {
-        std::span<const Vec3f> points = fiber;
-        if (report.resampled) {
-            resample_fixed_step(fiber, step, resampled);
-            points = resampled;
-        }
-        block_bytes.clear();
-        decoded.clear();
-        encoder.encode(points, f, block_bytes, &decoded);
-        out.write(block_bytes.data(), block_bytes.size());
-        for (std::size_t i = 0; i < points.size(); ++i) {
-            report.error.add(length(points[i], decoded[i]), f);
+    // Batches of whole fibers are read in order, encoded by `threads`
+    // workers on contiguous sub-ranges, and written in order.
+    const unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+    struct Work {
+        std::vector<std::uint8_t> blocks;
+        std::vector<Vec3f> decoded, resampled;
+        ErrorStats error, error_vs_original;
+    };
+    std::vector<Work> work(threads);
+    std::vector<std::vector<Vec3f>> batch;
+    auto encode_range = [&](Work& w, std::size_t begin, std::size_t end, std::uint32_t first_fiber) {
+        w.blocks.clear();
+        for (std::size_t i = begin; i < end; ++i) {
+            const std::vector<Vec3f>& original = batch[i];
+            std::span<const Vec3f> points = original;
             if (report.resampled) {
-                hint = i == 0 ? 0 : hint;
-                const std::size_t window = 16 + 2 * fiber.size() / std::max<std::size_t>(points.size(), 1);
-                report.error_vs_original.add(distance_to_polyline_near(decoded[i], fiber, hint, window), f);
+                resample_fixed_step(original, step, w.resampled);
+                points = w.resampled;
+            }
+            const auto f = std::uint32_t(first_fiber + i);
+            w.decoded.clear();
+            encoder.encode(points, f, w.blocks, &w.decoded);
+            std::size_t hint = 0;
+            const std::size_t window = 16 + 2 * original.size() / std::max<std::size_t>(points.size(), 1);
+            for (std::size_t k = 0; k < points.size(); ++k) {
+                w.error.add(length(points[k], w.decoded[k]), f);
+                if (report.resampled)
+                    w.error_vs_original.add(distance_to_polyline_near(w.decoded[k], original, hint, window), f);
             }
         }
-        if ((f & 1023) == 0) report_progress(options, "encode", reader);
+    };
+    constexpr std::size_t kBatchPoints = 1u << 20;
+    std::uint32_t next_fiber = 0;
+    for (bool more = true; more;) {
+        std::size_t n = 0, points = 0;
+        while (points < kBatchPoints) {
+            if (batch.size() <= n) batch.emplace_back();
+            if (!(more = reader.next(batch[n]))) break;
+            points += batch[n++].size();
+        }
+        if (n == 0) break;
+        // Split the batch into contiguous ranges of about equal point counts.
+        std::vector<std::size_t> cut{0};
+        std::size_t acc = 0;
+        for (std::size_t i = 0; i < n && cut.size() < threads; ++i)
+            if ((acc += batch[i].size()) * threads >= points * cut.size()) cut.push_back(i + 1);
+        if (cut.back() != n) cut.push_back(n);
+        std::vector<std::thread> pool;
+        for (std::size_t t = 1; t + 1 < cut.size(); ++t)
+            pool.emplace_back(encode_range, std::ref(work[t]), cut[t], cut[t + 1], next_fiber);
+        encode_range(work[0], cut[0], cut[1], next_fiber);
+        for (auto& th : pool) th.join();
+        for (std::size_t t = 0; t + 1 < cut.size(); ++t) out.write(work[t].blocks.data(), work[t].blocks.size());
+        next_fiber += std::uint32_t(n);
+        report_progress(options, "encode", reader);
     }
+    for (const Work& w : work) report.error.merge(w.error), report.error_vs_original.merge(w.error_vs_original);
     {
         const std::uint64_t at = out.size();
         std::vector<TrailerChunk> chunks{make_properties_chunk(reader.header().properties)};

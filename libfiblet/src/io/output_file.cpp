@@ -130,9 +130,13 @@ void AtomicOutputFile::write_at(const void* data, std::size_t size, std::uint64_
 
 void AtomicOutputFile::commit() {
     flush_buffer();
-    if (::fsync(fd_) != 0 && errno != EINVAL)
-        throw Error(Errc::io, path_ + ": sync failed: " + errno_text());
-    ::close(fd_);
+    // No fsync: the rename makes the output atomic for the process (error,
+    // crash, signal); like zstd or gzip, durability across power loss is
+    // left to the file system (an fsync costs more than encoding here).
+    if (::close(fd_) != 0) {
+        fd_ = -1;
+        throw Error(Errc::io, path_ + ": close failed: " + errno_text());
+    }
     fd_ = -1;
     if (!overwrite_ && path_exists(path_))  // appeared while we were writing
         throw Error(Errc::exists, path_ + ": output exists (use --force to overwrite)");

@@ -46,22 +46,18 @@ U load_swapped(const char* p, bool swap) {
 
 // Decodes one triplet of any datatype into doubles (float32 converts exactly).
 inline void decode_triplet(const char* p, TckDataType t, double out[3]) {
-    for (int i = 0; i < 3; ++i) {
-        switch (t) {
-            case TckDataType::float32le:
-            case TckDataType::float32be: {
-                const auto u = load_swapped<std::uint32_t>(p + 4 * i, t == TckDataType::float32be);
-                float f;
-                std::memcpy(&f, &u, 4);
-                out[i] = f;
-                break;
-            }
-            case TckDataType::float64le:
-            case TckDataType::float64be: {
-                const auto u = load_swapped<std::uint64_t>(p + 8 * i, t == TckDataType::float64be);
-                std::memcpy(&out[i], &u, 8);
-                break;
-            }
+    const bool swap = t == TckDataType::float32be || t == TckDataType::float64be;
+    if (tck_datatype_size(t) == 4) {
+        for (int i = 0; i < 3; ++i) {
+            const auto u = load_swapped<std::uint32_t>(p + 4 * i, swap);
+            float f;
+            std::memcpy(&f, &u, 4);
+            out[i] = f;
+        }
+    } else {
+        for (int i = 0; i < 3; ++i) {
+            const auto u = load_swapped<std::uint64_t>(p + 8 * i, swap);
+            std::memcpy(&out[i], &u, 8);
         }
     }
 }

@@ -1,0 +1,90 @@
+#include "fiblet/view.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "core/vec_math.hpp"
+
+namespace fiblet {
+using namespace detail;
+
+namespace {
+struct Basis {
+    Vec3f right, up, back;  // camera axes; the camera looks along -back
+};
+Basis camera_basis(const Camera& c) {
+    const Vec3f back = normalize(c.position - c.target);
+    const Vec3f right = normalize(cross(c.up, back));
+    return {right, cross(back, right), back};
+}
+}  // namespace
+
+Mat4 view_matrix(const Camera& c) {
+    const Basis b = camera_basis(c);
+    return {b.right.x, b.up.x, b.back.x, 0, b.right.y, b.up.y, b.back.y, 0, b.right.z, b.up.z, b.back.z, 0,
+            -dot(b.right, c.position), -dot(b.up, c.position), -dot(b.back, c.position), 1};
+}
+
+Mat4 projection_matrix(const Camera& c) {
+    const float f = 1.0f / std::tan(c.fov_y_deg * float(M_PI) / 360.0f);
+    const float n = c.near_mm, fa = c.far_mm;
+    return {f / c.aspect, 0, 0, 0, 0, f, 0, 0, 0, 0, (fa + n) / (n - fa), -1, 0, 0, 2 * fa * n / (n - fa), 0};
+}
+
+Mat4 view_projection_matrix(const Camera& c) {
+    const Mat4 p = projection_matrix(c), v = view_matrix(c);
+    Mat4 m{};
+    for (int col = 0; col < 4; ++col)
+        for (int row = 0; row < 4; ++row) {
+            float s = 0;
+            for (int k = 0; k < 4; ++k) s += p[k * 4 + row] * v[col * 4 + k];
+            m[col * 4 + row] = s;
+        }
+    return m;
+}
+
+Frustum frustum_from_camera(const Camera& c) {
+    // Planes built geometrically from the camera basis (exact, and the same
+    // on the GPU side, which receives these six planes as uniforms).
+    const Basis b = camera_basis(c);
+    const Vec3f fwd{-b.back.x, -b.back.y, -b.back.z};
+    const float ty = std::tan(c.fov_y_deg * float(M_PI) / 360.0f), tx = ty * c.aspect;
+    auto through_eye = [&](Vec3f n) {
+        n = normalize(n);
+        return Plane{n, -dot(n, c.position)};
+    };
+    Frustum f;
+    f.planes[0] = through_eye(tx * fwd + b.right);  // left
+    f.planes[1] = through_eye(tx * fwd - b.right);  // right
+    f.planes[2] = through_eye(ty * fwd + b.up);     // bottom
+    f.planes[3] = through_eye(ty * fwd - b.up);     // top
+    f.planes[4] = Plane{fwd, -dot(fwd, c.position) - c.near_mm};
+    f.planes[5] = Plane{-1.0f * fwd, dot(fwd, c.position) + c.far_mm};
+    return f;
+}
+
+bool sphere_intersects_frustum(const Frustum& f, Vec3f center, float radius) {
+    for (const Plane& p : f.planes)
+        if (dot(p.n, center) + p.d < -radius) return false;
+    return true;
+}
+
+float projected_radius_px(const Camera& c, const Viewport& v, Vec3f center, float radius) {
+    const Basis b = camera_basis(c);
+    const float depth = -dot(b.back, center - c.position);  // distance along the view direction
+    if (depth <= radius) return std::numeric_limits<float>::infinity();
+    const float ty = std::tan(c.fov_y_deg * float(M_PI) / 360.0f);
+    return radius / (depth * ty) * 0.5f * float(v.height);
+}
+
+Sphere block_bounding_sphere(const FftHeader& h, const std::uint8_t* bytes) {
+    const BlockView block{bytes};
+    const auto a = block.anchors_normalized();
+    const Vec3f a0 = h.to_world(a[0], a[1], a[2]), a1 = h.to_world(a[3], a[4], a[5]);
+    const std::uint32_t n = block.point_count();
+    if (n < 2) return {a0, 0.0f};
+    const float r = norm(a1 - a0) + float(n - 2) * h.step * h.scaling;
+    return {a0, r * (1 + 1e-5f) + 1e-5f * h.scaling};
+}
+
+}  // namespace fiblet
