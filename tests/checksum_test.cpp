@@ -291,9 +291,9 @@ TEST(Checksum, AGroupFailsForEveryReaderUntilItVerifies) {
     std::atomic<int> failures{0};
     for (int t = 0; t < 4; ++t)
         threads.emplace_back([&, t] {
-            std::vector<std::uint8_t> mine(70 * h.block_bytes());
+            std::vector<std::uint8_t> mine(40 * h.block_bytes());
             try {
-                good.read_blocks(kDefaultChecksumGroupBlocks + 3 + 70 * std::uint64_t(t), 70, mine.data());
+                good.read_blocks(kDefaultChecksumGroupBlocks + 3 + 40 * std::uint64_t(t), 40, mine.data());
             } catch (const Error&) {
                 ++failures;
             }
