@@ -1,7 +1,8 @@
 // Writes the seed corpora of the fuzz targets (scripts/fuzz.sh runs it):
 //   fiblet_fuzz_seeds SHARED_DATA_DIR OUT_DIR
-// OUT_DIR/tck_reader_fuzz: the small shared .tck files (conformance files,
-// valid and invalid, and the real bundles) and hand-made edge files;
+// OUT_DIR/tck_reader_fuzz and compress_fuzz: the small shared .tck files
+// (conformance files, valid and invalid, and the real bundles) and hand-made
+// edge files;
 // OUT_DIR/fft_file_fuzz: those compressed, in several layouts, with and
 // without the fiblet trailer; OUT_DIR/decode_blocks_fuzz: their blocks with
 // the parameters header of that target.
@@ -25,7 +26,7 @@ using namespace fiblet;
 
 namespace {
 
-constexpr std::size_t kMaxSeedBytes = 64 << 10;
+constexpr std::size_t kMaxSeedBytes = 16 << 10;  // scripts/fuzz.sh's -max_len
 
 std::string read_file(const fs::path& p) {
     std::ifstream f(p, std::ios::binary);
@@ -147,8 +148,8 @@ int main(int argc, char** argv) {
         return 2;
     }
     const fs::path shared = argv[1], out = argv[2];
-    const fs::path tck_dir = out / "tck_reader_fuzz", fft_dir = out / "fft_file_fuzz", blocks_dir = out / "decode_blocks_fuzz";
-    for (const auto& d : {tck_dir, fft_dir, blocks_dir}) fs::create_directories(d);
+    const fs::path tck_dir = out / "tck_reader_fuzz", compress_dir = out / "compress_fuzz", fft_dir = out / "fft_file_fuzz", blocks_dir = out / "decode_blocks_fuzz";
+    for (const auto& d : {tck_dir, compress_dir, fft_dir, blocks_dir}) fs::create_directories(d);
 
     // Small shared files: every conformance .tck, the original-resolution bundles.
     if (fs::is_directory(shared)) {
@@ -180,6 +181,7 @@ int main(int argc, char** argv) {
             }
         }
     }
+    fs::copy(tck_dir, compress_dir, fs::copy_options::overwrite_existing | fs::copy_options::recursive);
     std::printf("fiblet_fuzz_seeds: %zu .tck, %d .fft seeds in %s\n",
                 std::size_t(std::distance(fs::directory_iterator(tck_dir), fs::directory_iterator())), n_fft,
                 out.c_str());

@@ -1,5 +1,5 @@
-// libFuzzer harness: the .tck reader (any chunk size, rewind), then the whole
-// compression of small valid inputs and a decode of what it wrote.
+// libFuzzer harness: the .tck reader, whose result must not depend on the
+// read size, a rewind, or allow_count_mismatch on valid files.
 #include "fuzz_targets.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
