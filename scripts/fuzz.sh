@@ -2,7 +2,7 @@
 # Builds the libFuzzer harnesses (clang, ASan+UBSan; fuzz/) into build-fuzz/
 # and runs each one in turn, one process at a time.
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     SECONDS per target (default 60)
-#   FIBLET_FUZZ_RUNS=N scripts/fuzz.sh        N executions per target instead
+#   FIBLET_FUZZ_RUNS=N scripts/fuzz.sh S      stop at N executions or S seconds
 # Seeds are written by fiblet_fuzz_seeds (shared test files + hand-made edge
 # files); the corpus each run grows is kept in build-fuzz/corpus/TARGET.
 # A crash leaves its input in build-fuzz/crashes/TARGET/ and fails the script:
@@ -31,7 +31,7 @@ ASAN_OPTIONS=detect_leaks=0 "$build/fuzz/fiblet_fuzz_seeds" "$root/../shared/dat
 # use-after-free of recent frees is still caught.
 export ASAN_OPTIONS="${ASAN_OPTIONS:-quarantine_size_mb=16:malloc_context_size=8:max_malloc_fill_size=0}"
 limit=(-max_total_time="$seconds")
-[ -z "${FIBLET_FUZZ_RUNS:-}" ] || limit=(-runs="$FIBLET_FUZZ_RUNS")
+[ -z "${FIBLET_FUZZ_RUNS:-}" ] || limit+=(-runs="$FIBLET_FUZZ_RUNS")
 status=0
 summary=""
 for t in "${targets[@]}"; do
