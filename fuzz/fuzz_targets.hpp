@@ -121,9 +121,12 @@ inline TckOutcome read_tck(const std::string& path, TckReadOptions options, bool
 inline void tck_target(const std::uint8_t* data, std::size_t size) {
     static MemFile input;
     const std::string path = input.set(data, size);
+    TckReadOptions small_reads, lenient;
+    small_reads.chunk_bytes = 96;
+    lenient.allow_count_mismatch = true;
     const TckOutcome whole = read_tck(path, {});
-    check(read_tck(path, {.chunk_bytes = 96}, true) == whole, "result depends on the chunk size or rewind");
-    if (!whole.error) check(read_tck(path, {.allow_count_mismatch = true}) == whole, "allow_count_mismatch changed a valid read");
+    check(read_tck(path, small_reads, true) == whole, "result depends on the chunk size or rewind");
+    if (!whole.error) check(read_tck(path, lenient) == whole, "allow_count_mismatch changed a valid read");
 }
 
 // The whole compression of small valid .tck inputs, and a decode of what it
@@ -139,7 +142,10 @@ inline void compress_target(const std::uint8_t* data, std::size_t size) {
     const std::string out = scratch_dir() + "/out.fft";
     CompressReport report;
     try {
-        report = compress_tck(path, out, {.threads = 1, .overwrite = true});
+        CompressOptions options;
+        options.threads = 1;
+        options.overwrite = true;
+        report = compress_tck(path, out, options);
     } catch (const Error& e) {
         // Refusing a valid .tck is fine for content it cannot encode, never for its format.
         check(e.code() == Errc::invalid_input || e.code() == Errc::unsupported, "compress failed on a valid .tck");
@@ -263,7 +269,9 @@ inline void fft_target(const std::uint8_t* data, std::size_t size) {
             check(e.code() == Errc::fft_format, "properties(): unexpected category");
         }
         const FftOutcome ref = decode_reference(f);
-        const FftOutcome chunked = decode_whole(f, {.chunk_blocks = 3});
+        DecodeOptions small_chunks;
+        small_chunks.chunk_blocks = 3;
+        const FftOutcome chunked = decode_whole(f, small_chunks);
         // Both fail or both succeed (the category may differ: a chunked read
         // can meet a checksum mismatch before a malformed block further on).
         check(chunked.error.has_value() == ref.error.has_value(), "decode_file and the reference disagree");

@@ -171,7 +171,9 @@ int main(int argc, char** argv) {
         const std::string stem = e.path().stem().string();
         for (std::uint32_t ppb : {60u, 2u, 63u}) {
             const fs::path fft = fft_dir / (stem + "-ppb" + std::to_string(ppb) + ".fft");
-            if (!compress_seed(e.path(), fft, {.points_per_block = ppb})) continue;
+            CompressOptions options;
+            options.points_per_block = ppb;
+            if (!compress_seed(e.path(), fft, options)) continue;
             ++n_fft;
             if (ppb == 60) {
                 const std::string bytes = read_file(fft);

@@ -153,7 +153,9 @@ TEST(Memory, PagedErrorHistogramGivesTheSortedPercentiles) {
     for (double p : {1.0, 50.0, 90.0, 99.0, 99.9}) {
         const double exact = all[std::size_t(std::ceil(p / 100 * double(all.size()))) - 1];
         // Bins are 0.01 um wide: the percentile is the upper edge of the exact value's bin.
-        if (exact < 2.0) EXPECT_NEAR(merged.percentile_mm(p), exact, 1e-5) << "p" << p;
+        if (exact < 2.0) {
+            EXPECT_NEAR(merged.percentile_mm(p), exact, 1e-5) << "p" << p;
+        }
     }
     EXPECT_EQ(merged.count(), all.size());
     EXPECT_DOUBLE_EQ(merged.max_mm(), all.back());
