@@ -3,7 +3,7 @@
 //   make_big_tck OUT.tck [--bytes N] [--points P] [--step MM] [--seed S]
 // Fibers are smooth random walks at a fixed step (default 0.1 mm) inside a
 // brain-sized ball, with P points on average (default 80; each fiber has
-// between P/2 and 3P/2); as many fibers as make about N bytes (default 5e9).
+// between P/2 and 3P/2); as many fibers as make at least N bytes (default 5e9).
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -61,15 +61,15 @@ int main(int argc, char** argv) {
         else usage();
     }
     if (!(bytes > 0 && points >= 2 && step > 0)) usage();
-    const auto fibers = std::uint64_t(std::ceil(bytes / (12.0 * (points + 1))));
     const double radius = 70, turn = 0.02;  // mm; about a degree of turn per step
     const auto t0 = std::chrono::steady_clock::now();
     try {
         fiblet::TckWriter w(out, {{"step_size", std::to_string(step)}, {"source", "make_big_tck"}}, true);
         Rng rng{seed};
         std::vector<fiblet::Vec3f> f;
-        std::uint64_t total = 0;
-        for (std::uint64_t i = 0; i < fibers; ++i) {
+        std::uint64_t total = 0, fibers = 0;
+        // The header's few hundred bytes aside, each point and each separator is 12 bytes.
+        for (; 12.0 * double(total + fibers) < bytes; ++fibers) {
             const auto n = std::size_t(points / 2 + rng.uniform() * points);
             V p{radius * rng.symmetric() * 0.6, radius * rng.symmetric() * 0.6, radius * rng.symmetric() * 0.6};
             V d = unit({rng.symmetric(), rng.symmetric(), rng.symmetric() + 1e-9});
