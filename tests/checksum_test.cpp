@@ -302,27 +302,3 @@ TEST(Checksum, AGroupFailsForEveryReaderUntilItVerifies) {
     EXPECT_EQ(failures.load(), 0);
 }
 
-TEST(Checksum, BlocksReadAnotherWayAreCheckedTheSameWay) {
-    Fixture fx(600);
-    const FftHeader& h = fx.header;
-    const FftFile f(fx.fft);
-    // The blocks as a memory map would give them, then one direction byte damaged.
-    std::vector<std::uint8_t> mapped(fx.bytes.begin() + std::ptrdiff_t(h.blocks_offset()),
-                                     fx.bytes.begin() + std::ptrdiff_t(h.file_bytes()));
-    EXPECT_NO_THROW(f.check_blocks(0, h.blocks, mapped.data()));
-    const FftFile g(fx.fft);  // fresh: no group verified yet
-    mapped[700 * h.block_bytes() + kBlockDirectionsOffset] ^= 0x10;
-    try {
-        g.check_blocks(600, 200, mapped.data() + 600 * h.block_bytes());
-        ADD_FAILURE() << "damaged mapped blocks passed";
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), Errc::checksum);
-    }
-    mapped[700 * h.block_bytes() + kBlockFlagsOffset] = 0;  // 0 points
-    try {
-        g.check_blocks(700, 1, mapped.data() + 700 * h.block_bytes());
-        ADD_FAILURE() << "a block of 0 points passed";
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), Errc::fft_format);
-    }
-}

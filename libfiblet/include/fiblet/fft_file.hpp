@@ -76,10 +76,6 @@ public:
     // verified the first time any of its blocks is read. Thread-safe.
     void read_blocks(std::uint64_t first, std::uint64_t count, std::uint8_t* out) const;
     std::vector<std::uint8_t> read_blocks(std::uint64_t first, std::uint64_t count) const;
-    // The checks of read_blocks() on blocks [first, first+count) that the
-    // caller got another way (a memory map, a GPU upload path): readers that
-    // bypass read_blocks() call this before trusting the bytes.
-    void check_blocks(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const;
 
 private:
     void read_lut(std::uint64_t& lut_hash);
