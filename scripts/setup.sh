@@ -5,10 +5,11 @@ set -euo pipefail
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config
-  libcli11-dev libeigen3-dev libfmt-dev libzstd-dev
+  libcli11-dev libeigen3-dev libfmt-dev libzstd-dev libxxhash-dev
   libgtest-dev libgmock-dev libbenchmark-dev libhwy-dev
   python3 python3-numpy python3-nibabel python3-matplotlib
   mrtrix3 zstd time
+  clang-14 libclang-rt-14-dev  # libFuzzer harnesses (scripts/fuzz.sh)
 )
 
 missing=()

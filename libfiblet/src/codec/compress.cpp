@@ -11,6 +11,7 @@
 #include <limits>
 #include <thread>
 
+#include "fiblet/checksum.hpp"
 #include "fiblet/encode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/output_file.hpp"
@@ -206,10 +207,12 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
 
     // Pass 2: encode, measure, write.
     AtomicOutputFile out(fft_path, options.overwrite);
+    FftChecksumBuilder checksum(h.block_bytes());  // the CSUM trailer chunk (formats/fft-checksum.md)
     {
         const auto head = serialize_fft_header(h);
         out.write(head.data(), head.size());
         out.write(lut.data(), lut.size() * sizeof(FiberLutEntry));
+        checksum.add_lut(lut.data(), lut.size() * sizeof(FiberLutEntry));
     }
     reader.rewind();
     // Batches of whole fibers are read in order, encoded by `threads`
@@ -264,11 +267,17 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             pool.emplace_back(encode_range, std::ref(work[t]), cut[t], cut[t + 1], next_fiber);
         encode_range(work[0], cut[0], cut[1], next_fiber);
         for (auto& th : pool) th.join();
-        for (std::size_t t = 0; t + 1 < cut.size(); ++t) out.write(work[t].blocks.data(), work[t].blocks.size());
+        for (std::size_t t = 0; t + 1 < cut.size(); ++t) {
+            out.write(work[t].blocks.data(), work[t].blocks.size());
+            checksum.add_blocks(work[t].blocks.data(), work[t].blocks.size());
+        }
         next_fiber += std::uint32_t(n);
         report_progress(options, "encode", reader);
     }
     for (const Work& w : work) report.error.merge(w.error), report.error_vs_original.merge(w.error_vs_original);
+    h.max_error_mm = float(report.error.max_mm());
+    h.mean_error_mm = float(report.error.mean_mm());
+    const auto final_head = serialize_fft_header(h);
     {
         const std::uint64_t at = out.size();
         std::vector<TrailerChunk> chunks{make_properties_chunk(reader.header().properties)};
@@ -277,15 +286,11 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             std::memcpy(c.payload.data(), &step, 8);
             chunks.push_back(std::move(c));
         }
+        chunks.push_back(checksum.finish(final_head, chunks));  // last: it covers the chunks before it
         const auto trailer = serialize_trailer(chunks, at);
         out.write(trailer.data(), trailer.size());
     }
-    h.max_error_mm = float(report.error.max_mm());
-    h.mean_error_mm = float(report.error.mean_mm());
-    {
-        const auto head = serialize_fft_header(h);
-        out.write_at(head.data(), head.size(), 0);
-    }
+    out.write_at(final_head.data(), final_head.size(), 0);
     report.output_bytes = out.size();
     out.commit();
     if (options.progress) options.progress("encode", 1.0);
