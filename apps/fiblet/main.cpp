@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
     add_stats(app);
     add_info(app);
     add_verify(app);
+    add_help(app);
 
     fiblet::install_signal_cleanup();
     try {
