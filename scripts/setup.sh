@@ -9,6 +9,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev libhwy-dev
   python3 python3-numpy python3-nibabel python3-matplotlib
   mrtrix3 zstd time
+  libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libspng-dev
 )
 
 missing=()

@@ -61,5 +61,9 @@ void add_compress(CLI::App& app);
 void add_decompress(CLI::App& app);
 void add_stats(CLI::App& app);
 void add_info(CLI::App& app);
+#ifdef FIBLET_WITH_VIEWER
+void add_render(CLI::App& app);  // cmd_render.cpp, only with the viewer
+void add_view(CLI::App& app);    // cmd_view.cpp, only with the viewer
+#endif
 
 }  // namespace fiblet::cli

@@ -17,6 +17,10 @@ int main(int argc, char** argv) {
     add_decompress(app);
     add_stats(app);
     add_info(app);
+#ifdef FIBLET_WITH_VIEWER
+    add_render(app);
+    add_view(app);
+#endif
 
     fiblet::install_signal_cleanup();
     try {
