@@ -102,11 +102,16 @@ inline Projected to_window(const std::array<float, 4>& c, int width, int height)
     return {(c[0] / c[3] * 0.5f + 0.5f) * float(width), (0.5f - c[1] / c[3] * 0.5f) * float(height), c[3]};
 }
 
-// Reference rasterization of a segment: clipped to the near plane, then one
-// pixel per step along the major axis (DDA), as GL's aliased 1-pixel lines
-// cover up to the diamond-exit rule. Calls pixel(x, y) for pixels inside the image.
+// Reference rasterization of a segment, after clipping to the near plane: one
+// pixel per pixel centre crossed along the major axis, from the first end
+// (included) to the second (excluded): how GL's aliased one-pixel lines
+// cover up to the diamond-exit rule's choices at the ends. Calls pixel(x, y)
+// for the pixels inside the image.
+// With `touched`, every pixel the segment touches instead, both ends
+// included (a superset: which segments may have coloured a pixel).
 template <class Pixel>
-void rasterize_segment(const Mat4& view_projection, Vec3f p0, Vec3f p1, int width, int height, Pixel&& pixel) {
+void rasterize_segment(const Mat4& view_projection, Vec3f p0, Vec3f p1, int width, int height, Pixel&& pixel,
+                       bool touched = false) {
     auto c0 = clip_of(view_projection, p0), c1 = clip_of(view_projection, p1);
     const float d0 = c0[2] + c0[3], d1 = c1[2] + c1[3];  // >= 0 in front of the near plane
     if (d0 < 0 && d1 < 0) return;
@@ -118,11 +123,27 @@ void rasterize_segment(const Mat4& view_projection, Vec3f p0, Vec3f p1, int widt
     if (d0 < 0) c0 = lerp(c0, c1, d0 / (d0 - d1));
     if (d1 < 0) c1 = lerp(c0, c1, d0 / (d0 - d1));
     const Projected a = to_window(c0, width, height), b = to_window(c1, width, height);
-    const float dx = b.x - a.x, dy = b.y - a.y;
-    const int n = std::max(1, int(std::ceil(std::max(std::fabs(dx), std::fabs(dy)))));
-    for (int i = 0; i <= n; ++i) {
-        const float t = float(i) / float(n);
-        const int x = int(std::floor(a.x + t * dx)), y = int(std::floor(a.y + t * dy));
+    if (touched) {
+        const int n = std::max(1, int(std::ceil(2 * std::max(std::fabs(b.x - a.x), std::fabs(b.y - a.y)))));
+        for (int i = 0; i <= n; ++i) {
+            const float t = float(i) / float(n);
+            const int x = int(std::floor(a.x + t * (b.x - a.x))), y = int(std::floor(a.y + t * (b.y - a.y)));
+            if (x >= 0 && y >= 0 && x < width && y < height) pixel(x, y);
+        }
+        return;
+    }
+    const bool x_major = std::fabs(b.x - a.x) >= std::fabs(b.y - a.y);
+    // Coordinates along the major (u) and minor (v) axes.
+    const float u0 = x_major ? a.x : a.y, u1 = x_major ? b.x : b.y;
+    const float v0 = x_major ? a.y : a.x, v1 = x_major ? b.y : b.x;
+    if (u0 == u1) return;
+    const float dir = u1 > u0 ? 1.0f : -1.0f;
+    // Pixel centres c + 0.5 between u0 (included) and u1 (excluded).
+    for (float c = dir > 0 ? std::ceil(u0 - 0.5f) + 0.5f : std::floor(u0 - 0.5f) + 0.5f; dir * (u1 - c) > 0; c += dir) {
+        if (dir * (c - u0) < 0) continue;
+        const float v = v0 + (c - u0) / (u1 - u0) * (v1 - v0);
+        const int pu = int(std::floor(c)), pv = int(std::floor(v));
+        const int x = x_major ? pu : pv, y = x_major ? pv : pu;
         if (x >= 0 && y >= 0 && x < width && y < height) pixel(x, y);
     }
 }

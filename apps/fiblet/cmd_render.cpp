@@ -136,8 +136,8 @@ void add_render(CLI::App& app) {
     cmd->add_flag("-q,--quiet", args->quiet, "Print nothing on success");
     cmd->add_flag("--json", args->json, "Print the frame statistics (or the benchmark) as JSON");
     cmd->add_flag("--bench", args->bench,
-                  "Time frames (cull / decode / draw, GL timer queries) from three distances, with and without "
-                  "culling + LoD");
+                  "Time frames (cull / decode / draw: GL timer queries, glFinish on software renderers) "
+                  "from three distances, with and without culling + LoD");
     cmd->add_option("--frames", args->frames, "Timed frames per benchmark case")->capture_default_str();
     cmd->callback([args] { run(*args); });
 }
