@@ -10,6 +10,7 @@ PACKAGES=(
   python3 python3-numpy python3-nibabel python3-matplotlib
   mrtrix3 zstd time
   clang-14 libclang-rt-14-dev  # libFuzzer harnesses (scripts/fuzz.sh)
+  libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libspng-dev
 )
 
 missing=()

@@ -69,5 +69,9 @@ void add_stats(CLI::App& app);
 void add_info(CLI::App& app);
 void add_verify(CLI::App& app);
 void add_help(CLI::App& app);
+#ifdef FIBLET_WITH_VIEWER
+void add_render(CLI::App& app);  // cmd_render.cpp, only with the viewer
+void add_view(CLI::App& app);    // cmd_view.cpp, only with the viewer
+#endif
 
 }  // namespace fiblet::cli
