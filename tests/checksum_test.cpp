@@ -3,10 +3,12 @@
 // kind of silent corruption is reported as Errc::checksum where it is read.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "fiblet/checksum.hpp"
@@ -266,4 +268,36 @@ TEST(Checksum, MalformedChunkIsAFormatErrorUnknownAlgorithmUnsupported) {
     EXPECT_EQ(code(other, 8), Errc::unsupported);
     TrailerChunk tiny{kChecksumTag, std::vector<std::uint8_t>(31, 0)};
     EXPECT_EQ(code(tiny, 0), Errc::fft_format);
+}
+
+TEST(Checksum, AGroupFailsForEveryReaderUntilItVerifies) {
+    Fixture fx(600);
+    const FftHeader& h = fx.header;
+    const std::string bad = fx.corrupt(h.blocks_offset() + 10 * h.block_bytes() + kBlockDirectionsOffset);
+    const FftFile f(bad);
+    std::vector<std::uint8_t> buf(100 * h.block_bytes());
+    // Three readers of pieces of the damaged group: a failure is never remembered as a pass.
+    for (std::uint64_t first : {0u, 200u, 500u}) {
+        try {
+            f.read_blocks(first, 100, buf.data());
+            ADD_FAILURE() << "blocks " << first << "+100 read without error";
+        } catch (const Error& e) {
+            EXPECT_EQ(e.code(), Errc::checksum);
+        }
+    }
+    // Readers on four threads splitting the intact second group all succeed.
+    const FftFile good(fx.fft);
+    std::vector<std::thread> threads;
+    std::atomic<int> failures{0};
+    for (int t = 0; t < 4; ++t)
+        threads.emplace_back([&, t] {
+            std::vector<std::uint8_t> mine(40 * h.block_bytes());
+            try {
+                good.read_blocks(kDefaultChecksumGroupBlocks + 3 + 40 * std::uint64_t(t), 40, mine.data());
+            } catch (const Error&) {
+                ++failures;
+            }
+        });
+    for (auto& t : threads) t.join();
+    EXPECT_EQ(failures.load(), 0);
 }

@@ -8,7 +8,9 @@
 // (fiblet/checksum.hpp), against its checksums.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -70,7 +72,8 @@ public:
     // Reads blocks [first, first+count) into `out` (count * block_bytes
     // bytes), checks them against the LUT (Error{fft_format}) and the
     // checksums of the groups they touch (Error{checksum}; the rest of a
-    // group partly inside the range is read to hash it). Thread-safe.
+    // group partly inside the range is read to hash it). Each group is
+    // verified the first time any of its blocks is read. Thread-safe.
     void read_blocks(std::uint64_t first, std::uint64_t count, std::uint8_t* out) const;
     std::vector<std::uint8_t> read_blocks(std::uint64_t first, std::uint64_t count) const;
 
@@ -93,6 +96,7 @@ private:
     std::vector<TrailerChunk> trailer_;
     std::uint64_t checksum_chunk_offset_ = 0;  // where the CSUM chunk starts in the file
     std::optional<FftChecksums> checksums_;
+    std::unique_ptr<std::atomic<std::uint64_t>[]> verified_groups_;  // one bit per block group
 };
 
 }  // namespace fiblet

@@ -97,8 +97,12 @@ FftFile::FftFile(const std::string& path, FftOpenOptions options) : path_(path),
         // reported as such (fft_format) even when a checksum also fails.
         if (const TrailerChunk* c = find_chunk(kChecksumTag))
             checksums_ = FftChecksums::parse(*c, header_.blocks, path_);
-        if (verifies_checksums())
+        if (verifies_checksums()) {
             verify_open_checksums(std::span(head).first(std::size_t(header_.lut_offset())), lut_hash);
+            const std::uint64_t words = (checksums_->group_hashes.size() + 63) / 64;
+            verified_groups_ = std::make_unique<std::atomic<std::uint64_t>[]>(words);
+            for (std::uint64_t i = 0; i < words; ++i) verified_groups_[i].store(0, std::memory_order_relaxed);
+        }
     } catch (...) {
         close();
         throw;
@@ -250,6 +254,7 @@ FftFile& FftFile::operator=(FftFile&& o) noexcept {
         trailer_ = std::move(o.trailer_);
         checksum_chunk_offset_ = o.checksum_chunk_offset_;
         checksums_ = std::move(o.checksums_);
+        verified_groups_ = std::move(o.verified_groups_);
     }
     return *this;
 }
@@ -300,6 +305,9 @@ void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, cons
         hash.update(edge.data(), edge.size());
     };
     for (std::uint64_t g = first / g_blocks; g <= (end - 1) / g_blocks; ++g) {
+        std::atomic<std::uint64_t>& word = verified_groups_[g / 64];
+        const std::uint64_t bit = std::uint64_t{1} << (g % 64);
+        if (word.load(std::memory_order_acquire) & bit) continue;  // checked by an earlier read
         const std::uint64_t g0 = g * g_blocks, g1 = std::min(g0 + g_blocks, std::uint64_t{header_.blocks});
         hash.reset();
         if (g0 < first) hash_from_file(g0, first);
@@ -310,6 +318,7 @@ void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, cons
             throw Error(Errc::checksum, path_ + ": checksum mismatch in blocks " + std::to_string(g0) + ".." +
                                             std::to_string(g1 - 1) + " (group " + std::to_string(g) +
                                             "): the file is corrupted");
+        word.fetch_or(bit, std::memory_order_release);
     }
 }
 
