@@ -14,6 +14,7 @@ import gc
 import json
 import os
 import platform
+import resource
 import statistics
 import time
 
@@ -23,15 +24,21 @@ import numpy as np
 import fiblet
 
 
+def cpu_seconds():
+    r = resource.getrusage(resource.RUSAGE_SELF)  # all threads of the process
+    return r.ru_utime + r.ru_stime
+
+
 def timed(fn, repeat):
-    times, result = [], None
+    times, cpu, result = [], [], None
     for _ in range(repeat):
         result = None
         gc.collect()
-        t0 = time.perf_counter()
+        c0, t0 = cpu_seconds(), time.perf_counter()
         result = fn()
         times.append(time.perf_counter() - t0)
-    return times, result
+        cpu.append(cpu_seconds() - c0)
+    return times, cpu, result
 
 
 def warm(path):
@@ -56,9 +63,10 @@ def main():
     }
     rows = {}
     for name, fn in cases.items():
-        times, result = timed(fn, a.repeat if "fiblet" in name else max(2, a.repeat // 2))
+        times, cpu, result = timed(fn, a.repeat if "fiblet" in name else max(2, a.repeat // 2))
         points = len(result.points) if isinstance(result, fiblet.Streamlines) else len(result.get_data())
         rows[name] = {"best_s": min(times), "median_s": statistics.median(times), "runs": len(times),
+                      "median_cpu_s": statistics.median(cpu),
                       "points": points, "mpoints_per_s": points / statistics.median(times) / 1e6}
         del result
     base = rows["nibabel.streamlines.load(.tck)"]["median_s"]
@@ -69,13 +77,14 @@ def main():
     print(f"{os.path.basename(a.tck)}: {info['fibers']} fibers, {info['points']} points; "
           f".tck {os.path.getsize(a.tck) / 1e6:.1f} MB, .fft {os.path.getsize(a.fft) / 1e6:.1f} MB")
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores; "
-          f"fiblet {fiblet.__version__}, nibabel {nib.__version__}, numpy {np.__version__}")
+          f"fiblet {fiblet.__version__} (block decoder: {fiblet._fiblet.block_decoder}), "
+          f"nibabel {nib.__version__}, numpy {np.__version__}; load average {os.getloadavg()[0]:.1f}")
     print()
-    print("| load | median s | best s | M points/s | speed-up vs nibabel |")
-    print("|---|---|---|---|---|")
+    print("| load | median s | best s | CPU s (all threads) | M points/s | speed-up vs nibabel |")
+    print("|---|---|---|---|---|---|")
     for name, r in rows.items():
-        print(f"| `{name}` | {r['median_s']:.3f} | {r['best_s']:.3f} | {r['mpoints_per_s']:.1f} | "
-              f"{r['speedup_vs_nibabel']:.1f}x |")
+        print(f"| `{name}` | {r['median_s']:.3f} | {r['best_s']:.3f} | {r['median_cpu_s']:.3f} | "
+              f"{r['mpoints_per_s']:.1f} | {r['speedup_vs_nibabel']:.1f}x |")
     if a.json:
         with open(a.json, "w") as f:
             json.dump({"tck": a.tck, "fft": a.fft, "fibers": info["fibers"], "points": info["points"],

@@ -6,8 +6,12 @@ get_filename_component(FIBLET_SHARED_DATA "${PROJECT_SOURCE_DIR}/../shared/data"
 
 add_test(NAME ecosystem.install_downstream
   COMMAND ${PROJECT_SOURCE_DIR}/tests/downstream/run_downstream_test.sh
-          ${PROJECT_BINARY_DIR} ${FIBLET_SHARED_DATA}/dwi-small64d-ifod1.tck ${PROJECT_VERSION})
+          ${PROJECT_BINARY_DIR} ${FIBLET_SHARED_DATA}/dwi-small64d-ifod1.tck ${PROJECT_VERSION} ${Python_EXECUTABLE})
 set_tests_properties(ecosystem.install_downstream PROPERTIES TIMEOUT 300)
+if(FIBLET_SANITIZE)  # an instrumented libfiblet.a needs the sanitizer runtimes in the downstream link
+  set_tests_properties(ecosystem.install_downstream PROPERTIES
+    ENVIRONMENT "CXXFLAGS=-fsanitize=address,undefined;LDFLAGS=-fsanitize=address,undefined")
+endif()
 
 # docs/cli.md must equal what the CLI generates (scripts/gen_cli_docs.sh).
 add_test(NAME ecosystem.cli_docs_up_to_date

@@ -19,6 +19,7 @@
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/tck.hpp"
+#include "decode_range.hpp"
 #include "owned_array.hpp"
 #include "roi_filter.hpp"
 
@@ -58,7 +59,7 @@ Streamlines decode_indices(const FftFile& file, const std::vector<std::uint64_t>
         for (std::size_t k = 0; k < j - i; ++k) run_fiber.push_back(base_fiber + k);
         i = j;
     }
-    return gather_fibers(all, run_fiber);
+    return gather_fibers(view_of(all), run_fiber);
 }
 
 std::vector<Region> parse_regions(const py::list& regions) {
@@ -78,7 +79,8 @@ std::vector<Region> parse_regions(const py::list& regions) {
 
 // Decodes a file (all fibers, [begin, end), or a list of indices), keeps the
 // fibers the regions select, and returns (points (N,3) float32, offsets
-// (F+1) int64, fiber_ids (F) int64).
+// (F+1) int64, fiber_ids (F) int64). A range without regions, the common
+// case, is decoded straight into the memory numpy gets (decode_range).
 py::tuple decode(const std::string& path, std::uint64_t begin, std::optional<std::uint64_t> end,
                  const py::object& indices_or_none, const py::list& regions_list, unsigned threads) {
     const std::vector<Region> regions = parse_regions(regions_list);
@@ -88,38 +90,42 @@ py::tuple decode(const std::string& path, std::uint64_t begin, std::optional<std
         if (!a || a.ndim() != 1) throw Error(Errc::invalid_argument, "fiber indices must be a 1-D integer array");
         indices.emplace(a.data(), a.data() + a.shape(0));
     }
-    Streamlines s;
+    std::optional<DecodedRange> range;  // the result, when decoded as a range
+    Streamlines s;                      // else this
     std::vector<std::uint64_t> ids;
     {
         py::gil_scoped_release release;
         const FftFile file(path);
-        const DecodeOptions o = decode_options<DecodeOptions>(threads);
         if (indices) {
             for (std::uint64_t f : *indices)
                 if (f >= file.header().fibers)
                     throw Error(Errc::invalid_argument, path + ": fiber " + std::to_string(f) + " out of range (" +
                                                             std::to_string(file.header().fibers) + " fibers)");
-            s = decode_indices(file, *indices, o);
+            s = decode_indices(file, *indices, decode_options<DecodeOptions>(threads));
             ids = std::move(*indices);
         } else {
             const std::uint64_t e = end.value_or(file.header().fibers);
-            s = decode_fibers(file, begin, e, o);
-            ids.resize(s.size());
+            range = decode_range(file, begin, e, threads);
+            ids.resize(range->offsets.size() - 1);
             std::iota(ids.begin(), ids.end(), begin);
         }
         if (!regions.empty()) {
-            const std::vector<std::uint64_t> keep = fibers_kept(s, regions);
-            if (keep.size() != s.size()) {
-                s = gather_fibers(s, keep);
+            const FibersView all = range ? FibersView{range->xyz.as<const float>(), range->offsets} : view_of(s);
+            const std::vector<std::uint64_t> keep = fibers_kept(all, regions);
+            if (keep.size() != all.size()) {
+                s = gather_fibers(all, keep);
+                range.reset();
                 std::vector<std::uint64_t> kept_ids(keep.size());
                 for (std::size_t i = 0; i < keep.size(); ++i) kept_ids[i] = ids[keep[i]];
                 ids = std::move(kept_ids);
             }
         }
     }
-    const auto points = py::ssize_t(s.point_count()), fibers = py::ssize_t(s.size());
-    return py::make_tuple(to_numpy<float>(std::move(s.xyz), {points, 3}),
-                          to_numpy<std::int64_t>(std::move(s.offsets), {fibers + 1}),
+    const auto fibers = py::ssize_t(ids.size());
+    const auto points = py::ssize_t(range ? range->points : s.point_count());
+    py::array_t<float> xyz = range ? to_numpy<float>(std::move(range->xyz), {points, 3})
+                                   : to_numpy<float>(std::move(s.xyz), {points, 3});
+    return py::make_tuple(xyz, to_numpy<std::int64_t>(range ? std::move(range->offsets) : std::move(s.offsets), {fibers + 1}),
                           to_numpy<std::int64_t>(std::move(ids), {fibers}));
 }
 
@@ -222,7 +228,8 @@ PYBIND11_MODULE(_fiblet, m) {
     using namespace fiblet::python;
     m.doc() = "fiblet's compiled core; use the `fiblet` package instead.";
     m.attr("version") = FIBLET_VERSION;
-    m.attr("decode_threads_supported") = has_decode_threads<fiblet::DecodeOptions>;
+    // Which block decoder fiblet.load() runs on (decode_range.hpp).
+    m.attr("block_decoder") = fast_block_decoder_available() ? "library (fastest available)" : "scalar reference";
 
     // fiblet::Error -> fiblet.FibletError, with the stable category name
     // (errc_name: "io", "fft_format", ...) as its `category` attribute.

@@ -15,11 +15,11 @@ bool Region::contains(const float* p) const {
     return true;
 }
 
-std::vector<std::uint64_t> fibers_kept(const Streamlines& s, const std::vector<Region>& regions) {
+std::vector<std::uint64_t> fibers_kept(FibersView s, const std::vector<Region>& regions) {
     std::vector<std::uint64_t> keep;
     for (std::uint64_t f = 0; f < s.size(); ++f) {
-        const float* begin = s.xyz.data() + 3 * s.offsets[f];
-        const float* end = s.xyz.data() + 3 * s.offsets[f + 1];
+        const float* begin = s.xyz + 3 * s.offsets[f];
+        const float* end = s.xyz + 3 * s.offsets[f + 1];
         bool kept = true;
         for (const Region& r : regions) {
             bool hit = false;
@@ -34,7 +34,7 @@ std::vector<std::uint64_t> fibers_kept(const Streamlines& s, const std::vector<R
     return keep;
 }
 
-Streamlines gather_fibers(const Streamlines& s, const std::vector<std::uint64_t>& keep) {
+Streamlines gather_fibers(FibersView s, const std::vector<std::uint64_t>& keep) {
     Streamlines out;
     out.offsets.reserve(keep.size() + 1);
     std::uint64_t points = 0;
@@ -42,8 +42,7 @@ Streamlines gather_fibers(const Streamlines& s, const std::vector<std::uint64_t>
     out.xyz.resize(3 * points);
     for (std::size_t i = 0; i < keep.size(); ++i) {
         const std::uint64_t f = keep[i];
-        std::copy(s.xyz.begin() + 3 * s.offsets[f], s.xyz.begin() + 3 * s.offsets[f + 1],
-                  out.xyz.begin() + 3 * out.offsets[i]);
+        std::copy(s.xyz + 3 * s.offsets[f], s.xyz + 3 * s.offsets[f + 1], out.xyz.begin() + 3 * out.offsets[i]);
     }
     return out;
 }

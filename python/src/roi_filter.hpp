@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "fiblet/decode.hpp"
@@ -24,10 +25,19 @@ struct Region {
     bool contains(const float* p) const;
 };
 
+// Fibers in the TRX layout, wherever their memory lives: fiber i is the
+// points [offsets[i], offsets[i+1]) of xyz (3 floats each).
+struct FibersView {
+    const float* xyz;
+    std::span<const std::uint64_t> offsets;
+    std::uint64_t size() const { return offsets.size() - 1; }
+};
+inline FibersView view_of(const Streamlines& s) { return {s.xyz.data(), s.offsets}; }
+
 // Indices (into `s`) of the fibers the regions keep, in order.
-std::vector<std::uint64_t> fibers_kept(const Streamlines& s, const std::vector<Region>& regions);
+std::vector<std::uint64_t> fibers_kept(FibersView s, const std::vector<Region>& regions);
 
 // The fibers of `s` listed in `keep` (in that order), as a new Streamlines.
-Streamlines gather_fibers(const Streamlines& s, const std::vector<std::uint64_t>& keep);
+Streamlines gather_fibers(FibersView s, const std::vector<std::uint64_t>& keep);
 
 }  // namespace fiblet::python
