@@ -61,5 +61,6 @@ void add_compress(CLI::App& app);
 void add_decompress(CLI::App& app);
 void add_stats(CLI::App& app);
 void add_info(CLI::App& app);
+void add_extract(CLI::App& app);
 
 }  // namespace fiblet::cli

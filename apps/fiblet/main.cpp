@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
     add_decompress(app);
     add_stats(app);
     add_info(app);
+    add_extract(app);
 
     fiblet::install_signal_cleanup();
     try {
