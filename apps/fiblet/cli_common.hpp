@@ -67,6 +67,7 @@ void add_compress(CLI::App& app);
 void add_decompress(CLI::App& app);
 void add_stats(CLI::App& app);
 void add_info(CLI::App& app);
+void add_extract(CLI::App& app);
 void add_verify(CLI::App& app);
 void add_help(CLI::App& app);
 #ifdef FIBLET_WITH_VIEWER

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "fiblet/checksum.hpp"
+#include "fiblet/block_index.hpp"
 #include "fiblet/encode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/output_file.hpp"
@@ -222,11 +223,15 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         std::vector<std::uint8_t> blocks;
         std::vector<Vec3f> decoded, resampled;
         ErrorStats error, error_vs_original;
+        IndexBuilder index;  // bounds of this worker's blocks (the BIDX chunk)
     };
     std::vector<Work> work(threads);
+    IndexBuilder index(h);
+    for (Work& w : work) w.index = index;
     std::vector<std::vector<Vec3f>> batch;
     auto encode_range = [&](Work& w, std::size_t begin, std::size_t end, std::uint32_t first_fiber) {
         w.blocks.clear();
+        w.index.clear();
         for (std::size_t i = begin; i < end; ++i) {
             const std::vector<Vec3f>& original = batch[i];
             std::span<const Vec3f> points = original;
@@ -237,6 +242,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             const auto f = std::uint32_t(first_fiber + i);
             w.decoded.clear();
             encoder.encode(points, f, w.blocks, &w.decoded);
+            w.index.add_fiber(w.decoded);
             std::size_t hint = 0;
             const std::size_t window = 16 + 2 * original.size() / std::max<std::size_t>(points.size(), 1);
             for (std::size_t k = 0; k < points.size(); ++k) {
@@ -270,6 +276,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         for (std::size_t t = 0; t + 1 < cut.size(); ++t) {
             out.write(work[t].blocks.data(), work[t].blocks.size());
             checksum.add_blocks(work[t].blocks.data(), work[t].blocks.size());
+            index.append(work[t].index);
         }
         next_fiber += std::uint32_t(n);
         report_progress(options, "encode", reader);
@@ -286,6 +293,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             std::memcpy(c.payload.data(), &step, 8);
             chunks.push_back(std::move(c));
         }
+        if (auto bidx = index.finish()) chunks.push_back(std::move(*bidx));
         chunks.push_back(checksum.finish(final_head, chunks));  // last: it covers the chunks before it
         const auto trailer = serialize_trailer(chunks, at);
         out.write(trailer.data(), trailer.size());
