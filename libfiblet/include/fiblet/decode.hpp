@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "fiblet/direction_code.hpp"
@@ -17,11 +18,16 @@
 
 namespace fiblet {
 
+struct DecodeContext;
+// The 16-bit table of a version-16 header, null for version 2.
+std::shared_ptr<const DirectionTable16> make_direction_table16(const FftHeader& header);
+
 // Per-file constants the decoders need (built once per file).
 struct DecodeContext {
     explicit DecodeContext(const FftHeader& header);
     FftHeader header;
     DirectionTable table;
+    std::shared_ptr<const DirectionTable16> table16 = make_direction_table16(header);  // 16-bit files only
 };
 
 // Number of points held by `count` blocks; throws Error{fft_format} on a
@@ -34,6 +40,11 @@ std::size_t count_block_points(const DecodeContext& ctx, const std::uint8_t* blo
 // count_block_points().
 std::size_t decode_blocks_scalar(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count,
                                  float* xyz);
+
+// The same two for 16-bit files (formats/fft16.md).
+std::size_t count_block_points16(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count);
+std::size_t decode_blocks_scalar16(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count,
+                                   float* xyz);
 
 // Streamlines in the TRX layout: points of fiber i are xyz[3*offsets[i] ..
 // 3*offsets[i+1]).

@@ -1,5 +1,6 @@
 #include <algorithm>
 
+#include "decode/decode_scalar16.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 
@@ -10,6 +11,7 @@ namespace {
 // Decodes fibers [begin, end) whose blocks are already in memory.
 void decode_fiber_range(const FftFile& file, const DecodeContext& ctx, std::uint64_t begin, std::uint64_t end,
                         const std::vector<std::uint8_t>& blocks, Streamlines& out) {
+    if (ctx.header.direction_bits() == 16) return detail::decode_fiber_range16(file, ctx, begin, end, blocks, out);
     const std::size_t nblocks = blocks.size() / ctx.header.block_bytes();
     const std::size_t npoints = count_block_points(ctx, blocks.data(), nblocks);
     out.xyz.resize(3 * npoints);

@@ -37,8 +37,8 @@ FftHeader parse_fft_header(std::span<const std::uint8_t> b, std::uint64_t file_s
     FftHeader h;
     const std::uint8_t* p = b.data();
     h.version = p[0];
-    if (h.version != kFftVersion)
-        bad(name, "unsupported version " + std::to_string(h.version) + " (fiblet reads version 2)");
+    if (h.version != kFftVersion && h.version != kFft16Version)
+        bad(name, "unsupported version " + std::to_string(h.version) + " (fiblet reads versions 2 and 16)");
     h.fibers = get_le<std::uint64_t>(p + 1);
     h.points = get_le<std::uint64_t>(p + 9);
     h.blocks = get_le<std::uint32_t>(p + 17);
@@ -51,8 +51,9 @@ FftHeader parse_fft_header(std::span<const std::uint8_t> b, std::uint64_t file_s
     h.mean_error_mm = get_le<float>(p + 53);
     const unsigned buffers = p[57];
 
-    if (h.points_per_block < 2 || h.points_per_block > kMaxPointsPerBlock)
-        bad(name, "points per block " + std::to_string(h.points_per_block) + " outside [2, 63]");
+    if (h.points_per_block < 2 || h.points_per_block > h.max_points_per_block())
+        bad(name, "points per block " + std::to_string(h.points_per_block) + " outside [2, " +
+                      std::to_string(h.max_points_per_block()) + "]");
     if (!(std::isfinite(h.scaling) && h.scaling > 0)) bad(name, "scaling is not a positive finite number");
     for (float o : h.offset)
         if (!std::isfinite(o)) bad(name, "offset is not finite");
