@@ -25,6 +25,7 @@
 #include <functional>
 #include <span>
 #include <string>
+#include <memory>
 #include <vector>
 
 #include "fiblet/direction_code.hpp"
@@ -33,11 +34,16 @@
 
 namespace fiblet {
 
+struct DecodeContext;
+// The 16-bit table of a version-16 header, null for version 2.
+std::shared_ptr<const DirectionTable16> make_direction_table16(const FftHeader& header);
+
 // Per-file constants the decoders need (built once per file).
 struct DecodeContext {
     explicit DecodeContext(const FftHeader& header);
     FftHeader header;
     DirectionTable table;
+    std::shared_ptr<const DirectionTable16> table16 = make_direction_table16(header);  // 16-bit files only
     // The table's frames as rows of 16 floats, one 64-byte line per code:
     // component 3 col + row of code k at [16 k + 3 col + row], zero padded.
     // What the SIMD decoders load.
@@ -83,6 +89,11 @@ std::size_t decode_blocks(const DecodeContext& ctx, const std::uint8_t* blocks, 
 // count_block_points().
 std::size_t decode_blocks_scalar(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count,
                                  float* xyz);
+
+// The scalar decoder of 16-bit files (formats/fft16.md); count_block_points
+// and the dispatching decoders handle both kinds.
+std::size_t decode_blocks_scalar16(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count,
+                                   float* xyz);
 
 // Streamlines in the TRX layout: points of fiber i are xyz[3*offsets[i] ..
 // 3*offsets[i+1]).

@@ -116,6 +116,8 @@ void stream_copy(float* dst, const float* src, std::size_t n) {
 
 std::size_t detail::decode_resolved(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count,
                                     float* xyz, Decoder d) {
+    // 16-bit files (formats/fft16.md) have only the scalar decoder.
+    if (ctx.header.direction_bits() == 16) return decode_blocks_scalar16(ctx, blocks, count, xyz);
 #ifdef __SSE2__
     // Output far larger than the caches: written straight to memory, each
     // cache line is first read (write-allocate), doubling the traffic of a

@@ -74,7 +74,7 @@ public:
         offsets[0] = acc;
         for (std::uint64_t f = f0_; f < f1_; ++f) {
             for (std::uint32_t k = file_.block_count(f); k > 0; --k, ++b)
-                acc += BlockView{&data_[b * bb]}.point_count();
+                acc += block_flags(ctx_.header, &data_[b * bb]).point_count;
             offsets[f - f0_ + 1] = acc;
         }
     }

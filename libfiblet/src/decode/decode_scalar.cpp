@@ -26,7 +26,7 @@ std::size_t count_block_points(const DecodeContext& ctx, const std::uint8_t* blo
     const std::uint32_t bb = ctx.header.block_bytes();
     std::size_t total = 0;
     for (std::size_t b = 0; b < count; ++b) {
-        const std::uint32_t n = BlockView{blocks + b * bb}.point_count();
+        const std::uint32_t n = block_flags(ctx.header, blocks + b * bb).point_count;
         if (n == 0 || n > ctx.header.points_per_block)
             throw Error(Errc::fft_format, "block holds " + std::to_string(n) + " points (allowed 1.." +
                                               std::to_string(ctx.header.points_per_block) + ")");
