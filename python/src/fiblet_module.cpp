@@ -191,7 +191,8 @@ py::dict compress(const std::string& tck_path, const std::string& fft_path, std:
     d["fibers"] = r.header.fibers, d["points"] = r.header.points, d["blocks"] = r.header.blocks;
     d["input_bytes"] = r.input_bytes, d["output_bytes"] = r.output_bytes;
     d["ratio"] = r.output_bytes ? double(r.input_bytes) / double(r.output_bytes) : 0.0;
-    d["step_mm"] = r.step_mm, d["cap_ratio"] = r.header.ratio, d["resampled"] = r.resampled;
+    d["step_mm"] = r.step_mm, d["step_scale"] = r.step_scale, d["cap_ratio"] = r.header.ratio, d["resampled"] = r.resampled;
+    d["direction_bits"] = r.header.direction_bits();
     d["max_error_um"] = r.error.max_mm() * 1e3, d["mean_error_um"] = r.error.mean_mm() * 1e3;
     if (r.resampled)
         d["max_error_vs_original_um"] = r.error_vs_original.max_mm() * 1e3,

@@ -60,7 +60,8 @@ FftHeader parse_fft_header(std::span<const std::uint8_t> b, std::uint64_t file_s
     for (float o : h.offset)
         if (!std::isfinite(o)) bad(name, "offset is not finite");
     if (!(std::isfinite(h.ratio) && h.ratio > 0 && h.ratio <= 2)) bad(name, "ratio outside (0, 2]");
-    if (!(std::isfinite(h.step) && h.step >= 0 && h.step < 1)) bad(name, "step outside [0, 1)");
+    // A step may exceed the box (two points on its diagonal are sqrt(3) apart), never by much.
+    if (!(std::isfinite(h.step) && h.step >= 0 && h.step <= 16)) bad(name, "step outside [0, 16]");
     // Counts are checked against the file size before anything is allocated.
     const std::uint64_t fixed = kFftFixedHeaderBytes + 8ull * buffers;
     if (b.size() < fixed) bad(name, "truncated buffer table");
