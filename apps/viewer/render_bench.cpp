@@ -4,6 +4,8 @@
 #include <chrono>
 #include <functional>
 
+#include "gpu_timer.hpp"
+
 namespace fiblet::viewer {
 
 namespace {
@@ -48,6 +50,22 @@ std::vector<BenchCase> run_render_bench(const GpuScene& scene, Renderer& rendere
             out.push_back(c);
         }
     return out;
+}
+
+double time_full_decode(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind, int frames) {
+    const BlockDecoder decoder(programs, scene.header().points_per_block);
+    std::vector<double> ms;
+    for (int f = -1; f < frames; ++f) {
+        GpuTimer timer(default_timing_method());
+        timer.begin(Stage::decode);
+        for (std::uint32_t first = 0; first < scene.block_count(); first += decoder.capacity()) {
+            decoder.decode(scene, kind, false, first, std::min(decoder.capacity(), scene.block_count() - first));
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        }
+        timer.end();
+        if (f >= 0) ms.push_back(timer.collect()[std::size_t(Stage::decode)]);
+    }
+    return median(ms);
 }
 
 }  // namespace fiblet::viewer
