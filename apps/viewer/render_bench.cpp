@@ -24,9 +24,11 @@ std::vector<BenchCase> run_render_bench(const GpuScene& scene, Renderer& rendere
         const char* name;
         float zoom;
     };
-    // The whole scene; a close-up where most blocks are off-screen; far away,
-    // where most blocks are under the level-of-detail size.
-    const View views[] = {{"overview", 1.0f}, {"close-up", 3.0f}, {"far", 0.08f}};
+    // The whole scene; a close-up where about a third of the blocks are
+    // off-screen; far away, the scene about 24 pixels tall, where most blocks
+    // are under the level-of-detail size (a block's bounding sphere is about
+    // 12 mm across in a 90 mm brain).
+    const View views[] = {{"overview", 1.0f}, {"close-up", 3.0f}, {"far", 24.0f / float(target.height())}};
     std::vector<BenchCase> out;
     for (const View& v : views)
         for (bool selection : {true, false}) {
