@@ -1,4 +1,4 @@
-// The GPU decoder (decode_blocks.comp.glsl, run headless on whatever EGL
+// The two GPU decoders (decode_blocks*.comp.glsl, run headless on whatever EGL
 // offers: llvmpipe in CI) against the scalar reference decoder, on every
 // shared test file and on fibers whose lengths hit every block boundary case.
 #include <gtest/gtest.h>
@@ -15,6 +15,8 @@ using namespace fiblet::test;
 
 namespace {
 
+constexpr viewer::DecoderKind kBothDecoders[] = {viewer::DecoderKind::scan, viewer::DecoderKind::sequential};
+
 // Largest coordinate difference between the two decoders, in mm. Both
 // decode the same bytes; the GPU multiplies the frames in a different order
 // (a log-step scan instead of one after the other), so they differ by float
@@ -24,10 +26,11 @@ struct Comparison {
     double max_diff_mm = 0;
 };
 
-Comparison compare_decoders(const std::string& fft_path) {
+Comparison compare_decoders(const std::string& fft_path, viewer::DecoderKind kind) {
     const FftFile file(fft_path);
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
-    const std::vector<float> gpu = viewer::decode_blocks_on_gpu(scene, *viewer_gl().programs, 0, scene.block_count());
+    const viewer::GpuScene scene(file, *viewer_gl().programs, kind);
+    const std::vector<float> gpu =
+        viewer::decode_blocks_on_gpu(scene, *viewer_gl().programs, kind, 0, scene.block_count());
     const CpuDecoded cpu = cpu_decode_blocks(file);
     EXPECT_EQ(gpu.size(), cpu.xyz.size()) << fft_path;
     Comparison c;
@@ -61,10 +64,13 @@ TEST(ViewerGpuDecode, ReferenceFilesWrittenByTheOfficialEncoder) {
     FIBLET_REQUIRE_GL();
     for (const char* name : {"reference/small-ifod1.fft", "reference/small-sdstream.fft"}) {
         const std::string path = shared_data(name);
-        const Comparison c = compare_decoders(path);
-        EXPECT_GT(c.points, 100000u) << name;
-        EXPECT_LE(c.max_diff_mm, tolerance_mm(path)) << name;
-        std::printf("%s: %zu points, GPU vs scalar decoder max %.3g mm\n", name, c.points, c.max_diff_mm);
+        for (const auto kind : kBothDecoders) {
+            const Comparison c = compare_decoders(path, kind);
+            EXPECT_GT(c.points, 100000u) << name;
+            EXPECT_LE(c.max_diff_mm, tolerance_mm(path)) << name << " " << viewer::decoder_name(kind);
+            std::printf("%s: %zu points, GPU (%s) vs scalar decoder max %.3g mm\n", name, c.points,
+                        viewer::decoder_name(kind), c.max_diff_mm);
+        }
     }
 }
 
@@ -76,10 +82,13 @@ TEST(ViewerGpuDecode, SharedTractogramsCompressedHere) {
           "bundles/cingulum-1-step0.1.tck", "bundles/cingulum-2-step0.1.tck", "bundles/AF_L.tck",
           "dwi-small64d-ifod1.tck", "conformance/simple.tck", "conformance/standard.tck"}) {
         const std::string fft = compress_into(dir, shared_data(name), "f.fft");
-        const Comparison c = compare_decoders(fft);
-        EXPECT_GT(c.points, 0u) << name;
-        EXPECT_LE(c.max_diff_mm, tolerance_mm(fft)) << name;
-        std::printf("%s: %zu points, GPU vs scalar decoder max %.3g mm\n", name, c.points, c.max_diff_mm);
+        for (const auto kind : kBothDecoders) {
+            const Comparison c = compare_decoders(fft, kind);
+            EXPECT_GT(c.points, 0u) << name;
+            EXPECT_LE(c.max_diff_mm, tolerance_mm(fft)) << name << " " << viewer::decoder_name(kind);
+            std::printf("%s: %zu points, GPU (%s) vs scalar decoder max %.3g mm\n", name, c.points,
+                        viewer::decoder_name(kind), c.max_diff_mm);
+        }
     }
 }
 
@@ -100,7 +109,9 @@ TEST(ViewerGpuDecode, EveryBlockBoundaryCase) {
     const TempDir dir;
     write_tck(dir.file("cases.tck"), fibers);
     const std::string fft = compress_into(dir, dir.file("cases.tck"), "cases.fft");
-    const Comparison c = compare_decoders(fft);
-    EXPECT_EQ(c.points, FftFile(fft).header().points);
-    EXPECT_LE(c.max_diff_mm, tolerance_mm(fft));
+    for (const auto kind : kBothDecoders) {
+        const Comparison c = compare_decoders(fft, kind);
+        EXPECT_EQ(c.points, FftFile(fft).header().points) << viewer::decoder_name(kind);
+        EXPECT_LE(c.max_diff_mm, tolerance_mm(fft)) << viewer::decoder_name(kind);
+    }
 }

@@ -40,7 +40,8 @@ std::string stats_json(const viewer::FrameStats& s) {
 }
 
 void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::string& device, int width, int height,
-                 const std::vector<viewer::BenchCase>& cases) {
+                 const std::vector<viewer::BenchCase>& cases, double scan_ms, double sequential_ms,
+                 viewer::DecoderKind decoder) {
     if (a.json) {
         std::string list = "[";
         for (std::size_t i = 0; i < cases.size(); ++i) {
@@ -61,6 +62,9 @@ void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::
                                .integer("frames", std::uint64_t(a.frames))
                                .integer("fibers", scene.fiber_count())
                                .integer("blocks", scene.block_count())
+                               .str("decoder", viewer::decoder_name(decoder))
+                               .num("decode_all_scan_ms", scan_ms)
+                               .num("decode_all_sequential_ms", sequential_ms)
                                .raw("cases", list + "]")
                                .render());
         return;
@@ -68,6 +72,8 @@ void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::
     fmt::print("{}: {} fibers, {} blocks, {} segments; {}x{}, median of {} frames\n", a.view.input,
                scene.fiber_count(), scene.block_count(), scene.segment_count(), width, height, a.frames);
     fmt::print("device: {}; stage times by {}\n", device, viewer::timing_method_name(viewer::default_timing_method()));
+    fmt::print("decoding all {} blocks: scan {:.2f} ms, sequential {:.2f} ms; frames below use the {} decoder\n",
+               scene.block_count(), scan_ms, sequential_ms, viewer::decoder_name(decoder));
     fmt::print("{:<9} {:<12} {:>10} {:>10} {:>11} {:>9} {:>10} {:>9} {:>10} {:>9}\n", "view", "culling+LoD",
                "full blks", "coarse", "segments", "cull ms", "decode ms", "draw ms", "GPU ms", "frame ms");
     for (const auto& c : cases) {
@@ -105,7 +111,10 @@ void run(const RenderArgs& a) {
 
     if (a.bench) {
         const auto cases = viewer::run_render_bench(scene, renderer, target, camera_for, options, a.frames);
-        print_bench(a, scene, context.description(), width, height, cases);
+        const double scan_ms = viewer::time_full_decode(scene, programs, viewer::DecoderKind::scan, a.frames);
+        const double sequential_ms = viewer::time_full_decode(scene, programs, viewer::DecoderKind::sequential, a.frames);
+        print_bench(a, scene, context.description(), width, height, cases, scan_ms, sequential_ms,
+                    options.decoder.value_or(viewer::default_decoder()));
     }
     if (a.output.empty()) return;
     const viewer::FrameStats stats = renderer.render(scene, camera_for(1.0f), options, target);

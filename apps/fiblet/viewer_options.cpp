@@ -54,6 +54,10 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
     cmd->add_option("--fibers", a.fibers, "Only fibers whose ID is in FIRST:LAST (inclusive)");
     cmd->add_option("--min-length", a.min_length, "Only fibers at least this long (mm)");
     cmd->add_option("--max-length", a.max_length, "Only fibers at most this long (mm)");
+    cmd->add_option("--decoder", a.decoder,
+                    "GPU decoder: scan (prefix product, a workgroup per block), sequential (an invocation per "
+                    "block), or auto (sequential on software renderers, else scan)")
+        ->capture_default_str();
 }
 
 void parse_size(const std::string& text, int& width, int& height) {
@@ -91,6 +95,10 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
     }
     if (a.min_length < 0 || a.max_length < 0) throw Error(Errc::invalid_argument, "fiber lengths must be positive");
     o.min_length_mm = a.min_length;
+    if (a.decoder != "auto") {
+        o.decoder = viewer::parse_decoder(a.decoder);
+        if (!o.decoder) throw Error(Errc::invalid_argument, "--decoder: '" + a.decoder + "' is not auto, scan or sequential");
+    }
     if (a.max_length > 0) o.max_length_mm = a.max_length;
     return o;
 }

@@ -13,7 +13,7 @@ struct ViewerArgs {
     std::string size = "1920x1080";
     std::string camera = "oblique";
     float fov = 35, zoom = 1;
-    std::string color = "direction", background = "black", fibers;
+    std::string color = "direction", background = "black", fibers, decoder = "auto";
     bool no_lighting = false, no_culling = false, no_lod = false;
     float lod_pixels = 4, line_width = 1;
     double min_length = 0, max_length = 0;

@@ -25,7 +25,8 @@ GpuPrograms::GpuPrograms() {
     require_limit(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, 7, "shader storage blocks in compute shaders");
     const std::string defines = gpu_binding_defines();
     cull = build_program({"cull_blocks.comp.glsl"}, defines);
-    decode = build_program({"decode_blocks.comp.glsl"}, defines);
+    decode_scan = build_program({"decode_blocks.comp.glsl"}, defines);
+    decode_sequential = build_program({"decode_blocks_sequential.comp.glsl"}, defines);
     fine_lines = build_program({"fine_lines.vert.glsl", "lines.frag.glsl"}, defines);
     coarse_lines = build_program({"coarse_lines.vert.glsl", "lines.frag.glsl"}, defines);
 }

@@ -11,7 +11,8 @@ struct GpuPrograms {
     GpuPrograms();
 
     GlProgram cull;         // cull_blocks.comp.glsl
-    GlProgram decode;       // decode_blocks.comp.glsl
+    GlProgram decode_scan;        // decode_blocks.comp.glsl
+    GlProgram decode_sequential;  // decode_blocks_sequential.comp.glsl
     GlProgram fine_lines;   // fine_lines.vert.glsl + lines.frag.glsl
     GlProgram coarse_lines; // coarse_lines.vert.glsl + lines.frag.glsl
 };

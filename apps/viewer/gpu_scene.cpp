@@ -11,6 +11,7 @@
 #include "fiblet/direction_code.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/view.hpp"
+#include "block_decoder.hpp"
 #include "gpu_bindings.hpp"
 #include "shader_program.hpp"
 
@@ -49,7 +50,8 @@ void check_fits(std::uint64_t bytes, const char* what) {
 
 }  // namespace
 
-GpuScene::GpuScene(const FftFile& file, const GpuPrograms& programs) : header_(file.header()) {
+GpuScene::GpuScene(const FftFile& file, const GpuPrograms& programs, std::optional<DecoderKind> decoder)
+    : header_(file.header()) {
     const FftHeader& h = header_;
     const std::uint32_t bb = h.block_bytes();
     check_fits(std::uint64_t(h.blocks) * bb, "blocks");
@@ -101,22 +103,12 @@ GpuScene::GpuScene(const FftFile& file, const GpuPrograms& programs) : header_(f
     const std::vector<float> frames = local_frames_std140(h.ratio);
     local_frames_ = make_buffer(GLsizeiptr(frames.size() * 4), frames.data(), 0);
 
-    // The last point of every fiber, decoded on the GPU by the decoder's
-    // ends-only mode over the list of last blocks.
+    // The last point of every fiber, decoded on the GPU over the list of last blocks.
     if (!last_blocks.empty()) {
         const GlBuffer list = make_buffer(GLsizeiptr(last_blocks.size() * 4), last_blocks.data(), 0);
-        glUseProgram(programs.decode.get());
-        bind(programs.decode);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, list.get());
-        glUniform1i(uniform(programs.decode, "uUseList"), 1);
-        glUniform1i(uniform(programs.decode, "uEndsOnly"), 1);
-        constexpr std::size_t kMaxGroups = 65535;
-        for (std::size_t first = 0; first < last_blocks.size(); first += kMaxGroups) {
-            glUniform1ui(uniform(programs.decode, "uFirst"), GLuint(first));
-            glDispatchCompute(GLuint(std::min(kMaxGroups, last_blocks.size() - first)), 1, 1);
-        }
-        glUniform1i(uniform(programs.decode, "uEndsOnly"), 0);
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        dispatch_decode(programs, decoder.value_or(default_decoder()), *this, true, 0, std::uint32_t(last_blocks.size()), true);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
         glFinish();  // `list` is released on return
     }
 }

@@ -6,8 +6,10 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
+#include "decoder_kind.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/geometry.hpp"
 #include "gl_objects.hpp"
@@ -24,10 +26,11 @@ struct SceneBounds {
 
 class GpuScene {
 public:
-    // Reads and validates every block (point counts) and uploads the scene.
+    // Reads and validates every block (point counts) and uploads the scene;
+    // `decoder` (default: default_decoder()) decodes the fibers' last points.
     // Throws fiblet::Error{fft_format} on bad blocks, {unsupported} when the
     // blocks exceed the driver's largest storage buffer.
-    GpuScene(const FftFile& file, const GpuPrograms& programs);
+    GpuScene(const FftFile& file, const GpuPrograms& programs, std::optional<DecoderKind> decoder = {});
 
     const FftHeader& header() const { return header_; }
     std::uint32_t block_count() const { return header_.blocks; }

@@ -1,16 +1,10 @@
 #include "gpu_timer.hpp"
 
-#include <string>
+#include "gl_info.hpp"
 
 namespace fiblet::viewer {
 
-TimingMethod default_timing_method() {
-    const auto* r = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    const std::string renderer = r ? r : "";
-    for (const char* software : {"llvmpipe", "softpipe", "swrast"})
-        if (renderer.find(software) != std::string::npos) return TimingMethod::finish;
-    return TimingMethod::queries;
-}
+TimingMethod default_timing_method() { return is_software_renderer() ? TimingMethod::finish : TimingMethod::queries; }
 
 const char* timing_method_name(TimingMethod m) {
     switch (m) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "fiblet/error.hpp"
+#include "gl_info.hpp"
 
 namespace fiblet::viewer {
 
@@ -65,19 +66,6 @@ EGLContext try_context(EGLDisplay d) {
 }
 
 }  // namespace
-
-std::string current_gl_description() {
-    auto str = [](GLenum e) {
-        const auto* s = reinterpret_cast<const char*>(glGetString(e));
-        return std::string(s ? s : "?");
-    };
-    return str(GL_RENDERER) + ", OpenGL " + str(GL_VERSION);
-}
-
-void require_gl45() {
-    if (epoxy_gl_version() < 45)
-        throw Error(Errc::unsupported, "the viewer needs OpenGL 4.5; this context offers " + current_gl_description());
-}
 
 HeadlessContext::HeadlessContext() : state_(std::make_unique<State>()) {
     for (EGLDisplay d : candidate_displays()) {

@@ -26,10 +26,4 @@ private:
     std::string description_;
 };
 
-// The driver's renderer and version strings of the current context.
-std::string current_gl_description();
-
-// Throws fiblet::Error{unsupported} unless the current context is OpenGL 4.5 or newer.
-void require_gl45();
-
 }  // namespace fiblet::viewer

@@ -36,6 +36,7 @@ void write_png(const std::string& path, const RgbaImage& image, bool overwrite) 
     if (!ctx) throw Error(Errc::io, "cannot create a PNG encoder");
     const std::string what = "cannot encode " + path;
     check(spng_set_option(ctx.get(), SPNG_ENCODE_TO_BUFFER, 1), what);
+    check(spng_set_option(ctx.get(), SPNG_IMG_COMPRESSION_LEVEL, 9), what);  // renders are written once
     spng_ihdr ihdr{};
     ihdr.width = std::uint32_t(image.width), ihdr.height = std::uint32_t(image.height);
     ihdr.bit_depth = 8, ihdr.color_type = SPNG_COLOR_TYPE_TRUECOLOR;

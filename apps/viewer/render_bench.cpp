@@ -4,6 +4,8 @@
 #include <chrono>
 #include <functional>
 
+#include "gpu_timer.hpp"
+
 namespace fiblet::viewer {
 
 namespace {
@@ -22,9 +24,11 @@ std::vector<BenchCase> run_render_bench(const GpuScene& scene, Renderer& rendere
         const char* name;
         float zoom;
     };
-    // The whole scene; a close-up where most blocks are off-screen; far away,
-    // where most blocks are under the level-of-detail size.
-    const View views[] = {{"overview", 1.0f}, {"close-up", 3.0f}, {"far", 0.08f}};
+    // The whole scene; a close-up where about a third of the blocks are
+    // off-screen; far away, the scene about 24 pixels tall, where most blocks
+    // are under the level-of-detail size (a block's bounding sphere is about
+    // 12 mm across in a 90 mm brain).
+    const View views[] = {{"overview", 1.0f}, {"close-up", 3.0f}, {"far", 24.0f / float(target.height())}};
     std::vector<BenchCase> out;
     for (const View& v : views)
         for (bool selection : {true, false}) {
@@ -48,6 +52,22 @@ std::vector<BenchCase> run_render_bench(const GpuScene& scene, Renderer& rendere
             out.push_back(c);
         }
     return out;
+}
+
+double time_full_decode(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind, int frames) {
+    const BlockDecoder decoder(programs, scene.header().points_per_block);
+    std::vector<double> ms;
+    for (int f = -1; f < frames; ++f) {
+        GpuTimer timer(default_timing_method());
+        timer.begin(Stage::decode);
+        for (std::uint32_t first = 0; first < scene.block_count(); first += decoder.capacity()) {
+            decoder.decode(scene, kind, false, first, std::min(decoder.capacity(), scene.block_count() - first));
+            glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        }
+        timer.end();
+        if (f >= 0) ms.push_back(timer.collect()[std::size_t(Stage::decode)]);
+    }
+    return median(ms);
 }
 
 }  // namespace fiblet::viewer

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "fiblet/view.hpp"
+#include "block_decoder.hpp"
 #include "gpu_scene.hpp"
 #include "render_options.hpp"
 #include "renderer.hpp"
@@ -26,5 +27,9 @@ struct BenchCase {
 std::vector<BenchCase> run_render_bench(const GpuScene& scene, Renderer& renderer, RenderTarget& target,
                                         const std::function<Camera(float zoom)>& camera_for,
                                         const RenderOptions& base, int frames);
+
+// Median time (ms) to decode every block of the scene with `kind`, in
+// batches as the renderer does, without drawing.
+double time_full_decode(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind, int frames);
 
 }  // namespace fiblet::viewer

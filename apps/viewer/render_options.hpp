@@ -4,7 +4,9 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <optional>
 
+#include "decoder_kind.hpp"
 #include "fiblet/view.hpp"
 
 namespace fiblet::viewer {
@@ -17,6 +19,8 @@ struct RenderOptions {
     // Fiber subset: IDs in [id_min, id_max], nominal lengths in [min, max] mm.
     std::uint32_t id_min = 0, id_max = std::numeric_limits<std::uint32_t>::max();
     double min_length_mm = 0, max_length_mm = std::numeric_limits<double>::infinity();
+
+    std::optional<DecoderKind> decoder;  // unset: default_decoder()
 
     // Shading.
     bool color_by_direction = true;                    // |direction| as RGB, else fixed_color

@@ -135,6 +135,7 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const R
     glBindVertexArray(empty_vertex_array_.get());
 
     GpuTimer timer(o.time_stages ? default_timing_method() : TimingMethod::none);
+    const DecoderKind decoder = o.decoder.value_or(default_decoder());
     FrameStats stats;
     const bool select = o.frustum_culling || o.level_of_detail || o.subset_active();
     if (select) {
@@ -156,7 +157,7 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const R
         const std::uint32_t count = std::min<std::uint32_t>(decoder_->capacity(), std::uint32_t(stats.fine_blocks) - first);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, fine_list_.get());
         timer.begin(Stage::decode);
-        decoder_->decode(scene, select, first, count);
+        decoder_->decode(scene, decoder, select, first, count);
         timer.end();
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         timer.begin(Stage::draw);

@@ -17,7 +17,7 @@
 #include "fiblet/error.hpp"
 #include "gpu_programs.hpp"
 #include "gpu_scene.hpp"
-#include "headless_context.hpp"
+#include "gl_info.hpp"
 #include "orbit_camera.hpp"
 #include "png_file.hpp"
 #include "render_target.hpp"
