@@ -215,7 +215,10 @@ def _flatten(streamlines):
         lengths = np.asarray(streamlines._lengths, dtype=np.int64)
         points = streamlines.get_data() if len(lengths) else np.zeros((0, 3), np.float32)
     else:
-        fibers = [np.asarray(f, dtype=np.float32).reshape(-1, 3) for f in streamlines]
+        fibers = [np.asarray(f, dtype=np.float32) for f in streamlines]
+        for i, f in enumerate(fibers):
+            if f.ndim != 2 or f.shape[1] != 3:
+                raise ValueError(f"streamline {i} has shape {f.shape}, expected (n, 3)")
         lengths = np.array([len(f) for f in fibers], dtype=np.int64)
         points = np.concatenate(fibers) if fibers else np.zeros((0, 3), np.float32)
     offsets = np.zeros(len(lengths) + 1, dtype=np.int64)

@@ -82,6 +82,11 @@ def test_save_refuses_bad_input_and_existing_output(tmp_path):
     assert not (tmp_path / "nan.fft").exists()
     with pytest.raises(ValueError):
         fiblet.save(tmp_path / "shape.fft", (np.zeros((4, 2), np.float32), np.array([0, 4])))
+    with pytest.raises(ValueError):  # (3, 2) must not be taken for (2, 3)
+        fiblet.save(tmp_path / "shape.fft", [np.zeros((3, 2), np.float32)])
+    with pytest.raises(fiblet.FibletError):  # offsets that do not fit the points
+        fiblet.save(tmp_path / "offsets.fft", (np.zeros((4, 3), np.float32), np.array([0, 5])))
+    assert not any(tmp_path.glob("shape.fft*")) and not any(tmp_path.glob("offsets.fft*"))
 
 
 def test_save_report_has_the_cli_json_keys(tmp_path, shared, cli):

@@ -86,11 +86,13 @@ def test_cohort_summary(cohort):
 
 
 def test_glob_and_output_dir(cohort, tmp_path_factory):
+    # A dry run shows the jobs a glob selects, without the time of running them.
     out = tmp_path_factory.mktemp("out")
-    run_workflow(cohort, "pattern=sub-03/**/*cingulum*.tck", f"output_dir={out}")
-    with open(out / "summary.csv") as f:
-        rows = list(csv.DictReader(f))
-    assert [r["file"] for r in rows] == ["sub-03/dwi/sub-03_desc-cingulum_tracks.tck"]
+    plan = run_workflow(cohort, "pattern=sub-03/**/*cingulum*.tck", f"output_dir={out}", "--dry-run",
+                        "--printshellcmds").stdout
+    selected = "sub-03/dwi/sub-03_desc-cingulum_tracks"
+    assert f"{cohort}/{selected}.tck -o {out}/{selected}.fft" in plan
+    assert plan.count(" compress --json") == 1 and plan.count(" stats --json") == 1
     assert not (cohort / "derivatives").exists()
 
 
