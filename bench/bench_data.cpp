@@ -181,3 +181,40 @@ void decode_sequential(const SequentialCoded& c, float* out) {
 }
 
 }  // namespace fiblet::bench
+
+// ---- fixture ----
+#include <stdlib.h>
+
+#include <filesystem>
+#include <stdexcept>
+
+#include "bench_fixture.hpp"
+#include "fiblet/compress.hpp"
+#include "fiblet/fft_file.hpp"
+
+namespace fiblet::bench {
+
+Fixture::Fixture() : tck(default_bench_tck()) {
+    std::string tmpl = std::filesystem::temp_directory_path().string() + "/fiblet-bench-XXXXXX";
+    if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
+    dir = tmpl;
+    fft = dir + "/bench.fft";
+    compress_tck(tck, fft, {});
+    read_tck(tck, tractogram);
+    const FftFile file(fft);
+    header = file.header();
+    blocks = file.read_blocks(0, header.blocks);
+    points = header.points;
+}
+
+Fixture::~Fixture() {
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+}
+
+const Fixture& fixture() {
+    static const Fixture f;
+    return f;
+}
+
+}  // namespace fiblet::bench

@@ -2,17 +2,20 @@
 // (scripts/bench_table.sh runs each row in its own process, so that the peak
 // RSS it prints is that row's). Prints one JSON object.
 //
-//   decode FILE.fft [--decoder NAME] [--threads N] [--repeat R]
+//   decode FILE.fft [--decoder NAME] [--threads N] [--repeat R] [--cold 1]
 //       every fiber of the file decoded into float32 xyz + offsets, into
-//       buffers allocated (and touched) beforehand: best of R.
-//   tck-parse FILE.tck [--repeat R]      fiblet's TckReader, into memory
+//       buffers allocated (and touched) beforehand: best of R. --cold 1
+//       drops the file from the page cache before each run (read from disk).
+//   tck-parse FILE.tck [--repeat R] [--cold 1]   fiblet's TckReader, into memory
 //   zstd FILE.tck --level L [--repeat R] the .tck through libzstd (one thread)
 //   float16 FILE.tck [--repeat R]        positions rounded to half precision
 //   sequential FILE.tck [--repeat R]     fiblet recurrence over whole fibers
 //
 // Decode timings of the .tck-based baselines include parsing the .tck (the
 // zstd row: decompression + the tck-parse time, measured in the same run).
+#include <fcntl.h>
 #include <sys/resource.h>
+#include <unistd.h>
 #include <time.h>
 #include <zstd.h>
 
@@ -60,6 +63,15 @@ double best_seconds(int repeat, const std::function<void()>& run, double* cpu = 
     return best;
 }
 
+// Drops a file's pages from the page cache (clean pages only), so that the
+// next read comes from the disk: the "cold" rows.
+void evict(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_RDONLY);
+    if (fd < 0) throw std::runtime_error("cannot open " + path);
+    ::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);
+    ::close(fd);
+}
+
 long peak_rss_kib() {
     rusage u{};
     getrusage(RUSAGE_SELF, &u);
@@ -88,7 +100,7 @@ struct Json {
     void print() const { std::printf("%s}\n", body.c_str()); }
 };
 
-void decode_row(const std::string& path, const std::map<std::string, std::string>& opt, int repeat) {
+void decode_row(const std::string& path, const std::map<std::string, std::string>& opt, int repeat, bool cold) {
     const FftFile file(path);
     const FftHeader& h = file.header();
     DecodeOptions o;
@@ -99,10 +111,14 @@ void decode_row(const std::string& path, const std::map<std::string, std::string
     std::uint64_t points = 0;
     double cpu = 0;
     const double s =
-        best_seconds(repeat, [&] { points = decode_fibers_into(file, 0, h.fibers, xyz, offsets, o); }, &cpu);
+        best_seconds(repeat, [&] {
+            if (cold) evict(path);
+            points = decode_fibers_into(file, 0, h.fibers, xyz, offsets, o);
+        }, &cpu);
     Json()
         .str("row", "decode")
         .str("decoder", decoder_name(o.decoder))
+        .num("cold", cold)
         .num("threads", o.threads)
         .num("points", double(points))
         .num("fibers", double(h.fibers))
@@ -113,13 +129,17 @@ void decode_row(const std::string& path, const std::map<std::string, std::string
         .print();
 }
 
-void tck_parse_row(const std::string& path, int repeat) {
+void tck_parse_row(const std::string& path, int repeat, bool cold) {
     fb::Tractogram t;
     fb::read_tck(path, t);  // allocates the storage once
     double cpu = 0;
-    const double s = best_seconds(repeat, [&] { fb::read_tck(path, t); }, &cpu);
+    const double s = best_seconds(repeat, [&] {
+        if (cold) evict(path);
+        fb::read_tck(path, t);
+    }, &cpu);
     Json()
         .str("row", "tck-parse")
+        .num("cold", cold)
         .num("points", double(t.points()))
         .num("fibers", double(t.fibers()))
         .num("bytes", double(read_bytes(path).size()))
@@ -229,9 +249,10 @@ int main(int argc, char** argv) {
         opt[key.substr(2)] = argv[i + 1];
     }
     const int repeat = opt.count("repeat") ? std::stoi(opt["repeat"]) : 5;
+    const bool cold = opt.count("cold") && opt["cold"] != "0";
     try {
-        if (mode == "decode") decode_row(path, opt, repeat);
-        else if (mode == "tck-parse") tck_parse_row(path, repeat);
+        if (mode == "decode") decode_row(path, opt, repeat, cold);
+        else if (mode == "tck-parse") tck_parse_row(path, repeat, cold);
         else if (mode == "zstd") zstd_row(path, opt.count("level") ? std::stoi(opt["level"]) : 3, repeat);
         else if (mode == "float16") float16_row(path, repeat);
         else if (mode == "sequential") sequential_row(path, repeat);

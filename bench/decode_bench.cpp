@@ -5,7 +5,6 @@
 // Data: ../shared/data/small-ifod1.tck (or $FIBLET_BENCH_TCK), compressed
 // into a temporary directory at start.
 #include <benchmark/benchmark.h>
-#include <stdlib.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -14,6 +13,7 @@
 #include <vector>
 
 #include "bench_data.hpp"
+#include "bench_fixture.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/encode.hpp"
@@ -24,35 +24,8 @@ using namespace fiblet;
 
 namespace {
 
-struct Data {
-    std::string dir, tck, fft;
-    fb::Tractogram tractogram;
-    FftHeader header;
-    std::vector<std::uint8_t> blocks;
-    std::size_t points = 0;
-
-    Data() : tck(fb::default_bench_tck()) {
-        std::string tmpl = std::filesystem::temp_directory_path().string() + "/fiblet-bench-XXXXXX";
-        if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
-        dir = tmpl;
-        fft = dir + "/bench.fft";
-        compress_tck(tck, fft, {});
-        fb::read_tck(tck, tractogram);
-        const FftFile file(fft);
-        header = file.header();
-        blocks = file.read_blocks(0, header.blocks);
-        points = header.points;
-    }
-    ~Data() {
-        std::error_code ec;
-        std::filesystem::remove_all(dir, ec);
-    }
-};
-
-const Data& data() {
-    static const Data d;
-    return d;
-}
+using Data = fb::Fixture;
+const Data& data() { return fb::fixture(); }
 
 void set_points(benchmark::State& state, std::size_t points_per_iteration) {
     state.SetItemsProcessed(std::int64_t(state.iterations() * points_per_iteration));

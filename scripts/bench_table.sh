@@ -88,6 +88,14 @@ ROWS
 
 log "baselines"
 add_row "$("$table" tck-parse "$tck" --repeat "$repeat")" '{"label": "tck"}'
+# Read from the disk (each file dropped from the page cache before each run).
+log "cold reads"
+add_row "$("$table" tck-parse "$tck" --repeat 3 --cold 1)" '{"label": "tck-cold"}'
+fft="$work/fiblet-8bit.fft"
+"$cli" compress "$tck" -o "$fft" -f -q
+add_row "$("$table" decode "$fft" --threads 1 --repeat 3 --cold 1)" \
+  "$(/usr/bin/python3 -c 'import json,sys; print(json.dumps({"label": "fiblet-8bit-cold", "bytes": __import__("os").path.getsize(sys.argv[1])}))' "$fft")"
+
 for level in 3 19; do
   log "zstd -$level"
   add_row "$("$table" zstd "$tck" --level "$level" --repeat "$repeat")" "{\"label\": \"tck+zstd-$level\"}"
@@ -102,4 +110,5 @@ log "micro-benchmarks"
 /usr/bin/python3 "$root/bench/make_results.py" --rows "$rows" --micro "$work/micro.json" --tck "$tck" \
   --command "scripts/bench_table.sh${1:+ $1}" --md "$out/results.md" --png "$out/results.png"
 cp "$rows" "$out/results-rows.jsonl"
+cp "$work/micro.json" "$out/results-micro.json"
 log "wrote $out/results.md and $out/results.png"

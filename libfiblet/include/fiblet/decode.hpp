@@ -68,7 +68,8 @@ Decoder parse_decoder(const std::string& name);
 // Error{unsupported} when the CPU lacks the level asked for.
 Decoder resolve_decoder(Decoder decoder);
 std::string decoder_name(Decoder decoder);  // of the resolved decoder
-// Every concrete decoder this CPU runs, by name (the fastest first).
+// Every concrete decoder this CPU runs, by name; the first is the one
+// `auto` picks.
 std::vector<std::string> available_decoders();
 
 // Number of points held by `count` blocks; throws Error{fft_format} on a

@@ -182,12 +182,15 @@ std::string decoder_name(Decoder d) {
 }
 
 std::vector<std::string> available_decoders() {
-    std::vector<std::string> names;
+    std::vector<std::string> names{decoder_name({})};  // what `auto` picks, first
+    auto add = [&](std::string name) {
+        if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(std::move(name));
+    };
     for (SimdLevel level : {SimdLevel::avx512, SimdLevel::avx2, SimdLevel::portable})
-        if (cpu_has(level)) names.push_back(std::string("lanes-") + level_name(level));
-    names.push_back("scalar");
+        if (cpu_has(level)) add(std::string("lanes-") + level_name(level));
+    add("scalar");
     for (SimdLevel level : {SimdLevel::avx512, SimdLevel::avx2, SimdLevel::portable})
-        if (cpu_has(level)) names.push_back(std::string("warp-") + level_name(level));
+        if (cpu_has(level)) add(std::string("warp-") + level_name(level));
     return names;
 }
 
