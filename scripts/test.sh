@@ -2,6 +2,8 @@
 # The test command: installs dependencies, builds, runs the whole suite with CTest.
 #   scripts/test.sh              Release build in build/
 #   FIBLET_SANITIZE=ON scripts/test.sh   ASan+UBSan build in build-sanitize/
+# Then, when clang is installed (scripts/setup.sh installs it), each libFuzzer
+# harness runs briefly: FIBLET_FUZZ_SECONDS per harness (default 30; 0 skips).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 "$root/scripts/setup.sh"
@@ -14,3 +16,10 @@ fi
 build="${FIBLET_BUILD_DIR:-$root/build}"
 cd "$build"
 ctest --output-on-failure -j"$(nproc)"
+if [ "${FIBLET_SANITIZE:-OFF}" != "ON" ] && [ "${FIBLET_FUZZ_SECONDS:-30}" != "0" ]; then
+  if command -v clang++-14 >/dev/null || command -v clang++ >/dev/null; then
+    "$root/scripts/fuzz.sh" "${FIBLET_FUZZ_SECONDS:-30}"
+  else
+    echo "test.sh: clang not found: fuzzers skipped" >&2
+  fi
+fi

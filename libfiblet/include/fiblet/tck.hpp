@@ -57,6 +57,9 @@ struct TckReadOptions {
     // A "count:" that disagrees with the data is an error unless this is set
     // (a truncated or hand-edited file would otherwise lose fibers silently).
     bool allow_count_mismatch = false;
+    // A streamline of more points is Error{unsupported} (0: no limit), so
+    // that one absurd streamline cannot take all memory.
+    std::size_t max_points = 0;
 };
 
 // Streaming reader: next() returns one streamline at a time.

@@ -89,7 +89,9 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
 
     CompressReport report;
     TckScan& scan = report.scan;
-    TckReader reader(tck_path, {.allow_count_mismatch = options.allow_count_mismatch});
+    // The longest streamline a file can hold bounds the one in memory too.
+    const std::size_t max_fiber_points = std::size_t{0xffff} * options.points_per_block;
+    TckReader reader(tck_path, {.allow_count_mismatch = options.allow_count_mismatch, .max_points = max_fiber_points});
     scan.header_step = reader.header().step_size();
 
     // Pass 1: counts, bounding box, spacing, turning angles.
@@ -168,7 +170,12 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         h.offset[a] = float(-0.5 * (scan.min[a] + scan.max[a]));
         extent = std::max(extent, scan.max[a] - scan.min[a]);
     }
+    // A step longer than the largest side (a diagonal segment) would leave [0, 1): widen.
+    if (step >= extent) extent = step * 1.01;
     h.scaling = extent > 0 ? float(extent * (1 + 1e-6)) : 1.0f;  // a hair larger: float offsets stay inside [0,1]
+    if (!std::isfinite(h.scaling))
+        throw Error(Errc::invalid_input, tck_path + ": coordinates span more than the float range (" +
+                                             std::to_string(extent) + " mm)");
     h.step = float(step / h.scaling);
     step = double(h.step) * double(h.scaling);
     report.step_mm = step;
@@ -179,6 +186,12 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         turns = detail::TurnStatistics(points_per_block, kSharpBlocks);
         std::size_t f = 0;
         while (reader.next(fiber)) {
+            double fiber_length = 0;
+            for (std::size_t i = 1; i < fiber.size(); ++i) fiber_length += length(fiber[i - 1], fiber[i]);
+            if (!(fiber_length / step < double(max_fiber_points)))
+                throw Error(Errc::unsupported, tck_path + ": streamline " + std::to_string(f) + " (" +
+                                                   std::to_string(fiber_length) + " mm) needs more than 65535 blocks at a " +
+                                                   std::to_string(step) + " mm step");
             resample_fixed_step(fiber, step, resampled);
             fiber_points[f++] = std::uint32_t(resampled.size());
             turns.add_fiber(resampled);

@@ -139,12 +139,13 @@ TckHeader read_tck_header(const std::string& path) {
     // Reads another block; returns false at end of file.
     auto read_more = [&]() {
         if (eof) return false;
-        constexpr std::size_t kBlock = 64 << 10;
+        // Small reads first (headers are a few kB), doubling for long ones.
+        const std::size_t block = std::max<std::size_t>(4096, buf.size());
         const std::size_t old = buf.size();
-        buf.resize(old + kBlock);
+        buf.resize(old + block);
         ssize_t n;
         do {
-            n = ::read(f.fd, buf.data() + old, kBlock);
+            n = ::read(f.fd, buf.data() + old, block);
         } while (n < 0 && errno == EINTR);
         if (n < 0) throw Error(Errc::io, path + ": read failed: " + std::strerror(errno));
         buf.resize(old + std::size_t(n));

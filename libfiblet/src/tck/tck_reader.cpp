@@ -18,7 +18,8 @@ static_assert(sizeof(Vec3f) == 12, "Vec3f must be three packed floats: points ar
 
 constexpr std::uint32_t kExp32 = 0x7f800000u;  // all-ones exponent: Inf or NaN
 
-inline bool nonfinite_bits(std::uint32_t b) { return (b & kExp32) == kExp32; }
+// 0 or 1 (an integer, so that three results combine with a branch-free |).
+inline unsigned nonfinite_bits(std::uint32_t b) { return (b & kExp32) == kExp32; }
 
 enum class Kind { point, separator, end, bad };
 
@@ -105,6 +106,13 @@ struct TckReader::Impl {
                                               "--allow-count-mismatch to read it anyway)");
     }
 
+    void check_length(const std::vector<Vec3f>& out) const {
+        if (options.max_points && out.size() > options.max_points)
+            throw Error(Errc::unsupported, path + ": streamline " + std::to_string(streamlines + 1) +
+                                               " (counting from 1) has more than " +
+                                               std::to_string(options.max_points) + " points");
+    }
+
     // Reads the next chunk; false when the data section is exhausted.
     bool refill() {
         if (next_read >= data_end) return false;
@@ -185,6 +193,7 @@ struct TckReader::Impl {
                      " (counting from 1), byte " + std::to_string(file_pos()));
             if (fast) {
                 scan_float32le(out);
+                check_length(out);
                 if (chunk_len - chunk_pos < triplet) continue;  // run reached the end of the chunk
             }
             Vec3f v;
@@ -194,6 +203,7 @@ struct TckReader::Impl {
             switch (k) {
                 case Kind::point:
                     out.push_back(v);
+                    check_length(out);
                     break;
                 case Kind::separator:
                     ++streamlines;

@@ -1,0 +1,191 @@
+// Writes the seed corpora of the fuzz targets (scripts/fuzz.sh runs it):
+//   fiblet_fuzz_seeds SHARED_DATA_DIR OUT_DIR
+// OUT_DIR/tck_reader_fuzz and compress_fuzz: the small shared .tck files
+// (conformance files, valid and invalid, and the real bundles) and hand-made
+// edge files;
+// OUT_DIR/fft_file_fuzz: those compressed, in several layouts, with and
+// without the fiblet trailer; OUT_DIR/decode_blocks_fuzz: their blocks with
+// the parameters header of that target.
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "fiblet/compress.hpp"
+#include "fiblet/error.hpp"
+#include "fiblet/fft_file.hpp"
+#include "fiblet/tck.hpp"
+
+namespace fs = std::filesystem;
+using namespace fiblet;
+
+namespace {
+
+constexpr std::size_t kMaxSeedBytes = 16 << 10;  // scripts/fuzz.sh's -max_len
+
+std::string read_file(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+void write_file(const fs::path& p, const std::string& bytes) {
+    std::ofstream f(p, std::ios::binary | std::ios::trunc);
+    f.write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+template <class T>
+void append_raw(std::string& s, T v, bool big_endian = false) {
+    char b[sizeof v];
+    std::memcpy(b, &v, sizeof v);
+    if (big_endian) std::reverse(b, b + sizeof v);
+    s.append(b, sizeof v);
+}
+
+// A .tck with the given datatype; fibers of xyz triplets; `end` the end marker value.
+std::string make_tck(const std::vector<std::vector<double>>& fibers, const std::string& datatype,
+                     const std::string& extra_header = "", double end = HUGE_VAL) {
+    const bool f64 = datatype.rfind("Float64", 0) == 0, be = datatype.size() > 2 && datatype.substr(datatype.size() - 2) == "BE";
+    std::string data;
+    auto put = [&](double v) {
+        if (f64) append_raw(data, v, be);
+        else append_raw(data, float(v), be);
+    };
+    const double nan = std::nan("");
+    for (const auto& f : fibers) {
+        for (double v : f) put(v);
+        put(nan), put(nan), put(nan);
+    }
+    put(end), put(end), put(end);
+    const std::string head = "mrtrix tracks\n" + extra_header + "datatype: " + datatype + "\nfile: . ";
+    std::size_t offset = head.size() + 5 + 1;
+    while (std::to_string(offset).size() != offset - head.size() - 5) ++offset;
+    return head + std::to_string(offset) + "\nEND\n" + data;
+}
+
+std::vector<double> helix(int points, double step, double x0, double bend) {
+    std::vector<double> f;
+    double x = x0, y = 0, z = 0, a = 0;
+    for (int i = 0; i < points; ++i) {
+        f.insert(f.end(), {x, y, z});
+        a += bend;
+        x += step * std::cos(a) * 0.8, y += step * std::sin(a) * 0.8, z += step * 0.6;
+    }
+    return f;
+}
+
+void hand_made_tck(const fs::path& dir) {
+    const std::vector<std::vector<double>> small = {helix(5, 0.5, 0, 0.1), helix(1, 0.5, 3, 0), helix(70, 0.5, -2, 0.05)};
+    for (const char* dt : {"Float32LE", "Float32BE", "Float64LE", "Float64BE"})
+        write_file(dir / (std::string("edge-small-") + dt + ".tck"), make_tck(small, dt, "count: 3\nstep_size: 0.5\n"));
+    write_file(dir / "edge-empty-fibers.tck", make_tck({{}, helix(3, 0.1, 0, 0), {}, {}}, "Float32LE"));
+    write_file(dir / "edge-single-points.tck", make_tck({{1, 2, 3}, {4, 5, 6}, {1, 2, 3}}, "Float32LE"));
+    write_file(dir / "edge-zero-fibers.tck", make_tck({}, "Float32LE", "count: 0\n"));
+    write_file(dir / "edge-coincident-points.tck", make_tck({{1, 1, 1, 1, 1, 1, 1, 1, 1}, helix(4, 0.1, 0, 0)}, "Float32LE"));
+    write_file(dir / "edge-huge-coordinates.tck",
+               make_tck({{-3e38, 0, 0, 3e38, 0, 0}, {0, -3e38, 1e38, 0, 3e38, -1e38}}, "Float32LE"));
+    write_file(dir / "edge-float64-beyond-float32.tck", make_tck({{0, 0, 0, 1e300, 0, 0}}, "Float64LE"));
+    write_file(dir / "edge-tiny-coordinates.tck", make_tck({{1e-38, 0, 0, 2e-38, 0, 0, 3e-38, 0, 0}}, "Float32LE"));
+    write_file(dir / "edge-variable-step.tck",
+               make_tck({{0, 0, 0, 0.1, 0, 0, 0.5, 0, 0, 0.55, 0, 0, 1.5, 0, 0}, helix(20, 0.3, 1, 0.2)}, "Float32LE",
+                        "step_size: 0.3\n"));
+    write_file(dir / "edge-minus-inf-end.tck", make_tck({helix(4, 0.2, 0, 0.1)}, "Float32LE", "", -HUGE_VAL));
+    write_file(dir / "edge-count-mismatch.tck", make_tck({helix(4, 0.2, 0, 0.1)}, "Float32LE", "count: 7\n"));
+    write_file(dir / "edge-sharp-turns.tck",
+               make_tck({{0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0}}, "Float32LE"));
+    std::string partial_nan = make_tck({{0, 0, 0, 1, 0, 0}}, "Float32LE");
+    const float nan = std::nanf("");
+    std::memcpy(partial_nan.data() + partial_nan.size() - 12 - 12 - 8, &nan, 4);
+    write_file(dir / "edge-partial-nan.tck", partial_nan);
+    std::string crlf = make_tck({helix(3, 0.2, 0, 0)}, "Float32LE", "method: test\r\ncommand_history: a\nb c\n");
+    write_file(dir / "edge-multiline-crlf-header.tck", crlf);
+    const std::string good = make_tck(small, "Float32LE");
+    write_file(dir / "edge-truncated-mid-point.tck", good.substr(0, good.size() - 17));
+}
+
+// Compresses `tck` into `fft` with `options`; false if it fails or is too big.
+bool compress_seed(const fs::path& tck, const fs::path& fft, CompressOptions options) {
+    options.overwrite = true;
+    options.threads = 1;
+    try {
+        compress_tck(tck.string(), fft.string(), options);
+    } catch (const Error&) {
+        return false;
+    }
+    if (fs::file_size(fft) > kMaxSeedBytes) {
+        fs::remove(fft);
+        return false;
+    }
+    return true;
+}
+
+// The decode_blocks_fuzz input closest to a file's parameters (see fuzz_targets.hpp).
+std::string blocks_seed(const fs::path& fft) {
+    const FftFile f(fft.string(), {.verify_checksums = false});
+    const FftHeader& h = f.header();
+    auto u16 = [](double v) { return std::uint16_t(std::clamp(std::lround(v), 0l, 65535l)); };
+    std::string s;
+    s += char(h.points_per_block - 2);
+    append_raw(s, u16(h.ratio * 32768.0 - 1));
+    append_raw(s, u16(h.step * 65536.0));
+    append_raw(s, u16((std::log2(h.scaling) + 20.0) / 40.0 * 65536.0));
+    for (float o : h.offset)
+        append_raw(s, std::int16_t(std::clamp(std::lround(o / h.scaling * 1000.0), -32768l, 32767l)));
+    const auto blocks = f.read_blocks(0, h.blocks);
+    s.append(reinterpret_cast<const char*>(blocks.data()), std::min(blocks.size(), kMaxSeedBytes));
+    return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc != 3) {
+        std::fprintf(stderr, "usage: %s SHARED_DATA_DIR OUT_DIR\n", argv[0]);
+        return 2;
+    }
+    const fs::path shared = argv[1], out = argv[2];
+    const fs::path tck_dir = out / "tck_reader_fuzz", compress_dir = out / "compress_fuzz", fft_dir = out / "fft_file_fuzz", blocks_dir = out / "decode_blocks_fuzz";
+    for (const auto& d : {tck_dir, compress_dir, fft_dir, blocks_dir}) fs::create_directories(d);
+
+    // Small shared files: every conformance .tck, the original-resolution bundles.
+    if (fs::is_directory(shared)) {
+        for (const auto& e : fs::directory_iterator(shared / "conformance"))
+            if (e.path().extension() == ".tck") fs::copy_file(e.path(), tck_dir / ("shared-" + e.path().filename().string()), fs::copy_options::overwrite_existing);
+        for (const char* b : {"AF_L", "CC_ForcepsMajor", "CST_R", "cingulum-1", "cingulum-2"})
+            fs::copy_file(shared / "bundles" / (std::string(b) + ".tck"), tck_dir / ("shared-" + std::string(b) + ".tck"),
+                          fs::copy_options::overwrite_existing);
+    } else {
+        std::fprintf(stderr, "fiblet_fuzz_seeds: no shared data at %s: hand-made seeds only\n", shared.c_str());
+    }
+    hand_made_tck(tck_dir);
+
+    // .fft seeds: each .tck that compresses, with the default layout and
+    // the extreme block sizes; the first also cut after its blocks (a file
+    // without the fiblet trailer, as the official encoder writes).
+    int n_fft = 0;
+    for (const auto& e : fs::directory_iterator(tck_dir)) {
+        const std::string stem = e.path().stem().string();
+        for (std::uint32_t ppb : {60u, 2u, 63u}) {
+            const fs::path fft = fft_dir / (stem + "-ppb" + std::to_string(ppb) + ".fft");
+            CompressOptions options;
+            options.points_per_block = ppb;
+            if (!compress_seed(e.path(), fft, options)) continue;
+            ++n_fft;
+            if (ppb == 60) {
+                const std::string bytes = read_file(fft);
+                const FftFile f(fft.string());
+                write_file(fft_dir / (stem + "-no-trailer.fft"), bytes.substr(0, f.header().file_bytes()));
+                write_file(blocks_dir / (stem + ".blocks"), blocks_seed(fft));
+            }
+        }
+    }
+    fs::copy(tck_dir, compress_dir, fs::copy_options::overwrite_existing | fs::copy_options::recursive);
+    std::printf("fiblet_fuzz_seeds: %zu .tck, %d .fft seeds in %s\n",
+                std::size_t(std::distance(fs::directory_iterator(tck_dir), fs::directory_iterator())), n_fft,
+                out.c_str());
+    return 0;
+}

@@ -1,0 +1,95 @@
+// The fuzz targets (fuzz/fuzz_targets.hpp) run in the normal test suite, with
+// any compiler: on every input that once broke them (fuzz/regressions/TARGET/)
+// and on small shared and hand-damaged files, so their invariants (results
+// independent of chunk sizes and decoders, compress output that reads back,
+// only fiblet::Error on bad input) are checked on every build.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "../fuzz/fuzz_targets.hpp"
+#include "test_util.hpp"
+
+using namespace fiblet;
+namespace fs = std::filesystem;
+
+namespace {
+
+using Target = void (*)(const std::uint8_t*, std::size_t);
+
+void run(Target target, const std::string& bytes, const std::string& name) {
+    try {
+        target(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
+    } catch (const fuzz::HarnessFailure& e) {
+        ADD_FAILURE() << name << ": invariant broken: " << e.what();
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << name << ": unexpected exception: " << e.what();
+    }
+}
+
+// Every file of fuzz/regressions/TARGET; the number replayed.
+int replay_regressions(const std::string& target_name, Target target) {
+    const fs::path dir = fs::path(FIBLET_TESTS_DIR) / ".." / "fuzz" / "regressions" / target_name;
+    int n = 0;
+    if (!fs::is_directory(dir)) return 0;
+    for (const auto& e : fs::directory_iterator(dir)) {
+        if (!e.is_regular_file() || e.path().extension() == ".md") continue;
+        run(target, test::read_file(e.path().string()), e.path().string());
+        ++n;
+    }
+    return n;
+}
+
+std::vector<std::string> small_shared_tck() {
+    std::vector<std::string> files;
+    if (!test::shared_data_available()) return files;
+    for (const auto& e : fs::directory_iterator(test::shared_data("conformance")))
+        if (e.path().extension() == ".tck") files.push_back(e.path().string());
+    files.push_back(test::shared_data("bundles/AF_L.tck"));
+    files.push_back(test::shared_data("bundles/cingulum-1.tck"));
+    return files;
+}
+
+}  // namespace
+
+TEST(FuzzRegression, TckTargets) {
+    const int n = replay_regressions("tck_reader_fuzz", fuzz::tck_target) +
+                  replay_regressions("compress_fuzz", fuzz::compress_target);
+    for (const std::string& f : small_shared_tck()) {
+        const std::string bytes = test::read_file(f);
+        run(fuzz::tck_target, bytes, f);
+        run(fuzz::compress_target, bytes, f);
+        // Truncated anywhere: the same invariants.
+        for (std::size_t cut : {bytes.size() / 3, bytes.size() - 1, bytes.size() - 13})
+            if (cut < bytes.size()) run(fuzz::tck_target, bytes.substr(0, cut), f + " (cut)");
+    }
+    RecordProperty("regressions", n);
+}
+
+TEST(FuzzRegression, FftTargets) {
+    int n = replay_regressions("fft_file_fuzz", fuzz::fft_target) +
+            replay_regressions("decode_blocks_fuzz", fuzz::blocks_target);
+    if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
+    test::TempDir dir;
+    compress_tck(test::shared_data("bundles/AF_L.tck"), dir.file("a.fft"), {});
+    const std::string good = test::read_file(dir.file("a.fft"));
+    run(fuzz::fft_target, good, "AF_L.fft");
+    // Every 97th byte flipped in turn: checksum failures, malformed blocks,
+    // broken headers and LUT entries, each through every decoder.
+    for (std::size_t i = 0; i < good.size(); i += 97) {
+        std::string bad = good;
+        bad[i] = char(bad[i] ^ (1 << (i % 8)));
+        run(fuzz::fft_target, bad, "AF_L.fft with byte " + std::to_string(i) + " flipped");
+    }
+    // The blocks target on the file's blocks, under a few parameter headers.
+    const FftFile f(dir.file("a.fft"));
+    const std::vector<std::uint8_t> blocks = f.read_blocks(0, f.header().blocks);
+    for (const char* params : {"\x3a\xff\x0f\x00\x10\x00\xa0\x00\x00\x00\x00\x00\x00", "\x00\x01\x00\xff\xff\xff\xff\x10\x80\x10\x80\x10\x80"}) {
+        std::string in(params, fuzz::kBlocksInputHeader);
+        in.append(reinterpret_cast<const char*>(blocks.data()), blocks.size());
+        run(fuzz::blocks_target, in, "blocks");
+    }
+    RecordProperty("regressions", n);
+}
