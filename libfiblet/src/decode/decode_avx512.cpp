@@ -7,6 +7,7 @@
 // GCC 12 warns about the deliberately undefined source of its own
 // AVX-512 intrinsics (_mm512_undefined_*) in every inlined use.
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wuninitialized"
 #include <immintrin.h>
 
 #include <algorithm>
