@@ -90,7 +90,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     CompressReport report;
     TckScan& scan = report.scan;
     // The longest streamline a file can hold bounds the one in memory too.
-    const std::size_t max_fiber_points = std::size_t{0xffff} * options.points_per_block;
+    const std::size_t max_fiber_points = std::size_t{0xffff} * points_per_block;
     TckReader reader(tck_path, {.allow_count_mismatch = options.allow_count_mismatch, .max_points = max_fiber_points});
     scan.header_step = reader.header().step_size();
 
