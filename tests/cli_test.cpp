@@ -76,6 +76,18 @@ TEST(Cli, CompressDecompressStatsInfo) {
     EXPECT_EQ(back.header().get("method"), std::optional<std::string>("SDStream"));
     EXPECT_EQ(back.header().count(), std::optional<std::uint64_t>(1000));
 
+    // MRtrix3 itself reads the decoded file, with the source's properties.
+    if (std::system("command -v tckinfo >/dev/null 2>&1") == 0) {
+        FILE* p = ::popen(("tckinfo " + dir.file("b.tck") + " 2>&1").c_str(), "r");
+        std::string info;
+        std::array<char, 4096> buf{};
+        while (std::size_t k = std::fread(buf.data(), 1, buf.size(), p)) info.append(buf.data(), k);
+        EXPECT_EQ(::pclose(p), 0) << info;
+        EXPECT_NE(info.find("count:                0000001000"), std::string::npos) << info;
+        EXPECT_NE(info.find("SDStream"), std::string::npos) << info;
+        EXPECT_NE(info.find("step_size:            0.1"), std::string::npos) << info;
+    }
+
     EXPECT_EQ(cli("info " + dir.file("a.fft")).code, 0);
     r = cli("info " + in + " --json");
     EXPECT_EQ(r.code, 0);

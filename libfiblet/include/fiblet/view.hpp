@@ -45,6 +45,16 @@ Frustum frustum_from_camera(const Camera& c);
 // Conservative: false only when the sphere lies entirely outside one plane.
 bool sphere_intersects_frustum(const Frustum& f, Vec3f center, float radius);
 
+// Axis-aligned box in world mm (min <= max on each axis).
+struct Aabb {
+    Vec3f min, max;
+};
+
+// Conservative: false only when the box, grown by `margin` mm in every
+// direction, lies entirely outside one plane. With margin = r it is true for
+// every sphere of radius <= r centred in the box that meets the frustum.
+bool box_intersects_frustum(const Frustum& f, const Aabb& box, float margin = 0);
+
 // Radius in pixels of a sphere's projection (vertical), measured at its
 // centre's depth; +infinity when the sphere reaches the camera plane.
 float projected_radius_px(const Camera& c, const Viewport& v, Vec3f center, float radius);
@@ -68,5 +78,8 @@ struct Sphere {
     float radius;
 };
 Sphere block_bounding_sphere(const FftHeader& h, const std::uint8_t* block);
+// The same sphere from the block's first two decoded points (world mm) and
+// its point count, for code that holds decoded points rather than bytes.
+Sphere block_bounding_sphere(const FftHeader& h, Vec3f first, Vec3f second, std::uint32_t points);
 
 }  // namespace fiblet

@@ -39,8 +39,8 @@ FftHeader parse_fft_header(std::span<const std::uint8_t> b, std::uint64_t file_s
     FftHeader h;
     const std::uint8_t* p = b.data();
     h.version = p[0];
-    if (h.version != kFftVersion)
-        bad(name, "unsupported version " + std::to_string(h.version) + " (fiblet reads version 2)");
+    if (h.version != kFftVersion && h.version != kFft16Version)
+        bad(name, "unsupported version " + std::to_string(h.version) + " (fiblet reads versions 2 and 16)");
     h.fibers = get_le<std::uint64_t>(p + 1);
     h.points = get_le<std::uint64_t>(p + 9);
     h.blocks = get_le<std::uint32_t>(p + 17);
@@ -53,13 +53,15 @@ FftHeader parse_fft_header(std::span<const std::uint8_t> b, std::uint64_t file_s
     h.mean_error_mm = get_le<float>(p + 53);
     const unsigned buffers = p[57];
 
-    if (h.points_per_block < 2 || h.points_per_block > kMaxPointsPerBlock)
-        bad(name, "points per block " + std::to_string(h.points_per_block) + " outside [2, 63]");
+    if (h.points_per_block < 2 || h.points_per_block > h.max_points_per_block())
+        bad(name, "points per block " + std::to_string(h.points_per_block) + " outside [2, " +
+                      std::to_string(h.max_points_per_block()) + "]");
     if (!(std::isfinite(h.scaling) && h.scaling > 0)) bad(name, "scaling is not a positive finite number");
     for (float o : h.offset)
         if (!std::isfinite(o)) bad(name, "offset is not finite");
     if (!(std::isfinite(h.ratio) && h.ratio > 0 && h.ratio <= 2)) bad(name, "ratio outside (0, 2]");
-    if (!(std::isfinite(h.step) && h.step >= 0 && h.step < 1)) bad(name, "step outside [0, 1)");
+    // A step may exceed the box (two points on its diagonal are sqrt(3) apart), never by much.
+    if (!(std::isfinite(h.step) && h.step >= 0 && h.step <= 16)) bad(name, "step outside [0, 16]");
     // Counts are checked against the file size before anything is allocated.
     const std::uint64_t fixed = kFftFixedHeaderBytes + 8ull * buffers;
     if (b.size() < fixed) bad(name, "truncated buffer table");
@@ -280,8 +282,8 @@ void FftFile::check_block_structure(std::uint64_t first, std::uint64_t count, co
     std::uint64_t k = first - fiber_first_block_[f];
     for (std::uint64_t b = 0; b < count; ++b, ++k) {
         while (k >= lut_[f].block_count()) ++f, k = 0;
-        const BlockView v{blocks + b * bb};
-        const std::uint32_t n = v.point_count(), blocks_in_fiber = lut_[f].block_count();
+        const BlockFlags v = block_flags(header_, blocks + b * bb);
+        const std::uint32_t n = v.point_count, blocks_in_fiber = lut_[f].block_count();
         const auto where = [&] {
             return "block " + std::to_string(first + b) + " (block " + std::to_string(k) + " of " +
                    std::to_string(blocks_in_fiber) + " of fiber " + std::to_string(f) + ")";
@@ -289,7 +291,7 @@ void FftFile::check_block_structure(std::uint64_t first, std::uint64_t count, co
         if (n == 0 || n > header_.points_per_block)
             bad(path_, where() + " holds " + std::to_string(n) + " points (allowed 1.." +
                            std::to_string(header_.points_per_block) + ")");
-        if (v.is_first() != (k == 0) || v.is_last() != (k + 1 == blocks_in_fiber))
+        if (v.first != (k == 0) || v.last != (k + 1 == blocks_in_fiber))
             bad(path_, where() + " has first/last flags inconsistent with the fiber LUT");
     }
 }

@@ -69,6 +69,16 @@ bool sphere_intersects_frustum(const Frustum& f, Vec3f center, float radius) {
     return true;
 }
 
+bool box_intersects_frustum(const Frustum& f, const Aabb& box, float margin) {
+    for (const Plane& p : f.planes) {
+        // The box corner farthest along the plane's inward normal.
+        const Vec3f c{p.n.x >= 0 ? box.max.x : box.min.x, p.n.y >= 0 ? box.max.y : box.min.y,
+                      p.n.z >= 0 ? box.max.z : box.min.z};
+        if (dot(p.n, c) + p.d < -margin) return false;
+    }
+    return true;
+}
+
 float projected_radius_px(const Camera& c, const Viewport& v, Vec3f center, float radius) {
     const Basis b = camera_basis(c);
     const float depth = -dot(b.back, center - c.position);  // distance along the view direction
@@ -80,8 +90,10 @@ float projected_radius_px(const Camera& c, const Viewport& v, Vec3f center, floa
 Sphere block_bounding_sphere(const FftHeader& h, const std::uint8_t* bytes) {
     const BlockView block{bytes};
     const auto a = block.anchors_normalized();
-    const Vec3f a0 = h.to_world(a[0], a[1], a[2]), a1 = h.to_world(a[3], a[4], a[5]);
-    const std::uint32_t n = block.point_count();
+    return block_bounding_sphere(h, h.to_world(a[0], a[1], a[2]), h.to_world(a[3], a[4], a[5]), block.point_count());
+}
+
+Sphere block_bounding_sphere(const FftHeader& h, Vec3f a0, Vec3f a1, std::uint32_t n) {
     if (n < 2) return {a0, 0.0f};
     const float r = norm(a1 - a0) + float(n - 2) * h.step * h.scaling;
     return {a0, r * (1 + 1e-5f) + 1e-5f * h.scaling};

@@ -1,0 +1,228 @@
+// fiblet extract IN.fft -o OUT.tck|OUT.fft [criteria] — selective decoding.
+#include <fmt/core.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <optional>
+#include <sstream>
+
+#include "cli_common.hpp"
+#include "fiblet/block_index.hpp"
+#include "fiblet/fft_file.hpp"
+#include "fiblet/fft_subset.hpp"
+#include "fiblet/select.hpp"
+#include "fiblet/tck.hpp"
+
+namespace fiblet::cli {
+namespace {
+
+struct ExtractArgs {
+    std::string input, output;
+    std::string fibers;
+    std::optional<double> min_length, max_length, random_fraction;
+    std::uint64_t seed = 0;
+    std::vector<std::string> include, exclude;
+    std::string mode = "fibers";
+    std::string camera_position, camera_target, camera_up = "0,1,0", lod;
+    float fov = 45, aspect = 16.0f / 9.0f, near_mm = 1, far_mm = 2000, lod_pixels = kDefaultLodPixels;
+    bool no_cull = false, compute_index = false, force = false, quiet = false, json = false;
+};
+
+[[noreturn]] void usage(const std::string& what) { throw Error(Errc::invalid_argument, what); }
+
+std::vector<double> numbers(const std::string& option, const std::string& text) {
+    std::vector<double> v;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        std::size_t used = 0;
+        double x = 0;
+        try {
+            x = std::stod(item, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used == 0 || used != item.size() || !std::isfinite(x))
+            usage(option + ": '" + item + "' is not a number (expected comma-separated numbers)");
+        v.push_back(x);
+    }
+    return v;
+}
+
+Vec3f vec3(const std::string& option, const std::string& text) {
+    const auto v = numbers(option, text);
+    if (v.size() != 3) usage(option + " takes x,y,z");
+    return {float(v[0]), float(v[1]), float(v[2])};
+}
+
+// x,y,z,r: a sphere (as tckedit); x0,y0,z0,x1,y1,z1: a box.
+Region region(const std::string& option, const std::string& text) {
+    const auto v = numbers(option, text);
+    if (v.size() == 4) return Region::sphere({float(v[0]), float(v[1]), float(v[2])}, float(v[3]));
+    if (v.size() == 6) {
+        const Vec3f a{float(v[0]), float(v[1]), float(v[2])}, b{float(v[3]), float(v[4]), float(v[5])};
+        return Region::box_between({std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)},
+                                   {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)});
+    }
+    usage(option + " takes x,y,z,radius (sphere) or x0,y0,z0,x1,y1,z1 (box)");
+}
+
+// "0,5,10-20": IDs and inclusive ranges.
+std::vector<FiberRange> fiber_ranges(const std::string& text) {
+    std::vector<FiberRange> out;
+    std::stringstream ss(text);
+    std::string item;
+    auto id = [&](const std::string& s) {
+        if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos)
+            usage("--fibers: '" + item + "' is not an ID or a range FIRST-LAST");
+        try {
+            return std::uint64_t(std::stoull(s));
+        } catch (const std::exception&) {
+            usage("--fibers: '" + item + "' is out of range");
+        }
+    };
+    while (std::getline(ss, item, ',')) {
+        const auto dash = item.find('-');
+        if (dash == std::string::npos) {
+            const std::uint64_t f = id(item);
+            out.push_back({f, f});
+        } else {
+            out.push_back({id(item.substr(0, dash)), id(item.substr(dash + 1))});
+        }
+    }
+    if (out.empty()) usage("--fibers: empty list");
+    return out;
+}
+
+Query build_query(const ExtractArgs& a) {
+    Query q;
+    if (!a.fibers.empty()) q.fibers = fiber_ranges(a.fibers);
+    q.min_length_mm = a.min_length;
+    q.max_length_mm = a.max_length;
+    q.random_fraction = a.random_fraction;
+    q.random_seed = a.seed;
+    for (const auto& s : a.include) q.include.push_back(region("--include", s));
+    for (const auto& s : a.exclude) q.exclude.push_back(region("--exclude", s));
+    q.roi_mode = a.mode == "blocks" ? RoiMode::blocks : RoiMode::fibers;
+    if (a.camera_position.empty() != a.camera_target.empty())
+        usage("--camera-position and --camera-target go together");
+    if (!a.camera_position.empty()) {
+        ViewSelection v;
+        v.camera.position = vec3("--camera-position", a.camera_position);
+        v.camera.target = vec3("--camera-target", a.camera_target);
+        v.camera.up = vec3("--camera-up", a.camera_up);
+        v.camera.fov_y_deg = a.fov, v.camera.aspect = a.aspect, v.camera.near_mm = a.near_mm, v.camera.far_mm = a.far_mm;
+        v.cull = !a.no_cull;
+        if (!a.lod.empty()) {
+            const auto x = a.lod.find('x');
+            const auto w = x == std::string::npos ? std::vector<double>{} : numbers("--lod", a.lod.substr(0, x));
+            const auto h = x == std::string::npos ? std::vector<double>{} : numbers("--lod", a.lod.substr(x + 1));
+            if (w.size() != 1 || h.size() != 1 || !(w[0] >= 1 && h[0] >= 1 && w[0] < 1e6 && h[0] < 1e6))
+                usage("--lod takes the viewport size as WIDTHxHEIGHT pixels, e.g. 1920x1080");
+            v.lod = Viewport{int(w[0]), int(h[0])};
+            v.lod_pixels = a.lod_pixels;
+        }
+        q.view = v;
+    } else if (!a.lod.empty() || a.no_cull) {
+        usage("--lod and --no-cull need a camera (--camera-position, --camera-target)");
+    }
+    return q;
+}
+
+void run(const ExtractArgs& a) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::string ext = std::filesystem::path(a.output).extension().string();
+    if (ext != ".tck" && ext != ".fft") usage("-o: the output must be a .tck or a .fft file");
+    const Query query = build_query(a);
+    if (ext == ".fft" && query.has_level_of_detail())
+        usage("--lod produces segments that a .fft file cannot hold: write a .tck");
+    const FftFile file(a.input);
+    const FftHeader& h = file.header();
+    const auto t_open = std::chrono::steady_clock::now();
+    const BlockIndex index = a.compute_index ? BlockIndex::compute(file) : BlockIndex::load(file);
+    const auto t_index = std::chrono::steady_clock::now();
+
+    SelectionStats stats;
+    std::uint64_t bytes = 0;
+    if (ext == ".tck") {
+        TckHeader header;
+        header.properties = file.properties();
+        header.set("step_size", fmt::format("{:.9g}", double(h.step) * double(h.scaling)));
+        TckWriter writer(a.output, header.properties, a.force);
+        Progress progress(a.quiet || a.json);
+        stats = select(file, index, query, [&](const SelectedChunk& chunk) {
+            for (std::size_t i = 0; i < chunk.lines.size(); ++i)
+                writer.write(&chunk.lines.xyz[3 * chunk.lines.offsets[i]],
+                             chunk.lines.offsets[i + 1] - chunk.lines.offsets[i]);
+            if (!chunk.runs.empty() && h.fibers)
+                progress.update("extract", double(chunk.runs.back().fiber + 1) / double(h.fibers));
+        });
+        writer.finish();
+        progress.done();
+        bytes = std::filesystem::file_size(a.output);
+    } else {
+        const auto runs = select_runs(file, index, query, &stats);
+        bytes = write_fft_subset(file, runs, a.output, a.force).bytes;
+    }
+    const auto t1 = std::chrono::steady_clock::now();
+    auto secs = [](auto from, auto to) { return std::chrono::duration<double>(to - from).count(); };
+    const char* source = index.source() == BlockIndex::Source::chunk ? "stored" : "computed";
+    if (a.json) {
+        Json j;
+        j.str("input", a.input).str("output", a.output).str("index", source);
+        j.integer("fibers", stats.fibers).integer("streamlines", stats.runs).integer("blocks", stats.blocks);
+        j.integer("coarse_blocks", stats.coarse_blocks).integer("points", stats.points);
+        j.integer("source_blocks", h.blocks).integer("blocks_read", stats.blocks_read);
+        j.integer("blocks_decoded", stats.blocks_decoded).integer("output_bytes", bytes);
+        j.num("index_seconds", secs(t_open, t_index)).num("select_seconds", secs(t_index, t1));
+        j.num("seconds", secs(t0, t1));
+        fmt::print("{}\n", j.render());
+    } else if (!a.quiet) {
+        fmt::print("{} -> {}: {} of {} fibers as {} streamlines, {} points\n", a.input, a.output, stats.fibers,
+                   h.fibers, stats.runs, stats.points);
+        fmt::print("  blocks kept {} of {} ({:.2f}%){}, read {}, decoded {}\n", stats.blocks, h.blocks,
+                   h.blocks ? 100.0 * double(stats.blocks) / double(h.blocks) : 0.0,
+                   stats.coarse_blocks ? fmt::format(" ({} as one segment)", stats.coarse_blocks) : "",
+                   stats.blocks_read, stats.blocks_decoded);
+        fmt::print("  index {} in {:.3f} s, selection {:.3f} s, total {:.3f} s\n", source, secs(t_open, t_index),
+                   secs(t_index, t1), secs(t0, t1));
+    }
+}
+
+}  // namespace
+
+void add_extract(CLI::App& app) {
+    auto args = std::make_shared<ExtractArgs>();
+    CLI::App* cmd = app.add_subcommand(
+        "extract", "Decode only part of a .fft file: fiber subset, regions of interest, view frustum, level of detail");
+    cmd->add_option("input", args->input, "Input .fft file")->required()->check(CLI::ExistingFile);
+    cmd->add_option("-o,--output", args->output, "Output .tck (points) or .fft (a subset file)")->required();
+    cmd->add_option("--fibers", args->fibers, "Fiber IDs and inclusive ranges, e.g. 0,5,10-20 (0-based)");
+    cmd->add_option("--minlength", args->min_length, "Keep fibers at least this long (mm), as tckedit");
+    cmd->add_option("--maxlength", args->max_length, "Keep fibers at most this long (mm), as tckedit");
+    cmd->add_option("--random-fraction", args->random_fraction, "Keep this fraction of the fibers, at random");
+    cmd->add_option("--seed", args->seed, "Seed of --random-fraction (default 0)");
+    cmd->add_option("--include", args->include,
+                    "Include region: x,y,z,radius (sphere) or x0,y0,z0,x1,y1,z1 (box); repeatable");
+    cmd->add_option("--exclude", args->exclude, "Exclude region, same forms; repeatable");
+    cmd->add_option("--mode", args->mode, "fibers: keep whole fibers (tckedit); blocks: keep the blocks in the regions")
+        ->check(CLI::IsMember({"fibers", "blocks"}));
+    cmd->add_option("--camera-position", args->camera_position, "Camera position x,y,z (mm): frustum culling");
+    cmd->add_option("--camera-target", args->camera_target, "Point the camera looks at, x,y,z (mm)");
+    cmd->add_option("--camera-up", args->camera_up, "Camera up vector x,y,z (default 0,1,0)");
+    cmd->add_option("--fov", args->fov, "Vertical field of view in degrees (default 45)");
+    cmd->add_option("--aspect", args->aspect, "Viewport width / height (default 16/9)");
+    cmd->add_option("--near", args->near_mm, "Near clip distance in mm (default 1)");
+    cmd->add_option("--far", args->far_mm, "Far clip distance in mm (default 2000)");
+    cmd->add_flag("--no-cull", args->no_cull, "Keep blocks outside the frustum (with --lod)");
+    cmd->add_option("--lod", args->lod, "Level of detail for a viewport WIDTHxHEIGHT (pixels): .tck output only");
+    cmd->add_option("--lod-pixels", args->lod_pixels, "Blocks under this many pixels become one segment (default 4)");
+    cmd->add_flag("--compute-index", args->compute_index, "Compute the block index by decoding, ignoring a stored one");
+    cmd->add_flag("-f,--force", args->force, "Overwrite an existing output");
+    cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
+    cmd->add_flag("--json", args->json, "Print the summary as JSON");
+    cmd->callback([args] { run(*args); });
+}
+
+}  // namespace fiblet::cli

@@ -1,0 +1,33 @@
+// What both GPU decoders share: the inputs of a decode pass, and the first
+// frame of a block, computed as the CPU does (block_geometry.hpp,
+// direction_code.hpp).
+
+// fiblet::DirectionTable: frame k's columns (axis first), std140 mat3.
+layout(std140, binding = BINDING_LOCAL_FRAMES) uniform LocalFrames { mat3 localFrames[256]; };
+layout(std430, binding = BINDING_FINE_LIST) readonly buffer FineList { uint fineList[]; };
+layout(std430, binding = BINDING_POINTS) writeonly buffer Points { vec4 points[]; };
+layout(std430, binding = BINDING_FIBER_ENDS) writeonly buffer FiberEnds { vec4 fiberEnds[]; };
+
+uniform bool uUseList;  // blocks fineList[uFirst + slot], else blocks uFirst + slot
+uniform uint uFirst;
+uniform uint uCount;    // blocks in this pass
+uniform bool uEndsOnly; // last blocks of fibers: write only their last point to fiberEnds[fiber]
+
+// kFrameHelper of direction_code.hpp.
+const vec3 kHelper = vec3(-0.703023156622, 0.039959276793, 0.71004344758);
+
+// fiblet::frame_from_axis.
+mat3 frameFromAxis(vec3 axis) {
+    vec3 c1 = cross(axis, kHelper);
+    if (dot(c1, c1) < 1e-6) c1 = cross(axis, vec3(0.0, kHelper.z, -kHelper.y));
+    c1 = normalize(c1);
+    vec3 c2 = normalize(cross(axis, c1));
+    return mat3(axis, c1, c2);
+}
+
+// The first axis; coinciding anchors fall back to +x (block_geometry.hpp).
+vec3 anchorAxis(vec3 a0, vec3 a1) {
+    vec3 d = a1 - a0;
+    float n2 = dot(d, d);
+    return n2 > 0.0 ? (1.0 / sqrt(n2)) * d : vec3(1.0, 0.0, 0.0);
+}

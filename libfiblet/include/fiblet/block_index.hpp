@@ -1,0 +1,121 @@
+// fiblet — the block index: a bounding box for every block and a bounding
+// volume hierarchy over them, so that a query finds the blocks near a region
+// without reading (let alone decoding) the others.
+//
+// On disk it is the optional "BIDX" trailer chunk (formats/fft-index.md):
+// one quantized box per block in 28 bits plus one byte per fiber, about
+// 3.6 bytes per 76-byte block. Files without it (e.g. from the official
+// encoder) get the same index computed on load by decoding every block once.
+// The hierarchy is never stored: it is rebuilt in memory on load (storing
+// block ids would cost more than the boxes).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "fiblet/fft_file.hpp"
+#include "fiblet/fft_format.hpp"
+#include "fiblet/view.hpp"
+
+namespace fiblet {
+
+inline constexpr std::array<char, 4> kBlockIndexTag = {'B', 'I', 'D', 'X'};
+inline constexpr unsigned kDefaultIndexBitsPerBlock = 28;
+
+// Accumulates the bounds of blocks as they are written (compress, extract)
+// and serializes them as a BIDX chunk. Blocks come in file order, a fiber at
+// a time; builders filled in parallel on consecutive fibers are joined in
+// order with append(). Memory: 4 bytes per block.
+class IndexBuilder {
+public:
+    IndexBuilder() = default;  // unusable until assigned from a header-built one
+    explicit IndexBuilder(const FftHeader& header, unsigned bits_per_block = kDefaultIndexBitsPerBlock);
+
+    // The decoded points (world mm) of one whole fiber laid out as the
+    // encoder does: blocks of points_per_block points, the last one the rest.
+    void add_fiber(std::span<const Vec3f> decoded);
+    // One block: its decoded points (n xyz triplets, world mm) and whether it
+    // ends its fiber.
+    void add_block(const float* xyz, std::uint32_t n, bool last_of_fiber);
+    void append(const IndexBuilder& later);
+    void clear();
+
+    std::uint64_t blocks() const { return codes_.size(); }
+    std::uint64_t fibers() const { return last_points_.size(); }
+    // Blocks too large for the grid, stored as "unbounded" (never culled).
+    std::uint64_t unbounded_blocks() const { return unbounded_; }
+
+    // The BIDX chunk, or nullopt when the layout cannot be described: a
+    // block other than the last of its fiber holds fewer than
+    // points_per_block points (never the case for files fiblet writes).
+    std::optional<TrailerChunk> finish() const;
+
+private:
+    struct Grid {
+        Vec3f origin{};
+        float cell = 1;
+        std::uint32_t min_levels = 1, extent_levels = 1;
+    };
+    void add_box(const Aabb& box, std::uint32_t n, bool last_of_fiber, float sphere_radius);
+
+    FftHeader header_;
+    unsigned bits_ = kDefaultIndexBitsPerBlock;
+    Grid grid_;
+    std::vector<std::uint32_t> codes_;
+    std::vector<std::uint8_t> last_points_;
+    std::uint32_t open_fiber_blocks_ = 0;  // blocks of the fiber being added
+    bool layout_ok_ = true;
+    std::uint64_t unbounded_ = 0;
+    float max_sphere_radius_ = 0;
+};
+
+// The index of one file, in memory: per-block boxes, per-fiber point
+// counts, and a bounding volume hierarchy (8-wide, over blocks sorted along
+// a Morton curve) to find the blocks that meet a region.
+class BlockIndex {
+public:
+    enum class Source { chunk, decoded };
+
+    // The file's BIDX chunk when it has one, else computed by decoding every
+    // block. Throws Error{fft_format} on a malformed chunk.
+    static BlockIndex load(const FftFile& file);
+    // Always computed by decoding (exact boxes), ignoring any chunk.
+    static BlockIndex compute(const FftFile& file);
+
+    Source source() const { return source_; }
+    std::uint64_t blocks() const { return rank_.size(); }
+    std::uint64_t fibers() const { return fiber_points_.size(); }
+    std::uint64_t fiber_points(std::uint64_t fiber) const { return fiber_points_[fiber]; }
+    // Bounds of every point a block decodes to (conservative; escaped blocks
+    // have an unbounded box).
+    Aabb block_box(std::uint64_t block) const { return sorted_boxes_[rank_[block]]; }
+    // Every block's view sphere (view.hpp) has a radius at most this.
+    float max_sphere_radius() const { return max_sphere_radius_; }
+
+    // Blocks whose box may meet a sphere / a box / the frustum grown by
+    // `margin`: a bitmap of blocks() bits, ORed into `bits` (resized as
+    // needed). Conservative: a block with a point in the region is always
+    // set.
+    void blocks_near_sphere(Vec3f center, float radius, std::vector<std::uint64_t>& bits) const;
+    void blocks_near_box(const Aabb& box, std::vector<std::uint64_t>& bits) const;
+    void blocks_near_frustum(const Frustum& frustum, float margin, std::vector<std::uint64_t>& bits) const;
+
+private:
+    BlockIndex() = default;
+    void set_blocks(std::vector<Aabb> boxes);  // sorts and builds the hierarchy
+    template <class Classify>
+    void collect(const Classify& classify, std::vector<std::uint64_t>& bits) const;
+
+    Source source_ = Source::decoded;
+    std::vector<std::uint64_t> fiber_points_;
+    float max_sphere_radius_ = 0;
+    std::vector<Aabb> sorted_boxes_;             // in Morton order
+    std::vector<std::uint32_t> order_;           // Morton position -> block
+    std::vector<std::uint32_t> rank_;            // block -> Morton position
+    std::vector<std::vector<Aabb>> levels_;      // levels_[k][j]: node j of level k (k = 0: leaves)
+};
+
+}  // namespace fiblet

@@ -1,0 +1,95 @@
+#include "fiblet/fft_subset.hpp"
+
+#include <limits>
+#include <string>
+
+#include "fiblet/block_index.hpp"
+#include "fiblet/decode.hpp"
+#include "fiblet/error.hpp"
+#include "fiblet/output_file.hpp"
+#include "select/block_decoder.hpp"
+
+namespace fiblet {
+
+SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedRun>& runs, const std::string& path,
+                              bool overwrite) {
+    const FftHeader& src = source.header();
+    if (runs.size() > std::numeric_limits<std::uint32_t>::max())
+        throw Error(Errc::unsupported, path + ": more than 2^32 - 1 fibers (fiber IDs are 32-bit)");
+
+    // Header and LUT first: the same buffer split as the encoder makes.
+    FftHeader h = src;
+    h.fibers = runs.size();
+    h.points = 0;
+    h.buffer_ends.clear();
+    std::vector<FiberLutEntry> lut(runs.size());
+    const std::uint64_t per_buffer = fft_max_blocks_per_buffer(h.block_bytes());
+    std::uint64_t blocks = 0, in_buffer = 0;
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+        const SelectedRun& r = runs[i];
+        if (r.coarse_blocks > 0)
+            throw Error(Errc::invalid_argument, "a level of detail (coarse blocks) cannot be stored in a .fft file");
+        if (r.fiber >= src.fibers || r.block_count == 0 || r.block_count > 0xffff ||
+            r.first_block < source.first_block(r.fiber) ||
+            r.first_block + r.block_count > source.first_block(r.fiber) + source.block_count(r.fiber))
+            throw Error(Errc::invalid_argument, "run " + std::to_string(i) + " is not a block range of its fiber");
+        if (in_buffer + r.block_count > per_buffer) h.buffer_ends.push_back(blocks), in_buffer = 0;
+        if (h.buffer_ends.size() > 254) throw Error(Errc::unsupported, path + ": more than 255 GPU buffers of blocks");
+        lut[i] = {std::uint32_t(h.buffer_ends.size()) << 16 | r.block_count, std::uint32_t(in_buffer)};
+        blocks += r.block_count, in_buffer += r.block_count;
+    }
+    if (blocks > std::numeric_limits<std::uint32_t>::max())
+        throw Error(Errc::unsupported, path + ": more than 2^32 - 1 blocks");
+    if (blocks > 0) h.buffer_ends.push_back(blocks);
+    h.blocks = std::uint32_t(blocks);
+
+    AtomicOutputFile out(path, overwrite);
+    {
+        const auto head = serialize_fft_header(h);
+        out.write(head.data(), head.size());
+        out.write(lut.data(), lut.size() * sizeof(FiberLutEntry));
+    }
+    const DecodeContext ctx(src);
+    const std::uint32_t bb = h.block_bytes();
+    IndexBuilder index(h);
+    std::vector<std::uint8_t> raw;
+    std::vector<float> xyz;
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+        const SelectedRun& r = runs[i];
+        raw.resize(std::size_t(r.block_count) * bb);
+        source.read_blocks(r.first_block, r.block_count, raw.data());
+        xyz.resize(3 * count_block_points(ctx, raw.data(), r.block_count));
+        detail::decode_selected_blocks(ctx, raw.data(), r.block_count, xyz.data());
+        const float* p = xyz.data();
+        const auto id = std::uint32_t(i);
+        for (std::uint32_t k = 0; k < r.block_count; ++k) {
+            std::uint8_t* b = &raw[std::size_t(k) * bb];
+            const std::uint32_t n = BlockView{b}.point_count();
+            b[kBlockFiberIdOffset] = std::uint8_t(id >> 24), b[kBlockFiberIdOffset + 1] = std::uint8_t(id >> 16);
+            b[kBlockFiberIdOffset + 2] = std::uint8_t(id >> 8), b[kBlockFiberIdOffset + 3] = std::uint8_t(id);
+            b[kBlockFlagsOffset] = std::uint8_t((k > 0 ? kFlagNotFirst : 0) | (k + 1 < r.block_count ? kFlagNotLast : 0) |
+                                                (b[kBlockFlagsOffset] & kFlagCountMask));
+            b[kBlockIndexOffset] = std::uint8_t(k);  // modulo 256, as the format stores it
+            index.add_block(p, n, k + 1 == r.block_count);
+            p += 3 * n;
+            h.points += n;
+        }
+        out.write(raw.data(), raw.size());
+    }
+    {
+        const std::uint64_t at = out.size();
+        std::vector<TrailerChunk> chunks;
+        for (const auto tag : {kPropertiesTag, kResampledTag})
+            if (const TrailerChunk* c = source.find_chunk(tag)) chunks.push_back(*c);
+        if (auto bidx = index.finish()) chunks.push_back(std::move(*bidx));
+        const auto trailer = serialize_trailer(chunks, at);
+        out.write(trailer.data(), trailer.size());
+    }
+    const auto head = serialize_fft_header(h);
+    out.write_at(head.data(), head.size(), 0);
+    SubsetReport report{h.fibers, h.blocks, h.points, out.size()};
+    out.commit();
+    return report;
+}
+
+}  // namespace fiblet

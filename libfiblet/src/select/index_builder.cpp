@@ -1,0 +1,95 @@
+// IndexBuilder: block boxes quantized as blocks are written, so that the
+// index costs no extra pass over the data.
+#include <algorithm>
+
+#include "fiblet/block_index.hpp"
+#include "fiblet/error.hpp"
+#include "select/index_chunk.hpp"
+
+namespace fiblet {
+
+namespace {
+
+Aabb bounds_of(const float* xyz, std::uint32_t n) {
+    Aabb b{{xyz[0], xyz[1], xyz[2]}, {xyz[0], xyz[1], xyz[2]}};
+    for (std::uint32_t k = 1; k < n; ++k) {
+        const float* p = xyz + 3 * k;
+        b.min = {std::min(b.min.x, p[0]), std::min(b.min.y, p[1]), std::min(b.min.z, p[2])};
+        b.max = {std::max(b.max.x, p[0]), std::max(b.max.y, p[1]), std::max(b.max.z, p[2])};
+    }
+    return b;
+}
+
+}  // namespace
+
+IndexBuilder::IndexBuilder(const FftHeader& header, unsigned bits_per_block) : header_(header), bits_(bits_per_block) {
+    if (bits_per_block < 8 || bits_per_block > 32)
+        throw Error(Errc::invalid_argument, "index bits per block must be in [8, 32]");
+    const auto g = detail::IndexGrid::for_header(header, bits_per_block);
+    grid_ = {g.origin, g.cell, g.min_levels, g.extent_levels};
+}
+
+void IndexBuilder::add_fiber(std::span<const Vec3f> decoded) {
+    static_assert(sizeof(Vec3f) == 3 * sizeof(float));
+    const std::uint32_t ppb = header_.points_per_block;
+    if (decoded.empty()) {
+        last_points_.push_back(0);
+        return;
+    }
+    for (std::size_t i = 0; i < decoded.size(); i += ppb) {
+        const auto n = std::uint32_t(std::min<std::size_t>(ppb, decoded.size() - i));
+        add_block(&decoded[i].x, n, i + n == decoded.size());
+    }
+}
+
+void IndexBuilder::add_block(const float* xyz, std::uint32_t n, bool last_of_fiber) {
+    const Vec3f p0{xyz[0], xyz[1], xyz[2]};
+    const Vec3f p1 = n >= 2 ? Vec3f{xyz[3], xyz[4], xyz[5]} : p0;
+    add_box(bounds_of(xyz, n), n, last_of_fiber, block_bounding_sphere(header_, p0, p1, n).radius);
+}
+
+void IndexBuilder::add_box(const Aabb& box, std::uint32_t n, bool last_of_fiber, float sphere_radius) {
+    const detail::IndexGrid g{grid_.origin, grid_.cell, grid_.min_levels, grid_.extent_levels, bits_};
+    const std::uint32_t code = g.encode(box);
+    unbounded_ += code == g.unbounded_code();
+    codes_.push_back(code);
+    max_sphere_radius_ = std::max(max_sphere_radius_, sphere_radius);
+    ++open_fiber_blocks_;
+    if (last_of_fiber) {
+        last_points_.push_back(std::uint8_t(n));
+        open_fiber_blocks_ = 0;
+    } else if (n != header_.points_per_block) {
+        layout_ok_ = false;  // only a fiber's last block may be partial
+    }
+}
+
+void IndexBuilder::append(const IndexBuilder& later) {
+    codes_.insert(codes_.end(), later.codes_.begin(), later.codes_.end());
+    last_points_.insert(last_points_.end(), later.last_points_.begin(), later.last_points_.end());
+    layout_ok_ = layout_ok_ && later.layout_ok_ && later.open_fiber_blocks_ == 0;
+    unbounded_ += later.unbounded_;
+    max_sphere_radius_ = std::max(max_sphere_radius_, later.max_sphere_radius_);
+}
+
+void IndexBuilder::clear() {
+    codes_.clear();
+    last_points_.clear();
+    open_fiber_blocks_ = 0;
+    layout_ok_ = true;
+    unbounded_ = 0;
+    max_sphere_radius_ = 0;
+}
+
+std::optional<TrailerChunk> IndexBuilder::finish() const {
+    if (!layout_ok_ || open_fiber_blocks_ != 0) return std::nullopt;
+    detail::IndexChunk c;
+    c.grid = {grid_.origin, grid_.cell, grid_.min_levels, grid_.extent_levels, bits_};
+    c.fibers = last_points_.size();
+    c.blocks = codes_.size();
+    c.max_sphere_radius = max_sphere_radius_;
+    c.last_block_points = last_points_;
+    c.codes = codes_;
+    return TrailerChunk{kBlockIndexTag, detail::serialize_index_chunk(c)};
+}
+
+}  // namespace fiblet

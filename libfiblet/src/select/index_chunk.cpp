@@ -1,0 +1,173 @@
+#include "select/index_chunk.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+
+#include "core/bytes.hpp"
+#include "fiblet/error.hpp"
+
+namespace fiblet::detail {
+
+namespace {
+
+// Slack, in cells, between a box and its quantized bounds: far above the
+// float rounding of origin + i * cell, far below a cell.
+constexpr double kSlackCells = 1e-3;
+// Margin of the grid around the normalized cube, in normalized units:
+// decoded points may stray a few micrometres outside it (about 1e-4).
+constexpr double kCubeMargin = 1.0 / 1024;
+
+// Largest v with v^3 < 2^bits - 1 (so that the all-ones code stays free).
+std::uint32_t max_axis_levels(unsigned bits) {
+    const std::uint64_t limit = (std::uint64_t{1} << bits) - 1;
+    std::uint64_t v = std::uint64_t(std::cbrt(double(limit))) + 2;
+    while (v * v * v >= limit) --v;
+    return std::uint32_t(v);
+}
+
+}  // namespace
+
+IndexGrid IndexGrid::for_header(const FftHeader& h, unsigned bits) {
+    IndexGrid g;
+    g.bits = bits;
+    const float lo = float(-kCubeMargin);
+    g.origin = h.to_world(lo, lo, lo);
+    const double range = double(h.scaling) * (1 + 2 * kCubeMargin);
+    // Blocks span at most (n-1) steps plus the quantization of their second
+    // anchor; one more step of room keeps every block fiblet writes on the
+    // grid (larger ones are stored as unbounded, never wrongly culled).
+    const double extent = double(h.points_per_block) * double(h.step) * double(h.scaling);
+    const std::uint32_t v = max_axis_levels(bits);
+    double best = std::numeric_limits<double>::infinity();
+    // A box of extent x spans i..j with j - i < x / cell + 2 + 2 * slack
+    // (floor below, ceil above), so e < extent_levels needs
+    // extent <= (extent_levels - 2 - 2 * slack) * cell.
+    for (std::uint32_t e = 3; e <= v / 2; ++e) {
+        const std::uint32_t n = v / e;
+        const double cell = std::max(extent / (double(e) - 2 - 2 * kSlackCells), range / double(n - 1));
+        if (cell < best) best = cell, g.extent_levels = e, g.min_levels = n;
+    }
+    // Round the cell up to a float, then make sure the grid still covers the range.
+    g.cell = std::nextafter(float(best), std::numeric_limits<float>::infinity());
+    return g;
+}
+
+std::uint32_t IndexGrid::encode(const Aabb& box) const {
+    std::uint32_t code = 0, scale = 1;
+    const float lo[3] = {box.min.x, box.min.y, box.min.z}, hi[3] = {box.max.x, box.max.y, box.max.z};
+    const float o[3] = {origin.x, origin.y, origin.z};
+    for (int a = 0; a < 3; ++a) {
+        const double b = (double(lo[a]) - o[a]) / cell - kSlackCells;
+        const double t = (double(hi[a]) - o[a]) / cell + kSlackCells;
+        if (!(b >= 0 && t >= b && t < double(min_levels + extent_levels))) return unbounded_code();
+        const auto i = std::uint32_t(std::floor(b));
+        const auto j = std::uint32_t(std::ceil(t));
+        if (i >= min_levels || j - i >= extent_levels) return unbounded_code();
+        code += (i * extent_levels + (j - i)) * scale;
+        scale *= axis_levels();
+    }
+    return code;
+}
+
+Aabb IndexGrid::decode(std::uint32_t code) const {
+    if (code == unbounded_code())
+        return {{-kUnboundedExtentMm, -kUnboundedExtentMm, -kUnboundedExtentMm},
+                {kUnboundedExtentMm, kUnboundedExtentMm, kUnboundedExtentMm}};
+    float lo[3], hi[3];
+    const float o[3] = {origin.x, origin.y, origin.z};
+    const std::uint32_t levels = axis_levels();
+    for (int a = 0; a < 3; ++a) {
+        const std::uint32_t c = code % levels;
+        code /= levels;
+        const std::uint32_t i = c / extent_levels, e = c % extent_levels;
+        lo[a] = o[a] + float(i) * cell;
+        hi[a] = o[a] + float(i + e) * cell;
+    }
+    return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
+}
+
+std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c) {
+    const unsigned bits = c.grid.bits;
+    // Fixed header, at the offsets parse_index_chunk reads.
+    std::vector<std::uint8_t> out(kIndexChunkHeaderBytes, 0);
+    auto put = [&](std::size_t at, auto v) { std::memcpy(&out[at], &v, sizeof v); };
+    put(0, kIndexChunkVersion);
+    put(4, std::uint32_t(bits));
+    put(8, c.fibers);
+    put(16, c.blocks);
+    put(24, c.grid.origin.x), put(28, c.grid.origin.y), put(32, c.grid.origin.z);
+    put(36, c.grid.cell);
+    put(40, c.grid.min_levels);
+    put(44, c.grid.extent_levels);
+    put(48, c.max_sphere_radius);
+    out.resize(kIndexChunkHeaderBytes + c.last_block_points.size());
+    if (!c.last_block_points.empty())
+        std::memcpy(&out[kIndexChunkHeaderBytes], c.last_block_points.data(), c.last_block_points.size());
+    // Codes as one little-endian bit stream, least significant bit first.
+    std::uint64_t acc = 0;
+    unsigned filled = 0;
+    for (std::uint32_t code : c.codes) {
+        acc |= std::uint64_t(code) << filled;
+        filled += bits;
+        while (filled >= 8) out.push_back(std::uint8_t(acc)), acc >>= 8, filled -= 8;
+    }
+    if (filled > 0) out.push_back(std::uint8_t(acc));
+    return out;
+}
+
+IndexChunk parse_index_chunk(const std::vector<std::uint8_t>& p, const FftHeader& h, const std::string& file) {
+    auto bad = [&](const std::string& what) -> IndexChunk {
+        throw Error(Errc::fft_format, file + ": malformed BIDX (block index) chunk: " + what);
+    };
+    if (p.size() < kIndexChunkHeaderBytes) return bad("truncated header");
+    IndexChunk c;
+    const std::uint8_t* b = p.data();
+    if (get_le<std::uint32_t>(b) != kIndexChunkVersion)
+        return bad("unsupported version " + std::to_string(get_le<std::uint32_t>(b)));
+    c.grid.bits = get_le<std::uint32_t>(b + 4);
+    c.fibers = get_le<std::uint64_t>(b + 8);
+    c.blocks = get_le<std::uint64_t>(b + 16);
+    c.grid.origin = {get_le<float>(b + 24), get_le<float>(b + 28), get_le<float>(b + 32)};
+    c.grid.cell = get_le<float>(b + 36);
+    c.grid.min_levels = get_le<std::uint32_t>(b + 40);
+    c.grid.extent_levels = get_le<std::uint32_t>(b + 44);
+    c.max_sphere_radius = get_le<float>(b + 48);
+
+    const unsigned bits = c.grid.bits;
+    if (bits < 8 || bits > 32) return bad("bits per block " + std::to_string(bits) + " outside [8, 32]");
+    if (c.fibers != h.fibers || c.blocks != h.blocks) return bad("its fiber or block count differs from the header's");
+    if (!(std::isfinite(c.grid.origin.x) && std::isfinite(c.grid.origin.y) && std::isfinite(c.grid.origin.z)))
+        return bad("grid origin is not finite");
+    if (!(std::isfinite(c.grid.cell) && c.grid.cell > 0)) return bad("grid cell is not a positive number");
+    if (!(std::isfinite(c.max_sphere_radius) && c.max_sphere_radius >= 0)) return bad("invalid sphere radius");
+    const std::uint64_t levels = std::uint64_t(c.grid.min_levels) * c.grid.extent_levels;
+    if (c.grid.min_levels == 0 || c.grid.extent_levels == 0 || levels > 0xffffffffull ||
+        levels * levels * levels > std::uint64_t(c.grid.unbounded_code()))
+        return bad("grid levels do not fit the code width");
+    const std::uint64_t code_bytes = (c.blocks * bits + 7) / 8;
+    if (p.size() != kIndexChunkHeaderBytes + c.fibers + code_bytes) return bad("payload size does not match its counts");
+
+    const std::uint8_t* last = b + kIndexChunkHeaderBytes;
+    c.last_block_points.assign(last, last + c.fibers);
+    for (std::uint8_t n : c.last_block_points)
+        if (n > h.points_per_block) return bad("a fiber's last block holds more points than a block can");
+
+    c.codes.resize(c.blocks);
+    const std::uint8_t* s = last + c.fibers;
+    const std::uint64_t max_code = levels * levels * levels;
+    const std::uint32_t mask = c.grid.unbounded_code();
+    for (std::uint64_t k = 0; k < c.blocks; ++k) {
+        const std::uint64_t bit = k * bits, byte = bit / 8;
+        std::uint64_t word = 0;
+        std::memcpy(&word, s + byte, std::min<std::uint64_t>(8, code_bytes - byte));
+        const auto code = std::uint32_t((word >> (bit % 8)) & mask);
+        if (code != mask && code >= max_code) return bad("block code out of range");
+        c.codes[k] = code;
+    }
+    return c;
+}
+
+}  // namespace fiblet::detail

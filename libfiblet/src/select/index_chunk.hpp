@@ -1,0 +1,57 @@
+// Internal: the BIDX chunk's layout (formats/fft-index.md): the grid that
+// quantizes block boxes, the packing of the per-block codes, and parsing
+// with validation.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "fiblet/fft_format.hpp"
+#include "fiblet/view.hpp"
+
+namespace fiblet::detail {
+
+inline constexpr std::uint32_t kIndexChunkVersion = 1;
+inline constexpr std::size_t kIndexChunkHeaderBytes = 56;
+
+// Boxes are stored on a cubic grid: on each axis a box is [origin + i*cell,
+// origin + (i+e)*cell] with i < min_levels and e < extent_levels, the axis
+// code is i*extent_levels + e, and the block code is the three axis codes in
+// mixed radix (x fastest). The all-ones code of `bits` bits means
+// "unbounded" (a block that does not fit the grid).
+struct IndexGrid {
+    Vec3f origin{};
+    float cell = 1;
+    std::uint32_t min_levels = 1, extent_levels = 1;
+    unsigned bits = 28;
+
+    std::uint32_t axis_levels() const { return min_levels * extent_levels; }
+    std::uint32_t unbounded_code() const { return bits >= 32 ? 0xffffffffu : (1u << bits) - 1; }
+
+    // The grid for a file: covers the normalized cube (with a margin) and
+    // makes the cells as small as `bits` allow for blocks up to
+    // points_per_block steps across.
+    static IndexGrid for_header(const FftHeader& h, unsigned bits);
+    // Conservative code of a box (the decoded box contains it, with a small
+    // slack for float rounding), or unbounded_code().
+    std::uint32_t encode(const Aabb& box) const;
+    // The box of a code; unbounded boxes span +-1e30 mm.
+    Aabb decode(std::uint32_t code) const;
+};
+
+inline constexpr float kUnboundedExtentMm = 1e30f;
+
+struct IndexChunk {
+    IndexGrid grid;
+    std::uint64_t fibers = 0, blocks = 0;
+    float max_sphere_radius = 0;
+    std::vector<std::uint8_t> last_block_points;  // per fiber
+    std::vector<std::uint32_t> codes;             // per block
+};
+
+std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c);
+// Parses and validates a chunk against its file's header (counts, levels,
+// sizes, point totals). Throws Error{fft_format} naming `file`.
+IndexChunk parse_index_chunk(const std::vector<std::uint8_t>& payload, const FftHeader& h, const std::string& file);
+
+}  // namespace fiblet::detail

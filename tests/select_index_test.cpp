@@ -1,0 +1,265 @@
+// The block index: every stored or computed box contains every point its
+// block decodes to, candidate sets never miss a block with a point in the
+// region, the stored chunk has the documented size, and malformed chunks
+// are rejected with a clear error.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+
+#include "fiblet/checksum.hpp"
+#include "fiblet/block_index.hpp"
+#include "fiblet/compress.hpp"
+#include "fiblet/error.hpp"
+#include "select_reference.hpp"
+#include "test_util.hpp"
+
+using namespace fiblet;
+using namespace fiblet::test;
+
+namespace {
+
+class SelectIndex : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        if (!shared_data_available()) return;
+        dir_ = new TempDir;
+        CompressOptions o;
+        o.threads = 2;
+        compress_tck(shared_data("small-sdstream.tck"), dir_->file("sdstream.fft"), o);
+        compress_tck(shared_data("dwi-small64d-ifod1.tck"), dir_->file("dwi.fft"), o);
+    }
+    static void TearDownTestSuite() {
+        delete dir_;
+        dir_ = nullptr;
+    }
+    void SetUp() override {
+        if (!dir_) GTEST_SKIP() << "shared test data not found";
+    }
+    static std::string fiblet_file() { return dir_->file("sdstream.fft"); }
+    static inline TempDir* dir_ = nullptr;
+};
+
+bool bit(const std::vector<std::uint64_t>& bits, std::size_t b) { return (bits[b >> 6] >> (b & 63)) & 1; }
+
+void expect_boxes_hold_points(const FftFile& file, const BlockIndex& index, const DecodedFile& d) {
+    ASSERT_EQ(index.blocks(), file.header().blocks);
+    ASSERT_EQ(index.fibers(), file.header().fibers);
+    for (std::uint64_t f = 0; f < index.fibers(); ++f)
+        ASSERT_EQ(index.fiber_points(f), d.points.offsets[f + 1] - d.points.offsets[f]) << "fiber " << f;
+    for (std::size_t b = 0; b < d.blocks.size(); ++b) {
+        const Aabb box = index.block_box(b);
+        for (std::uint32_t k = 0; k < d.blocks[b].points; ++k) {
+            const Vec3f p = point_at(d, d.blocks[b].first_point + k);
+            ASSERT_TRUE(box.min.x <= p.x && p.x <= box.max.x && box.min.y <= p.y && p.y <= box.max.y &&
+                        box.min.z <= p.z && p.z <= box.max.z)
+                << "block " << b << " point " << k;
+        }
+        ASSERT_LE(d.blocks[b].sphere.radius, index.max_sphere_radius()) << "block " << b;
+    }
+}
+
+TEST_F(SelectIndex, CompressStoresAnIndexWhoseBoxesHoldEveryPoint) {
+    for (const std::string& path : {fiblet_file(), dir_->file("dwi.fft")}) {
+        const FftFile file(path);
+        ASSERT_NE(file.find_chunk(kBlockIndexTag), nullptr);
+        const BlockIndex index = BlockIndex::load(file);
+        EXPECT_EQ(index.source(), BlockIndex::Source::chunk);
+        expect_boxes_hold_points(file, index, decode_everything(file));
+    }
+}
+
+TEST_F(SelectIndex, ComputedIndexOfOfficialEncoderFilesHoldsEveryPoint) {
+    const FftFile file(shared_data("reference/small-sdstream.fft"));
+    ASSERT_EQ(file.find_chunk(kBlockIndexTag), nullptr);
+    const BlockIndex index = BlockIndex::load(file);
+    EXPECT_EQ(index.source(), BlockIndex::Source::decoded);
+    const DecodedFile d = decode_everything(file);
+    expect_boxes_hold_points(file, index, d);
+    // Computed boxes are exact: each face touches a point.
+    for (std::size_t b = 0; b < d.blocks.size(); b += 97) {
+        float lo = INFINITY;
+        for (std::uint32_t k = 0; k < d.blocks[b].points; ++k)
+            lo = std::min(lo, point_at(d, d.blocks[b].first_point + k).x);
+        EXPECT_EQ(index.block_box(b).min.x, lo);
+    }
+}
+
+TEST_F(SelectIndex, StoredBoxesAreWithinACellOfTheExactBoxes) {
+    const FftFile file(fiblet_file());
+    const BlockIndex stored = BlockIndex::load(file), exact = BlockIndex::compute(file);
+    // 28 bits give 645 levels per axis, shared between the position (range
+    // 87 mm / cell) and the extent (6 mm / cell + 2): here 80 x 8 levels of
+    // a 1.10 mm cell, and a side moves by less than one cell.
+    double grow = 0;
+    for (std::uint64_t b = 0; b < stored.blocks(); ++b) {
+        const Aabb s = stored.block_box(b), e = exact.block_box(b);
+        for (float d : {e.min.x - s.min.x, e.min.y - s.min.y, e.min.z - s.min.z, s.max.x - e.max.x, s.max.y - e.max.y,
+                        s.max.z - e.max.z}) {
+            ASSERT_GE(d, 0.0f);
+            ASSERT_LT(d, 1.15f) << "block " << b;
+            grow += d;
+        }
+    }
+    EXPECT_LT(grow / double(6 * stored.blocks()), 0.6);  // about half a cell on average
+}
+
+TEST_F(SelectIndex, ChunkHasTheDocumentedSize) {
+    for (const std::string& path : {fiblet_file(), dir_->file("dwi.fft")}) {
+        const FftFile file(path);
+        const TrailerChunk* c = file.find_chunk(kBlockIndexTag);
+        ASSERT_NE(c, nullptr);
+        const FftHeader& h = file.header();
+        EXPECT_EQ(c->payload.size(), 56 + h.fibers + (std::uint64_t{h.blocks} * 28 + 7) / 8);
+    }
+    // 3.5 bytes per 76-byte block plus one byte per fiber: under 5 % of the file.
+    const FftFile file(fiblet_file());
+    EXPECT_LT(double(file.find_chunk(kBlockIndexTag)->payload.size() + 16), 0.05 * double(file.file_size()));
+}
+
+TEST_F(SelectIndex, CandidatesNeverMissABlockWithAPointInTheRegion) {
+    for (const std::string& path : {fiblet_file(), shared_data("reference/small-ifod1.fft")}) {
+        const FftFile file(path);
+        const DecodedFile d = decode_everything(file);
+        const BlockIndex index = BlockIndex::load(file);
+        QueryGenerator gen(d, 5);
+        std::size_t candidates = 0, hits = 0;
+        for (int i = 0; i < 40; ++i) {
+            const Region r = gen.region();
+            std::vector<std::uint64_t> bits;
+            if (r.shape == Region::Shape::sphere)
+                index.blocks_near_sphere(r.center, r.radius, bits);
+            else
+                index.blocks_near_box(r.box, bits);
+            for (std::size_t b = 0; b < d.blocks.size(); ++b) {
+                candidates += bit(bits, b);
+                if (any_inside(d, d.blocks[b].first_point, d.blocks[b].points, r)) {
+                    ++hits;
+                    ASSERT_TRUE(bit(bits, b)) << path << ": region " << i << " misses block " << b;
+                }
+            }
+        }
+        // Pruning works: small regions leave most blocks out, and the
+        // candidates are not many more than the blocks really hit.
+        EXPECT_LT(candidates, 40 * d.blocks.size() / 4);
+        EXPECT_LT(candidates, 3 * hits);
+    }
+}
+
+TEST_F(SelectIndex, FrustumCandidatesCoverEveryBlockSphereThatMeetsTheFrustum) {
+    const FftFile file(fiblet_file());
+    const DecodedFile d = decode_everything(file);
+    const BlockIndex index = BlockIndex::load(file);
+    QueryGenerator gen(d, 9);
+    for (int i = 0; i < 20; ++i) {
+        const Frustum f = frustum_from_camera(gen.camera());
+        std::vector<std::uint64_t> bits;
+        index.blocks_near_frustum(f, index.max_sphere_radius() * (1 + 1e-5f) + 1e-3f, bits);
+        for (std::size_t b = 0; b < d.blocks.size(); ++b)
+            if (sphere_intersects_frustum(f, d.blocks[b].sphere.center, d.blocks[b].sphere.radius))
+                ASSERT_TRUE(bit(bits, b)) << "camera " << i << " block " << b;
+    }
+}
+
+// A copy of `from` whose trailer's BIDX payload is replaced by `payload`
+// (without the CSUM chunk, which would report the change first).
+std::string with_index_payload(const FftFile& from, const std::vector<std::uint8_t>& payload, const std::string& to) {
+    const std::string bytes = read_file(from.path());
+    const std::uint64_t end = from.header().file_bytes();
+    std::vector<TrailerChunk> chunks;
+    for (const TrailerChunk& c : from.trailer())
+        if (c.tag != kChecksumTag) chunks.push_back(c.tag == kBlockIndexTag ? TrailerChunk{c.tag, payload} : c);
+    const auto trailer = serialize_trailer(chunks, end);
+    write_file(to, bytes.substr(0, end) + std::string(trailer.begin(), trailer.end()));
+    return to;
+}
+
+TEST_F(SelectIndex, MalformedChunksAreRejected) {
+    const FftFile good(fiblet_file());
+    const std::vector<std::uint8_t> payload = good.find_chunk(kBlockIndexTag)->payload;
+    auto rejected = [&](std::vector<std::uint8_t> p, const std::string& name) {
+        const FftFile bad(with_index_payload(good, p, dir_->file(name)));
+        try {
+            BlockIndex::load(bad);
+        } catch (const Error& e) {
+            EXPECT_EQ(e.code(), Errc::fft_format);
+            EXPECT_NE(std::string(e.what()).find("BIDX"), std::string::npos) << e.what();
+            return true;
+        }
+        return false;
+    };
+    EXPECT_FALSE(rejected(payload, "same.fft"));
+    auto p = payload;
+    p.resize(30);
+    EXPECT_TRUE(rejected(p, "truncated.fft"));
+    p = payload, p.pop_back();
+    EXPECT_TRUE(rejected(p, "short.fft"));
+    p = payload, p[0] = 9;
+    EXPECT_TRUE(rejected(p, "version.fft"));
+    p = payload, p[8] ^= 1;  // fiber count
+    EXPECT_TRUE(rejected(p, "fibers.fft"));
+    p = payload, p[4] = 40;  // bits per block
+    EXPECT_TRUE(rejected(p, "bits.fft"));
+    p = payload, std::memset(&p[36], 0, 4);  // cell 0
+    EXPECT_TRUE(rejected(p, "cell.fft"));
+    p = payload, p[56] = std::uint8_t(p[56] == 1 ? 2 : 1);  // first fiber's point count no longer adds up
+    EXPECT_TRUE(rejected(p, "points.fft"));
+    p = payload, p[56] = 64;
+    EXPECT_TRUE(rejected(p, "toomany.fft"));
+    p = payload, std::memset(&p[40], 0xff, 4);  // levels overflow the code
+    EXPECT_TRUE(rejected(p, "levels.fft"));
+}
+
+TEST_F(SelectIndex, BlocksOffTheGridAreNeverCulled) {
+    // Block 0's bounds replaced by a box far larger than any block: the
+    // builder stores it as unbounded, and every query returns it.
+    const FftFile file(dir_->file("dwi.fft"));
+    const DecodedFile d = decode_everything(file);
+    IndexBuilder builder(file.header());
+    for (std::size_t b = 0; b < d.blocks.size(); ++b) {
+        std::vector<float> pts(&d.points.xyz[3 * d.blocks[b].first_point],
+                               &d.points.xyz[3 * (d.blocks[b].first_point + d.blocks[b].points)]);
+        if (b == 0) pts[0] += 1000;
+        builder.add_block(pts.data(), d.blocks[b].points, d.blocks[b].last_of_fiber);
+    }
+    EXPECT_EQ(builder.unbounded_blocks(), 1u);
+    const auto chunk = builder.finish();
+    ASSERT_TRUE(chunk);
+    const FftFile patched(with_index_payload(file, chunk->payload, dir_->file("unbounded.fft")));
+    const BlockIndex index = BlockIndex::load(patched);
+    EXPECT_GT(index.block_box(0).max.x, 1e20f);
+    std::vector<std::uint64_t> bits;
+    index.blocks_near_sphere({-5000, 0, 0}, 1, bits);
+    EXPECT_TRUE(bit(bits, 0));
+    for (std::size_t b = 1; b < d.blocks.size(); ++b) EXPECT_FALSE(bit(bits, b));
+}
+
+TEST_F(SelectIndex, BuilderRefusesLayoutsItCannotDescribe) {
+    const FftFile file(dir_->file("dwi.fft"));
+    IndexBuilder builder(file.header());
+    const float pts[9] = {0, 0, 0, 0.1f, 0, 0, 0.2f, 0, 0};
+    builder.add_block(pts, 3, false);  // partial, yet not the fiber's last block
+    builder.add_block(pts, 3, true);
+    EXPECT_FALSE(builder.finish());
+    IndexBuilder fine(file.header());
+    fine.add_block(pts, 3, true);
+    EXPECT_TRUE(fine.finish());
+}
+
+TEST_F(SelectIndex, ParallelPartsJoinToTheSameChunk) {
+    const FftFile file(fiblet_file());
+    const DecodedFile d = decode_everything(file);
+    IndexBuilder whole(file.header()), first(file.header()), second(file.header());
+    for (std::size_t b = 0; b < d.blocks.size(); ++b) {
+        const float* p = &d.points.xyz[3 * d.blocks[b].first_point];
+        whole.add_block(p, d.blocks[b].points, d.blocks[b].last_of_fiber);
+        (d.blocks[b].fiber < 400 ? first : second).add_block(p, d.blocks[b].points, d.blocks[b].last_of_fiber);
+    }
+    first.append(second);
+    EXPECT_EQ(first.finish()->payload, whole.finish()->payload);
+    // ... and to what compress stored.
+    EXPECT_EQ(whole.finish()->payload, file.find_chunk(kBlockIndexTag)->payload);
+}
+
+}  // namespace

@@ -1,0 +1,358 @@
+// Selective decoding against brute force: for many random queries, select()
+// returns exactly the runs and points that decoding everything and then
+// filtering by the documented rules gives; whichever index it uses (stored
+// in the file or computed on load), on files from fiblet and from the
+// official encoder.
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "fiblet/compress.hpp"
+#include "fiblet/error.hpp"
+#include "fiblet/fft_subset.hpp"
+#include "fiblet/select.hpp"
+#include "select_reference.hpp"
+#include "test_util.hpp"
+
+using namespace fiblet;
+using namespace fiblet::test;
+
+namespace {
+
+struct Subject {
+    std::string name;
+    std::unique_ptr<FftFile> file;
+    DecodedFile decoded;
+    std::unique_ptr<BlockIndex> stored_or_loaded, computed;
+};
+
+class SelectQuery : public ::testing::TestWithParam<int> {
+protected:
+    static void SetUpTestSuite() {
+        if (!shared_data_available()) return;
+        dir_ = new TempDir;
+        auto add = [](const std::string& name, const std::string& fft) {
+            auto s = std::make_unique<Subject>();
+            s->name = name;
+            s->file = std::make_unique<FftFile>(fft);
+            s->decoded = decode_everything(*s->file);
+            s->stored_or_loaded = std::make_unique<BlockIndex>(BlockIndex::load(*s->file));
+            s->computed = std::make_unique<BlockIndex>(BlockIndex::compute(*s->file));
+            subjects_.push_back(std::move(s));
+        };
+        CompressOptions o;
+        o.threads = 2;
+        compress_tck(shared_data("small-sdstream.tck"), dir_->file("sdstream.fft"), o);
+        add("fiblet small-sdstream", dir_->file("sdstream.fft"));
+        compress_tck(shared_data("bundles/CST_R-step0.1.tck"), dir_->file("cst.fft"), o);
+        add("fiblet CST_R", dir_->file("cst.fft"));
+        add("official small-sdstream", shared_data("reference/small-sdstream.fft"));
+    }
+    static void TearDownTestSuite() {
+        subjects_.clear();
+        delete dir_;
+        dir_ = nullptr;
+    }
+    void SetUp() override {
+        if (subjects_.empty()) GTEST_SKIP() << "shared test data not found";
+    }
+    const Subject& subject() const { return *subjects_[std::size_t(GetParam())]; }
+
+    // Runs a query with both indexes and compares each with brute force.
+    void check(const Query& q, const std::string& what) const {
+        const Subject& s = subject();
+        const ReferenceSelection ref = reference_select(*s.file, s.decoded, q);
+        for (const BlockIndex* index : {s.stored_or_loaded.get(), s.computed.get()}) {
+            std::vector<SelectedRun> runs;
+            SelectionStats stats;
+            const Streamlines got = select_streamlines(*s.file, *index, q, &runs, &stats);
+            expect_same_selection(ref, got, runs, s.name + ": " + what);
+            EXPECT_EQ(stats.runs, runs.size());
+            EXPECT_EQ(stats.points, got.point_count());
+            std::uint64_t blocks = 0;
+            for (const auto& r : runs) blocks += r.block_count;
+            EXPECT_EQ(stats.blocks, blocks);
+        }
+    }
+
+    static inline TempDir* dir_ = nullptr;
+    static inline std::vector<std::unique_ptr<Subject>> subjects_;
+};
+
+TEST_P(SelectQuery, EmptyQueryGivesTheWholeFile) {
+    const Subject& s = subject();
+    std::vector<SelectedRun> runs;
+    const Streamlines got = select_streamlines(*s.file, *s.stored_or_loaded, Query{}, &runs);
+    EXPECT_EQ(got.xyz, s.decoded.points.xyz);
+    EXPECT_EQ(got.offsets, s.decoded.points.offsets);
+    EXPECT_EQ(runs.size(), s.file->header().fibers);
+}
+
+TEST_P(SelectQuery, FiberSubsetsMatchBruteForce) {
+    const Subject& s = subject();
+    QueryGenerator gen(s.decoded, 11);
+    const std::uint64_t n = s.file->header().fibers;
+    for (int i = 0; i < 12; ++i) {
+        Query q;
+        const int kind = i % 4;
+        if (kind == 0 || kind == 3) {
+            for (int r = 0; r < 3; ++r) {
+                const auto a = std::uint64_t(gen.uniform(0, float(n + 5)));
+                q.fibers.push_back({a, a + std::uint64_t(gen.uniform(0, float(n) / 4))});
+            }
+        }
+        if (kind == 1 || kind == 3) {
+            q.min_length_mm = gen.uniform(0, 100);
+            if (i % 2) q.max_length_mm = *q.min_length_mm + gen.uniform(0, 80);
+        }
+        if (kind == 2 || kind == 3) {
+            q.random_fraction = gen.uniform(0, 1);
+            q.random_seed = std::uint64_t(i) * 7919;
+        }
+        check(q, "fiber subset " + std::to_string(i));
+    }
+}
+
+TEST_P(SelectQuery, RandomFractionIsReproducibleAndAboutRight) {
+    const Subject& s = subject();
+    Query q;
+    q.random_fraction = 0.3;
+    q.random_seed = 42;
+    const auto a = select_runs(*s.file, *s.stored_or_loaded, q);
+    const auto b = select_runs(*s.file, *s.computed, q);
+    ASSERT_EQ(a.size(), b.size());
+    const double n = double(s.file->header().fibers);
+    EXPECT_NEAR(double(a.size()) / n, 0.3, 4 * std::sqrt(0.3 * 0.7 / n));
+    for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i].fiber, b[i].fiber);
+    q.random_seed = 43;
+    const auto c = select_runs(*s.file, *s.stored_or_loaded, q);
+    std::size_t same = 0;
+    for (std::size_t i = 0; i < std::min(a.size(), c.size()); ++i) same += a[i].fiber == c[i].fiber;
+    EXPECT_LT(same, a.size());  // another seed, another subset
+}
+
+TEST_P(SelectQuery, FiberRegionsMatchBruteForce) {
+    const Subject& s = subject();
+    QueryGenerator gen(s.decoded, 21);
+    int nonempty = 0;
+    for (int i = 0; i < 16; ++i) {
+        Query q;
+        const int includes = i % 5 == 4 ? 0 : 1 + i % 3;
+        for (int k = 0; k < includes; ++k) q.include.push_back(gen.region());
+        for (int k = 0; k < i % 3; ++k) q.exclude.push_back(gen.region());
+        const ReferenceSelection ref = reference_select(*s.file, s.decoded, q);
+        nonempty += !ref.runs.empty();
+        check(q, "fiber regions " + std::to_string(i));
+    }
+    EXPECT_GT(nonempty, 4);  // the generator makes queries that keep something
+}
+
+TEST_P(SelectQuery, BlockRegionsMatchBruteForce) {
+    const Subject& s = subject();
+    QueryGenerator gen(s.decoded, 31);
+    for (int i = 0; i < 16; ++i) {
+        Query q;
+        q.roi_mode = RoiMode::blocks;
+        for (int k = 0; k < 1 + i % 3; ++k) q.include.push_back(gen.region());
+        if (i % 4 == 3) q.include.clear();
+        for (int k = 0; k < i % 2; ++k) q.exclude.push_back(gen.region());
+        if (i % 5 == 0) q.random_fraction = 0.5;
+        check(q, "block regions " + std::to_string(i));
+    }
+}
+
+TEST_P(SelectQuery, ViewFrustumAndLevelOfDetailMatchBruteForce) {
+    const Subject& s = subject();
+    QueryGenerator gen(s.decoded, 41);
+    for (int i = 0; i < 18; ++i) {
+        Query q;
+        ViewSelection v;
+        v.camera = gen.camera();
+        v.cull = i % 6 != 5;
+        if (i % 3 != 0) {
+            v.lod = Viewport{int(gen.uniform(64, 2000)), int(gen.uniform(64, 1200))};
+            v.lod_pixels = gen.uniform(0.5f, 40);
+        }
+        q.view = v;
+        if (i % 4 == 1) q.include.push_back(gen.region()), q.roi_mode = RoiMode::blocks;
+        if (i % 4 == 2) q.include.push_back(gen.region());
+        check(q, "view " + std::to_string(i));
+    }
+}
+
+TEST_P(SelectQuery, FrustumCullingNeverDropsABlockWithAPointInside) {
+    const Subject& s = subject();
+    QueryGenerator gen(s.decoded, 51);
+    for (int i = 0; i < 10; ++i) {
+        Query q;
+        q.view = ViewSelection{gen.camera(), true, std::nullopt, kDefaultLodPixels};
+        const Frustum f = frustum_from_camera(q.view->camera);
+        std::vector<std::uint8_t> kept(s.file->header().blocks, 0);
+        for (const auto& r : select_runs(*s.file, *s.stored_or_loaded, q))
+            for (std::uint64_t b = r.first_block; b < r.first_block + r.block_count; ++b) kept[b] = 1;
+        for (std::size_t b = 0; b < s.decoded.blocks.size(); ++b) {
+            const DecodedBlock& blk = s.decoded.blocks[b];
+            for (std::uint32_t k = 0; k < blk.points; ++k) {
+                const Vec3f p = point_at(s.decoded, blk.first_point + k);
+                bool in = true;
+                for (const Plane& pl : f.planes) in = in && pl.n.x * p.x + pl.n.y * p.y + pl.n.z * p.z + pl.d >= 0;
+                if (in) {
+                    ASSERT_TRUE(kept[b]) << "block " << b << " has a point in the frustum";
+                    break;
+                }
+            }
+        }
+    }
+}
+
+TEST_P(SelectQuery, MixedQueriesMatchBruteForce) {
+    const Subject& s = subject();
+    QueryGenerator gen(s.decoded, 61);
+    for (int i = 0; i < 12; ++i) {
+        Query q;
+        if (i % 2) q.random_fraction = gen.uniform(0.2f, 1), q.random_seed = std::uint64_t(i);
+        if (i % 3 == 0) q.min_length_mm = gen.uniform(0, 80);
+        q.include.push_back(gen.region());
+        if (i % 4 == 0) q.exclude.push_back(gen.region());
+        q.roi_mode = i % 2 ? RoiMode::blocks : RoiMode::fibers;
+        if (i % 3 != 2) {
+            ViewSelection v{gen.camera(), true, std::nullopt, kDefaultLodPixels};
+            if (i % 2 == 0) v.lod = Viewport{800, 600}, v.lod_pixels = gen.uniform(1, 30);
+            q.view = v;
+        }
+        check(q, "mixed " + std::to_string(i));
+    }
+}
+
+TEST_P(SelectQuery, ChunkedOutputEqualsTheWholeOutput) {
+    const Subject& s = subject();
+    QueryGenerator gen(s.decoded, 71);
+    Query q;
+    q.view = ViewSelection{gen.camera(), true, Viewport{640, 480}, 6};
+    std::vector<SelectedRun> runs;
+    const Streamlines whole = select_streamlines(*s.file, *s.stored_or_loaded, q, &runs);
+    Streamlines joined;
+    std::vector<SelectedRun> joined_runs;
+    std::size_t chunks = 0;
+    SelectOptions o;
+    o.chunk_points = 500;
+    select(
+        *s.file, *s.stored_or_loaded, q,
+        [&](const SelectedChunk& c) {
+            ++chunks;
+            ASSERT_EQ(c.lines.size(), c.runs.size());
+            const std::uint64_t base = joined.point_count();
+            joined.xyz.insert(joined.xyz.end(), c.lines.xyz.begin(), c.lines.xyz.end());
+            for (std::size_t i = 1; i < c.lines.offsets.size(); ++i) joined.offsets.push_back(base + c.lines.offsets[i]);
+            joined_runs.insert(joined_runs.end(), c.runs.begin(), c.runs.end());
+        },
+        o);
+    EXPECT_EQ(joined.xyz, whole.xyz);
+    EXPECT_EQ(joined.offsets, whole.offsets);
+    EXPECT_EQ(joined_runs.size(), runs.size());
+    if (whole.point_count() > 2000) EXPECT_GT(chunks, 1u);
+}
+
+TEST_P(SelectQuery, SubsetFileDecodesToTheSelection) {
+    const Subject& s = subject();
+    QueryGenerator gen(s.decoded, 81);
+    TempDir dir;
+    for (int i = 0; i < 4; ++i) {
+        Query q;
+        q.include.push_back(gen.region());
+        q.roi_mode = i % 2 ? RoiMode::blocks : RoiMode::fibers;
+        if (i == 3) q.view = ViewSelection{gen.camera(), true, std::nullopt, kDefaultLodPixels};
+        std::vector<SelectedRun> runs;
+        const Streamlines expected = select_streamlines(*s.file, *s.stored_or_loaded, q, &runs);
+        const std::string out = dir.file("subset" + std::to_string(i) + ".fft");
+        const SubsetReport rep = write_fft_subset(*s.file, select_runs(*s.file, *s.stored_or_loaded, q), out, false);
+        EXPECT_EQ(rep.fibers, runs.size());
+        const FftFile subset(out);  // validates header, LUT and trailer
+        EXPECT_EQ(subset.header().points, expected.point_count());
+        EXPECT_EQ(subset.properties(), s.file->properties());
+        const DecodedFile d = decode_everything(subset);
+        EXPECT_EQ(d.points.xyz, expected.xyz);
+        EXPECT_EQ(d.points.offsets, expected.offsets);
+        // Its blocks carry their new fiber IDs and flags.
+        for (std::size_t b = 0; b < d.blocks.size(); ++b) {
+            const auto raw = subset.read_blocks(b, 1);
+            const BlockView v{raw.data()};
+            EXPECT_EQ(v.fiber_id(), d.blocks[b].fiber);
+            EXPECT_EQ(v.is_last(), d.blocks[b].last_of_fiber);
+            EXPECT_EQ(v.is_first(), b == subset.first_block(d.blocks[b].fiber));
+        }
+        // A subset of the official encoder's file gets fiblet's index.
+        const BlockIndex index = BlockIndex::load(subset);
+        EXPECT_EQ(index.source(), BlockIndex::Source::chunk);
+        const Query everything;
+        EXPECT_EQ(select_streamlines(subset, index, everything).xyz, expected.xyz);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Files, SelectQuery, ::testing::Values(0, 1, 2));
+
+TEST(SelectQueryErrors, BadQueriesAreRejectedBeforeReading) {
+    if (!shared_data_available()) GTEST_SKIP();
+    const FftFile file(shared_data("reference/small-sdstream.fft"));
+    const BlockIndex index = BlockIndex::load(file);
+    auto rejects = [&](const Query& q) {
+        try {
+            select_runs(file, index, q);
+        } catch (const Error& e) {
+            return e.code() == Errc::invalid_argument;
+        }
+        return false;
+    };
+    Query q;
+    q.random_fraction = 1.5;
+    EXPECT_TRUE(rejects(q));
+    q = {};
+    q.min_length_mm = 50, q.max_length_mm = 10;
+    EXPECT_TRUE(rejects(q));
+    q = {};
+    q.include.push_back(Region::sphere({0, 0, 0}, -1));
+    EXPECT_TRUE(rejects(q));
+    q = {};
+    q.exclude.push_back(Region::box_between({1, 0, 0}, {0, 1, 1}));
+    EXPECT_TRUE(rejects(q));
+    q = {};
+    q.fibers.push_back({10, 5});
+    EXPECT_TRUE(rejects(q));
+    q = {};
+    q.view = ViewSelection{};
+    q.view->camera.target = q.view->camera.position;
+    EXPECT_TRUE(rejects(q));
+    q.view = ViewSelection{};
+    q.view->camera.up = {0, 0, 1};  // parallel to the default view direction
+    EXPECT_TRUE(rejects(q));
+    q.view = ViewSelection{};
+    q.view->camera.near_mm = 0;
+    EXPECT_TRUE(rejects(q));
+    q.view = ViewSelection{};
+    q.view->lod = Viewport{0, 10};
+    EXPECT_TRUE(rejects(q));
+    q = {};
+    for (int i = 0; i < 65; ++i) q.include.push_back(Region::sphere({0, 0, 0}, 1));
+    EXPECT_TRUE(rejects(q));
+    q.roi_mode = RoiMode::blocks;  // no per-fiber mask in blocks mode
+    EXPECT_FALSE(rejects(q));
+}
+
+TEST(SelectQueryErrors, LevelOfDetailCannotBeWrittenAsFft) {
+    if (!shared_data_available()) GTEST_SKIP();
+    const FftFile file(shared_data("reference/small-sdstream.fft"));
+    const BlockIndex index = BlockIndex::load(file);
+    Query q;
+    q.view = ViewSelection{};
+    q.view->camera.position = {0, 0, 3000};
+    q.view->camera.far_mm = 5000;
+    q.view->lod = Viewport{100, 100};
+    const auto runs = select_runs(file, index, q);
+    ASSERT_FALSE(runs.empty());
+    ASSERT_GT(runs.front().coarse_blocks, 0u);
+    TempDir dir;
+    EXPECT_THROW(write_fft_subset(file, runs, dir.file("x.fft"), false), Error);
+    EXPECT_FALSE(std::filesystem::exists(dir.file("x.fft")));
+}
+
+}  // namespace
