@@ -2,6 +2,7 @@
 # (DecodeOptions::decoder, parse_decoder, available_decoders), so that the
 # fuzz targets run every decoder this CPU has. A compile-only check.
 include(CheckCXXSourceCompiles)
+unset(FIBLET_HAS_DECODER_CHOICE CACHE)  # re-check at each configure: decode.hpp changes under it
 set(CMAKE_REQUIRED_INCLUDES ${PROJECT_SOURCE_DIR}/libfiblet/include)
 set(CMAKE_REQUIRED_FLAGS "-std=c++20")
 check_cxx_source_compiles("
