@@ -3,8 +3,8 @@
 // OUT_DIR/tck_reader_fuzz and compress_fuzz: the small shared .tck files
 // (conformance files, valid and invalid, and the real bundles) and hand-made
 // edge files;
-// OUT_DIR/fft_file_fuzz: those compressed, in several layouts, with and
-// without the fiblet trailer; OUT_DIR/decode_blocks_fuzz: their blocks with
+// OUT_DIR/fft_file_fuzz: those compressed, in several layouts (8- and 16-bit
+// codes), with and without the fiblet trailer; OUT_DIR/decode_blocks_fuzz: their blocks with
 // the parameters header of that target.
 #include <cmath>
 #include <cstdio>
@@ -129,7 +129,8 @@ std::string blocks_seed(const fs::path& fft) {
     const FftHeader& h = f.header();
     auto u16 = [](double v) { return std::uint16_t(std::clamp(std::lround(v), 0l, 65535l)); };
     std::string s;
-    s += char(h.points_per_block - 2);
+    if (h.direction_bits() == 16 && h.points_per_block > 129) return {};  // beyond the target's range
+    s += char((h.direction_bits() == 16 ? 0x80 : 0) | (h.points_per_block - 2));
     append_raw(s, u16(h.ratio * 32768.0 - 1));
     append_raw(s, u16(h.step * 65536.0));
     append_raw(s, u16((std::log2(h.scaling) + 20.0) / 40.0 * 65536.0));
@@ -181,6 +182,17 @@ int main(int argc, char** argv) {
                 write_file(fft_dir / (stem + "-no-trailer.fft"), bytes.substr(0, f.header().file_bytes()));
                 write_file(blocks_dir / (stem + ".blocks"), blocks_seed(fft));
             }
+        }
+        // The 16-bit variant (formats/fft16.md), with its default and a short block.
+        for (std::uint32_t ppb : {0u, 7u}) {
+            const fs::path fft = fft_dir / (stem + "-16bit-ppb" + std::to_string(ppb) + ".fft");
+            CompressOptions options;
+            options.direction_bits = 16;
+            options.points_per_block = ppb;
+            if (!compress_seed(e.path(), fft, options)) continue;
+            ++n_fft;
+            if (const std::string b = blocks_seed(fft); !b.empty())
+                write_file(blocks_dir / (stem + "-16bit-ppb" + std::to_string(ppb) + ".blocks"), b);
         }
     }
     fs::copy(tck_dir, compress_dir, fs::copy_options::overwrite_existing | fs::copy_options::recursive);

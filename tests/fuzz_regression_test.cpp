@@ -74,19 +74,26 @@ TEST(FuzzRegression, FftTargets) {
     if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
     test::TempDir dir;
     compress_tck(test::shared_data("bundles/AF_L.tck"), dir.file("a.fft"), {});
-    const std::string good = test::read_file(dir.file("a.fft"));
-    run(fuzz::fft_target, good, "AF_L.fft");
+    CompressOptions wide;
+    wide.direction_bits = 16;
+    compress_tck(test::shared_data("bundles/AF_L.tck"), dir.file("a16.fft"), wide);
     // Every 97th byte flipped in turn: checksum failures, malformed blocks,
     // broken headers and LUT entries, each through every decoder.
-    for (std::size_t i = 0; i < good.size(); i += 97) {
-        std::string bad = good;
-        bad[i] = char(bad[i] ^ (1 << (i % 8)));
-        run(fuzz::fft_target, bad, "AF_L.fft with byte " + std::to_string(i) + " flipped");
+    for (const char* name : {"a.fft", "a16.fft"}) {
+        const std::string good = test::read_file(dir.file(name));
+        run(fuzz::fft_target, good, name);
+        for (std::size_t i = 0; i < good.size(); i += 97) {
+            std::string bad = good;
+            bad[i] = char(bad[i] ^ (1 << (i % 8)));
+            run(fuzz::fft_target, bad, std::string(name) + " with byte " + std::to_string(i) + " flipped");
+        }
     }
     // The blocks target on the file's blocks, under a few parameter headers.
     const FftFile f(dir.file("a.fft"));
     const std::vector<std::uint8_t> blocks = f.read_blocks(0, f.header().blocks);
-    for (const char* params : {"\x3a\xff\x0f\x00\x10\x00\xa0\x00\x00\x00\x00\x00\x00", "\x00\x01\x00\xff\xff\xff\xff\x10\x80\x10\x80\x10\x80"}) {
+    for (const char* params : {"\x3a\xff\x0f\x00\x10\x00\xa0\x00\x00\x00\x00\x00\x00",
+                               "\x00\x01\x00\xff\xff\xff\xff\x10\x80\x10\x80\x10\x80",
+                               "\xfc\xff\x0f\x00\x10\x00\xa0\x00\x00\x00\x00\x00\x00"}) {  // 16-bit, 126 points
         std::string in(params, fuzz::kBlocksInputHeader);
         in.append(reinterpret_cast<const char*>(blocks.data()), blocks.size());
         run(fuzz::blocks_target, in, "blocks");
