@@ -165,7 +165,9 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
         } else if (i0 > 0) {
             p1 = {2 * p0.x - fiber[i0 - 1].x, 2 * p0.y - fiber[i0 - 1].y, 2 * p0.z - fiber[i0 - 1].z};
         }
-        const auto [a0, a1] = write_block_head(h, block, p0, p1, fiber_id, b, n_blocks, n);
+        // Not a structured binding: clang 14 (the fuzz build) cannot capture one in a lambda.
+        const std::pair<Vec3f, Vec3f> anchors = write_block_head(h, block, p0, p1, fiber_id, b, n_blocks, n);
+        const Vec3f a0 = anchors.first, a1 = anchors.second;
         emit(a0);
         if (n < 2) continue;
         emit(a1);
