@@ -66,12 +66,12 @@ void parse_size(const std::string& text, int& width, int& height) {
     if (x != std::string::npos) {
         const std::string w = text.substr(0, x), h = text.substr(x + 1);
         const long lw = std::strtol(w.c_str(), &e1, 10), lh = std::strtol(h.c_str(), &e2, 10);
-        if (!w.empty() && !h.empty() && *e1 == '\0' && *e2 == '\0' && lw >= 1 && lh >= 1 && lw <= 16384 && lh <= 16384) {
+        if (!w.empty() && !h.empty() && *e1 == '\0' && *e2 == '\0' && lw >= 1 && lh >= 1 && lw <= 8192 && lh <= 8192) {
             width = int(lw), height = int(lh);
             return;
         }
     }
-    throw Error(Errc::invalid_argument, "--size: '" + text + "' is not WIDTHxHEIGHT (1..16384 pixels a side)");
+    throw Error(Errc::invalid_argument, "--size: '" + text + "' is not WIDTHxHEIGHT (1..8192 pixels a side)");
 }
 
 viewer::RenderOptions render_options_from(const ViewerArgs& a) {

@@ -21,6 +21,8 @@ void RenderTarget::resize(int width, int height) {
 }
 
 void RenderTarget::allocate() {
+    while (glGetError() != GL_NO_ERROR) {
+    }
     auto texture = [&](GLenum format) {
         GLuint t = 0;
         glCreateTextures(GL_TEXTURE_2D, 1, &t);
@@ -38,6 +40,9 @@ void RenderTarget::allocate() {
     glNamedFramebufferTexture(f, GL_DEPTH_ATTACHMENT, depth_.get(), 0);
     const GLenum draw_buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
     glNamedFramebufferDrawBuffers(f, 2, draw_buffers);
+    if (glGetError() == GL_OUT_OF_MEMORY)
+        throw Error(Errc::unsupported, "the GL driver has no memory for a " + std::to_string(width_) + "x" +
+                                           std::to_string(height_) + " image");
     if (glCheckNamedFramebufferStatus(f, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
         throw Error(Errc::unsupported, "the GL driver cannot render to an RGBA8 + R32UI + depth framebuffer");
 }
