@@ -155,9 +155,11 @@ TEST_F(SelectIndex, FrustumCandidatesCoverEveryBlockSphereThatMeetsTheFrustum) {
         const Frustum f = frustum_from_camera(gen.camera());
         std::vector<std::uint64_t> bits;
         index.blocks_near_frustum(f, index.max_sphere_radius() * (1 + 1e-5f) + 1e-3f, bits);
-        for (std::size_t b = 0; b < d.blocks.size(); ++b)
-            if (sphere_intersects_frustum(f, d.blocks[b].sphere.center, d.blocks[b].sphere.radius))
+        for (std::size_t b = 0; b < d.blocks.size(); ++b) {
+            if (sphere_intersects_frustum(f, d.blocks[b].sphere.center, d.blocks[b].sphere.radius)) {
                 ASSERT_TRUE(bit(bits, b)) << "camera " << i << " block " << b;
+            }
+        }
     }
 }
 

@@ -250,7 +250,9 @@ TEST_P(SelectQuery, ChunkedOutputEqualsTheWholeOutput) {
     EXPECT_EQ(joined.xyz, whole.xyz);
     EXPECT_EQ(joined.offsets, whole.offsets);
     EXPECT_EQ(joined_runs.size(), runs.size());
-    if (whole.point_count() > 2000) EXPECT_GT(chunks, 1u);
+    if (whole.point_count() > 2000) {
+        EXPECT_GT(chunks, 1u);
+    }
 }
 
 TEST_P(SelectQuery, SubsetFileDecodesToTheSelection) {

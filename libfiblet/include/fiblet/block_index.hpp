@@ -106,6 +106,8 @@ public:
 private:
     BlockIndex() = default;
     void set_blocks(std::vector<Aabb> boxes);  // sorts and builds the hierarchy
+    template <class BoxOf>
+    void build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of);  // (Morton key << 32 | block)
     template <class Classify>
     void collect(const Classify& classify, std::vector<std::uint64_t>& bits) const;
 

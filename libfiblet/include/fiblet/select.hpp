@@ -47,7 +47,14 @@ struct Region {
 
     static Region sphere(Vec3f center, float radius);
     static Region box_between(Vec3f min, Vec3f max);
-    bool contains(Vec3f p) const;
+    bool contains(Vec3f p) const {
+        if (shape == Shape::sphere) {
+            const float dx = p.x - center.x, dy = p.y - center.y, dz = p.z - center.z;
+            return dx * dx + dy * dy + dz * dz <= radius * radius;
+        }
+        return p.x >= box.min.x && p.x <= box.max.x && p.y >= box.min.y && p.y <= box.max.y && p.z >= box.min.z &&
+               p.z <= box.max.z;
+    }
 };
 
 enum class RoiMode { fibers, blocks };
@@ -113,7 +120,7 @@ struct SelectedChunk {
 
 struct SelectOptions {
     bool points = true;                       // decode and output points
-    std::size_t chunk_points = 1u << 20;      // points per chunk handed to the sink
+    std::size_t chunk_points = 1u << 18;      // points per chunk handed to the sink
 };
 
 // Runs a query, handing the output to `sink` in file order, a chunk of whole

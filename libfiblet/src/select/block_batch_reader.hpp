@@ -12,7 +12,7 @@ namespace fiblet::detail {
 
 class BlockBatchReader {
 public:
-    explicit BlockBatchReader(const FftFile& file, std::uint64_t max_gap_blocks = 32);
+    explicit BlockBatchReader(const FftFile& file, std::uint64_t max_gap_blocks = 8);
 
     // Reads `blocks` (ascending, unique); block(i) then points at blocks[i].
     void read(const std::vector<std::uint32_t>& blocks);

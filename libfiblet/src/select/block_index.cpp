@@ -81,9 +81,21 @@ BlockIndex BlockIndex::load(const FftFile& file) {
         throw Error(Errc::fft_format, file.path() + ": malformed BIDX (block index) chunk: its fibers hold " +
                                           std::to_string(total) + " points, the header says " +
                                           std::to_string(h.points));
-    std::vector<Aabb> boxes(c.blocks);
-    for (std::uint64_t b = 0; b < c.blocks; ++b) boxes[b] = c.grid.decode(c.codes[b]);
-    index.set_blocks(std::move(boxes));
+    // Morton keys straight from the codes' cells, then boxes decoded in that order.
+    const detail::IndexBoxDecoder decoder(c.grid);
+    unsigned shift = 0;
+    while ((decoder.max_centre2() >> shift) >= 1024) ++shift;
+    std::vector<std::uint64_t> keyed(c.blocks);
+    for (std::uint64_t b = 0; b < c.blocks; ++b) {
+        std::uint64_t key = std::uint64_t{1} << 30;
+        if (!decoder.unbounded(c.codes[b])) {
+            std::uint32_t m[3];
+            decoder.centre2(c.codes[b], m);
+            key = spread_bits(m[0] >> shift) | spread_bits(m[1] >> shift) << 1 | spread_bits(m[2] >> shift) << 2;
+        }
+        keyed[b] = key << 32 | b;
+    }
+    index.build(keyed, [&](std::uint32_t b) { return decoder.box(c.codes[b]); });
     return index;
 }
 
@@ -151,15 +163,22 @@ void BlockIndex::set_blocks(std::vector<Aabb> boxes) {
         }
         keyed[i] = key << 32 | i;
     }
+    build(keyed, [&](std::uint32_t b) { return boxes[b]; });
+}
+
+template <class BoxOf>
+void BlockIndex::build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of) {
+    const std::size_t n = keyed.size();
     radix_sort(keyed, 31);
-    order_.resize(n);
+    // Filled by push_back: no zeroing pass over memory written right after.
+    order_.clear(), order_.reserve(n);
+    sorted_boxes_.clear(), sorted_boxes_.reserve(n);
     rank_.resize(n);
-    sorted_boxes_.resize(n);
     for (std::size_t pos = 0; pos < n; ++pos) {
         const auto block = std::uint32_t(keyed[pos]);
-        order_[pos] = block;
+        order_.push_back(block);
         rank_[block] = std::uint32_t(pos);
-        sorted_boxes_[pos] = boxes[block];
+        sorted_boxes_.push_back(box_of(block));
     }
     // Levels of the tree: each node bounds kFanout consecutive children.
     levels_.clear();

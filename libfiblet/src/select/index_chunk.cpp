@@ -72,21 +72,17 @@ std::uint32_t IndexGrid::encode(const Aabb& box) const {
     return code;
 }
 
-Aabb IndexGrid::decode(std::uint32_t code) const {
-    if (code == unbounded_code())
-        return {{-kUnboundedExtentMm, -kUnboundedExtentMm, -kUnboundedExtentMm},
-                {kUnboundedExtentMm, kUnboundedExtentMm, kUnboundedExtentMm}};
-    float lo[3], hi[3];
-    const float o[3] = {origin.x, origin.y, origin.z};
-    const std::uint32_t levels = axis_levels();
+IndexBoxDecoder::IndexBoxDecoder(const IndexGrid& g)
+    : levels_(g.axis_levels()), e_(g.extent_levels), unbounded_(g.unbounded_code()) {
+    const float o[3] = {g.origin.x, g.origin.y, g.origin.z};
     for (int a = 0; a < 3; ++a) {
-        const std::uint32_t c = code % levels;
-        code /= levels;
-        const std::uint32_t i = c / extent_levels, e = c % extent_levels;
-        lo[a] = o[a] + float(i) * cell;
-        hi[a] = o[a] + float(i + e) * cell;
+        lo_[a].resize(levels_), hi_[a].resize(levels_);
+        for (std::uint32_t c = 0; c < levels_; ++c) {
+            const std::uint32_t i = c / e_, e = c % e_;
+            lo_[a][c] = o[a] + float(i) * g.cell;
+            hi_[a][c] = o[a] + float(i + e) * g.cell;
+        }
     }
-    return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
 }
 
 std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c) {

@@ -94,34 +94,15 @@ private:
     std::uint64_t fiber_ = 0, in_fiber_ = 0;
 };
 
-// Blocks copied into one buffer and decoded with one call.
-class DecodeStage {
-public:
-    explicit DecodeStage(const DecodeContext& ctx) : ctx_(ctx), bb_(ctx.header.block_bytes()) {}
-    void clear() { raw_.clear(), first_point_.clear(); }
-    std::size_t add(const std::uint8_t* block) {
-        raw_.insert(raw_.end(), block, block + bb_);
-        first_point_.push_back(0);
-        return first_point_.size() - 1;
-    }
-    std::size_t size() const { return first_point_.size(); }
-    void decode() {
-        const std::size_t n = size();
-        std::size_t total = count_block_points(ctx_, raw_.data(), n);
-        xyz_.resize(3 * total);
-        detail::decode_selected_blocks(ctx_, raw_.data(), n, xyz_.data());
-        std::size_t at = 0;
-        for (std::size_t i = 0; i < n; ++i) first_point_[i] = at, at += BlockView{&raw_[i * bb_]}.point_count();
-    }
-    const float* points(std::size_t i) const { return &xyz_[3 * first_point_[i]]; }
-
-private:
-    const DecodeContext& ctx_;
-    std::uint32_t bb_;
-    std::vector<std::uint8_t> raw_;
-    std::vector<std::size_t> first_point_;
-    std::vector<float> xyz_;
-};
+// Decodes `count` consecutive blocks (contiguous in memory) into xyz, which
+// must have room; returns their point counts' sum. Validates the counts.
+std::size_t decode_into(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count,
+                        std::vector<float>& xyz, std::size_t at_point) {
+    const std::size_t n = count_block_points(ctx, blocks, count);
+    if (xyz.size() < 3 * (at_point + n)) xyz.resize(3 * (at_point + n));
+    detail::decode_selected_blocks(ctx, blocks, count, &xyz[3 * at_point]);
+    return n;
+}
 
 bool any_point_in(const Region& r, const float* p, std::uint32_t n) {
     for (std::uint32_t k = 0; k < n; ++k, p += 3)
@@ -142,15 +123,35 @@ Vec3f first_point(const FftHeader& h, const std::uint8_t* block) {
 }
 
 // Assembles kept blocks into runs and hands chunks of them to the sink.
+// Fine blocks are decoded straight into the output buffer, after its end
+// (decode_space()), then kept in place or moved down over rejected ones.
 class RunWriter {
 public:
-    RunWriter(const SelectOptions& o, const std::function<void(const SelectedChunk&)>& sink, SelectionStats& stats)
-        : options_(o), sink_(sink), stats_(stats) {}
+    RunWriter(const SelectOptions& o, const std::function<void(const SelectedChunk&)>& sink, SelectionStats& stats,
+              std::size_t max_batch_points)
+        : options_(o), sink_(sink), stats_(stats) {
+        // Room for a chunk plus a batch: no reallocation, hence no copy.
+        chunk_.lines.xyz.reserve(3 * (o.chunk_points + 2 * max_batch_points));
+    }
 
-    // A fine block with its n points (points may be null when not output).
-    void fine(std::uint64_t fiber, std::uint64_t block, const float* points, std::uint32_t n) {
+    // Closes the open run unless `block` of `fiber` continues it.
+    void break_unless_continues(std::uint64_t fiber, std::uint64_t block) {
+        if (open_ && (run_.fiber != fiber || run_.first_block + run_.block_count != block)) close();
+    }
+    // The output buffer, where points decoded at point index end() and after
+    // wait for fine() (kept) or nothing (rejected).
+    std::vector<float>& buffer() { return chunk_.lines.xyz; }
+    std::size_t end() const { return end_; }
+
+    // A fine block of n points, decoded at `src` (at or after end(); null
+    // when points are not output).
+    void fine(std::uint64_t fiber, std::uint64_t block, const float* src, std::uint32_t n) {
         extend(fiber, block);
-        if (options_.points) append(points, n);
+        if (options_.points && src) {
+            float* dst = &chunk_.lines.xyz[3 * end_];
+            if (src != dst) std::memmove(dst, src, 12 * std::size_t(n));
+            end_ += n;
+        }
         stats_.points += n;
         has_end_ = false;
     }
@@ -158,11 +159,22 @@ public:
     void coarse(std::uint64_t fiber, std::uint64_t block, Vec3f first, const Vec3f* end) {
         extend(fiber, block);
         ++run_.coarse_blocks, ++stats_.coarse_blocks;
-        const float p[3] = {first.x, first.y, first.z};
-        if (options_.points) append(p, 1);
-        ++stats_.points;
+        put(first);
         has_end_ = end != nullptr;
-        if (end) end_ = *end;
+        if (end) end_point_ = *end;
+    }
+    // Hands the closed runs to the sink when the chunk is full (the open
+    // run's points move to the next chunk); only where no decoded points wait
+    // after end().
+    void maybe_flush() {
+        if (chunk_.runs.empty() || (end_ < options_.chunk_points && chunk_.runs.size() < options_.chunk_points)) return;
+        const std::size_t done = options_.points ? chunk_.lines.offsets.back() : 0;
+        auto& xyz = chunk_.lines.xyz;
+        open_points_.assign(xyz.begin() + std::ptrdiff_t(3 * done), xyz.begin() + std::ptrdiff_t(3 * end_));
+        end_ = done;
+        flush();
+        xyz.assign(open_points_.begin(), open_points_.end());
+        end_ = open_points_.size() / 3;
     }
     void finish() {
         close();
@@ -171,7 +183,7 @@ public:
 
 private:
     void extend(std::uint64_t fiber, std::uint64_t block) {
-        if (open_ && (run_.fiber != fiber || run_.first_block + run_.block_count != block)) close();
+        break_unless_continues(fiber, block);
         if (!open_) {
             if (fiber != last_fiber_) ++stats_.fibers, last_fiber_ = fiber;
             run_ = {fiber, block, 0, 0};
@@ -179,36 +191,43 @@ private:
         }
         ++run_.block_count, ++stats_.blocks;
     }
-    void append(const float* p, std::uint32_t n) { chunk_.lines.xyz.insert(chunk_.lines.xyz.end(), p, p + 3 * n); }
+    void put(Vec3f p) {
+        if (options_.points) {
+            auto& xyz = chunk_.lines.xyz;
+            if (xyz.size() < 3 * (end_ + 1)) xyz.resize(3 * (end_ + 1));
+            xyz[3 * end_] = p.x, xyz[3 * end_ + 1] = p.y, xyz[3 * end_ + 2] = p.z;
+            ++end_;
+        }
+        ++stats_.points;
+    }
     void close() {
         if (!open_) return;
-        if (has_end_) {
-            const float p[3] = {end_.x, end_.y, end_.z};
-            if (options_.points) append(p, 1);
-            ++stats_.points;
-            has_end_ = false;
-        }
+        // A pending end point may land on decoded points waiting after end(),
+        // but only on those of the rejected block that broke the run.
+        if (has_end_) put(end_point_), has_end_ = false;
         open_ = false;
         ++stats_.runs;
         chunk_.runs.push_back(run_);
-        if (options_.points) chunk_.lines.offsets.push_back(chunk_.lines.xyz.size() / 3);
-        if (chunk_.lines.xyz.size() / 3 >= options_.chunk_points || chunk_.runs.size() >= options_.chunk_points)
-            flush();
+        if (options_.points) chunk_.lines.offsets.push_back(end_);
     }
     void flush() {
+        chunk_.lines.xyz.resize(3 * end_);
         sink_(chunk_);
         chunk_.lines.xyz.clear();
         chunk_.lines.offsets.assign(1, 0);
         chunk_.runs.clear();
+        end_ = 0;
     }
 
     const SelectOptions& options_;
     const std::function<void(const SelectedChunk&)>& sink_;
     SelectionStats& stats_;
     SelectedChunk chunk_;
+    std::size_t end_ = 0;  // points of the chunk so far
+    std::vector<float> open_points_;
     SelectedRun run_;
     bool open_ = false, has_end_ = false;
-    Vec3f end_{};
+    Vec3f end_point_{};
     std::uint64_t last_fiber_ = ~std::uint64_t{0};
 };
 
@@ -292,18 +311,23 @@ private:
         CandidateBlocks candidates(file_, keep_, &to_test);
         std::vector<std::uint32_t> blocks;
         std::vector<std::uint64_t> fibers;
-        DecodeStage stage(ctx_);
+        const std::uint32_t bb = h_.block_bytes();
         while (candidates.next(kBatchBlocks, blocks, fibers)) {
             reader_.read(blocks);
-            stage.clear();
-            for (std::size_t i = 0; i < blocks.size(); ++i) stage.add(reader_.block(i));
-            stage.decode();
+            // Runs of consecutive blocks are contiguous in the read buffer: one decode call each.
+            std::vector<std::size_t> first_point(blocks.size() + 1, 0);
+            for (std::size_t i = 0, j; i < blocks.size(); i = j) {
+                for (j = i + 1; j < blocks.size() && blocks[j] == blocks[j - 1] + 1;) ++j;
+                decode_into(ctx_, reader_.block(i), j - i, scratch_, first_point[i]);
+                for (std::size_t k = i; k < j; ++k)
+                    first_point[k + 1] = first_point[k] + BlockView{reader_.block(i) + (k - i) * bb}.point_count();
+            }
             stats_.blocks_decoded += blocks.size();
             for (std::size_t i = 0; i < blocks.size(); ++i) {
                 const std::uint64_t f = fibers[i], b = blocks[i];
                 if (excluded[f]) continue;
-                const float* p = stage.points(i);
-                const std::uint32_t n = BlockView{reader_.block(i)}.point_count();
+                const float* p = &scratch_[3 * first_point[i]];
+                const auto n = std::uint32_t(first_point[i + 1] - first_point[i]);
                 for (std::size_t k = 0; k < k_inc; ++k)
                     if (!(met[f] >> k & 1) && has_bit(inc[k], b) && any_point_in(q_.include[k], p, n))
                         met[f] |= std::uint64_t{1} << k;
@@ -340,14 +364,22 @@ private:
         }
         if (blocks_mode && !q_.exclude.empty()) exc = near_any(q_.exclude);
 
-        RunWriter out(options_, sink, stats_);
+        RunWriter out(options_, sink, stats_, kBatchBlocks * h_.points_per_block);
         CandidateBlocks candidates(file_, keep_, only ? &*only : nullptr);
         std::vector<std::uint32_t> blocks, need;
         std::vector<std::uint64_t> fibers;
-        std::vector<std::size_t> at_need, next_at_need, staged;
+        std::vector<std::size_t> at_need, next_at_need;
         enum Kind : std::uint8_t { dropped, fine, coarse };
         std::vector<Kind> kind;
-        DecodeStage stage(ctx_);
+        const std::uint32_t bb = h_.block_bytes();
+        auto region_test = [&](std::size_t i) {
+            return blocks_mode && (!q_.include.empty() || (!exc.empty() && has_bit(exc, blocks[i])));
+        };
+        auto passes_regions = [&](std::size_t i, const float* p, std::uint32_t n) {
+            if (!region_test(i)) return true;
+            if (!q_.include.empty() && !any_point_in(q_.include, p, n)) return false;
+            return !(!exc.empty() && has_bit(exc, blocks[i]) && any_point_in(q_.exclude, p, n));
+        };
         while (candidates.next(kBatchBlocks, blocks, fibers)) {
             // With a level of detail, the next block's first point may end a segment.
             need.clear(), at_need.assign(blocks.size(), 0), next_at_need.assign(blocks.size(), SIZE_MAX);
@@ -362,56 +394,60 @@ private:
             }
             reader_.read(need);
 
-            // Header tests, then one decode call for the blocks whose points are needed.
-            kind.assign(blocks.size(), dropped);
-            staged.assign(blocks.size(), SIZE_MAX);
-            stage.clear();
-            for (std::size_t i = 0; i < blocks.size(); ++i) {
-                const std::uint8_t* block = reader_.block(at_need[i]);
-                kind[i] = fine;
-                if (q_.view) {
-                    const Sphere s = block_bounding_sphere(h_, block);
-                    if (cull && !sphere_intersects_frustum(frustum, s.center, s.radius)) {
+            // Header tests: the block's sphere against the frustum and the level of detail.
+            kind.assign(blocks.size(), fine);
+            if (q_.view)
+                for (std::size_t i = 0; i < blocks.size(); ++i) {
+                    const Sphere s = block_bounding_sphere(h_, reader_.block(at_need[i]));
+                    if (cull && !sphere_intersects_frustum(frustum, s.center, s.radius))
                         kind[i] = dropped;
-                        continue;
-                    }
-                    if (lod && block_is_coarse(q_.view->camera, *q_.view->lod, s.center, s.radius, q_.view->lod_pixels))
+                    else if (lod && block_is_coarse(q_.view->camera, *q_.view->lod, s.center, s.radius,
+                                                    q_.view->lod_pixels))
                         kind[i] = coarse;
                 }
-                const bool region_test = blocks_mode && (!q_.include.empty() || (!exc.empty() && has_bit(exc, blocks[i])));
-                const bool last_of_fiber = std::uint64_t(blocks[i]) + 1 == file_.block_end(fibers[i] + 1);
-                const bool needs_points = region_test || (kind[i] == fine && options_.points) ||
-                                          (kind[i] == coarse && last_of_fiber && BlockView{block}.point_count() > 1);
-                if (needs_points) staged[i] = stage.add(block);
-            }
-            if (stage.size() > 0) stage.decode();
-            stats_.blocks_decoded += stage.size();
 
-            for (std::size_t i = 0; i < blocks.size(); ++i) {
+            for (std::size_t i = 0, j; i < blocks.size(); i = j) {
+                j = i + 1;
                 if (kind[i] == dropped) continue;
                 const std::uint8_t* block = reader_.block(at_need[i]);
-                const std::uint32_t n = BlockView{block}.point_count();
-                const float* p = staged[i] == SIZE_MAX ? nullptr : stage.points(staged[i]);
-                if (blocks_mode && p && (!q_.include.empty() || (!exc.empty() && has_bit(exc, blocks[i])))) {
-                    const bool meets = q_.include.empty() || any_point_in(q_.include, p, n);
-                    if (!meets || (!exc.empty() && has_bit(exc, blocks[i]) && any_point_in(q_.exclude, p, n)))
-                        continue;
-                }
-                if (kind[i] == fine) {
-                    out.fine(fibers[i], blocks[i], p, n);
+                if (kind[i] == coarse) {
+                    // First point, then the next block's first point or the fiber's last point.
+                    const std::uint32_t n = BlockView{block}.point_count();
+                    const bool last = next_at_need[i] == SIZE_MAX;
+                    if (region_test(i) || (last && n > 1)) {
+                        decode_into(ctx_, block, 1, scratch_, 0);
+                        ++stats_.blocks_decoded;
+                        if (!passes_regions(i, scratch_.data(), n)) continue;
+                    }
+                    Vec3f end{};
+                    if (!last) end = first_point(h_, reader_.block(next_at_need[i]));
+                    else if (n > 1) end = {scratch_[3 * (n - 1)], scratch_[3 * (n - 1) + 1], scratch_[3 * (n - 1) + 2]};
+                    out.coarse(fibers[i], blocks[i], first_point(h_, block), last && n < 2 ? nullptr : &end);
+                    out.maybe_flush();
                     continue;
                 }
-                // Coarse: first point, then the next block's first point or the fiber's last point.
-                Vec3f end{};
-                const Vec3f* end_ptr = nullptr;
-                if (next_at_need[i] != SIZE_MAX) {
-                    end = first_point(h_, reader_.block(next_at_need[i]));
-                    end_ptr = &end;
-                } else if (n > 1) {
-                    end = {p[3 * (n - 1)], p[3 * (n - 1) + 1], p[3 * (n - 1) + 2]};
-                    end_ptr = &end;
+                // Fine blocks that follow each other: decoded with one call,
+                // straight into the output, then kept or dropped in place.
+                bool test = region_test(i);
+                while (j < blocks.size() && kind[j] == fine && blocks[j] == blocks[j - 1] + 1) test |= region_test(j++);
+                if (!options_.points && !test) {
+                    for (std::size_t k = i; k < j; ++k)
+                        out.fine(fibers[k], blocks[k], nullptr, BlockView{reader_.block(at_need[k])}.point_count());
+                    out.maybe_flush();
+                    continue;
                 }
-                out.coarse(fibers[i], blocks[i], first_point(h_, block), end_ptr);
+                out.break_unless_continues(fibers[i], blocks[i]);
+                const std::size_t base = out.end();
+                decode_into(ctx_, block, j - i, out.buffer(), base);
+                stats_.blocks_decoded += j - i;
+                std::size_t at = base;
+                for (std::size_t k = i; k < j; ++k) {
+                    const std::uint32_t n = BlockView{block + (k - i) * bb}.point_count();
+                    const float* p = &out.buffer()[3 * at];
+                    at += n;
+                    if (passes_regions(k, p, n)) out.fine(fibers[k], blocks[k], options_.points ? p : nullptr, n);
+                }
+                out.maybe_flush();
             }
         }
         out.finish();
@@ -425,6 +461,7 @@ private:
     DecodeContext ctx_;
     detail::BlockBatchReader reader_;
     std::vector<std::uint8_t> keep_;
+    std::vector<float> scratch_;  // decoded points that are tested, not output
     SelectionStats stats_;
 };
 
