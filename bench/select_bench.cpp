@@ -93,10 +93,15 @@ Query make_query(Family family, double t) {
             break;
         case Family::frustum:
         case Family::frustum_lod: {
+            // A camera 250 mm away, zooming in: field of view t degrees and
+            // a depth slab of +-2t mm around the centre.
             ViewSelection v;
             v.camera.position = {0, -30, 250};
             v.camera.target = centre;
-            v.camera.fov_y_deg = float(t);
+            const float d = std::sqrt(30.0f * 30.0f + 250.0f * 250.0f);
+            v.camera.fov_y_deg = float(t) + 0.01f;
+            v.camera.near_mm = d - 2 * float(t);
+            v.camera.far_mm = d + 2 * float(t) + 0.01f;
             v.camera.aspect = 1.0f;
             if (family == Family::frustum_lod) v.lod = Viewport{1024, 1024};
             q.view = v;
@@ -128,6 +133,7 @@ void report(benchmark::State& state, const SelectionStats& s) {
     state.counters["kept_pct"] = 100.0 * double(s.blocks) / blocks;
     state.counters["read_pct"] = 100.0 * double(s.blocks_read) / blocks;
     state.counters["decoded_pct"] = 100.0 * double(s.blocks_decoded) / blocks;
+    state.counters["coarse_pct"] = 100.0 * double(s.coarse_blocks) / blocks;
     state.SetLabel(bench_file().label);
 }
 
@@ -157,7 +163,7 @@ void BM_SelectQuery(benchmark::State& state, Family family) {
 BENCHMARK_CAPTURE(BM_SelectQuery, RegionBlocks, Family::region_blocks)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SelectQuery, RegionFibers, Family::region_fibers)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SelectQuery, Frustum, Family::frustum)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_SelectQuery, FrustumLod, Family::frustum_lod)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SelectQuery, FrustumLod, Family::frustum_lod)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SelectQuery, RandomFibers, Family::random_fibers)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 
 void BM_SelectEverything(benchmark::State& state) {
