@@ -19,25 +19,26 @@ using namespace fiblet::test;
 
 namespace {
 
+// Files are compressed on first use (CTest runs every test in its own process).
 class SelectIndex : public ::testing::Test {
 protected:
-    static void SetUpTestSuite() {
-        if (!shared_data_available()) return;
-        dir_ = new TempDir;
-        CompressOptions o;
-        o.threads = 2;
-        compress_tck(shared_data("small-sdstream.tck"), dir_->file("sdstream.fft"), o);
-        compress_tck(shared_data("dwi-small64d-ifod1.tck"), dir_->file("dwi.fft"), o);
-    }
-    static void TearDownTestSuite() {
-        delete dir_;
-        dir_ = nullptr;
-    }
+    static void TearDownTestSuite() { dir_.reset(); }
     void SetUp() override {
-        if (!dir_) GTEST_SKIP() << "shared test data not found";
+        if (!shared_data_available()) GTEST_SKIP() << "shared test data not found";
     }
-    static std::string fiblet_file() { return dir_->file("sdstream.fft"); }
-    static inline TempDir* dir_ = nullptr;
+    static std::string compressed(const std::string& tck, const std::string& name) {
+        if (!dir_) dir_ = std::make_unique<TempDir>();
+        const std::string out = dir_->file(name);
+        if (!std::filesystem::exists(out)) {
+            CompressOptions o;
+            o.threads = 2;
+            compress_tck(shared_data(tck), out, o);
+        }
+        return out;
+    }
+    static std::string fiblet_file() { return compressed("small-sdstream.tck", "sdstream.fft"); }
+    static std::string dwi_file() { return compressed("dwi-small64d-ifod1.tck", "dwi.fft"); }
+    static inline std::unique_ptr<TempDir> dir_;
 };
 
 bool bit(const std::vector<std::uint64_t>& bits, std::size_t b) { return (bits[b >> 6] >> (b & 63)) & 1; }
@@ -60,7 +61,7 @@ void expect_boxes_hold_points(const FftFile& file, const BlockIndex& index, cons
 }
 
 TEST_F(SelectIndex, CompressStoresAnIndexWhoseBoxesHoldEveryPoint) {
-    for (const std::string& path : {fiblet_file(), dir_->file("dwi.fft")}) {
+    for (const std::string& path : {fiblet_file(), dwi_file()}) {
         const FftFile file(path);
         ASSERT_NE(file.find_chunk(kBlockIndexTag), nullptr);
         const BlockIndex index = BlockIndex::load(file);
@@ -105,7 +106,7 @@ TEST_F(SelectIndex, StoredBoxesAreWithinACellOfTheExactBoxes) {
 }
 
 TEST_F(SelectIndex, ChunkHasTheDocumentedSize) {
-    for (const std::string& path : {fiblet_file(), dir_->file("dwi.fft")}) {
+    for (const std::string& path : {fiblet_file(), dwi_file()}) {
         const FftFile file(path);
         const TrailerChunk* c = file.find_chunk(kBlockIndexTag);
         ASSERT_NE(c, nullptr);
@@ -214,7 +215,7 @@ TEST_F(SelectIndex, MalformedChunksAreRejected) {
 TEST_F(SelectIndex, BlocksOffTheGridAreNeverCulled) {
     // Block 0's bounds replaced by a box far larger than any block: the
     // builder stores it as unbounded, and every query returns it.
-    const FftFile file(dir_->file("dwi.fft"));
+    const FftFile file(dwi_file());
     const DecodedFile d = decode_everything(file);
     IndexBuilder builder(file.header());
     for (std::size_t b = 0; b < d.blocks.size(); ++b) {
@@ -236,7 +237,7 @@ TEST_F(SelectIndex, BlocksOffTheGridAreNeverCulled) {
 }
 
 TEST_F(SelectIndex, BuilderRefusesLayoutsItCannotDescribe) {
-    const FftFile file(dir_->file("dwi.fft"));
+    const FftFile file(dwi_file());
     IndexBuilder builder(file.header());
     const float pts[9] = {0, 0, 0, 0.1f, 0, 0, 0.2f, 0, 0};
     builder.add_block(pts, 3, false);  // partial, yet not the fiber's last block

@@ -26,37 +26,47 @@ struct Subject {
     std::unique_ptr<BlockIndex> stored_or_loaded, computed;
 };
 
+// Each test process builds only the subject its parameter names (CTest
+// runs every test in its own process).
 class SelectQuery : public ::testing::TestWithParam<int> {
 protected:
-    static void SetUpTestSuite() {
-        if (!shared_data_available()) return;
-        dir_ = new TempDir;
-        auto add = [](const std::string& name, const std::string& fft) {
-            auto s = std::make_unique<Subject>();
-            s->name = name;
-            s->file = std::make_unique<FftFile>(fft);
-            s->decoded = decode_everything(*s->file);
-            s->stored_or_loaded = std::make_unique<BlockIndex>(BlockIndex::load(*s->file));
-            s->computed = std::make_unique<BlockIndex>(BlockIndex::compute(*s->file));
-            subjects_.push_back(std::move(s));
-        };
-        CompressOptions o;
-        o.threads = 2;
-        compress_tck(shared_data("small-sdstream.tck"), dir_->file("sdstream.fft"), o);
-        add("fiblet small-sdstream", dir_->file("sdstream.fft"));
-        compress_tck(shared_data("bundles/CST_R-step0.1.tck"), dir_->file("cst.fft"), o);
-        add("fiblet CST_R", dir_->file("cst.fft"));
-        add("official small-sdstream", shared_data("reference/small-sdstream.fft"));
-    }
     static void TearDownTestSuite() {
-        subjects_.clear();
-        delete dir_;
-        dir_ = nullptr;
+        subject_.reset();
+        dir_.reset();
     }
     void SetUp() override {
-        if (subjects_.empty()) GTEST_SKIP() << "shared test data not found";
+        if (!shared_data_available()) GTEST_SKIP() << "shared test data not found";
     }
-    const Subject& subject() const { return *subjects_[std::size_t(GetParam())]; }
+    const Subject& subject() const {
+        if (subject_ && subject_param_ == GetParam()) return *subject_;
+        if (!dir_) dir_ = std::make_unique<TempDir>();
+        auto s = std::make_unique<Subject>();
+        std::string fft;
+        CompressOptions o;
+        o.threads = 2;
+        switch (GetParam()) {
+            case 0:  // short fibers from a real scan
+                s->name = "fiblet dwi-small64d";
+                fft = dir_->file("dwi.fft");
+                compress_tck(shared_data("dwi-small64d-ifod1.tck"), fft, o);
+                break;
+            case 1:  // long real bundle
+                s->name = "fiblet CST_R";
+                fft = dir_->file("cst.fft");
+                compress_tck(shared_data("bundles/CST_R-step0.1.tck"), fft, o);
+                break;
+            default:  // written by another tool, no stored index
+                s->name = "official small-sdstream";
+                fft = shared_data("reference/small-sdstream.fft");
+        }
+        s->file = std::make_unique<FftFile>(fft);
+        s->decoded = decode_everything(*s->file);
+        s->stored_or_loaded = std::make_unique<BlockIndex>(BlockIndex::load(*s->file));
+        s->computed = std::make_unique<BlockIndex>(BlockIndex::compute(*s->file));
+        subject_ = std::move(s);
+        subject_param_ = GetParam();
+        return *subject_;
+    }
 
     // Runs a query with both indexes and compares each with brute force.
     void check(const Query& q, const std::string& what) const {
@@ -75,8 +85,9 @@ protected:
         }
     }
 
-    static inline TempDir* dir_ = nullptr;
-    static inline std::vector<std::unique_ptr<Subject>> subjects_;
+    static inline std::unique_ptr<TempDir> dir_;
+    static inline std::unique_ptr<Subject> subject_;
+    static inline int subject_param_ = -1;
 };
 
 TEST_P(SelectQuery, EmptyQueryGivesTheWholeFile) {
