@@ -5,6 +5,7 @@
 // official encoder.
 #include <gtest/gtest.h>
 
+#include <map>
 #include <memory>
 
 #include "fiblet/compress.hpp"
@@ -31,14 +32,14 @@ struct Subject {
 class SelectQuery : public ::testing::TestWithParam<int> {
 protected:
     static void TearDownTestSuite() {
-        subject_.reset();
+        subjects_.clear();
         dir_.reset();
     }
     void SetUp() override {
         if (!shared_data_available()) GTEST_SKIP() << "shared test data not found";
     }
     const Subject& subject() const {
-        if (subject_ && subject_param_ == GetParam()) return *subject_;
+        if (auto it = subjects_.find(GetParam()); it != subjects_.end()) return *it->second;
         if (!dir_) dir_ = std::make_unique<TempDir>();
         auto s = std::make_unique<Subject>();
         std::string fft;
@@ -63,20 +64,31 @@ protected:
         s->decoded = decode_everything(*s->file);
         s->stored_or_loaded = std::make_unique<BlockIndex>(BlockIndex::load(*s->file));
         s->computed = std::make_unique<BlockIndex>(BlockIndex::compute(*s->file));
-        subject_ = std::move(s);
-        subject_param_ = GetParam();
-        return *subject_;
+        return *(subjects_[GetParam()] = std::move(s));
     }
 
-    // Runs a query with both indexes and compares each with brute force.
+    // Runs a query with both indexes, reading blocks through the file's
+    // mapping with one and with reads with the other, and compares each
+    // with brute force.
     void check(const Query& q, const std::string& what) const {
         const Subject& s = subject();
         const ReferenceSelection ref = reference_select(*s.file, s.decoded, q);
         for (const BlockIndex* index : {s.stored_or_loaded.get(), s.computed.get()}) {
+            SelectOptions o;
+            o.map_file = index == s.stored_or_loaded.get();
+            o.chunk_points = 5000;
+            Streamlines got;
             std::vector<SelectedRun> runs;
-            SelectionStats stats;
-            const Streamlines got = select_streamlines(*s.file, *index, q, &runs, &stats);
-            expect_same_selection(ref, got, runs, s.name + ": " + what);
+            const SelectionStats stats = select(
+                *s.file, *index, q,
+                [&](const SelectedChunk& c) {
+                    const std::uint64_t base = got.point_count();
+                    got.xyz.insert(got.xyz.end(), c.lines.xyz.begin(), c.lines.xyz.end());
+                    for (std::size_t i = 1; i < c.lines.offsets.size(); ++i) got.offsets.push_back(base + c.lines.offsets[i]);
+                    runs.insert(runs.end(), c.runs.begin(), c.runs.end());
+                },
+                o);
+            expect_same_selection(ref, got, runs, s.name + ": " + what + (o.map_file ? " (mapped)" : " (read)"));
             EXPECT_EQ(stats.runs, runs.size());
             EXPECT_EQ(stats.points, got.point_count());
             std::uint64_t blocks = 0;
@@ -86,8 +98,7 @@ protected:
     }
 
     static inline std::unique_ptr<TempDir> dir_;
-    static inline std::unique_ptr<Subject> subject_;
-    static inline int subject_param_ = -1;
+    static inline std::map<int, std::unique_ptr<Subject>> subjects_;
 };
 
 TEST_P(SelectQuery, EmptyQueryGivesTheWholeFile) {

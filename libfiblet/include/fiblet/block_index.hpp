@@ -98,9 +98,12 @@ public:
     // Blocks whose box may meet a sphere / a box / the frustum grown by
     // `margin`: a bitmap of blocks() bits, ORed into `bits` (resized as
     // needed). Conservative: a block with a point in the region is always
-    // set.
-    void blocks_near_sphere(Vec3f center, float radius, std::vector<std::uint64_t>& bits) const;
-    void blocks_near_box(const Aabb& box, std::vector<std::uint64_t>& bits) const;
+    // set. When `inside` is given, the blocks whose box lies wholly inside
+    // the region (so every point does) are also set there.
+    void blocks_near_sphere(Vec3f center, float radius, std::vector<std::uint64_t>& bits,
+                            std::vector<std::uint64_t>* inside = nullptr) const;
+    void blocks_near_box(const Aabb& box, std::vector<std::uint64_t>& bits,
+                         std::vector<std::uint64_t>* inside = nullptr) const;
     void blocks_near_frustum(const Frustum& frustum, float margin, std::vector<std::uint64_t>& bits) const;
 
 private:
@@ -109,7 +112,7 @@ private:
     template <class BoxOf>
     void build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of);  // (Morton key << 32 | block)
     template <class Classify>
-    void collect(const Classify& classify, std::vector<std::uint64_t>& bits) const;
+    void collect(const Classify& classify, std::vector<std::uint64_t>& bits, std::vector<std::uint64_t>* inside) const;
 
     Source source_ = Source::decoded;
     std::vector<std::uint64_t> fiber_points_;

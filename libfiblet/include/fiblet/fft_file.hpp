@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <utility>
@@ -53,7 +54,14 @@ public:
     void read_blocks(std::uint64_t first, std::uint64_t count, std::uint8_t* out) const;
     std::vector<std::uint8_t> read_blocks(std::uint64_t first, std::uint64_t count) const;
 
+    // All blocks as one read-only memory mapping (made on first call, kept
+    // until the FftFile goes), for reading scattered blocks without a system
+    // call each; empty when the file cannot be mapped (then use
+    // read_blocks). The file must not shrink while mapped (SIGBUS).
+    std::span<const std::uint8_t> mapped_blocks() const;
+
 private:
+    struct Mapping;
     void read_trailer();
     std::string path_;
     int fd_ = -1;
@@ -62,6 +70,7 @@ private:
     std::vector<FiberLutEntry> lut_;
     std::vector<std::uint64_t> fiber_first_block_;
     std::vector<TrailerChunk> trailer_;
+    std::unique_ptr<Mapping> mapping_;
 };
 
 }  // namespace fiblet

@@ -107,7 +107,7 @@ struct SelectionStats {
     std::uint64_t blocks = 0;          // blocks kept (fine + coarse)
     std::uint64_t coarse_blocks = 0;
     std::uint64_t points = 0;          // points output
-    std::uint64_t blocks_read = 0;     // blocks read from the file (all passes)
+    std::uint64_t blocks_read = 0;     // blocks read or accessed in the mapping (all passes)
     std::uint64_t blocks_decoded = 0;  // blocks decoded (all passes)
 };
 
@@ -121,6 +121,7 @@ struct SelectedChunk {
 struct SelectOptions {
     bool points = true;                       // decode and output points
     std::size_t chunk_points = 1u << 18;      // points per chunk handed to the sink
+    bool map_file = true;                     // read blocks through FftFile::mapped_blocks()
 };
 
 // Runs a query, handing the output to `sink` in file order, a chunk of whole

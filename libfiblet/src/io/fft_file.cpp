@@ -1,12 +1,14 @@
 #include "fiblet/fft_file.hpp"
 
 #include <fcntl.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 
 #include "core/bytes.hpp"
 #include "fiblet/error.hpp"
@@ -78,7 +80,33 @@ FftHeader parse_fft_header(std::span<const std::uint8_t> b, std::uint64_t file_s
     return h;
 }
 
-FftFile::FftFile(const std::string& path) : path_(path) {
+struct FftFile::Mapping {
+    std::once_flag once;
+    void* address = nullptr;
+    std::size_t length = 0;
+    std::size_t skip = 0;  // from the page boundary to the first block
+    ~Mapping() {
+        if (address) ::munmap(address, length);
+    }
+};
+
+std::span<const std::uint8_t> FftFile::mapped_blocks() const {
+    const std::uint64_t bytes = std::uint64_t{header_.blocks} * header_.block_bytes();
+    if (bytes == 0 || fd_ < 0 || !mapping_) return {};
+    Mapping& m = *mapping_;
+    std::call_once(m.once, [&] {
+        const std::uint64_t page = std::uint64_t(::sysconf(_SC_PAGESIZE));
+        const std::uint64_t start = header_.blocks_offset() / page * page;
+        m.skip = std::size_t(header_.blocks_offset() - start);
+        m.length = std::size_t(bytes + m.skip);
+        void* a = ::mmap(nullptr, m.length, PROT_READ, MAP_SHARED, fd_, off_t(start));
+        if (a != MAP_FAILED) m.address = a;
+    });
+    if (!m.address) return {};
+    return {static_cast<const std::uint8_t*>(m.address) + m.skip, std::size_t(bytes)};
+}
+
+FftFile::FftFile(const std::string& path) : path_(path), mapping_(std::make_unique<Mapping>()) {
     fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd_ < 0) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
     struct stat st {};
@@ -185,7 +213,8 @@ FftFile::~FftFile() {
 
 FftFile::FftFile(FftFile&& o) noexcept
     : path_(std::move(o.path_)), fd_(o.fd_), file_size_(o.file_size_), header_(std::move(o.header_)),
-      lut_(std::move(o.lut_)), fiber_first_block_(std::move(o.fiber_first_block_)), trailer_(std::move(o.trailer_)) {
+      lut_(std::move(o.lut_)), fiber_first_block_(std::move(o.fiber_first_block_)), trailer_(std::move(o.trailer_)),
+      mapping_(std::move(o.mapping_)) {
     o.fd_ = -1;
 }
 
@@ -200,6 +229,7 @@ FftFile& FftFile::operator=(FftFile&& o) noexcept {
         lut_ = std::move(o.lut_);
         fiber_first_block_ = std::move(o.fiber_first_block_);
         trailer_ = std::move(o.trailer_);
+        mapping_ = std::move(o.mapping_);
     }
     return *this;
 }

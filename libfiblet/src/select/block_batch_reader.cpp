@@ -2,12 +2,20 @@
 
 namespace fiblet::detail {
 
-BlockBatchReader::BlockBatchReader(const FftFile& file, std::uint64_t max_gap_blocks)
-    : file_(file), max_gap_(max_gap_blocks), block_bytes_(file.header().block_bytes()) {}
+BlockBatchReader::BlockBatchReader(const FftFile& file, bool use_mapping, std::uint64_t max_gap_blocks)
+    : file_(file), max_gap_(max_gap_blocks), block_bytes_(file.header().block_bytes()) {
+    if (use_mapping) mapped_ = file.mapped_blocks();
+}
 
 void BlockBatchReader::read(const std::vector<std::uint32_t>& blocks) {
     pointers_.resize(blocks.size());
     if (blocks.empty()) return;
+    if (!mapped_.empty()) {
+        for (std::size_t i = 0; i < blocks.size(); ++i)
+            pointers_[i] = mapped_.data() + std::uint64_t(blocks[i]) * block_bytes_;
+        blocks_read_ += blocks.size();
+        return;
+    }
     // Spans [first, last] of blocks with gaps up to max_gap_ between them.
     struct Span {
         std::uint64_t first, last;

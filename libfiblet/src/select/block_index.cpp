@@ -193,21 +193,29 @@ void BlockIndex::build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of) {
 }
 
 template <class Classify>
-void BlockIndex::collect(const Classify& classify, std::vector<std::uint64_t>& bits) const {
+void BlockIndex::collect(const Classify& classify, std::vector<std::uint64_t>& bits,
+                         std::vector<std::uint64_t>* inside) const {
     const std::size_t n = sorted_boxes_.size();
     bits.resize((n + 63) / 64, 0);
+    if (inside) inside->resize((n + 63) / 64, 0);
     if (n == 0) return;
     // Positions covered by node j of level k: [j * span, (j + 1) * span), span = 8^(k+1).
     auto mark_all = [&](std::size_t first, std::size_t last) {
-        for (std::size_t pos = first; pos < std::min(last, n); ++pos) set_bit(bits, order_[pos]);
+        for (std::size_t pos = first; pos < std::min(last, n); ++pos) {
+            set_bit(bits, order_[pos]);
+            if (inside) set_bit(*inside, order_[pos]);
+        }
     };
     auto visit = [&](auto& self, std::size_t k, std::size_t j, std::size_t span) -> void {
         const Overlap o = classify(levels_[k][j]);
         if (o == Overlap::outside) return;
         if (o == Overlap::inside) return mark_all(j * span, (j + 1) * span);
         if (k == 0) {
-            for (std::size_t pos = j * kFanout; pos < std::min(n, (j + 1) * kFanout); ++pos)
-                if (classify(sorted_boxes_[pos]) != Overlap::outside) set_bit(bits, order_[pos]);
+            for (std::size_t pos = j * kFanout; pos < std::min(n, (j + 1) * kFanout); ++pos) {
+                const Overlap b = classify(sorted_boxes_[pos]);
+                if (b != Overlap::outside) set_bit(bits, order_[pos]);
+                if (b == Overlap::inside && inside) set_bit(*inside, order_[pos]);
+            }
             return;
         }
         const std::size_t children = levels_[k - 1].size();
@@ -220,7 +228,8 @@ void BlockIndex::collect(const Classify& classify, std::vector<std::uint64_t>& b
     for (std::size_t j = 0; j < levels_[top].size(); ++j) visit(visit, top, j, span);
 }
 
-void BlockIndex::blocks_near_sphere(Vec3f c, float radius, std::vector<std::uint64_t>& bits) const {
+void BlockIndex::blocks_near_sphere(Vec3f c, float radius, std::vector<std::uint64_t>& bits,
+                                    std::vector<std::uint64_t>* inside) const {
     // Squared distances with a relative slack, so float rounding never culls
     // a block whose point passes Region::contains.
     const float r2 = radius * radius * (1 + 1e-5f);
@@ -234,20 +243,21 @@ void BlockIndex::blocks_near_sphere(Vec3f c, float radius, std::vector<std::uint
                         fz = far(c.z, b.min.z, b.max.z);
             return fx * fx + fy * fy + fz * fz <= radius * radius * (1 - 1e-5f) ? Overlap::inside : Overlap::partial;
         },
-        bits);
+        bits, inside);
 }
 
-void BlockIndex::blocks_near_box(const Aabb& r, std::vector<std::uint64_t>& bits) const {
+void BlockIndex::blocks_near_box(const Aabb& r, std::vector<std::uint64_t>& bits,
+                                 std::vector<std::uint64_t>* inside) const {
     collect(
         [&](const Aabb& b) {
             if (b.max.x < r.min.x || b.min.x > r.max.x || b.max.y < r.min.y || b.min.y > r.max.y ||
                 b.max.z < r.min.z || b.min.z > r.max.z)
                 return Overlap::outside;
-            const bool inside = b.min.x >= r.min.x && b.max.x <= r.max.x && b.min.y >= r.min.y &&
+            const bool within = b.min.x >= r.min.x && b.max.x <= r.max.x && b.min.y >= r.min.y &&
                                 b.max.y <= r.max.y && b.min.z >= r.min.z && b.max.z <= r.max.z;
-            return inside ? Overlap::inside : Overlap::partial;
+            return within ? Overlap::inside : Overlap::partial;
         },
-        bits);
+        bits, inside);
 }
 
 void BlockIndex::blocks_near_frustum(const Frustum& f, float margin, std::vector<std::uint64_t>& bits) const {
@@ -263,7 +273,7 @@ void BlockIndex::blocks_near_frustum(const Frustum& f, float margin, std::vector
             }
             return Overlap::inside;
         },
-        bits);
+        bits, nullptr);
 }
 
 }  // namespace fiblet

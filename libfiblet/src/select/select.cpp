@@ -234,7 +234,7 @@ private:
 class Selector {
 public:
     Selector(const FftFile& file, const BlockIndex& index, const Query& q, const SelectOptions& o)
-        : file_(file), index_(index), q_(q), options_(o), h_(file.header()), ctx_(h_), reader_(file) {
+        : file_(file), index_(index), q_(q), options_(o), h_(file.header()), ctx_(h_), reader_(file, o.map_file) {
         if (index.blocks() != h_.blocks || index.fibers() != h_.fibers)
             throw Error(Errc::invalid_argument, file.path() + ": the block index belongs to another file");
         detail::check_query(q);
@@ -249,20 +249,26 @@ public:
     }
 
 private:
-    Bits near(const Region& r) const {
+    // Blocks whose box meets a region (and, in `inside`, those wholly in it).
+    Bits near(const Region& r, Bits* inside = nullptr) const {
         Bits bits;
         if (r.shape == Region::Shape::sphere)
-            index_.blocks_near_sphere(r.center, r.radius, bits);
+            index_.blocks_near_sphere(r.center, r.radius, bits, inside);
         else
-            index_.blocks_near_box(r.box, bits);
+            index_.blocks_near_box(r.box, bits, inside);
         bits.resize((h_.blocks + 63) / 64, 0);
+        if (inside) inside->resize(bits.size(), 0);
         return bits;
     }
-    Bits near_any(const std::vector<Region>& regions) const {
+    Bits near_any(const std::vector<Region>& regions, Bits* inside = nullptr) const {
         Bits all((h_.blocks + 63) / 64, 0);
+        if (inside) inside->assign(all.size(), 0);
         for (const Region& r : regions) {
-            const Bits b = near(r);
+            Bits in;
+            const Bits b = near(r, inside ? &in : nullptr);
             for (std::size_t i = 0; i < all.size(); ++i) all[i] |= b[i];
+            if (inside)
+                for (std::size_t i = 0; i < all.size(); ++i) (*inside)[i] |= in[i];
         }
         return all;
     }
@@ -286,27 +292,38 @@ private:
     // exclude region. Only blocks the index puts near a region are decoded.
     void fiber_regions() {
         const std::size_t k_inc = q_.include.size();
-        std::vector<Bits> inc(k_inc);
-        for (std::size_t k = 0; k < k_inc; ++k) inc[k] = near(q_.include[k]);
+        std::vector<Bits> inc(k_inc), inside(k_inc);
+        for (std::size_t k = 0; k < k_inc; ++k) inc[k] = near(q_.include[k], &inside[k]);
         const Bits exc = near_any(q_.exclude);
         const std::uint64_t all = k_inc == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << k_inc) - 1;
 
-        // Fibers with no block near some include region fail without decoding.
+        // Fibers with no block near some include region fail without
+        // decoding; a block wholly inside a region meets it without decoding.
         std::vector<std::uint64_t> may_meet(h_.fibers, 0), met(h_.fibers, 0);
         for (std::size_t k = 0; k < k_inc; ++k) {
             FiberCursor cursor(file_);
             for (std::size_t w = 0; w < inc[k].size(); ++w)
                 for (std::uint64_t bits = inc[k][w]; bits; bits &= bits - 1) {
                     const std::uint64_t b = w * 64 + std::uint64_t(std::countr_zero(bits));
-                    may_meet[cursor.fiber_of(b)] |= std::uint64_t{1} << k;
+                    const std::uint64_t f = cursor.fiber_of(b);
+                    may_meet[f] |= std::uint64_t{1} << k;
+                    if (has_bit(inside[k], b)) met[f] |= std::uint64_t{1} << k;
                 }
         }
         for (std::uint64_t f = 0; f < h_.fibers; ++f)
             if (may_meet[f] != all) keep_[f] = 0;
 
+        // Decoded: blocks near an exclude region, and blocks near (not
+        // wholly inside) an include region that their fiber has not met yet.
         Bits to_test = exc;
-        for (const Bits& b : inc)
-            for (std::size_t i = 0; i < to_test.size(); ++i) to_test[i] |= b[i];
+        for (std::size_t k = 0; k < k_inc; ++k) {
+            FiberCursor cursor(file_);
+            for (std::size_t w = 0; w < inc[k].size(); ++w)
+                for (std::uint64_t bits = inc[k][w] & ~inside[k][w]; bits; bits &= bits - 1) {
+                    const std::uint64_t b = w * 64 + std::uint64_t(std::countr_zero(bits));
+                    if (!(met[cursor.fiber_of(b)] >> k & 1)) to_test[w] |= std::uint64_t{1} << (b & 63);
+                }
+        }
         std::vector<std::uint8_t> excluded(h_.fibers, 0);
         CandidateBlocks candidates(file_, keep_, &to_test);
         std::vector<std::uint32_t> blocks;
@@ -356,9 +373,9 @@ private:
             f.resize((h_.blocks + 63) / 64, 0);
             only = std::move(f);
         }
-        Bits exc;
+        Bits exc, inc_inside;
         if (blocks_mode && !q_.include.empty()) {
-            Bits inc = near_any(q_.include);
+            Bits inc = near_any(q_.include, &inc_inside);
             if (only) and_bits(*only, inc);
             else only = std::move(inc);
         }
@@ -372,13 +389,16 @@ private:
         enum Kind : std::uint8_t { dropped, fine, coarse };
         std::vector<Kind> kind;
         const std::uint32_t bb = h_.block_bytes();
-        auto region_test = [&](std::size_t i) {
-            return blocks_mode && (!q_.include.empty() || (!exc.empty() && has_bit(exc, blocks[i])));
+        // Point tests needed: near an include region but not wholly inside one,
+        // or near an exclude region.
+        auto include_test = [&](std::size_t i) {
+            return blocks_mode && !q_.include.empty() && !has_bit(inc_inside, blocks[i]);
         };
+        auto exclude_test = [&](std::size_t i) { return blocks_mode && !exc.empty() && has_bit(exc, blocks[i]); };
+        auto region_test = [&](std::size_t i) { return include_test(i) || exclude_test(i); };
         auto passes_regions = [&](std::size_t i, const float* p, std::uint32_t n) {
-            if (!region_test(i)) return true;
-            if (!q_.include.empty() && !any_point_in(q_.include, p, n)) return false;
-            return !(!exc.empty() && has_bit(exc, blocks[i]) && any_point_in(q_.exclude, p, n));
+            if (include_test(i) && !any_point_in(q_.include, p, n)) return false;
+            return !(exclude_test(i) && any_point_in(q_.exclude, p, n));
         };
         while (candidates.next(kBatchBlocks, blocks, fibers)) {
             // With a level of detail, the next block's first point may end a segment.
