@@ -159,7 +159,7 @@ void BM_SelectQuery(benchmark::State& state, Family family) {
     for (auto _ : state) {
         std::uint64_t points = 0;
         stats = select(*bench_file().file, *bench_file().index, q,
-                       [&](const SelectedChunk& c) { points += c.lines.point_count(); });
+                       [&](const SelectedChunk& c) { points += c.point_count(); });
         benchmark::DoNotOptimize(points);
     }
     report(state, stats);
@@ -175,7 +175,7 @@ void BM_SelectEverything(benchmark::State& state) {
     for (auto _ : state) {
         std::uint64_t points = 0;
         stats = select(*bench_file().file, *bench_file().index, Query{},
-                       [&](const SelectedChunk& c) { points += c.lines.point_count(); });
+                       [&](const SelectedChunk& c) { points += c.point_count(); });
         benchmark::DoNotOptimize(points);
     }
     report(state, stats);

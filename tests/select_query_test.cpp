@@ -83,8 +83,8 @@ protected:
                 *s.file, *index, q,
                 [&](const SelectedChunk& c) {
                     const std::uint64_t base = got.point_count();
-                    got.xyz.insert(got.xyz.end(), c.lines.xyz.begin(), c.lines.xyz.end());
-                    for (std::size_t i = 1; i < c.lines.offsets.size(); ++i) got.offsets.push_back(base + c.lines.offsets[i]);
+                    got.xyz.insert(got.xyz.end(), c.xyz.begin(), c.xyz.end());
+                    for (std::size_t i = 1; i < c.offsets.size(); ++i) got.offsets.push_back(base + c.offsets[i]);
                     runs.insert(runs.end(), c.runs.begin(), c.runs.end());
                 },
                 o);
@@ -262,10 +262,10 @@ TEST_P(SelectQuery, ChunkedOutputEqualsTheWholeOutput) {
         *s.file, *s.stored_or_loaded, q,
         [&](const SelectedChunk& c) {
             ++chunks;
-            ASSERT_EQ(c.lines.size(), c.runs.size());
+            ASSERT_EQ(c.offsets.size(), c.runs.size() + 1);
             const std::uint64_t base = joined.point_count();
-            joined.xyz.insert(joined.xyz.end(), c.lines.xyz.begin(), c.lines.xyz.end());
-            for (std::size_t i = 1; i < c.lines.offsets.size(); ++i) joined.offsets.push_back(base + c.lines.offsets[i]);
+            joined.xyz.insert(joined.xyz.end(), c.xyz.begin(), c.xyz.end());
+            for (std::size_t i = 1; i < c.offsets.size(); ++i) joined.offsets.push_back(base + c.offsets[i]);
             joined_runs.insert(joined_runs.end(), c.runs.begin(), c.runs.end());
         },
         o);

@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -111,11 +112,19 @@ struct SelectionStats {
     std::uint64_t blocks_decoded = 0;  // blocks decoded (all passes)
 };
 
-// A chunk of output: runs[i] is streamline i of `lines` (lines is empty
-// when points were not asked for).
+// A chunk of output, valid during the sink call: streamline i comes from
+// runs[i] and has the points xyz[3 * offsets[i] .. 3 * offsets[i + 1]) (the
+// TRX layout of Streamlines; xyz and offsets are empty when points were not
+// asked for).
 struct SelectedChunk {
-    Streamlines lines;
-    std::vector<SelectedRun> runs;
+    std::span<const float> xyz;
+    std::span<const std::uint64_t> offsets;
+    std::span<const SelectedRun> runs;
+
+    std::size_t size() const { return runs.size(); }
+    std::uint64_t point_count() const { return offsets.empty() ? 0 : offsets.back(); }
+    std::uint64_t points_of(std::size_t i) const { return offsets[i + 1] - offsets[i]; }
+    const float* xyz_of(std::size_t i) const { return xyz.data() + 3 * offsets[i]; }
 };
 
 struct SelectOptions {

@@ -123,24 +123,21 @@ Vec3f first_point(const FftHeader& h, const std::uint8_t* block) {
 }
 
 // Assembles kept blocks into runs and hands chunks of them to the sink.
-// Fine blocks are decoded straight into the output buffer, after its end
-// (decode_space()), then kept in place or moved down over rejected ones.
+// Fine blocks are decoded straight into the output buffer after its end,
+// then kept in place or moved down over rejected ones. The buffer only
+// grows: no zero-filling per chunk.
 class RunWriter {
 public:
-    RunWriter(const SelectOptions& o, const std::function<void(const SelectedChunk&)>& sink, SelectionStats& stats,
-              std::size_t max_batch_points)
-        : options_(o), sink_(sink), stats_(stats) {
-        // Room for a chunk plus a batch: no reallocation, hence no copy.
-        chunk_.lines.xyz.reserve(3 * (o.chunk_points + 2 * max_batch_points));
-    }
+    RunWriter(const SelectOptions& o, const std::function<void(const SelectedChunk&)>& sink, SelectionStats& stats)
+        : options_(o), sink_(sink), stats_(stats) {}
 
     // Closes the open run unless `block` of `fiber` continues it.
     void break_unless_continues(std::uint64_t fiber, std::uint64_t block) {
         if (open_ && (run_.fiber != fiber || run_.first_block + run_.block_count != block)) close();
     }
-    // The output buffer, where points decoded at point index end() and after
-    // wait for fine() (kept) or nothing (rejected).
-    std::vector<float>& buffer() { return chunk_.lines.xyz; }
+    // The output buffer: points decoded at point index end() and after wait
+    // for fine() (kept) or nothing (rejected).
+    std::vector<float>& buffer() { return xyz_; }
     std::size_t end() const { return end_; }
 
     // A fine block of n points, decoded at `src` (at or after end(); null
@@ -148,7 +145,7 @@ public:
     void fine(std::uint64_t fiber, std::uint64_t block, const float* src, std::uint32_t n) {
         extend(fiber, block);
         if (options_.points && src) {
-            float* dst = &chunk_.lines.xyz[3 * end_];
+            float* dst = &xyz_[3 * end_];
             if (src != dst) std::memmove(dst, src, 12 * std::size_t(n));
             end_ += n;
         }
@@ -164,21 +161,20 @@ public:
         if (end) end_point_ = *end;
     }
     // Hands the closed runs to the sink when the chunk is full (the open
-    // run's points move to the next chunk); only where no decoded points wait
+    // run's points move to the front); only where no decoded points wait
     // after end().
     void maybe_flush() {
-        if (chunk_.runs.empty() || (end_ < options_.chunk_points && chunk_.runs.size() < options_.chunk_points)) return;
-        const std::size_t done = options_.points ? chunk_.lines.offsets.back() : 0;
-        auto& xyz = chunk_.lines.xyz;
-        open_points_.assign(xyz.begin() + std::ptrdiff_t(3 * done), xyz.begin() + std::ptrdiff_t(3 * end_));
+        if (runs_.empty() || (end_ < options_.chunk_points && runs_.size() < options_.chunk_points)) return;
+        const std::size_t done = options_.points ? offsets_.back() : 0;
+        const std::size_t open_points = end_ - done;
         end_ = done;
         flush();
-        xyz.assign(open_points_.begin(), open_points_.end());
-        end_ = open_points_.size() / 3;
+        if (open_points) std::memmove(xyz_.data(), &xyz_[3 * done], 12 * open_points);
+        end_ = open_points;
     }
     void finish() {
         close();
-        if (!chunk_.runs.empty()) flush();
+        if (!runs_.empty()) flush();
     }
 
 private:
@@ -193,9 +189,8 @@ private:
     }
     void put(Vec3f p) {
         if (options_.points) {
-            auto& xyz = chunk_.lines.xyz;
-            if (xyz.size() < 3 * (end_ + 1)) xyz.resize(3 * (end_ + 1));
-            xyz[3 * end_] = p.x, xyz[3 * end_ + 1] = p.y, xyz[3 * end_ + 2] = p.z;
+            if (xyz_.size() < 3 * (end_ + 1)) xyz_.resize(std::max(3 * (end_ + 1), 2 * xyz_.size()));
+            xyz_[3 * end_] = p.x, xyz_[3 * end_ + 1] = p.y, xyz_[3 * end_ + 2] = p.z;
             ++end_;
         }
         ++stats_.points;
@@ -207,24 +202,26 @@ private:
         if (has_end_) put(end_point_), has_end_ = false;
         open_ = false;
         ++stats_.runs;
-        chunk_.runs.push_back(run_);
-        if (options_.points) chunk_.lines.offsets.push_back(end_);
+        runs_.push_back(run_);
+        if (options_.points) offsets_.push_back(end_);
     }
     void flush() {
-        chunk_.lines.xyz.resize(3 * end_);
-        sink_(chunk_);
-        chunk_.lines.xyz.clear();
-        chunk_.lines.offsets.assign(1, 0);
-        chunk_.runs.clear();
+        SelectedChunk c;
+        c.runs = runs_;
+        if (options_.points) c.xyz = {xyz_.data(), 3 * end_}, c.offsets = offsets_;
+        sink_(c);
+        offsets_.assign(1, 0);
+        runs_.clear();
         end_ = 0;
     }
 
     const SelectOptions& options_;
     const std::function<void(const SelectedChunk&)>& sink_;
     SelectionStats& stats_;
-    SelectedChunk chunk_;
-    std::size_t end_ = 0;  // points of the chunk so far
-    std::vector<float> open_points_;
+    std::vector<float> xyz_;  // size only grows; end_ points are valid
+    std::size_t end_ = 0;
+    std::vector<std::uint64_t> offsets_{0};
+    std::vector<SelectedRun> runs_;
     SelectedRun run_;
     bool open_ = false, has_end_ = false;
     Vec3f end_point_{};
@@ -359,7 +356,8 @@ private:
     void blocks(const std::function<void(const SelectedChunk&)>& sink) {
         const bool blocks_mode = q_.roi_mode == RoiMode::blocks;
         const bool cull = q_.view && q_.view->cull;
-        const bool lod = q_.has_level_of_detail();
+        std::optional<LevelOfDetail> lod;
+        if (q_.has_level_of_detail()) lod.emplace(q_.view->camera, *q_.view->lod, q_.view->lod_pixels);
         Frustum frustum{};
         if (q_.view) frustum = frustum_from_camera(q_.view->camera);
 
@@ -381,7 +379,7 @@ private:
         }
         if (blocks_mode && !q_.exclude.empty()) exc = near_any(q_.exclude);
 
-        RunWriter out(options_, sink, stats_, kBatchBlocks * h_.points_per_block);
+        RunWriter out(options_, sink, stats_);
         CandidateBlocks candidates(file_, keep_, only ? &*only : nullptr);
         std::vector<std::uint32_t> blocks, need;
         std::vector<std::uint64_t> fibers;
@@ -421,8 +419,7 @@ private:
                     const Sphere s = block_bounding_sphere(h_, reader_.block(at_need[i]));
                     if (cull && !sphere_intersects_frustum(frustum, s.center, s.radius))
                         kind[i] = dropped;
-                    else if (lod && block_is_coarse(q_.view->camera, *q_.view->lod, s.center, s.radius,
-                                                    q_.view->lod_pixels))
+                    else if (lod && lod->coarse(s.center, s.radius))
                         kind[i] = coarse;
                 }
 
@@ -498,8 +495,8 @@ Streamlines select_streamlines(const FftFile& file, const BlockIndex& index, con
     if (runs) runs->clear();
     const SelectionStats s = select(file, index, query, [&](const SelectedChunk& c) {
         const std::uint64_t base = all.point_count();
-        all.xyz.insert(all.xyz.end(), c.lines.xyz.begin(), c.lines.xyz.end());
-        for (std::size_t i = 1; i < c.lines.offsets.size(); ++i) all.offsets.push_back(base + c.lines.offsets[i]);
+        all.xyz.insert(all.xyz.end(), c.xyz.begin(), c.xyz.end());
+        for (std::size_t i = 1; i < c.offsets.size(); ++i) all.offsets.push_back(base + c.offsets[i]);
         if (runs) runs->insert(runs->end(), c.runs.begin(), c.runs.end());
     });
     if (stats) *stats = s;
