@@ -416,6 +416,8 @@ private:
             kind.assign(blocks.size(), fine);
             if (q_.view)
                 for (std::size_t i = 0; i < blocks.size(); ++i) {
+                    // Scattered headers: fetch a few blocks ahead.
+                    if (i + 8 < blocks.size()) __builtin_prefetch(reader_.block(at_need[i + 8]));
                     const Sphere s = block_bounding_sphere(h_, reader_.block(at_need[i]));
                     if (cull && !sphere_intersects_frustum(frustum, s.center, s.radius))
                         kind[i] = dropped;
