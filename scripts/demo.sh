@@ -5,12 +5,12 @@
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 "$root/scripts/setup.sh"
-"$root/scripts/build.sh"
+"$root/scripts/build.sh" > "${FIBLET_BUILD_DIR:-$root/build}.log" 2>&1 || { cat "${FIBLET_BUILD_DIR:-$root/build}.log"; exit 1; }
 fiblet="${FIBLET_BUILD_DIR:-$root/build}/bin/fiblet"
 work="${FIBLET_DEMO_DIR:-$root/build/demo}"
 mkdir -p "$work"
 
-input="$root/../shared/data/small-ifod1.tck"
+input="$(realpath -m "$root/../shared/data/small-ifod1.tck")"
 if [ ! -f "$input" ]; then
   input="$work/generated.tck"
   echo "== ../shared/data not found: generating $input"

@@ -5,10 +5,13 @@ set -euo pipefail
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config
-  libcli11-dev libeigen3-dev libfmt-dev libzstd-dev
+  libcli11-dev libeigen3-dev libfmt-dev libzstd-dev libxxhash-dev
   libgtest-dev libgmock-dev libbenchmark-dev libhwy-dev
   python3 python3-numpy python3-nibabel python3-matplotlib
+  python3-dev python3-pybind11 pybind11-dev python3-pytest snakemake
   mrtrix3 zstd time
+  clang-14 libclang-rt-14-dev  # libFuzzer harnesses (scripts/fuzz.sh)
+  libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libspng-dev
 )
 
 missing=()
@@ -20,6 +23,6 @@ if ((${#missing[@]})); then
   SUDO=""
   [ "$(id -u)" -eq 0 ] || SUDO="sudo"
   export DEBIAN_FRONTEND=noninteractive
-  $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  $SUDO apt-get -o DPkg::Lock::Timeout=600 update -qq
+  $SUDO apt-get -o DPkg::Lock::Timeout=600 install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi

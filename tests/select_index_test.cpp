@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "fiblet/block_index.hpp"
+#include "fiblet/checksum.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/error.hpp"
 #include "select_reference.hpp"
@@ -26,11 +27,10 @@ protected:
     void SetUp() override {
         if (!shared_data_available()) GTEST_SKIP() << "shared test data not found";
     }
-    static std::string compressed(const std::string& tck, const std::string& name) {
+    static std::string compressed(const std::string& tck, const std::string& name, CompressOptions o = {}) {
         if (!dir_) dir_ = std::make_unique<TempDir>();
         const std::string out = dir_->file(name);
         if (!std::filesystem::exists(out)) {
-            CompressOptions o;
             o.threads = 2;
             compress_tck(shared_data(tck), out, o);
         }
@@ -106,12 +106,19 @@ TEST_F(SelectIndex, StoredBoxesAreWithinACellOfTheExactBoxes) {
 }
 
 TEST_F(SelectIndex, ChunkHasTheDocumentedSize) {
-    for (const std::string& path : {fiblet_file(), dwi_file()}) {
+    CompressOptions wide;
+    wide.direction_bits = 16, wide.points_per_block = 300;
+    const std::string wide_file = compressed("bundles/CST_R-step0.1.tck", "cst16.fft", wide);
+    for (const std::string& path : {fiblet_file(), dwi_file(), wide_file}) {
         const FftFile file(path);
         const TrailerChunk* c = file.find_chunk(kBlockIndexTag);
         ASSERT_NE(c, nullptr);
         const FftHeader& h = file.header();
-        EXPECT_EQ(c->payload.size(), 56 + h.fibers + (std::uint64_t{h.blocks} * 28 + 7) / 8);
+        const std::uint64_t count_bytes = h.points_per_block > 255 ? 2 : 1;
+        EXPECT_EQ(c->payload.size(), 56 + count_bytes * h.fibers + (std::uint64_t{h.blocks} * 28 + 7) / 8) << path;
+        const BlockIndex index = BlockIndex::load(file);
+        EXPECT_EQ(index.source(), BlockIndex::Source::chunk);
+        expect_boxes_hold_points(file, index, decode_everything(file));
     }
     // 3.5 bytes per 76-byte block plus one byte per fiber: under 5 % of the file.
     const FftFile file(fiblet_file());
@@ -164,13 +171,14 @@ TEST_F(SelectIndex, FrustumCandidatesCoverEveryBlockSphereThatMeetsTheFrustum) {
     }
 }
 
-// A copy of `from` whose trailer's BIDX payload is replaced by `payload`.
+// A copy of `from` whose trailer's BIDX payload is replaced by `payload`
+// (without the CSUM chunk, which would no longer match).
 std::string with_index_payload(const FftFile& from, const std::vector<std::uint8_t>& payload, const std::string& to) {
     const std::string bytes = read_file(from.path());
     const std::uint64_t end = from.header().file_bytes();
     std::vector<TrailerChunk> chunks;
     for (const TrailerChunk& c : from.trailer())
-        chunks.push_back(c.tag == kBlockIndexTag ? TrailerChunk{c.tag, payload} : c);
+        if (c.tag != kChecksumTag) chunks.push_back(c.tag == kBlockIndexTag ? TrailerChunk{c.tag, payload} : c);
     const auto trailer = serialize_trailer(chunks, end);
     write_file(to, bytes.substr(0, end) + std::string(trailer.begin(), trailer.end()));
     return to;

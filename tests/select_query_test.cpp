@@ -56,9 +56,22 @@ protected:
                 fft = dir_->file("cst.fft");
                 compress_tck(shared_data("bundles/CST_R-step0.1.tck"), fft, o);
                 break;
-            default:  // written by another tool, no stored index
+            case 2:  // written by another tool, no stored index
                 s->name = "official small-sdstream";
                 fft = shared_data("reference/small-sdstream.fft");
+                break;
+            case 3:  // 16-bit directions, default 126 points a block
+                s->name = "fiblet 16-bit dwi-small64d";
+                fft = dir_->file("dwi16.fft");
+                o.direction_bits = 16;
+                compress_tck(shared_data("dwi-small64d-ifod1.tck"), fft, o);
+                break;
+            default:  // 16-bit directions, 400 points a block (2-byte counts in the index)
+                s->name = "fiblet 16-bit CST_R, 400 points a block";
+                fft = dir_->file("cst16.fft");
+                o.direction_bits = 16;
+                o.points_per_block = 400;
+                compress_tck(shared_data("bundles/CST_R-step0.1.tck"), fft, o);
         }
         s->file = std::make_unique<FftFile>(fft);
         s->decoded = decode_everything(*s->file);
@@ -291,7 +304,8 @@ TEST_P(SelectQuery, SubsetFileDecodesToTheSelection) {
         const std::string out = dir.file("subset" + std::to_string(i) + ".fft");
         const SubsetReport rep = write_fft_subset(*s.file, select_runs(*s.file, *s.stored_or_loaded, q), out, false);
         EXPECT_EQ(rep.fibers, runs.size());
-        const FftFile subset(out);  // validates header, LUT and trailer
+        const FftFile subset(out);  // validates header, LUT, trailer and checksums
+        EXPECT_TRUE(subset.verifies_checksums());
         EXPECT_EQ(subset.header().points, expected.point_count());
         EXPECT_EQ(subset.properties(), s.file->properties());
         const DecodedFile d = decode_everything(subset);
@@ -300,10 +314,11 @@ TEST_P(SelectQuery, SubsetFileDecodesToTheSelection) {
         // Its blocks carry their new fiber IDs and flags.
         for (std::size_t b = 0; b < d.blocks.size(); ++b) {
             const auto raw = subset.read_blocks(b, 1);
-            const BlockView v{raw.data()};
-            EXPECT_EQ(v.fiber_id(), d.blocks[b].fiber);
-            EXPECT_EQ(v.is_last(), d.blocks[b].last_of_fiber);
-            EXPECT_EQ(v.is_first(), b == subset.first_block(d.blocks[b].fiber));
+            const bool wide = subset.header().direction_bits() == 16;
+            EXPECT_EQ(wide ? BlockView16{raw.data()}.fiber_id() : BlockView{raw.data()}.fiber_id(), d.blocks[b].fiber);
+            const BlockFlags flags = block_flags(subset.header(), raw.data());
+            EXPECT_EQ(flags.last, d.blocks[b].last_of_fiber);
+            EXPECT_EQ(flags.first, b == subset.first_block(d.blocks[b].fiber));
         }
         // A subset of the official encoder's file gets fiblet's index.
         const BlockIndex index = BlockIndex::load(subset);
@@ -313,7 +328,7 @@ TEST_P(SelectQuery, SubsetFileDecodesToTheSelection) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Files, SelectQuery, ::testing::Values(0, 1, 2));
+INSTANTIATE_TEST_SUITE_P(Files, SelectQuery, ::testing::Values(0, 1, 2, 3, 4));
 
 TEST(SelectQueryErrors, BadQueriesAreRejectedBeforeReading) {
     if (!shared_data_available()) GTEST_SKIP();

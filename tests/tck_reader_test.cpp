@@ -337,7 +337,8 @@ TEST(TckHeader, ContinuationRepeatsAndWhitespace) {
     // Trailing spaces after the magic, CRLF lines, a continued value and a repeated key.
     const std::string data = f32({kInf, kInf, kInf});
     std::string text = "mrtrix tracks   \r\ncommand_history: first\r\n  continued here\ncount: 0\n"
-                       "command_history: second\n  key with spaces  :  v : w  \nfile: . 1000\ndatatype: float32le\nEND\n";
+                       "command_history: second\n  key with spaces  :  v : w  \nfile: . 1000\n"
+                       "datatype: float32le\nEND\n";
     text.resize(1000, '\0');
     test::write_file(p, text + data);
     const TckHeader h = read_tck_header(p);

@@ -23,6 +23,21 @@ int exit_code_for(Errc c) {
     return kInternal;
 }
 
+const std::vector<ExitCodeInfo>& exit_code_table() {
+    static const std::vector<ExitCodeInfo> table = {
+        {kOk, "success"},
+        {kInternal, "internal error (a bug: please report it)"},
+        {kUsage, "bad command line or option value"},
+        {kIo, "a file cannot be read or written"},
+        {kBadInput, "malformed or inconsistent input file (.tck or .fft)"},
+        {kExists, "the output exists and --force was not given"},
+        {kUnsupported, "valid input that fiblet does not support"},
+        {kChecksum, "integrity check failed"},
+        {130, "interrupted by SIGINT (128 + signal number for other signals); no partial output is left"},
+    };
+    return table;
+}
+
 Progress::Progress(bool quiet) : enabled_(!quiet && ::isatty(STDERR_FILENO)) {}
 Progress::~Progress() { done(); }
 

@@ -23,6 +23,12 @@ enum ExitCode : int {
     kChecksum = 7,     // integrity check failed
 };
 int exit_code_for(Errc c);
+// Every code the CLI returns, with its meaning (for `fiblet help --markdown`).
+struct ExitCodeInfo {
+    int code;
+    const char* meaning;
+};
+const std::vector<ExitCodeInfo>& exit_code_table();
 
 // Progress on stderr, only when stderr is a terminal and not --quiet.
 class Progress {
@@ -62,5 +68,11 @@ void add_decompress(CLI::App& app);
 void add_stats(CLI::App& app);
 void add_info(CLI::App& app);
 void add_extract(CLI::App& app);
+void add_verify(CLI::App& app);
+void add_help(CLI::App& app);
+#ifdef FIBLET_WITH_VIEWER
+void add_render(CLI::App& app);  // cmd_render.cpp, only with the viewer
+void add_view(CLI::App& app);    // cmd_view.cpp, only with the viewer
+#endif
 
 }  // namespace fiblet::cli

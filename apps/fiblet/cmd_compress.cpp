@@ -6,6 +6,7 @@
 
 #include "cli_common.hpp"
 #include "fiblet/compress.hpp"
+#include "fiblet/encode.hpp"
 
 namespace fiblet::cli {
 namespace {
@@ -15,6 +16,13 @@ struct CompressArgs {
     std::string output, output_dir;
     std::optional<double> step;
     unsigned threads = 0;
+    // Encoder choices.
+    unsigned bits = 8;
+    std::uint32_t block_points = 0;
+    int effort = kDefaultEffort;
+    std::optional<unsigned> beam, radius, retry_beam;
+    std::optional<double> cap_ratio, step_scale;
+    std::optional<double> turn_percentile;
     bool force = false, quiet = false, json = false, allow_count_mismatch = false;
 };
 
@@ -37,7 +45,8 @@ std::string report_json(const std::string& in, const std::string& out, const Com
     j.integer("fibers", r.header.fibers).integer("points", r.header.points).integer("blocks", r.header.blocks);
     j.integer("input_bytes", r.input_bytes).integer("output_bytes", r.output_bytes);
     j.num("ratio", r.output_bytes ? double(r.input_bytes) / double(r.output_bytes) : 0.0);
-    j.num("step_mm", r.step_mm).num("cap_ratio", r.header.ratio).boolean("resampled", r.resampled);
+    j.num("step_mm", r.step_mm).num("step_scale", r.step_scale).num("cap_ratio", r.header.ratio);
+    j.boolean("resampled", r.resampled).integer("direction_bits", r.header.direction_bits());
     j.num("max_error_um", r.error.max_mm() * 1e3).num("mean_error_um", r.error.mean_mm() * 1e3);
     if (r.resampled)
         j.num("max_error_vs_original_um", r.error_vs_original.max_mm() * 1e3)
@@ -61,6 +70,15 @@ void run(const CompressArgs& a) {
         o.overwrite = a.force;
         o.threads = a.threads;
         o.allow_count_mismatch = a.allow_count_mismatch;
+        o.direction_bits = a.bits;
+        o.points_per_block = a.block_points;
+        o.search = search_for_effort(a.effort);
+        if (a.beam) o.search.beam_width = *a.beam;
+        if (a.radius) o.search.radius = *a.radius;
+        if (a.retry_beam) o.search.retry_beam_width = *a.retry_beam;
+        o.cap_ratio = a.cap_ratio;
+        o.step_scale = a.step_scale;
+        o.turn_percentile = a.turn_percentile;
         const std::string name = std::filesystem::path(in).filename().string();
         o.progress = [&](const char* phase, double f) { progress.update(name + ": " + phase, f); };
         try {
@@ -72,9 +90,9 @@ void run(const CompressArgs& a) {
                 fmt::print("{} -> {}\n", in, out);
                 fmt::print("  {} fibers, {} points, {} blocks of {} points ({} B)\n", r.header.fibers,
                            r.header.points, r.header.blocks, r.header.points_per_block, r.header.block_bytes());
-                fmt::print("  step {:.6g} mm{}, cap ratio {:.4f}\n", r.step_mm,
+                fmt::print("  step {:.6g} mm{}, decoder step x{:.5f}, cap ratio {:.4f}\n", r.step_mm,
                            r.resampled ? " (variable spacing in the input: resampled to this fixed step)" : "",
-                           r.header.ratio);
+                           r.step_scale, r.header.ratio);
                 fmt::print("  {} -> {} ({:.2f}x smaller)\n", human_bytes(r.input_bytes), human_bytes(r.output_bytes),
                            double(r.input_bytes) / double(r.output_bytes));
                 fmt::print("  error vs {}: {}\n", r.resampled ? "resampled points" : "input", describe_errors(r.error));
@@ -112,6 +130,22 @@ void add_compress(CLI::App& app) {
     cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs)");
     cmd->add_option("--step", args->step, "Fixed step in mm (default: measured; variable spacing is resampled)");
     cmd->add_option("-j,--threads", args->threads, "Encoding threads (default: all cores)");
+    cmd->add_option("--bits", args->bits, "Bits per direction: 8 (.fft version 2) or 16 (formats/fft16.md)")
+        ->check(CLI::IsMember({8u, 16u}));
+    cmd->add_option("--block-points", args->block_points, "Points per block (default 60 for 8 bits, 126 for 16)");
+    cmd->add_option("-e,--effort", args->effort,
+                    "Code search effort 0..4 (default 1): slower searches give smaller errors, same decoder")
+        ->check(CLI::Range(0, kMaxEffort));
+    cmd->add_option("--retry-beam", args->retry_beam, "Beam width for re-searching the worst blocks (0 = none)")
+        ->check(CLI::Range(0u, 64u));
+    cmd->add_option("--beam", args->beam, "Code search: sequences kept per step (1 = greedy)")->check(CLI::Range(1u, 64u));
+    cmd->add_option("--search-radius", args->radius, "Code search: candidate codes within this many levels")
+        ->check(CLI::Range(1u, 3u));
+    cmd->add_option("--cap-ratio", args->cap_ratio, "Cap ratio of the direction code (default: from the data)");
+    cmd->add_option("--turn-percentile", args->turn_percentile,
+                    "Size the cap for this percentile of the turning angles (default: tuned)")
+        ->check(CLI::Range(50.0, 100.0));
+    cmd->add_option("--step-scale", args->step_scale, "Decoder step / sampling step (default: tuned on a sample)");
     cmd->add_flag("-f,--force", args->force, "Overwrite existing outputs");
     cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
     cmd->add_flag("--json", args->json, "Print the report as JSON");

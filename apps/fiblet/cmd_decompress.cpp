@@ -1,4 +1,4 @@
-// fiblet decompress IN.fft -o OUT.tck
+// fiblet decompress IN.fft -o OUT.tck [-j N] [--decoder NAME]
 #include <fmt/core.h>
 
 #include <chrono>
@@ -12,7 +12,8 @@ namespace fiblet::cli {
 namespace {
 
 struct DecompressArgs {
-    std::string input, output;
+    std::string input, output, decoder = "auto";
+    unsigned threads = 0;
     bool force = false, quiet = false, json = false;
 };
 
@@ -26,13 +27,20 @@ void run(const DecompressArgs& a) {
     TckHeader header;
     header.properties = props;
     header.set("step_size", fmt::format("{:.9g}", double(h.step) * double(h.scaling)));
+    DecodeOptions options;
+    options.decoder = parse_decoder(a.decoder);
+    options.threads = a.threads;
+    const std::string decoder = decoder_name(options.decoder);
     TckWriter writer(a.output, header.properties, a.force);
     Progress progress(a.quiet);
-    decode_file(file, [&](std::uint64_t first, const Streamlines& chunk) {
-        for (std::size_t i = 0; i < chunk.size(); ++i)
-            writer.write(&chunk.xyz[3 * chunk.offsets[i]], chunk.offsets[i + 1] - chunk.offsets[i]);
-        progress.update("decompress", h.fibers ? double(first + chunk.size()) / double(h.fibers) : 1.0);
-    });
+    decode_file(
+        file,
+        [&](std::uint64_t first, const Streamlines& chunk) {
+            for (std::size_t i = 0; i < chunk.size(); ++i)
+                writer.write(&chunk.xyz[3 * chunk.offsets[i]], chunk.offsets[i + 1] - chunk.offsets[i]);
+            progress.update("decompress", h.fibers ? double(first + chunk.size()) / double(h.fibers) : 1.0);
+        },
+        options);
     writer.finish();
     progress.done();
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -42,6 +50,7 @@ void run(const DecompressArgs& a) {
                                .str("output", a.output)
                                .integer("fibers", h.fibers)
                                .integer("points", h.points)
+                               .str("decoder", decoder)
                                .num("seconds", s)
                                .render());
     } else if (!a.quiet) {
@@ -56,6 +65,15 @@ void add_decompress(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("decompress", "Decode a .fft file back into a .tck file");
     cmd->add_option("input", args->input, "Input .fft file")->required()->check(CLI::ExistingFile);
     cmd->add_option("-o,--output", args->output, "Output .tck file")->required();
+    cmd->add_option("-j,--threads", args->threads, "Decoding threads (default: all cores)");
+    cmd->add_option("--decoder", args->decoder,
+                    "auto (the fastest), scalar, lanes, warp, or one with its SIMD level: " +
+                        [] {
+                            std::string all;
+                            for (const std::string& n : available_decoders()) all += (all.empty() ? "" : ", ") + n;
+                            return all;
+                        }())
+        ->default_str("auto");
     cmd->add_flag("-f,--force", args->force, "Overwrite an existing output");
     cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
     cmd->add_flag("--json", args->json, "Print the summary as JSON");

@@ -18,6 +18,12 @@ int main(int argc, char** argv) {
     add_stats(app);
     add_info(app);
     add_extract(app);
+    add_verify(app);
+#ifdef FIBLET_WITH_VIEWER
+    add_render(app);
+    add_view(app);
+#endif
+    add_help(app);
 
     fiblet::install_signal_cleanup();
     try {

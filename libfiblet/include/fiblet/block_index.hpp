@@ -3,8 +3,8 @@
 // without reading (let alone decoding) the others.
 //
 // On disk it is the optional "BIDX" trailer chunk (formats/fft-index.md):
-// one quantized box per block in 28 bits plus one byte per fiber, about
-// 3.6 bytes per 76-byte block. Files without it (e.g. from the official
+// one quantized box per block in 28 bits plus one byte per fiber (two when
+// blocks hold more than 255 points), about 3.6 bytes per 76-byte block. Files without it (e.g. from the official
 // encoder) get the same index computed on load by decoding every block once.
 // The hierarchy is never stored: it is rebuilt in memory on load (storing
 // block ids would cost more than the boxes).
@@ -65,7 +65,7 @@ private:
     unsigned bits_ = kDefaultIndexBitsPerBlock;
     Grid grid_;
     std::vector<std::uint32_t> codes_;
-    std::vector<std::uint8_t> last_points_;
+    std::vector<std::uint16_t> last_points_;
     std::uint32_t open_fiber_blocks_ = 0;  // blocks of the fiber being added
     bool layout_ok_ = true;
     std::uint64_t unbounded_ = 0;

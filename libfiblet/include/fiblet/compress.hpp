@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "fiblet/encode.hpp"
 #include "fiblet/error_stats.hpp"
 #include "fiblet/fft_format.hpp"
 
@@ -23,9 +24,25 @@ struct TckScan {
     std::uint64_t off_step_segments = 0; // segments farther than the tolerance from the chosen step
 };
 
+// The zstd stage (formats/fftz.md): groups of blocks compressed into
+// independent frames plus a seek table.
+struct ZstdOptions {
+    int level = 19;                      // zstd compression level
+    std::uint32_t group_blocks = 4096;   // blocks per frame (the unit of random access)
+    bool transpose = true;               // store each group's blocks field by field
+};
+
 struct CompressOptions {
     std::optional<double> step_mm;            // overrides the measured step
-    std::uint32_t points_per_block = kDefaultPointsPerBlock;
+    std::uint32_t points_per_block = 0;       // 0: 60 for 8-bit codes, 126 for 16-bit codes
+    // Encoder choices; the decoder is the same whatever they are (docs/encode.md).
+    unsigned direction_bits = 8;              // 8: version-2 .fft; 16: the 16-bit variant (formats/fft16.md)
+    SearchOptions search = search_for_effort(kDefaultEffort);  // code search (see search_for_effort)
+    std::optional<double> cap_ratio;          // cap ratio; default: tuned on a sample
+    std::optional<double> turn_percentile;    // or: a cap that holds this percentile of the turning angles
+    std::optional<double> step_scale;         // decoder step / sampling step; default: tuned on a sample
+    std::size_t tuning_points = 1u << 15;     // points in the tuning sample
+    std::optional<ZstdOptions> zstd;          // write the seekable zstd container instead of a plain file
     double step_tolerance = 0.01;             // relative spacing deviation that triggers resampling
     unsigned threads = 0;                     // encoding threads; 0 = all cores
     bool overwrite = false;
@@ -37,7 +54,9 @@ struct CompressOptions {
 struct CompressReport {
     TckScan scan;
     FftHeader header;
-    double step_mm = 0;
+    double step_mm = 0;              // sampling step: the spacing of the encoded points
+    double step_scale = 1;           // decoder step / sampling step (header step = step_mm * step_scale)
+    SearchOptions search;            // the search used (with the retry threshold chosen)
     bool resampled = false;          // the input was resampled to the fixed step
     ErrorStats error;                // decoded vs the encoded points (resampled ones if resampled)
     ErrorStats error_vs_original;    // decoded vs the original polyline (only if resampled)

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "fiblet/geometry.hpp"
 
@@ -54,6 +55,27 @@ public:
 private:
     float ratio_;
     std::array<Frame, 256> frames_;
+};
+
+// The 16-bit direction code of the .fft16 layout (formats/fft16.md): the
+// same cap mapping and half-octahedron, quantized with 256 levels on each
+// diagonal axis (high byte: y+z, low byte: y-z).
+std::uint16_t quantize_half_octahedron16(Vec3f dir);
+Vec3f dequantize_half_octahedron16(std::uint16_t code);
+
+// The 65536 local frames of a 16-bit file (2.4 MB, built once per file).
+class DirectionTable16 {
+public:
+    explicit DirectionTable16(float ratio);
+    float ratio() const { return ratio_; }
+    const Frame& frame(std::uint16_t code) const { return frames_[code]; }
+    const Vec3f& direction(std::uint16_t code) const { return frames_[code].c[0]; }
+    // As DirectionTable::nearest_code, with 16-bit codes.
+    std::uint16_t nearest_code(Vec3f local_dir) const;
+
+private:
+    float ratio_;
+    std::vector<Frame> frames_;
 };
 
 }  // namespace fiblet

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -10,19 +11,48 @@
 
 namespace fiblet {
 
+// How hard the encoder searches for the codes of a block (the decoder is the
+// same whatever is chosen). beam_width 1 is greedy closed-loop aiming; a
+// wider beam keeps that many candidate code sequences per step and returns
+// the one with the smallest sum of squared point errors over the block.
+// A block whose largest error exceeds retry_error_mm is searched again
+// with the retry beam, and the better of the two kept (smaller max error):
+// the rare blocks at turns sharper than the cap get the wide search, the
+// others stay fast.
+struct SearchOptions {
+    unsigned beam_width = 1;        // 1..64
+    unsigned radius = 1;            // candidates per sequence: (2 radius + 1)^2 codes around the aimed one; 1..3
+    unsigned retry_beam_width = 0;  // 0: no retry; else 2..64
+    unsigned retry_radius = 1;      // 1..3
+    double retry_error_mm = 0;      // retry blocks whose max error exceeds this (> 0)
+};
+
+// The search of each effort level (0..kMaxEffort), from fast to thorough;
+// docs/encode.md lists them with their measured speed and error. The
+// retry threshold is set by the compress pipeline from the tuning sample.
+inline constexpr int kDefaultEffort = 1;
+inline constexpr int kMaxEffort = 4;
+SearchOptions search_for_effort(int effort);
+
 // Encodes one fixed-step streamline at a time into blocks, with the file's
-// parameters (scaling, offset, ratio, step, points per block) taken from a
-// header. Closed loop: each direction is chosen from the *decoded* previous
-// point and frame, so quantization errors do not accumulate along a block.
-// Thread-safe (const).
+// parameters (scaling, offset, ratio, step, points per block, and the
+// direction bits through the version) taken from a header. Closed loop:
+// each direction is chosen from the *decoded* previous point and frame, so
+// quantization errors do not accumulate along a block. Thread-safe (const).
 class FiberEncoder {
 public:
-    explicit FiberEncoder(const FftHeader& header);
+    explicit FiberEncoder(const FftHeader& header, SearchOptions search = {});
 
     const FftHeader& header() const { return header_; }
+    const SearchOptions& search() const { return search_; }
     std::uint32_t block_count(std::size_t points) const {
         return std::uint32_t((points + header_.points_per_block - 1) / header_.points_per_block);
     }
+
+    // The same encoder walking another step (normalized units); shares the
+    // code tables, so trying several steps costs no table builds.
+    FiberEncoder with_step(float step) const;
+    FiberEncoder with_search(const SearchOptions& search) const;
 
     // Appends block_count(fiber.size()) blocks to `out`. When `decoded` is
     // given, the points a decoder will produce (world mm) are appended to it.
@@ -30,14 +60,17 @@ public:
                 std::vector<Vec3f>* decoded = nullptr) const;
 
 private:
+    struct Tables;
     FftHeader header_;
-    DirectionTable table_;
+    SearchOptions search_;
+    std::shared_ptr<const Tables> tables_;
 };
 
 // Ratio of the direction code for a file: E = scaling / 2^16 (anchor
 // quantization), A = atan(2E / (step - 2E)), Ratio = min(2, 1 - cos(acos(minDot) + A)),
 // with step in mm and minDot the smallest dot product of consecutive unit
-// segment directions.
+// segment directions (or, for a robust cap, that of a high percentile of
+// the turning angles).
 float compute_ratio(double scaling_mm, double step_mm, double min_dot);
 
 }  // namespace fiblet

@@ -2,16 +2,22 @@
 //
 // FftFile reads and validates the header and the fiber LUT up front (every
 // count is checked against the file size before it is trusted), then reads
-// blocks on demand, so a file of any size is opened in O(fibers) memory.
+// blocks on demand, so a file of any size is opened in O(fibers) memory
+// (12 bytes per fiber). Every block read is checked against the LUT (point
+// count, first/last flags) and, when the file carries a CSUM chunk
+// (fiblet/checksum.hpp), against its checksums.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "fiblet/checksum.hpp"
 #include "fiblet/fft_format.hpp"
 
 namespace fiblet {
@@ -21,9 +27,17 @@ namespace fiblet {
 // Throws Error{fft_format}.
 FftHeader parse_fft_header(std::span<const std::uint8_t> bytes, std::uint64_t file_size, const std::string& name);
 
+struct FftOpenOptions {
+    // Check the CSUM chunk's hashes (header and LUT at open, block groups on
+    // read) when the file has one. Off only where speed matters more than
+    // detecting corruption (or to look at a damaged file).
+    bool verify_checksums = true;
+};
+
 class FftFile {
 public:
-    explicit FftFile(const std::string& path);
+    // Throws Error{io | fft_format | checksum | unsupported}.
+    explicit FftFile(const std::string& path, FftOpenOptions options = {});
     ~FftFile();
     FftFile(FftFile&&) noexcept;
     FftFile& operator=(FftFile&&) noexcept;
@@ -46,31 +60,52 @@ public:
 
     // Chunks of the fiblet trailer (empty for files without one), and the
     // source .tck properties stored in its PROP chunk.
+    // Unknown chunks above 16 MiB are not loaded (memory stays bounded).
+    bool has_trailer() const { return has_trailer_; }
     const std::vector<TrailerChunk>& trailer() const { return trailer_; }
     const TrailerChunk* find_chunk(std::array<char, 4> tag) const;
     std::vector<std::pair<std::string, std::string>> properties() const;
+    // The parsed CSUM chunk, or nullptr for a file without checksums.
+    const FftChecksums* checksums() const { return checksums_ ? &*checksums_ : nullptr; }
+    bool verifies_checksums() const { return checksums_ && options_.verify_checksums; }
 
-    // Reads blocks [first, first+count) into `out` (count * block_bytes bytes).
+    // Reads blocks [first, first+count) into `out` (count * block_bytes
+    // bytes), checks them against the LUT (Error{fft_format}) and the
+    // checksums of the groups they touch (Error{checksum}; the rest of a
+    // group partly inside the range is read to hash it). Each group is
+    // verified the first time any of its blocks is read. Thread-safe.
     void read_blocks(std::uint64_t first, std::uint64_t count, std::uint8_t* out) const;
     std::vector<std::uint8_t> read_blocks(std::uint64_t first, std::uint64_t count) const;
 
-    // All blocks as one read-only memory mapping (made on first call, kept
-    // until the FftFile goes), for reading scattered blocks without a system
-    // call each; empty when the file cannot be mapped (then use
-    // read_blocks). The file must not shrink while mapped (SIGBUS).
-    std::span<const std::uint8_t> mapped_blocks() const;
+    // Blocks [first, first+count) in place, in a read-only memory mapping of
+    // the file (made on the first call, kept until the FftFile goes), checked
+    // as read_blocks checks them: for reading scattered blocks without a
+    // system call and a copy each. Empty when the file cannot be mapped (use
+    // read_blocks then). The file must not shrink while mapped (SIGBUS).
+    std::span<const std::uint8_t> mapped_blocks(std::uint64_t first, std::uint64_t count) const;
 
 private:
     struct Mapping;
+    void read_lut(std::uint64_t& lut_hash);
     void read_trailer();
+    void verify_open_checksums(std::span<const std::uint8_t> head, std::uint64_t lut_hash) const;
+    void check_block_structure(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const;
+    void verify_block_groups(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const;
+    void close() noexcept;
+
     std::string path_;
+    FftOpenOptions options_;
     int fd_ = -1;
     std::uint64_t file_size_ = 0;
     FftHeader header_;
     std::vector<FiberLutEntry> lut_;
-    std::vector<std::uint64_t> fiber_first_block_;
+    std::vector<std::uint32_t> fiber_first_block_;  // block counts are 32-bit, so are first blocks
+    bool has_trailer_ = false;
     std::vector<TrailerChunk> trailer_;
-    std::unique_ptr<Mapping> mapping_;
+    std::uint64_t checksum_chunk_offset_ = 0;  // where the CSUM chunk starts in the file
+    std::optional<FftChecksums> checksums_;
+    std::unique_ptr<std::atomic<std::uint64_t>[]> verified_groups_;  // one bit per block group
+    std::unique_ptr<Mapping> mapping_;                                // mapped_blocks()
 };
 
 }  // namespace fiblet

@@ -9,6 +9,10 @@
 //   LUT      per fiber u32 x, u32 y (x = buffer << 16 | blocks, y = first block
 //            of the fiber inside its buffer)
 //   blocks   nbBlocks x blockSize bytes (76 for 60 points)
+//
+// The 16-bit variant (formats/fft16.md) has the same header and LUT with
+// version = 16, so readers of version 2 reject it cleanly; its blocks hold
+// unorm24 anchors and 16-bit direction codes.
 #pragma once
 
 #include <array>
@@ -23,6 +27,7 @@
 namespace fiblet {
 
 inline constexpr std::uint8_t kFftVersion = 2;
+inline constexpr std::uint8_t kFft16Version = 16;  // 16-bit directions (formats/fft16.md)
 inline constexpr std::uint32_t kDefaultPointsPerBlock = 60;
 inline constexpr std::uint32_t kMaxPointsPerBlock = 63;  // 6-bit count in the flags byte
 inline constexpr std::size_t kFftFixedHeaderBytes = 1 + 8 + 8 + 4 + 4 + 4 * 8 + 1;  // up to the SSBO table
@@ -41,6 +46,23 @@ inline constexpr std::uint8_t kFlagCountMask = 0x3f;
 // Block size for a number of points: points + 16 rounded up to 4 bytes.
 constexpr std::uint32_t fft_block_bytes(std::uint32_t points_per_block) {
     return (points_per_block + 16 + 3) / 4 * 4;
+}
+
+// 16-bit blocks (formats/fft16.md): six unorm24 anchor coordinates (18
+// bytes), u32 fiber id, u16 flags/count, then one u16 code per further
+// point; everything little-endian.
+inline constexpr std::uint32_t kDefaultPointsPerBlock16 = 126;
+inline constexpr std::uint32_t kMaxPointsPerBlock16 = 16383;  // 14-bit count
+inline constexpr std::size_t kBlock16FiberIdOffset = 18;
+inline constexpr std::size_t kBlock16FlagsOffset = 22;
+inline constexpr std::size_t kBlock16DirectionsOffset = 24;
+inline constexpr std::uint16_t kFlag16NotFirst = 0x8000;
+inline constexpr std::uint16_t kFlag16NotLast = 0x4000;
+inline constexpr std::uint16_t kFlag16CountMask = 0x3fff;
+
+// 24 header bytes + 2 per direction, rounded up to 4 bytes.
+constexpr std::uint32_t fft16_block_bytes(std::uint32_t points_per_block) {
+    return (24 + 2 * (points_per_block - 2) + 3) / 4 * 4;
 }
 
 // Largest number of blocks one GPU buffer holds (2^31 bytes / block size).
@@ -62,7 +84,14 @@ struct FftHeader {
     float mean_error_mm = 0;
     std::vector<std::uint64_t> buffer_ends;  // cumulative block count at the end of each buffer
 
-    std::uint32_t block_bytes() const { return fft_block_bytes(points_per_block); }
+    // 8 for version 2, 16 for the 16-bit variant.
+    unsigned direction_bits() const { return version == kFft16Version ? 16 : 8; }
+    std::uint32_t max_points_per_block() const {
+        return version == kFft16Version ? kMaxPointsPerBlock16 : kMaxPointsPerBlock;
+    }
+    std::uint32_t block_bytes() const {
+        return version == kFft16Version ? fft16_block_bytes(points_per_block) : fft_block_bytes(points_per_block);
+    }
     float step_mm() const { return step * scaling; }
     // Bytes before the fiber LUT / before the first block.
     std::uint64_t lut_offset() const { return kFftFixedHeaderBytes + 8 * buffer_ends.size(); }
@@ -97,6 +126,8 @@ struct TrailerChunk {
     std::array<char, 4> tag{};
     std::vector<std::uint8_t> payload;
 };
+// Appends one chunk (16-byte head, then the payload) to `out`.
+void append_trailer_chunk(std::vector<std::uint8_t>& out, const TrailerChunk& chunk);
 // Serializes chunks + footer; `trailer_offset` is where the first chunk starts.
 std::vector<std::uint8_t> serialize_trailer(const std::vector<TrailerChunk>& chunks, std::uint64_t trailer_offset);
 
@@ -131,5 +162,57 @@ struct BlockView {
 // unorm16 as GLSL packUnorm2x16 defines it: round(clamp(v, 0, 1) * 65535).
 std::uint16_t pack_unorm16(float v);
 inline float unpack_unorm16(std::uint16_t q) { return float(q) / 65535.0f; }
+
+// unorm24 (16-bit blocks): round(clamp(v, 0, 1) * (2^24 - 1)); every value
+// is exact in a float, so decoding rounds once.
+inline constexpr std::uint32_t kUnorm24Max = (1u << 24) - 1;
+inline float unpack_unorm24(std::uint32_t q) { return float(q) / float(kUnorm24Max); }
+
+// Read-only view of one 16-bit block's fields.
+struct BlockView16 {
+    const std::uint8_t* bytes;
+
+    std::uint16_t flags() const { return std::uint16_t(bytes[kBlock16FlagsOffset] | bytes[kBlock16FlagsOffset + 1] << 8); }
+    std::uint32_t point_count() const { return flags() & kFlag16CountMask; }
+    bool is_first() const { return !(flags() & kFlag16NotFirst); }
+    bool is_last() const { return !(flags() & kFlag16NotLast); }
+    std::uint32_t fiber_id() const {
+        const std::uint8_t* p = bytes + kBlock16FiberIdOffset;
+        return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 | std::uint32_t{p[3]} << 24;
+    }
+    // The six anchor coordinates (x0 y0 z0 x1 y1 z1), unorm24.
+    std::uint32_t anchor_word(int i) const {
+        const std::uint8_t* p = bytes + 3 * i;
+        return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16;
+    }
+    std::array<float, 6> anchors_normalized() const {
+        std::array<float, 6> v{};
+        for (int i = 0; i < 6; ++i) v[i] = unpack_unorm24(anchor_word(i));
+        return v;
+    }
+    std::uint16_t code(std::uint32_t k) const {  // direction of point k + 2
+        const std::uint8_t* p = bytes + kBlock16DirectionsOffset + 2 * k;
+        return std::uint16_t(p[0] | p[1] << 8);
+    }
+};
+
+// Point count and first/last flags of a block of either kind (8-bit
+// version-2 blocks or 16-bit blocks), for code that only walks the structure.
+struct BlockFlags {
+    std::uint32_t point_count;
+    bool first, last;
+};
+inline BlockFlags block_flags(const FftHeader& h, const std::uint8_t* block) {
+    if (h.direction_bits() == 16) {
+        const BlockView16 v{block};
+        return {v.point_count(), v.is_first(), v.is_last()};
+    }
+    const BlockView v{block};
+    return {v.point_count(), v.is_first(), v.is_last()};
+}
+// The two anchors (x0 y0 z0 x1 y1 z1, normalized) of a block of either kind.
+inline std::array<float, 6> block_anchors_normalized(const FftHeader& h, const std::uint8_t* block) {
+    return h.direction_bits() == 16 ? BlockView16{block}.anchors_normalized() : BlockView{block}.anchors_normalized();
+}
 
 }  // namespace fiblet

@@ -5,6 +5,7 @@
 //   tck.hpp            streaming .tck reader, atomic .tck writer
 //   fft_format.hpp     the .fft layout: header, LUT, blocks, trailer
 //   fft_file.hpp       validated .fft reading (header + LUT up front, blocks on demand)
+//   checksum.hpp       XXH64 integrity chunk of .fft files, whole-file verification
 //   direction_code.hpp the 8-bit direction code and its frames
 //   encode.hpp         one streamline -> blocks (closed loop)
 //   compress.hpp       the whole .tck -> .fft pipeline
@@ -20,6 +21,7 @@
 #pragma once
 
 #include "fiblet/block_index.hpp"
+#include "fiblet/checksum.hpp"
 #include "fiblet/compare.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/decode.hpp"

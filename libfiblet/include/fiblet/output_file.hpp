@@ -24,7 +24,9 @@ public:
     void write(const void* data, std::size_t size);               // appends
     void write_at(const void* data, std::size_t size, std::uint64_t offset);  // patches
     std::uint64_t size() const { return written_; }
-    void commit();  // flushes, renames over the destination
+    // Flushes and renames into place: over the destination if `overwrite`,
+    // else only if it still does not exist (Error{exists}, atomically).
+    void commit();
 
     const std::string& path() const { return path_; }
     const std::string& temporary_path() const { return tmp_; }
@@ -40,11 +42,11 @@ private:
 };
 
 // Removes every temporary output still pending. Async-signal-safe: a CLI calls
-// it from its SIGINT/SIGTERM handler before exiting.
+// it from its SIGINT/SIGTERM/SIGHUP handler before exiting.
 void remove_pending_outputs() noexcept;
 
-// Installs SIGINT/SIGTERM handlers that remove pending outputs and exit with
-// 128+signal (the shell convention).
+// Installs SIGINT/SIGTERM/SIGHUP handlers that remove pending outputs and
+// exit with 128+signal (the shell convention).
 void install_signal_cleanup();
 
 }  // namespace fiblet

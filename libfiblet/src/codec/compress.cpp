@@ -5,12 +5,15 @@
 
 #include <sys/stat.h>
 
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <thread>
 
+#include "codec/parameters.hpp"
+#include "fiblet/checksum.hpp"
 #include "fiblet/block_index.hpp"
 #include "fiblet/encode.hpp"
 #include "fiblet/error.hpp"
@@ -22,28 +25,35 @@ namespace fiblet {
 
 namespace {
 
-// Median of segment lengths from a log-spaced histogram (1e-4 relative
-// resolution between 1 nm and 1 m): constant memory for any input size.
+// Median of segment lengths from a histogram of their float32 bit patterns
+// (the top 13 mantissa bits: 1.2e-4 relative resolution between 1 um and
+// 2 m, no logarithm per segment): constant memory for any input size.
 class LengthHistogram {
 public:
     LengthHistogram() : bins_(kBins + 2, 0) {}
     void add(double len) {
+        const float f = float(len);
         std::size_t i = 0;
-        if (len >= kMin) i = 1 + std::min<std::size_t>(kBins, std::size_t(std::log(len / kMin) / kLogStep));
+        if (f >= kMin) i = 1 + std::min<std::size_t>(kBins, (std::bit_cast<std::uint32_t>(f) - kMinBits) >> kShift);
         ++bins_[i], ++count_;
     }
     double median() const {
         std::uint64_t seen = 0;
         for (std::size_t i = 0; i < bins_.size(); ++i) {
             seen += bins_[i];
-            if (2 * seen >= count_ && count_ > 0) return i == 0 ? 0.0 : kMin * std::exp((double(i - 1) + 0.5) * kLogStep);
+            if (2 * seen >= count_ && count_ > 0) {
+                if (i == 0) return 0.0;
+                const auto lo = std::uint32_t(kMinBits + ((i - 1) << kShift));
+                return 0.5 * (double(std::bit_cast<float>(lo)) + double(std::bit_cast<float>(lo + (1u << kShift))));
+            }
         }
         return 0.0;
     }
 
 private:
-    static constexpr double kMin = 1e-6, kLogStep = 1e-4;
-    static constexpr std::size_t kBins = 207233;  // ln(1e9) / 1e-4
+    static constexpr float kMin = 0x1p-20f;
+    static constexpr std::uint32_t kMinBits = std::bit_cast<std::uint32_t>(kMin), kShift = 10;
+    static constexpr std::size_t kBins = std::size_t(31) << (23 - kShift);  // 2^-20 .. 2^11
     std::vector<std::uint64_t> bins_;
     std::uint64_t count_ = 0;
 };
@@ -51,23 +61,6 @@ private:
 double length(Vec3f a, Vec3f b) {
     const double dx = double(b.x) - a.x, dy = double(b.y) - a.y, dz = double(b.z) - a.z;
     return std::sqrt(dx * dx + dy * dy + dz * dz);
-}
-
-// Smallest dot product of consecutive unit segment directions (zero-length
-// segments carry no direction and are skipped).
-double min_turn_dot(std::span<const Vec3f> f) {
-    double best = 1.0;
-    double px = 0, py = 0, pz = 0;
-    bool have = false;
-    for (std::size_t i = 1; i < f.size(); ++i) {
-        double dx = double(f[i].x) - f[i - 1].x, dy = double(f[i].y) - f[i - 1].y, dz = double(f[i].z) - f[i - 1].z;
-        const double n = std::sqrt(dx * dx + dy * dy + dz * dz);
-        if (!(n > 0)) continue;
-        dx /= n, dy /= n, dz /= n;
-        if (have) best = std::min(best, px * dx + py * dy + pz * dz);
-        px = dx, py = dy, pz = dz, have = true;
-    }
-    return best;
 }
 
 struct Timer {
@@ -83,8 +76,14 @@ void report_progress(const CompressOptions& o, const char* phase, const TckReade
 
 CompressReport compress_tck(const std::string& tck_path, const std::string& fft_path, const CompressOptions& options) {
     const Timer timer;
-    if (options.points_per_block < 2 || options.points_per_block > kMaxPointsPerBlock)
-        throw Error(Errc::invalid_argument, "points per block must be in [2, 63]");
+    if (options.direction_bits != 8 && options.direction_bits != 16)
+        throw Error(Errc::invalid_argument, "direction bits must be 8 or 16");
+    const bool wide = options.direction_bits == 16;
+    const std::uint32_t points_per_block =
+        options.points_per_block ? options.points_per_block : (wide ? kDefaultPointsPerBlock16 : kDefaultPointsPerBlock);
+    const std::uint32_t max_points_per_block = wide ? kMaxPointsPerBlock16 : kMaxPointsPerBlock;
+    if (points_per_block < 2 || points_per_block > max_points_per_block)
+        throw Error(Errc::invalid_argument, "points per block must be in [2, " + std::to_string(max_points_per_block) + "]");
     if (options.step_mm && !(std::isfinite(*options.step_mm) && *options.step_mm > 0))
         throw Error(Errc::invalid_argument, "--step must be a positive number of millimetres");
 
@@ -97,6 +96,10 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     std::vector<std::uint32_t> fiber_points;
     std::vector<Vec3f> fiber, resampled;
     LengthHistogram lengths;
+    // Turning angles and a sample of fibers, for the encoder's choices (parameters.cpp).
+    constexpr std::size_t kSharpBlocks = 32;
+    detail::TurnStatistics turns(points_per_block, kSharpBlocks);
+    detail::FiberSample sample(options.tuning_points);
     double length_sum = 0;
     scan.min = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
                 std::numeric_limits<double>::infinity()};
@@ -126,7 +129,8 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
                 ++scan.segments;
             }
         }
-        scan.min_dot = std::min(scan.min_dot, min_turn_dot(fiber));
+        turns.add_fiber(fiber);
+        sample.offer(fiber);
         if ((scan.fibers & 1023) == 0) report_progress(options, "scan", reader);
     }
     if (scan.points == 0) scan.min = scan.max = {0, 0, 0};
@@ -156,7 +160,8 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     // Normalization into the unit cube; the step is what the decoder will
     // use (float, normalized), and resampling uses exactly that length.
     FftHeader& h = report.header;
-    h.points_per_block = options.points_per_block;
+    h.version = wide ? kFft16Version : kFftVersion;
+    h.points_per_block = points_per_block;
     h.fibers = scan.fibers;
     double extent = 0;
     for (int a = 0; a < 3; ++a) {
@@ -171,21 +176,35 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     // Pass 1b (resampling only): the counts and turning angles change.
     if (report.resampled) {
         reader.rewind();
-        scan.min_dot = 1;
+        turns = detail::TurnStatistics(points_per_block, kSharpBlocks);
         std::size_t f = 0;
         while (reader.next(fiber)) {
             resample_fixed_step(fiber, step, resampled);
             fiber_points[f++] = std::uint32_t(resampled.size());
-            scan.min_dot = std::min(scan.min_dot, min_turn_dot(resampled));
+            turns.add_fiber(resampled);
             for (std::size_t i = 1; i < fiber.size(); ++i)
                 scan.off_step_segments += std::fabs(length(fiber[i - 1], fiber[i]) - step) > tol * step;
             if ((f & 1023) == 0) report_progress(options, "resample-scan", reader);
         }
     }
 
-    // Header: normalization, ratio, block layout and buffer table.
-    h.ratio = compute_ratio(h.scaling, step, scan.min_dot);
-    const FiberEncoder encoder(h);
+    // Header: the encoder's choices (parameters.cpp), block layout and buffer table.
+    scan.min_dot = turns.min_dot();
+    if (options.cap_ratio && !(*options.cap_ratio > 0 && *options.cap_ratio <= 2))
+        throw Error(Errc::invalid_argument, "the cap ratio must be in (0, 2]");
+    if (options.step_scale && !(*options.step_scale > 0.5 && *options.step_scale < 2))
+        throw Error(Errc::invalid_argument, "the step scale must be in (0.5, 2)");
+    std::optional<float> fixed_ratio;
+    if (options.cap_ratio) fixed_ratio = float(*options.cap_ratio);
+    else if (options.turn_percentile) fixed_ratio = compute_ratio(h.scaling, step, turns.dot_at_percentile(*options.turn_percentile));
+    detail::TunedParameters tuned = detail::tune_parameters(
+        {sample.fibers(), turns.sharpest_blocks(), report.resampled ? step : 0.0}, turns, h, options.search, step,
+        fixed_ratio, options.step_scale);
+    h.ratio = tuned.ratio;
+    report.step_scale = tuned.step_scale;
+    h.step = float(step * report.step_scale / h.scaling);
+    const FiberEncoder encoder = tuned.encoder ? std::move(*tuned.encoder) : FiberEncoder(h, tuned.search);
+    report.search = encoder.search();
     std::vector<FiberLutEntry> lut(scan.fibers);
     const std::uint64_t per_buffer = fft_max_blocks_per_buffer(h.block_bytes());
     std::uint64_t blocks = 0, in_buffer = 0;
@@ -207,10 +226,12 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
 
     // Pass 2: encode, measure, write.
     AtomicOutputFile out(fft_path, options.overwrite);
+    FftChecksumBuilder checksum(h.block_bytes());  // the CSUM trailer chunk (formats/fft-checksum.md)
     {
         const auto head = serialize_fft_header(h);
         out.write(head.data(), head.size());
         out.write(lut.data(), lut.size() * sizeof(FiberLutEntry));
+        checksum.add_lut(lut.data(), lut.size() * sizeof(FiberLutEntry));
     }
     reader.rewind();
     // Batches of whole fibers are read in order, encoded by `threads`
@@ -272,12 +293,16 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         for (auto& th : pool) th.join();
         for (std::size_t t = 0; t + 1 < cut.size(); ++t) {
             out.write(work[t].blocks.data(), work[t].blocks.size());
+            checksum.add_blocks(work[t].blocks.data(), work[t].blocks.size());
             index.append(work[t].index);
         }
         next_fiber += std::uint32_t(n);
         report_progress(options, "encode", reader);
     }
     for (const Work& w : work) report.error.merge(w.error), report.error_vs_original.merge(w.error_vs_original);
+    h.max_error_mm = float(report.error.max_mm());
+    h.mean_error_mm = float(report.error.mean_mm());
+    const auto final_head = serialize_fft_header(h);
     {
         const std::uint64_t at = out.size();
         std::vector<TrailerChunk> chunks{make_properties_chunk(reader.header().properties)};
@@ -287,15 +312,11 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             chunks.push_back(std::move(c));
         }
         if (auto bidx = index.finish()) chunks.push_back(std::move(*bidx));
+        chunks.push_back(checksum.finish(final_head, chunks));  // last: it covers the chunks before it
         const auto trailer = serialize_trailer(chunks, at);
         out.write(trailer.data(), trailer.size());
     }
-    h.max_error_mm = float(report.error.max_mm());
-    h.mean_error_mm = float(report.error.mean_mm());
-    {
-        const auto head = serialize_fft_header(h);
-        out.write_at(head.data(), head.size(), 0);
-    }
+    out.write_at(final_head.data(), final_head.size(), 0);
     report.output_bytes = out.size();
     out.commit();
     if (options.progress) options.progress("encode", 1.0);

@@ -32,23 +32,63 @@ Vec3f map_cap_to_half_sphere(Vec3f v, float ratio) {
     return {x, v.y * lateral, v.z * lateral};
 }
 
-std::uint8_t quantize_half_octahedron(Vec3f d) {
+namespace {
+
+// Half-octahedron quantizer with `Levels` levels per diagonal axis: the
+// code is level(y+z) * Levels + level(y-z), i.e. the high nibble/byte holds
+// y+z. 8-bit codes use 16 levels, 16-bit codes 256.
+template <int Levels>
+unsigned quantize_levels(Vec3f d) {
+    constexpr float half = 0.5f * float(Levels - 1);
     const float ax = d.x > 0.0f ? d.x : 0.0f;  // below the rim: project onto x = 0
     const float l1 = ax + std::fabs(d.y) + std::fabs(d.z);
     const float vy = l1 > 0.0f ? d.y / l1 : 0.0f;
     const float vz = l1 > 0.0f ? d.z / l1 : 0.0f;
     auto level = [](float u) {
-        return static_cast<std::uint8_t>(std::clamp(std::floor(0.5f + 7.5f * (1.0f + u)), 0.0f, 15.0f));
+        return static_cast<unsigned>(std::clamp(std::floor(0.5f + half * (1.0f + u)), 0.0f, float(Levels - 1)));
     };
-    return static_cast<std::uint8_t>(level(vy + vz) << 4 | level(vy - vz));
+    return level(vy + vz) * Levels + level(vy - vz);
 }
 
-Vec3f dequantize_half_octahedron(std::uint8_t code) {
-    const float q1 = float(code >> 4) / 7.5f - 1.0f;
-    const float q2 = float(code & 15) / 7.5f - 1.0f;
+template <int Levels>
+Vec3f dequantize_levels(unsigned code) {
+    constexpr float half = 0.5f * float(Levels - 1);
+    const float q1 = float(code / Levels) / half - 1.0f;
+    const float q2 = float(code % Levels) / half - 1.0f;
     const float y = 0.5f * (q1 + q2), z = 0.5f * (q1 - q2);
     return normalize(Vec3f{1.0f - std::fabs(y) - std::fabs(z), y, z});
 }
+
+// The code whose cap direction is closest in angle to `local`: the formula
+// code of the direction mapped back to the half sphere, refined over its
+// 3x3 neighbourhood (the cap mapping bends the cells a little).
+template <int Levels, class Table>
+unsigned nearest_levels(const Table& t, Vec3f local) {
+    const float ratio = t.ratio();
+    if (!(dot(local, local) > 0.0f)) return quantize_levels<Levels>(map_cap_to_half_sphere({1, 0, 0}, ratio));
+    const Vec3f unit = normalize(local);
+    // Outside the cap the code can only lie on the rim: aim along (0, y, z).
+    const Vec3f on_half_sphere =
+        unit.x >= 1.0f - ratio ? map_cap_to_half_sphere(unit, ratio) : Vec3f{0.0f, unit.y, unit.z};
+    const unsigned guess = quantize_levels<Levels>(on_half_sphere);
+    const int h0 = int(guess / Levels), l0 = int(guess % Levels);
+    unsigned best = guess;
+    float best_dot = dot(t.direction(guess), local);
+    for (int h = std::max(h0 - 1, 0); h <= std::min(h0 + 1, Levels - 1); ++h)
+        for (int l = std::max(l0 - 1, 0); l <= std::min(l0 + 1, Levels - 1); ++l) {
+            const auto code = unsigned(h * Levels + l);
+            const float d = dot(t.direction(code), local);
+            if (d > best_dot) best_dot = d, best = code;
+        }
+    return best;
+}
+
+}  // namespace
+
+std::uint8_t quantize_half_octahedron(Vec3f d) { return static_cast<std::uint8_t>(quantize_levels<16>(d)); }
+Vec3f dequantize_half_octahedron(std::uint8_t code) { return dequantize_levels<16>(code); }
+std::uint16_t quantize_half_octahedron16(Vec3f d) { return static_cast<std::uint16_t>(quantize_levels<256>(d)); }
+Vec3f dequantize_half_octahedron16(std::uint16_t code) { return dequantize_levels<256>(code); }
 
 DirectionTable::DirectionTable(float ratio) : ratio_(ratio) {
     for (int k = 0; k < 256; ++k) {
@@ -58,22 +98,18 @@ DirectionTable::DirectionTable(float ratio) : ratio_(ratio) {
 }
 
 std::uint8_t DirectionTable::nearest_code(Vec3f local) const {
-    if (!(dot(local, local) > 0.0f)) return quantize_half_octahedron(map_cap_to_half_sphere({1, 0, 0}, ratio_));
-    const Vec3f unit = normalize(local);
-    // Outside the cap the code can only lie on the rim: aim along (0, y, z).
-    const Vec3f on_half_sphere =
-        unit.x >= 1.0f - ratio_ ? map_cap_to_half_sphere(unit, ratio_) : Vec3f{0.0f, unit.y, unit.z};
-    const std::uint8_t guess = quantize_half_octahedron(on_half_sphere);
-    const int h0 = guess >> 4, l0 = guess & 15;
-    std::uint8_t best = guess;
-    float best_dot = dot(direction(guess), local);
-    for (int h = std::max(h0 - 1, 0); h <= std::min(h0 + 1, 15); ++h)
-        for (int l = std::max(l0 - 1, 0); l <= std::min(l0 + 1, 15); ++l) {
-            const auto code = static_cast<std::uint8_t>(h << 4 | l);
-            const float d = dot(direction(code), local);
-            if (d > best_dot) best_dot = d, best = code;
-        }
-    return best;
+    return static_cast<std::uint8_t>(nearest_levels<16>(*this, local));
+}
+
+DirectionTable16::DirectionTable16(float ratio) : ratio_(ratio), frames_(65536) {
+    for (unsigned k = 0; k < 65536; ++k) {
+        const Vec3f d = normalize(map_half_sphere_to_cap(dequantize_half_octahedron16(std::uint16_t(k)), ratio));
+        frames_[k] = frame_from_axis(d);
+    }
+}
+
+std::uint16_t DirectionTable16::nearest_code(Vec3f local) const {
+    return static_cast<std::uint16_t>(nearest_levels<256>(*this, local));
 }
 
 }  // namespace fiblet

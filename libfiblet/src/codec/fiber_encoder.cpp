@@ -1,6 +1,9 @@
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
+#include "codec/code_search.hpp"
+#include "codec/nearest_code_lut.hpp"
 #include "core/block_geometry.hpp"
 #include "core/vec_math.hpp"
 #include "fiblet/encode.hpp"
@@ -11,27 +14,69 @@ using namespace detail;
 
 namespace {
 
-// unorm16 words of a point in normalized coordinates (computed in double so
-// that the rounding to 1/65535 is the only loss).
+// A point's anchor words in normalized coordinates, computed in double so
+// that the rounding to the unorm grid (2^16 - 1 or 2^24 - 1 steps) is the
+// only loss.
 struct Quantized {
-    std::uint16_t q[3];
-    Vec3f decoded() const { return {unpack_unorm16(q[0]), unpack_unorm16(q[1]), unpack_unorm16(q[2])}; }
+    std::uint32_t q[3];
 };
 
-Quantized quantize_point(const FftHeader& h, double x, double y, double z) {
+Quantized quantize_point(const FftHeader& h, Vec3f p, double levels) {
     auto one = [&](double v, int axis) {
         const double n = (v + h.offset[axis]) / h.scaling + 0.5;
-        return static_cast<std::uint16_t>(std::lround(std::clamp(n, 0.0, 1.0) * 65535.0));
+        return static_cast<std::uint32_t>(std::lround(std::clamp(n, 0.0, 1.0) * levels));
     };
-    return {{one(x, 0), one(y, 1), one(z, 2)}};
+    return {{one(p.x, 0), one(p.y, 1), one(p.z, 2)}};
 }
 
-void put_word(std::uint8_t* w, std::uint16_t a, std::uint16_t b) {
-    // a | b << 16, most-significant byte first.
+void put_word(std::uint8_t* w, std::uint32_t a, std::uint32_t b) {
+    // Version 2 anchor word: a | b << 16, most-significant byte first.
     w[0] = std::uint8_t(b >> 8), w[1] = std::uint8_t(b), w[2] = std::uint8_t(a >> 8), w[3] = std::uint8_t(a);
 }
 
+void put_le(std::uint8_t* p, std::uint32_t v, int bytes) {
+    for (int i = 0; i < bytes; ++i) p[i] = std::uint8_t(v >> (8 * i));
+}
+
+// Writes the anchors, fiber id and flags of block b (of n_blocks) holding n
+// points; returns the decoded anchors (normalized coordinates).
+std::pair<Vec3f, Vec3f> write_block_head(const FftHeader& h, std::uint8_t* block, Vec3f p0, Vec3f p1,
+                                         std::uint32_t fiber_id, std::uint32_t b, std::uint32_t n_blocks,
+                                         std::uint32_t n) {
+    const bool first = b == 0, last = b + 1 == n_blocks;
+    if (h.direction_bits() == 16) {
+        const Quantized q0 = quantize_point(h, p0, kUnorm24Max), q1 = quantize_point(h, p1, kUnorm24Max);
+        for (int i = 0; i < 3; ++i) put_le(block + 3 * i, q0.q[i], 3), put_le(block + 9 + 3 * i, q1.q[i], 3);
+        put_le(block + kBlock16FiberIdOffset, fiber_id, 4);
+        put_le(block + kBlock16FlagsOffset, (first ? 0u : kFlag16NotFirst) | (last ? 0u : kFlag16NotLast) | n, 2);
+        auto decoded = [](const Quantized& q) {
+            return Vec3f{unpack_unorm24(q.q[0]), unpack_unorm24(q.q[1]), unpack_unorm24(q.q[2])};
+        };
+        return {decoded(q0), decoded(q1)};
+    }
+    const Quantized q0 = quantize_point(h, p0, 65535.0), q1 = quantize_point(h, p1, 65535.0);
+    put_word(block + 0, q0.q[0], q0.q[1]);
+    put_word(block + 4, q0.q[2], q1.q[0]);
+    put_word(block + 8, q1.q[1], q1.q[2]);
+    block[12] = std::uint8_t(fiber_id >> 24), block[13] = std::uint8_t(fiber_id >> 16);
+    block[14] = std::uint8_t(fiber_id >> 8), block[15] = std::uint8_t(fiber_id);
+    block[kBlockFlagsOffset] = std::uint8_t((first ? 0 : kFlagNotFirst) | (last ? 0 : kFlagNotLast) | n);
+    block[kBlockIndexOffset] = std::uint8_t(b);  // modulo 256, as the format stores it
+    auto decoded = [](const Quantized& q) {
+        return Vec3f{unpack_unorm16(std::uint16_t(q.q[0])), unpack_unorm16(std::uint16_t(q.q[1])),
+                     unpack_unorm16(std::uint16_t(q.q[2]))};
+    };
+    return {decoded(q0), decoded(q1)};
+}
+
 }  // namespace
+
+// The per-file code tables: 8-bit table and its lookup, or the 16-bit table.
+struct FiberEncoder::Tables {
+    std::optional<DirectionTable> table8;
+    std::optional<NearestCodeLut> lut8;
+    std::optional<DirectionTable16> table16;
+};
 
 float compute_ratio(double scaling_mm, double step_mm, double min_dot) {
     const double e = scaling_mm / 65536.0;
@@ -43,7 +88,45 @@ float compute_ratio(double scaling_mm, double step_mm, double min_dot) {
     return float(std::clamp(ratio, 1e-4, 2.0));
 }
 
-FiberEncoder::FiberEncoder(const FftHeader& header) : header_(header), table_(header.ratio) {}
+SearchOptions search_for_effort(int effort) {
+    switch (effort) {
+        case 0: return {1, 1, 0, 1, 0};
+        case 1: return {1, 1, 8, 1, 0};
+        case 2: return {4, 1, 16, 1, 0};
+        case 3: return {8, 1, 32, 2, 0};
+        case 4: return {16, 2, 64, 2, 0};
+        default: throw Error(Errc::invalid_argument, "effort must be in [0, " + std::to_string(kMaxEffort) + "]");
+    }
+}
+
+FiberEncoder::FiberEncoder(const FftHeader& header, SearchOptions search) : header_(header), search_(search) {
+    if (search_.beam_width < 1 || search_.beam_width > 64)
+        throw Error(Errc::invalid_argument, "beam width must be in [1, 64]");
+    if (search_.radius < 1 || search_.radius > 3) throw Error(Errc::invalid_argument, "search radius must be in [1, 3]");
+    if (search_.retry_beam_width > 64 || search_.retry_radius < 1 || search_.retry_radius > 3 ||
+        !(search_.retry_error_mm >= 0))
+        throw Error(Errc::invalid_argument, "retry beam width must be in [0, 64], its radius in [1, 3]");
+    auto t = std::make_shared<Tables>();
+    if (header_.direction_bits() == 16) {
+        t->table16.emplace(header_.ratio);
+    } else {
+        t->table8.emplace(header_.ratio);
+        t->lut8.emplace(*t->table8);
+    }
+    tables_ = std::move(t);
+}
+
+FiberEncoder FiberEncoder::with_step(float step) const {
+    FiberEncoder e = *this;
+    e.header_.step = step;
+    return e;
+}
+
+FiberEncoder FiberEncoder::with_search(const SearchOptions& search) const {
+    FiberEncoder e = *this;
+    e.search_ = search;
+    return e;
+}
 
 void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, std::vector<std::uint8_t>& out,
                           std::vector<Vec3f>* decoded) const {
@@ -57,6 +140,14 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
     auto emit = [&](Vec3f p) {
         if (decoded) decoded->push_back(h.to_world(p.x, p.y, p.z));
     };
+    const SearchParams params{search_.beam_width, search_.radius};
+    const SearchParams retry_params{search_.retry_beam_width, search_.retry_radius};
+    const bool retry = search_.retry_beam_width > 0 && search_.retry_error_mm > 0;
+    const float retry_error2 = float(search_.retry_error_mm / h.scaling) * float(search_.retry_error_mm / h.scaling);
+    thread_local std::vector<Vec3f> targets, points, retry_points;
+    thread_local std::vector<std::uint16_t> codes16, retry_codes16;
+    thread_local std::vector<std::uint8_t> retry_codes8;
+    const double inv_scaling = 1.0 / double(h.scaling);
     for (std::uint32_t b = 0; b < n_blocks; ++b) {
         const std::size_t i0 = std::size_t(b) * ppb;
         const auto n = std::uint32_t(std::min<std::size_t>(ppb, n_points - i0));
@@ -74,33 +165,60 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
         } else if (i0 > 0) {
             p1 = {2 * p0.x - fiber[i0 - 1].x, 2 * p0.y - fiber[i0 - 1].y, 2 * p0.z - fiber[i0 - 1].z};
         }
-        const Quantized q0 = quantize_point(h, p0.x, p0.y, p0.z), q1 = quantize_point(h, p1.x, p1.y, p1.z);
-        put_word(block + 0, q0.q[0], q0.q[1]);
-        put_word(block + 4, q0.q[2], q1.q[0]);
-        put_word(block + 8, q1.q[1], q1.q[2]);
-        block[12] = std::uint8_t(fiber_id >> 24), block[13] = std::uint8_t(fiber_id >> 16);
-        block[14] = std::uint8_t(fiber_id >> 8), block[15] = std::uint8_t(fiber_id);
-        block[kBlockFlagsOffset] = std::uint8_t((b > 0 ? kFlagNotFirst : 0) | (b + 1 < n_blocks ? kFlagNotLast : 0) | n);
-        block[kBlockIndexOffset] = std::uint8_t(b);  // modulo 256, as the format stores it
-
-        const Vec3f a0 = q0.decoded(), a1 = q1.decoded();
+        const auto [a0, a1] = write_block_head(h, block, p0, p1, fiber_id, b, n_blocks, n);
         emit(a0);
         if (n < 2) continue;
         emit(a1);
-        // Closed loop: aim each step from the decoded point and frame.
-        Frame frame = frame_from_axis(anchor_axis(a0, a1));
-        Vec3f p = a1;
-        for (std::uint32_t k = 2; k < n; ++k) {
-            const Vec3f& src = fiber[i0 + k];
-            const Vec3f target{float((double(src.x) + h.offset[0]) / h.scaling + 0.5),
-                               float((double(src.y) + h.offset[1]) / h.scaling + 0.5),
-                               float((double(src.z) + h.offset[2]) / h.scaling + 0.5)};
-            const std::uint8_t code = table_.nearest_code(apply_transposed(frame, target - p));
-            block[kBlockDirectionsOffset + k - 2] = code;
-            frame = compose(frame, table_.frame(code));
-            p = p + h.step * frame.c[0];
-            emit(p);
+        if (n < 3) continue;
+
+        const std::size_t m = n - 2;
+        targets.resize(m);
+        points.resize(m);
+        for (std::size_t k = 0; k < m; ++k) {
+            const Vec3f& s = fiber[i0 + 2 + k];
+            targets[k] = {float((double(s.x) + h.offset[0]) * inv_scaling + 0.5),
+                          float((double(s.y) + h.offset[1]) * inv_scaling + 0.5),
+                          float((double(s.z) + h.offset[2]) * inv_scaling + 0.5)};
         }
+        const Frame frame = frame_from_axis(anchor_axis(a0, a1));
+        auto search = [&](const SearchParams& sp, auto* codes, Vec3f* decoded_points) {
+            if constexpr (sizeof(*codes) == 2)
+                search_codes(Codebook16{*tables_->table16}, sp, frame, a1, h.step, targets, codes, decoded_points);
+            else
+                search_codes(Codebook8{*tables_->table8, *tables_->lut8}, sp, frame, a1, h.step, targets, codes,
+                             decoded_points);
+        };
+        auto max_error2 = [&](const Vec3f* decoded_points) {
+            float worst = 0;
+            for (std::size_t k = 0; k < m; ++k) {
+                const Vec3f d = decoded_points[k] - targets[k];
+                worst = std::max(worst, dot(d, d));
+            }
+            return worst;
+        };
+        if (tables_->table16) {
+            codes16.resize(m);
+            search(params, codes16.data(), points.data());
+            if (retry && max_error2(points.data()) > retry_error2) {
+                retry_codes16.resize(m);
+                retry_points.resize(m);
+                search(retry_params, retry_codes16.data(), retry_points.data());
+                if (max_error2(retry_points.data()) < max_error2(points.data()))
+                    codes16.swap(retry_codes16), points.swap(retry_points);
+            }
+            for (std::size_t k = 0; k < m; ++k) put_le(block + kBlock16DirectionsOffset + 2 * k, codes16[k], 2);
+        } else {
+            std::uint8_t* codes = block + kBlockDirectionsOffset;
+            search(params, codes, points.data());
+            if (retry && max_error2(points.data()) > retry_error2) {
+                retry_codes8.resize(m);
+                retry_points.resize(m);
+                search(retry_params, retry_codes8.data(), retry_points.data());
+                if (max_error2(retry_points.data()) < max_error2(points.data()))
+                    std::copy(retry_codes8.begin(), retry_codes8.end(), codes), points.swap(retry_points);
+            }
+        }
+        for (std::size_t k = 0; k < m; ++k) emit(points[k]);
     }
 }
 

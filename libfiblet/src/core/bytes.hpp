@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 #include <vector>
 
 namespace fiblet::detail {
@@ -10,9 +11,9 @@ namespace fiblet::detail {
 template <class T>
 void put_le(std::vector<std::uint8_t>& out, T value) {
     static_assert(std::is_trivially_copyable_v<T>);
-    std::uint8_t raw[sizeof(T)];
-    std::memcpy(raw, &value, sizeof(T));  // hosts are little-endian (checked in CMake)
-    out.insert(out.end(), raw, raw + sizeof(T));
+    const std::size_t at = out.size();
+    out.resize(at + sizeof(T));
+    std::memcpy(out.data() + at, &value, sizeof(T));  // hosts are little-endian (checked in CMake)
 }
 
 template <class T>

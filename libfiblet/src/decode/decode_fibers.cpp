@@ -1,5 +1,14 @@
+// Whole fibers out of a file: chunks of whole fibers are read and decoded
+// by `threads` workers, each on a contiguous run of the chunk's blocks
+// (reading, counting and decoding all in parallel), into one output in
+// fiber order.
 #include <algorithm>
+#include <string>
+#include <thread>
+#include <vector>
 
+#include "decode/decode_kernels.hpp"
+#include "decode/parallel_runs.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 
@@ -7,52 +16,138 @@ namespace fiblet {
 
 namespace {
 
-// Decodes fibers [begin, end) whose blocks are already in memory.
-void decode_fiber_range(const FftFile& file, const DecodeContext& ctx, std::uint64_t begin, std::uint64_t end,
-                        const std::vector<std::uint8_t>& blocks, Streamlines& out) {
-    const std::size_t nblocks = blocks.size() / ctx.header.block_bytes();
-    const std::size_t npoints = count_block_points(ctx, blocks.data(), nblocks);
-    out.xyz.resize(3 * npoints);
-    decode_blocks_scalar(ctx, blocks.data(), nblocks, out.xyz.data());
-    // Per-fiber offsets from the blocks' point counts.
-    out.offsets.assign(1, 0);
-    out.offsets.reserve(end - begin + 1);
-    const std::uint32_t bb = ctx.header.block_bytes();
-    std::size_t b = 0;
-    std::uint64_t acc = 0;
-    for (std::uint64_t f = begin; f < end; ++f) {
-        for (std::uint32_t k = 0; k < file.block_count(f); ++k, ++b) acc += BlockView{&blocks[b * bb]}.point_count();
-        out.offsets.push_back(acc);
+class ChunkDecoder {
+public:
+    ChunkDecoder(const FftFile& file, const DecodeOptions& options)
+        : file_(file),
+          ctx_(file.header()),
+          decoder_(resolve_decoder(options.decoder)),
+          threads_(options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency())),
+          chunk_blocks_(std::max<std::size_t>(options.chunk_blocks, 1)) {}
+
+    // End of the chunk of whole fibers starting at `f`: at least one fiber,
+    // at most chunk_blocks blocks otherwise.
+    std::uint64_t chunk_end(std::uint64_t f, std::uint64_t end) const {
+        const std::uint64_t b0 = file_.block_end(f);
+        // Fibers' first blocks increase: binary search the last fiber that fits.
+        std::uint64_t lo = f + 1, hi = end;
+        while (lo < hi) {
+            const std::uint64_t mid = lo + (hi - lo + 1) / 2;
+            if (file_.block_end(mid) - b0 <= chunk_blocks_) lo = mid;
+            else hi = mid - 1;
+        }
+        return lo;
     }
+
+    // Reads the blocks of fibers [f0, f1) and counts their points (validating
+    // every block); returns that count.
+    std::uint64_t load(std::uint64_t f0, std::uint64_t f1) {
+        f0_ = f0, f1_ = f1;
+        const std::uint64_t b0 = file_.block_end(f0);
+        blocks_ = file_.block_end(f1) - b0;
+        const std::size_t bb = ctx_.header.block_bytes();
+        data_.resize(blocks_ * bb);
+        // Runs of at least a few thousand blocks (below that a thread costs more than it saves).
+        runs_ = unsigned(std::clamp<std::uint64_t>(blocks_ / 2048, 1, threads_));
+        first_.assign(runs_ + 1, 0);
+        points_.assign(runs_ + 1, 0);
+        for (unsigned t = 0; t <= runs_; ++t) first_[t] = blocks_ * t / runs_;
+        detail::parallel_runs(runs_, [&](unsigned t) {
+            const std::size_t n = first_[t + 1] - first_[t];
+            file_.read_blocks(b0 + first_[t], n, data_.data() + first_[t] * bb);
+            points_[t + 1] = count_block_points(ctx_, data_.data() + first_[t] * bb, n);
+        });
+        for (unsigned t = 0; t < runs_; ++t) points_[t + 1] += points_[t];
+        return points_[runs_];
+    }
+
+    // Decodes the loaded chunk into xyz (load()'s number of points) and
+    // writes offsets[0 .. f1 - f0] = base + points before each fiber.
+    void decode(float* xyz, std::uint64_t* offsets, std::uint64_t base) {
+        const std::size_t bb = ctx_.header.block_bytes();
+        detail::parallel_runs(runs_, [&](unsigned t) {
+            detail::decode_resolved(ctx_, data_.data() + first_[t] * bb, first_[t + 1] - first_[t],
+                                    xyz + 3 * points_[t], decoder_);
+        });
+        std::size_t b = 0;
+        std::uint64_t acc = base;
+        offsets[0] = acc;
+        for (std::uint64_t f = f0_; f < f1_; ++f) {
+            for (std::uint32_t k = file_.block_count(f); k > 0; --k, ++b)
+                acc += block_flags(ctx_.header, &data_[b * bb]).point_count;
+            offsets[f - f0_ + 1] = acc;
+        }
+    }
+
+private:
+    const FftFile& file_;
+    const DecodeContext ctx_;
+    const Decoder decoder_;
+    const unsigned threads_;
+    const std::size_t chunk_blocks_;
+    std::uint64_t f0_ = 0, f1_ = 0, blocks_ = 0;
+    unsigned runs_ = 1;
+    std::vector<std::uint8_t> data_;
+    std::vector<std::uint64_t> first_, points_;
+};
+
+void check_range(const FftFile& file, std::uint64_t begin, std::uint64_t end) {
+    if (begin > end || end > file.header().fibers)
+        throw Error(Errc::invalid_argument, file.path() + ": fiber range past the end");
 }
 
 }  // namespace
 
-Streamlines decode_fibers(const FftFile& file, std::uint64_t begin, std::uint64_t end, const DecodeOptions&) {
-    if (begin > end || end > file.header().fibers)
-        throw Error(Errc::invalid_argument, file.path() + ": fiber range past the end");
-    const DecodeContext ctx(file.header());
-    const std::uint64_t b0 = file.block_end(begin), b1 = file.block_end(end);
+Streamlines decode_fibers(const FftFile& file, std::uint64_t begin, std::uint64_t end, const DecodeOptions& options) {
+    check_range(file, begin, end);
+    ChunkDecoder chunks(file, options);
     Streamlines out;
-    decode_fiber_range(file, ctx, begin, end, file.read_blocks(b0, b1 - b0), out);
+    out.offsets.resize(end - begin + 1);
+    // Reserving the most the blocks can hold maps memory without touching it.
+    out.xyz.reserve(3 * (file.block_end(end) - file.block_end(begin)) * file.header().points_per_block);
+    for (std::uint64_t f = begin; f < end;) {
+        const std::uint64_t e = chunks.chunk_end(f, end);
+        const std::uint64_t n = chunks.load(f, e), done = out.xyz.size() / 3;
+        out.xyz.resize(3 * (done + n));
+        chunks.decode(out.xyz.data() + 3 * done, &out.offsets[f - begin], done);
+        f = e;
+    }
     return out;
+}
+
+std::uint64_t decode_fibers_into(const FftFile& file, std::uint64_t begin, std::uint64_t end, std::span<float> xyz,
+                                 std::span<std::uint64_t> offsets, const DecodeOptions& options) {
+    check_range(file, begin, end);
+    if (offsets.size() < end - begin + 1)
+        throw Error(Errc::invalid_argument, "decode_fibers_into: " + std::to_string(end - begin + 1) +
+                                                " offsets needed, room for " + std::to_string(offsets.size()));
+    ChunkDecoder chunks(file, options);
+    std::uint64_t done = 0;
+    offsets[0] = 0;
+    for (std::uint64_t f = begin; f < end;) {
+        const std::uint64_t e = chunks.chunk_end(f, end);
+        const std::uint64_t n = chunks.load(f, e);
+        if (3 * (done + n) > xyz.size())
+            throw Error(Errc::invalid_argument, "decode_fibers_into: " + file.path() + " holds more points than the " +
+                                                    std::to_string(xyz.size() / 3) + " the buffer has room for");
+        chunks.decode(xyz.data() + 3 * done, &offsets[f - begin], done);
+        done += n;
+        f = e;
+    }
+    return done;
 }
 
 void decode_file(const FftFile& file, const std::function<void(std::uint64_t, const Streamlines&)>& sink,
                  const DecodeOptions& options) {
-    const DecodeContext ctx(file.header());
+    ChunkDecoder chunks(file, options);
     const std::uint64_t fibers = file.header().fibers;
     Streamlines chunk;
-    std::vector<std::uint8_t> blocks;
-    std::uint64_t f = 0;
-    while (f < fibers) {
-        // Whole fibers, at least one, up to chunk_blocks blocks.
-        std::uint64_t e = f + 1;
-        while (e < fibers && file.block_end(e + 1) - file.block_end(f) <= options.chunk_blocks) ++e;
-        const std::uint64_t b0 = file.block_end(f), b1 = file.block_end(e);
-        blocks.resize((b1 - b0) * ctx.header.block_bytes());
-        file.read_blocks(b0, b1 - b0, blocks.data());
-        decode_fiber_range(file, ctx, f, e, blocks, chunk);
+    for (std::uint64_t f = 0; f < fibers;) {
+        const std::uint64_t e = chunks.chunk_end(f, fibers);
+        const std::uint64_t n = chunks.load(f, e);
+        chunk.xyz.resize(3 * n);
+        chunk.offsets.resize(e - f + 1);
+        chunks.decode(chunk.xyz.data(), chunk.offsets.data(), 0);
         sink(f, chunk);
         f = e;
     }

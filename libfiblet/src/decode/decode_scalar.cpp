@@ -11,13 +11,22 @@
 namespace fiblet {
 using namespace detail;
 
-DecodeContext::DecodeContext(const FftHeader& h) : header(h), table(h.ratio) {}
+DecodeContext::DecodeContext(const FftHeader& h) : header(h), table(h.ratio) {
+    for (int k = 0; k < 256; ++k) {
+        const Frame& f = table.frame(std::uint8_t(k));
+        for (int col = 0; col < 3; ++col) {
+            frame_rows[16 * k + 3 * col + 0] = f.c[col].x;
+            frame_rows[16 * k + 3 * col + 1] = f.c[col].y;
+            frame_rows[16 * k + 3 * col + 2] = f.c[col].z;
+        }
+    }
+}
 
 std::size_t count_block_points(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count) {
     const std::uint32_t bb = ctx.header.block_bytes();
     std::size_t total = 0;
     for (std::size_t b = 0; b < count; ++b) {
-        const std::uint32_t n = BlockView{blocks + b * bb}.point_count();
+        const std::uint32_t n = block_flags(ctx.header, blocks + b * bb).point_count;
         if (n == 0 || n > ctx.header.points_per_block)
             throw Error(Errc::fft_format, "block holds " + std::to_string(n) + " points (allowed 1.." +
                                               std::to_string(ctx.header.points_per_block) + ")");

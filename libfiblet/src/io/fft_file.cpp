@@ -5,10 +5,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <mutex>
+#include <utility>
 
 #include "core/bytes.hpp"
 #include "fiblet/error.hpp"
@@ -39,8 +41,8 @@ FftHeader parse_fft_header(std::span<const std::uint8_t> b, std::uint64_t file_s
     FftHeader h;
     const std::uint8_t* p = b.data();
     h.version = p[0];
-    if (h.version != kFftVersion)
-        bad(name, "unsupported version " + std::to_string(h.version) + " (fiblet reads version 2)");
+    if (h.version != kFftVersion && h.version != kFft16Version)
+        bad(name, "unsupported version " + std::to_string(h.version) + " (fiblet reads versions 2 and 16)");
     h.fibers = get_le<std::uint64_t>(p + 1);
     h.points = get_le<std::uint64_t>(p + 9);
     h.blocks = get_le<std::uint32_t>(p + 17);
@@ -53,8 +55,9 @@ FftHeader parse_fft_header(std::span<const std::uint8_t> b, std::uint64_t file_s
     h.mean_error_mm = get_le<float>(p + 53);
     const unsigned buffers = p[57];
 
-    if (h.points_per_block < 2 || h.points_per_block > kMaxPointsPerBlock)
-        bad(name, "points per block " + std::to_string(h.points_per_block) + " outside [2, 63]");
+    if (h.points_per_block < 2 || h.points_per_block > h.max_points_per_block())
+        bad(name, "points per block " + std::to_string(h.points_per_block) + " outside [2, " +
+                      std::to_string(h.max_points_per_block()) + "]");
     if (!(std::isfinite(h.scaling) && h.scaling > 0)) bad(name, "scaling is not a positive finite number");
     for (float o : h.offset)
         if (!std::isfinite(o)) bad(name, "offset is not finite");
@@ -90,68 +93,73 @@ struct FftFile::Mapping {
     }
 };
 
-std::span<const std::uint8_t> FftFile::mapped_blocks() const {
-    const std::uint64_t bytes = std::uint64_t{header_.blocks} * header_.block_bytes();
-    if (bytes == 0 || fd_ < 0 || !mapping_) return {};
-    Mapping& m = *mapping_;
-    std::call_once(m.once, [&] {
-        const std::uint64_t page = std::uint64_t(::sysconf(_SC_PAGESIZE));
-        const std::uint64_t start = header_.blocks_offset() / page * page;
-        m.skip = std::size_t(header_.blocks_offset() - start);
-        m.length = std::size_t(bytes + m.skip);
-        void* a = ::mmap(nullptr, m.length, PROT_READ, MAP_SHARED, fd_, off_t(start));
-        if (a != MAP_FAILED) m.address = a;
-    });
-    if (!m.address) return {};
-    return {static_cast<const std::uint8_t*>(m.address) + m.skip, std::size_t(bytes)};
-}
-
-FftFile::FftFile(const std::string& path) : path_(path), mapping_(std::make_unique<Mapping>()) {
+FftFile::FftFile(const std::string& path, FftOpenOptions options)
+    : path_(path), options_(options), mapping_(std::make_unique<Mapping>()) {
     fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd_ < 0) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
-    struct stat st {};
-    if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) {
-        ::close(fd_);
-        throw Error(Errc::io, path + ": not a regular file");
-    }
-    file_size_ = std::uint64_t(st.st_size);
     try {
+        struct stat st {};
+        if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) throw Error(Errc::io, path + ": not a regular file");
+        file_size_ = std::uint64_t(st.st_size);
         std::vector<std::uint8_t> head(std::min<std::uint64_t>(file_size_, kFftFixedHeaderBytes + 8 * 255));
         pread_all(fd_, head.data(), head.size(), 0, path);
         header_ = parse_fft_header(head, file_size_, path);
-
-        std::vector<std::uint8_t> raw(8 * header_.fibers);
-        pread_all(fd_, raw.data(), raw.size(), header_.lut_offset(), path);
-        lut_.resize(header_.fibers);
-        fiber_first_block_.resize(header_.fibers);
-        std::uint64_t next = 0;  // fibers are stored in order, their blocks contiguous
-        for (std::uint64_t i = 0; i < header_.fibers; ++i) {
-            lut_[i] = {get_le<std::uint32_t>(&raw[8 * i]), get_le<std::uint32_t>(&raw[8 * i + 4])};
-            const std::uint32_t buffer = lut_[i].buffer();
-            if (buffer >= header_.buffer_ends.size() && lut_[i].block_count() > 0)
-                bad(path, "fiber " + std::to_string(i) + " points to buffer " + std::to_string(buffer) +
-                              " past the buffer table");
-            const std::uint64_t base = buffer == 0 || buffer > header_.buffer_ends.size()
-                                           ? 0
-                                           : header_.buffer_ends[buffer - 1];
-            const std::uint64_t first = base + lut_[i].y;
-            if (lut_[i].block_count() > 0 && first != next)
-                bad(path, "fiber " + std::to_string(i) + " LUT entry points to block " + std::to_string(first) +
-                              ", expected " + std::to_string(next));
-            fiber_first_block_[i] = next;
-            next += lut_[i].block_count();
-            if (next > header_.blocks)
-                bad(path, "fiber " + std::to_string(i) + " LUT entry points past the last block");
-        }
-        if (next != header_.blocks)
-            bad(path, "the fiber LUT covers " + std::to_string(next) + " blocks, the header says " +
-                          std::to_string(header_.blocks));
+        std::uint64_t lut_hash = 0;
+        read_lut(lut_hash);
         read_trailer();
+        // Structure first, then integrity: a file that is malformed is
+        // reported as such (fft_format) even when a checksum also fails.
+        if (const TrailerChunk* c = find_chunk(kChecksumTag))
+            checksums_ = FftChecksums::parse(*c, header_.blocks, path_);
+        if (verifies_checksums()) {
+            verify_open_checksums(std::span(head).first(std::size_t(header_.lut_offset())), lut_hash);
+            const std::uint64_t words = (checksums_->group_hashes.size() + 63) / 64;
+            verified_groups_ = std::make_unique<std::atomic<std::uint64_t>[]>(words);
+            for (std::uint64_t i = 0; i < words; ++i) verified_groups_[i].store(0, std::memory_order_relaxed);
+        }
     } catch (...) {
-        ::close(fd_);
-        fd_ = -1;
+        close();
         throw;
     }
+}
+
+// Reads and validates the LUT a slice at a time (no second copy of it in
+// memory), hashing its bytes for the checksum check.
+void FftFile::read_lut(std::uint64_t& lut_hash) {
+    constexpr std::uint64_t kSliceEntries = 1u << 16;
+    lut_.resize(header_.fibers);
+    fiber_first_block_.resize(header_.fibers);
+    std::vector<std::uint8_t> raw;
+    Xxh64Stream hash;
+    std::uint64_t next = 0;  // fibers are stored in order, their blocks contiguous
+    for (std::uint64_t s = 0; s < header_.fibers; s += kSliceEntries) {
+        const std::uint64_t n = std::min(kSliceEntries, header_.fibers - s);
+        raw.resize(8 * n);
+        pread_all(fd_, raw.data(), raw.size(), header_.lut_offset() + 8 * s, path_);
+        hash.update(raw.data(), raw.size());
+        for (std::uint64_t j = 0; j < n; ++j) {
+            const std::uint64_t i = s + j;
+            lut_[i] = {get_le<std::uint32_t>(&raw[8 * j]), get_le<std::uint32_t>(&raw[8 * j + 4])};
+            const std::uint32_t buffer = lut_[i].buffer();
+            if (buffer >= header_.buffer_ends.size() && lut_[i].block_count() > 0)
+                bad(path_, "fiber " + std::to_string(i) + " points to buffer " + std::to_string(buffer) +
+                               " past the buffer table");
+            const std::uint64_t base =
+                buffer == 0 || buffer > header_.buffer_ends.size() ? 0 : header_.buffer_ends[buffer - 1];
+            const std::uint64_t first = base + lut_[i].y;
+            if (lut_[i].block_count() > 0 && first != next)
+                bad(path_, "fiber " + std::to_string(i) + " LUT entry points to block " + std::to_string(first) +
+                               ", expected " + std::to_string(next));
+            fiber_first_block_[i] = std::uint32_t(next);  // next <= blocks, a u32 (checked below)
+            next += lut_[i].block_count();
+            if (next > header_.blocks)
+                bad(path_, "fiber " + std::to_string(i) + " LUT entry points past the last block");
+        }
+    }
+    if (next != header_.blocks)
+        bad(path_, "the fiber LUT covers " + std::to_string(next) + " blocks, the header says " +
+                       std::to_string(header_.blocks));
+    lut_hash = hash.digest();
 }
 
 void FftFile::read_trailer() {
@@ -161,6 +169,10 @@ void FftFile::read_trailer() {
     pread_all(fd_, footer, sizeof footer, file_size_ - sizeof footer, path_);
     if (std::memcmp(footer + 8, kTrailerMagic, 8) != 0) return;  // foreign trailing bytes: ignored
     if (get_le<std::uint64_t>(footer) != end) bad(path_, "trailer does not start after the last block");
+    has_trailer_ = true;
+    // Chunks fiblet reads are loaded whole (up to a bound that keeps memory
+    // in check); unknown large ones are skipped.
+    constexpr std::uint64_t kMaxKnownChunk = 64u << 20, kMaxUnknownChunk = 16u << 20;
     std::uint64_t pos = end;
     const std::uint64_t stop = file_size_ - kTrailerFooterBytes;
     while (pos < stop) {
@@ -171,11 +183,37 @@ void FftFile::read_trailer() {
         if (size > stop - pos - sizeof head) bad(path_, "trailer chunk runs past the footer");
         TrailerChunk chunk;
         std::memcpy(chunk.tag.data(), head, 4);
-        chunk.payload.resize(size);
-        pread_all(fd_, chunk.payload.data(), size, pos + sizeof head, path_);
-        trailer_.push_back(std::move(chunk));
+        const bool known = chunk.tag == kPropertiesTag || chunk.tag == kResampledTag || chunk.tag == kChecksumTag;
+        if (known && size > kMaxKnownChunk)
+            bad(path_, "trailer chunk " + std::string(chunk.tag.data(), 4) + " of " + std::to_string(size) +
+                           " bytes (at most " + std::to_string(kMaxKnownChunk) + ")");
+        if (known || size <= kMaxUnknownChunk) {
+            if (chunk.tag == kChecksumTag && checksum_chunk_offset_ == 0) checksum_chunk_offset_ = pos;  // the one find_chunk() gives
+            chunk.payload.resize(size);
+            pread_all(fd_, chunk.payload.data(), size, pos + sizeof head, path_);
+            trailer_.push_back(std::move(chunk));
+        }
         pos += sizeof head + size;
     }
+}
+
+void FftFile::verify_open_checksums(std::span<const std::uint8_t> head, std::uint64_t lut_hash) const {
+    const FftChecksums& c = *checksums_;
+    auto fail = [&](const std::string& what) {
+        throw Error(Errc::checksum, path_ + ": checksum mismatch in the " + what + ": the file is corrupted");
+    };
+    if (xxh64(head.data(), head.size()) != c.header_hash) fail("header");
+    if (lut_hash != c.lut_hash) fail("fiber LUT");
+    // The chunks before CSUM, hashed from the file as stored.
+    Xxh64Stream hash;
+    std::vector<std::uint8_t> buf;
+    for (std::uint64_t pos = header_.file_bytes(); pos < checksum_chunk_offset_;) {
+        buf.resize(std::size_t(std::min<std::uint64_t>(1u << 20, checksum_chunk_offset_ - pos)));
+        pread_all(fd_, buf.data(), buf.size(), pos, path_);
+        hash.update(buf.data(), buf.size());
+        pos += buf.size();
+    }
+    if (hash.digest() != c.trailer_hash) fail("trailer chunks");
 }
 
 const TrailerChunk* FftFile::find_chunk(std::array<char, 4> tag) const {
@@ -207,28 +245,30 @@ std::vector<std::pair<std::string, std::string>> FftFile::properties() const {
     return props;
 }
 
-FftFile::~FftFile() {
+void FftFile::close() noexcept {
     if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
 }
 
-FftFile::FftFile(FftFile&& o) noexcept
-    : path_(std::move(o.path_)), fd_(o.fd_), file_size_(o.file_size_), header_(std::move(o.header_)),
-      lut_(std::move(o.lut_)), fiber_first_block_(std::move(o.fiber_first_block_)), trailer_(std::move(o.trailer_)),
-      mapping_(std::move(o.mapping_)) {
-    o.fd_ = -1;
-}
+FftFile::~FftFile() { close(); }
+
+FftFile::FftFile(FftFile&& o) noexcept { *this = std::move(o); }
 
 FftFile& FftFile::operator=(FftFile&& o) noexcept {
     if (this != &o) {
-        if (fd_ >= 0) ::close(fd_);
+        close();
         path_ = std::move(o.path_);
-        fd_ = o.fd_;
-        o.fd_ = -1;
+        options_ = o.options_;
+        fd_ = std::exchange(o.fd_, -1);
         file_size_ = o.file_size_;
         header_ = std::move(o.header_);
         lut_ = std::move(o.lut_);
         fiber_first_block_ = std::move(o.fiber_first_block_);
+        has_trailer_ = o.has_trailer_;
         trailer_ = std::move(o.trailer_);
+        checksum_chunk_offset_ = o.checksum_chunk_offset_;
+        checksums_ = std::move(o.checksums_);
+        verified_groups_ = std::move(o.verified_groups_);
         mapping_ = std::move(o.mapping_);
     }
     return *this;
@@ -237,8 +277,85 @@ FftFile& FftFile::operator=(FftFile&& o) noexcept {
 void FftFile::read_blocks(std::uint64_t first, std::uint64_t count, std::uint8_t* out) const {
     if (first > header_.blocks || count > header_.blocks - first)
         throw Error(Errc::invalid_argument, path_ + ": block range past the end");
+    if (count == 0) return;
     const std::uint64_t bb = header_.block_bytes();
     pread_all(fd_, out, count * bb, header_.blocks_offset() + first * bb, path_);
+    check_block_structure(first, count, out);
+    if (verifies_checksums()) verify_block_groups(first, count, out);
+}
+
+void FftFile::check_block_structure(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const {
+    const std::uint32_t bb = header_.block_bytes();
+    // The fiber holding block `first`: the last one starting at or before it
+    // (an empty fiber shares its successor's first block, so it is skipped).
+    std::uint64_t f = std::uint64_t(std::upper_bound(fiber_first_block_.begin(), fiber_first_block_.end(),
+                                                     std::uint32_t(first)) -
+                                    fiber_first_block_.begin()) -
+                      1;
+    std::uint64_t k = first - fiber_first_block_[f];
+    for (std::uint64_t b = 0; b < count; ++b, ++k) {
+        while (k >= lut_[f].block_count()) ++f, k = 0;
+        const BlockFlags v = block_flags(header_, blocks + b * bb);
+        const std::uint32_t n = v.point_count, blocks_in_fiber = lut_[f].block_count();
+        const auto where = [&] {
+            return "block " + std::to_string(first + b) + " (block " + std::to_string(k) + " of " +
+                   std::to_string(blocks_in_fiber) + " of fiber " + std::to_string(f) + ")";
+        };
+        if (n == 0 || n > header_.points_per_block)
+            bad(path_, where() + " holds " + std::to_string(n) + " points (allowed 1.." +
+                           std::to_string(header_.points_per_block) + ")");
+        if (v.first != (k == 0) || v.last != (k + 1 == blocks_in_fiber))
+            bad(path_, where() + " has first/last flags inconsistent with the fiber LUT");
+    }
+}
+
+void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const {
+    const FftChecksums& c = *checksums_;
+    const std::uint64_t bb = header_.block_bytes(), g_blocks = c.group_blocks, end = first + count;
+    std::vector<std::uint8_t> edge;  // the part of a group outside [first, end)
+    Xxh64Stream hash;
+    auto hash_from_file = [&](std::uint64_t b0, std::uint64_t b1) {
+        edge.resize((b1 - b0) * bb);
+        pread_all(fd_, edge.data(), edge.size(), header_.blocks_offset() + b0 * bb, path_);
+        hash.update(edge.data(), edge.size());
+    };
+    for (std::uint64_t g = first / g_blocks; g <= (end - 1) / g_blocks; ++g) {
+        std::atomic<std::uint64_t>& word = verified_groups_[g / 64];
+        const std::uint64_t bit = std::uint64_t{1} << (g % 64);
+        if (word.load(std::memory_order_acquire) & bit) continue;  // checked by an earlier read
+        const std::uint64_t g0 = g * g_blocks, g1 = std::min(g0 + g_blocks, std::uint64_t{header_.blocks});
+        hash.reset();
+        if (g0 < first) hash_from_file(g0, first);
+        const std::uint64_t in0 = std::max(g0, first), in1 = std::min(g1, end);
+        hash.update(blocks + (in0 - first) * bb, (in1 - in0) * bb);
+        if (g1 > end) hash_from_file(end, g1);
+        if (hash.digest() != c.group_hashes[g])
+            throw Error(Errc::checksum, path_ + ": checksum mismatch in blocks " + std::to_string(g0) + ".." +
+                                            std::to_string(g1 - 1) + " (group " + std::to_string(g) +
+                                            "): the file is corrupted");
+        word.fetch_or(bit, std::memory_order_release);
+    }
+}
+
+std::span<const std::uint8_t> FftFile::mapped_blocks(std::uint64_t first, std::uint64_t count) const {
+    if (first > header_.blocks || count > header_.blocks - first)
+        throw Error(Errc::invalid_argument, path_ + ": block range past the end");
+    if (count == 0 || fd_ < 0 || !mapping_) return {};
+    const std::uint64_t bb = header_.block_bytes();
+    Mapping& m = *mapping_;
+    std::call_once(m.once, [&] {
+        const std::uint64_t page = std::uint64_t(::sysconf(_SC_PAGESIZE));
+        const std::uint64_t start = header_.blocks_offset() / page * page;
+        m.skip = std::size_t(header_.blocks_offset() - start);
+        m.length = std::size_t(std::uint64_t{header_.blocks} * bb + m.skip);
+        void* a = ::mmap(nullptr, m.length, PROT_READ, MAP_SHARED, fd_, off_t(start));
+        if (a != MAP_FAILED) m.address = a;
+    });
+    if (!m.address) return {};
+    const std::uint8_t* blocks = static_cast<const std::uint8_t*>(m.address) + m.skip + first * bb;
+    check_block_structure(first, count, blocks);
+    if (verifies_checksums()) verify_block_groups(first, count, blocks);
+    return {blocks, std::size_t(count * bb)};
 }
 
 std::vector<std::uint8_t> FftFile::read_blocks(std::uint64_t first, std::uint64_t count) const {

@@ -1,6 +1,8 @@
 #include "fiblet/output_file.hpp"
 
 #include <fcntl.h>
+#include <pthread.h>
+#include <stdio.h>  // renameat2, RENAME_NOREPLACE
 #include <unistd.h>
 
 #include <atomic>
@@ -49,6 +51,40 @@ std::string errno_text() { return std::strerror(errno); }
 
 bool path_exists(const std::string& p) { return ::access(p.c_str(), F_OK) == 0; }
 
+// Moves `from` to `to` unless `to` exists, atomically: an output that
+// appeared while we were writing (another process) is never replaced.
+void rename_no_replace(const std::string& from, const std::string& to) {
+    if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return;
+    if (errno == EEXIST) throw Error(Errc::exists, to + ": output exists (use --force to overwrite)");
+    if (errno != EINVAL && errno != ENOSYS)
+        throw Error(Errc::io, to + ": cannot rename temporary into place: " + errno_text());
+    // File systems without RENAME_NOREPLACE: link() fails on an existing target too.
+    if (::link(from.c_str(), to.c_str()) != 0) {
+        if (errno == EEXIST) throw Error(Errc::exists, to + ": output exists (use --force to overwrite)");
+        throw Error(Errc::io, to + ": cannot move temporary into place: " + errno_text());
+    }
+    ::unlink(from.c_str());
+}
+
+constexpr int kCleanupSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
+// Blocks the cleanup signals in this thread for its lifetime.
+class SignalBlock {
+public:
+    SignalBlock() {
+        sigset_t set;
+        sigemptyset(&set);
+        for (int sig : kCleanupSignals) sigaddset(&set, sig);
+        ::pthread_sigmask(SIG_BLOCK, &set, &old_);
+    }
+    ~SignalBlock() { ::pthread_sigmask(SIG_SETMASK, &old_, nullptr); }
+    SignalBlock(const SignalBlock&) = delete;
+    SignalBlock& operator=(const SignalBlock&) = delete;
+
+private:
+    sigset_t old_;
+};
+
 void handle_signal(int sig) {
     remove_pending_outputs();
     ::_exit(128 + sig);
@@ -65,26 +101,31 @@ void install_signal_cleanup() {
     struct sigaction sa {};
     sa.sa_handler = handle_signal;
     sigemptyset(&sa.sa_mask);
-    ::sigaction(SIGINT, &sa, nullptr);
-    ::sigaction(SIGTERM, &sa, nullptr);
+    for (int sig : kCleanupSignals) sigaddset(&sa.sa_mask, sig);  // one handler at a time
+    for (int sig : kCleanupSignals) ::sigaction(sig, &sa, nullptr);
 }
 
 AtomicOutputFile::AtomicOutputFile(const std::string& path, bool overwrite) : path_(path), overwrite_(overwrite) {
     if (!overwrite && path_exists(path))
         throw Error(Errc::exists, path + ": output exists (use --force to overwrite)");
     std::random_device rd;
-    for (int attempt = 0; attempt < 16 && fd_ < 0; ++attempt) {
-        tmp_ = path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(rd() % 1000000);
-        fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-        if (fd_ < 0 && errno != EEXIST) break;
+    {
+        // A signal between creating the temporary and registering it would leak it.
+        const SignalBlock block;
+        for (int attempt = 0; attempt < 16 && fd_ < 0; ++attempt) {
+            tmp_ = path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(rd() % 1000000);
+            fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+            if (fd_ < 0 && errno != EEXIST) break;
+        }
+        if (fd_ >= 0) registry_slot_ = register_temporary(tmp_);
     }
     if (fd_ < 0) throw Error(Errc::io, path + ": cannot create output: " + errno_text());
-    registry_slot_ = register_temporary(tmp_);
     buffer_.reserve(1u << 20);
 }
 
 AtomicOutputFile::~AtomicOutputFile() {
     if (fd_ >= 0) ::close(fd_);
+    const SignalBlock block;  // unlink and unregister together
     if (!committed_) ::unlink(tmp_.c_str());
     unregister_temporary(registry_slot_);
 }
@@ -138,11 +179,16 @@ void AtomicOutputFile::commit() {
         throw Error(Errc::io, path_ + ": close failed: " + errno_text());
     }
     fd_ = -1;
-    if (!overwrite_ && path_exists(path_))  // appeared while we were writing
-        throw Error(Errc::exists, path_ + ": output exists (use --force to overwrite)");
-    if (::rename(tmp_.c_str(), path_.c_str()) != 0)
-        throw Error(Errc::io, path_ + ": cannot rename temporary into place: " + errno_text());
+    const SignalBlock block;  // the rename and the registry agree on what exists
+    if (overwrite_) {
+        if (::rename(tmp_.c_str(), path_.c_str()) != 0)
+            throw Error(Errc::io, path_ + ": cannot rename temporary into place: " + errno_text());
+    } else {
+        rename_no_replace(tmp_, path_);
+    }
     committed_ = true;
+    unregister_temporary(registry_slot_);
+    registry_slot_ = -1;
 }
 
 }  // namespace fiblet

@@ -1,11 +1,11 @@
-// Internal: access to a sorted set of scattered blocks. From the file's
-// memory mapping when there is one (no copy, no system call); else by reads
-// in which blocks closer than a small gap share one span (the gap bytes cost
-// less than another read).
+// Internal: access to a sorted set of scattered blocks, checked as
+// FftFile::read_blocks checks them. Through the file's memory mapping when
+// there is one (no copy, no system call per block); else by reads in which
+// blocks closer than a small gap share one span (the gap bytes cost less
+// than another read).
 #pragma once
 
 #include <cstdint>
-#include <span>
 #include <vector>
 
 #include "fiblet/fft_file.hpp"
@@ -16,7 +16,8 @@ class BlockBatchReader {
 public:
     BlockBatchReader(const FftFile& file, bool use_mapping, std::uint64_t max_gap_blocks = 64);
 
-    // Reads `blocks` (ascending, unique); block(i) then points at blocks[i].
+    // Reads `blocks` (ascending, unique); block(i) then points at blocks[i],
+    // and consecutive blocks lie one after the other in memory.
     void read(const std::vector<std::uint32_t>& blocks);
     const std::uint8_t* block(std::size_t i) const { return pointers_[i]; }
     // Blocks accessed (mapped) or transferred (read, gaps included) so far.
@@ -24,9 +25,9 @@ public:
 
 private:
     const FftFile& file_;
+    bool use_mapping_;
     std::uint64_t max_gap_;
     std::uint32_t block_bytes_;
-    std::span<const std::uint8_t> mapped_;
     std::vector<std::uint8_t> buffer_;
     std::vector<const std::uint8_t*> pointers_;
     std::uint64_t blocks_read_ = 0;

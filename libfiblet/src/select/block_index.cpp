@@ -70,7 +70,7 @@ BlockIndex BlockIndex::load(const FftFile& file) {
     std::uint64_t total = 0;
     for (std::uint64_t f = 0; f < h.fibers; ++f) {
         const std::uint32_t nb = file.block_count(f);
-        const std::uint8_t last = c.last_block_points[f];
+        const std::uint16_t last = c.last_block_points[f];
         if ((nb == 0) != (last == 0))
             throw Error(Errc::fft_format, file.path() + ": malformed BIDX (block index) chunk: fiber " +
                                               std::to_string(f) + " point count disagrees with its blocks");
@@ -106,12 +106,12 @@ BlockIndex BlockIndex::compute(const FftFile& file) {
     BlockIndex index;
     index.source_ = Source::decoded;
     std::vector<Aabb> boxes(h.blocks);
-    std::vector<std::uint8_t> counts(h.blocks);
+    std::vector<std::uint16_t> counts(h.blocks);
     std::vector<std::uint8_t> raw;
     std::vector<float> xyz;
-    constexpr std::uint64_t kChunk = 1u << 15;
-    for (std::uint64_t b0 = 0; b0 < h.blocks; b0 += kChunk) {
-        const std::uint64_t n = std::min<std::uint64_t>(kChunk, h.blocks - b0);
+    const std::uint64_t chunk = std::max<std::uint64_t>(1, (1u << 21) / h.points_per_block);  // blocks of ~2M points
+    for (std::uint64_t b0 = 0; b0 < h.blocks; b0 += chunk) {
+        const std::uint64_t n = std::min<std::uint64_t>(chunk, h.blocks - b0);
         raw.resize(n * bb);
         file.read_blocks(b0, n, raw.data());
         xyz.resize(3 * count_block_points(ctx, raw.data(), n));
@@ -119,12 +119,12 @@ BlockIndex BlockIndex::compute(const FftFile& file) {
         const float* p = xyz.data();
         for (std::uint64_t k = 0; k < n; ++k) {
             const std::uint8_t* block = &raw[k * bb];
-            const std::uint32_t np = BlockView{block}.point_count();
+            const std::uint32_t np = block_flags(h, block).point_count;
             Aabb box{{p[0], p[1], p[2]}, {p[0], p[1], p[2]}};
             for (std::uint32_t i = 1; i < np; ++i)
                 grow(box, {{p[3 * i], p[3 * i + 1], p[3 * i + 2]}, {p[3 * i], p[3 * i + 1], p[3 * i + 2]}});
             boxes[b0 + k] = box;
-            counts[b0 + k] = std::uint8_t(np);
+            counts[b0 + k] = std::uint16_t(np);
             index.max_sphere_radius_ = std::max(index.max_sphere_radius_, block_bounding_sphere(h, block).radius);
             p += 3 * np;
         }

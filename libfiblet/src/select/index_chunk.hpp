@@ -73,15 +73,18 @@ private:
     std::vector<float> lo_[3], hi_[3];
 };
 
+// Bytes per fiber of the last-block point counts.
+inline unsigned index_count_bytes(const FftHeader& h) { return h.points_per_block <= 255 ? 1 : 2; }
+
 struct IndexChunk {
     IndexGrid grid;
     std::uint64_t fibers = 0, blocks = 0;
     float max_sphere_radius = 0;
-    std::vector<std::uint8_t> last_block_points;  // per fiber
+    std::vector<std::uint16_t> last_block_points;  // per fiber (stored in 1 byte, or 2 beyond 255 points a block)
     std::vector<std::uint32_t> codes;             // per block
 };
 
-std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c);
+std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c, const FftHeader& h);
 // Parses and validates a chunk against its file's header (counts, levels,
 // sizes, point totals). Throws Error{fft_format} naming `file`.
 IndexChunk parse_index_chunk(const std::vector<std::uint8_t>& payload, const FftHeader& h, const std::string& file);

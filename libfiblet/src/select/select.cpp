@@ -22,7 +22,11 @@ namespace fiblet {
 namespace {
 
 using Bits = std::vector<std::uint64_t>;
-constexpr std::size_t kBatchBlocks = 4096;
+
+// Blocks handled at a time: about 2^18 points (blocks hold 2 to 16383).
+std::size_t batch_blocks(const FftHeader& h) {
+    return std::clamp<std::size_t>((std::size_t{1} << 18) / h.points_per_block, 16, 4096);
+}
 
 bool has_bit(const Bits& b, std::uint64_t i) { return (b[i >> 6] >> (i & 63)) & 1; }
 
@@ -118,7 +122,7 @@ bool any_point_in(const std::vector<Region>& regions, const float* p, std::uint3
 }
 
 Vec3f first_point(const FftHeader& h, const std::uint8_t* block) {
-    const auto a = BlockView{block}.anchors_normalized();
+    const auto a = block_anchors_normalized(h, block);
     return h.to_world(a[0], a[1], a[2]);
 }
 
@@ -326,7 +330,7 @@ private:
         std::vector<std::uint32_t> blocks;
         std::vector<std::uint64_t> fibers;
         const std::uint32_t bb = h_.block_bytes();
-        while (candidates.next(kBatchBlocks, blocks, fibers)) {
+        while (candidates.next(batch_blocks(h_), blocks, fibers)) {
             reader_.read(blocks);
             // Runs of consecutive blocks are contiguous in the read buffer: one decode call each.
             std::vector<std::size_t> first_point(blocks.size() + 1, 0);
@@ -334,7 +338,7 @@ private:
                 for (j = i + 1; j < blocks.size() && blocks[j] == blocks[j - 1] + 1;) ++j;
                 decode_into(ctx_, reader_.block(i), j - i, scratch_, first_point[i]);
                 for (std::size_t k = i; k < j; ++k)
-                    first_point[k + 1] = first_point[k] + BlockView{reader_.block(i) + (k - i) * bb}.point_count();
+                    first_point[k + 1] = first_point[k] + block_flags(h_, reader_.block(i) + (k - i) * bb).point_count;
             }
             stats_.blocks_decoded += blocks.size();
             for (std::size_t i = 0; i < blocks.size(); ++i) {
@@ -398,7 +402,7 @@ private:
             if (include_test(i) && !any_point_in(q_.include, p, n)) return false;
             return !(exclude_test(i) && any_point_in(q_.exclude, p, n));
         };
-        while (candidates.next(kBatchBlocks, blocks, fibers)) {
+        while (candidates.next(batch_blocks(h_), blocks, fibers)) {
             // With a level of detail, the next block's first point may end a segment.
             need.clear(), at_need.assign(blocks.size(), 0), next_at_need.assign(blocks.size(), SIZE_MAX);
             for (std::size_t i = 0; i < blocks.size(); ++i) {
@@ -431,7 +435,7 @@ private:
                 const std::uint8_t* block = reader_.block(at_need[i]);
                 if (kind[i] == coarse) {
                     // First point, then the next block's first point or the fiber's last point.
-                    const std::uint32_t n = BlockView{block}.point_count();
+                    const std::uint32_t n = block_flags(h_, block).point_count;
                     const bool last = next_at_need[i] == SIZE_MAX;
                     if (region_test(i) || (last && n > 1)) {
                         decode_into(ctx_, block, 1, scratch_, 0);
@@ -451,7 +455,7 @@ private:
                 while (j < blocks.size() && kind[j] == fine && blocks[j] == blocks[j - 1] + 1) test |= region_test(j++);
                 if (!options_.points && !test) {
                     for (std::size_t k = i; k < j; ++k)
-                        out.fine(fibers[k], blocks[k], nullptr, BlockView{reader_.block(at_need[k])}.point_count());
+                        out.fine(fibers[k], blocks[k], nullptr, block_flags(h_, reader_.block(at_need[k])).point_count);
                     out.maybe_flush();
                     continue;
                 }
@@ -461,7 +465,7 @@ private:
                 stats_.blocks_decoded += j - i;
                 std::size_t at = base;
                 for (std::size_t k = i; k < j; ++k) {
-                    const std::uint32_t n = BlockView{block + (k - i) * bb}.point_count();
+                    const std::uint32_t n = block_flags(h_, block + (k - i) * bb).point_count;
                     const float* p = &out.buffer()[3 * at];
                     at += n;
                     if (passes_regions(k, p, n)) out.fine(fibers[k], blocks[k], options_.points ? p : nullptr, n);

@@ -101,9 +101,9 @@ bool block_is_coarse(const Camera& c, const Viewport& v, Vec3f center, float rad
 }
 
 Sphere block_bounding_sphere(const FftHeader& h, const std::uint8_t* bytes) {
-    const BlockView block{bytes};
-    const auto a = block.anchors_normalized();
-    return block_bounding_sphere(h, h.to_world(a[0], a[1], a[2]), h.to_world(a[3], a[4], a[5]), block.point_count());
+    const auto a = block_anchors_normalized(h, bytes);
+    return block_bounding_sphere(h, h.to_world(a[0], a[1], a[2]), h.to_world(a[3], a[4], a[5]),
+                                 block_flags(h, bytes).point_count);
 }
 
 Sphere block_bounding_sphere(const FftHeader& h, Vec3f a0, Vec3f a1, std::uint32_t n) {

@@ -1,0 +1,29 @@
+// fiblet view IN — the interactive viewer (needs a display).
+#include "cli_common.hpp"
+#include "viewer_options.hpp"
+#include "viewer_window.hpp"
+
+namespace fiblet::cli {
+namespace {
+
+void run(const ViewerArgs& a) {
+    viewer::WindowOptions o;
+    parse_size(a.size, o.width, o.height);
+    o.render = render_options_from(a);
+    o.camera = a.camera, o.fov_y_deg = a.fov, o.zoom = a.zoom;
+    viewer::run_viewer_window(a.input, o);
+}
+
+}  // namespace
+
+void add_view(CLI::App& app) {
+    auto args = std::make_shared<ViewerArgs>();
+    args->size = "1280x800";
+    CLI::App* cmd = app.add_subcommand("view", "Show a .fft (or .tck) file in a window (needs a display)");
+    add_viewer_options(cmd, *args);
+    cmd->add_option("--size", args->size, "Window size WIDTHxHEIGHT")->capture_default_str();
+    cmd->footer(std::string("Controls:\n") + viewer::window_controls_help());
+    cmd->callback([args] { run(*args); });
+}
+
+}  // namespace fiblet::cli

@@ -1,0 +1,31 @@
+// Command-line options shared by `fiblet render` and `fiblet view`.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "render_options.hpp"
+
+namespace fiblet::cli {
+
+struct ViewerArgs {
+    std::string input;
+    std::string size = "1920x1080";
+    std::string camera = "oblique";
+    float fov = 35, zoom = 1;
+    std::string color = "direction", background = "black", fibers;
+    bool no_lighting = false, no_culling = false, no_lod = false;
+    float lod_pixels = 4, line_width = 1;
+    double min_length = 0, max_length = 0;
+};
+
+// Adds the input file and the camera, shading and selection options.
+void add_viewer_options(CLI::App* cmd, ViewerArgs& args);
+
+// Width and height of "WxH"; throws fiblet::Error{invalid_argument}.
+void parse_size(const std::string& text, int& width, int& height);
+
+// The render options the arguments describe; throws fiblet::Error{invalid_argument}.
+viewer::RenderOptions render_options_from(const ViewerArgs& args);
+
+}  // namespace fiblet::cli

@@ -1,0 +1,41 @@
+// Binding points shared by the C++ side and the shaders: the shaders receive
+// them as #defines (gpu_binding_defines), so both sides use one definition.
+#pragma once
+
+#include <string>
+
+namespace fiblet::viewer {
+
+namespace binding {
+// Shader storage buffers.
+inline constexpr unsigned kBlocks = 0;       // the raw blocks of the file, as uint words
+inline constexpr unsigned kBlockFiber = 1;   // per block: index of its fiber in the file
+inline constexpr unsigned kFiberPoints = 2;  // per fiber: number of points
+inline constexpr unsigned kFiberEnds = 3;    // per fiber: last point (world mm), decoded once at load
+inline constexpr unsigned kFineList = 4;     // blocks to decode and draw in full
+inline constexpr unsigned kCoarseList = 5;   // blocks drawn as one segment (level of detail)
+inline constexpr unsigned kCounters = 6;     // sizes of the two lists and their segment counts
+inline constexpr unsigned kPoints = 7;       // decoded points, pointsPerBlock + 1 slots per block
+inline constexpr unsigned kDecisions = 8;    // per block culling decision (tests, statistics)
+inline constexpr unsigned kStorageCount = 9;
+// Uniform buffers.
+inline constexpr unsigned kLocalFrames = 0;  // the 256 frames of the direction code (DirectionTable)
+}  // namespace binding
+
+// Per-block decisions written by the culling pass.
+enum class BlockDecision : unsigned {
+    outside_frustum = 0,  // bounding sphere entirely outside one frustum plane
+    coarse = 1,           // visible, under the level-of-detail size: one segment
+    fine = 2,             // visible, decoded and drawn in full
+    not_selected = 3,     // excluded by the fiber subset (ID / length)
+};
+
+// Layout of the counters buffer (uint each).
+struct DrawCounters {
+    unsigned fine_blocks = 0, coarse_blocks = 0, fine_segments = 0, coarse_segments = 0;
+};
+
+// "#define BINDING_BLOCKS 0\n..." for every binding point and decision code.
+std::string gpu_binding_defines();
+
+}  // namespace fiblet::viewer

@@ -1,0 +1,33 @@
+#include "gpu_programs.hpp"
+
+#include <string>
+
+#include "fiblet/error.hpp"
+#include "gpu_bindings.hpp"
+#include "shader_program.hpp"
+
+namespace fiblet::viewer {
+
+namespace {
+void require_limit(GLenum name, GLint at_least, const char* what) {
+    GLint v = 0;
+    glGetIntegerv(name, &v);
+    if (v < at_least)
+        throw Error(Errc::unsupported, std::string("the GL driver offers too few ") + what + " (" +
+                                           std::to_string(v) + ", the viewer needs " + std::to_string(at_least) + ")");
+}
+}  // namespace
+
+GpuPrograms::GpuPrograms() {
+    require_limit(GL_MAX_SHADER_STORAGE_BUFFER_BINDINGS, GLint(binding::kStorageCount),
+                  "shader storage buffer bindings");
+    require_limit(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, 5, "shader storage blocks in vertex shaders");
+    require_limit(GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS, 7, "shader storage blocks in compute shaders");
+    const std::string defines = gpu_binding_defines();
+    cull = build_program({"cull_blocks.comp.glsl"}, defines);
+    decode = build_program({"decode_blocks.comp.glsl"}, defines);
+    fine_lines = build_program({"fine_lines.vert.glsl", "lines.frag.glsl"}, defines);
+    coarse_lines = build_program({"coarse_lines.vert.glsl", "lines.frag.glsl"}, defines);
+}
+
+}  // namespace fiblet::viewer

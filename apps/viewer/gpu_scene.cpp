@@ -1,0 +1,152 @@
+#include "gpu_scene.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "fiblet/decode.hpp"
+#include "fiblet/direction_code.hpp"
+#include "fiblet/error.hpp"
+#include "fiblet/view.hpp"
+#include "gpu_bindings.hpp"
+#include "shader_program.hpp"
+
+namespace fiblet::viewer {
+
+float SceneBounds::radius() const {
+    const float dx = max.x - min.x, dy = max.y - min.y, dz = max.z - min.z;
+    return 0.5f * std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+std::uint64_t max_storage_buffer_bytes() {
+    GLint64 v = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &v);
+    return std::uint64_t(v);
+}
+
+namespace {
+
+// The DirectionTable as std140 mat3[256] (each column padded to a vec4).
+std::vector<float> local_frames_std140(float ratio) {
+    const DirectionTable table(ratio);
+    std::vector<float> out;
+    out.reserve(256 * 12);
+    for (int k = 0; k < 256; ++k)
+        for (const Vec3f& c : table.frame(std::uint8_t(k)).c) out.insert(out.end(), {c.x, c.y, c.z, 0.0f});
+    return out;
+}
+
+void check_fits(std::uint64_t bytes, const char* what) {
+    const std::uint64_t limit = max_storage_buffer_bytes();
+    if (bytes > limit)
+        throw Error(Errc::unsupported, fmt::format("the {} take {:.1f} MiB, more than this GL driver's largest storage "
+                                                   "buffer ({:.1f} MiB)",
+                                                   what, bytes / 1048576.0, limit / 1048576.0));
+}
+
+}  // namespace
+
+GpuScene::GpuScene(const FftFile& file, const GpuPrograms& programs) : header_(file.header()) {
+    const FftHeader& h = header_;
+    const std::uint32_t bb = h.block_bytes();
+    check_fits(std::uint64_t(h.blocks) * bb, "blocks");
+    const std::vector<std::uint8_t> blocks = file.read_blocks(0, h.blocks);
+    const DecodeContext ctx(h);
+    count_block_points(ctx, blocks.data(), h.blocks);  // validates every point count
+
+    // Per-block fiber index and per-fiber tables, from the LUT (validated by
+    // FftFile: a fiber's blocks are contiguous and in fiber order).
+    const std::uint64_t fibers = h.fibers;
+    std::vector<std::uint32_t> block_fiber(h.blocks);
+    std::vector<std::uint32_t> last_blocks;
+    fiber_ids_.resize(fibers);
+    fiber_points_.assign(fibers, 0);
+    block_points_.resize(h.blocks);
+    for (std::uint32_t b = 0; b < h.blocks; ++b)
+        block_points_[b] = std::uint8_t(BlockView{&blocks[std::size_t(b) * bb]}.point_count());
+    for (std::uint64_t f = 0; f < fibers; ++f) {
+        const std::uint64_t first = file.first_block(f), count = file.block_count(f);
+        for (std::uint64_t b = first; b < first + count; ++b) {
+            block_fiber[b] = std::uint32_t(f);
+            fiber_points_[f] += block_points_[b];
+        }
+        fiber_ids_[f] = count ? BlockView{&blocks[first * bb]}.fiber_id() : std::uint32_t(f);
+        if (count) last_blocks.push_back(std::uint32_t(first + count - 1));
+        if (fiber_points_[f] > 1) segments_ += fiber_points_[f] - 1;
+    }
+
+    // Bounds: the union of the blocks' bounding spheres (no decoding).
+    if (h.blocks > 0) {
+        const float inf = std::numeric_limits<float>::infinity();
+        bounds_.min = {inf, inf, inf}, bounds_.max = {-inf, -inf, -inf};
+        const std::uint32_t sample_stride = (h.blocks + 65535) / 65536;
+        for (std::uint32_t b = 0; b < h.blocks; ++b) {
+            const Sphere s = block_bounding_sphere(h, &blocks[std::size_t(b) * bb]);
+            if (b % sample_stride == 0) sample_points_.push_back(s.center);  // the block's first point
+            bounds_.min = {std::min(bounds_.min.x, s.center.x - s.radius), std::min(bounds_.min.y, s.center.y - s.radius),
+                           std::min(bounds_.min.z, s.center.z - s.radius)};
+            bounds_.max = {std::max(bounds_.max.x, s.center.x + s.radius), std::max(bounds_.max.y, s.center.y + s.radius),
+                           std::max(bounds_.max.z, s.center.z + s.radius)};
+        }
+    }
+
+    check_fits(fibers * 16, "fiber end points");
+    blocks_ = make_buffer(GLsizeiptr(blocks.size()), blocks.data(), 0);
+    block_fiber_ = make_buffer(GLsizeiptr(block_fiber.size() * 4), block_fiber.data(), 0);
+    fiber_points_buffer_ = make_buffer(GLsizeiptr(fiber_points_.size() * 4), fiber_points_.data(), 0);
+    fiber_ends_ = make_buffer(GLsizeiptr(fibers * 16), nullptr, 0);
+    const std::vector<float> frames = local_frames_std140(h.ratio);
+    local_frames_ = make_buffer(GLsizeiptr(frames.size() * 4), frames.data(), 0);
+
+    // The last point of every fiber, decoded on the GPU by the decoder's
+    // ends-only mode over the list of last blocks.
+    if (!last_blocks.empty()) {
+        const GlBuffer list = make_buffer(GLsizeiptr(last_blocks.size() * 4), last_blocks.data(), 0);
+        glUseProgram(programs.decode.get());
+        bind(programs.decode);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, list.get());
+        glUniform1i(uniform(programs.decode, "uUseList"), 1);
+        glUniform1i(uniform(programs.decode, "uEndsOnly"), 1);
+        constexpr std::size_t kMaxGroups = 65535;
+        for (std::size_t first = 0; first < last_blocks.size(); first += kMaxGroups) {
+            glUniform1ui(uniform(programs.decode, "uFirst"), GLuint(first));
+            glDispatchCompute(GLuint(std::min(kMaxGroups, last_blocks.size() - first)), 1, 1);
+        }
+        glUniform1i(uniform(programs.decode, "uEndsOnly"), 0);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        glFinish();  // `list` is released on return
+    }
+}
+
+double GpuScene::fiber_length_mm(std::uint64_t index) const {
+    const std::uint32_t n = fiber_points_[index];
+    return n > 1 ? double(n - 1) * double(header_.step) * double(header_.scaling) : 0.0;
+}
+
+std::vector<Vec3f> GpuScene::read_fiber_ends() const {
+    std::vector<float> xyzw(fiber_count() * 4);
+    if (!xyzw.empty()) glGetNamedBufferSubData(fiber_ends_.get(), 0, GLsizeiptr(xyzw.size() * 4), xyzw.data());
+    std::vector<Vec3f> out(fiber_count());
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = {xyzw[4 * i], xyzw[4 * i + 1], xyzw[4 * i + 2]};
+    return out;
+}
+
+void GpuScene::bind(const GlProgram& program) const {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kBlocks, blocks_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kBlockFiber, block_fiber_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberPoints, fiber_points_buffer_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberEnds, fiber_ends_.get());
+    glBindBufferBase(GL_UNIFORM_BUFFER, binding::kLocalFrames, local_frames_.get());
+    const GLuint p = program.get();
+    glProgramUniform1ui(p, uniform(program, "uBlockCount"), header_.blocks);
+    glProgramUniform1ui(p, uniform(program, "uBlockWords"), header_.block_bytes() / 4);
+    glProgramUniform1ui(p, uniform(program, "uPointsPerBlock"), header_.points_per_block);
+    glProgramUniform1f(p, uniform(program, "uScaling"), header_.scaling);
+    glProgramUniform3f(p, uniform(program, "uOffset"), header_.offset[0], header_.offset[1], header_.offset[2]);
+    glProgramUniform1f(p, uniform(program, "uStep"), header_.step);
+}
+
+}  // namespace fiblet::viewer

@@ -1,0 +1,69 @@
+// A .fft file on the GPU: its blocks uploaded as they are in the file (76
+// bytes each for 60 points; never decoded on the CPU), the 256 local frames
+// of its direction code, and small tables built from the fiber LUT (fiber of
+// each block, points of each fiber). The last point of every fiber, which the
+// level of detail needs, is decoded once on the GPU at load.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "fiblet/fft_file.hpp"
+#include "fiblet/geometry.hpp"
+#include "gl_objects.hpp"
+#include "gpu_programs.hpp"
+
+namespace fiblet::viewer {
+
+// An axis-aligned box around every block's bounding sphere (world mm).
+struct SceneBounds {
+    Vec3f min{-1, -1, -1}, max{1, 1, 1};
+    Vec3f center() const { return {(min.x + max.x) / 2, (min.y + max.y) / 2, (min.z + max.z) / 2}; }
+    float radius() const;  // of the sphere around the box
+};
+
+class GpuScene {
+public:
+    // Reads and validates every block (point counts) and uploads the scene.
+    // Throws fiblet::Error{fft_format} on bad blocks, {unsupported} when the
+    // blocks exceed the driver's largest storage buffer.
+    GpuScene(const FftFile& file, const GpuPrograms& programs);
+
+    const FftHeader& header() const { return header_; }
+    std::uint32_t block_count() const { return header_.blocks; }
+    std::uint64_t fiber_count() const { return fiber_ids_.size(); }
+    std::uint64_t segment_count() const { return segments_; }  // of all fibers, drawn in full
+    const SceneBounds& bounds() const { return bounds_; }
+    // First points of the blocks (all of them, or an even sample of 65536),
+    // world mm: what a camera fits to frame the fibers rather than their box.
+    const std::vector<Vec3f>& sample_points() const { return sample_points_; }
+
+    // Fiber `index` (its position in the file): its ID as stored in its
+    // blocks, its number of points and its nominal length (points - 1) x step.
+    std::uint32_t fiber_id(std::uint64_t index) const { return fiber_ids_[index]; }
+    std::uint32_t fiber_points(std::uint64_t index) const { return fiber_points_[index]; }
+    // Points held by block `b` (its flags, validated at load).
+    std::uint32_t block_points(std::uint32_t b) const { return block_points_[b]; }
+    double fiber_length_mm(std::uint64_t index) const;
+
+    // Binds the scene's buffers to their binding points and sets the scene
+    // uniforms (scene_buffers.glsl) of `program`.
+    void bind(const GlProgram& program) const;
+
+    // The last point of every fiber as decoded on the GPU at load (world mm).
+    std::vector<Vec3f> read_fiber_ends() const;
+
+private:
+    FftHeader header_;
+    std::vector<std::uint32_t> fiber_ids_, fiber_points_;
+    std::vector<std::uint8_t> block_points_;
+    std::uint64_t segments_ = 0;
+    SceneBounds bounds_;
+    std::vector<Vec3f> sample_points_;
+    GlBuffer blocks_, block_fiber_, fiber_points_buffer_, fiber_ends_, local_frames_;
+};
+
+// Largest shader storage buffer of the current context, in bytes.
+std::uint64_t max_storage_buffer_bytes();
+
+}  // namespace fiblet::viewer

@@ -1,0 +1,45 @@
+// What a frame draws and how, and what it measured.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+
+#include "fiblet/view.hpp"
+
+namespace fiblet::viewer {
+
+struct RenderOptions {
+    // Per-frame selection on the GPU (fiblet/view.hpp definitions).
+    bool frustum_culling = true;
+    bool level_of_detail = true;
+    float lod_pixels = kDefaultLodPixels;
+    // Fiber subset: IDs in [id_min, id_max], nominal lengths in [min, max] mm.
+    std::uint32_t id_min = 0, id_max = std::numeric_limits<std::uint32_t>::max();
+    double min_length_mm = 0, max_length_mm = std::numeric_limits<double>::infinity();
+
+    // Shading.
+    bool color_by_direction = true;                    // |direction| as RGB, else fixed_color
+    std::array<float, 3> fixed_color{0.95f, 0.85f, 0.6f};
+    bool lighting = true;                              // illuminated lines
+    float line_width = 1;                              // pixels
+    std::array<float, 3> background{0, 0, 0};
+
+    bool time_stages = false;       // time cull / decode / draw (GpuTimer, default_timing_method)
+    bool record_decisions = false;  // keep each block's culling decision (Renderer::read_decisions)
+
+    bool subset_active() const {
+        return id_min > 0 || id_max < std::numeric_limits<std::uint32_t>::max() || min_length_mm > 0 ||
+               max_length_mm < std::numeric_limits<double>::infinity();
+    }
+};
+
+struct FrameStats {
+    std::uint64_t fine_blocks = 0, coarse_blocks = 0;      // blocks drawn in full / as one segment
+    std::uint64_t fine_segments = 0, coarse_segments = 0;  // line segments drawn
+    double cull_ms = 0, decode_ms = 0, draw_ms = 0;         // GPU time (time_stages)
+    std::uint64_t drawn_blocks() const { return fine_blocks + coarse_blocks; }
+    std::uint64_t drawn_segments() const { return fine_segments + coarse_segments; }
+};
+
+}  // namespace fiblet::viewer

@@ -1,0 +1,199 @@
+#include "renderer.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "gpu_timer.hpp"
+#include "shader_program.hpp"
+#include "vec_ops.hpp"
+
+namespace fiblet::viewer {
+
+namespace {
+
+struct CameraBasis {
+    Vec3f right, up, back;  // as view.hpp builds them; the camera looks along -back
+};
+CameraBasis camera_basis(const Camera& c) {
+    const Vec3f back = normalized(sub(c.position, c.target));
+    const Vec3f right = normalized(cross(c.up, back));
+    return {right, cross(back, right), back};
+}
+
+// Points of a fiber of `mm` length at the file's step: length = (points - 1) step.
+std::uint32_t points_for_length(double mm, double step_mm, bool round_up) {
+    if (!std::isfinite(mm)) return 0xffffffffu;
+    const double p = mm / step_mm + 1.0;
+    const double r = round_up ? std::ceil(p - 1e-9) : std::floor(p + 1e-9);
+    return std::uint32_t(std::clamp(r, 0.0, 4294967295.0));
+}
+
+}  // namespace
+
+Renderer::Renderer(const GpuPrograms& programs) : programs_(programs) {
+    GLuint vao = 0;
+    glCreateVertexArrays(1, &vao);
+    empty_vertex_array_ = GlVertexArray(vao);
+    counters_ = make_buffer(sizeof(DrawCounters), nullptr, GL_DYNAMIC_STORAGE_BIT);
+}
+
+void Renderer::ensure_buffers(const GpuScene& scene, bool decisions) {
+    const std::uint32_t blocks = std::max(scene.block_count(), 1u);
+    if (list_capacity_ < blocks) {
+        fine_list_ = make_buffer(GLsizeiptr(blocks) * 4, nullptr, 0);
+        coarse_list_ = make_buffer(GLsizeiptr(blocks) * 4, nullptr, 0);
+        list_capacity_ = blocks;
+    }
+    if (decisions && decisions_capacity_ < blocks) {
+        decisions_ = make_buffer(GLsizeiptr(blocks) * 4, nullptr, 0);
+        decisions_capacity_ = blocks;
+    }
+    if (!decoder_ || decoder_->points_per_block() != scene.header().points_per_block)
+        decoder_ = std::make_unique<BlockDecoder>(programs_, scene.header().points_per_block);
+}
+
+DrawCounters Renderer::select_blocks(const GpuScene& scene, const Camera& camera, const Viewport& viewport,
+                                     const RenderOptions& o) {
+    ensure_buffers(scene, o.record_decisions);
+    const GlProgram& p = programs_.cull;
+    const GLuint id = p.get();
+    glUseProgram(id);
+    scene.bind(p);
+    const GLuint zero = 0;
+    glClearNamedBufferData(counters_.get(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, fine_list_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCoarseList, coarse_list_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCounters, counters_.get());
+    const bool decisions = o.record_decisions && decisions_;
+    if (decisions) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kDecisions, decisions_.get());
+    glProgramUniform1i(id, uniform(p, "uWriteDecisions"), decisions ? 1 : 0);
+
+    // The frustum planes and LoD terms of view.hpp, computed on the CPU once.
+    const Frustum f = frustum_from_camera(camera);
+    float planes[24];
+    for (int i = 0; i < 6; ++i) {
+        const Plane& pl = f.planes[std::size_t(i)];
+        planes[4 * i] = pl.n.x, planes[4 * i + 1] = pl.n.y, planes[4 * i + 2] = pl.n.z, planes[4 * i + 3] = pl.d;
+    }
+    glProgramUniform1i(id, uniform(p, "uFrustumCulling"), o.frustum_culling ? 1 : 0);
+    glProgramUniform4fv(id, uniform(p, "uPlanes"), 6, planes);
+    const CameraBasis basis = camera_basis(camera);
+    glProgramUniform1i(id, uniform(p, "uLevelOfDetail"), o.level_of_detail ? 1 : 0);
+    glProgramUniform1f(id, uniform(p, "uLodPixels"), o.lod_pixels);
+    glProgramUniform3f(id, uniform(p, "uCameraPosition"), camera.position.x, camera.position.y, camera.position.z);
+    glProgramUniform3f(id, uniform(p, "uCameraBack"), basis.back.x, basis.back.y, basis.back.z);
+    glProgramUniform1f(id, uniform(p, "uTanHalfFovY"), std::tan(camera.fov_y_deg * float(M_PI) / 360.0f));
+    glProgramUniform1f(id, uniform(p, "uViewportHeight"), float(viewport.height));
+
+    const double step_mm = double(scene.header().step) * scene.header().scaling;
+    glProgramUniform2ui(id, uniform(p, "uFiberIdRange"), o.id_min, o.id_max);
+    glProgramUniform2ui(id, uniform(p, "uPointRange"), points_for_length(o.min_length_mm, step_mm, true),
+                        points_for_length(o.max_length_mm, step_mm, false));
+
+    glDispatchCompute((scene.block_count() + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    DrawCounters c;
+    glGetNamedBufferSubData(counters_.get(), 0, sizeof c, &c);
+    return c;
+}
+
+void Renderer::set_shading(const GlProgram& p, const Camera& camera, const RenderOptions& o) const {
+    const GLuint id = p.get();
+    const Mat4 vp = view_projection_matrix(camera);
+    glProgramUniformMatrix4fv(id, uniform(p, "uViewProjection"), 1, GL_FALSE, vp.data());
+    glProgramUniform1i(id, uniform(p, "uColorByDirection"), o.color_by_direction ? 1 : 0);
+    glProgramUniform3f(id, uniform(p, "uFixedColor"), o.fixed_color[0], o.fixed_color[1], o.fixed_color[2]);
+    glProgramUniform1i(id, uniform(p, "uLighting"), o.lighting ? 1 : 0);
+    glProgramUniform3f(id, uniform(p, "uCameraPosition"), camera.position.x, camera.position.y, camera.position.z);
+    // A headlight a little above and to the left of the eye, so that lines
+    // facing the viewer are not all equally lit.
+    const CameraBasis b = camera_basis(camera);
+    const Vec3f light = normalized(add(add(b.back, scale(0.5f, b.up)), scale(-0.35f, b.right)));
+    glProgramUniform3f(id, uniform(p, "uLightDirection"), light.x, light.y, light.z);
+    glProgramUniform1f(id, uniform(p, "uAmbient"), 0.25f);
+    glProgramUniform1f(id, uniform(p, "uDiffuse"), 0.75f);
+    glProgramUniform1f(id, uniform(p, "uSpecular"), 0.35f);
+    glProgramUniform1f(id, uniform(p, "uShininess"), 24.0f);
+}
+
+FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const RenderOptions& o,
+                            RenderTarget& target) {
+    ensure_buffers(scene, o.record_decisions);
+    const Viewport viewport{target.width(), target.height()};
+    const GLuint fb = target.framebuffer();
+    glBindFramebuffer(GL_FRAMEBUFFER, fb);
+    glViewport(0, 0, viewport.width, viewport.height);
+    const float background[4] = {o.background[0], o.background[1], o.background[2], 1.0f};
+    const GLuint no_fiber[4] = {0, 0, 0, 0};
+    const float far_depth = 1.0f;
+    glClearNamedFramebufferfv(fb, GL_COLOR, 0, background);
+    glClearNamedFramebufferuiv(fb, GL_COLOR, 1, no_fiber);
+    glClearNamedFramebufferfv(fb, GL_DEPTH, 0, &far_depth);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glLineWidth(o.line_width);
+    glBindVertexArray(empty_vertex_array_.get());
+
+    GpuTimer timer(o.time_stages ? default_timing_method() : TimingMethod::none);
+    FrameStats stats;
+    const bool select = o.frustum_culling || o.level_of_detail || o.subset_active();
+    if (select) {
+        timer.begin(Stage::cull);
+        const DrawCounters c = select_blocks(scene, camera, viewport, o);
+        timer.end();
+        stats.fine_blocks = c.fine_blocks, stats.coarse_blocks = c.coarse_blocks;
+        stats.fine_segments = c.fine_segments, stats.coarse_segments = c.coarse_segments;
+    } else {
+        stats.fine_blocks = scene.block_count();
+        stats.fine_segments = scene.segment_count();
+    }
+
+    // Full blocks, a batch at a time: decode into the points buffer, draw it.
+    const GlProgram& fine = programs_.fine_lines;
+    set_shading(fine, camera, o);
+    const std::uint32_t ppb = scene.header().points_per_block;
+    for (std::uint32_t first = 0; first < stats.fine_blocks; first += decoder_->capacity()) {
+        const std::uint32_t count = std::min<std::uint32_t>(decoder_->capacity(), std::uint32_t(stats.fine_blocks) - first);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, fine_list_.get());
+        timer.begin(Stage::decode);
+        decoder_->decode(scene, select, first, count);
+        timer.end();
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        timer.begin(Stage::draw);
+        glUseProgram(fine.get());
+        scene.bind(fine);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kPoints, decoder_->points_buffer());
+        glProgramUniform1i(fine.get(), uniform(fine, "uUseList"), select ? 1 : 0);
+        glProgramUniform1ui(fine.get(), uniform(fine, "uFirst"), first);
+        glDrawArrays(GL_LINES, 0, GLsizei(2 * ppb * count));
+        timer.end();
+        // The next batch overwrites the points this draw reads.
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
+
+    // Coarse blocks: one segment each, straight from the raw blocks.
+    if (stats.coarse_blocks > 0) {
+        const GlProgram& coarse = programs_.coarse_lines;
+        set_shading(coarse, camera, o);
+        timer.begin(Stage::draw);
+        glUseProgram(coarse.get());
+        scene.bind(coarse);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCoarseList, coarse_list_.get());
+        glDrawArrays(GL_LINES, 0, GLsizei(2 * stats.coarse_blocks));
+        timer.end();
+    }
+
+    const auto ms = timer.collect();
+    stats.cull_ms = ms[0], stats.decode_ms = ms[1], stats.draw_ms = ms[2];
+    return stats;
+}
+
+std::vector<BlockDecision> Renderer::read_decisions(const GpuScene& scene) const {
+    std::vector<BlockDecision> out(scene.block_count());
+    if (!decisions_ || out.empty()) return out;
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(decisions_.get(), 0, GLsizeiptr(out.size() * 4), out.data());
+    return out;
+}
+
+}  // namespace fiblet::viewer

@@ -1,0 +1,50 @@
+// One frame: select blocks on the GPU (fiber subset, frustum culling, level
+// of detail), decode the selected blocks on the GPU a batch at a time and
+// draw them as illuminated lines, then draw the coarse blocks as one segment
+// each. Everything stays on the GPU except four counters read back per frame
+// (the list sizes, which size the batches and are shown to the user).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "block_decoder.hpp"
+#include "fiblet/view.hpp"
+#include "gl_objects.hpp"
+#include "gpu_bindings.hpp"
+#include "gpu_programs.hpp"
+#include "gpu_scene.hpp"
+#include "render_options.hpp"
+#include "render_target.hpp"
+
+namespace fiblet::viewer {
+
+class Renderer {
+public:
+    explicit Renderer(const GpuPrograms& programs);
+
+    FrameStats render(const GpuScene& scene, const Camera& camera, const RenderOptions& options,
+                      RenderTarget& target);
+
+    // The selection pass alone (what render() runs first when culling, LoD
+    // or a subset is on): fills the fine and coarse lists and returns their
+    // sizes.
+    DrawCounters select_blocks(const GpuScene& scene, const Camera& camera, const Viewport& viewport,
+                               const RenderOptions& options);
+
+    // Each block's decision in the last selection pass run with
+    // options.record_decisions.
+    std::vector<BlockDecision> read_decisions(const GpuScene& scene) const;
+
+private:
+    void ensure_buffers(const GpuScene& scene, bool decisions);
+    void set_shading(const GlProgram& p, const Camera& camera, const RenderOptions& options) const;
+
+    const GpuPrograms& programs_;
+    std::unique_ptr<BlockDecoder> decoder_;
+    GlBuffer fine_list_, coarse_list_, counters_, decisions_;
+    std::uint32_t list_capacity_ = 0, decisions_capacity_ = 0;
+    GlVertexArray empty_vertex_array_;  // core profile draws need one bound
+};
+
+}  // namespace fiblet::viewer

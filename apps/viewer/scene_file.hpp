@@ -1,0 +1,16 @@
+// Opening what the viewer draws: a .fft file as it is, or a .tck file
+// compressed on the fly (into a temporary .fft, removed once open).
+#pragma once
+
+#include <string>
+
+#include "fiblet/fft_file.hpp"
+
+namespace fiblet::viewer {
+
+bool looks_like_tck(const std::string& path);
+
+// Throws fiblet::Error like FftFile / compress_tck.
+FftFile open_scene_file(const std::string& path);
+
+}  // namespace fiblet::viewer

@@ -1,0 +1,82 @@
+#version 450
+// GPU decoding of fiblets, one workgroup per block, one invocation per point
+// (the prefix-product scheme): invocation t takes the local frame of
+// direction code t from the LUT, a log-step (Hillis-Steele) scan in shared
+// memory turns these into the running frames L0 L1 ... Lt, and a second scan
+// sums the steps into positions. Points are written to slot `slot` of the
+// points buffer: pointsPerBlock + 1 entries, the last used by the point that
+// joins the next block of the fiber (its first anchor).
+layout(local_size_x = 64) in;
+
+#include "scene_buffers.glsl"
+
+// fiblet::DirectionTable: frame k's columns (axis first), std140 mat3.
+layout(std140, binding = BINDING_LOCAL_FRAMES) uniform LocalFrames { mat3 localFrames[256]; };
+layout(std430, binding = BINDING_FINE_LIST) readonly buffer FineList { uint fineList[]; };
+layout(std430, binding = BINDING_POINTS) writeonly buffer Points { vec4 points[]; };
+layout(std430, binding = BINDING_FIBER_ENDS) writeonly buffer FiberEnds { vec4 fiberEnds[]; };
+
+uniform bool uUseList;     // blocks fineList[uFirst + slot], else blocks uFirst + slot
+uniform uint uFirst;
+uniform bool uEndsOnly;    // last blocks of fibers: write only their last point to fiberEnds[fiber]
+
+// kFrameHelper of direction_code.hpp.
+const vec3 kHelper = vec3(-0.703023156622, 0.039959276793, 0.71004344758);
+
+shared mat3 sFrames[64];
+shared vec3 sSteps[64];
+
+// fiblet::frame_from_axis.
+mat3 frameFromAxis(vec3 axis) {
+    vec3 c1 = cross(axis, kHelper);
+    if (dot(c1, c1) < 1e-6) c1 = cross(axis, vec3(0.0, kHelper.z, -kHelper.y));
+    c1 = normalize(c1);
+    vec3 c2 = normalize(cross(axis, c1));
+    return mat3(axis, c1, c2);
+}
+
+// The first axis; coinciding anchors fall back to +x (block_geometry.hpp).
+vec3 anchorAxis(vec3 a0, vec3 a1) {
+    vec3 d = a1 - a0;
+    float n2 = dot(d, d);
+    return n2 > 0.0 ? (1.0 / sqrt(n2)) * d : vec3(1.0, 0.0, 0.0);
+}
+
+void main() {
+    uint slot = gl_WorkGroupID.x;
+    uint t = gl_LocalInvocationIndex;
+    uint block = uUseList ? fineList[uFirst + slot] : uFirst + slot;
+    uint n = blockPointCount(block);
+    vec3 a0, a1;
+    blockAnchors(block, a0, a1);
+    mat3 first = frameFromAxis(anchorAxis(a0, a1));
+
+    // Point t + 2 turns the frame by the local frame of code t.
+    bool hasCode = t + 2u < n;
+    mat3 running = hasCode ? localFrames[blockCode(block, t)] : mat3(1.0);
+    for (uint d = 1u; d < 64u; d <<= 1) {
+        sFrames[t] = running;
+        barrier();
+        if (t >= d) running = sFrames[t - d] * running;
+        barrier();
+    }
+    vec3 offset = hasCode ? uStep * (first * running[0]) : vec3(0.0);
+    for (uint d = 1u; d < 64u; d <<= 1) {
+        sSteps[t] = offset;
+        barrier();
+        if (t >= d) offset += sSteps[t - d];
+        barrier();
+    }
+    vec3 p = a1 + offset;  // point t + 2
+
+    if (uEndsOnly) {
+        vec3 last = n == 1u ? a0 : n == 2u ? a1 : p;
+        if ((n <= 2u && t == 0u) || (n > 2u && t + 3u == n)) fiberEnds[blockFiber[block]] = vec4(toWorld(last), 1.0);
+        return;
+    }
+    uint base = slot * (uPointsPerBlock + 1u);
+    if (t == 0u) points[base] = vec4(toWorld(a0), 1.0);
+    if (t == 1u && n >= 2u) points[base + 1u] = vec4(toWorld(a1), 1.0);
+    if (hasCode) points[base + t + 2u] = vec4(toWorld(p), 1.0);
+    if (t == 63u && !isLastBlockOfFiber(block)) points[base + n] = vec4(toWorld(blockAnchor0(block + 1u)), 1.0);
+}

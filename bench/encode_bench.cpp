@@ -1,0 +1,89 @@
+// Encoder throughput (points per second on one core): the code search alone
+// on fibers already in memory, at each effort level, and the whole
+// compress pipeline (.tck on disk -> .fft on disk, one thread).
+//
+//   build/bench/fiblet_bench --benchmark_filter=Encode
+//
+// Input: FIBLET_BENCH_TCK (default ../shared/data/small-ifod1.tck).
+#include <benchmark/benchmark.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "fiblet/compress.hpp"
+#include "fiblet/encode.hpp"
+#include "fiblet/tck.hpp"
+
+namespace {
+
+std::string bench_tck() {
+    if (const char* p = std::getenv("FIBLET_BENCH_TCK")) return p;
+    return std::string(FIBLET_SHARED_DIR) + "/data/small-ifod1.tck";
+}
+
+struct Input {
+    std::vector<std::vector<fiblet::Vec3f>> fibers;
+    std::size_t points = 0;
+    fiblet::CompressReport report;  // the header and search the pipeline chose for it
+};
+
+// The input fibers, and what the pipeline chooses for them at this effort.
+const Input& input(unsigned bits, int effort) {
+    static std::map<std::pair<unsigned, int>, Input> cache;
+    Input& in = cache[{bits, effort}];
+    if (in.fibers.empty()) {
+        fiblet::TckReader r(bench_tck());
+        std::vector<fiblet::Vec3f> f;
+        while (r.next(f)) in.points += f.size(), in.fibers.push_back(f);
+        fiblet::CompressOptions o;
+        o.direction_bits = bits;
+        o.search = fiblet::search_for_effort(effort);
+        o.overwrite = true;
+        const std::string tmp = std::filesystem::temp_directory_path() / "fiblet-encode-bench.fft";
+        in.report = fiblet::compress_tck(bench_tck(), tmp, o);
+        std::filesystem::remove(tmp);
+    }
+    return in;
+}
+
+// The code search alone (fibers in memory, blocks to memory), one thread.
+void BM_EncodeSearch(benchmark::State& state) {
+    const Input& in = input(unsigned(state.range(0)), int(state.range(1)));
+    const fiblet::FiberEncoder encoder(in.report.header, in.report.search);
+    std::vector<std::uint8_t> blocks;
+    for (auto _ : state) {
+        for (std::size_t i = 0; i < in.fibers.size(); ++i) {
+            blocks.clear();
+            encoder.encode(in.fibers[i], std::uint32_t(i), blocks);
+            benchmark::DoNotOptimize(blocks.data());
+        }
+    }
+    state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(in.points));
+    state.counters["max_um"] = in.report.error.max_mm() * 1e3;
+    state.counters["mean_um"] = in.report.error.mean_mm() * 1e3;
+}
+BENCHMARK(BM_EncodeSearch)
+    ->ArgNames({"bits", "effort"})
+    ->ArgsProduct({{8}, {0, 1, 2, 3, 4}})
+    ->Args({16, 0})
+    ->Args({16, 1})
+    ->Unit(benchmark::kMillisecond);
+
+// The whole pipeline (.tck on disk -> .fft on disk), one thread.
+void BM_EncodePipeline(benchmark::State& state) {
+    const std::string tmp = std::filesystem::temp_directory_path() / "fiblet-encode-bench-pipeline.fft";
+    fiblet::CompressOptions o;
+    o.overwrite = true;
+    o.threads = 1;
+    o.search = fiblet::search_for_effort(int(state.range(0)));
+    std::uint64_t points = 0;
+    for (auto _ : state) points += fiblet::compress_tck(bench_tck(), tmp, o).header.points;
+    std::filesystem::remove(tmp);
+    state.SetItemsProcessed(std::int64_t(points));
+}
+BENCHMARK(BM_EncodePipeline)->ArgNames({"effort"})->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
+
+}  // namespace

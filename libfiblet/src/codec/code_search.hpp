@@ -1,0 +1,148 @@
+// Internal: choosing the direction codes of one block.
+//
+// The decoder walks p_k = p_{k-1} + step * F_k.c0 with F_k = F_{k-1} *
+// frame(code_k); the encoder chooses the codes so that the decoded points
+// stay close to the input points t_k. Both searches run the decoder's own
+// float operations (closed loop), so the positions they score are the ones
+// a decoder will produce, bit for bit.
+//
+// - greedy (beam width 1): each code is the one aimed most directly at the
+//   next input point from the decoded point and frame. Aiming maximizes
+//   dot(d, t - p) over unit d, which is the same as minimizing |p + step d - t|.
+// - beam search (width W): keeps the W code sequences with the smallest sum
+//   of squared point errors so far, expanding each by the (2r+1)^2 codes
+//   around its aimed code. A code is thus judged by the errors it causes
+//   later in the block too (zig-zag around a straight path, lag, turns
+//   sharper than the cap), which greedy aiming cannot see.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "codec/nearest_code_lut.hpp"
+#include "core/vec_math.hpp"
+#include "fiblet/direction_code.hpp"
+
+namespace fiblet::detail {
+
+struct SearchParams {
+    unsigned beam = 1;    // sequences kept per step; 1 = greedy
+    unsigned radius = 1;  // candidate codes: levels within +-radius of the aimed code on both axes
+};
+
+// The 8-bit codes of version-2 files, with the fast nearest-code lookup.
+struct Codebook8 {
+    using Code = std::uint8_t;
+    static constexpr int kLevels = 16;
+    const DirectionTable& table;
+    const NearestCodeLut& lut;
+
+    Code nearest(Vec3f local) const { return lut.usable() ? lut(local) : table.nearest_code(local); }
+    const Frame& frame(unsigned c) const { return table.frame(Code(c)); }
+    const Vec3f& direction(unsigned c) const { return table.direction(Code(c)); }
+};
+
+// The 16-bit codes of .fft16 files.
+struct Codebook16 {
+    using Code = std::uint16_t;
+    static constexpr int kLevels = 256;
+    const DirectionTable16& table;
+
+    Code nearest(Vec3f local) const { return table.nearest_code(local); }
+    const Frame& frame(unsigned c) const { return table.frame(Code(c)); }
+    const Vec3f& direction(unsigned c) const { return table.direction(Code(c)); }
+};
+
+// Chooses codes[k] for targets[k] (normalized coordinates), starting from
+// the block's second anchor `p` and first frame `f`; writes the decoded
+// points to decoded[k].
+template <class Codebook>
+void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, float step,
+                  std::span<const Vec3f> targets, typename Codebook::Code* codes, Vec3f* decoded) {
+    using Code = typename Codebook::Code;
+    const std::size_t m = targets.size();
+    if (sp.beam <= 1) {
+        for (std::size_t k = 0; k < m; ++k) {
+            const Code code = cb.nearest(apply_transposed(f, targets[k] - p));
+            codes[k] = code;
+            f = compose(f, cb.frame(code));
+            p = p + step * f.c[0];
+            decoded[k] = p;
+        }
+        return;
+    }
+
+    struct State {
+        Frame f;
+        Vec3f p;
+        float cost;
+    };
+    struct Candidate {
+        float cost;
+        std::uint32_t parent;
+        std::uint32_t code;
+    };
+    struct Link {
+        std::uint32_t parent;
+        std::uint32_t code;
+    };
+    const unsigned width = sp.beam;
+    const int r = int(sp.radius);
+    thread_local std::vector<State> states, next;
+    thread_local std::vector<Candidate> cand;
+    thread_local std::vector<Link> links;  // links[k * width + j]: how state j of step k was reached
+    states.assign(1, State{f, p, 0.0f});
+    next.resize(width);
+    cand.resize(std::size_t(width) * std::size_t(2 * r + 1) * std::size_t(2 * r + 1));
+    links.resize(m * width);
+    const float step2 = step * step, two_step = 2.0f * step;
+
+    for (std::size_t k = 0; k < m; ++k) {
+        std::size_t nc = 0;
+        for (std::uint32_t s = 0; s < states.size(); ++s) {
+            const State& st = states[s];
+            // |p + step d - t|^2 = |t - p|^2 + step^2 - 2 step d.(t - p), and d.(t - p) in
+            // the local frame is direction(code).local: three products per candidate.
+            const Vec3f local = apply_transposed(st.f, targets[k] - st.p);
+            const float base = st.cost + dot(local, local) + step2;
+            const unsigned aimed = cb.nearest(local);
+            const int h0 = int(aimed) / Codebook::kLevels, l0 = int(aimed) % Codebook::kLevels;
+            for (int h = std::max(h0 - r, 0); h <= std::min(h0 + r, Codebook::kLevels - 1); ++h)
+                for (int l = std::max(l0 - r, 0); l <= std::min(l0 + r, Codebook::kLevels - 1); ++l) {
+                    const auto code = std::uint32_t(h * Codebook::kLevels + l);
+                    cand[nc++] = {base - two_step * dot(cb.direction(code), local), s, code};
+                }
+        }
+        const std::size_t keep = std::min<std::size_t>(width, nc);
+        auto by_cost = [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; };
+        if (keep < nc) std::nth_element(cand.begin(), cand.begin() + std::ptrdiff_t(keep), cand.begin() + std::ptrdiff_t(nc), by_cost);
+        for (std::size_t j = 0; j < keep; ++j) {
+            const Candidate& c = cand[j];
+            const State& parent = states[c.parent];
+            State& n = next[j];
+            n.f = compose(parent.f, cb.frame(c.code));
+            n.p = parent.p + step * n.f.c[0];
+            n.cost = c.cost;
+            links[k * width + j] = {c.parent, c.code};
+        }
+        states.assign(next.begin(), next.begin() + std::ptrdiff_t(keep));
+    }
+
+    // Back-track the cheapest sequence, then replay it for the decoded points.
+    std::uint32_t j = 0;
+    for (std::uint32_t s = 1; s < states.size(); ++s)
+        if (states[s].cost < states[j].cost) j = s;
+    for (std::size_t k = m; k-- > 0;) {
+        codes[k] = Code(links[k * width + j].code);
+        j = links[k * width + j].parent;
+    }
+    for (std::size_t k = 0; k < m; ++k) {
+        f = compose(f, cb.frame(codes[k]));
+        p = p + step * f.c[0];
+        decoded[k] = p;
+    }
+}
+
+}  // namespace fiblet::detail

@@ -1,0 +1,185 @@
+#include "codec/parameters.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "fiblet/resample.hpp"
+
+namespace fiblet::detail {
+
+namespace {
+// Bins of (1 - dot) / 2 = sin^2(angle / 2) in [0, 1]: 0.013 degree wide at
+// a 15 degree turn. Float is enough: |u - v|^2 has no cancellation.
+constexpr std::size_t kTurnBins = 1u << 15;
+}  // namespace
+
+TurnStatistics::TurnStatistics(std::uint32_t points_per_block, std::size_t kept_blocks)
+    : bins_(kTurnBins + 1, 0), points_per_block_(std::max<std::uint32_t>(points_per_block, 1)), kept_blocks_(kept_blocks) {}
+
+void TurnStatistics::add_fiber(std::span<const Vec3f> f) {
+    float px = 0, py = 0, pz = 0;
+    bool have = false;
+    float fiber_max = -1;  // largest sin^2(angle / 2) of the fiber
+    std::size_t at = 0;
+    for (std::size_t i = 1; i < f.size(); ++i) {
+        float dx = f[i].x - f[i - 1].x, dy = f[i].y - f[i - 1].y, dz = f[i].z - f[i - 1].z;
+        const float n2 = dx * dx + dy * dy + dz * dz;
+        if (!(n2 > 0)) continue;
+        const float inv = 1.0f / std::sqrt(n2);
+        dx *= inv, dy *= inv, dz *= inv;
+        if (have) {
+            const float ex = dx - px, ey = dy - py, ez = dz - pz;
+            const float s2 = std::min(0.25f * (ex * ex + ey * ey + ez * ez), 1.0f);
+            if (s2 > fiber_max) fiber_max = s2, at = i - 1;  // the turn at point i - 1
+            ++bins_[std::size_t(s2 * float(kTurnBins))];
+            ++count_;
+        }
+        px = dx, py = dy, pz = dz, have = true;
+    }
+    if (fiber_max < 0) return;
+    const double fiber_min = 1.0 - 2.0 * double(fiber_max);  // the dot of the sharpest turn
+    min_dot_ = std::min(min_dot_, fiber_min);
+    if (kept_blocks_ == 0) return;
+    auto by_dot = [](const auto& a, const auto& b) { return a.first < b.first; };
+    if (sharpest_.size() == kept_blocks_) {
+        if (fiber_min >= sharpest_.front().first) return;
+        std::pop_heap(sharpest_.begin(), sharpest_.end(), by_dot);
+        sharpest_.pop_back();
+    }
+    const std::size_t b0 = at / points_per_block_ * points_per_block_;
+    const std::size_t b1 = std::min(f.size(), b0 + points_per_block_);
+    sharpest_.emplace_back(fiber_min, std::vector<Vec3f>(f.begin() + std::ptrdiff_t(b0), f.begin() + std::ptrdiff_t(b1)));
+    std::push_heap(sharpest_.begin(), sharpest_.end(), by_dot);
+}
+
+double TurnStatistics::dot_at_percentile(double p) const {
+    if (count_ == 0 || p >= 100) return min_dot_;
+    const auto rank = std::uint64_t(std::ceil(std::max(p, 0.0) / 100.0 * double(count_)));
+    std::uint64_t seen = 0;
+    for (std::size_t i = 0; i < bins_.size(); ++i) {
+        seen += bins_[i];
+        if (seen >= rank) {
+            const double s2 = std::min(1.0, double(i + 1) / double(kTurnBins));  // the bin's upper edge
+            return std::max(min_dot_, 1.0 - 2.0 * s2);
+        }
+    }
+    return min_dot_;
+}
+
+std::vector<std::vector<Vec3f>> TurnStatistics::sharpest_blocks() const {
+    std::vector<std::vector<Vec3f>> out;
+    for (const auto& [dot, points] : sharpest_) out.push_back(points);
+    return out;
+}
+
+void FiberSample::offer(std::span<const Vec3f> fiber) {
+    if (seen_++ % stride_ != 0) return;
+    fibers_.emplace_back(fiber.begin(), fiber.end());
+    points_ += fiber.size();
+    while (points_ > max_points_ && fibers_.size() > 1) {
+        // Keep every other fiber of the sample: those at multiples of 2 * stride.
+        std::size_t w = 0;
+        points_ = 0;
+        for (std::size_t i = 0; i < fibers_.size(); i += 2) points_ += fibers_[i].size(), fibers_[w++] = std::move(fibers_[i]);
+        fibers_.resize(w);
+        stride_ *= 2;
+    }
+}
+
+SampleError measure(const TuningSet& set, const FiberEncoder& encoder) {
+    std::vector<std::uint8_t> blocks;
+    std::vector<Vec3f> decoded, resampled;
+    double sum = 0, max = 0;
+    std::size_t n = 0;
+    auto encode = [&](std::span<const Vec3f> points, bool in_mean) {
+        blocks.clear();
+        decoded.clear();
+        encoder.encode(points, 0, blocks, &decoded);
+        for (std::size_t k = 0; k < points.size(); ++k) {
+            const double dx = double(decoded[k].x) - points[k].x, dy = double(decoded[k].y) - points[k].y,
+                         dz = double(decoded[k].z) - points[k].z;
+            const double e = std::sqrt(dx * dx + dy * dy + dz * dz);
+            max = std::max(max, e);
+            if (in_mean) sum += e;
+        }
+        if (in_mean) n += points.size();
+    };
+    for (const auto& fiber : set.fibers) {
+        if (set.resample_step_mm > 0) {
+            resample_fixed_step(fiber, set.resample_step_mm, resampled);
+            encode(resampled, true);
+        } else {
+            encode(fiber, true);
+        }
+    }
+    for (const auto& block : set.sharp_blocks) encode(block, false);
+    return {n ? sum / double(n) : 0.0, max};
+}
+
+TunedParameters tune_parameters(const TuningSet& set, const TurnStatistics& turns, FftHeader h,
+                                const SearchOptions& search, double sampling_step_mm,
+                                std::optional<float> fixed_ratio, std::optional<double> fixed_scale) {
+    constexpr double kDefaultScale = 1.0005;
+    TunedParameters best{fixed_ratio.value_or(compute_ratio(h.scaling, sampling_step_mm, turns.min_dot())),
+                         fixed_scale.value_or(1.0), search};
+    const bool have_data = !set.fibers.empty() || !set.sharp_blocks.empty();
+    const bool auto_retry = search.retry_beam_width > 0 && !(search.retry_error_mm > 0);
+    if (!have_data || !(sampling_step_mm > 0)) {
+        if (auto_retry) best.search.retry_beam_width = 0;  // no data to set a threshold from
+        return best;
+    }
+    auto step_for = [&](double scale) { return float(sampling_step_mm * scale / h.scaling); };
+
+    // 16-bit codes are 16 times finer: a turn sharper than the cap costs far
+    // more than the finer codes of a smaller cap save, and the zig-zag lag
+    // (angle^2 / 2) is 256 times smaller: the cap holds every turn and the
+    // decoder walks the sampling step.
+    if (h.direction_bits() == 16) {
+        if (!fixed_ratio) fixed_ratio = best.ratio;
+        if (!fixed_scale) fixed_scale = 1.0;
+    }
+    // Cap ratio: turn angles from the 99.9th percentile to the sharpest.
+    std::vector<float> ratios;
+    if (fixed_ratio) {
+        ratios.push_back(*fixed_ratio);
+    } else {
+        const double lo = std::acos(std::clamp(turns.dot_at_percentile(99.9), -1.0, 1.0));
+        const double hi = std::acos(std::clamp(turns.min_dot(), -1.0, 1.0));
+        constexpr int kRatios = 6;
+        for (int i = 0; i < kRatios; ++i) {
+            const double angle = hi - (hi - lo) * i / (kRatios - 1);
+            const float r = compute_ratio(h.scaling, sampling_step_mm, std::cos(angle));
+            if (ratios.empty() || std::fabs(r - ratios.back()) > 1e-4f * ratios.back()) ratios.push_back(r);
+        }
+    }
+    const double scale0 = fixed_scale.value_or(kDefaultScale);
+    double best_objective = INFINITY;
+    std::optional<FiberEncoder> best_encoder;
+    for (float r : ratios) {
+        h.ratio = r;
+        h.step = step_for(scale0);
+        FiberEncoder encoder(h, search);
+        if (auto_retry) {
+            SearchOptions first = search;
+            first.retry_beam_width = 0;
+            SearchOptions retry = search;
+            retry.retry_error_mm = kRetryOverMeanError * measure(set, encoder.with_search(first)).mean_mm;
+            if (!(retry.retry_error_mm > 0)) retry.retry_beam_width = 0;  // an exact encoding: nothing to retry
+            encoder = encoder.with_search(retry);
+        }
+        const SampleError e = measure(set, encoder);
+        if (e.objective() < best_objective) best_objective = e.objective(), best.ratio = r, best_encoder.emplace(std::move(encoder));
+    }
+    best.step_scale = scale0;
+    if (!fixed_scale) {
+        for (double scale : {1.0, 1.00025, 1.00075, 1.001, 1.0015}) {
+            const SampleError e = measure(set, best_encoder->with_step(step_for(scale)));
+            if (e.objective() < best_objective) best_objective = e.objective(), best.step_scale = scale;
+        }
+    }
+    best.encoder = best_encoder->with_step(step_for(best.step_scale));
+    best.search = best.encoder->search();
+    return best;
+}
+
+}  // namespace fiblet::detail

@@ -1,0 +1,149 @@
+// The "lanes" decoder: one block per SIMD lane, W blocks at a time, each
+// decoded sequentially. Every lane performs the reference decoder's float
+// operations in the reference's order (separate multiplies and adds, never
+// fused: the library is built with -ffp-contract=off), so the points are
+// bit-identical to decode_blocks_scalar's.
+//
+// Per step the W lanes look their local frame up (V::lookup: W row loads
+// and a transpose), compose it into their frame, advance and convert to
+// world coordinates. Points are staged as rows (x, y, z of point i for all
+// lanes) and every W points three W x W transposes turn 3W rows into each
+// lane's 3W consecutive output floats, written with (masked) vector stores.
+// Included by decode_{portable,avx2,avx512}.cpp after the definition of V.
+
+namespace lanes {
+
+struct Vec {
+    V::F x, y, z;
+};
+inline V::F dot(const Vec& a, const Vec& b) {
+    return V::add(V::add(V::mul(a.x, b.x), V::mul(a.y, b.y)), V::mul(a.z, b.z));
+}
+inline Vec cross(const Vec& a, const Vec& b) {
+    return {V::sub(V::mul(a.y, b.z), V::mul(a.z, b.y)), V::sub(V::mul(a.z, b.x), V::mul(a.x, b.z)),
+            V::sub(V::mul(a.x, b.y), V::mul(a.y, b.x))};
+}
+inline Vec scale(V::F s, const Vec& a) { return {V::mul(s, a.x), V::mul(s, a.y), V::mul(s, a.z)}; }
+inline Vec normalize(const Vec& a) { return scale(V::div(V::set1(1.0f), V::sqrt(dot(a, a))), a); }
+inline Vec select(V::M m, const Vec& a, const Vec& b) {
+    return {V::select(m, a.x, b.x), V::select(m, a.y, b.y), V::select(m, a.z, b.z)};
+}
+
+// block_start() for W blocks at once: the anchors from their unorm16 words
+// (`words[k][lane]`, as floats) and the first frame. Operation for operation
+// the scalar anchor_axis() (core/block_geometry.hpp) and frame_from_axis()
+// (codec/direction_code.cpp), so the frames are bit-identical (the lanes
+// equivalence test fails if they part).
+inline void block_starts(const float (&words)[6][V::W], Vec& a0, Vec& a1, V::F (&frame)[9]) {
+    const V::F unorm = V::set1(65535.0f);
+    a0 = {V::div(V::load(words[0]), unorm), V::div(V::load(words[1]), unorm), V::div(V::load(words[2]), unorm)};
+    a1 = {V::div(V::load(words[3]), unorm), V::div(V::load(words[4]), unorm), V::div(V::load(words[5]), unorm)};
+    const V::F zero = V::set1(0.0f), one = V::set1(1.0f);
+    const Vec d{V::sub(a1.x, a0.x), V::sub(a1.y, a0.y), V::sub(a1.z, a0.z)};
+    const V::F n2 = dot(d, d);
+    const Vec axis = select(V::less(zero, n2), scale(V::div(one, V::sqrt(n2)), d), Vec{one, zero, zero});
+    const Vec helper{V::set1(kFrameHelper[0]), V::set1(kFrameHelper[1]), V::set1(kFrameHelper[2])};
+    const Vec other{zero, helper.z, V::set1(-kFrameHelper[1])};
+    Vec c1 = cross(axis, helper);
+    c1 = select(V::less(dot(c1, c1), V::set1(1e-6f)), cross(axis, other), c1);
+    c1 = normalize(c1);
+    const Vec c2 = normalize(cross(axis, c1));
+    const V::F f[9] = {axis.x, axis.y, axis.z, c1.x, c1.y, c1.z, c2.x, c2.y, c2.z};
+    for (int c = 0; c < 9; ++c) frame[c] = f[c];
+}
+
+}  // namespace lanes
+
+inline std::size_t decode_lanes(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count, float* xyz) {
+    using F = V::F;
+    constexpr int W = V::W;
+    const FftHeader& h = ctx.header;
+    const int bb = int(h.block_bytes());
+    const float* rows_table = ctx.frame_rows.data();
+    const F step = V::set1(h.step), half = V::set1(0.5f), scaling = V::set1(h.scaling);
+    const F offset[3] = {V::set1(h.offset[0]), V::set1(h.offset[1]), V::set1(h.offset[2])};
+
+    // Per lane: the six unorm16 anchor coordinates, as floats.
+    alignas(64) float words[6][W];
+    // The last group's missing lanes repeat its last block (and write
+    // nothing), so every lane reads a whole block.
+    std::vector<std::uint8_t> padded;
+    alignas(64) float rows[3 * W][W];
+    float* dst[W];
+    int lane_floats[W];
+
+    float* out = xyz;
+    for (std::size_t g = 0; g < count; g += W) {
+        const int m = int(std::min<std::size_t>(W, count - g));
+        const std::uint8_t* base = blocks + g * std::size_t(bb);
+        if (m < W) {
+            padded.resize(std::size_t(W) * bb);
+            std::memcpy(padded.data(), base, std::size_t(m) * bb);
+            for (int l = m; l < W; ++l) std::memcpy(&padded[std::size_t(l) * bb], base + std::size_t(m - 1) * bb, bb);
+            base = padded.data();
+        }
+        int max_points = 0, min_floats = 3 * 64;
+        for (int l = 0; l < W; ++l) {
+            const BlockView block{base + std::size_t(l) * std::size_t(bb)};
+            const auto q = block.anchor_words();
+            for (int k = 0; k < 6; ++k) words[k][l] = float(q[k]);
+            const int n = l < m ? int(block.point_count()) : 0;
+            dst[l] = out;
+            lane_floats[l] = 3 * n;
+            out += 3 * n;
+            max_points = std::max(max_points, n);
+            min_floats = std::min(min_floats, 3 * n);
+        }
+        lanes::Vec a0, a1;
+        F frame[9];  // component 3 col + row
+        lanes::block_starts(words, a0, a1, frame);
+
+        // Rows 3(i % W) + c hold component c of point i. After point
+        // `first + W - 1` (or the last point), rows q W .. q W + W - 1
+        // transposed are the floats 3 first + q W .. + W of every lane.
+        auto flush = [&](int first) {
+            for (int q = 0; q < 3; ++q) {
+                F t[W];
+                for (int j = 0; j < W; ++j) t[j] = V::load(rows[q * W + j]);
+                V::transpose(t);
+                const int at = 3 * first + q * W;
+                if (at + W <= min_floats) {  // every lane has all W floats
+                    for (int l = 0; l < W; ++l) V::storeu(dst[l] + at, t[l]);
+                } else {
+                    for (int l = 0; l < W; ++l) {
+                        const int k = std::min(lane_floats[l] - at, W);
+                        if (k > 0) V::store_n(dst[l] + at, t[l], k);
+                    }
+                }
+            }
+        };
+        auto emit = [&](int i, F x, F y, F z) {
+            const int r = 3 * (i % W);
+            V::store(rows[r], V::sub(V::mul(V::sub(x, half), scaling), offset[0]));
+            V::store(rows[r + 1], V::sub(V::mul(V::sub(y, half), scaling), offset[1]));
+            V::store(rows[r + 2], V::sub(V::mul(V::sub(z, half), scaling), offset[2]));
+            if (i % W == W - 1 || i == max_points - 1) flush(i - i % W);
+        };
+
+        emit(0, a0.x, a0.y, a0.z);
+        F p[3] = {a1.x, a1.y, a1.z};
+        if (max_points >= 2) emit(1, p[0], p[1], p[2]);
+
+        const std::uint8_t* codes = base + kBlockDirectionsOffset;
+        for (int k = 0; k + 2 < max_points; ++k) {
+            F local[9];
+            V::lookup(rows_table, codes + k, bb, local);
+            // frame = frame * local, as compose(): column j = F * local.c[j],
+            // summed left to right.
+            F next[9];
+            for (int j = 0; j < 3; ++j)
+                for (int r = 0; r < 3; ++r)
+                    next[3 * j + r] = V::add(V::add(V::mul(frame[r], local[3 * j]), V::mul(frame[3 + r], local[3 * j + 1])),
+                                             V::mul(frame[6 + r], local[3 * j + 2]));
+            for (int c = 0; c < 9; ++c) frame[c] = next[c];
+            for (int r = 0; r < 3; ++r) p[r] = V::add(p[r], V::mul(step, frame[r]));
+            emit(k + 2, p[0], p[1], p[2]);
+        }
+    }
+    return std::size_t(out - xyz) / 3;
+}

@@ -1,0 +1,50 @@
+// The scalar reference decoder of 16-bit files (formats/fft16.md): the same
+// walk as decode_scalar.cpp with unorm24 anchors and 16-bit codes.
+#include "fiblet/decode.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "core/block_geometry.hpp"
+#include "core/vec_math.hpp"
+#include "fiblet/error.hpp"
+
+namespace fiblet {
+using namespace detail;
+
+std::shared_ptr<const DirectionTable16> make_direction_table16(const FftHeader& header) {
+    if (header.direction_bits() != 16) return nullptr;
+    return std::make_shared<const DirectionTable16>(header.ratio);
+}
+
+std::size_t decode_blocks_scalar16(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count,
+                                   float* xyz) {
+    const FftHeader& h = ctx.header;
+    if (!ctx.table16) throw Error(Errc::invalid_argument, "decode_blocks_scalar16 on a file without 16-bit codes");
+    const DirectionTable16& table = *ctx.table16;
+    const std::uint32_t bb = h.block_bytes();
+    float* out = xyz;
+    for (std::size_t b = 0; b < count; ++b) {
+        const BlockView16 block{blocks + b * bb};
+        const std::uint32_t n = block.point_count();
+        const auto a = block.anchors_normalized();
+        const Vec3f a0{a[0], a[1], a[2]}, a1{a[3], a[4], a[5]};
+        auto emit = [&](Vec3f p) {
+            const Vec3f w = h.to_world(p.x, p.y, p.z);
+            *out++ = w.x, *out++ = w.y, *out++ = w.z;
+        };
+        emit(a0);
+        if (n < 2) continue;
+        emit(a1);
+        Frame frame = frame_from_axis(anchor_axis(a0, a1));
+        Vec3f p = a1;
+        for (std::uint32_t k = 2; k < n; ++k) {
+            frame = compose(frame, table.frame(block.code(k - 2)));
+            p = p + h.step * frame.c[0];
+            emit(p);
+        }
+    }
+    return std::size_t(out - xyz) / 3;
+}
+
+}  // namespace fiblet

@@ -1,0 +1,255 @@
+// fiblet._fiblet — the compiled half of the Python module (pybind11). The
+// Python package (python/fiblet/__init__.py) normalizes arguments and builds
+// the user-facing objects; this file only moves data in and out of the
+// library. Decoded buffers are handed to numpy without a copy (owned_array.hpp)
+// and the GIL is released while the library works.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <numeric>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fiblet/compare.hpp"
+#include "fiblet/compress.hpp"
+#include "fiblet/decode.hpp"
+#include "fiblet/error.hpp"
+#include "fiblet/fft_file.hpp"
+#include "fiblet/tck.hpp"
+#include "decode_range.hpp"
+#include "owned_array.hpp"
+#include "roi_filter.hpp"
+
+namespace py = pybind11;
+
+namespace fiblet::python {
+namespace {
+
+// DecodeOptions gains a thread count with the multithreaded decoders; until
+// then decoding runs on one thread and `threads` is accepted and ignored.
+template <typename Options>
+constexpr bool has_decode_threads = requires(Options o) { o.threads; };
+
+template <typename Options>
+Options decode_options(unsigned threads) {
+    Options o;
+    if constexpr (has_decode_threads<Options>) {
+        if (threads) o.threads = static_cast<decltype(o.threads)>(threads);
+    }
+    return o;
+}
+
+// Decodes `indices` (any order, repeats allowed): each run of consecutive
+// indices is decoded with one call, then the runs are gathered in order.
+Streamlines decode_indices(const FftFile& file, const std::vector<std::uint64_t>& indices, const DecodeOptions& o) {
+    Streamlines all;
+    std::vector<std::uint64_t> run_fiber;  // position in `all` of each requested fiber
+    std::size_t i = 0;
+    while (i < indices.size()) {
+        std::size_t j = i + 1;
+        while (j < indices.size() && indices[j] == indices[j - 1] + 1) ++j;
+        Streamlines part = decode_fibers(file, indices[i], indices[j - 1] + 1, o);
+        if (i == 0 && j == indices.size()) return part;  // one contiguous run: no gather
+        const std::uint64_t base_fiber = all.size(), base_point = all.point_count();
+        all.xyz.insert(all.xyz.end(), part.xyz.begin(), part.xyz.end());
+        for (std::size_t k = 1; k < part.offsets.size(); ++k) all.offsets.push_back(base_point + part.offsets[k]);
+        for (std::size_t k = 0; k < j - i; ++k) run_fiber.push_back(base_fiber + k);
+        i = j;
+    }
+    return gather_fibers(view_of(all), run_fiber);
+}
+
+std::vector<Region> parse_regions(const py::list& regions) {
+    std::vector<Region> out;
+    for (const py::handle& item : regions) {
+        const auto t = item.cast<std::tuple<std::string, std::array<double, 3>, std::array<double, 3>, bool>>();
+        Region r;
+        const std::string& shape = std::get<0>(t);
+        if (shape == "sphere") r.shape = Region::Shape::sphere;
+        else if (shape == "box") r.shape = Region::Shape::box;
+        else throw Error(Errc::invalid_argument, "unknown region shape '" + shape + "'");
+        r.a = std::get<1>(t), r.b = std::get<2>(t), r.exclude = std::get<3>(t);
+        out.push_back(r);
+    }
+    return out;
+}
+
+// Decodes a file (all fibers, [begin, end), or a list of indices), keeps the
+// fibers the regions select, and returns (points (N,3) float32, offsets
+// (F+1) int64, fiber_ids (F) int64). A range without regions, the common
+// case, is decoded straight into the memory numpy gets (decode_range).
+py::tuple decode(const std::string& path, std::uint64_t begin, std::optional<std::uint64_t> end,
+                 const py::object& indices_or_none, const py::list& regions_list, unsigned threads) {
+    const std::vector<Region> regions = parse_regions(regions_list);
+    std::optional<std::vector<std::uint64_t>> indices;
+    if (!indices_or_none.is_none()) {
+        const auto a = py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>::ensure(indices_or_none);
+        if (!a || a.ndim() != 1) throw Error(Errc::invalid_argument, "fiber indices must be a 1-D integer array");
+        indices.emplace(a.data(), a.data() + a.shape(0));
+    }
+    std::optional<DecodedRange> range;  // the result, when decoded as a range
+    Streamlines s;                      // else this
+    std::vector<std::uint64_t> ids;
+    {
+        py::gil_scoped_release release;
+        const FftFile file(path);
+        if (indices) {
+            for (std::uint64_t f : *indices)
+                if (f >= file.header().fibers)
+                    throw Error(Errc::invalid_argument, path + ": fiber " + std::to_string(f) + " out of range (" +
+                                                            std::to_string(file.header().fibers) + " fibers)");
+            s = decode_indices(file, *indices, decode_options<DecodeOptions>(threads));
+            ids = std::move(*indices);
+        } else {
+            const std::uint64_t e = end.value_or(file.header().fibers);
+            range = decode_range(file, begin, e, threads);
+            ids.resize(range->offsets.size() - 1);
+            std::iota(ids.begin(), ids.end(), begin);
+        }
+        if (!regions.empty()) {
+            const FibersView all = range ? FibersView{range->xyz.as<const float>(), range->offsets} : view_of(s);
+            const std::vector<std::uint64_t> keep = fibers_kept(all, regions);
+            if (keep.size() != all.size()) {
+                s = gather_fibers(all, keep);
+                range.reset();
+                std::vector<std::uint64_t> kept_ids(keep.size());
+                for (std::size_t i = 0; i < keep.size(); ++i) kept_ids[i] = ids[keep[i]];
+                ids = std::move(kept_ids);
+            }
+        }
+    }
+    const auto fibers = py::ssize_t(ids.size());
+    const auto points = py::ssize_t(range ? range->points : s.point_count());
+    py::array_t<float> xyz = range ? to_numpy<float>(std::move(range->xyz), {points, 3})
+                                   : to_numpy<float>(std::move(s.xyz), {points, 3});
+    return py::make_tuple(xyz, to_numpy<std::int64_t>(range ? std::move(range->offsets) : std::move(s.offsets), {fibers + 1}),
+                          to_numpy<std::int64_t>(std::move(ids), {fibers}));
+}
+
+py::dict header_dict(const FftFile& f) {
+    const FftHeader& h = f.header();
+    py::dict d;
+    d["fibers"] = h.fibers, d["points"] = h.points, d["blocks"] = h.blocks;
+    d["points_per_block"] = h.points_per_block, d["block_bytes"] = h.block_bytes();
+    d["step_mm"] = double(h.step) * double(h.scaling), d["cap_ratio"] = h.ratio;
+    d["scaling_mm"] = h.scaling, d["offset_mm"] = py::make_tuple(h.offset[0], h.offset[1], h.offset[2]);
+    d["max_error_um"] = double(h.max_error_mm) * 1e3, d["mean_error_um"] = double(h.mean_error_mm) * 1e3;
+    d["file_bytes"] = f.file_size();
+    d["resampled"] = f.find_chunk(kResampledTag) != nullptr;
+    d["properties"] = f.properties();
+    return d;
+}
+
+py::dict info(const std::string& path) { return header_dict(FftFile(path)); }
+
+py::dict error_dict(const ErrorStats& e) {
+    py::dict d;
+    d["max_um"] = e.max_mm() * 1e3, d["mean_um"] = e.mean_mm() * 1e3, d["rms_um"] = e.rms_mm() * 1e3;
+    d["p50_um"] = e.percentile_mm(50) * 1e3, d["p95_um"] = e.percentile_mm(95) * 1e3;
+    d["p99_um"] = e.percentile_mm(99) * 1e3, d["worst_fiber"] = e.worst_fiber(), d["points"] = e.count();
+    return d;
+}
+
+// Same keys as `fiblet stats --json`.
+py::dict stats(const std::string& fft_path, const std::string& reference) {
+    std::optional<FftFile> file;
+    Comparison c;
+    {
+        py::gil_scoped_release release;
+        file.emplace(fft_path);
+        c = compare_to_reference(*file, reference);
+    }
+    const FftHeader& h = file->header();
+    py::dict d;
+    d["file"] = fft_path, d["reference"] = reference;
+    d["fibers"] = c.fibers, d["points"] = c.points, d["blocks"] = c.blocks;
+    d["fft_bytes"] = c.fft_bytes, d["reference_bytes"] = c.reference_bytes;
+    d["ratio"] = c.fft_bytes ? double(c.reference_bytes) / double(c.fft_bytes) : 0.0;
+    d["bytes_per_point"] = c.points ? double(c.fft_bytes) / double(c.points) : 0.0;
+    d["resampled"] = c.resampled;
+    d["error"] = error_dict(c.error);
+    if (c.resampled) d["error_vs_original"] = error_dict(c.error_vs_original);
+    d["header_max_error_um"] = double(h.max_error_mm) * 1e3, d["header_mean_error_um"] = double(h.mean_error_mm) * 1e3;
+    return d;
+}
+
+// Same keys as `fiblet compress --json`.
+py::dict compress(const std::string& tck_path, const std::string& fft_path, std::optional<double> step_mm,
+                  bool overwrite, unsigned threads) {
+    CompressOptions o;
+    o.step_mm = step_mm, o.overwrite = overwrite, o.threads = threads;
+    CompressReport r;
+    {
+        py::gil_scoped_release release;
+        r = compress_tck(tck_path, fft_path, o);
+    }
+    py::dict d;
+    d["input"] = tck_path, d["output"] = fft_path;
+    d["fibers"] = r.header.fibers, d["points"] = r.header.points, d["blocks"] = r.header.blocks;
+    d["input_bytes"] = r.input_bytes, d["output_bytes"] = r.output_bytes;
+    d["ratio"] = r.output_bytes ? double(r.input_bytes) / double(r.output_bytes) : 0.0;
+    d["step_mm"] = r.step_mm, d["cap_ratio"] = r.header.ratio, d["resampled"] = r.resampled;
+    d["max_error_um"] = r.error.max_mm() * 1e3, d["mean_error_um"] = r.error.mean_mm() * 1e3;
+    if (r.resampled)
+        d["max_error_vs_original_um"] = r.error_vs_original.max_mm() * 1e3,
+        d["mean_error_vs_original_um"] = r.error_vs_original.mean_mm() * 1e3;
+    d["seconds"] = r.seconds;
+    return d;
+}
+
+// Writes streamlines given as points (N,3) float32 and offsets (F+1) to a
+// .tck file (atomically, through TckWriter).
+void write_tck(const std::string& path, py::array_t<float, py::array::c_style | py::array::forcecast> points,
+               py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> offsets,
+               const std::vector<std::pair<std::string, std::string>>& properties, bool overwrite) {
+    if (points.ndim() != 2 || points.shape(1) != 3) throw Error(Errc::invalid_argument, "points must be an (N, 3) array");
+    if (offsets.ndim() != 1 || offsets.shape(0) < 1) throw Error(Errc::invalid_argument, "offsets must be 1-D, F+1 long");
+    const float* xyz = points.data();
+    const std::int64_t* off = offsets.data();
+    const auto n_offsets = std::size_t(offsets.shape(0));
+    const auto n_points = std::int64_t(points.shape(0));
+    if (off[0] != 0 || off[n_offsets - 1] != n_points)
+        throw Error(Errc::invalid_argument, "offsets must start at 0 and end at the number of points");
+    for (std::size_t i = 1; i < n_offsets; ++i)
+        if (off[i] < off[i - 1]) throw Error(Errc::invalid_argument, "offsets must not decrease");
+    py::gil_scoped_release release;
+    TckWriter writer(path, properties, overwrite);
+    for (std::size_t i = 0; i + 1 < n_offsets; ++i) writer.write(xyz + 3 * off[i], std::size_t(off[i + 1] - off[i]));
+    writer.finish();
+}
+
+}  // namespace
+}  // namespace fiblet::python
+
+PYBIND11_MODULE(_fiblet, m) {
+    using namespace fiblet::python;
+    m.doc() = "fiblet's compiled core; use the `fiblet` package instead.";
+    m.attr("version") = FIBLET_VERSION;
+    // Which block decoder fiblet.load() runs on (decode_range.hpp).
+    m.attr("block_decoder") = fast_block_decoder_available() ? "library (fastest available)" : "scalar reference";
+
+    // fiblet::Error -> fiblet.FibletError, with the stable category name
+    // (errc_name: "io", "fft_format", ...) as its `category` attribute.
+    static py::exception<fiblet::Error> error_type(m, "FibletError", PyExc_RuntimeError);
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const fiblet::Error& e) {
+            py::object instance = py::reinterpret_borrow<py::object>(error_type.ptr())(e.what());
+            instance.attr("category") = fiblet::errc_name(e.code());
+            PyErr_SetObject(error_type.ptr(), instance.ptr());
+        }
+    });
+
+    m.def("decode", &decode, py::arg("path"), py::arg("begin"), py::arg("end"), py::arg("indices"),
+          py::arg("regions"), py::arg("threads"));
+    m.def("info", &info, py::arg("path"));
+    m.def("stats", &stats, py::arg("fft"), py::arg("reference"));
+    m.def("compress", &compress, py::arg("tck"), py::arg("fft"), py::arg("step_mm"), py::arg("overwrite"),
+          py::arg("threads"));
+    m.def("write_tck", &write_tck, py::arg("path"), py::arg("points"), py::arg("offsets"), py::arg("properties"),
+          py::arg("overwrite"));
+}

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Compresses every shared tractogram and prints a Markdown table: sizes,
+# ratio, max/mean error (µm, measured by `fiblet stats` against the input),
+# compress and decompress wall time. Usage: scripts/core_table.sh [fiblet args...]
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+fiblet="${FIBLET:-$root/build/bin/fiblet}"
+data="$root/../shared/data"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+files=(small-ifod1.tck small-ifod1-step0.05.tck small-sdstream.tck small-ifod2.tck dwi-small64d-ifod1.tck
+       bundles/AF_L-step0.1.tck bundles/CC_ForcepsMajor-step0.1.tck bundles/CST_R-step0.1.tck
+       bundles/cingulum-1-step0.1.tck bundles/cingulum-2-step0.1.tck)
+echo "| file | .tck | .fft | ratio | max / mean error (µm) | compress (s) | decompress (s) |"
+echo "|---|---|---|---|---|---|---|"
+for f in "${files[@]}"; do
+  in="$data/$f"
+  [ -f "$in" ] || continue
+  out="$work/$(basename "$f" .tck).fft"
+  t0=$(date +%s.%N)
+  "$fiblet" compress -q "$in" -o "$out" "$@"
+  t1=$(date +%s.%N)
+  "$fiblet" decompress -q "$out" -o "$work/back.tck" --force
+  t2=$(date +%s.%N)
+  "$fiblet" stats "$out" -r "$in" --json -q > "$work/stats.json"
+  /usr/bin/python3 - "$f" "$work/stats.json" "$t0" "$t1" "$t2" <<'PY'
+import json, sys
+name, path, t0, t1, t2 = sys.argv[1], sys.argv[2], *map(float, sys.argv[3:])
+s = json.load(open(path))
+e = s["error"]
+extra = ""
+if s["resampled"]:
+    o = s["error_vs_original"]
+    extra = f" (resampled; vs original polyline {o['max_um']:.2f} / {o['mean_um']:.2f})"
+print(f"| {name} | {s['reference_bytes']/1e6:.2f} MB | {s['fft_bytes']/1e6:.3f} MB | {s['ratio']:.2f}× | "
+      f"{e['max_um']:.2f} / {e['mean_um']:.2f}{extra} | {t1-t0:.2f} | {t2-t1:.2f} |")
+PY
+done

@@ -1,0 +1,34 @@
+# Tests of how fiblet fits its ecosystem, run by ctest next to the GoogleTest
+# suite: an installed package used by a downstream project, the generated CLI
+# reference, and the Snakemake cohort workflow. (The Python module's pytest
+# suite is registered in python/CMakeLists.txt.)
+get_filename_component(FIBLET_SHARED_DATA "${PROJECT_SOURCE_DIR}/../shared/data" ABSOLUTE)
+
+add_test(NAME ecosystem.install_downstream
+  COMMAND ${PROJECT_SOURCE_DIR}/tests/downstream/run_downstream_test.sh
+          ${PROJECT_BINARY_DIR} ${FIBLET_SHARED_DATA}/dwi-small64d-ifod1.tck ${PROJECT_VERSION} ${Python_EXECUTABLE})
+set_tests_properties(ecosystem.install_downstream PROPERTIES TIMEOUT 300)
+if(FIBLET_SANITIZE)  # an instrumented libfiblet.a needs the sanitizer runtimes in the downstream link
+  set_tests_properties(ecosystem.install_downstream PROPERTIES
+    ENVIRONMENT "CXXFLAGS=-fsanitize=address,undefined;LDFLAGS=-fsanitize=address,undefined")
+endif()
+
+# docs/cli.md must equal what the CLI generates (scripts/gen_cli_docs.sh).
+add_test(NAME ecosystem.cli_docs_up_to_date
+  COMMAND ${PROJECT_SOURCE_DIR}/scripts/gen_cli_docs.sh --check $<TARGET_FILE:fiblet_cli>)
+
+# The Snakemake cohort workflow on 3 generated subjects.
+if(DEFINED Python_EXECUTABLE)
+  add_test(NAME ecosystem.cohort_workflow
+    COMMAND ${Python_EXECUTABLE} -m pytest -q -p no:cacheprovider ${PROJECT_SOURCE_DIR}/scripts/workflow/test_workflow.py)
+  set_tests_properties(ecosystem.cohort_workflow PROPERTIES TIMEOUT 300
+    ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA};FIBLET_CLI=$<TARGET_FILE:fiblet_cli>")
+endif()
+
+# CLI conventions: help, --version, --json, documented exit codes.
+if(DEFINED Python_EXECUTABLE)
+  add_test(NAME ecosystem.cli_conventions
+    COMMAND ${Python_EXECUTABLE} -m pytest -q -p no:cacheprovider ${PROJECT_SOURCE_DIR}/tests/test_cli_conventions.py)
+  set_tests_properties(ecosystem.cli_conventions PROPERTIES TIMEOUT 120
+    ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA};FIBLET_CLI=$<TARGET_FILE:fiblet_cli>;FIBLET_VERSION=${PROJECT_VERSION}")
+endif()

@@ -1,0 +1,37 @@
+// ErrorStats against a brute-force computation on the same samples.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "fiblet/error_stats.hpp"
+
+using namespace fiblet;
+
+TEST(ErrorStats, MatchesBruteForce) {
+    std::mt19937 rng(9);
+    std::gamma_distribution<double> g(2.0, 0.002);  // mm, like codec errors
+    std::vector<double> all;
+    ErrorStats a, b;
+    for (int i = 0; i < 100000; ++i) {
+        const double e = g(rng);
+        all.push_back(e);
+        (i % 3 ? a : b).add(e, std::uint64_t(i / 100));
+    }
+    a.merge(b);
+    std::vector<double> sorted = all;
+    std::sort(sorted.begin(), sorted.end());
+    double sum = 0, sq = 0;
+    for (double e : all) sum += e, sq += e * e;
+    const auto worst = std::max_element(all.begin(), all.end()) - all.begin();
+    EXPECT_EQ(a.count(), all.size());
+    EXPECT_DOUBLE_EQ(a.max_mm(), sorted.back());
+    EXPECT_NEAR(a.mean_mm(), sum / double(all.size()), 1e-12);
+    EXPECT_NEAR(a.rms_mm(), std::sqrt(sq / double(all.size())), 1e-12);
+    EXPECT_EQ(a.worst_fiber(), std::uint64_t(worst / 100));
+    for (double p : {50.0, 95.0, 99.0}) {
+        const double exact = sorted[std::size_t(std::ceil(p / 100 * double(all.size()))) - 1];
+        EXPECT_NEAR(a.percentile_mm(p), exact, 1e-5 + 1e-12) << p;  // 0.01 µm bins
+    }
+}
