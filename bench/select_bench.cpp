@@ -5,8 +5,10 @@
 // Data: $FIBLET_BENCH_DATA (default: bench-data/ next to the build's bench/
 // directory, i.e. build/bench-data) must hold medium-ifod1.tck (made by
 // `shared/data/make-tractograms.sh -o build/bench-data medium`); it is
-// compressed once to medium-ifod1.fft there. Without it the benchmarks use
-// shared/data/small-ifod1.tck and say so in their labels.
+// compressed once to medium-ifod1.fft there (again when the .tck is newer:
+// delete the .fft after changing the encoder). Without it the benchmarks use
+// shared/data/small-ifod1.tck and say so in their labels. Everything runs on
+// one thread; times are compared as CPU time.
 // scripts/bench_select.sh runs everything and prints the table of docs/select.md.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
@@ -50,9 +52,7 @@ BenchFile& bench_file() {
         fs::path tck = dir / "medium-ifod1.tck";
         b.label = "medium";
         if (!fs::exists(tck)) {
-            const char* shared = std::getenv("FIBLET_SHARED_DIR");
-            tck = (shared ? fs::path(shared) : executable_dir().parent_path().parent_path() / ".." / "shared") / "data" /
-                  "small-ifod1.tck";
+            tck = fs::path(FIBLET_SHARED_DIR) / "data" / "small-ifod1.tck";
             b.label = "small (medium-ifod1.tck not found)";
         }
         fs::create_directories(dir);
@@ -137,19 +137,21 @@ void report(benchmark::State& state, const SelectionStats& s) {
     state.SetLabel(bench_file().label);
 }
 
-// Full decode with decode_file, in chunks of state.range(0) blocks (its
-// default, 65536, is 47 MB of points per chunk; 4096 stays in cache).
+// Full decode with decode_file on one thread (as the selection runs), in
+// chunks of state.range(0) blocks (its default, 65536, is 47 MB of points
+// per chunk; 4096 stays in cache).
 void BM_SelectFullDecode(benchmark::State& state) {
     const FftFile& file = *bench_file().file;
     std::uint64_t points = 0;
     DecodeOptions o;
     o.chunk_blocks = std::size_t(state.range(0));
+    o.threads = 1;
     for (auto _ : state) {
         decode_file(file, [&](std::uint64_t, const Streamlines& c) { points += c.point_count(); }, o);
         benchmark::DoNotOptimize(points);
     }
     state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(file.header().points));
-    state.SetLabel(bench_file().label);
+    state.SetLabel(bench_file().label + ", " + decoder_name(resolve_decoder({})));
 }
 BENCHMARK(BM_SelectFullDecode)->Arg(DecodeOptions{}.chunk_blocks)->Arg(4096)->Unit(benchmark::kMillisecond);
 

@@ -25,13 +25,14 @@ by = {b["run_name"]: b for b in runs}
 # its default or small chunks, or a selection with an empty query.
 fulls = [b for b in runs if b["run_name"].startswith("BM_SelectFullDecode/")] + [by["BM_SelectEverything"]]
 full = min(fulls, key=lambda b: b["cpu_time"])
-print(f"file: {full.get('label', '')}; median of repetitions; CPU time (real time in brackets); "
+print(f"file, decoder: {full.get('label', '')}; one thread; median of repetitions; CPU time (real time in brackets); "
       f"ratios against the fastest full decode ({full['run_name']})\n")
 print("| query | blocks kept | read | decoded | time | vs full decode |")
 print("|---|---|---|---|---|---|")
 for b in fulls:
     name = b["run_name"].replace("BM_SelectFullDecode/", "full decode, decode_file, chunks of ").replace(
-        "BM_SelectEverything", "full decode, select() with an empty query")
+        "BM_SelectEverything", "full decode, select() with an empty query").replace(
+        "chunks of 65536", "chunks of 65536 (default)")
     print(f"| {name} | 100 % | 100 % | 100 % | {b['cpu_time']:.1f} ms ({b['real_time']:.1f}) | "
           f"{100 * b['cpu_time'] / full['cpu_time']:.1f} % |")
 for b in runs:

@@ -104,7 +104,10 @@ public:
                             std::vector<std::uint64_t>* inside = nullptr) const;
     void blocks_near_box(const Aabb& box, std::vector<std::uint64_t>& bits,
                          std::vector<std::uint64_t>* inside = nullptr) const;
-    void blocks_near_frustum(const Frustum& frustum, float margin, std::vector<std::uint64_t>& bits) const;
+    // For the frustum, `inside` gets the blocks whose box lies inside it
+    // (without the margin, by at least 1 µm): their points all do.
+    void blocks_near_frustum(const Frustum& frustum, float margin, std::vector<std::uint64_t>& bits,
+                             std::vector<std::uint64_t>* inside = nullptr) const;
 
 private:
     BlockIndex() = default;

@@ -1,5 +1,7 @@
 #include "select/block_batch_reader.hpp"
 
+#include <algorithm>
+
 namespace fiblet::detail {
 
 BlockBatchReader::BlockBatchReader(const FftFile& file, bool use_mapping, std::uint64_t max_gap_blocks)
@@ -31,8 +33,21 @@ void BlockBatchReader::read(const std::vector<std::uint32_t>& blocks) {
         blocks_read_ += spans[s].last - spans[s].first + 1;
     };
     if (use_mapping_) {
+        // Scattered blocks miss the cache: fetch the spans a few ahead.
+        const std::uint8_t* base = nullptr;
         for (std::size_t s = 0; s < spans.size(); ++s) {
+            if (base && s + 8 < spans.size()) {
+                const std::uint8_t* ahead = base + (spans[s + 8].first - spans[0].first) * block_bytes_;
+                __builtin_prefetch(ahead), __builtin_prefetch(ahead + 64);
+            }
             const auto m = file_.mapped_blocks(spans[s].first, spans[s].last - spans[s].first + 1);
+            if (s == 0 && !m.empty()) {
+                base = m.data();
+                for (std::size_t a = 1; a < std::min<std::size_t>(8, spans.size()); ++a) {
+                    const std::uint8_t* ahead = base + (spans[a].first - spans[0].first) * block_bytes_;
+                    __builtin_prefetch(ahead), __builtin_prefetch(ahead + 64);
+                }
+            }
             if (m.empty()) {  // the file cannot be mapped (that fails on the first call or never)
                 use_mapping_ = false;
                 return read(blocks);

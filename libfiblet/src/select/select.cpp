@@ -109,8 +109,20 @@ std::size_t decode_into(const DecodeContext& ctx, const std::uint8_t* blocks, st
 }
 
 bool any_point_in(const Region& r, const float* p, std::uint32_t n) {
+    // Region::contains with the shape chosen once per block.
+    if (r.shape == Region::Shape::sphere) {
+        const float cx = r.center.x, cy = r.center.y, cz = r.center.z, r2 = r.radius * r.radius;
+        for (std::uint32_t k = 0; k < n; ++k, p += 3) {
+            const float dx = p[0] - cx, dy = p[1] - cy, dz = p[2] - cz;
+            if (dx * dx + dy * dy + dz * dz <= r2) return true;
+        }
+        return false;
+    }
+    const Aabb& b = r.box;
     for (std::uint32_t k = 0; k < n; ++k, p += 3)
-        if (r.contains({p[0], p[1], p[2]})) return true;
+        if (p[0] >= b.min.x && p[0] <= b.max.x && p[1] >= b.min.y && p[1] <= b.max.y && p[2] >= b.min.z &&
+            p[2] <= b.max.z)
+            return true;
     return false;
 }
 
@@ -132,8 +144,13 @@ Vec3f first_point(const FftHeader& h, const std::uint8_t* block) {
 // grows: no zero-filling per chunk.
 class RunWriter {
 public:
-    RunWriter(const SelectOptions& o, const std::function<void(const SelectedChunk&)>& sink, SelectionStats& stats)
-        : options_(o), sink_(sink), stats_(stats) {}
+    RunWriter(const SelectOptions& o, const std::function<void(const SelectedChunk&)>& sink, SelectionStats& stats,
+              std::size_t batch_points)
+        : options_(o), sink_(sink), stats_(stats) {
+        // Room for a full chunk and a batch decoded after it: no reallocation
+        // (a copy and fresh pages each time).
+        if (o.points) xyz_.reserve(3 * (o.chunk_points + 2 * batch_points));
+    }
 
     // Closes the open run unless `block` of `fiber` continues it.
     void break_unless_continues(std::uint64_t fiber, std::uint64_t block) {
@@ -332,14 +349,13 @@ private:
         const std::uint32_t bb = h_.block_bytes();
         while (candidates.next(batch_blocks(h_), blocks, fibers)) {
             reader_.read(blocks);
-            // Runs of consecutive blocks are contiguous in the read buffer: one decode call each.
-            std::vector<std::size_t> first_point(blocks.size() + 1, 0);
-            for (std::size_t i = 0, j; i < blocks.size(); i = j) {
-                for (j = i + 1; j < blocks.size() && blocks[j] == blocks[j - 1] + 1;) ++j;
-                decode_into(ctx_, reader_.block(i), j - i, scratch_, first_point[i]);
-                for (std::size_t k = i; k < j; ++k)
-                    first_point[k + 1] = first_point[k] + block_flags(h_, reader_.block(i) + (k - i) * bb).point_count;
-            }
+            // One decode call for the whole batch (SIMD decoders fill their lanes).
+            std::vector<std::size_t> first_point(blocks.size() + 1, 0), all(blocks.size());
+            for (std::size_t i = 0; i < blocks.size(); ++i) all[i] = i;
+            const std::uint8_t* bytes = contiguous(blocks, all, [&](std::size_t i) { return reader_.block(i); });
+            decode_into(ctx_, bytes, blocks.size(), scratch_, 0);
+            for (std::size_t i = 0; i < blocks.size(); ++i)
+                first_point[i + 1] = first_point[i] + block_flags(h_, bytes + i * bb).point_count;
             stats_.blocks_decoded += blocks.size();
             for (std::size_t i = 0; i < blocks.size(); ++i) {
                 const std::uint64_t f = fibers[i], b = blocks[i];
@@ -367,12 +383,16 @@ private:
 
         // Candidate blocks from the index: near the frustum (grown by the
         // largest sphere radius) and, in blocks mode, near an include region.
+        // Blocks whose box lies inside the frustum keep their sphere
+        // without a test (their first point, the sphere's centre, is inside).
         std::optional<Bits> only;
+        Bits in_frustum;
         if (cull) {
             Bits f;
             const float margin = index_.max_sphere_radius() * (1 + 1e-5f) + 1e-3f;
-            index_.blocks_near_frustum(frustum, margin, f);
+            index_.blocks_near_frustum(frustum, margin, f, &in_frustum);
             f.resize((h_.blocks + 63) / 64, 0);
+            in_frustum.resize(f.size(), 0);
             only = std::move(f);
         }
         Bits exc, inc_inside;
@@ -383,7 +403,7 @@ private:
         }
         if (blocks_mode && !q_.exclude.empty()) exc = near_any(q_.exclude);
 
-        RunWriter out(options_, sink, stats_);
+        RunWriter out(options_, sink, stats_, batch_blocks(h_) * h_.points_per_block);
         CandidateBlocks candidates(file_, keep_, only ? &*only : nullptr);
         std::vector<std::uint32_t> blocks, need;
         std::vector<std::uint64_t> fibers;
@@ -420,6 +440,7 @@ private:
             kind.assign(blocks.size(), fine);
             if (q_.view)
                 for (std::size_t i = 0; i < blocks.size(); ++i) {
+                    if (!lod && has_bit(in_frustum, blocks[i])) continue;
                     // Scattered headers: fetch a few blocks ahead.
                     if (i + 8 < blocks.size()) __builtin_prefetch(reader_.block(at_need[i + 8]));
                     const Sphere s = block_bounding_sphere(h_, reader_.block(at_need[i]));
@@ -449,31 +470,59 @@ private:
                     out.maybe_flush();
                     continue;
                 }
-                // Fine blocks that follow each other: decoded with one call,
-                // straight into the output, then kept or dropped in place.
+                // Fine blocks up to the next coarse one (dropped ones left
+                // out): decoded with one call, straight into the output, then
+                // kept or dropped in place.
+                segment_.assign(1, i);
                 bool test = region_test(i);
-                while (j < blocks.size() && kind[j] == fine && blocks[j] == blocks[j - 1] + 1) test |= region_test(j++);
+                for (; j < blocks.size() && kind[j] != coarse; ++j)
+                    if (kind[j] == fine) segment_.push_back(j), test |= region_test(j);
                 if (!options_.points && !test) {
-                    for (std::size_t k = i; k < j; ++k)
+                    for (std::size_t k : segment_)
                         out.fine(fibers[k], blocks[k], nullptr, block_flags(h_, reader_.block(at_need[k])).point_count);
                     out.maybe_flush();
                     continue;
                 }
-                out.break_unless_continues(fibers[i], blocks[i]);
-                const std::size_t base = out.end();
-                decode_into(ctx_, block, j - i, out.buffer(), base);
-                stats_.blocks_decoded += j - i;
-                std::size_t at = base;
-                for (std::size_t k = i; k < j; ++k) {
-                    const std::uint32_t n = block_flags(h_, block + (k - i) * bb).point_count;
-                    const float* p = &out.buffer()[3 * at];
-                    at += n;
-                    if (passes_regions(k, p, n)) out.fine(fibers[k], blocks[k], options_.points ? p : nullptr, n);
+                const std::uint8_t* bytes =
+                    contiguous(blocks, segment_, [&](std::size_t k) { return reader_.block(at_need[k]); });
+                // With point tests, rejected blocks make the kept ones after
+                // them move down: decoding 32 blocks at a time bounds that.
+                const std::size_t step = test ? 32 : segment_.size();
+                for (std::size_t s0 = 0; s0 < segment_.size(); s0 += step) {
+                    const std::size_t s1 = std::min(segment_.size(), s0 + step);
+                    out.break_unless_continues(fibers[segment_[s0]], blocks[segment_[s0]]);
+                    const std::size_t base = out.end();
+                    decode_into(ctx_, bytes + s0 * bb, s1 - s0, out.buffer(), base);
+                    stats_.blocks_decoded += s1 - s0;
+                    std::size_t at = base;
+                    for (std::size_t s = s0; s < s1; ++s) {
+                        const std::size_t k = segment_[s];
+                        const std::uint32_t n = block_flags(h_, bytes + s * bb).point_count;
+                        const float* p = &out.buffer()[3 * at];
+                        at += n;
+                        if (passes_regions(k, p, n)) out.fine(fibers[k], blocks[k], options_.points ? p : nullptr, n);
+                    }
                 }
                 out.maybe_flush();
             }
         }
         out.finish();
+    }
+
+    // The blocks blocks[items[0]], blocks[items[1]], ... one after the other
+    // in memory: where they are when they follow each other in the file,
+    // else copied into staging_ (76 bytes a block, against 720 decoded).
+    template <class BlockOf>
+    const std::uint8_t* contiguous(const std::vector<std::uint32_t>& blocks, const std::vector<std::size_t>& items,
+                                   const BlockOf& block_of) {
+        const std::uint32_t bb = h_.block_bytes();
+        bool in_place = true;
+        for (std::size_t s = 1; s < items.size() && in_place; ++s)
+            in_place = blocks[items[s]] == blocks[items[0]] + s;
+        if (in_place) return block_of(items[0]);
+        staging_.resize(items.size() * bb);
+        for (std::size_t s = 0; s < items.size(); ++s) std::memcpy(&staging_[s * bb], block_of(items[s]), bb);
+        return staging_.data();
     }
 
     const FftFile& file_;
@@ -485,6 +534,8 @@ private:
     detail::BlockBatchReader reader_;
     std::vector<std::uint8_t> keep_;
     std::vector<float> scratch_;  // decoded points that are tested, not output
+    std::vector<std::uint8_t> staging_;
+    std::vector<std::size_t> segment_;
     SelectionStats stats_;
 };
 
