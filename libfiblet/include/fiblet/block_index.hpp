@@ -104,10 +104,7 @@ public:
                             std::vector<std::uint64_t>* inside = nullptr) const;
     void blocks_near_box(const Aabb& box, std::vector<std::uint64_t>& bits,
                          std::vector<std::uint64_t>* inside = nullptr) const;
-    // For the frustum, `inside` gets the blocks whose box lies inside it
-    // (without the margin, by at least 1 µm): their points all do.
-    void blocks_near_frustum(const Frustum& frustum, float margin, std::vector<std::uint64_t>& bits,
-                             std::vector<std::uint64_t>* inside = nullptr) const;
+    void blocks_near_frustum(const Frustum& frustum, float margin, std::vector<std::uint64_t>& bits) const;
 
 private:
     BlockIndex() = default;

@@ -260,24 +260,20 @@ void BlockIndex::blocks_near_box(const Aabb& r, std::vector<std::uint64_t>& bits
         bits, inside);
 }
 
-void BlockIndex::blocks_near_frustum(const Frustum& f, float margin, std::vector<std::uint64_t>& bits,
-                                     std::vector<std::uint64_t>* inside) const {
-    // Signed distance of a box's nearest corner to a plane (inside >= 0).
-    auto nearest = [](const Plane& p, const Aabb& b) {
-        const Vec3f c{p.n.x >= 0 ? b.min.x : b.max.x, p.n.y >= 0 ? b.min.y : b.max.y, p.n.z >= 0 ? b.min.z : b.max.z};
-        return p.n.x * c.x + p.n.y * c.y + p.n.z * c.z + p.d;
-    };
-    // "Inside" for the hierarchy (every box below passes the grown test)
-    // and, when asked, for the blocks (the box is within the frustum itself).
-    const float threshold = inside ? 1e-3f : -margin + 1e-3f;
+void BlockIndex::blocks_near_frustum(const Frustum& f, float margin, std::vector<std::uint64_t>& bits) const {
     collect(
         [&](const Aabb& b) {
             if (!box_intersects_frustum(f, b, margin)) return Overlap::outside;
-            for (const Plane& p : f.planes)
-                if (nearest(p, b) < threshold) return Overlap::partial;
+            // Inside when even the nearest corner is within the margin of every
+            // plane, with room for rounding between corners.
+            for (const Plane& p : f.planes) {
+                const Vec3f c{p.n.x >= 0 ? b.min.x : b.max.x, p.n.y >= 0 ? b.min.y : b.max.y,
+                              p.n.z >= 0 ? b.min.z : b.max.z};
+                if (p.n.x * c.x + p.n.y * c.y + p.n.z * c.z + p.d < -margin + 1e-3f) return Overlap::partial;
+            }
             return Overlap::inside;
         },
-        bits, inside);
+        bits, nullptr);
 }
 
 }  // namespace fiblet

@@ -109,21 +109,22 @@ std::size_t decode_into(const DecodeContext& ctx, const std::uint8_t* blocks, st
 }
 
 bool any_point_in(const Region& r, const float* p, std::uint32_t n) {
-    // Region::contains with the shape chosen once per block.
+    // Region::contains with the shape chosen once per block, without an
+    // early exit so that the compiler vectorizes the loop.
+    bool any = false;
     if (r.shape == Region::Shape::sphere) {
         const float cx = r.center.x, cy = r.center.y, cz = r.center.z, r2 = r.radius * r.radius;
-        for (std::uint32_t k = 0; k < n; ++k, p += 3) {
-            const float dx = p[0] - cx, dy = p[1] - cy, dz = p[2] - cz;
-            if (dx * dx + dy * dy + dz * dz <= r2) return true;
+        for (std::uint32_t k = 0; k < n; ++k) {
+            const float dx = p[3 * k] - cx, dy = p[3 * k + 1] - cy, dz = p[3 * k + 2] - cz;
+            any |= dx * dx + dy * dy + dz * dz <= r2;
         }
-        return false;
+        return any;
     }
     const Aabb& b = r.box;
-    for (std::uint32_t k = 0; k < n; ++k, p += 3)
-        if (p[0] >= b.min.x && p[0] <= b.max.x && p[1] >= b.min.y && p[1] <= b.max.y && p[2] >= b.min.z &&
-            p[2] <= b.max.z)
-            return true;
-    return false;
+    for (std::uint32_t k = 0; k < n; ++k)
+        any |= (p[3 * k] >= b.min.x) & (p[3 * k] <= b.max.x) & (p[3 * k + 1] >= b.min.y) & (p[3 * k + 1] <= b.max.y) &
+               (p[3 * k + 2] >= b.min.z) & (p[3 * k + 2] <= b.max.z);
+    return any;
 }
 
 bool any_point_in(const std::vector<Region>& regions, const float* p, std::uint32_t n) {
@@ -383,16 +384,12 @@ private:
 
         // Candidate blocks from the index: near the frustum (grown by the
         // largest sphere radius) and, in blocks mode, near an include region.
-        // Blocks whose box lies inside the frustum keep their sphere
-        // without a test (their first point, the sphere's centre, is inside).
         std::optional<Bits> only;
-        Bits in_frustum;
         if (cull) {
             Bits f;
             const float margin = index_.max_sphere_radius() * (1 + 1e-5f) + 1e-3f;
-            index_.blocks_near_frustum(frustum, margin, f, &in_frustum);
+            index_.blocks_near_frustum(frustum, margin, f);
             f.resize((h_.blocks + 63) / 64, 0);
-            in_frustum.resize(f.size(), 0);
             only = std::move(f);
         }
         Bits exc, inc_inside;
@@ -440,7 +437,6 @@ private:
             kind.assign(blocks.size(), fine);
             if (q_.view)
                 for (std::size_t i = 0; i < blocks.size(); ++i) {
-                    if (!lod && has_bit(in_frustum, blocks[i])) continue;
                     // Scattered headers: fetch a few blocks ahead.
                     if (i + 8 < blocks.size()) __builtin_prefetch(reader_.block(at_need[i + 8]));
                     const Sphere s = block_bounding_sphere(h_, reader_.block(at_need[i]));
