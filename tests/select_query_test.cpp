@@ -20,6 +20,21 @@ using namespace fiblet::test;
 
 namespace {
 
+// A chunk's streamlines appended in the TRX layout, checking that they lie
+// in order inside the chunk's points, without overlapping.
+void append_chunk(const SelectedChunk& c, Streamlines& out) {
+    std::uint64_t used = 0, total = 0;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+        EXPECT_GE(c.first[i], used);
+        used = c.first[i] + c.count[i];
+        EXPECT_LE(3 * used, c.xyz.size());
+        total += c.points_of(i);
+        out.xyz.insert(out.xyz.end(), c.xyz_of(i), c.xyz_of(i) + 3 * c.points_of(i));
+        out.offsets.push_back(out.offsets.back() + c.points_of(i));
+    }
+    EXPECT_EQ(total, c.point_count());
+}
+
 struct Subject {
     std::string name;
     std::unique_ptr<FftFile> file;
@@ -95,9 +110,7 @@ protected:
             const SelectionStats stats = select(
                 *s.file, *index, q,
                 [&](const SelectedChunk& c) {
-                    const std::uint64_t base = got.point_count();
-                    got.xyz.insert(got.xyz.end(), c.xyz.begin(), c.xyz.end());
-                    for (std::size_t i = 1; i < c.offsets.size(); ++i) got.offsets.push_back(base + c.offsets[i]);
+                    append_chunk(c, got);
                     runs.insert(runs.end(), c.runs.begin(), c.runs.end());
                 },
                 o);
@@ -275,10 +288,8 @@ TEST_P(SelectQuery, ChunkedOutputEqualsTheWholeOutput) {
         *s.file, *s.stored_or_loaded, q,
         [&](const SelectedChunk& c) {
             ++chunks;
-            ASSERT_EQ(c.offsets.size(), c.runs.size() + 1);
-            const std::uint64_t base = joined.point_count();
-            joined.xyz.insert(joined.xyz.end(), c.xyz.begin(), c.xyz.end());
-            for (std::size_t i = 1; i < c.offsets.size(); ++i) joined.offsets.push_back(base + c.offsets[i]);
+            ASSERT_EQ(c.first.size(), c.runs.size());
+            append_chunk(c, joined);
             joined_runs.insert(joined_runs.end(), c.runs.begin(), c.runs.end());
         },
         o);

@@ -113,18 +113,20 @@ struct SelectionStats {
 };
 
 // A chunk of output, valid during the sink call: streamline i comes from
-// runs[i] and has the points xyz[3 * offsets[i] .. 3 * offsets[i + 1]) (the
-// TRX layout of Streamlines; xyz and offsets are empty when points were not
-// asked for).
+// runs[i] and has the points_of(i) points that start at xyz_of(i) (xyz
+// triplets, world mm). Streamlines lie in order in `xyz`, possibly with
+// unused points between them (a rejected block's), so that nothing is moved
+// after decoding; first/count are empty when points were not asked for.
 struct SelectedChunk {
     std::span<const float> xyz;
-    std::span<const std::uint64_t> offsets;
+    std::span<const std::uint64_t> first, count;  // per streamline, in points
     std::span<const SelectedRun> runs;
+    std::uint64_t points = 0;  // sum of count
 
     std::size_t size() const { return runs.size(); }
-    std::uint64_t point_count() const { return offsets.empty() ? 0 : offsets.back(); }
-    std::uint64_t points_of(std::size_t i) const { return offsets[i + 1] - offsets[i]; }
-    const float* xyz_of(std::size_t i) const { return xyz.data() + 3 * offsets[i]; }
+    std::uint64_t point_count() const { return points; }
+    std::uint64_t points_of(std::size_t i) const { return count[i]; }
+    const float* xyz_of(std::size_t i) const { return xyz.data() + 3 * first[i]; }
 };
 
 struct SelectOptions {

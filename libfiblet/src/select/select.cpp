@@ -109,22 +109,31 @@ std::size_t decode_into(const DecodeContext& ctx, const std::uint8_t* blocks, st
 }
 
 bool any_point_in(const Region& r, const float* p, std::uint32_t n) {
-    // Region::contains with the shape chosen once per block, without an
-    // early exit so that the compiler vectorizes the loop.
-    bool any = false;
+    // Region::contains with the shape chosen once per block; eight points
+    // at a time without a branch (vectorizable), stopping at the first hit.
+    auto scan = [&](auto inside) {
+        std::uint32_t k = 0;
+        for (; k + 8 <= n; k += 8) {
+            bool any = false;
+            for (std::uint32_t j = k; j < k + 8; ++j) any |= inside(p + 3 * j);
+            if (any) return true;
+        }
+        for (; k < n; ++k)
+            if (inside(p + 3 * k)) return true;
+        return false;
+    };
     if (r.shape == Region::Shape::sphere) {
         const float cx = r.center.x, cy = r.center.y, cz = r.center.z, r2 = r.radius * r.radius;
-        for (std::uint32_t k = 0; k < n; ++k) {
-            const float dx = p[3 * k] - cx, dy = p[3 * k + 1] - cy, dz = p[3 * k + 2] - cz;
-            any |= dx * dx + dy * dy + dz * dz <= r2;
-        }
-        return any;
+        return scan([&](const float* q) {
+            const float dx = q[0] - cx, dy = q[1] - cy, dz = q[2] - cz;
+            return dx * dx + dy * dy + dz * dz <= r2;
+        });
     }
     const Aabb& b = r.box;
-    for (std::uint32_t k = 0; k < n; ++k)
-        any |= (p[3 * k] >= b.min.x) & (p[3 * k] <= b.max.x) & (p[3 * k + 1] >= b.min.y) & (p[3 * k + 1] <= b.max.y) &
-               (p[3 * k + 2] >= b.min.z) & (p[3 * k + 2] <= b.max.z);
-    return any;
+    return scan([&](const float* q) {
+        return (q[0] >= b.min.x) & (q[0] <= b.max.x) & (q[1] >= b.min.y) & (q[1] <= b.max.y) & (q[2] >= b.min.z) &
+               (q[2] <= b.max.z);
+    });
 }
 
 bool any_point_in(const std::vector<Region>& regions, const float* p, std::uint32_t n) {
@@ -140,9 +149,9 @@ Vec3f first_point(const FftHeader& h, const std::uint8_t* block) {
 }
 
 // Assembles kept blocks into runs and hands chunks of them to the sink.
-// Fine blocks are decoded straight into the output buffer after its end,
-// then kept in place or moved down over rejected ones. The buffer only
-// grows: no zero-filling per chunk.
+// Fine blocks are decoded straight into the output buffer at its frontier
+// and stay where they are: a rejected block leaves unused points between
+// two runs instead of making the next ones move. The buffer only grows.
 class RunWriter {
 public:
     RunWriter(const SelectOptions& o, const std::function<void(const SelectedChunk&)>& sink, SelectionStats& stats,
@@ -157,42 +166,44 @@ public:
     void break_unless_continues(std::uint64_t fiber, std::uint64_t block) {
         if (open_ && (run_.fiber != fiber || run_.first_block + run_.block_count != block)) close();
     }
-    // The output buffer: points decoded at point index end() and after wait
-    // for fine() (kept) or nothing (rejected).
+    // The output buffer and its frontier (in points), where blocks are
+    // decoded; advance() moves the frontier past them.
     std::vector<float>& buffer() { return xyz_; }
-    std::size_t end() const { return end_; }
+    std::size_t frontier() const { return frontier_; }
+    void advance(std::size_t points) { frontier_ += points; }
 
-    // A fine block of n points, decoded at `src` (at or after end(); null
-    // when points are not output).
-    void fine(std::uint64_t fiber, std::uint64_t block, const float* src, std::uint32_t n) {
-        extend(fiber, block);
-        if (options_.points && src) {
-            float* dst = &xyz_[3 * end_];
-            if (src != dst) std::memmove(dst, src, 12 * std::size_t(n));
-            end_ += n;
-        }
+    // A fine block of n points, decoded at point index `at` (ignored when
+    // points are not output). A block that continues the open run lies
+    // right after it, since both were decoded in order.
+    void fine(std::uint64_t fiber, std::uint64_t block, std::size_t at, std::uint32_t n) {
+        extend(fiber, block, at);
+        run_end_ += n;
         stats_.points += n;
         has_end_ = false;
     }
-    // A coarse block: its first point now, `end` when the run stops after it.
+    // A coarse block: its first point now (at the frontier), `end` when the
+    // run stops after it.
     void coarse(std::uint64_t fiber, std::uint64_t block, Vec3f first, const Vec3f* end) {
-        extend(fiber, block);
+        break_unless_continues(fiber, block);  // first: closing may put an end point at the frontier
+        extend(fiber, block, frontier_);
         ++run_.coarse_blocks, ++stats_.coarse_blocks;
-        put(first);
+        put(run_end_++, first);
+        frontier_ = std::max(frontier_, run_end_);
         has_end_ = end != nullptr;
         if (end) end_point_ = *end;
     }
     // Hands the closed runs to the sink when the chunk is full (the open
     // run's points move to the front); only where no decoded points wait
-    // after end().
+    // after the frontier.
     void maybe_flush() {
-        if (runs_.empty() || (end_ < options_.chunk_points && runs_.size() < options_.chunk_points)) return;
-        const std::size_t done = options_.points ? offsets_.back() : 0;
-        const std::size_t open_points = end_ - done;
-        end_ = done;
+        if (runs_.empty() || (frontier_ < options_.chunk_points && runs_.size() < options_.chunk_points)) return;
         flush();
-        if (open_points) std::memmove(xyz_.data(), &xyz_[3 * done], 12 * open_points);
-        end_ = open_points;
+        if (open_) {
+            if (options_.points && run_first_ > 0)
+                std::memmove(xyz_.data(), &xyz_[3 * run_first_], 12 * (run_end_ - run_first_));
+            run_end_ -= run_first_, run_first_ = 0;
+        }
+        frontier_ = open_ ? run_end_ : 0;
     }
     void finish() {
         close();
@@ -200,49 +211,56 @@ public:
     }
 
 private:
-    void extend(std::uint64_t fiber, std::uint64_t block) {
+    void extend(std::uint64_t fiber, std::uint64_t block, std::size_t at) {
         break_unless_continues(fiber, block);
         if (!open_) {
             if (fiber != last_fiber_) ++stats_.fibers, last_fiber_ = fiber;
             run_ = {fiber, block, 0, 0};
+            run_first_ = run_end_ = at;
             open_ = true;
         }
         ++run_.block_count, ++stats_.blocks;
     }
-    void put(Vec3f p) {
-        if (options_.points) {
-            if (xyz_.size() < 3 * (end_ + 1)) xyz_.resize(std::max(3 * (end_ + 1), 2 * xyz_.size()));
-            xyz_[3 * end_] = p.x, xyz_[3 * end_ + 1] = p.y, xyz_[3 * end_ + 2] = p.z;
-            ++end_;
-        }
+    void put(std::size_t at, Vec3f p) {
         ++stats_.points;
+        if (!options_.points) return;
+        if (xyz_.size() < 3 * (at + 1)) xyz_.resize(std::max(3 * (at + 1), 2 * xyz_.size()));
+        xyz_[3 * at] = p.x, xyz_[3 * at + 1] = p.y, xyz_[3 * at + 2] = p.z;
     }
     void close() {
         if (!open_) return;
-        // A pending end point may land on decoded points waiting after end(),
-        // but only on those of the rejected block that broke the run.
-        if (has_end_) put(end_point_), has_end_ = false;
+        // The end point of a last coarse block goes right after the run: at
+        // the frontier, or over the points of the rejected block that broke
+        // the run (it has at least one).
+        if (has_end_) {
+            put(run_end_++, end_point_);
+            frontier_ = std::max(frontier_, run_end_);
+            has_end_ = false;
+        }
         open_ = false;
         ++stats_.runs;
         runs_.push_back(run_);
-        if (options_.points) offsets_.push_back(end_);
+        if (options_.points) first_.push_back(run_first_), count_.push_back(run_end_ - run_first_);
+        chunk_points_ += run_end_ - run_first_;
     }
     void flush() {
         SelectedChunk c;
         c.runs = runs_;
-        if (options_.points) c.xyz = {xyz_.data(), 3 * end_}, c.offsets = offsets_;
+        if (options_.points) c.xyz = {xyz_.data(), 3 * frontier_}, c.first = first_, c.count = count_;
+        c.points = options_.points ? chunk_points_ : 0;
         sink_(c);
-        offsets_.assign(1, 0);
-        runs_.clear();
-        end_ = 0;
+        first_.clear(), count_.clear(), runs_.clear();
+        chunk_points_ = 0;
     }
 
     const SelectOptions& options_;
     const std::function<void(const SelectedChunk&)>& sink_;
     SelectionStats& stats_;
-    std::vector<float> xyz_;  // size only grows; end_ points are valid
-    std::size_t end_ = 0;
-    std::vector<std::uint64_t> offsets_{0};
+    std::vector<float> xyz_;  // size only grows
+    std::size_t frontier_ = 0;                // points of the buffer in use
+    std::size_t run_first_ = 0, run_end_ = 0;  // the open run's points
+    std::vector<std::uint64_t> first_, count_;
+    std::uint64_t chunk_points_ = 0;
     std::vector<SelectedRun> runs_;
     SelectedRun run_;
     bool open_ = false, has_end_ = false;
@@ -475,30 +493,24 @@ private:
                     if (kind[j] == fine) segment_.push_back(j), test |= region_test(j);
                 if (!options_.points && !test) {
                     for (std::size_t k : segment_)
-                        out.fine(fibers[k], blocks[k], nullptr, block_flags(h_, reader_.block(at_need[k])).point_count);
+                        out.fine(fibers[k], blocks[k], 0, block_flags(h_, reader_.block(at_need[k])).point_count);
                     out.maybe_flush();
                     continue;
                 }
                 const std::uint8_t* bytes =
                     contiguous(blocks, segment_, [&](std::size_t k) { return reader_.block(at_need[k]); });
-                // With point tests, rejected blocks make the kept ones after
-                // them move down: decoding 32 blocks at a time bounds that.
-                const std::size_t step = test ? 32 : segment_.size();
-                for (std::size_t s0 = 0; s0 < segment_.size(); s0 += step) {
-                    const std::size_t s1 = std::min(segment_.size(), s0 + step);
-                    out.break_unless_continues(fibers[segment_[s0]], blocks[segment_[s0]]);
-                    const std::size_t base = out.end();
-                    decode_into(ctx_, bytes + s0 * bb, s1 - s0, out.buffer(), base);
-                    stats_.blocks_decoded += s1 - s0;
-                    std::size_t at = base;
-                    for (std::size_t s = s0; s < s1; ++s) {
-                        const std::size_t k = segment_[s];
-                        const std::uint32_t n = block_flags(h_, bytes + s * bb).point_count;
-                        const float* p = &out.buffer()[3 * at];
-                        at += n;
-                        if (passes_regions(k, p, n)) out.fine(fibers[k], blocks[k], options_.points ? p : nullptr, n);
-                    }
+                out.break_unless_continues(fibers[i], blocks[i]);
+                const std::size_t base = out.frontier();
+                const std::size_t decoded = decode_into(ctx_, bytes, segment_.size(), out.buffer(), base);
+                stats_.blocks_decoded += segment_.size();
+                std::size_t at = base;
+                for (std::size_t s = 0; s < segment_.size(); ++s) {
+                    const std::size_t k = segment_[s];
+                    const std::uint32_t n = block_flags(h_, bytes + s * bb).point_count;
+                    if (passes_regions(k, &out.buffer()[3 * at], n)) out.fine(fibers[k], blocks[k], at, n);
+                    at += n;
                 }
+                out.advance(decoded);
                 out.maybe_flush();
             }
         }
@@ -547,9 +559,10 @@ Streamlines select_streamlines(const FftFile& file, const BlockIndex& index, con
     Streamlines all;
     if (runs) runs->clear();
     const SelectionStats s = select(file, index, query, [&](const SelectedChunk& c) {
-        const std::uint64_t base = all.point_count();
-        all.xyz.insert(all.xyz.end(), c.xyz.begin(), c.xyz.end());
-        for (std::size_t i = 1; i < c.offsets.size(); ++i) all.offsets.push_back(base + c.offsets[i]);
+        for (std::size_t i = 0; i < c.size(); ++i) {
+            all.xyz.insert(all.xyz.end(), c.xyz_of(i), c.xyz_of(i) + 3 * c.points_of(i));
+            all.offsets.push_back(all.offsets.back() + c.points_of(i));
+        }
         if (runs) runs->insert(runs->end(), c.runs.begin(), c.runs.end());
     });
     if (stats) *stats = s;
