@@ -8,8 +8,8 @@
 #include <cstring>
 #include <filesystem>
 
-#include "fiblet/checksum.hpp"
 #include "fiblet/block_index.hpp"
+#include "fiblet/checksum.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/error.hpp"
 #include "select_reference.hpp"
@@ -20,25 +20,25 @@ using namespace fiblet::test;
 
 namespace {
 
+// Files are compressed on first use (CTest runs every test in its own process).
 class SelectIndex : public ::testing::Test {
 protected:
-    static void SetUpTestSuite() {
-        if (!shared_data_available()) return;
-        dir_ = new TempDir;
-        CompressOptions o;
-        o.threads = 2;
-        compress_tck(shared_data("small-sdstream.tck"), dir_->file("sdstream.fft"), o);
-        compress_tck(shared_data("dwi-small64d-ifod1.tck"), dir_->file("dwi.fft"), o);
-    }
-    static void TearDownTestSuite() {
-        delete dir_;
-        dir_ = nullptr;
-    }
+    static void TearDownTestSuite() { dir_.reset(); }
     void SetUp() override {
-        if (!dir_) GTEST_SKIP() << "shared test data not found";
+        if (!shared_data_available()) GTEST_SKIP() << "shared test data not found";
     }
-    static std::string fiblet_file() { return dir_->file("sdstream.fft"); }
-    static inline TempDir* dir_ = nullptr;
+    static std::string compressed(const std::string& tck, const std::string& name, CompressOptions o = {}) {
+        if (!dir_) dir_ = std::make_unique<TempDir>();
+        const std::string out = dir_->file(name);
+        if (!std::filesystem::exists(out)) {
+            o.threads = 2;
+            compress_tck(shared_data(tck), out, o);
+        }
+        return out;
+    }
+    static std::string fiblet_file() { return compressed("small-sdstream.tck", "sdstream.fft"); }
+    static std::string dwi_file() { return compressed("dwi-small64d-ifod1.tck", "dwi.fft"); }
+    static inline std::unique_ptr<TempDir> dir_;
 };
 
 bool bit(const std::vector<std::uint64_t>& bits, std::size_t b) { return (bits[b >> 6] >> (b & 63)) & 1; }
@@ -61,7 +61,7 @@ void expect_boxes_hold_points(const FftFile& file, const BlockIndex& index, cons
 }
 
 TEST_F(SelectIndex, CompressStoresAnIndexWhoseBoxesHoldEveryPoint) {
-    for (const std::string& path : {fiblet_file(), dir_->file("dwi.fft")}) {
+    for (const std::string& path : {fiblet_file(), dwi_file()}) {
         const FftFile file(path);
         ASSERT_NE(file.find_chunk(kBlockIndexTag), nullptr);
         const BlockIndex index = BlockIndex::load(file);
@@ -106,12 +106,19 @@ TEST_F(SelectIndex, StoredBoxesAreWithinACellOfTheExactBoxes) {
 }
 
 TEST_F(SelectIndex, ChunkHasTheDocumentedSize) {
-    for (const std::string& path : {fiblet_file(), dir_->file("dwi.fft")}) {
+    CompressOptions wide;
+    wide.direction_bits = 16, wide.points_per_block = 300;
+    const std::string wide_file = compressed("bundles/CST_R-step0.1.tck", "cst16.fft", wide);
+    for (const std::string& path : {fiblet_file(), dwi_file(), wide_file}) {
         const FftFile file(path);
         const TrailerChunk* c = file.find_chunk(kBlockIndexTag);
         ASSERT_NE(c, nullptr);
         const FftHeader& h = file.header();
-        EXPECT_EQ(c->payload.size(), 56 + h.fibers + (std::uint64_t{h.blocks} * 28 + 7) / 8);
+        const std::uint64_t count_bytes = h.points_per_block > 255 ? 2 : 1;
+        EXPECT_EQ(c->payload.size(), 56 + count_bytes * h.fibers + (std::uint64_t{h.blocks} * 28 + 7) / 8) << path;
+        const BlockIndex index = BlockIndex::load(file);
+        EXPECT_EQ(index.source(), BlockIndex::Source::chunk);
+        expect_boxes_hold_points(file, index, decode_everything(file));
     }
     // 3.5 bytes per 76-byte block plus one byte per fiber: under 5 % of the file.
     const FftFile file(fiblet_file());
@@ -156,14 +163,16 @@ TEST_F(SelectIndex, FrustumCandidatesCoverEveryBlockSphereThatMeetsTheFrustum) {
         const Frustum f = frustum_from_camera(gen.camera());
         std::vector<std::uint64_t> bits;
         index.blocks_near_frustum(f, index.max_sphere_radius() * (1 + 1e-5f) + 1e-3f, bits);
-        for (std::size_t b = 0; b < d.blocks.size(); ++b)
-            if (sphere_intersects_frustum(f, d.blocks[b].sphere.center, d.blocks[b].sphere.radius))
+        for (std::size_t b = 0; b < d.blocks.size(); ++b) {
+            if (sphere_intersects_frustum(f, d.blocks[b].sphere.center, d.blocks[b].sphere.radius)) {
                 ASSERT_TRUE(bit(bits, b)) << "camera " << i << " block " << b;
+            }
+        }
     }
 }
 
 // A copy of `from` whose trailer's BIDX payload is replaced by `payload`
-// (without the CSUM chunk, which would report the change first).
+// (without the CSUM chunk, which would no longer match).
 std::string with_index_payload(const FftFile& from, const std::vector<std::uint8_t>& payload, const std::string& to) {
     const std::string bytes = read_file(from.path());
     const std::uint64_t end = from.header().file_bytes();
@@ -214,7 +223,7 @@ TEST_F(SelectIndex, MalformedChunksAreRejected) {
 TEST_F(SelectIndex, BlocksOffTheGridAreNeverCulled) {
     // Block 0's bounds replaced by a box far larger than any block: the
     // builder stores it as unbounded, and every query returns it.
-    const FftFile file(dir_->file("dwi.fft"));
+    const FftFile file(dwi_file());
     const DecodedFile d = decode_everything(file);
     IndexBuilder builder(file.header());
     for (std::size_t b = 0; b < d.blocks.size(); ++b) {
@@ -236,7 +245,7 @@ TEST_F(SelectIndex, BlocksOffTheGridAreNeverCulled) {
 }
 
 TEST_F(SelectIndex, BuilderRefusesLayoutsItCannotDescribe) {
-    const FftFile file(dir_->file("dwi.fft"));
+    const FftFile file(dwi_file());
     IndexBuilder builder(file.header());
     const float pts[9] = {0, 0, 0, 0.1f, 0, 0, 0.2f, 0, 0};
     builder.add_block(pts, 3, false);  // partial, yet not the fiber's last block

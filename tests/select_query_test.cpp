@@ -5,6 +5,7 @@
 // official encoder.
 #include <gtest/gtest.h>
 
+#include <map>
 #include <memory>
 
 #include "fiblet/compress.hpp"
@@ -19,6 +20,21 @@ using namespace fiblet::test;
 
 namespace {
 
+// A chunk's streamlines appended in the TRX layout, checking that they lie
+// in order inside the chunk's points, without overlapping.
+void append_chunk(const SelectedChunk& c, Streamlines& out) {
+    std::uint64_t used = 0, total = 0;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+        EXPECT_GE(c.first[i], used);
+        used = c.first[i] + c.count[i];
+        EXPECT_LE(3 * used, c.xyz.size());
+        total += c.points_of(i);
+        out.xyz.insert(out.xyz.end(), c.xyz_of(i), c.xyz_of(i) + 3 * c.points_of(i));
+        out.offsets.push_back(out.offsets.back() + c.points_of(i));
+    }
+    EXPECT_EQ(total, c.point_count());
+}
+
 struct Subject {
     std::string name;
     std::unique_ptr<FftFile> file;
@@ -26,47 +42,79 @@ struct Subject {
     std::unique_ptr<BlockIndex> stored_or_loaded, computed;
 };
 
+// Each test process builds only the subject its parameter names (CTest
+// runs every test in its own process).
 class SelectQuery : public ::testing::TestWithParam<int> {
 protected:
-    static void SetUpTestSuite() {
-        if (!shared_data_available()) return;
-        dir_ = new TempDir;
-        auto add = [](const std::string& name, const std::string& fft) {
-            auto s = std::make_unique<Subject>();
-            s->name = name;
-            s->file = std::make_unique<FftFile>(fft);
-            s->decoded = decode_everything(*s->file);
-            s->stored_or_loaded = std::make_unique<BlockIndex>(BlockIndex::load(*s->file));
-            s->computed = std::make_unique<BlockIndex>(BlockIndex::compute(*s->file));
-            subjects_.push_back(std::move(s));
-        };
-        CompressOptions o;
-        o.threads = 2;
-        compress_tck(shared_data("small-sdstream.tck"), dir_->file("sdstream.fft"), o);
-        add("fiblet small-sdstream", dir_->file("sdstream.fft"));
-        compress_tck(shared_data("bundles/CST_R-step0.1.tck"), dir_->file("cst.fft"), o);
-        add("fiblet CST_R", dir_->file("cst.fft"));
-        add("official small-sdstream", shared_data("reference/small-sdstream.fft"));
-    }
     static void TearDownTestSuite() {
         subjects_.clear();
-        delete dir_;
-        dir_ = nullptr;
+        dir_.reset();
     }
     void SetUp() override {
-        if (subjects_.empty()) GTEST_SKIP() << "shared test data not found";
+        if (!shared_data_available()) GTEST_SKIP() << "shared test data not found";
     }
-    const Subject& subject() const { return *subjects_[std::size_t(GetParam())]; }
+    const Subject& subject() const {
+        if (auto it = subjects_.find(GetParam()); it != subjects_.end()) return *it->second;
+        if (!dir_) dir_ = std::make_unique<TempDir>();
+        auto s = std::make_unique<Subject>();
+        std::string fft;
+        CompressOptions o;
+        o.threads = 2;
+        switch (GetParam()) {
+            case 0:  // short fibers from a real scan
+                s->name = "fiblet dwi-small64d";
+                fft = dir_->file("dwi.fft");
+                compress_tck(shared_data("dwi-small64d-ifod1.tck"), fft, o);
+                break;
+            case 1:  // long real bundle
+                s->name = "fiblet CST_R";
+                fft = dir_->file("cst.fft");
+                compress_tck(shared_data("bundles/CST_R-step0.1.tck"), fft, o);
+                break;
+            case 2:  // written by another tool, no stored index
+                s->name = "official small-sdstream";
+                fft = shared_data("reference/small-sdstream.fft");
+                break;
+            case 3:  // 16-bit directions, default 126 points a block
+                s->name = "fiblet 16-bit dwi-small64d";
+                fft = dir_->file("dwi16.fft");
+                o.direction_bits = 16;
+                compress_tck(shared_data("dwi-small64d-ifod1.tck"), fft, o);
+                break;
+            default:  // 16-bit directions, 400 points a block (2-byte counts in the index)
+                s->name = "fiblet 16-bit CST_R, 400 points a block";
+                fft = dir_->file("cst16.fft");
+                o.direction_bits = 16;
+                o.points_per_block = 400;
+                compress_tck(shared_data("bundles/CST_R-step0.1.tck"), fft, o);
+        }
+        s->file = std::make_unique<FftFile>(fft);
+        s->decoded = decode_everything(*s->file);
+        s->stored_or_loaded = std::make_unique<BlockIndex>(BlockIndex::load(*s->file));
+        s->computed = std::make_unique<BlockIndex>(BlockIndex::compute(*s->file));
+        return *(subjects_[GetParam()] = std::move(s));
+    }
 
-    // Runs a query with both indexes and compares each with brute force.
+    // Runs a query with both indexes, reading blocks through the file's
+    // mapping with one and with reads with the other, and compares each
+    // with brute force.
     void check(const Query& q, const std::string& what) const {
         const Subject& s = subject();
         const ReferenceSelection ref = reference_select(*s.file, s.decoded, q);
         for (const BlockIndex* index : {s.stored_or_loaded.get(), s.computed.get()}) {
+            SelectOptions o;
+            o.map_file = index == s.stored_or_loaded.get();
+            o.chunk_points = 5000;
+            Streamlines got;
             std::vector<SelectedRun> runs;
-            SelectionStats stats;
-            const Streamlines got = select_streamlines(*s.file, *index, q, &runs, &stats);
-            expect_same_selection(ref, got, runs, s.name + ": " + what);
+            const SelectionStats stats = select(
+                *s.file, *index, q,
+                [&](const SelectedChunk& c) {
+                    append_chunk(c, got);
+                    runs.insert(runs.end(), c.runs.begin(), c.runs.end());
+                },
+                o);
+            expect_same_selection(ref, got, runs, s.name + ": " + what + (o.map_file ? " (mapped)" : " (read)"));
             EXPECT_EQ(stats.runs, runs.size());
             EXPECT_EQ(stats.points, got.point_count());
             std::uint64_t blocks = 0;
@@ -75,8 +123,8 @@ protected:
         }
     }
 
-    static inline TempDir* dir_ = nullptr;
-    static inline std::vector<std::unique_ptr<Subject>> subjects_;
+    static inline std::unique_ptr<TempDir> dir_;
+    static inline std::map<int, std::unique_ptr<Subject>> subjects_;
 };
 
 TEST_P(SelectQuery, EmptyQueryGivesTheWholeFile) {
@@ -240,17 +288,17 @@ TEST_P(SelectQuery, ChunkedOutputEqualsTheWholeOutput) {
         *s.file, *s.stored_or_loaded, q,
         [&](const SelectedChunk& c) {
             ++chunks;
-            ASSERT_EQ(c.lines.size(), c.runs.size());
-            const std::uint64_t base = joined.point_count();
-            joined.xyz.insert(joined.xyz.end(), c.lines.xyz.begin(), c.lines.xyz.end());
-            for (std::size_t i = 1; i < c.lines.offsets.size(); ++i) joined.offsets.push_back(base + c.lines.offsets[i]);
+            ASSERT_EQ(c.first.size(), c.runs.size());
+            append_chunk(c, joined);
             joined_runs.insert(joined_runs.end(), c.runs.begin(), c.runs.end());
         },
         o);
     EXPECT_EQ(joined.xyz, whole.xyz);
     EXPECT_EQ(joined.offsets, whole.offsets);
     EXPECT_EQ(joined_runs.size(), runs.size());
-    if (whole.point_count() > 2000) EXPECT_GT(chunks, 1u);
+    if (whole.point_count() > 2000) {
+        EXPECT_GT(chunks, 1u);
+    }
 }
 
 TEST_P(SelectQuery, SubsetFileDecodesToTheSelection) {
@@ -267,7 +315,8 @@ TEST_P(SelectQuery, SubsetFileDecodesToTheSelection) {
         const std::string out = dir.file("subset" + std::to_string(i) + ".fft");
         const SubsetReport rep = write_fft_subset(*s.file, select_runs(*s.file, *s.stored_or_loaded, q), out, false);
         EXPECT_EQ(rep.fibers, runs.size());
-        const FftFile subset(out);  // validates header, LUT and trailer
+        const FftFile subset(out);  // validates header, LUT, trailer and checksums
+        EXPECT_TRUE(subset.verifies_checksums());
         EXPECT_EQ(subset.header().points, expected.point_count());
         EXPECT_EQ(subset.properties(), s.file->properties());
         const DecodedFile d = decode_everything(subset);
@@ -276,10 +325,11 @@ TEST_P(SelectQuery, SubsetFileDecodesToTheSelection) {
         // Its blocks carry their new fiber IDs and flags.
         for (std::size_t b = 0; b < d.blocks.size(); ++b) {
             const auto raw = subset.read_blocks(b, 1);
-            const BlockView v{raw.data()};
-            EXPECT_EQ(v.fiber_id(), d.blocks[b].fiber);
-            EXPECT_EQ(v.is_last(), d.blocks[b].last_of_fiber);
-            EXPECT_EQ(v.is_first(), b == subset.first_block(d.blocks[b].fiber));
+            const bool wide = subset.header().direction_bits() == 16;
+            EXPECT_EQ(wide ? BlockView16{raw.data()}.fiber_id() : BlockView{raw.data()}.fiber_id(), d.blocks[b].fiber);
+            const BlockFlags flags = block_flags(subset.header(), raw.data());
+            EXPECT_EQ(flags.last, d.blocks[b].last_of_fiber);
+            EXPECT_EQ(flags.first, b == subset.first_block(d.blocks[b].fiber));
         }
         // A subset of the official encoder's file gets fiblet's index.
         const BlockIndex index = BlockIndex::load(subset);
@@ -289,7 +339,7 @@ TEST_P(SelectQuery, SubsetFileDecodesToTheSelection) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Files, SelectQuery, ::testing::Values(0, 1, 2));
+INSTANTIATE_TEST_SUITE_P(Files, SelectQuery, ::testing::Values(0, 1, 2, 3, 4));
 
 TEST(SelectQueryErrors, BadQueriesAreRejectedBeforeReading) {
     if (!shared_data_available()) GTEST_SKIP();

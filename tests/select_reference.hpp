@@ -43,7 +43,7 @@ inline DecodedFile decode_everything(const FftFile& file) {
         const std::uint64_t first = file.first_block(f), count = file.block_count(f);
         for (std::uint64_t b = first; b < first + count; ++b) {
             const std::uint8_t* bytes = &raw[b * h.block_bytes()];
-            const std::uint32_t n = BlockView{bytes}.point_count();
+            const std::uint32_t n = block_flags(h, bytes).point_count;
             d.blocks.push_back({f, at, n, block_bounding_sphere(h, bytes), b + 1 == first + count});
             at += n;
         }

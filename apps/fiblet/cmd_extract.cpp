@@ -152,9 +152,7 @@ void run(const ExtractArgs& a) {
         TckWriter writer(a.output, header.properties, a.force);
         Progress progress(a.quiet || a.json);
         stats = select(file, index, query, [&](const SelectedChunk& chunk) {
-            for (std::size_t i = 0; i < chunk.lines.size(); ++i)
-                writer.write(&chunk.lines.xyz[3 * chunk.lines.offsets[i]],
-                             chunk.lines.offsets[i + 1] - chunk.lines.offsets[i]);
+            for (std::size_t i = 0; i < chunk.size(); ++i) writer.write(chunk.xyz_of(i), chunk.points_of(i));
             if (!chunk.runs.empty() && h.fibers)
                 progress.update("extract", double(chunk.runs.back().fiber + 1) / double(h.fibers));
         });

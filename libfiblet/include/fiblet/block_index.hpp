@@ -3,8 +3,8 @@
 // without reading (let alone decoding) the others.
 //
 // On disk it is the optional "BIDX" trailer chunk (formats/fft-index.md):
-// one quantized box per block in 28 bits plus one byte per fiber, about
-// 3.6 bytes per 76-byte block. Files without it (e.g. from the official
+// one quantized box per block in 28 bits plus one byte per fiber (two when
+// blocks hold more than 255 points), about 3.6 bytes per 76-byte block. Files without it (e.g. from the official
 // encoder) get the same index computed on load by decoding every block once.
 // The hierarchy is never stored: it is rebuilt in memory on load (storing
 // block ids would cost more than the boxes).
@@ -65,7 +65,7 @@ private:
     unsigned bits_ = kDefaultIndexBitsPerBlock;
     Grid grid_;
     std::vector<std::uint32_t> codes_;
-    std::vector<std::uint8_t> last_points_;
+    std::vector<std::uint16_t> last_points_;
     std::uint32_t open_fiber_blocks_ = 0;  // blocks of the fiber being added
     bool layout_ok_ = true;
     std::uint64_t unbounded_ = 0;
@@ -98,16 +98,21 @@ public:
     // Blocks whose box may meet a sphere / a box / the frustum grown by
     // `margin`: a bitmap of blocks() bits, ORed into `bits` (resized as
     // needed). Conservative: a block with a point in the region is always
-    // set.
-    void blocks_near_sphere(Vec3f center, float radius, std::vector<std::uint64_t>& bits) const;
-    void blocks_near_box(const Aabb& box, std::vector<std::uint64_t>& bits) const;
+    // set. When `inside` is given, the blocks whose box lies wholly inside
+    // the region (so every point does) are also set there.
+    void blocks_near_sphere(Vec3f center, float radius, std::vector<std::uint64_t>& bits,
+                            std::vector<std::uint64_t>* inside = nullptr) const;
+    void blocks_near_box(const Aabb& box, std::vector<std::uint64_t>& bits,
+                         std::vector<std::uint64_t>* inside = nullptr) const;
     void blocks_near_frustum(const Frustum& frustum, float margin, std::vector<std::uint64_t>& bits) const;
 
 private:
     BlockIndex() = default;
     void set_blocks(std::vector<Aabb> boxes);  // sorts and builds the hierarchy
+    template <class BoxOf>
+    void build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of);  // (Morton key << 32 | block)
     template <class Classify>
-    void collect(const Classify& classify, std::vector<std::uint64_t>& bits) const;
+    void collect(const Classify& classify, std::vector<std::uint64_t>& bits, std::vector<std::uint64_t>* inside) const;
 
     Source source_ = Source::decoded;
     std::vector<std::uint64_t> fiber_points_;

@@ -210,5 +210,9 @@ inline BlockFlags block_flags(const FftHeader& h, const std::uint8_t* block) {
     const BlockView v{block};
     return {v.point_count(), v.is_first(), v.is_last()};
 }
+// The two anchors (x0 y0 z0 x1 y1 z1, normalized) of a block of either kind.
+inline std::array<float, 6> block_anchors_normalized(const FftHeader& h, const std::uint8_t* block) {
+    return h.direction_bits() == 16 ? BlockView16{block}.anchors_normalized() : BlockView{block}.anchors_normalized();
+}
 
 }  // namespace fiblet

@@ -14,9 +14,13 @@
 //   error_stats.hpp    max / mean / RMS / percentiles of position errors
 //   resample.hpp       fixed-step resampling, point-to-polyline distance
 //   view.hpp           camera, frustum, level of detail, block bounding spheres
+//   block_index.hpp    per-block boxes (BIDX chunk) and a hierarchy over them
+//   select.hpp         selective decoding: fiber subsets, regions, frustum, LoD
+//   fft_subset.hpp     a selection written as a smaller .fft file
 //   output_file.hpp    atomic outputs, cleanup on signals
 #pragma once
 
+#include "fiblet/block_index.hpp"
 #include "fiblet/checksum.hpp"
 #include "fiblet/compare.hpp"
 #include "fiblet/compress.hpp"
@@ -27,8 +31,10 @@
 #include "fiblet/error_stats.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/fft_format.hpp"
+#include "fiblet/fft_subset.hpp"
 #include "fiblet/geometry.hpp"
 #include "fiblet/output_file.hpp"
 #include "fiblet/resample.hpp"
+#include "fiblet/select.hpp"
 #include "fiblet/tck.hpp"
 #include "fiblet/view.hpp"

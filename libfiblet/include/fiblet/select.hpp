@@ -26,6 +26,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -47,7 +48,14 @@ struct Region {
 
     static Region sphere(Vec3f center, float radius);
     static Region box_between(Vec3f min, Vec3f max);
-    bool contains(Vec3f p) const;
+    bool contains(Vec3f p) const {
+        if (shape == Shape::sphere) {
+            const float dx = p.x - center.x, dy = p.y - center.y, dz = p.z - center.z;
+            return dx * dx + dy * dy + dz * dz <= radius * radius;
+        }
+        return p.x >= box.min.x && p.x <= box.max.x && p.y >= box.min.y && p.y <= box.max.y && p.z >= box.min.z &&
+               p.z <= box.max.z;
+    }
 };
 
 enum class RoiMode { fibers, blocks };
@@ -100,20 +108,31 @@ struct SelectionStats {
     std::uint64_t blocks = 0;          // blocks kept (fine + coarse)
     std::uint64_t coarse_blocks = 0;
     std::uint64_t points = 0;          // points output
-    std::uint64_t blocks_read = 0;     // blocks read from the file (all passes)
+    std::uint64_t blocks_read = 0;     // blocks read or accessed in the mapping (all passes)
     std::uint64_t blocks_decoded = 0;  // blocks decoded (all passes)
 };
 
-// A chunk of output: runs[i] is streamline i of `lines` (lines is empty
-// when points were not asked for).
+// A chunk of output, valid during the sink call: streamline i comes from
+// runs[i] and has the points_of(i) points that start at xyz_of(i) (xyz
+// triplets, world mm). Streamlines lie in order in `xyz`, possibly with
+// unused points between them (a rejected block's), so that nothing is moved
+// after decoding; first/count are empty when points were not asked for.
 struct SelectedChunk {
-    Streamlines lines;
-    std::vector<SelectedRun> runs;
+    std::span<const float> xyz;
+    std::span<const std::uint64_t> first, count;  // per streamline, in points
+    std::span<const SelectedRun> runs;
+    std::uint64_t points = 0;  // sum of count
+
+    std::size_t size() const { return runs.size(); }
+    std::uint64_t point_count() const { return points; }
+    std::uint64_t points_of(std::size_t i) const { return count[i]; }
+    const float* xyz_of(std::size_t i) const { return xyz.data() + 3 * first[i]; }
 };
 
 struct SelectOptions {
     bool points = true;                       // decode and output points
-    std::size_t chunk_points = 1u << 20;      // points per chunk handed to the sink
+    std::size_t chunk_points = 1u << 18;      // points per chunk handed to the sink
+    bool map_file = true;                     // read blocks through FftFile::mapped_blocks()
 };
 
 // Runs a query, handing the output to `sink` in file order, a chunk of whole

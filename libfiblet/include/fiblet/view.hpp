@@ -63,10 +63,21 @@ float projected_radius_px(const Camera& c, const Viewport& v, Vec3f center, floa
 // `lod_pixels` pixels (diameter) is drawn as one segment from its first point
 // to the next block's first point (the paper uses ~4 px).
 inline constexpr float kDefaultLodPixels = 4.0f;
-inline bool block_is_coarse(const Camera& c, const Viewport& v, Vec3f center, float radius,
-                            float lod_pixels = kDefaultLodPixels) {
-    return 2.0f * projected_radius_px(c, v, center, radius) < lod_pixels;
-}
+bool block_is_coarse(const Camera& c, const Viewport& v, Vec3f center, float radius,
+                     float lod_pixels = kDefaultLodPixels);
+
+// The two functions above for many spheres: the camera's terms computed
+// once (they are defined through this class, so the results are the same).
+class LevelOfDetail {
+public:
+    LevelOfDetail(const Camera& c, const Viewport& v, float lod_pixels = kDefaultLodPixels);
+    float radius_px(Vec3f center, float radius) const;
+    bool coarse(Vec3f center, float radius) const { return 2.0f * radius_px(center, radius) < lod_pixels_; }
+
+private:
+    Vec3f position_, back_;
+    float tan_half_fov_, half_height_, lod_pixels_;
+};
 
 // Bounding sphere of a block from its header fields alone (no decoding):
 // centre at the first anchor, radius |anchor1 - anchor0| + (n - 2) * step,

@@ -1,6 +1,7 @@
 #include "fiblet/fft_file.hpp"
 
 #include <fcntl.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -8,6 +9,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 #include <utility>
 
 #include "core/bytes.hpp"
@@ -82,7 +84,18 @@ FftHeader parse_fft_header(std::span<const std::uint8_t> b, std::uint64_t file_s
     return h;
 }
 
-FftFile::FftFile(const std::string& path, FftOpenOptions options) : path_(path), options_(options) {
+struct FftFile::Mapping {
+    std::once_flag once;
+    void* address = nullptr;
+    std::size_t length = 0;
+    std::size_t skip = 0;  // from the page boundary to the first block
+    ~Mapping() {
+        if (address) ::munmap(address, length);
+    }
+};
+
+FftFile::FftFile(const std::string& path, FftOpenOptions options)
+    : path_(path), options_(options), mapping_(std::make_unique<Mapping>()) {
     fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd_ < 0) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
     try {
@@ -257,6 +270,7 @@ FftFile& FftFile::operator=(FftFile&& o) noexcept {
         checksum_chunk_offset_ = o.checksum_chunk_offset_;
         checksums_ = std::move(o.checksums_);
         verified_groups_ = std::move(o.verified_groups_);
+        mapping_ = std::move(o.mapping_);
     }
     return *this;
 }
@@ -322,6 +336,27 @@ void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, cons
                                             "): the file is corrupted");
         word.fetch_or(bit, std::memory_order_release);
     }
+}
+
+std::span<const std::uint8_t> FftFile::mapped_blocks(std::uint64_t first, std::uint64_t count) const {
+    if (first > header_.blocks || count > header_.blocks - first)
+        throw Error(Errc::invalid_argument, path_ + ": block range past the end");
+    if (count == 0 || fd_ < 0 || !mapping_) return {};
+    const std::uint64_t bb = header_.block_bytes();
+    Mapping& m = *mapping_;
+    std::call_once(m.once, [&] {
+        const std::uint64_t page = std::uint64_t(::sysconf(_SC_PAGESIZE));
+        const std::uint64_t start = header_.blocks_offset() / page * page;
+        m.skip = std::size_t(header_.blocks_offset() - start);
+        m.length = std::size_t(std::uint64_t{header_.blocks} * bb + m.skip);
+        void* a = ::mmap(nullptr, m.length, PROT_READ, MAP_SHARED, fd_, off_t(start));
+        if (a != MAP_FAILED) m.address = a;
+    });
+    if (!m.address) return {};
+    const std::uint8_t* blocks = static_cast<const std::uint8_t*>(m.address) + m.skip + first * bb;
+    check_block_structure(first, count, blocks);
+    if (verifies_checksums()) verify_block_groups(first, count, blocks);
+    return {blocks, std::size_t(count * bb)};
 }
 
 std::vector<std::uint8_t> FftFile::read_blocks(std::uint64_t first, std::uint64_t count) const {

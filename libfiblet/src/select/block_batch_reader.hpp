@@ -1,6 +1,8 @@
-// Internal: reads a sorted set of scattered blocks with few system calls:
-// blocks closer than a small gap are read in one span (the gap bytes cost
-// less than another read).
+// Internal: access to a sorted set of scattered blocks, checked as
+// FftFile::read_blocks checks them. Through the file's memory mapping when
+// there is one (no copy, no system call per block); else by reads in which
+// blocks closer than a small gap share one span (the gap bytes cost less
+// than another read).
 #pragma once
 
 #include <cstdint>
@@ -12,16 +14,18 @@ namespace fiblet::detail {
 
 class BlockBatchReader {
 public:
-    explicit BlockBatchReader(const FftFile& file, std::uint64_t max_gap_blocks = 32);
+    BlockBatchReader(const FftFile& file, bool use_mapping, std::uint64_t max_gap_blocks = 64);
 
-    // Reads `blocks` (ascending, unique); block(i) then points at blocks[i].
+    // Reads `blocks` (ascending, unique); block(i) then points at blocks[i],
+    // and consecutive blocks lie one after the other in memory.
     void read(const std::vector<std::uint32_t>& blocks);
     const std::uint8_t* block(std::size_t i) const { return pointers_[i]; }
-    // Blocks transferred so far, gaps included.
+    // Blocks accessed (mapped) or transferred (read, gaps included) so far.
     std::uint64_t blocks_read() const { return blocks_read_; }
 
 private:
     const FftFile& file_;
+    bool use_mapping_;
     std::uint64_t max_gap_;
     std::uint32_t block_bytes_;
     std::vector<std::uint8_t> buffer_;

@@ -70,7 +70,7 @@ BlockIndex BlockIndex::load(const FftFile& file) {
     std::uint64_t total = 0;
     for (std::uint64_t f = 0; f < h.fibers; ++f) {
         const std::uint32_t nb = file.block_count(f);
-        const std::uint8_t last = c.last_block_points[f];
+        const std::uint16_t last = c.last_block_points[f];
         if ((nb == 0) != (last == 0))
             throw Error(Errc::fft_format, file.path() + ": malformed BIDX (block index) chunk: fiber " +
                                               std::to_string(f) + " point count disagrees with its blocks");
@@ -81,9 +81,21 @@ BlockIndex BlockIndex::load(const FftFile& file) {
         throw Error(Errc::fft_format, file.path() + ": malformed BIDX (block index) chunk: its fibers hold " +
                                           std::to_string(total) + " points, the header says " +
                                           std::to_string(h.points));
-    std::vector<Aabb> boxes(c.blocks);
-    for (std::uint64_t b = 0; b < c.blocks; ++b) boxes[b] = c.grid.decode(c.codes[b]);
-    index.set_blocks(std::move(boxes));
+    // Morton keys straight from the codes' cells, then boxes decoded in that order.
+    const detail::IndexBoxDecoder decoder(c.grid);
+    unsigned shift = 0;
+    while ((decoder.max_centre2() >> shift) >= 1024) ++shift;
+    std::vector<std::uint64_t> keyed(c.blocks);
+    for (std::uint64_t b = 0; b < c.blocks; ++b) {
+        std::uint64_t key = std::uint64_t{1} << 30;
+        if (!decoder.unbounded(c.codes[b])) {
+            std::uint32_t m[3];
+            decoder.centre2(c.codes[b], m);
+            key = spread_bits(m[0] >> shift) | spread_bits(m[1] >> shift) << 1 | spread_bits(m[2] >> shift) << 2;
+        }
+        keyed[b] = key << 32 | b;
+    }
+    index.build(keyed, [&](std::uint32_t b) { return decoder.box(c.codes[b]); });
     return index;
 }
 
@@ -94,12 +106,12 @@ BlockIndex BlockIndex::compute(const FftFile& file) {
     BlockIndex index;
     index.source_ = Source::decoded;
     std::vector<Aabb> boxes(h.blocks);
-    std::vector<std::uint8_t> counts(h.blocks);
+    std::vector<std::uint16_t> counts(h.blocks);
     std::vector<std::uint8_t> raw;
     std::vector<float> xyz;
-    constexpr std::uint64_t kChunk = 1u << 15;
-    for (std::uint64_t b0 = 0; b0 < h.blocks; b0 += kChunk) {
-        const std::uint64_t n = std::min<std::uint64_t>(kChunk, h.blocks - b0);
+    const std::uint64_t chunk = std::max<std::uint64_t>(1, (1u << 21) / h.points_per_block);  // blocks of ~2M points
+    for (std::uint64_t b0 = 0; b0 < h.blocks; b0 += chunk) {
+        const std::uint64_t n = std::min<std::uint64_t>(chunk, h.blocks - b0);
         raw.resize(n * bb);
         file.read_blocks(b0, n, raw.data());
         xyz.resize(3 * count_block_points(ctx, raw.data(), n));
@@ -107,12 +119,12 @@ BlockIndex BlockIndex::compute(const FftFile& file) {
         const float* p = xyz.data();
         for (std::uint64_t k = 0; k < n; ++k) {
             const std::uint8_t* block = &raw[k * bb];
-            const std::uint32_t np = BlockView{block}.point_count();
+            const std::uint32_t np = block_flags(h, block).point_count;
             Aabb box{{p[0], p[1], p[2]}, {p[0], p[1], p[2]}};
             for (std::uint32_t i = 1; i < np; ++i)
                 grow(box, {{p[3 * i], p[3 * i + 1], p[3 * i + 2]}, {p[3 * i], p[3 * i + 1], p[3 * i + 2]}});
             boxes[b0 + k] = box;
-            counts[b0 + k] = std::uint8_t(np);
+            counts[b0 + k] = std::uint16_t(np);
             index.max_sphere_radius_ = std::max(index.max_sphere_radius_, block_bounding_sphere(h, block).radius);
             p += 3 * np;
         }
@@ -151,15 +163,22 @@ void BlockIndex::set_blocks(std::vector<Aabb> boxes) {
         }
         keyed[i] = key << 32 | i;
     }
+    build(keyed, [&](std::uint32_t b) { return boxes[b]; });
+}
+
+template <class BoxOf>
+void BlockIndex::build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of) {
+    const std::size_t n = keyed.size();
     radix_sort(keyed, 31);
-    order_.resize(n);
+    // Filled by push_back: no zeroing pass over memory written right after.
+    order_.clear(), order_.reserve(n);
+    sorted_boxes_.clear(), sorted_boxes_.reserve(n);
     rank_.resize(n);
-    sorted_boxes_.resize(n);
     for (std::size_t pos = 0; pos < n; ++pos) {
         const auto block = std::uint32_t(keyed[pos]);
-        order_[pos] = block;
+        order_.push_back(block);
         rank_[block] = std::uint32_t(pos);
-        sorted_boxes_[pos] = boxes[block];
+        sorted_boxes_.push_back(box_of(block));
     }
     // Levels of the tree: each node bounds kFanout consecutive children.
     levels_.clear();
@@ -174,21 +193,29 @@ void BlockIndex::set_blocks(std::vector<Aabb> boxes) {
 }
 
 template <class Classify>
-void BlockIndex::collect(const Classify& classify, std::vector<std::uint64_t>& bits) const {
+void BlockIndex::collect(const Classify& classify, std::vector<std::uint64_t>& bits,
+                         std::vector<std::uint64_t>* inside) const {
     const std::size_t n = sorted_boxes_.size();
     bits.resize((n + 63) / 64, 0);
+    if (inside) inside->resize((n + 63) / 64, 0);
     if (n == 0) return;
     // Positions covered by node j of level k: [j * span, (j + 1) * span), span = 8^(k+1).
     auto mark_all = [&](std::size_t first, std::size_t last) {
-        for (std::size_t pos = first; pos < std::min(last, n); ++pos) set_bit(bits, order_[pos]);
+        for (std::size_t pos = first; pos < std::min(last, n); ++pos) {
+            set_bit(bits, order_[pos]);
+            if (inside) set_bit(*inside, order_[pos]);
+        }
     };
     auto visit = [&](auto& self, std::size_t k, std::size_t j, std::size_t span) -> void {
         const Overlap o = classify(levels_[k][j]);
         if (o == Overlap::outside) return;
         if (o == Overlap::inside) return mark_all(j * span, (j + 1) * span);
         if (k == 0) {
-            for (std::size_t pos = j * kFanout; pos < std::min(n, (j + 1) * kFanout); ++pos)
-                if (classify(sorted_boxes_[pos]) != Overlap::outside) set_bit(bits, order_[pos]);
+            for (std::size_t pos = j * kFanout; pos < std::min(n, (j + 1) * kFanout); ++pos) {
+                const Overlap b = classify(sorted_boxes_[pos]);
+                if (b != Overlap::outside) set_bit(bits, order_[pos]);
+                if (b == Overlap::inside && inside) set_bit(*inside, order_[pos]);
+            }
             return;
         }
         const std::size_t children = levels_[k - 1].size();
@@ -201,7 +228,8 @@ void BlockIndex::collect(const Classify& classify, std::vector<std::uint64_t>& b
     for (std::size_t j = 0; j < levels_[top].size(); ++j) visit(visit, top, j, span);
 }
 
-void BlockIndex::blocks_near_sphere(Vec3f c, float radius, std::vector<std::uint64_t>& bits) const {
+void BlockIndex::blocks_near_sphere(Vec3f c, float radius, std::vector<std::uint64_t>& bits,
+                                    std::vector<std::uint64_t>* inside) const {
     // Squared distances with a relative slack, so float rounding never culls
     // a block whose point passes Region::contains.
     const float r2 = radius * radius * (1 + 1e-5f);
@@ -215,20 +243,21 @@ void BlockIndex::blocks_near_sphere(Vec3f c, float radius, std::vector<std::uint
                         fz = far(c.z, b.min.z, b.max.z);
             return fx * fx + fy * fy + fz * fz <= radius * radius * (1 - 1e-5f) ? Overlap::inside : Overlap::partial;
         },
-        bits);
+        bits, inside);
 }
 
-void BlockIndex::blocks_near_box(const Aabb& r, std::vector<std::uint64_t>& bits) const {
+void BlockIndex::blocks_near_box(const Aabb& r, std::vector<std::uint64_t>& bits,
+                                 std::vector<std::uint64_t>* inside) const {
     collect(
         [&](const Aabb& b) {
             if (b.max.x < r.min.x || b.min.x > r.max.x || b.max.y < r.min.y || b.min.y > r.max.y ||
                 b.max.z < r.min.z || b.min.z > r.max.z)
                 return Overlap::outside;
-            const bool inside = b.min.x >= r.min.x && b.max.x <= r.max.x && b.min.y >= r.min.y &&
+            const bool within = b.min.x >= r.min.x && b.max.x <= r.max.x && b.min.y >= r.min.y &&
                                 b.max.y <= r.max.y && b.min.z >= r.min.z && b.max.z <= r.max.z;
-            return inside ? Overlap::inside : Overlap::partial;
+            return within ? Overlap::inside : Overlap::partial;
         },
-        bits);
+        bits, inside);
 }
 
 void BlockIndex::blocks_near_frustum(const Frustum& f, float margin, std::vector<std::uint64_t>& bits) const {
@@ -244,7 +273,7 @@ void BlockIndex::blocks_near_frustum(const Frustum& f, float margin, std::vector
             }
             return Overlap::inside;
         },
-        bits);
+        bits, nullptr);
 }
 
 }  // namespace fiblet

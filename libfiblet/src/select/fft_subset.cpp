@@ -4,12 +4,36 @@
 #include <string>
 
 #include "fiblet/block_index.hpp"
+#include "fiblet/checksum.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/output_file.hpp"
 #include "select/block_decoder.hpp"
 
 namespace fiblet {
+
+namespace {
+
+// Gives a copied block its place in the new file: fiber ID, first/last
+// flags and (8-bit blocks) index in the fiber; its points stay as they are.
+void place_block(const FftHeader& h, std::uint8_t* b, std::uint32_t id, std::uint32_t k, std::uint32_t count) {
+    const bool not_first = k > 0, not_last = k + 1 < count;
+    if (h.direction_bits() == 16) {
+        std::uint8_t* p = b + kBlock16FiberIdOffset;
+        p[0] = std::uint8_t(id), p[1] = std::uint8_t(id >> 8), p[2] = std::uint8_t(id >> 16), p[3] = std::uint8_t(id >> 24);
+        const auto flags = std::uint16_t((BlockView16{b}.flags() & kFlag16CountMask) | (not_first ? kFlag16NotFirst : 0) |
+                                         (not_last ? kFlag16NotLast : 0));
+        b[kBlock16FlagsOffset] = std::uint8_t(flags), b[kBlock16FlagsOffset + 1] = std::uint8_t(flags >> 8);
+        return;
+    }
+    b[kBlockFiberIdOffset] = std::uint8_t(id >> 24), b[kBlockFiberIdOffset + 1] = std::uint8_t(id >> 16);
+    b[kBlockFiberIdOffset + 2] = std::uint8_t(id >> 8), b[kBlockFiberIdOffset + 3] = std::uint8_t(id);
+    b[kBlockFlagsOffset] = std::uint8_t((not_first ? kFlagNotFirst : 0) | (not_last ? kFlagNotLast : 0) |
+                                        (b[kBlockFlagsOffset] & kFlagCountMask));
+    b[kBlockIndexOffset] = std::uint8_t(k);  // modulo 256, as the format stores it
+}
+
+}  // namespace
 
 SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedRun>& runs, const std::string& path,
                               bool overwrite) {
@@ -44,10 +68,12 @@ SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedR
     h.blocks = std::uint32_t(blocks);
 
     AtomicOutputFile out(path, overwrite);
+    FftChecksumBuilder checksum(h.block_bytes());  // the CSUM chunk, as compress writes it
     {
         const auto head = serialize_fft_header(h);
         out.write(head.data(), head.size());
         out.write(lut.data(), lut.size() * sizeof(FiberLutEntry));
+        checksum.add_lut(lut.data(), lut.size() * sizeof(FiberLutEntry));
     }
     const DecodeContext ctx(src);
     const std::uint32_t bb = h.block_bytes();
@@ -64,28 +90,26 @@ SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedR
         const auto id = std::uint32_t(i);
         for (std::uint32_t k = 0; k < r.block_count; ++k) {
             std::uint8_t* b = &raw[std::size_t(k) * bb];
-            const std::uint32_t n = BlockView{b}.point_count();
-            b[kBlockFiberIdOffset] = std::uint8_t(id >> 24), b[kBlockFiberIdOffset + 1] = std::uint8_t(id >> 16);
-            b[kBlockFiberIdOffset + 2] = std::uint8_t(id >> 8), b[kBlockFiberIdOffset + 3] = std::uint8_t(id);
-            b[kBlockFlagsOffset] = std::uint8_t((k > 0 ? kFlagNotFirst : 0) | (k + 1 < r.block_count ? kFlagNotLast : 0) |
-                                                (b[kBlockFlagsOffset] & kFlagCountMask));
-            b[kBlockIndexOffset] = std::uint8_t(k);  // modulo 256, as the format stores it
+            const std::uint32_t n = block_flags(h, b).point_count;
+            place_block(h, b, id, k, r.block_count);
             index.add_block(p, n, k + 1 == r.block_count);
             p += 3 * n;
             h.points += n;
         }
         out.write(raw.data(), raw.size());
+        checksum.add_blocks(raw.data(), raw.size());
     }
+    const auto head = serialize_fft_header(h);
     {
         const std::uint64_t at = out.size();
         std::vector<TrailerChunk> chunks;
         for (const auto tag : {kPropertiesTag, kResampledTag})
             if (const TrailerChunk* c = source.find_chunk(tag)) chunks.push_back(*c);
         if (auto bidx = index.finish()) chunks.push_back(std::move(*bidx));
+        chunks.push_back(checksum.finish(head, chunks));  // last: it covers the chunks before it
         const auto trailer = serialize_trailer(chunks, at);
         out.write(trailer.data(), trailer.size());
     }
-    const auto head = serialize_fft_header(h);
     out.write_at(head.data(), head.size(), 0);
     SubsetReport report{h.fibers, h.blocks, h.points, out.size()};
     out.commit();

@@ -56,7 +56,7 @@ void IndexBuilder::add_box(const Aabb& box, std::uint32_t n, bool last_of_fiber,
     max_sphere_radius_ = std::max(max_sphere_radius_, sphere_radius);
     ++open_fiber_blocks_;
     if (last_of_fiber) {
-        last_points_.push_back(std::uint8_t(n));
+        last_points_.push_back(std::uint16_t(n));
         open_fiber_blocks_ = 0;
     } else if (n != header_.points_per_block) {
         layout_ok_ = false;  // only a fiber's last block may be partial
@@ -89,7 +89,7 @@ std::optional<TrailerChunk> IndexBuilder::finish() const {
     c.max_sphere_radius = max_sphere_radius_;
     c.last_block_points = last_points_;
     c.codes = codes_;
-    return TrailerChunk{kBlockIndexTag, detail::serialize_index_chunk(c)};
+    return TrailerChunk{kBlockIndexTag, detail::serialize_index_chunk(c, header_)};
 }
 
 }  // namespace fiblet

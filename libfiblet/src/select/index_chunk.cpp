@@ -72,24 +72,20 @@ std::uint32_t IndexGrid::encode(const Aabb& box) const {
     return code;
 }
 
-Aabb IndexGrid::decode(std::uint32_t code) const {
-    if (code == unbounded_code())
-        return {{-kUnboundedExtentMm, -kUnboundedExtentMm, -kUnboundedExtentMm},
-                {kUnboundedExtentMm, kUnboundedExtentMm, kUnboundedExtentMm}};
-    float lo[3], hi[3];
-    const float o[3] = {origin.x, origin.y, origin.z};
-    const std::uint32_t levels = axis_levels();
+IndexBoxDecoder::IndexBoxDecoder(const IndexGrid& g)
+    : levels_(g.axis_levels()), e_(g.extent_levels), unbounded_(g.unbounded_code()) {
+    const float o[3] = {g.origin.x, g.origin.y, g.origin.z};
     for (int a = 0; a < 3; ++a) {
-        const std::uint32_t c = code % levels;
-        code /= levels;
-        const std::uint32_t i = c / extent_levels, e = c % extent_levels;
-        lo[a] = o[a] + float(i) * cell;
-        hi[a] = o[a] + float(i + e) * cell;
+        lo_[a].resize(levels_), hi_[a].resize(levels_);
+        for (std::uint32_t c = 0; c < levels_; ++c) {
+            const std::uint32_t i = c / e_, e = c % e_;
+            lo_[a][c] = o[a] + float(i) * g.cell;
+            hi_[a][c] = o[a] + float(i + e) * g.cell;
+        }
     }
-    return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
 }
 
-std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c) {
+std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c, const FftHeader& h) {
     const unsigned bits = c.grid.bits;
     // Fixed header, at the offsets parse_index_chunk reads.
     std::vector<std::uint8_t> out(kIndexChunkHeaderBytes, 0);
@@ -103,9 +99,13 @@ std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c) {
     put(40, c.grid.min_levels);
     put(44, c.grid.extent_levels);
     put(48, c.max_sphere_radius);
-    out.resize(kIndexChunkHeaderBytes + c.last_block_points.size());
-    if (!c.last_block_points.empty())
-        std::memcpy(&out[kIndexChunkHeaderBytes], c.last_block_points.data(), c.last_block_points.size());
+    const unsigned count_bytes = index_count_bytes(h);
+    out.resize(kIndexChunkHeaderBytes + count_bytes * c.last_block_points.size());
+    for (std::size_t f = 0; f < c.last_block_points.size(); ++f) {
+        const std::uint16_t n = c.last_block_points[f];
+        out[kIndexChunkHeaderBytes + count_bytes * f] = std::uint8_t(n);
+        if (count_bytes == 2) out[kIndexChunkHeaderBytes + 2 * f + 1] = std::uint8_t(n >> 8);
+    }
     // Codes as one little-endian bit stream, least significant bit first.
     std::uint64_t acc = 0;
     unsigned filled = 0;
@@ -148,15 +148,20 @@ IndexChunk parse_index_chunk(const std::vector<std::uint8_t>& p, const FftHeader
         levels * levels * levels > std::uint64_t(c.grid.unbounded_code()))
         return bad("grid levels do not fit the code width");
     const std::uint64_t code_bytes = (c.blocks * bits + 7) / 8;
-    if (p.size() != kIndexChunkHeaderBytes + c.fibers + code_bytes) return bad("payload size does not match its counts");
+    const unsigned count_bytes = index_count_bytes(h);
+    if (p.size() != kIndexChunkHeaderBytes + count_bytes * c.fibers + code_bytes)
+        return bad("payload size does not match its counts");
 
     const std::uint8_t* last = b + kIndexChunkHeaderBytes;
-    c.last_block_points.assign(last, last + c.fibers);
-    for (std::uint8_t n : c.last_block_points)
+    c.last_block_points.resize(c.fibers);
+    for (std::uint64_t f = 0; f < c.fibers; ++f) {
+        const std::uint16_t n = count_bytes == 1 ? last[f] : std::uint16_t(last[2 * f] | last[2 * f + 1] << 8);
         if (n > h.points_per_block) return bad("a fiber's last block holds more points than a block can");
+        c.last_block_points[f] = n;
+    }
 
     c.codes.resize(c.blocks);
-    const std::uint8_t* s = last + c.fibers;
+    const std::uint8_t* s = last + count_bytes * c.fibers;
     const std::uint64_t max_code = levels * levels * levels;
     const std::uint32_t mask = c.grid.unbounded_code();
     for (std::uint64_t k = 0; k < c.blocks; ++k) {

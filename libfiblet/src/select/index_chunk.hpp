@@ -35,21 +35,56 @@ struct IndexGrid {
     // Conservative code of a box (the decoded box contains it, with a small
     // slack for float rounding), or unbounded_code().
     std::uint32_t encode(const Aabb& box) const;
-    // The box of a code; unbounded boxes span +-1e30 mm.
-    Aabb decode(std::uint32_t code) const;
 };
 
 inline constexpr float kUnboundedExtentMm = 1e30f;
+
+// Decodes codes into boxes (unbounded ones span +-1e30 mm) with per-axis
+// tables: no integer division per block.
+class IndexBoxDecoder {
+public:
+    explicit IndexBoxDecoder(const IndexGrid& g);
+    bool unbounded(std::uint32_t code) const { return code == unbounded_; }
+    Aabb box(std::uint32_t code) const {
+        if (unbounded(code))
+            return {{-kUnboundedExtentMm, -kUnboundedExtentMm, -kUnboundedExtentMm},
+                    {kUnboundedExtentMm, kUnboundedExtentMm, kUnboundedExtentMm}};
+        std::uint32_t c[3];
+        split(code, c);
+        return {{lo_[0][c[0]], lo_[1][c[1]], lo_[2][c[2]]}, {hi_[0][c[0]], hi_[1][c[1]], hi_[2][c[2]]}};
+    }
+    // Twice the box centre in cells, per axis (for ordering boxes).
+    void centre2(std::uint32_t code, std::uint32_t out[3]) const {
+        std::uint32_t c[3];
+        split(code, c);
+        for (int a = 0; a < 3; ++a) out[a] = 2 * (c[a] / e_) + c[a] % e_;
+    }
+    std::uint32_t max_centre2() const { return 2 * (levels_ / e_) + e_; }
+
+private:
+    void split(std::uint32_t code, std::uint32_t c[3]) const {
+        // Exact: a quotient of integers below 2^32 by one below 2^16 is never
+        // rounded across an integer in double precision.
+        const auto q = std::uint32_t(double(code) / double(levels_));
+        const auto z = std::uint32_t(double(q) / double(levels_));
+        c[0] = code - q * levels_, c[1] = q - z * levels_, c[2] = z;
+    }
+    std::uint32_t levels_, e_, unbounded_;
+    std::vector<float> lo_[3], hi_[3];
+};
+
+// Bytes per fiber of the last-block point counts.
+inline unsigned index_count_bytes(const FftHeader& h) { return h.points_per_block <= 255 ? 1 : 2; }
 
 struct IndexChunk {
     IndexGrid grid;
     std::uint64_t fibers = 0, blocks = 0;
     float max_sphere_radius = 0;
-    std::vector<std::uint8_t> last_block_points;  // per fiber
+    std::vector<std::uint16_t> last_block_points;  // per fiber (stored in 1 byte, or 2 beyond 255 points a block)
     std::vector<std::uint32_t> codes;             // per block
 };
 
-std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c);
+std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c, const FftHeader& h);
 // Parses and validates a chunk against its file's header (counts, levels,
 // sizes, point totals). Throws Error{fft_format} naming `file`.
 IndexChunk parse_index_chunk(const std::vector<std::uint8_t>& payload, const FftHeader& h, const std::string& file);

@@ -26,15 +26,6 @@ Region Region::box_between(Vec3f min, Vec3f max) {
     return r;
 }
 
-bool Region::contains(Vec3f p) const {
-    if (shape == Shape::sphere) {
-        const float dx = p.x - center.x, dy = p.y - center.y, dz = p.z - center.z;
-        return dx * dx + dy * dy + dz * dz <= radius * radius;
-    }
-    return p.x >= box.min.x && p.x <= box.max.x && p.y >= box.min.y && p.y <= box.max.y && p.z >= box.min.z &&
-           p.z <= box.max.z;
-}
-
 std::uint64_t splitmix64(std::uint64_t x) {
     x += 0x9e3779b97f4a7c15ull;
     x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;

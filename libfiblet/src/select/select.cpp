@@ -22,7 +22,11 @@ namespace fiblet {
 namespace {
 
 using Bits = std::vector<std::uint64_t>;
-constexpr std::size_t kBatchBlocks = 4096;
+
+// Blocks handled at a time: about 2^18 points (blocks hold 2 to 16383).
+std::size_t batch_blocks(const FftHeader& h) {
+    return std::clamp<std::size_t>((std::size_t{1} << 18) / h.points_per_block, 16, 4096);
+}
 
 bool has_bit(const Bits& b, std::uint64_t i) { return (b[i >> 6] >> (i & 63)) & 1; }
 
@@ -94,39 +98,42 @@ private:
     std::uint64_t fiber_ = 0, in_fiber_ = 0;
 };
 
-// Blocks copied into one buffer and decoded with one call.
-class DecodeStage {
-public:
-    explicit DecodeStage(const DecodeContext& ctx) : ctx_(ctx), bb_(ctx.header.block_bytes()) {}
-    void clear() { raw_.clear(), first_point_.clear(); }
-    std::size_t add(const std::uint8_t* block) {
-        raw_.insert(raw_.end(), block, block + bb_);
-        first_point_.push_back(0);
-        return first_point_.size() - 1;
-    }
-    std::size_t size() const { return first_point_.size(); }
-    void decode() {
-        const std::size_t n = size();
-        std::size_t total = count_block_points(ctx_, raw_.data(), n);
-        xyz_.resize(3 * total);
-        detail::decode_selected_blocks(ctx_, raw_.data(), n, xyz_.data());
-        std::size_t at = 0;
-        for (std::size_t i = 0; i < n; ++i) first_point_[i] = at, at += BlockView{&raw_[i * bb_]}.point_count();
-    }
-    const float* points(std::size_t i) const { return &xyz_[3 * first_point_[i]]; }
-
-private:
-    const DecodeContext& ctx_;
-    std::uint32_t bb_;
-    std::vector<std::uint8_t> raw_;
-    std::vector<std::size_t> first_point_;
-    std::vector<float> xyz_;
-};
+// Decodes `count` consecutive blocks (contiguous in memory) into xyz, which
+// must have room; returns their point counts' sum. Validates the counts.
+std::size_t decode_into(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count,
+                        std::vector<float>& xyz, std::size_t at_point) {
+    const std::size_t n = count_block_points(ctx, blocks, count);
+    if (xyz.size() < 3 * (at_point + n)) xyz.resize(3 * (at_point + n));
+    detail::decode_selected_blocks(ctx, blocks, count, &xyz[3 * at_point]);
+    return n;
+}
 
 bool any_point_in(const Region& r, const float* p, std::uint32_t n) {
-    for (std::uint32_t k = 0; k < n; ++k, p += 3)
-        if (r.contains({p[0], p[1], p[2]})) return true;
-    return false;
+    // Region::contains with the shape chosen once per block; eight points
+    // at a time without a branch (vectorizable), stopping at the first hit.
+    auto scan = [&](auto inside) {
+        std::uint32_t k = 0;
+        for (; k + 8 <= n; k += 8) {
+            bool any = false;
+            for (std::uint32_t j = k; j < k + 8; ++j) any |= inside(p + 3 * j);
+            if (any) return true;
+        }
+        for (; k < n; ++k)
+            if (inside(p + 3 * k)) return true;
+        return false;
+    };
+    if (r.shape == Region::Shape::sphere) {
+        const float cx = r.center.x, cy = r.center.y, cz = r.center.z, r2 = r.radius * r.radius;
+        return scan([&](const float* q) {
+            const float dx = q[0] - cx, dy = q[1] - cy, dz = q[2] - cz;
+            return dx * dx + dy * dy + dz * dz <= r2;
+        });
+    }
+    const Aabb& b = r.box;
+    return scan([&](const float* q) {
+        return (q[0] >= b.min.x) & (q[0] <= b.max.x) & (q[1] >= b.min.y) & (q[1] <= b.max.y) & (q[2] >= b.min.z) &
+               (q[2] <= b.max.z);
+    });
 }
 
 bool any_point_in(const std::vector<Region>& regions, const float* p, std::uint32_t n) {
@@ -137,85 +144,134 @@ bool any_point_in(const std::vector<Region>& regions, const float* p, std::uint3
 }
 
 Vec3f first_point(const FftHeader& h, const std::uint8_t* block) {
-    const auto a = BlockView{block}.anchors_normalized();
+    const auto a = block_anchors_normalized(h, block);
     return h.to_world(a[0], a[1], a[2]);
 }
 
 // Assembles kept blocks into runs and hands chunks of them to the sink.
+// Fine blocks are decoded straight into the output buffer at its frontier
+// and stay where they are: a rejected block leaves unused points between
+// two runs instead of making the next ones move. The buffer only grows.
 class RunWriter {
 public:
-    RunWriter(const SelectOptions& o, const std::function<void(const SelectedChunk&)>& sink, SelectionStats& stats)
-        : options_(o), sink_(sink), stats_(stats) {}
+    RunWriter(const SelectOptions& o, const std::function<void(const SelectedChunk&)>& sink, SelectionStats& stats,
+              std::size_t batch_points)
+        : options_(o), sink_(sink), stats_(stats) {
+        // Room for a full chunk and a batch decoded after it: no reallocation
+        // (a copy and fresh pages each time).
+        if (o.points) xyz_.reserve(3 * (o.chunk_points + 2 * batch_points));
+    }
 
-    // A fine block with its n points (points may be null when not output).
-    void fine(std::uint64_t fiber, std::uint64_t block, const float* points, std::uint32_t n) {
-        extend(fiber, block);
-        if (options_.points) append(points, n);
+    // Closes the open run unless `block` of `fiber` continues it.
+    void break_unless_continues(std::uint64_t fiber, std::uint64_t block) {
+        if (open_ && (run_.fiber != fiber || run_.first_block + run_.block_count != block)) close();
+    }
+    // The output buffer and its frontier (in points), where blocks are
+    // decoded; advance() moves the frontier past them.
+    std::vector<float>& buffer() { return xyz_; }
+    std::size_t frontier() const { return frontier_; }
+    void advance(std::size_t points) { frontier_ += points; }
+
+    // A fine block of n points, decoded at point index `at` (ignored when
+    // points are not output). A block that continues the open run lies
+    // right after it, since both were decoded in order.
+    void fine(std::uint64_t fiber, std::uint64_t block, std::size_t at, std::uint32_t n) {
+        extend(fiber, block, at);
+        run_end_ += n;
         stats_.points += n;
         has_end_ = false;
     }
-    // A coarse block: its first point now, `end` when the run stops after it.
+    // A coarse block: its first point now (at the frontier), `end` when the
+    // run stops after it.
     void coarse(std::uint64_t fiber, std::uint64_t block, Vec3f first, const Vec3f* end) {
-        extend(fiber, block);
+        break_unless_continues(fiber, block);  // first: closing may put an end point at the frontier
+        extend(fiber, block, frontier_);
         ++run_.coarse_blocks, ++stats_.coarse_blocks;
-        const float p[3] = {first.x, first.y, first.z};
-        if (options_.points) append(p, 1);
-        ++stats_.points;
+        put(run_end_++, first);
+        frontier_ = std::max(frontier_, run_end_);
         has_end_ = end != nullptr;
-        if (end) end_ = *end;
+        if (end) end_point_ = *end;
+    }
+    // Hands the closed runs to the sink when the chunk is full (the open
+    // run's points move to the front); only where no decoded points wait
+    // after the frontier.
+    void maybe_flush() {
+        if (runs_.empty() || (frontier_ < options_.chunk_points && runs_.size() < options_.chunk_points)) return;
+        flush();
+        if (open_) {
+            if (options_.points && run_first_ > 0)
+                std::memmove(xyz_.data(), &xyz_[3 * run_first_], 12 * (run_end_ - run_first_));
+            run_end_ -= run_first_, run_first_ = 0;
+        }
+        frontier_ = open_ ? run_end_ : 0;
     }
     void finish() {
         close();
-        if (!chunk_.runs.empty()) flush();
+        if (!runs_.empty()) flush();
     }
 
 private:
-    void extend(std::uint64_t fiber, std::uint64_t block) {
-        if (open_ && (run_.fiber != fiber || run_.first_block + run_.block_count != block)) close();
+    void extend(std::uint64_t fiber, std::uint64_t block, std::size_t at) {
+        break_unless_continues(fiber, block);
         if (!open_) {
             if (fiber != last_fiber_) ++stats_.fibers, last_fiber_ = fiber;
             run_ = {fiber, block, 0, 0};
+            run_first_ = run_end_ = at;
             open_ = true;
         }
         ++run_.block_count, ++stats_.blocks;
     }
-    void append(const float* p, std::uint32_t n) { chunk_.lines.xyz.insert(chunk_.lines.xyz.end(), p, p + 3 * n); }
+    void put(std::size_t at, Vec3f p) {
+        ++stats_.points;
+        if (!options_.points) return;
+        if (xyz_.size() < 3 * (at + 1)) xyz_.resize(std::max(3 * (at + 1), 2 * xyz_.size()));
+        xyz_[3 * at] = p.x, xyz_[3 * at + 1] = p.y, xyz_[3 * at + 2] = p.z;
+    }
     void close() {
         if (!open_) return;
+        // The end point of a last coarse block goes right after the run: at
+        // the frontier, or over the points of the rejected block that broke
+        // the run (it has at least one).
         if (has_end_) {
-            const float p[3] = {end_.x, end_.y, end_.z};
-            if (options_.points) append(p, 1);
-            ++stats_.points;
+            put(run_end_++, end_point_);
+            frontier_ = std::max(frontier_, run_end_);
             has_end_ = false;
         }
         open_ = false;
         ++stats_.runs;
-        chunk_.runs.push_back(run_);
-        if (options_.points) chunk_.lines.offsets.push_back(chunk_.lines.xyz.size() / 3);
-        if (chunk_.lines.xyz.size() / 3 >= options_.chunk_points || chunk_.runs.size() >= options_.chunk_points)
-            flush();
+        runs_.push_back(run_);
+        if (options_.points) first_.push_back(run_first_), count_.push_back(run_end_ - run_first_);
+        chunk_points_ += run_end_ - run_first_;
     }
     void flush() {
-        sink_(chunk_);
-        chunk_.lines.xyz.clear();
-        chunk_.lines.offsets.assign(1, 0);
-        chunk_.runs.clear();
+        SelectedChunk c;
+        c.runs = runs_;
+        if (options_.points) c.xyz = {xyz_.data(), 3 * frontier_}, c.first = first_, c.count = count_;
+        c.points = options_.points ? chunk_points_ : 0;
+        sink_(c);
+        first_.clear(), count_.clear(), runs_.clear();
+        chunk_points_ = 0;
     }
 
     const SelectOptions& options_;
     const std::function<void(const SelectedChunk&)>& sink_;
     SelectionStats& stats_;
-    SelectedChunk chunk_;
+    std::vector<float> xyz_;  // size only grows
+    std::size_t frontier_ = 0;                // points of the buffer in use
+    std::size_t run_first_ = 0, run_end_ = 0;  // the open run's points
+    std::vector<std::uint64_t> first_, count_;
+    std::uint64_t chunk_points_ = 0;
+    std::vector<SelectedRun> runs_;
     SelectedRun run_;
     bool open_ = false, has_end_ = false;
-    Vec3f end_{};
+    Vec3f end_point_{};
     std::uint64_t last_fiber_ = ~std::uint64_t{0};
 };
 
 class Selector {
 public:
     Selector(const FftFile& file, const BlockIndex& index, const Query& q, const SelectOptions& o)
-        : file_(file), index_(index), q_(q), options_(o), h_(file.header()), ctx_(h_), reader_(file) {
+        : file_(file), index_(index), q_(q), options_(o), h_(file.header()), ctx_(h_), reader_(file, o.map_file) {
         if (index.blocks() != h_.blocks || index.fibers() != h_.fibers)
             throw Error(Errc::invalid_argument, file.path() + ": the block index belongs to another file");
         detail::check_query(q);
@@ -230,20 +286,26 @@ public:
     }
 
 private:
-    Bits near(const Region& r) const {
+    // Blocks whose box meets a region (and, in `inside`, those wholly in it).
+    Bits near(const Region& r, Bits* inside = nullptr) const {
         Bits bits;
         if (r.shape == Region::Shape::sphere)
-            index_.blocks_near_sphere(r.center, r.radius, bits);
+            index_.blocks_near_sphere(r.center, r.radius, bits, inside);
         else
-            index_.blocks_near_box(r.box, bits);
+            index_.blocks_near_box(r.box, bits, inside);
         bits.resize((h_.blocks + 63) / 64, 0);
+        if (inside) inside->resize(bits.size(), 0);
         return bits;
     }
-    Bits near_any(const std::vector<Region>& regions) const {
+    Bits near_any(const std::vector<Region>& regions, Bits* inside = nullptr) const {
         Bits all((h_.blocks + 63) / 64, 0);
+        if (inside) inside->assign(all.size(), 0);
         for (const Region& r : regions) {
-            const Bits b = near(r);
+            Bits in;
+            const Bits b = near(r, inside ? &in : nullptr);
             for (std::size_t i = 0; i < all.size(); ++i) all[i] |= b[i];
+            if (inside)
+                for (std::size_t i = 0; i < all.size(); ++i) (*inside)[i] |= in[i];
         }
         return all;
     }
@@ -267,43 +329,58 @@ private:
     // exclude region. Only blocks the index puts near a region are decoded.
     void fiber_regions() {
         const std::size_t k_inc = q_.include.size();
-        std::vector<Bits> inc(k_inc);
-        for (std::size_t k = 0; k < k_inc; ++k) inc[k] = near(q_.include[k]);
+        std::vector<Bits> inc(k_inc), inside(k_inc);
+        for (std::size_t k = 0; k < k_inc; ++k) inc[k] = near(q_.include[k], &inside[k]);
         const Bits exc = near_any(q_.exclude);
         const std::uint64_t all = k_inc == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << k_inc) - 1;
 
-        // Fibers with no block near some include region fail without decoding.
+        // Fibers with no block near some include region fail without
+        // decoding; a block wholly inside a region meets it without decoding.
         std::vector<std::uint64_t> may_meet(h_.fibers, 0), met(h_.fibers, 0);
         for (std::size_t k = 0; k < k_inc; ++k) {
             FiberCursor cursor(file_);
             for (std::size_t w = 0; w < inc[k].size(); ++w)
                 for (std::uint64_t bits = inc[k][w]; bits; bits &= bits - 1) {
                     const std::uint64_t b = w * 64 + std::uint64_t(std::countr_zero(bits));
-                    may_meet[cursor.fiber_of(b)] |= std::uint64_t{1} << k;
+                    const std::uint64_t f = cursor.fiber_of(b);
+                    may_meet[f] |= std::uint64_t{1} << k;
+                    if (has_bit(inside[k], b)) met[f] |= std::uint64_t{1} << k;
                 }
         }
         for (std::uint64_t f = 0; f < h_.fibers; ++f)
             if (may_meet[f] != all) keep_[f] = 0;
 
+        // Decoded: blocks near an exclude region, and blocks near (not
+        // wholly inside) an include region that their fiber has not met yet.
         Bits to_test = exc;
-        for (const Bits& b : inc)
-            for (std::size_t i = 0; i < to_test.size(); ++i) to_test[i] |= b[i];
+        for (std::size_t k = 0; k < k_inc; ++k) {
+            FiberCursor cursor(file_);
+            for (std::size_t w = 0; w < inc[k].size(); ++w)
+                for (std::uint64_t bits = inc[k][w] & ~inside[k][w]; bits; bits &= bits - 1) {
+                    const std::uint64_t b = w * 64 + std::uint64_t(std::countr_zero(bits));
+                    if (!(met[cursor.fiber_of(b)] >> k & 1)) to_test[w] |= std::uint64_t{1} << (b & 63);
+                }
+        }
         std::vector<std::uint8_t> excluded(h_.fibers, 0);
         CandidateBlocks candidates(file_, keep_, &to_test);
         std::vector<std::uint32_t> blocks;
         std::vector<std::uint64_t> fibers;
-        DecodeStage stage(ctx_);
-        while (candidates.next(kBatchBlocks, blocks, fibers)) {
+        const std::uint32_t bb = h_.block_bytes();
+        while (candidates.next(batch_blocks(h_), blocks, fibers)) {
             reader_.read(blocks);
-            stage.clear();
-            for (std::size_t i = 0; i < blocks.size(); ++i) stage.add(reader_.block(i));
-            stage.decode();
+            // One decode call for the whole batch (SIMD decoders fill their lanes).
+            std::vector<std::size_t> first_point(blocks.size() + 1, 0), all(blocks.size());
+            for (std::size_t i = 0; i < blocks.size(); ++i) all[i] = i;
+            const std::uint8_t* bytes = contiguous(blocks, all, [&](std::size_t i) { return reader_.block(i); });
+            decode_into(ctx_, bytes, blocks.size(), scratch_, 0);
+            for (std::size_t i = 0; i < blocks.size(); ++i)
+                first_point[i + 1] = first_point[i] + block_flags(h_, bytes + i * bb).point_count;
             stats_.blocks_decoded += blocks.size();
             for (std::size_t i = 0; i < blocks.size(); ++i) {
                 const std::uint64_t f = fibers[i], b = blocks[i];
                 if (excluded[f]) continue;
-                const float* p = stage.points(i);
-                const std::uint32_t n = BlockView{reader_.block(i)}.point_count();
+                const float* p = &scratch_[3 * first_point[i]];
+                const auto n = std::uint32_t(first_point[i + 1] - first_point[i]);
                 for (std::size_t k = 0; k < k_inc; ++k)
                     if (!(met[f] >> k & 1) && has_bit(inc[k], b) && any_point_in(q_.include[k], p, n))
                         met[f] |= std::uint64_t{1} << k;
@@ -318,7 +395,8 @@ private:
     void blocks(const std::function<void(const SelectedChunk&)>& sink) {
         const bool blocks_mode = q_.roi_mode == RoiMode::blocks;
         const bool cull = q_.view && q_.view->cull;
-        const bool lod = q_.has_level_of_detail();
+        std::optional<LevelOfDetail> lod;
+        if (q_.has_level_of_detail()) lod.emplace(q_.view->camera, *q_.view->lod, q_.view->lod_pixels);
         Frustum frustum{};
         if (q_.view) frustum = frustum_from_camera(q_.view->camera);
 
@@ -332,23 +410,34 @@ private:
             f.resize((h_.blocks + 63) / 64, 0);
             only = std::move(f);
         }
-        Bits exc;
+        Bits exc, inc_inside;
         if (blocks_mode && !q_.include.empty()) {
-            Bits inc = near_any(q_.include);
+            Bits inc = near_any(q_.include, &inc_inside);
             if (only) and_bits(*only, inc);
             else only = std::move(inc);
         }
         if (blocks_mode && !q_.exclude.empty()) exc = near_any(q_.exclude);
 
-        RunWriter out(options_, sink, stats_);
+        RunWriter out(options_, sink, stats_, batch_blocks(h_) * h_.points_per_block);
         CandidateBlocks candidates(file_, keep_, only ? &*only : nullptr);
         std::vector<std::uint32_t> blocks, need;
         std::vector<std::uint64_t> fibers;
-        std::vector<std::size_t> at_need, next_at_need, staged;
+        std::vector<std::size_t> at_need, next_at_need;
         enum Kind : std::uint8_t { dropped, fine, coarse };
         std::vector<Kind> kind;
-        DecodeStage stage(ctx_);
-        while (candidates.next(kBatchBlocks, blocks, fibers)) {
+        const std::uint32_t bb = h_.block_bytes();
+        // Point tests needed: near an include region but not wholly inside one,
+        // or near an exclude region.
+        auto include_test = [&](std::size_t i) {
+            return blocks_mode && !q_.include.empty() && !has_bit(inc_inside, blocks[i]);
+        };
+        auto exclude_test = [&](std::size_t i) { return blocks_mode && !exc.empty() && has_bit(exc, blocks[i]); };
+        auto region_test = [&](std::size_t i) { return include_test(i) || exclude_test(i); };
+        auto passes_regions = [&](std::size_t i, const float* p, std::uint32_t n) {
+            if (include_test(i) && !any_point_in(q_.include, p, n)) return false;
+            return !(exclude_test(i) && any_point_in(q_.exclude, p, n));
+        };
+        while (candidates.next(batch_blocks(h_), blocks, fibers)) {
             // With a level of detail, the next block's first point may end a segment.
             need.clear(), at_need.assign(blocks.size(), 0), next_at_need.assign(blocks.size(), SIZE_MAX);
             for (std::size_t i = 0; i < blocks.size(); ++i) {
@@ -362,59 +451,86 @@ private:
             }
             reader_.read(need);
 
-            // Header tests, then one decode call for the blocks whose points are needed.
-            kind.assign(blocks.size(), dropped);
-            staged.assign(blocks.size(), SIZE_MAX);
-            stage.clear();
-            for (std::size_t i = 0; i < blocks.size(); ++i) {
-                const std::uint8_t* block = reader_.block(at_need[i]);
-                kind[i] = fine;
-                if (q_.view) {
-                    const Sphere s = block_bounding_sphere(h_, block);
-                    if (cull && !sphere_intersects_frustum(frustum, s.center, s.radius)) {
+            // Header tests: the block's sphere against the frustum and the level of detail.
+            kind.assign(blocks.size(), fine);
+            if (q_.view)
+                for (std::size_t i = 0; i < blocks.size(); ++i) {
+                    // Scattered headers: fetch a few blocks ahead.
+                    if (i + 8 < blocks.size()) __builtin_prefetch(reader_.block(at_need[i + 8]));
+                    const Sphere s = block_bounding_sphere(h_, reader_.block(at_need[i]));
+                    if (cull && !sphere_intersects_frustum(frustum, s.center, s.radius))
                         kind[i] = dropped;
-                        continue;
-                    }
-                    if (lod && block_is_coarse(q_.view->camera, *q_.view->lod, s.center, s.radius, q_.view->lod_pixels))
+                    else if (lod && lod->coarse(s.center, s.radius))
                         kind[i] = coarse;
                 }
-                const bool region_test = blocks_mode && (!q_.include.empty() || (!exc.empty() && has_bit(exc, blocks[i])));
-                const bool last_of_fiber = std::uint64_t(blocks[i]) + 1 == file_.block_end(fibers[i] + 1);
-                const bool needs_points = region_test || (kind[i] == fine && options_.points) ||
-                                          (kind[i] == coarse && last_of_fiber && BlockView{block}.point_count() > 1);
-                if (needs_points) staged[i] = stage.add(block);
-            }
-            if (stage.size() > 0) stage.decode();
-            stats_.blocks_decoded += stage.size();
 
-            for (std::size_t i = 0; i < blocks.size(); ++i) {
+            for (std::size_t i = 0, j; i < blocks.size(); i = j) {
+                j = i + 1;
                 if (kind[i] == dropped) continue;
                 const std::uint8_t* block = reader_.block(at_need[i]);
-                const std::uint32_t n = BlockView{block}.point_count();
-                const float* p = staged[i] == SIZE_MAX ? nullptr : stage.points(staged[i]);
-                if (blocks_mode && p && (!q_.include.empty() || (!exc.empty() && has_bit(exc, blocks[i])))) {
-                    const bool meets = q_.include.empty() || any_point_in(q_.include, p, n);
-                    if (!meets || (!exc.empty() && has_bit(exc, blocks[i]) && any_point_in(q_.exclude, p, n)))
-                        continue;
-                }
-                if (kind[i] == fine) {
-                    out.fine(fibers[i], blocks[i], p, n);
+                if (kind[i] == coarse) {
+                    // First point, then the next block's first point or the fiber's last point.
+                    const std::uint32_t n = block_flags(h_, block).point_count;
+                    const bool last = next_at_need[i] == SIZE_MAX;
+                    if (region_test(i) || (last && n > 1)) {
+                        decode_into(ctx_, block, 1, scratch_, 0);
+                        ++stats_.blocks_decoded;
+                        if (!passes_regions(i, scratch_.data(), n)) continue;
+                    }
+                    Vec3f end{};
+                    if (!last) end = first_point(h_, reader_.block(next_at_need[i]));
+                    else if (n > 1) end = {scratch_[3 * (n - 1)], scratch_[3 * (n - 1) + 1], scratch_[3 * (n - 1) + 2]};
+                    out.coarse(fibers[i], blocks[i], first_point(h_, block), last && n < 2 ? nullptr : &end);
+                    out.maybe_flush();
                     continue;
                 }
-                // Coarse: first point, then the next block's first point or the fiber's last point.
-                Vec3f end{};
-                const Vec3f* end_ptr = nullptr;
-                if (next_at_need[i] != SIZE_MAX) {
-                    end = first_point(h_, reader_.block(next_at_need[i]));
-                    end_ptr = &end;
-                } else if (n > 1) {
-                    end = {p[3 * (n - 1)], p[3 * (n - 1) + 1], p[3 * (n - 1) + 2]};
-                    end_ptr = &end;
+                // Fine blocks up to the next coarse one (dropped ones left
+                // out): decoded with one call, straight into the output, then
+                // kept or dropped in place.
+                segment_.assign(1, i);
+                bool test = region_test(i);
+                for (; j < blocks.size() && kind[j] != coarse; ++j)
+                    if (kind[j] == fine) segment_.push_back(j), test |= region_test(j);
+                if (!options_.points && !test) {
+                    for (std::size_t k : segment_)
+                        out.fine(fibers[k], blocks[k], 0, block_flags(h_, reader_.block(at_need[k])).point_count);
+                    out.maybe_flush();
+                    continue;
                 }
-                out.coarse(fibers[i], blocks[i], first_point(h_, block), end_ptr);
+                const std::uint8_t* bytes =
+                    contiguous(blocks, segment_, [&](std::size_t k) { return reader_.block(at_need[k]); });
+                out.break_unless_continues(fibers[i], blocks[i]);
+                const std::size_t base = out.frontier();
+                const std::size_t decoded = decode_into(ctx_, bytes, segment_.size(), out.buffer(), base);
+                stats_.blocks_decoded += segment_.size();
+                std::size_t at = base;
+                for (std::size_t s = 0; s < segment_.size(); ++s) {
+                    const std::size_t k = segment_[s];
+                    const std::uint32_t n = block_flags(h_, bytes + s * bb).point_count;
+                    if (passes_regions(k, &out.buffer()[3 * at], n)) out.fine(fibers[k], blocks[k], at, n);
+                    at += n;
+                }
+                out.advance(decoded);
+                out.maybe_flush();
             }
         }
         out.finish();
+    }
+
+    // The blocks blocks[items[0]], blocks[items[1]], ... one after the other
+    // in memory: where they are when they follow each other in the file,
+    // else copied into staging_ (76 bytes a block, against 720 decoded).
+    template <class BlockOf>
+    const std::uint8_t* contiguous(const std::vector<std::uint32_t>& blocks, const std::vector<std::size_t>& items,
+                                   const BlockOf& block_of) {
+        const std::uint32_t bb = h_.block_bytes();
+        bool in_place = true;
+        for (std::size_t s = 1; s < items.size() && in_place; ++s)
+            in_place = blocks[items[s]] == blocks[items[0]] + s;
+        if (in_place) return block_of(items[0]);
+        staging_.resize(items.size() * bb);
+        for (std::size_t s = 0; s < items.size(); ++s) std::memcpy(&staging_[s * bb], block_of(items[s]), bb);
+        return staging_.data();
     }
 
     const FftFile& file_;
@@ -425,6 +541,9 @@ private:
     DecodeContext ctx_;
     detail::BlockBatchReader reader_;
     std::vector<std::uint8_t> keep_;
+    std::vector<float> scratch_;  // decoded points that are tested, not output
+    std::vector<std::uint8_t> staging_;
+    std::vector<std::size_t> segment_;
     SelectionStats stats_;
 };
 
@@ -440,9 +559,10 @@ Streamlines select_streamlines(const FftFile& file, const BlockIndex& index, con
     Streamlines all;
     if (runs) runs->clear();
     const SelectionStats s = select(file, index, query, [&](const SelectedChunk& c) {
-        const std::uint64_t base = all.point_count();
-        all.xyz.insert(all.xyz.end(), c.lines.xyz.begin(), c.lines.xyz.end());
-        for (std::size_t i = 1; i < c.lines.offsets.size(); ++i) all.offsets.push_back(base + c.lines.offsets[i]);
+        for (std::size_t i = 0; i < c.size(); ++i) {
+            all.xyz.insert(all.xyz.end(), c.xyz_of(i), c.xyz_of(i) + 3 * c.points_of(i));
+            all.offsets.push_back(all.offsets.back() + c.points_of(i));
+        }
         if (runs) runs->insert(runs->end(), c.runs.begin(), c.runs.end());
     });
     if (stats) *stats = s;

@@ -79,18 +79,31 @@ bool box_intersects_frustum(const Frustum& f, const Aabb& box, float margin) {
     return true;
 }
 
-float projected_radius_px(const Camera& c, const Viewport& v, Vec3f center, float radius) {
-    const Basis b = camera_basis(c);
-    const float depth = -dot(b.back, center - c.position);  // distance along the view direction
+LevelOfDetail::LevelOfDetail(const Camera& c, const Viewport& v, float lod_pixels)
+    : position_(c.position),
+      back_(camera_basis(c).back),
+      tan_half_fov_(std::tan(c.fov_y_deg * float(M_PI) / 360.0f)),
+      half_height_(0.5f * float(v.height)),
+      lod_pixels_(lod_pixels) {}
+
+float LevelOfDetail::radius_px(Vec3f center, float radius) const {
+    const float depth = -dot(back_, center - position_);  // distance along the view direction
     if (depth <= radius) return std::numeric_limits<float>::infinity();
-    const float ty = std::tan(c.fov_y_deg * float(M_PI) / 360.0f);
-    return radius / (depth * ty) * 0.5f * float(v.height);
+    return radius / (depth * tan_half_fov_) * half_height_;
+}
+
+float projected_radius_px(const Camera& c, const Viewport& v, Vec3f center, float radius) {
+    return LevelOfDetail(c, v).radius_px(center, radius);
+}
+
+bool block_is_coarse(const Camera& c, const Viewport& v, Vec3f center, float radius, float lod_pixels) {
+    return LevelOfDetail(c, v, lod_pixels).coarse(center, radius);
 }
 
 Sphere block_bounding_sphere(const FftHeader& h, const std::uint8_t* bytes) {
-    const BlockView block{bytes};
-    const auto a = block.anchors_normalized();
-    return block_bounding_sphere(h, h.to_world(a[0], a[1], a[2]), h.to_world(a[3], a[4], a[5]), block.point_count());
+    const auto a = block_anchors_normalized(h, bytes);
+    return block_bounding_sphere(h, h.to_world(a[0], a[1], a[2]), h.to_world(a[3], a[4], a[5]),
+                                 block_flags(h, bytes).point_count);
 }
 
 Sphere block_bounding_sphere(const FftHeader& h, Vec3f a0, Vec3f a1, std::uint32_t n) {

@@ -1,0 +1,205 @@
+// Selective decoding on the medium tractogram: the time of queries keeping
+// about 1 %, 10 % and 50 % of the blocks against a full decode, and the
+// index's size and load/compute times.
+//
+// Data: $FIBLET_BENCH_DATA (default: bench-data/ next to the build's bench/
+// directory, i.e. build/bench-data) must hold medium-ifod1.tck (made by
+// `shared/data/make-tractograms.sh -o build/bench-data medium`); it is
+// compressed once to medium-ifod1.fft there (again when the .tck is newer:
+// delete the .fft after changing the encoder). Without it the benchmarks use
+// shared/data/small-ifod1.tck and say so in their labels. Everything runs on
+// one thread; times are compared as CPU time.
+// scripts/bench_select.sh runs everything and prints the table of docs/select.md.
+#include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "fiblet/block_index.hpp"
+#include "fiblet/compress.hpp"
+#include "fiblet/decode.hpp"
+#include "fiblet/fft_file.hpp"
+#include "fiblet/select.hpp"
+
+namespace fs = std::filesystem;
+using namespace fiblet;
+
+namespace {
+
+fs::path executable_dir() {
+    std::error_code ec;
+    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    return ec ? fs::current_path() : exe.parent_path();
+}
+
+// The benchmark file (compressed on first use) and its name for labels.
+struct BenchFile {
+    std::string path, label;
+    std::unique_ptr<FftFile> file;
+    std::unique_ptr<BlockIndex> index;
+};
+
+BenchFile& bench_file() {
+    static BenchFile f = [] {
+        BenchFile b;
+        const char* env = std::getenv("FIBLET_BENCH_DATA");
+        const fs::path dir = env ? fs::path(env) : executable_dir().parent_path() / "bench-data";
+        fs::path tck = dir / "medium-ifod1.tck";
+        b.label = "medium";
+        if (!fs::exists(tck)) {
+            tck = fs::path(FIBLET_SHARED_DIR) / "data" / "small-ifod1.tck";
+            b.label = "small (medium-ifod1.tck not found)";
+        }
+        fs::create_directories(dir);
+        const fs::path fft = dir / (tck.stem().string() + ".fft");
+        if (!fs::exists(fft) || fs::last_write_time(fft) < fs::last_write_time(tck)) {
+            CompressOptions o;
+            o.overwrite = true;
+            compress_tck(tck.string(), fft.string(), o);
+        }
+        b.path = fft.string();
+        b.file = std::make_unique<FftFile>(b.path);
+        b.index = std::make_unique<BlockIndex>(BlockIndex::load(*b.file));
+        return b;
+    }();
+    return f;
+}
+
+std::uint64_t kept_blocks(const Query& q) {
+    SelectionStats s;
+    select_runs(*bench_file().file, *bench_file().index, q, &s);
+    return s.blocks;
+}
+
+// The query of a family keeping about `percent` % of the blocks: a
+// parameter found by bisection (cached).
+enum class Family { region_blocks, region_fibers, frustum, frustum_lod, random_fibers };
+
+Query make_query(Family family, double t) {
+    Query q;
+    const Vec3f centre{0, 0, 0};
+    switch (family) {
+        case Family::region_blocks:
+            q.roi_mode = RoiMode::blocks;
+            q.include.push_back(Region::sphere(centre, float(t)));
+            break;
+        case Family::region_fibers:
+            q.include.push_back(Region::sphere(centre, float(t)));
+            break;
+        case Family::frustum:
+        case Family::frustum_lod: {
+            // A camera 250 mm away, zooming in: field of view t degrees and
+            // a depth slab of +-2t mm around the centre.
+            ViewSelection v;
+            v.camera.position = {0, -30, 250};
+            v.camera.target = centre;
+            const float d = std::sqrt(30.0f * 30.0f + 250.0f * 250.0f);
+            v.camera.fov_y_deg = float(t) + 0.01f;
+            v.camera.near_mm = d - 2 * float(t);
+            v.camera.far_mm = d + 2 * float(t) + 0.01f;
+            v.camera.aspect = 1.0f;
+            if (family == Family::frustum_lod) v.lod = Viewport{1024, 1024};
+            q.view = v;
+            break;
+        }
+        case Family::random_fibers:
+            q.random_fraction = t;
+            q.random_seed = 1;
+            break;
+    }
+    return q;
+}
+
+Query query_keeping(Family family, int percent) {
+    static std::map<std::pair<int, int>, Query> cache;
+    const auto key = std::make_pair(int(family), percent);
+    if (auto it = cache.find(key); it != cache.end()) return it->second;
+    const double target = percent / 100.0 * double(bench_file().file->header().blocks);
+    double lo = 0, hi = family == Family::random_fibers ? 1.0 : (family == Family::frustum || family == Family::frustum_lod ? 60.0 : 80.0);
+    for (int i = 0; i < 22; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (double(kept_blocks(make_query(family, mid))) < target ? lo : hi) = mid;
+    }
+    return cache[key] = make_query(family, 0.5 * (lo + hi));
+}
+
+void report(benchmark::State& state, const SelectionStats& s) {
+    const double blocks = double(bench_file().file->header().blocks);
+    state.counters["kept_pct"] = 100.0 * double(s.blocks) / blocks;
+    state.counters["read_pct"] = 100.0 * double(s.blocks_read) / blocks;
+    state.counters["decoded_pct"] = 100.0 * double(s.blocks_decoded) / blocks;
+    state.counters["coarse_pct"] = 100.0 * double(s.coarse_blocks) / blocks;
+    state.SetLabel(bench_file().label);
+}
+
+// Full decode with decode_file on one thread (as the selection runs), in
+// chunks of state.range(0) blocks (its default, 65536, is 47 MB of points
+// per chunk; 4096 stays in cache).
+void BM_SelectFullDecode(benchmark::State& state) {
+    const FftFile& file = *bench_file().file;
+    std::uint64_t points = 0;
+    DecodeOptions o;
+    o.chunk_blocks = std::size_t(state.range(0));
+    o.threads = 1;
+    for (auto _ : state) {
+        decode_file(file, [&](std::uint64_t, const Streamlines& c) { points += c.point_count(); }, o);
+        benchmark::DoNotOptimize(points);
+    }
+    state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(file.header().points));
+    state.SetLabel(bench_file().label + ", " + decoder_name(resolve_decoder({})));
+}
+BENCHMARK(BM_SelectFullDecode)->Arg(DecodeOptions{}.chunk_blocks)->Arg(4096)->Unit(benchmark::kMillisecond);
+
+void BM_SelectQuery(benchmark::State& state, Family family) {
+    const Query q = query_keeping(family, int(state.range(0)));
+    SelectionStats stats;
+    for (auto _ : state) {
+        std::uint64_t points = 0;
+        stats = select(*bench_file().file, *bench_file().index, q,
+                       [&](const SelectedChunk& c) { points += c.point_count(); });
+        benchmark::DoNotOptimize(points);
+    }
+    report(state, stats);
+}
+BENCHMARK_CAPTURE(BM_SelectQuery, RegionBlocks, Family::region_blocks)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SelectQuery, RegionFibers, Family::region_fibers)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SelectQuery, Frustum, Family::frustum)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SelectQuery, FrustumLod, Family::frustum_lod)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SelectQuery, RandomFibers, Family::random_fibers)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
+
+void BM_SelectEverything(benchmark::State& state) {
+    SelectionStats stats;
+    for (auto _ : state) {
+        std::uint64_t points = 0;
+        stats = select(*bench_file().file, *bench_file().index, Query{},
+                       [&](const SelectedChunk& c) { points += c.point_count(); });
+        benchmark::DoNotOptimize(points);
+    }
+    report(state, stats);
+}
+BENCHMARK(BM_SelectEverything)->Unit(benchmark::kMillisecond);
+
+void BM_SelectIndexLoad(benchmark::State& state) {
+    const FftFile& file = *bench_file().file;
+    for (auto _ : state) benchmark::DoNotOptimize(BlockIndex::load(file).blocks());
+    const TrailerChunk* c = file.find_chunk(kBlockIndexTag);
+    const double index_bytes = c ? double(c->payload.size() + 16) : 0.0;
+    state.counters["index_bytes"] = index_bytes;
+    state.counters["index_pct_of_file"] = 100.0 * index_bytes / double(file.file_size() - std::uint64_t(index_bytes));
+    state.counters["bytes_per_block"] = index_bytes / double(file.header().blocks);
+    state.SetLabel(bench_file().label);
+}
+BENCHMARK(BM_SelectIndexLoad)->Unit(benchmark::kMillisecond);
+
+void BM_SelectIndexCompute(benchmark::State& state) {
+    for (auto _ : state) benchmark::DoNotOptimize(BlockIndex::compute(*bench_file().file).blocks());
+    state.SetLabel(bench_file().label);
+}
+BENCHMARK(BM_SelectIndexCompute)->Unit(benchmark::kMillisecond);
+
+}  // namespace
