@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "codec/parameters.hpp"
+#include "io/fft_sink.hpp"
 #include "fiblet/encode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/output_file.hpp"
@@ -223,16 +224,14 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     h.blocks = std::uint32_t(blocks);
 
     // Pass 2: encode, measure, write.
-    AtomicOutputFile out(fft_path, options.overwrite);
-    {
-        const auto head = serialize_fft_header(h);
-        out.write(head.data(), head.size());
-        out.write(lut.data(), lut.size() * sizeof(FiberLutEntry));
-    }
+    const unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+    const auto out = detail::open_fft_sink(fft_path, options.overwrite, options.zstd, h.direction_bits(),
+                                           h.block_bytes(), threads);
+    out->begin(serialize_fft_header(h), {reinterpret_cast<const std::uint8_t*>(lut.data()),
+                                         lut.size() * sizeof(FiberLutEntry)});
     reader.rewind();
     // Batches of whole fibers are read in order, encoded by `threads`
     // workers on contiguous sub-ranges, and written in order.
-    const unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
     struct Work {
         std::vector<std::uint8_t> blocks;
         std::vector<Vec3f> decoded, resampled;
@@ -282,30 +281,27 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             pool.emplace_back(encode_range, std::ref(work[t]), cut[t], cut[t + 1], next_fiber);
         encode_range(work[0], cut[0], cut[1], next_fiber);
         for (auto& th : pool) th.join();
-        for (std::size_t t = 0; t + 1 < cut.size(); ++t) out.write(work[t].blocks.data(), work[t].blocks.size());
+        for (std::size_t t = 0; t + 1 < cut.size(); ++t) out->write_blocks(work[t].blocks);
         next_fiber += std::uint32_t(n);
         report_progress(options, "encode", reader);
     }
     for (const Work& w : work) report.error.merge(w.error), report.error_vs_original.merge(w.error_vs_original);
+    std::vector<std::uint8_t> trailer;
     {
-        const std::uint64_t at = out.size();
+        const std::uint64_t at = out->logical_size();
         std::vector<TrailerChunk> chunks{make_properties_chunk(reader.header().properties)};
         if (report.resampled) {
             TrailerChunk c{kResampledTag, std::vector<std::uint8_t>(8)};
             std::memcpy(c.payload.data(), &step, 8);
             chunks.push_back(std::move(c));
         }
-        const auto trailer = serialize_trailer(chunks, at);
-        out.write(trailer.data(), trailer.size());
+        trailer = serialize_trailer(chunks, at);
     }
     h.max_error_mm = float(report.error.max_mm());
     h.mean_error_mm = float(report.error.mean_mm());
-    {
-        const auto head = serialize_fft_header(h);
-        out.write_at(head.data(), head.size(), 0);
-    }
-    report.output_bytes = out.size();
-    out.commit();
+    out->finish(trailer, serialize_fft_header(h));
+    report.output_bytes = out->stored_size();
+    out->commit();
     if (options.progress) options.progress("encode", 1.0);
 
     struct stat st {};

@@ -10,6 +10,7 @@
 
 #include "core/bytes.hpp"
 #include "fiblet/error.hpp"
+#include "io/fftz_reader.hpp"
 
 namespace fiblet {
 using detail::get_le;
@@ -87,14 +88,21 @@ FftFile::FftFile(const std::string& path) : path_(path) {
         ::close(fd_);
         throw Error(Errc::io, path + ": not a regular file");
     }
-    file_size_ = std::uint64_t(st.st_size);
+    file_size_ = logical_size_ = std::uint64_t(st.st_size);
     try {
-        std::vector<std::uint8_t> head(std::min<std::uint64_t>(file_size_, kFftFixedHeaderBytes + 8 * 255));
-        pread_all(fd_, head.data(), head.size(), 0, path);
-        header_ = parse_fft_header(head, file_size_, path);
+        std::uint8_t magic[12] = {};
+        if (file_size_ >= sizeof magic) pread_all(fd_, magic, sizeof magic, 0, path);
+        if (detail::FftzReader::recognizes(magic, file_size_ >= sizeof magic ? sizeof magic : 0)) {
+            fftz_ = std::make_unique<detail::FftzReader>(fd_, file_size_, path);
+            logical_size_ = fftz_->logical_size();
+        }
+        std::vector<std::uint8_t> head(std::min<std::uint64_t>(logical_size_, kFftFixedHeaderBytes + 8 * 255));
+        read_at(head.data(), head.size(), 0);
+        header_ = parse_fft_header(head, logical_size_, path);
+        if (fftz_) fftz_->check_layout(header_);
 
         std::vector<std::uint8_t> raw(8 * header_.fibers);
-        pread_all(fd_, raw.data(), raw.size(), header_.lut_offset(), path);
+        read_at(raw.data(), raw.size(), header_.lut_offset());
         lut_.resize(header_.fibers);
         fiber_first_block_.resize(header_.fibers);
         std::uint64_t next = 0;  // fibers are stored in order, their blocks contiguous
@@ -121,31 +129,37 @@ FftFile::FftFile(const std::string& path) : path_(path) {
                           std::to_string(header_.blocks));
         read_trailer();
     } catch (...) {
+        fftz_.reset();
         ::close(fd_);
         fd_ = -1;
         throw;
     }
 }
 
+void FftFile::read_at(std::uint8_t* out, std::uint64_t size, std::uint64_t offset) const {
+    if (fftz_) fftz_->read(out, size, offset);
+    else pread_all(fd_, out, size, offset, path_);
+}
+
 void FftFile::read_trailer() {
     const std::uint64_t end = header_.file_bytes();
-    if (file_size_ < end + kTrailerFooterBytes) return;  // no trailer: a plain version-2 file
+    if (logical_size_ < end + kTrailerFooterBytes) return;  // no trailer: a plain version-2 file
     std::uint8_t footer[kTrailerFooterBytes];
-    pread_all(fd_, footer, sizeof footer, file_size_ - sizeof footer, path_);
+    read_at(footer, sizeof footer, logical_size_ - sizeof footer);
     if (std::memcmp(footer + 8, kTrailerMagic, 8) != 0) return;  // foreign trailing bytes: ignored
     if (get_le<std::uint64_t>(footer) != end) bad(path_, "trailer does not start after the last block");
     std::uint64_t pos = end;
-    const std::uint64_t stop = file_size_ - kTrailerFooterBytes;
+    const std::uint64_t stop = logical_size_ - kTrailerFooterBytes;
     while (pos < stop) {
         std::uint8_t head[16];
         if (stop - pos < sizeof head) bad(path_, "truncated trailer chunk header");
-        pread_all(fd_, head, sizeof head, pos, path_);
+        read_at(head, sizeof head, pos);
         const std::uint64_t size = get_le<std::uint64_t>(head + 8);
         if (size > stop - pos - sizeof head) bad(path_, "trailer chunk runs past the footer");
         TrailerChunk chunk;
         std::memcpy(chunk.tag.data(), head, 4);
         chunk.payload.resize(size);
-        pread_all(fd_, chunk.payload.data(), size, pos + sizeof head, path_);
+        read_at(chunk.payload.data(), size, pos + sizeof head);
         trailer_.push_back(std::move(chunk));
         pos += sizeof head + size;
     }
@@ -185,7 +199,8 @@ FftFile::~FftFile() {
 }
 
 FftFile::FftFile(FftFile&& o) noexcept
-    : path_(std::move(o.path_)), fd_(o.fd_), file_size_(o.file_size_), header_(std::move(o.header_)),
+    : path_(std::move(o.path_)), fd_(o.fd_), file_size_(o.file_size_), logical_size_(o.logical_size_),
+      fftz_(std::move(o.fftz_)), header_(std::move(o.header_)),
       lut_(std::move(o.lut_)), fiber_first_block_(std::move(o.fiber_first_block_)), trailer_(std::move(o.trailer_)) {
     o.fd_ = -1;
 }
@@ -197,6 +212,8 @@ FftFile& FftFile::operator=(FftFile&& o) noexcept {
         fd_ = o.fd_;
         o.fd_ = -1;
         file_size_ = o.file_size_;
+        logical_size_ = o.logical_size_;
+        fftz_ = std::move(o.fftz_);
         header_ = std::move(o.header_);
         lut_ = std::move(o.lut_);
         fiber_first_block_ = std::move(o.fiber_first_block_);
@@ -209,7 +226,7 @@ void FftFile::read_blocks(std::uint64_t first, std::uint64_t count, std::uint8_t
     if (first > header_.blocks || count > header_.blocks - first)
         throw Error(Errc::invalid_argument, path_ + ": block range past the end");
     const std::uint64_t bb = header_.block_bytes();
-    pread_all(fd_, out, count * bb, header_.blocks_offset() + first * bb, path_);
+    read_at(out, count * bb, header_.blocks_offset() + first * bb);
 }
 
 std::vector<std::uint8_t> FftFile::read_blocks(std::uint64_t first, std::uint64_t count) const {
