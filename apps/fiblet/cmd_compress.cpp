@@ -23,6 +23,7 @@ struct CompressArgs {
     std::optional<unsigned> beam, radius, retry_beam;
     std::optional<double> cap_ratio, step_scale;
     std::optional<double> turn_percentile;
+    std::optional<std::size_t> tuning_points;
     // The seekable zstd container.
     bool zstd = false, no_transpose = false;
     int zstd_level = ZstdOptions{}.level;
@@ -83,6 +84,7 @@ void run(const CompressArgs& a) {
         o.cap_ratio = a.cap_ratio;
         o.step_scale = a.step_scale;
         o.turn_percentile = a.turn_percentile;
+        if (a.tuning_points) o.tuning_points = *a.tuning_points;
         if (a.zstd) o.zstd = ZstdOptions{a.zstd_level, a.zstd_group, !a.no_transpose};
         const std::string name = std::filesystem::path(in).filename().string();
         o.progress = [&](const char* phase, double f) { progress.update(name + ": " + phase, f); };
@@ -150,6 +152,7 @@ void add_compress(CLI::App& app) {
     cmd->add_option("--turn-percentile", args->turn_percentile,
                     "Size the cap for this percentile of the turning angles (default: tuned)")
         ->check(CLI::Range(50.0, 100.0));
+    cmd->add_option("--tuning-points", args->tuning_points, "Points in the sample the cap and step are tuned on");
     cmd->add_option("--step-scale", args->step_scale, "Decoder step / sampling step (default: tuned on a sample)");
     cmd->add_flag("-z,--zstd", args->zstd,
                   "Write the seekable zstd container (.fftz, formats/fftz.md): smaller, still random access");

@@ -260,7 +260,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             }
         }
     };
-    constexpr std::size_t kBatchPoints = 1u << 20;
+    const std::size_t kBatchPoints = std::size_t(threads) << 16;  // ~0.8 MB of points per thread: stays in cache
     std::uint32_t next_fiber = 0;
     for (bool more = true; more;) {
         std::size_t n = 0, points = 0;
