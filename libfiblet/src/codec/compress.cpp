@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <thread>
 
 #include "codec/parameters.hpp"
@@ -26,24 +27,30 @@ namespace {
 
 // Median of segment lengths from a histogram of their float32 bit patterns
 // (the top 13 mantissa bits: 1.2e-4 relative resolution between 1 um and
-// 2 m, no logarithm per segment): constant memory for any input size.
+// 2 m, no logarithm per segment), one block of bins per binary exponent,
+// allocated when a length first falls in it: constant, small memory.
 class LengthHistogram {
 public:
-    LengthHistogram() : bins_(kBins + 2, 0) {}
     void add(double len) {
         const float f = float(len);
-        std::size_t i = 0;
-        if (f >= kMin) i = 1 + std::min<std::size_t>(kBins, (std::bit_cast<std::uint32_t>(f) - kMinBits) >> kShift);
-        ++bins_[i], ++count_;
+        ++count_;
+        if (!(f >= kMin)) return ++below_, void();
+        const std::uint32_t i = std::min<std::uint32_t>((std::bit_cast<std::uint32_t>(f) - kMinBits) >> kShift, kBins - 1);
+        auto& block = blocks_[i >> kMantissaBits];
+        if (!block) block = std::make_unique<std::uint64_t[]>(kBlock);  // zeroed
+        ++block[i & (kBlock - 1)];
     }
     double median() const {
-        std::uint64_t seen = 0;
-        for (std::size_t i = 0; i < bins_.size(); ++i) {
-            seen += bins_[i];
-            if (2 * seen >= count_ && count_ > 0) {
-                if (i == 0) return 0.0;
-                const auto lo = std::uint32_t(kMinBits + ((i - 1) << kShift));
-                return 0.5 * (double(std::bit_cast<float>(lo)) + double(std::bit_cast<float>(lo + (1u << kShift))));
+        std::uint64_t seen = below_;
+        if (count_ == 0 || 2 * seen >= count_) return 0.0;
+        for (std::uint32_t e = 0; e < kExponents; ++e) {
+            if (!blocks_[e]) continue;
+            for (std::uint32_t j = 0; j < kBlock; ++j) {
+                seen += blocks_[e][j];
+                if (2 * seen >= count_) {
+                    const std::uint32_t lo = kMinBits + ((e * kBlock + j) << kShift);
+                    return 0.5 * (double(std::bit_cast<float>(lo)) + double(std::bit_cast<float>(lo + (1u << kShift))));
+                }
             }
         }
         return 0.0;
@@ -52,9 +59,10 @@ public:
 private:
     static constexpr float kMin = 0x1p-20f;
     static constexpr std::uint32_t kMinBits = std::bit_cast<std::uint32_t>(kMin), kShift = 10;
-    static constexpr std::size_t kBins = std::size_t(31) << (23 - kShift);  // 2^-20 .. 2^11
-    std::vector<std::uint64_t> bins_;
-    std::uint64_t count_ = 0;
+    static constexpr std::uint32_t kMantissaBits = 23 - kShift, kBlock = 1u << kMantissaBits;
+    static constexpr std::uint32_t kExponents = 31, kBins = kExponents * kBlock;  // 2^-20 .. 2^11 mm
+    std::array<std::unique_ptr<std::uint64_t[]>, kExponents> blocks_;
+    std::uint64_t count_ = 0, below_ = 0;
 };
 
 double length(Vec3f a, Vec3f b) {
