@@ -191,13 +191,14 @@ double ratio_for_angle(double a) { return 1 - std::cos(a); }
 
 TEST(EncodeStress, FiberOf100000Points) {
     // 10 m of fiber wound into a 30 x 30 x 50 mm helix with wiggles (turns
-    // of up to ~8 degrees per step), so that anchors stay fine-grained and
-    // the bound is set by the codes. Resampled to an exact 0.1 mm step.
+    // of up to ~7 degrees per step, inside the 12-degree cap), so that anchors
+    // stay fine-grained and the bound is set by the codes. Resampled to an
+    // exact 0.1 mm step.
     Fiber raw;
     for (int k = 0; k < 400000; ++k) {
         const double t = 0.025 * k / 15.0;  // ~0.025 mm of arc per raw point
-        raw.push_back({float(15 * std::cos(t) + 0.3 * std::sin(37 * t)), float(15 * std::sin(t) + 0.3 * std::cos(29 * t)),
-                       float(0.08 * t + 0.4 * std::sin(23 * t))});
+        raw.push_back({float(15 * std::cos(t) + 0.1 * std::sin(37 * t)), float(15 * std::sin(t) + 0.1 * std::cos(29 * t)),
+                       float(0.08 * t + 0.2 * std::sin(23 * t))});
     }
     Fiber f;
     resample_fixed_step(raw, 0.1, f);
@@ -205,7 +206,7 @@ TEST(EncodeStress, FiberOf100000Points) {
     ASSERT_EQ(f.size(), 100000u);
     const FftHeader h = header_for({f}, 8, ratio_for_angle(12 * kDeg), 0.1, 1.0005);
     const Outcome o = check_encoding({f}, h, "1e5 points");
-    EXPECT_GT(o.max_excess, -0.01);  // the bound is within 10 um of the worst error: not vacuous
+    EXPECT_GT(o.max_excess, -1e-3);  // somewhere the bound is within 1 um of the error: not vacuous
 }
 
 TEST(EncodeStress, SharpTurnsAtAndBeyondTheCap) {
