@@ -163,3 +163,17 @@ TEST(Fftz, DamagedContainersAreRejected) {
     descriptor[12] = 9;  // container version
     EXPECT_THROW(opens_and_decodes(descriptor), Error);
 }
+
+TEST(Fftz, SeekTablesClaimingHugeFramesAreRejectedBeforeAllocating) {
+    Files f;
+    make(f, 8, true);
+    std::string packed = test::read_file(f.packed);
+    std::uint32_t frames;
+    std::memcpy(&frames, packed.data() + packed.size() - 9, 4);
+    // Entry of frame 2 (the LUT): decompressed size 4 GiB - 1.
+    const std::size_t entry = packed.size() - 9 - 8 * frames + 8 * 2;
+    const std::uint32_t huge = 0xffffffffu;
+    std::memcpy(&packed[entry + 4], &huge, 4);
+    test::write_file(f.dir.file("huge.fftz"), packed);
+    EXPECT_THROW(FftFile{f.dir.file("huge.fftz")}, Error);
+}

@@ -213,7 +213,9 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
         }
     }
     for (; b < n_blocks; ++b)
-        if (block_points(b) > 2) search_block(b, params, codes8_of(b), &codes16[std::size_t(b) * ppb], &points[std::size_t(b) * ppb + 2]);
+        if (block_points(b) > 2)
+            search_block(b, params, wide ? nullptr : codes8_of(b), wide ? codes16.data() + std::size_t(b) * ppb : nullptr,
+                         &points[std::size_t(b) * ppb + 2]);
 
     // Retry: blocks whose largest error exceeds the threshold are searched
     // again with the retry beam; the smaller max error wins.
@@ -239,7 +241,7 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
             search_block(b, retry_params, retry_codes8.data(), retry_codes16.data(), retry_points.data());
             if (max_error2(retry_points.data(), &targets[i0 + 2], m) < first) {
                 std::copy(retry_points.begin(), retry_points.end(), &points[i0 + 2]);
-                if (wide) std::copy(retry_codes16.begin(), retry_codes16.end(), &codes16[i0]);
+                if (wide) std::copy(retry_codes16.begin(), retry_codes16.end(), codes16.begin() + std::ptrdiff_t(i0));
                 else std::copy(retry_codes8.begin(), retry_codes8.end(), codes8_of(b));
             }
         }

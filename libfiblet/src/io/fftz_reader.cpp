@@ -15,6 +15,7 @@ namespace fiblet::detail {
 namespace {
 
 constexpr std::size_t kFrameHeaderBytes = 8;  // skippable frame: magic, size
+constexpr std::uint32_t kMaxFrameBytes = 1u << 30;
 
 void pread_exact(int fd, std::uint8_t* out, std::uint64_t size, std::uint64_t offset, const std::string& name) {
     while (size > 0) {
@@ -57,6 +58,11 @@ FftzReader::FftzReader(int fd, std::uint64_t file_size, std::string name) : fd_(
     for (std::uint32_t i = 0; i < count; ++i) {
         const std::uint8_t* e = table.data() + kFrameHeaderBytes + i * entry_bytes;
         const std::uint32_t c = get_le<std::uint32_t>(e), d = get_le<std::uint32_t>(e + 4);
+        // Sizes are checked before anything is allocated for them: a frame
+        // holds at most 1 GiB (the zstd seekable format's own limit), the
+        // header frame at most the largest .fft header.
+        if (d > kMaxFrameBytes || (i == 1 && d > kFftFixedHeaderBytes + 8 * 255))
+            bad("frame " + std::to_string(i) + " claims " + std::to_string(d) + " bytes");
         frames_.push_back({stored, c, logical, d});
         stored += c, logical += d;
         if (stored > table_at) bad("seek table frames run past the seek table");
