@@ -23,13 +23,18 @@ struct CompressArgs {
     std::optional<unsigned> beam, radius, retry_beam;
     std::optional<double> cap_ratio, step_scale;
     std::optional<double> turn_percentile;
+    std::optional<std::size_t> tuning_points;
+    // The seekable zstd container.
+    bool zstd = false, no_transpose = false;
+    int zstd_level = ZstdOptions{}.level;
+    std::uint32_t zstd_group = ZstdOptions{}.group_blocks;
     bool force = false, quiet = false, json = false, allow_count_mismatch = false;
 };
 
 std::string output_for(const CompressArgs& a, const std::string& in) {
     if (!a.output.empty()) return a.output;
     std::filesystem::path p = std::filesystem::path(in).filename();
-    p.replace_extension(".fft");
+    p.replace_extension(a.zstd ? ".fftz" : ".fft");
     return (a.output_dir.empty() ? std::filesystem::path(in).parent_path() / p : std::filesystem::path(a.output_dir) / p)
         .string();
 }
@@ -79,6 +84,8 @@ void run(const CompressArgs& a) {
         o.cap_ratio = a.cap_ratio;
         o.step_scale = a.step_scale;
         o.turn_percentile = a.turn_percentile;
+        if (a.tuning_points) o.tuning_points = *a.tuning_points;
+        if (a.zstd) o.zstd = ZstdOptions{a.zstd_level, a.zstd_group, !a.no_transpose};
         const std::string name = std::filesystem::path(in).filename().string();
         o.progress = [&](const char* phase, double f) { progress.update(name + ": " + phase, f); };
         try {
@@ -145,7 +152,15 @@ void add_compress(CLI::App& app) {
     cmd->add_option("--turn-percentile", args->turn_percentile,
                     "Size the cap for this percentile of the turning angles (default: tuned)")
         ->check(CLI::Range(50.0, 100.0));
+    cmd->add_option("--tuning-points", args->tuning_points, "Points in the sample the cap and step are tuned on");
     cmd->add_option("--step-scale", args->step_scale, "Decoder step / sampling step (default: tuned on a sample)");
+    cmd->add_flag("-z,--zstd", args->zstd,
+                  "Write the seekable zstd container (.fftz, formats/fftz.md): smaller, still random access");
+    cmd->add_option("--zstd-level", args->zstd_level, "zstd level (default 17)")->check(CLI::Range(1, 22));
+    cmd->add_option("--zstd-group", args->zstd_group, "Blocks per zstd frame, the unit of random access (default 4096)")
+        ->check(CLI::Range(1u, 1u << 24));
+    cmd->add_flag("--no-transpose", args->no_transpose,
+                  "Store block groups as in the .fft (zstd -d then gives back the .fft; slightly larger)");
     cmd->add_flag("-f,--force", args->force, "Overwrite existing outputs");
     cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
     cmd->add_flag("--json", args->json, "Print the report as JSON");

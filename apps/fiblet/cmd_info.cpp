@@ -57,7 +57,7 @@ void info_fft(const InfoArgs& a) {
     for (const auto& c : f.trailer()) chunks += (chunks.empty() ? "" : " ") + std::string(c.tag.data(), 4);
     if (a.json) {
         Json j;
-        j.str("file", a.input).str("format", "fft").integer("version", h.version);
+        j.str("file", a.input).str("format", f.is_zstd_container() ? "fftz" : "fft").integer("version", h.version);
         j.integer("fibers", h.fibers).integer("points", h.points).integer("blocks", h.blocks);
         j.integer("points_per_block", h.points_per_block).integer("block_bytes", h.block_bytes());
         j.num("scaling_mm", h.scaling);
@@ -70,7 +70,10 @@ void info_fft(const InfoArgs& a) {
         fmt::print("{}\n", j.render());
         return;
     }
-    fmt::print("{}: fiblet .fft version {}, {}\n", a.input, h.version, human_bytes(f.file_size()));
+    fmt::print("{}: fiblet .fft version {}{}, {}\n", a.input, h.version,
+               f.is_zstd_container() ? fmt::format(" in a seekable zstd container ({} as .fft)", human_bytes(f.logical_size()))
+                                     : std::string(),
+               human_bytes(f.file_size()));
     fmt::print("  fibers                 {}\n  points                 {}\n", h.fibers, h.points);
     fmt::print("  blocks                 {} x {} B ({} points each)\n", h.blocks, h.block_bytes(), h.points_per_block);
     fmt::print("  step                   {:.6g} mm ({:.6g} normalized)\n", double(h.step) * h.scaling, h.step);

@@ -22,6 +22,10 @@
 
 namespace fiblet {
 
+namespace detail {
+class FftzReader;
+}
+
 // Parses and validates a header from the first bytes of a file. `file_size`
 // is the whole file's size (for the size checks); `name` is used in errors.
 // Throws Error{fft_format}.
@@ -34,6 +38,9 @@ struct FftOpenOptions {
     bool verify_checksums = true;
 };
 
+// Opens plain .fft files and .fftz containers (formats/fftz.md) alike: a
+// container is read through its seek table, decompressing only the frames
+// that hold the requested bytes.
 class FftFile {
 public:
     // Throws Error{io | fft_format | checksum | unsupported}.
@@ -46,7 +53,10 @@ public:
 
     const std::string& path() const { return path_; }
     const FftHeader& header() const { return header_; }
+    // Bytes on disk; for a .fftz, logical_size() is that of the .fft it holds.
     std::uint64_t file_size() const { return file_size_; }
+    std::uint64_t logical_size() const { return logical_size_; }
+    bool is_zstd_container() const { return fftz_ != nullptr; }
     const std::vector<FiberLutEntry>& lut() const { return lut_; }
 
     // Global index of a fiber's first block, and its block count. The LUT is
@@ -93,10 +103,12 @@ private:
     void verify_block_groups(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const;
     void close() noexcept;
 
+    void read_at(std::uint8_t* out, std::uint64_t size, std::uint64_t offset) const;
     std::string path_;
     FftOpenOptions options_;
     int fd_ = -1;
-    std::uint64_t file_size_ = 0;
+    std::uint64_t file_size_ = 0, logical_size_ = 0;
+    std::unique_ptr<detail::FftzReader> fftz_;
     FftHeader header_;
     std::vector<FiberLutEntry> lut_;
     std::vector<std::uint32_t> fiber_first_block_;  // block counts are 32-bit, so are first blocks

@@ -95,12 +95,14 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
     thread_local std::vector<Link> links;  // links[k * width + j]: how state j of step k was reached
     states.assign(1, State{f, p, 0.0f});
     next.resize(width);
-    cand.resize(std::size_t(width) * std::size_t(2 * r + 1) * std::size_t(2 * r + 1));
+    cand.resize(width);
     links.resize(m * width);
     const float step2 = step * step, two_step = 2.0f * step;
 
     for (std::size_t k = 0; k < m; ++k) {
-        std::size_t nc = 0;
+        // The `width` cheapest candidates, kept sorted by cost (insertion from
+        // the end; most candidates are rejected by the first comparison).
+        std::size_t kept = 0;
         for (std::uint32_t s = 0; s < states.size(); ++s) {
             const State& st = states[s];
             // |p + step d - t|^2 = |t - p|^2 + step^2 - 2 step d.(t - p), and d.(t - p) in
@@ -112,13 +114,14 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
             for (int h = std::max(h0 - r, 0); h <= std::min(h0 + r, Codebook::kLevels - 1); ++h)
                 for (int l = std::max(l0 - r, 0); l <= std::min(l0 + r, Codebook::kLevels - 1); ++l) {
                     const auto code = std::uint32_t(h * Codebook::kLevels + l);
-                    cand[nc++] = {base - two_step * dot(cb.direction(code), local), s, code};
+                    const float cost = base - two_step * dot(cb.direction(code), local);
+                    if (kept == width && !(cost < cand[width - 1].cost)) continue;
+                    std::size_t i = kept < width ? kept++ : width - 1;
+                    for (; i > 0 && cand[i - 1].cost > cost; --i) cand[i] = cand[i - 1];
+                    cand[i] = {cost, s, code};
                 }
         }
-        const std::size_t keep = std::min<std::size_t>(width, nc);
-        auto by_cost = [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; };
-        if (keep < nc) std::nth_element(cand.begin(), cand.begin() + std::ptrdiff_t(keep), cand.begin() + std::ptrdiff_t(nc), by_cost);
-        for (std::size_t j = 0; j < keep; ++j) {
+        for (std::size_t j = 0; j < kept; ++j) {
             const Candidate& c = cand[j];
             const State& parent = states[c.parent];
             State& n = next[j];
@@ -127,7 +130,9 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
             n.cost = c.cost;
             links[k * width + j] = {c.parent, c.code};
         }
-        states.assign(next.begin(), next.begin() + std::ptrdiff_t(keep));
+        next.resize(kept);
+        states.swap(next);
+        next.resize(width);
     }
 
     // Back-track the cheapest sequence, then replay it for the decoded points.
@@ -144,5 +149,30 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
         decoded[k] = p;
     }
 }
+
+// Greedy aiming for N blocks of `m` codes each, in lockstep: the blocks are
+// independent, so the N dependency chains (frame -> aim -> code -> frame)
+// overlap in the CPU's pipelines. Same result as search_codes with beam 1.
+template <class Codebook, int N>
+struct GreedyLanes {
+    Frame f[N];
+    Vec3f p[N];
+    const Vec3f* targets[N];
+    typename Codebook::Code* codes[N];
+    Vec3f* decoded[N];
+
+    void run(const Codebook& cb, float step, std::size_t m) {
+        for (std::size_t k = 0; k < m; ++k) {
+            typename Codebook::Code code[N];
+            for (int i = 0; i < N; ++i) code[i] = cb.nearest(apply_transposed(f[i], targets[i][k] - p[i]));
+            for (int i = 0; i < N; ++i) {
+                codes[i][k] = code[i];
+                f[i] = compose(f[i], cb.frame(code[i]));
+                p[i] = p[i] + step * f[i].c[0];
+                decoded[i][k] = p[i];
+            }
+        }
+    }
+};
 
 }  // namespace fiblet::detail

@@ -10,11 +10,13 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <thread>
 
 #include "codec/parameters.hpp"
-#include "fiblet/checksum.hpp"
 #include "fiblet/block_index.hpp"
+#include "fiblet/checksum.hpp"
+#include "io/fft_sink.hpp"
 #include "fiblet/encode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/output_file.hpp"
@@ -27,24 +29,30 @@ namespace {
 
 // Median of segment lengths from a histogram of their float32 bit patterns
 // (the top 13 mantissa bits: 1.2e-4 relative resolution between 1 um and
-// 2 m, no logarithm per segment): constant memory for any input size.
+// 2 m, no logarithm per segment), one block of bins per binary exponent,
+// allocated when a length first falls in it: constant, small memory.
 class LengthHistogram {
 public:
-    LengthHistogram() : bins_(kBins + 2, 0) {}
     void add(double len) {
         const float f = float(len);
-        std::size_t i = 0;
-        if (f >= kMin) i = 1 + std::min<std::size_t>(kBins, (std::bit_cast<std::uint32_t>(f) - kMinBits) >> kShift);
-        ++bins_[i], ++count_;
+        ++count_;
+        if (!(f >= kMin)) return ++below_, void();
+        const std::uint32_t i = std::min<std::uint32_t>((std::bit_cast<std::uint32_t>(f) - kMinBits) >> kShift, kBins - 1);
+        auto& block = blocks_[i >> kMantissaBits];
+        if (!block) block = std::make_unique<std::uint64_t[]>(kBlock);  // zeroed
+        ++block[i & (kBlock - 1)];
     }
     double median() const {
-        std::uint64_t seen = 0;
-        for (std::size_t i = 0; i < bins_.size(); ++i) {
-            seen += bins_[i];
-            if (2 * seen >= count_ && count_ > 0) {
-                if (i == 0) return 0.0;
-                const auto lo = std::uint32_t(kMinBits + ((i - 1) << kShift));
-                return 0.5 * (double(std::bit_cast<float>(lo)) + double(std::bit_cast<float>(lo + (1u << kShift))));
+        std::uint64_t seen = below_;
+        if (count_ == 0 || 2 * seen >= count_) return 0.0;
+        for (std::uint32_t e = 0; e < kExponents; ++e) {
+            if (!blocks_[e]) continue;
+            for (std::uint32_t j = 0; j < kBlock; ++j) {
+                seen += blocks_[e][j];
+                if (2 * seen >= count_) {
+                    const std::uint32_t lo = kMinBits + ((e * kBlock + j) << kShift);
+                    return 0.5 * (double(std::bit_cast<float>(lo)) + double(std::bit_cast<float>(lo + (1u << kShift))));
+                }
             }
         }
         return 0.0;
@@ -53,9 +61,10 @@ public:
 private:
     static constexpr float kMin = 0x1p-20f;
     static constexpr std::uint32_t kMinBits = std::bit_cast<std::uint32_t>(kMin), kShift = 10;
-    static constexpr std::size_t kBins = std::size_t(31) << (23 - kShift);  // 2^-20 .. 2^11
-    std::vector<std::uint64_t> bins_;
-    std::uint64_t count_ = 0;
+    static constexpr std::uint32_t kMantissaBits = 23 - kShift, kBlock = 1u << kMantissaBits;
+    static constexpr std::uint32_t kExponents = 31, kBins = kExponents * kBlock;  // 2^-20 .. 2^11 mm
+    std::array<std::unique_ptr<std::uint64_t[]>, kExponents> blocks_;
+    std::uint64_t count_ = 0, below_ = 0;
 };
 
 double length(Vec3f a, Vec3f b) {
@@ -238,18 +247,19 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     h.blocks = std::uint32_t(blocks);
 
     // Pass 2: encode, measure, write.
-    AtomicOutputFile out(fft_path, options.overwrite);
+    const unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+    const auto out = detail::open_fft_sink(fft_path, options.overwrite, options.zstd, h.direction_bits(),
+                                           h.block_bytes(), threads);
     FftChecksumBuilder checksum(h.block_bytes());  // the CSUM trailer chunk (formats/fft-checksum.md)
     {
-        const auto head = serialize_fft_header(h);
-        out.write(head.data(), head.size());
-        out.write(lut.data(), lut.size() * sizeof(FiberLutEntry));
-        checksum.add_lut(lut.data(), lut.size() * sizeof(FiberLutEntry));
+        const std::span<const std::uint8_t> lut_bytes{reinterpret_cast<const std::uint8_t*>(lut.data()),
+                                                      lut.size() * sizeof(FiberLutEntry)};
+        out->begin(serialize_fft_header(h), lut_bytes);
+        checksum.add_lut(lut_bytes.data(), lut_bytes.size());
     }
     reader.rewind();
     // Batches of whole fibers are read in order, encoded by `threads`
     // workers on contiguous sub-ranges, and written in order.
-    const unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
     struct Work {
         std::vector<std::uint8_t> blocks;
         std::vector<Vec3f> decoded, resampled;
@@ -283,7 +293,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             }
         }
     };
-    constexpr std::size_t kBatchPoints = 1u << 20;
+    const std::size_t kBatchPoints = std::size_t(threads) << 16;  // ~0.8 MB of points per thread: stays in cache
     std::uint32_t next_fiber = 0;
     for (bool more = true; more;) {
         std::size_t n = 0, points = 0;
@@ -305,7 +315,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         encode_range(work[0], cut[0], cut[1], next_fiber);
         for (auto& th : pool) th.join();
         for (std::size_t t = 0; t + 1 < cut.size(); ++t) {
-            out.write(work[t].blocks.data(), work[t].blocks.size());
+            out->write_blocks(work[t].blocks);
             checksum.add_blocks(work[t].blocks.data(), work[t].blocks.size());
             index.append(work[t].index);
         }
@@ -316,8 +326,9 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     h.max_error_mm = float(report.error.max_mm());
     h.mean_error_mm = float(report.error.mean_mm());
     const auto final_head = serialize_fft_header(h);
+    std::vector<std::uint8_t> trailer;
     {
-        const std::uint64_t at = out.size();
+        const std::uint64_t at = out->logical_size();
         std::vector<TrailerChunk> chunks{make_properties_chunk(reader.header().properties)};
         if (report.resampled) {
             TrailerChunk c{kResampledTag, std::vector<std::uint8_t>(8)};
@@ -326,12 +337,11 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         }
         if (auto bidx = index.finish()) chunks.push_back(std::move(*bidx));
         chunks.push_back(checksum.finish(final_head, chunks));  // last: it covers the chunks before it
-        const auto trailer = serialize_trailer(chunks, at);
-        out.write(trailer.data(), trailer.size());
+        trailer = serialize_trailer(chunks, at);
     }
-    out.write_at(final_head.data(), final_head.size(), 0);
-    report.output_bytes = out.size();
-    out.commit();
+    out->finish(trailer, final_head);
+    report.output_bytes = out->stored_size();
+    out->commit();
     if (options.progress) options.progress("encode", 1.0);
 
     struct stat st {};

@@ -27,9 +27,15 @@ Vec3f map_half_sphere_to_cap(Vec3f v, float ratio) {
 }
 
 Vec3f map_cap_to_half_sphere(Vec3f v, float ratio) {
-    const float x = (v.x + ratio - 1.0f) / ratio;
-    const float lateral = std::sqrt(std::max(1.0f - x * x, 0.0f) / std::max(1.0f - v.x * v.x, 1e-12f));
-    return {x, v.y * lateral, v.z * lateral};
+    // Encoder side only (decoders use the forward map), so computed for
+    // accuracy: near the axis 1 - v.x^2 cancels in float, and a 16-bit code
+    // is finer than that error. For a unit v, 1 - v.x = (y^2 + z^2) / (1 + v.x).
+    const float s2 = v.y * v.y + v.z * v.z;
+    const float d = v.x >= 0.0f ? s2 / (1.0f + v.x) : 1.0f - v.x;  // 1 - v.x
+    const float e = d / ratio;                                       // 1 - x
+    if (!(s2 > 0.0f)) return {1.0f - e, 0.0f, 0.0f};
+    const float lateral = std::sqrt(std::max(e * (2.0f - e), 0.0f) / s2);
+    return {1.0f - e, v.y * lateral, v.z * lateral};
 }
 
 namespace {

@@ -89,12 +89,15 @@ float compute_ratio(double scaling_mm, double step_mm, double min_dot) {
 }
 
 SearchOptions search_for_effort(int effort) {
+    // Measured on the shared tractograms (docs/encode.md): a radius of 2
+    // never changes the result (codes two levels off the aim never make the
+    // beam), so every level searches the 3x3 neighbourhood.
     switch (effort) {
-        case 0: return {1, 1, 0, 1, 0};
-        case 1: return {1, 1, 8, 1, 0};
-        case 2: return {4, 1, 16, 1, 0};
-        case 3: return {8, 1, 32, 2, 0};
-        case 4: return {16, 2, 64, 2, 0};
+        case 0: return {1, 1, 0, 1, 0};    // greedy aiming
+        case 1: return {1, 1, 8, 1, 0};    // + a beam of 8 for the worst blocks
+        case 2: return {2, 1, 8, 1, 0};
+        case 3: return {8, 1, 32, 1, 0};
+        case 4: return {16, 1, 64, 1, 0};
         default: throw Error(Errc::invalid_argument, "effort must be in [0, " + std::to_string(kMaxEffort) + "]");
     }
 }
@@ -137,27 +140,36 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
     if (n_blocks > 0xffff)
         throw Error(Errc::unsupported, "fiber " + std::to_string(fiber_id) + " has " + std::to_string(n_points) +
                                            " points: more than 65535 blocks");
-    auto emit = [&](Vec3f p) {
-        if (decoded) decoded->push_back(h.to_world(p.x, p.y, p.z));
-    };
-    const SearchParams params{search_.beam_width, search_.radius};
-    const SearchParams retry_params{search_.retry_beam_width, search_.retry_radius};
-    const bool retry = search_.retry_beam_width > 0 && search_.retry_error_mm > 0;
-    const float retry_error2 = float(search_.retry_error_mm / h.scaling) * float(search_.retry_error_mm / h.scaling);
+    const bool wide = tables_->table16.has_value();
+    const std::size_t base = out.size();
+    out.resize(base + std::size_t(n_blocks) * bb, 0);
+
+    // Per point of the fiber: the target and the decoded point (normalized
+    // coordinates); per block: the first frame. Codes go straight into the
+    // blocks (8-bit) or through `codes16`.
     thread_local std::vector<Vec3f> targets, points, retry_points;
+    thread_local std::vector<Frame> frames;
     thread_local std::vector<std::uint16_t> codes16, retry_codes16;
     thread_local std::vector<std::uint8_t> retry_codes8;
+    targets.resize(n_points);
+    points.resize(n_points);
+    frames.resize(n_blocks);
+    if (wide) codes16.assign(n_points, 0);
     const double inv_scaling = 1.0 / double(h.scaling);
+    for (std::size_t k = 0; k < n_points; ++k) {
+        const Vec3f& s = fiber[k];
+        targets[k] = {float((double(s.x) + h.offset[0]) * inv_scaling + 0.5),
+                      float((double(s.y) + h.offset[1]) * inv_scaling + 0.5),
+                      float((double(s.z) + h.offset[2]) * inv_scaling + 0.5)};
+    }
+    auto block_points = [&](std::uint32_t b) { return std::uint32_t(std::min<std::size_t>(ppb, n_points - std::size_t(b) * ppb)); };
+
+    // Block heads. Anchors: the block's first two points; a one-point block
+    // stores the point extrapolated from the previous segment as its second
+    // anchor (the tangent a renderer needs), a one-point fiber the point itself.
     for (std::uint32_t b = 0; b < n_blocks; ++b) {
         const std::size_t i0 = std::size_t(b) * ppb;
-        const auto n = std::uint32_t(std::min<std::size_t>(ppb, n_points - i0));
-        const std::size_t base = out.size();
-        out.resize(base + bb, 0);
-        std::uint8_t* block = &out[base];
-
-        // Anchors: the block's first two points; a one-point block stores the
-        // point extrapolated from the previous segment as its second anchor
-        // (the tangent a renderer needs), a one-point fiber the point itself.
+        const std::uint32_t n = block_points(b);
         const Vec3f p0 = fiber[i0];
         Vec3f p1 = p0;
         if (n >= 2) {
@@ -165,62 +177,83 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
         } else if (i0 > 0) {
             p1 = {2 * p0.x - fiber[i0 - 1].x, 2 * p0.y - fiber[i0 - 1].y, 2 * p0.z - fiber[i0 - 1].z};
         }
-        // Not a structured binding: clang 14 (the fuzz build) cannot capture one in a lambda.
-        const std::pair<Vec3f, Vec3f> anchors = write_block_head(h, block, p0, p1, fiber_id, b, n_blocks, n);
-        const Vec3f a0 = anchors.first, a1 = anchors.second;
-        emit(a0);
-        if (n < 2) continue;
-        emit(a1);
-        if (n < 3) continue;
+        const auto [a0, a1] = write_block_head(h, &out[base + std::size_t(b) * bb], p0, p1, fiber_id, b, n_blocks, n);
+        points[i0] = a0;
+        if (n >= 2) points[i0 + 1] = a1;
+        frames[b] = frame_from_axis(anchor_axis(a0, a1));
+    }
 
-        const std::size_t m = n - 2;
-        targets.resize(m);
-        points.resize(m);
-        for (std::size_t k = 0; k < m; ++k) {
-            const Vec3f& s = fiber[i0 + 2 + k];
-            targets[k] = {float((double(s.x) + h.offset[0]) * inv_scaling + 0.5),
-                          float((double(s.y) + h.offset[1]) * inv_scaling + 0.5),
-                          float((double(s.z) + h.offset[2]) * inv_scaling + 0.5)};
+    // The codes of block b: points i0 + 2 .. i0 + n.
+    auto codes8_of = [&](std::uint32_t b) { return &out[base + std::size_t(b) * bb + kBlockDirectionsOffset]; };
+    auto search_block = [&](std::uint32_t b, const SearchParams& sp, std::uint8_t* c8, std::uint16_t* c16, Vec3f* dec) {
+        const std::size_t i0 = std::size_t(b) * ppb;
+        const std::span<const Vec3f> t(&targets[i0 + 2], block_points(b) - 2);
+        if (wide) search_codes(Codebook16{*tables_->table16}, sp, frames[b], points[i0 + 1], h.step, t, c16, dec);
+        else search_codes(Codebook8{*tables_->table8, *tables_->lut8}, sp, frames[b], points[i0 + 1], h.step, t, c8, dec);
+    };
+    const SearchParams params{search_.beam_width, search_.radius};
+    std::uint32_t b = 0;
+    if (params.beam <= 1 && !wide) {
+        // Greedy: four full blocks at a time (16-bit codes gain nothing: their
+        // nearest-code search is branchy and dominates).
+        constexpr int kLanes = 4;
+        using Lanes = GreedyLanes<Codebook8, kLanes>;
+        const Codebook8 cb{*tables_->table8, *tables_->lut8};
+        for (; b + kLanes <= n_blocks && block_points(b + kLanes - 1) == ppb; b += kLanes) {
+            Lanes lanes;
+            for (int i = 0; i < kLanes; ++i) {
+                const std::size_t i0 = std::size_t(b + i) * ppb;
+                lanes.f[i] = frames[b + i];
+                lanes.p[i] = points[i0 + 1];
+                lanes.targets[i] = &targets[i0 + 2];
+                lanes.codes[i] = codes8_of(b + i);
+                lanes.decoded[i] = &points[i0 + 2];
+            }
+            lanes.run(cb, h.step, ppb - 2);
         }
-        const Frame frame = frame_from_axis(anchor_axis(a0, a1));
-        auto search = [&](const SearchParams& sp, auto* codes, Vec3f* decoded_points) {
-            if constexpr (sizeof(*codes) == 2)
-                search_codes(Codebook16{*tables_->table16}, sp, frame, a1, h.step, targets, codes, decoded_points);
-            else
-                search_codes(Codebook8{*tables_->table8, *tables_->lut8}, sp, frame, a1, h.step, targets, codes,
-                             decoded_points);
-        };
-        auto max_error2 = [&](const Vec3f* decoded_points) {
+    }
+    for (; b < n_blocks; ++b)
+        if (block_points(b) > 2)
+            search_block(b, params, wide ? nullptr : codes8_of(b), wide ? codes16.data() + std::size_t(b) * ppb : nullptr,
+                         &points[std::size_t(b) * ppb + 2]);
+
+    // Retry: blocks whose largest error exceeds the threshold are searched
+    // again with the retry beam; the smaller max error wins.
+    if (search_.retry_beam_width > 0 && search_.retry_error_mm > 0) {
+        const float threshold2 = float(search_.retry_error_mm / h.scaling) * float(search_.retry_error_mm / h.scaling);
+        const SearchParams retry_params{search_.retry_beam_width, search_.retry_radius};
+        auto max_error2 = [&](const Vec3f* decoded_points, const Vec3f* target, std::size_t m) {
             float worst = 0;
             for (std::size_t k = 0; k < m; ++k) {
-                const Vec3f d = decoded_points[k] - targets[k];
+                const Vec3f d = decoded_points[k] - target[k];
                 worst = std::max(worst, dot(d, d));
             }
             return worst;
         };
-        if (tables_->table16) {
-            codes16.resize(m);
-            search(params, codes16.data(), points.data());
-            if (retry && max_error2(points.data()) > retry_error2) {
-                retry_codes16.resize(m);
-                retry_points.resize(m);
-                search(retry_params, retry_codes16.data(), retry_points.data());
-                if (max_error2(retry_points.data()) < max_error2(points.data()))
-                    codes16.swap(retry_codes16), points.swap(retry_points);
-            }
-            for (std::size_t k = 0; k < m; ++k) put_le(block + kBlock16DirectionsOffset + 2 * k, codes16[k], 2);
-        } else {
-            std::uint8_t* codes = block + kBlockDirectionsOffset;
-            search(params, codes, points.data());
-            if (retry && max_error2(points.data()) > retry_error2) {
-                retry_codes8.resize(m);
-                retry_points.resize(m);
-                search(retry_params, retry_codes8.data(), retry_points.data());
-                if (max_error2(retry_points.data()) < max_error2(points.data()))
-                    std::copy(retry_codes8.begin(), retry_codes8.end(), codes), points.swap(retry_points);
+        for (b = 0; b < n_blocks; ++b) {
+            const std::size_t i0 = std::size_t(b) * ppb, m = block_points(b) >= 2 ? block_points(b) - 2 : 0;
+            if (m == 0) continue;
+            const float first = max_error2(&points[i0 + 2], &targets[i0 + 2], m);
+            if (!(first > threshold2)) continue;
+            retry_points.resize(m);
+            retry_codes8.resize(m);
+            retry_codes16.resize(m);
+            search_block(b, retry_params, retry_codes8.data(), retry_codes16.data(), retry_points.data());
+            if (max_error2(retry_points.data(), &targets[i0 + 2], m) < first) {
+                std::copy(retry_points.begin(), retry_points.end(), &points[i0 + 2]);
+                if (wide) std::copy(retry_codes16.begin(), retry_codes16.end(), codes16.begin() + std::ptrdiff_t(i0));
+                else std::copy(retry_codes8.begin(), retry_codes8.end(), codes8_of(b));
             }
         }
-        for (std::size_t k = 0; k < m; ++k) emit(points[k]);
+    }
+
+    if (wide)
+        for (b = 0; b < n_blocks; ++b)
+            for (std::size_t k = 0; k + 2 < block_points(b); ++k)
+                put_le(&out[base + std::size_t(b) * bb + kBlock16DirectionsOffset + 2 * k], codes16[std::size_t(b) * ppb + k], 2);
+    if (decoded) {
+        decoded->reserve(decoded->size() + n_points);
+        for (std::size_t k = 0; k < n_points; ++k) decoded->push_back(h.to_world(points[k].x, points[k].y, points[k].z));
     }
 }
 

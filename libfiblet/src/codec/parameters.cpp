@@ -80,7 +80,10 @@ void FiberSample::offer(std::span<const Vec3f> fiber) {
         // Keep every other fiber of the sample: those at multiples of 2 * stride.
         std::size_t w = 0;
         points_ = 0;
-        for (std::size_t i = 0; i < fibers_.size(); i += 2) points_ += fibers_[i].size(), fibers_[w++] = std::move(fibers_[i]);
+        for (std::size_t i = 0; i < fibers_.size(); i += 2, ++w) {
+            points_ += fibers_[i].size();
+            if (w != i) fibers_[w] = std::move(fibers_[i]);
+        }
         fibers_.resize(w);
         stride_ *= 2;
     }

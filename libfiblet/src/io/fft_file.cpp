@@ -14,6 +14,7 @@
 
 #include "core/bytes.hpp"
 #include "fiblet/error.hpp"
+#include "io/fftz_reader.hpp"
 
 namespace fiblet {
 using detail::get_le;
@@ -101,10 +102,17 @@ FftFile::FftFile(const std::string& path, FftOpenOptions options)
     try {
         struct stat st {};
         if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) throw Error(Errc::io, path + ": not a regular file");
-        file_size_ = std::uint64_t(st.st_size);
-        std::vector<std::uint8_t> head(std::min<std::uint64_t>(file_size_, kFftFixedHeaderBytes + 8 * 255));
-        pread_all(fd_, head.data(), head.size(), 0, path);
-        header_ = parse_fft_header(head, file_size_, path);
+        file_size_ = logical_size_ = std::uint64_t(st.st_size);
+        std::uint8_t magic[12] = {};
+        if (file_size_ >= sizeof magic) pread_all(fd_, magic, sizeof magic, 0, path);
+        if (detail::FftzReader::recognizes(magic, file_size_ >= sizeof magic ? sizeof magic : 0)) {
+            fftz_ = std::make_unique<detail::FftzReader>(fd_, file_size_, path);
+            logical_size_ = fftz_->logical_size();
+        }
+        std::vector<std::uint8_t> head(std::min<std::uint64_t>(logical_size_, kFftFixedHeaderBytes + 8 * 255));
+        read_at(head.data(), head.size(), 0);
+        header_ = parse_fft_header(head, logical_size_, path);
+        if (fftz_) fftz_->check_layout(header_);
         std::uint64_t lut_hash = 0;
         read_lut(lut_hash);
         read_trailer();
@@ -136,7 +144,7 @@ void FftFile::read_lut(std::uint64_t& lut_hash) {
     for (std::uint64_t s = 0; s < header_.fibers; s += kSliceEntries) {
         const std::uint64_t n = std::min(kSliceEntries, header_.fibers - s);
         raw.resize(8 * n);
-        pread_all(fd_, raw.data(), raw.size(), header_.lut_offset() + 8 * s, path_);
+        read_at(raw.data(), raw.size(), header_.lut_offset() + 8 * s);
         hash.update(raw.data(), raw.size());
         for (std::uint64_t j = 0; j < n; ++j) {
             const std::uint64_t i = s + j;
@@ -163,11 +171,16 @@ void FftFile::read_lut(std::uint64_t& lut_hash) {
     lut_hash = hash.digest();
 }
 
+void FftFile::read_at(std::uint8_t* out, std::uint64_t size, std::uint64_t offset) const {
+    if (fftz_) fftz_->read(out, size, offset);
+    else pread_all(fd_, out, size, offset, path_);
+}
+
 void FftFile::read_trailer() {
     const std::uint64_t end = header_.file_bytes();
-    if (file_size_ < end + kTrailerFooterBytes) return;  // no trailer: a plain version-2 file
+    if (logical_size_ < end + kTrailerFooterBytes) return;  // no trailer: a plain version-2 file
     std::uint8_t footer[kTrailerFooterBytes];
-    pread_all(fd_, footer, sizeof footer, file_size_ - sizeof footer, path_);
+    read_at(footer, sizeof footer, logical_size_ - sizeof footer);
     if (std::memcmp(footer + 8, kTrailerMagic, 8) != 0) return;  // foreign trailing bytes: ignored
     if (get_le<std::uint64_t>(footer) != end) bad(path_, "trailer does not start after the last block");
     has_trailer_ = true;
@@ -175,11 +188,11 @@ void FftFile::read_trailer() {
     // in check); unknown large ones are skipped.
     constexpr std::uint64_t kMaxKnownChunk = 64u << 20, kMaxUnknownChunk = 16u << 20;
     std::uint64_t pos = end;
-    const std::uint64_t stop = file_size_ - kTrailerFooterBytes;
+    const std::uint64_t stop = logical_size_ - kTrailerFooterBytes;
     while (pos < stop) {
         std::uint8_t head[16];
         if (stop - pos < sizeof head) bad(path_, "truncated trailer chunk header");
-        pread_all(fd_, head, sizeof head, pos, path_);
+        read_at(head, sizeof head, pos);
         const std::uint64_t size = get_le<std::uint64_t>(head + 8);
         if (size > stop - pos - sizeof head) bad(path_, "trailer chunk runs past the footer");
         TrailerChunk chunk;
@@ -191,7 +204,7 @@ void FftFile::read_trailer() {
         if (known || size <= kMaxUnknownChunk) {
             if (chunk.tag == kChecksumTag && checksum_chunk_offset_ == 0) checksum_chunk_offset_ = pos;  // the one find_chunk() gives
             chunk.payload.resize(size);
-            pread_all(fd_, chunk.payload.data(), size, pos + sizeof head, path_);
+            read_at(chunk.payload.data(), size, pos + sizeof head);
             trailer_.push_back(std::move(chunk));
         }
         pos += sizeof head + size;
@@ -210,7 +223,7 @@ void FftFile::verify_open_checksums(std::span<const std::uint8_t> head, std::uin
     std::vector<std::uint8_t> buf;
     for (std::uint64_t pos = header_.file_bytes(); pos < checksum_chunk_offset_;) {
         buf.resize(std::size_t(std::min<std::uint64_t>(1u << 20, checksum_chunk_offset_ - pos)));
-        pread_all(fd_, buf.data(), buf.size(), pos, path_);
+        read_at(buf.data(), buf.size(), pos);
         hash.update(buf.data(), buf.size());
         pos += buf.size();
     }
@@ -247,6 +260,7 @@ std::vector<std::pair<std::string, std::string>> FftFile::properties() const {
 }
 
 void FftFile::close() noexcept {
+    fftz_.reset();
     if (fd_ >= 0) ::close(fd_);
     fd_ = -1;
 }
@@ -262,6 +276,8 @@ FftFile& FftFile::operator=(FftFile&& o) noexcept {
         options_ = o.options_;
         fd_ = std::exchange(o.fd_, -1);
         file_size_ = o.file_size_;
+        logical_size_ = o.logical_size_;
+        fftz_ = std::move(o.fftz_);
         header_ = std::move(o.header_);
         lut_ = std::move(o.lut_);
         fiber_first_block_ = std::move(o.fiber_first_block_);
@@ -280,7 +296,7 @@ void FftFile::read_blocks(std::uint64_t first, std::uint64_t count, std::uint8_t
         throw Error(Errc::invalid_argument, path_ + ": block range past the end");
     if (count == 0) return;
     const std::uint64_t bb = header_.block_bytes();
-    pread_all(fd_, out, count * bb, header_.blocks_offset() + first * bb, path_);
+    read_at(out, count * bb, header_.blocks_offset() + first * bb);
     check_block_structure(first, count, out);
     if (verifies_checksums()) verify_block_groups(first, count, out);
 }
@@ -317,7 +333,7 @@ void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, cons
     Xxh64Stream hash;
     auto hash_from_file = [&](std::uint64_t b0, std::uint64_t b1) {
         edge.resize((b1 - b0) * bb);
-        pread_all(fd_, edge.data(), edge.size(), header_.blocks_offset() + b0 * bb, path_);
+        read_at(edge.data(), edge.size(), header_.blocks_offset() + b0 * bb);
         hash.update(edge.data(), edge.size());
     };
     for (std::uint64_t g = first / g_blocks; g <= (end - 1) / g_blocks; ++g) {
@@ -341,7 +357,7 @@ void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, cons
 std::span<const std::uint8_t> FftFile::mapped_blocks(std::uint64_t first, std::uint64_t count) const {
     if (first > header_.blocks || count > header_.blocks - first)
         throw Error(Errc::invalid_argument, path_ + ": block range past the end");
-    if (count == 0 || fd_ < 0 || !mapping_) return {};
+    if (count == 0 || fd_ < 0 || !mapping_ || fftz_) return {};  // a container has no blocks to map
     const std::uint64_t bb = header_.block_bytes();
     Mapping& m = *mapping_;
     std::call_once(m.once, [&] {

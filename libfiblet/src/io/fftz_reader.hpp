@@ -1,0 +1,57 @@
+// Internal: random access to the logical .fft bytes of a .fftz container
+// (formats/fftz.md). Every size read from the file is checked before it is
+// trusted; frames are decompressed on demand (the last one is cached).
+#pragma once
+
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "fiblet/fft_format.hpp"
+#include "fiblet/fftz_format.hpp"
+
+namespace fiblet::detail {
+
+class FftzReader {
+public:
+    // True when the file starts with the FFTZ descriptor frame.
+    static bool recognizes(const std::uint8_t* first8, std::size_t size);
+
+    // Reads the seek table and the descriptor; throws Error{fft_format}.
+    FftzReader(int fd, std::uint64_t file_size, std::string name);
+
+    std::uint64_t logical_size() const { return logical_size_; }
+    const FftzDescriptor& descriptor() const { return descriptor_; }
+
+    // Checks the frames against the parsed header (header, LUT, one frame
+    // per group of blocks, trailer) and enables reading blocks.
+    void check_layout(const FftHeader& header);
+
+    // Logical bytes [offset, offset + size).
+    void read(std::uint8_t* out, std::uint64_t size, std::uint64_t offset) const;
+
+private:
+    struct Frame {
+        std::uint64_t stored_at, stored_size;  // in the file
+        std::uint64_t logical_at, logical_size;
+    };
+    const std::vector<std::uint8_t>& frame_bytes(std::size_t index) const;  // call with mutex_ held
+
+    int fd_;
+    std::string name_;
+    std::vector<Frame> frames_;
+    FftzDescriptor descriptor_;
+    std::uint64_t logical_size_ = 0;
+    // Block groups: frames [first_group_, first_group_ + groups_), to untranspose.
+    std::size_t first_group_ = 0, groups_ = 0;
+    unsigned direction_bits_ = 8;
+    std::uint32_t block_bytes_ = 0;
+    bool layout_checked_ = false;
+
+    mutable std::mutex mutex_;
+    mutable std::size_t cached_ = SIZE_MAX;
+    mutable std::vector<std::uint8_t> cache_;
+};
+
+}  // namespace fiblet::detail

@@ -1,0 +1,185 @@
+// The encoder's code search: the fast nearest-code lookup against brute
+// force, the beam against greedy aiming, the retry of the worst blocks, and
+// the effort presets.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "codec/nearest_code_lut.hpp"
+#include "fiblet/decode.hpp"
+#include "fiblet/encode.hpp"
+#include "fiblet/error.hpp"
+
+using namespace fiblet;
+
+namespace {
+
+double angle(Vec3f a, Vec3f b) {
+    const double c = (double(a.x) * b.x + double(a.y) * b.y + double(a.z) * b.z) /
+                     std::sqrt((double(a.x) * a.x + double(a.y) * a.y + double(a.z) * a.z) *
+                               (double(b.x) * b.x + double(b.y) * b.y + double(b.z) * b.z));
+    return std::acos(std::clamp(c, -1.0, 1.0));
+}
+
+double nearest_angle(const DirectionTable& t, Vec3f d) {
+    double best = M_PI;
+    for (int c = 0; c < 256; ++c) best = std::min(best, angle(t.direction(std::uint8_t(c)), d));
+    return best;
+}
+
+// Fibers of 0.1 mm steps turning up to 12 degrees per step, inside a 40 mm box.
+std::vector<std::vector<Vec3f>> walks(int count, int points, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::vector<std::vector<Vec3f>> out;
+    for (int i = 0; i < count; ++i) {
+        double p[3] = {20 * u(rng), 20 * u(rng), 20 * u(rng)}, d[3] = {u(rng), u(rng), u(rng)};
+        std::vector<Vec3f> f;
+        for (int k = 0; k < points; ++k) {
+            f.push_back({float(p[0]), float(p[1]), float(p[2])});
+            const double n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            for (double& c : d) c /= n;
+            for (double& c : d) c += 0.2 * u(rng);  // about 12 degrees at most
+            const double m = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            for (int a = 0; a < 3; ++a) p[a] += 0.1 * d[a] / m;
+        }
+        out.push_back(f);
+    }
+    return out;
+}
+
+FftHeader header(float ratio) {
+    FftHeader h;
+    h.scaling = 80;
+    h.offset = {0, 0, 0};
+    h.ratio = ratio;
+    h.step = float(0.1 / 80);
+    return h;
+}
+
+// Per block: the largest distance between a decoded point and its input.
+std::vector<double> block_max_errors(const FiberEncoder& e, const std::vector<Vec3f>& f, double* sum2 = nullptr) {
+    std::vector<std::uint8_t> blocks;
+    std::vector<Vec3f> decoded;
+    e.encode(f, 0, blocks, &decoded);
+    std::vector<double> out;
+    for (std::size_t k = 0; k < f.size(); ++k) {
+        if (k % e.header().points_per_block == 0) out.push_back(0);
+        const double d2 = std::pow(double(decoded[k].x) - f[k].x, 2) + std::pow(double(decoded[k].y) - f[k].y, 2) +
+                          std::pow(double(decoded[k].z) - f[k].z, 2);
+        out.back() = std::max(out.back(), std::sqrt(d2));
+        if (sum2) *sum2 += d2;
+    }
+    return out;
+}
+
+}  // namespace
+
+TEST(NearestCodeLut, PicksACodeWithinTwoCellsOfTheNearest) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (float ratio : {0.01f, 0.0968f, 0.1458f, 0.5f, 0.95f}) {
+        const DirectionTable t(ratio);
+        const detail::NearestCodeLut lut(t);
+        ASSERT_TRUE(lut.usable());
+        const double cap = std::acos(1.0 - ratio);
+        // Two cells' half-diagonals, in gnomonic units (an upper bound on the angle).
+        const double slack = 2 * std::sqrt(2.0) * std::tan(cap) / detail::NearestCodeLut::kGrid + 1e-6;
+        for (int i = 0; i < 20000; ++i) {
+            // Directions in the cap, and (one in four) anywhere on the sphere.
+            Vec3f d;
+            if (i % 4 == 3) {
+                d = {float(u(rng)), float(u(rng)), float(u(rng))};
+            } else {
+                const double polar = cap * std::sqrt(std::fabs(u(rng))), az = M_PI * u(rng);
+                const double len = 0.01 + std::fabs(u(rng));  // any length
+                d = {float(len * std::cos(polar)), float(len * std::sin(polar) * std::cos(az)),
+                     float(len * std::sin(polar) * std::sin(az))};
+            }
+            const std::uint8_t c = lut(d);
+            if (i % 4 == 3 && angle(d, {1, 0, 0}) > cap) {
+                // Outside the cap: as good as the nearest code of the rim point in d's azimuth.
+                const double lateral = std::hypot(double(d.y), double(d.z));
+                const Vec3f rim{float(std::cos(cap)), float(std::sin(cap) * d.y / lateral), float(std::sin(cap) * d.z / lateral)};
+                EXPECT_LE(angle(t.direction(c), d), angle(d, rim) + nearest_angle(t, rim) + slack) << ratio;
+            } else if (i % 4 != 3) {
+                EXPECT_LE(angle(t.direction(c), d), nearest_angle(t, d) + slack) << "ratio " << ratio;
+            }
+        }
+    }
+}
+
+TEST(NearestCodeLut, NotUsedForCapsReachingTheHalfSphere) {
+    EXPECT_FALSE(detail::NearestCodeLut(DirectionTable(1.0f)).usable());
+    EXPECT_FALSE(detail::NearestCodeLut(DirectionTable(1.7f)).usable());
+}
+
+TEST(CodeSearch, BeamLowersTheSquaredErrorOfGreedyAiming) {
+    const auto fibers = walks(40, 300, 1);
+    const FftHeader h = header(0.0968f);
+    double greedy = 0, beam4 = 0, beam16 = 0;
+    for (const auto& f : fibers) {
+        block_max_errors(FiberEncoder(h, {1, 1, 0, 1, 0}), f, &greedy);
+        block_max_errors(FiberEncoder(h, {4, 1, 0, 1, 0}), f, &beam4);
+        block_max_errors(FiberEncoder(h, {16, 1, 0, 1, 0}), f, &beam16);
+    }
+    EXPECT_LT(beam4, 0.85 * greedy);
+    EXPECT_LT(beam16, beam4);
+}
+
+TEST(CodeSearch, RetryNeverRaisesABlocksMaxErrorAndLowersTheWorst) {
+    const auto fibers = walks(40, 300, 2);
+    const FftHeader h = header(0.0968f);
+    const FiberEncoder greedy(h, {1, 1, 0, 1, 0});
+    const FiberEncoder retry(h, {1, 1, 16, 1, 3e-3});  // blocks above 3 um are searched again
+    double worst_greedy = 0, worst_retry = 0;
+    int retried_better = 0;
+    for (const auto& f : fibers) {
+        const auto a = block_max_errors(greedy, f), b = block_max_errors(retry, f);
+        ASSERT_EQ(a.size(), b.size());
+        for (std::size_t i = 0; i < a.size(); ++i) {
+            EXPECT_LE(b[i], a[i]);
+            if (a[i] <= 3e-3) EXPECT_EQ(b[i], a[i]);  // below the threshold: untouched
+            retried_better += b[i] < a[i];
+            worst_greedy = std::max(worst_greedy, a[i]), worst_retry = std::max(worst_retry, b[i]);
+        }
+    }
+    EXPECT_GT(retried_better, 0);
+    EXPECT_LT(worst_retry, worst_greedy);
+}
+
+TEST(CodeSearch, EffortPresetsAreValidAndSearchMoreAsTheyGrow) {
+    unsigned last_candidates = 0;
+    for (int e = 0; e <= kMaxEffort; ++e) {
+        const SearchOptions s = search_for_effort(e);
+        EXPECT_NO_THROW(FiberEncoder(header(0.1f), s));
+        const unsigned candidates = s.beam_width * (2 * s.radius + 1) * (2 * s.radius + 1);
+        EXPECT_GE(candidates, last_candidates);
+        last_candidates = candidates;
+    }
+    EXPECT_THROW(search_for_effort(-1), Error);
+    EXPECT_THROW(search_for_effort(kMaxEffort + 1), Error);
+    EXPECT_THROW(FiberEncoder(header(0.1f), {0, 1, 0, 1, 0}), Error);
+    EXPECT_THROW(FiberEncoder(header(0.1f), {1, 4, 0, 1, 0}), Error);
+}
+
+TEST(CodeSearch, SixteenBitSearchDecodesToWhatTheEncoderPredicted) {
+    FftHeader h = header(0.12f);
+    h.version = kFft16Version;
+    h.points_per_block = 126;
+    const DecodeContext ctx(h);
+    for (SearchOptions s : {SearchOptions{1, 1, 0, 1, 0}, SearchOptions{4, 1, 8, 1, 1e-9}}) {
+        const FiberEncoder e(h, s);
+        for (const auto& f : walks(5, 400, 3)) {
+            std::vector<std::uint8_t> blocks;
+            std::vector<Vec3f> predicted;
+            e.encode(f, 7, blocks, &predicted);
+            ASSERT_EQ(blocks.size(), e.block_count(f.size()) * std::size_t(h.block_bytes()));
+            std::vector<float> xyz(3 * f.size());
+            ASSERT_EQ(decode_blocks_scalar16(ctx, blocks.data(), blocks.size() / h.block_bytes(), xyz.data()), f.size());
+            for (std::size_t k = 0; k < f.size(); ++k) EXPECT_EQ((Vec3f{xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]}), predicted[k]);
+            EXPECT_EQ(BlockView16{blocks.data()}.fiber_id(), 7u);
+        }
+    }
+}
