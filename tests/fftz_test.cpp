@@ -71,7 +71,9 @@ TEST(FftzTranspose, IsInvertibleForBothBlockLayouts) {
             for (auto& b : blocks) b = std::uint8_t(rng());
             const auto t = transpose_block_group(blocks, bits, bb);
             ASSERT_EQ(t.size(), blocks.size());
-            if (n > 1) EXPECT_NE(t, blocks);
+            if (n > 1) {
+                EXPECT_NE(t, blocks);
+            }
             EXPECT_EQ(untranspose_block_group(t, bits, bb), blocks);
         }
     }
