@@ -136,7 +136,9 @@ struct SelectOptions {
 };
 
 // Runs a query, handing the output to `sink` in file order, a chunk of whole
-// runs at a time (bounded memory). Throws Error{invalid_argument} on a bad
+// runs at a time (bounded memory). Output is made of runs of blocks, so a
+// fiber without points (an empty streamline of the .tck, kept by compress)
+// is never part of it. Throws Error{invalid_argument} on a bad
 // query, Error{fft_format} on a malformed block.
 SelectionStats select(const FftFile& file, const BlockIndex& index, const Query& query,
                       const std::function<void(const SelectedChunk&)>& sink, const SelectOptions& options = {});
