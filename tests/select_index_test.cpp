@@ -70,6 +70,19 @@ TEST_F(SelectIndex, CompressStoresAnIndexWhoseBoxesHoldEveryPoint) {
     }
 }
 
+TEST_F(SelectIndex, WithoutTheIndexTheFileIsSmallerAndTheIndexIsComputedOnLoad) {
+    CompressOptions o;
+    o.block_index = false;
+    const FftFile bare(compressed("small-sdstream.tck", "sdstream-noindex.fft", o));
+    const FftFile full(fiblet_file());
+    ASSERT_EQ(bare.find_chunk(kBlockIndexTag), nullptr);
+    EXPECT_EQ(bare.file_size() + 16 + full.find_chunk(kBlockIndexTag)->payload.size(), full.file_size());  // chunk header + payload
+    EXPECT_EQ(bare.read_blocks(0, bare.header().blocks), full.read_blocks(0, full.header().blocks));
+    const BlockIndex index = BlockIndex::load(bare);
+    EXPECT_EQ(index.source(), BlockIndex::Source::decoded);
+    expect_boxes_hold_points(bare, index, decode_everything(bare));
+}
+
 TEST_F(SelectIndex, ComputedIndexOfOfficialEncoderFilesHoldsEveryPoint) {
     const FftFile file(shared_data("reference/small-sdstream.fft"));
     ASSERT_EQ(file.find_chunk(kBlockIndexTag), nullptr);

@@ -26,6 +26,7 @@ struct CompressArgs {
     std::optional<std::size_t> tuning_points;
     // The seekable zstd container.
     bool zstd = false, no_transpose = false;
+    bool no_index = false;
     int zstd_level = ZstdOptions{}.level;
     std::uint32_t zstd_group = ZstdOptions{}.group_blocks;
     bool force = false, quiet = false, json = false, allow_count_mismatch = false;
@@ -86,6 +87,7 @@ void run(const CompressArgs& a) {
         o.turn_percentile = a.turn_percentile;
         if (a.tuning_points) o.tuning_points = *a.tuning_points;
         if (a.zstd) o.zstd = ZstdOptions{a.zstd_level, a.zstd_group, !a.no_transpose};
+        o.block_index = !a.no_index;
         const std::string name = std::filesystem::path(in).filename().string();
         o.progress = [&](const char* phase, double f) { progress.update(name + ": " + phase, f); };
         try {
@@ -154,6 +156,8 @@ void add_compress(CLI::App& app) {
         ->check(CLI::Range(50.0, 100.0));
     cmd->add_option("--tuning-points", args->tuning_points, "Points in the sample the cap and step are tuned on");
     cmd->add_option("--step-scale", args->step_scale, "Decoder step / sampling step (default: tuned on a sample)");
+    cmd->add_flag("--no-index", args->no_index,
+                  "Leave out the block index (BIDX chunk, ~5 % of the file; extract and render compute it on load)");
     cmd->add_flag("-z,--zstd", args->zstd,
                   "Write the seekable zstd container (.fftz, formats/fftz.md): smaller, still random access");
     cmd->add_option("--zstd-level", args->zstd_level, "zstd level (default 17)")->check(CLI::Range(1, 22));

@@ -43,6 +43,7 @@ struct CompressOptions {
     std::optional<double> step_scale;         // decoder step / sampling step; default: tuned on a sample
     std::size_t tuning_points = 1u << 14;     // points in the tuning sample (8k to 32k choose alike)
     std::optional<ZstdOptions> zstd;          // write the seekable zstd container instead of a plain file
+    bool block_index = true;                  // write the BIDX chunk (formats/fft-index.md; ~5 % of the file)
     double step_tolerance = 0.01;             // relative spacing deviation that triggers resampling
     unsigned threads = 0;                     // encoding threads; 0 = all cores
     bool overwrite = false;

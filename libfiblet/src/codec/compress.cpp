@@ -283,7 +283,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             const auto f = std::uint32_t(first_fiber + i);
             w.decoded.clear();
             encoder.encode(points, f, w.blocks, &w.decoded);
-            w.index.add_fiber(w.decoded);
+            if (options.block_index) w.index.add_fiber(w.decoded);
             std::size_t hint = 0;
             const std::size_t window = 16 + 2 * original.size() / std::max<std::size_t>(points.size(), 1);
             for (std::size_t k = 0; k < points.size(); ++k) {
@@ -335,7 +335,8 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             std::memcpy(c.payload.data(), &step, 8);
             chunks.push_back(std::move(c));
         }
-        if (auto bidx = index.finish()) chunks.push_back(std::move(*bidx));
+        if (options.block_index)
+            if (auto bidx = index.finish()) chunks.push_back(std::move(*bidx));
         chunks.push_back(checksum.finish(final_head, chunks));  // last: it covers the chunks before it
         trailer = serialize_trailer(chunks, at);
     }
