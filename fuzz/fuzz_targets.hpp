@@ -308,7 +308,7 @@ inline void fft_target(const std::uint8_t* data, std::size_t size) {
         verified_open = verify;
         const FftFile& f = *file;
         const FftHeader& h = f.header();
-        check(h.file_bytes() <= f.file_size(), "opened a file shorter than its header says");
+        check(h.file_bytes() <= f.logical_size(), "opened a file shorter than its header says");
         check(f.block_end(h.fibers) == h.blocks, "LUT does not cover the blocks");
         try {
             (void)f.properties();

@@ -183,6 +183,14 @@ int main(int argc, char** argv) {
                 write_file(blocks_dir / (stem + ".blocks"), blocks_seed(fft));
             }
         }
+        // The seekable zstd container (formats/fftz.md), small frames so a
+        // seed holds several, transposed and not.
+        for (const bool transpose : {true, false}) {
+            const fs::path fftz = fft_dir / (stem + (transpose ? "-zstd.fftz" : "-zstd-plain.fftz"));
+            CompressOptions options;
+            options.zstd = ZstdOptions{.level = 3, .group_blocks = 4, .transpose = transpose};
+            if (compress_seed(e.path(), fftz, options)) ++n_fft;
+        }
         // The 16-bit variant (formats/fft16.md), with its default and a short block.
         for (std::uint32_t ppb : {0u, 7u}) {
             const fs::path fft = fft_dir / (stem + "-16bit-ppb" + std::to_string(ppb) + ".fft");

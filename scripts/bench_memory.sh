@@ -12,7 +12,7 @@ gb="${1:-5}"
 points="${2:-80}"
 work="${3:-$root/build/bench-memory}"
 build="${FIBLET_BUILD_DIR:-$root/build}"
-cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DFIBLET_BUILD_BENCH=ON >/dev/null
 cmake --build "$build" --target fiblet_cli make_big_tck -j"${FIBLET_BUILD_JOBS:-2}" >/dev/null
 fiblet="$build/bin/fiblet"
 mkdir -p "$work"

@@ -8,6 +8,8 @@
 #include <cstring>
 #include <random>
 
+#include "fiblet/block_index.hpp"
+#include "fiblet/checksum.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
@@ -126,6 +128,22 @@ TEST(Fftz, ReadsEveryBlockRangeAsThePlainFile) {
             EXPECT_EQ(s1.xyz, s2.xyz);
             EXPECT_EQ(s1.offsets, s2.offsets);
         }
+}
+
+TEST(Fftz, CarriesTheChecksumsAndIndexOfThePlainFileAndVerifies) {
+    Files f;
+    make(f, 8, true);
+    const FftFile plain(f.plain), packed(f.packed);
+    for (const auto tag : {kChecksumTag, kBlockIndexTag}) {
+        ASSERT_NE(packed.find_chunk(tag), nullptr);
+        EXPECT_EQ(packed.find_chunk(tag)->payload, plain.find_chunk(tag)->payload);
+    }
+    const VerifyReport r = verify_fft_file(f.packed);
+    EXPECT_TRUE(r.has_checksum);
+    EXPECT_EQ(r.blocks, plain.header().blocks);
+    EXPECT_EQ(r.groups, verify_fft_file(f.plain).groups);
+    EXPECT_EQ(r.unrecognized_trailing_bytes, 0u);
+    EXPECT_EQ(BlockIndex::load(packed).source(), BlockIndex::Source::chunk);
 }
 
 TEST(Fftz, IsAZstdStreamThatGivesBackThePlainFile) {

@@ -12,6 +12,7 @@
 #include <limits>
 #include <memory>
 #include <thread>
+#include <utility>
 
 #include "codec/parameters.hpp"
 #include "fiblet/block_index.hpp"
@@ -257,6 +258,10 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         out->begin(serialize_fft_header(h), lut_bytes);
         checksum.add_lut(lut_bytes.data(), lut_bytes.size());
     }
+    // The per-fiber tables are written: free them (12 bytes per fiber, 62 MB
+    // for 5 M fibers) before the block index grows.
+    std::vector<FiberLutEntry>().swap(lut);
+    std::vector<std::uint32_t>().swap(fiber_points);
     reader.rewind();
     // Batches of whole fibers are read in order, encoded by `threads`
     // workers on contiguous sub-ranges, and written in order.
@@ -335,8 +340,9 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             std::memcpy(c.payload.data(), &step, 8);
             chunks.push_back(std::move(c));
         }
+        // The builder goes as soon as its chunk is made (its codes are larger than the chunk).
         if (options.block_index)
-            if (auto bidx = index.finish()) chunks.push_back(std::move(*bidx));
+            if (auto bidx = std::exchange(index, IndexBuilder(h)).finish()) chunks.push_back(std::move(*bidx));
         chunks.push_back(checksum.finish(final_head, chunks));  // last: it covers the chunks before it
         trailer = serialize_trailer(chunks, at);
     }

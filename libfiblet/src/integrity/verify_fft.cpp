@@ -13,7 +13,7 @@ VerifyReport verify_fft_file(const std::string& path, const std::function<void(d
     VerifyReport r;
     r.has_checksum = file.checksums() != nullptr;
     r.blocks = h.blocks;
-    if (!file.has_trailer()) r.unrecognized_trailing_bytes = file.file_size() - h.file_bytes();
+    if (!file.has_trailer()) r.unrecognized_trailing_bytes = file.logical_size() - h.file_bytes();
     // Whole checksum groups at a time, so that no block is read twice.
     const std::uint64_t group = r.has_checksum ? file.checksums()->group_blocks : kDefaultChecksumGroupBlocks;
     const std::uint64_t step = std::max<std::uint64_t>(1, (std::uint64_t{4} << 20) / h.block_bytes() / group) * group;
