@@ -33,7 +33,7 @@ print("|---|---|---|---|---|---|")
 for b in fulls:
     name = b["run_name"].replace("BM_SelectFullDecode/", "full decode, decode_file, chunks of ").replace(
         "BM_SelectEverything", "full decode, select() with an empty query").replace(
-        "chunks of 65536", "chunks of 65536 (default)")
+        "chunks of 0", "default chunks (4096 blocks)")
     print(f"| {name} | 100 % | 100 % | 100 % | {b['cpu_time']:.1f} ms ({b['real_time']:.1f}) | "
           f"{100 * b['cpu_time'] / full['cpu_time']:.1f} % |")
 for b in runs:

@@ -18,12 +18,16 @@ namespace {
 
 class ChunkDecoder {
 public:
+    static constexpr std::size_t kBlocksPerThread = 4096;
+
     ChunkDecoder(const FftFile& file, const DecodeOptions& options)
         : file_(file),
           ctx_(file.header()),
           decoder_(resolve_decoder(options.decoder)),
           threads_(options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency())),
-          chunk_blocks_(std::max<std::size_t>(options.chunk_blocks, 1)) {}
+          chunk_blocks_(options.chunk_blocks ? options.chunk_blocks : kBlocksPerThread * threads_) {}
+
+    std::size_t chunk_blocks() const { return chunk_blocks_; }
 
     // End of the chunk of whole fibers starting at `f`: at least one fiber,
     // at most chunk_blocks blocks otherwise.
@@ -142,6 +146,9 @@ void decode_file(const FftFile& file, const std::function<void(std::uint64_t, co
     ChunkDecoder chunks(file, options);
     const std::uint64_t fibers = file.header().fibers;
     Streamlines chunk;
+    // Room for a usual chunk up front: growing would copy it.
+    chunk.xyz.reserve(3 * std::min<std::uint64_t>(chunks.chunk_blocks(), file.header().blocks) *
+                      file.header().points_per_block);
     for (std::uint64_t f = 0; f < fibers;) {
         const std::uint64_t e = chunks.chunk_end(f, fibers);
         const std::uint64_t n = chunks.load(f, e);
