@@ -271,7 +271,11 @@ private:
 class Selector {
 public:
     Selector(const FftFile& file, const BlockIndex& index, const Query& q, const SelectOptions& o)
-        : file_(file), index_(index), q_(q), options_(o), h_(file.header()), ctx_(h_), reader_(file, o.map_file) {
+        : file_(file), index_(index), q_(q), options_(o), h_(file.header()), ctx_(h_), reader_(file, o.map_file),
+          // A stored index describes the blocks as written: trusted to say a
+          // block lies wholly inside a region only when the checksums tie it
+          // to the blocks read (a damaged block read unverified may be elsewhere).
+          trust_inside_(index.source() == BlockIndex::Source::decoded || file.verifies_checksums()) {
         if (index.blocks() != h_.blocks || index.fibers() != h_.fibers)
             throw Error(Errc::invalid_argument, file.path() + ": the block index belongs to another file");
         detail::check_query(q);
@@ -289,10 +293,11 @@ private:
     // Blocks whose box meets a region (and, in `inside`, those wholly in it).
     Bits near(const Region& r, Bits* inside = nullptr) const {
         Bits bits;
+        Bits* whole = trust_inside_ ? inside : nullptr;  // otherwise none: their points are tested
         if (r.shape == Region::Shape::sphere)
-            index_.blocks_near_sphere(r.center, r.radius, bits, inside);
+            index_.blocks_near_sphere(r.center, r.radius, bits, whole);
         else
-            index_.blocks_near_box(r.box, bits, inside);
+            index_.blocks_near_box(r.box, bits, whole);
         bits.resize((h_.blocks + 63) / 64, 0);
         if (inside) inside->resize(bits.size(), 0);
         return bits;
@@ -540,6 +545,7 @@ private:
     const FftHeader& h_;
     DecodeContext ctx_;
     detail::BlockBatchReader reader_;
+    const bool trust_inside_;
     std::vector<std::uint8_t> keep_;
     std::vector<float> scratch_;  // decoded points that are tested, not output
     std::vector<std::uint8_t> staging_;
