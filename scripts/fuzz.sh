@@ -3,7 +3,9 @@
 # and runs each one in turn, one process at a time.
 #   scripts/fuzz.sh [SECONDS] [TARGET...]     SECONDS per target (default 60)
 #   FIBLET_FUZZ_RUNS=N scripts/fuzz.sh S      stop at N executions or S seconds
-#   FIBLET_FUZZ_TIMEOUT=S                     seconds one input may take (default 20)
+#   FIBLET_FUZZ_TIMEOUT=S                     seconds one input may take (default 120:
+#                                             valid inputs that resample to millions of
+#                                             points take tens of seconds under ASan)
 # Seeds are written by fiblet_fuzz_seeds (shared test files + hand-made edge
 # files); the corpus each run grows is kept in build-fuzz/corpus/TARGET.
 # A crash leaves its input in build-fuzz/crashes/TARGET/ and fails the script:
@@ -43,7 +45,7 @@ for t in "${targets[@]}"; do
   [ ! -d "$root/fuzz/regressions/$t" ] || extra=("$root/fuzz/regressions/$t")
   echo "== $t (${limit[*]})"
   start=$(date +%s)
-  if "$build/fuzz/$t" "${limit[@]}" -max_len="${FIBLET_FUZZ_MAX_LEN:-16384}" -timeout="${FIBLET_FUZZ_TIMEOUT:-20}" -rss_limit_mb=2048 -print_final_stats=1 \
+  if "$build/fuzz/$t" "${limit[@]}" -max_len="${FIBLET_FUZZ_MAX_LEN:-16384}" -timeout="${FIBLET_FUZZ_TIMEOUT:-120}" -rss_limit_mb=2048 -print_final_stats=1 \
       -artifact_prefix="$crashes/" "$corpus" "$build/seeds/$t" "${extra[@]}" >"$log" 2>&1; then
     result=ok
   else
