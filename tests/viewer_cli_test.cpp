@@ -82,6 +82,13 @@ TEST(ViewerCli, RenderRefusesBadArgumentsAndExistingOutputs) {
     EXPECT_EQ(no_output.status, 2) << no_output.output;
     const CliRun bad_file = run_cli("render " + shared_data("conformance/no_magic_number.tck") + " -o " + dir.file("x.png"));
     EXPECT_EQ(bad_file.status, 4) << bad_file.output;
+    // 16-bit files: refused (unsupported), not drawn as 8-bit codes.
+    const std::string wide = dir.file("af16.fft");
+    ASSERT_EQ(run_cli("compress -q --bits 16 " + shared_data("bundles/AF_L.tck") + " -o " + wide).status, 0);
+    const CliRun r16 = run_cli("render " + wide + " -o " + dir.file("x.png") + " --size 32x32");
+    EXPECT_EQ(r16.status, 6) << r16.output;
+    EXPECT_NE(r16.output.find("16-bit"), std::string::npos) << r16.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("x.png")));
 }
 
 TEST(ViewerCli, BenchPrintsEveryStageForEveryCase) {

@@ -53,6 +53,10 @@ void check_fits(std::uint64_t bytes, const char* what) {
 GpuScene::GpuScene(const FftFile& file, const GpuPrograms& programs, std::optional<DecoderKind> decoder)
     : header_(file.header()) {
     const FftHeader& h = header_;
+    // The shaders decode the 8-bit layout only: a 16-bit file would draw as noise.
+    if (h.direction_bits() != 8)
+        throw Error(Errc::unsupported, file.path() + ": 16-bit direction files (formats/fft16.md) are not drawn by "
+                                                     "the GPU decoder; `fiblet decompress` it and render the .tck");
     const std::uint32_t bb = h.block_bytes();
     check_fits(std::uint64_t(h.blocks) * bb, "blocks");
     const std::vector<std::uint8_t> blocks = file.read_blocks(0, h.blocks);
