@@ -21,6 +21,7 @@
 #include "fiblet/error.hpp"
 #include "fiblet/output_file.hpp"
 #include "fiblet/tck.hpp"
+#include "cli_runner.hpp"
 #include "test_util.hpp"
 
 using namespace fiblet;
@@ -63,16 +64,7 @@ void write_long_tractogram(const std::string& path, std::size_t points) {
 int signal_cli_while_writing(const std::vector<std::string>& args, const std::string& dir, int sig) {
     const int in = ::inotify_init1(IN_CLOEXEC);
     if (in < 0 || ::inotify_add_watch(in, dir.c_str(), IN_CREATE) < 0) return -1;
-    const pid_t pid = ::fork();
-    if (pid == 0) {
-        const int null = ::open("/dev/null", O_WRONLY);
-        ::dup2(null, 1), ::dup2(null, 2);
-        std::vector<char*> argv{const_cast<char*>(FIBLET_CLI)};
-        for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-        argv.push_back(nullptr);
-        ::execv(FIBLET_CLI, argv.data());
-        ::_exit(127);
-    }
+    const pid_t pid = test::spawn_cli(args);
     bool sent = false;
     alignas(inotify_event) char buf[4096];
     while (!sent) {

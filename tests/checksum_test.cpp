@@ -23,12 +23,7 @@ using namespace fiblet;
 
 namespace {
 
-template <class T>
-T at(const std::string& b, std::size_t off) {
-    T v;
-    std::memcpy(&v, b.data() + off, sizeof v);
-    return v;
-}
+using test::at;
 
 // A tractogram of `fibers` gently curving fibers of 40..159 points, with an
 // empty fiber at index 1 (its LUT entry carries no block).

@@ -1,37 +1,22 @@
 // The fiblet CLI end to end: outputs, exit codes, refusal to overwrite, no
 // output left behind on bad input.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 
 #include "fiblet/fft_file.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/tck.hpp"
+#include "cli_runner.hpp"
 #include "test_util.hpp"
 
 using namespace fiblet;
 namespace fs = std::filesystem;
+using fiblet::test::CommandResult;
+using fiblet::test::run_cli;
 
 namespace {
-
-struct CliResult {
-    int code;
-    std::string out;
-};
-
-CliResult cli(const std::string& args) {
-    const std::string cmd = std::string(FIBLET_CLI) + " " + args + " 2>&1";
-    FILE* p = ::popen(cmd.c_str(), "r");
-    std::string out;
-    std::array<char, 4096> buf{};
-    while (std::size_t n = std::fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
-    const int status = ::pclose(p);
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), out};
-}
 
 std::vector<std::string> listing(const std::string& dir) {
     std::vector<std::string> names;
@@ -46,17 +31,17 @@ TEST(Cli, CompressDecompressStatsInfo) {
     if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
     test::TempDir dir;
     const std::string in = test::shared_data("small-sdstream.tck");
-    CliResult r = cli("compress " + in + " -o " + dir.file("a.fft"));
-    ASSERT_EQ(r.code, 0) << r.out;
-    EXPECT_NE(r.out.find("1000 fibers, 853199 points"), std::string::npos) << r.out;
+    CommandResult r = run_cli("compress " + in + " -o " + dir.file("a.fft"));
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("1000 fibers, 853199 points"), std::string::npos) << r.output;
 
-    r = cli("stats " + dir.file("a.fft") + " --reference " + in + " --json");
-    ASSERT_EQ(r.code, 0) << r.out;
-    EXPECT_NE(r.out.find("\"fibers\": 1000"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("\"max_um\""), std::string::npos);
+    r = run_cli("stats " + dir.file("a.fft") + " --reference " + in + " --json");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("\"fibers\": 1000"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("\"max_um\""), std::string::npos);
 
-    r = cli("decompress " + dir.file("a.fft") + " -o " + dir.file("b.tck"));
-    ASSERT_EQ(r.code, 0) << r.out;
+    r = run_cli("decompress " + dir.file("a.fft") + " -o " + dir.file("b.tck"));
+    ASSERT_EQ(r.status, 0) << r.output;
     TckReader back(dir.file("b.tck")), orig(in);
     std::vector<Vec3f> x, y;
     std::uint64_t n = 0;
@@ -78,20 +63,18 @@ TEST(Cli, CompressDecompressStatsInfo) {
 
     // MRtrix3 itself reads the decoded file, with the source's properties.
     if (std::system("command -v tckinfo >/dev/null 2>&1") == 0) {
-        FILE* p = ::popen(("tckinfo " + dir.file("b.tck") + " 2>&1").c_str(), "r");
-        std::string info;
-        std::array<char, 4096> buf{};
-        while (std::size_t k = std::fread(buf.data(), 1, buf.size(), p)) info.append(buf.data(), k);
-        EXPECT_EQ(::pclose(p), 0) << info;
+        const CommandResult tckinfo = fiblet::test::run_command("tckinfo " + dir.file("b.tck") + " 2>&1");
+        const std::string& info = tckinfo.output;
+        EXPECT_EQ(tckinfo.status, 0) << info;
         EXPECT_NE(info.find("count:                0000001000"), std::string::npos) << info;
         EXPECT_NE(info.find("SDStream"), std::string::npos) << info;
         EXPECT_NE(info.find("step_size:            0.1"), std::string::npos) << info;
     }
 
-    EXPECT_EQ(cli("info " + dir.file("a.fft")).code, 0);
-    r = cli("info " + in + " --json");
-    EXPECT_EQ(r.code, 0);
-    EXPECT_NE(r.out.find("\"datatype\": \"Float32LE\""), std::string::npos) << r.out;
+    EXPECT_EQ(run_cli("info " + dir.file("a.fft")).status, 0);
+    r = run_cli("info " + in + " --json");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.output.find("\"datatype\": \"Float32LE\""), std::string::npos) << r.output;
 }
 
 TEST(Cli, RefusesToOverwriteWithoutForce) {
@@ -99,9 +82,9 @@ TEST(Cli, RefusesToOverwriteWithoutForce) {
     test::TempDir dir;
     test::write_file(dir.file("a.fft"), "precious");
     const std::string in = test::shared_data("dwi-small64d-ifod1.tck");
-    EXPECT_EQ(cli("compress " + in + " -o " + dir.file("a.fft")).code, 5);
+    EXPECT_EQ(run_cli("compress " + in + " -o " + dir.file("a.fft")).status, 5);
     EXPECT_EQ(test::read_file(dir.file("a.fft")), "precious");
-    EXPECT_EQ(cli("compress -q " + in + " -o " + dir.file("a.fft") + " --force").code, 0);
+    EXPECT_EQ(run_cli("compress -q " + in + " -o " + dir.file("a.fft") + " --force").status, 0);
     EXPECT_NE(test::read_file(dir.file("a.fft")), "precious");
     EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"a.fft"});
 }
@@ -119,30 +102,30 @@ TEST(Cli, BadInputExitsNonZeroAndLeavesNoOutput) {
     for (const Case& c : {Case{test::shared_data("conformance/no_magic_number.tck"), 4},
                           Case{test::shared_data("conformance/no_header_end.tck"), 4}, Case{dir.file("trunc.tck"), 4},
                           Case{test::shared_data("conformance/matlab_nan.tck"), 4}}) {
-        const CliResult r = cli("compress " + c.input + " -o " + dir.file("out.fft"));
-        EXPECT_EQ(r.code, c.code) << c.input << "\n" << r.out;
-        EXPECT_NE(r.out.find("error"), std::string::npos);
+        const CommandResult r = run_cli("compress " + c.input + " -o " + dir.file("out.fft"));
+        EXPECT_EQ(r.status, c.code) << c.input << "\n" << r.output;
+        EXPECT_NE(r.output.find("error"), std::string::npos);
         EXPECT_FALSE(fs::exists(dir.file("out.fft"))) << c.input;
     }
     EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"trunc.tck"}) << "temporary files left behind";
     // A .tck given where a .fft is expected, and a reference that does not match.
-    EXPECT_EQ(cli("decompress " + test::shared_data("conformance/simple.tck") + " -o " + dir.file("x.tck")).code, 4);
+    EXPECT_EQ(run_cli("decompress " + test::shared_data("conformance/simple.tck") + " -o " + dir.file("x.tck")).status, 4);
     EXPECT_FALSE(fs::exists(dir.file("x.tck")));
-    EXPECT_EQ(cli("stats " + test::shared_data("reference/small-ifod1.fft") + " -r " +
+    EXPECT_EQ(run_cli("stats " + test::shared_data("reference/small-ifod1.fft") + " -r " +
                   test::shared_data("small-sdstream.tck"))
-                  .code,
+                  .status,
               4);
-    EXPECT_EQ(cli("compress --step -1 " + test::shared_data("conformance/simple.tck") + " -o " + dir.file("y.fft")).code,
+    EXPECT_EQ(run_cli("compress --step -1 " + test::shared_data("conformance/simple.tck") + " -o " + dir.file("y.fft")).status,
               2);
-    EXPECT_EQ(cli("frobnicate").code, 2);
+    EXPECT_EQ(run_cli("frobnicate").status, 2);
 }
 
 TEST(Cli, BatchCompressionIntoADirectory) {
     if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
     test::TempDir dir;
-    const CliResult r = cli("compress -q " + test::shared_data("bundles/AF_L-step0.1.tck") + " " +
+    const CommandResult r = run_cli("compress -q " + test::shared_data("bundles/AF_L-step0.1.tck") + " " +
                       test::shared_data("bundles/CST_R-step0.1.tck") + " --output-dir " + dir.path());
-    ASSERT_EQ(r.code, 0) << r.out;
+    ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_EQ(listing(dir.path()), (std::vector<std::string>{"AF_L-step0.1.fft", "CST_R-step0.1.fft"}));
 }
 
@@ -150,17 +133,17 @@ TEST(Cli, VariableStepInputIsResampledAndMeasuredBothWays) {
     if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
     test::TempDir dir;
     const std::string in = test::shared_data("small-ifod2.tck");
-    CliResult r = cli("compress " + in + " -o " + dir.file("v.fft") + " --json");
-    ASSERT_EQ(r.code, 0) << r.out;
-    EXPECT_NE(r.out.find("\"resampled\": true"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("\"step_mm\": 0.5"), std::string::npos) << r.out;  // the header's step_size
-    r = cli("stats " + dir.file("v.fft") + " -r " + in);
-    ASSERT_EQ(r.code, 0) << r.out;
-    EXPECT_NE(r.out.find("vs original polyline"), std::string::npos) << r.out;
+    CommandResult r = run_cli("compress " + in + " -o " + dir.file("v.fft") + " --json");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("\"resampled\": true"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("\"step_mm\": 0.5"), std::string::npos) << r.output;  // the header's step_size
+    r = run_cli("stats " + dir.file("v.fft") + " -r " + in);
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("vs original polyline"), std::string::npos) << r.output;
     // --step overrides.
-    r = cli("compress " + in + " -o " + dir.file("w.fft") + " --step 0.25 --json");
-    ASSERT_EQ(r.code, 0) << r.out;
-    EXPECT_NE(r.out.find("\"step_mm\": 0.25"), std::string::npos) << r.out;
+    r = run_cli("compress " + in + " -o " + dir.file("w.fft") + " --step 0.25 --json");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("\"step_mm\": 0.25"), std::string::npos) << r.output;
 }
 
 TEST(Cli, EdgeCaseFilesRoundTrip) {
@@ -170,10 +153,10 @@ TEST(Cli, EdgeCaseFilesRoundTrip) {
     for (const char* name : {"empty.tck", "multiline_header_field.tck", "simple.tck", "simple_big_endian.tck"}) {
         const std::string in = test::shared_data(std::string("conformance/") + name);
         const std::string out = dir.file(std::string(name) + ".fft");
-        CliResult r = cli("compress -q " + in + " -o " + out);
-        ASSERT_EQ(r.code, 0) << name << "\n" << r.out;
-        r = cli("stats " + out + " -r " + in + " --json");
-        ASSERT_EQ(r.code, 0) << name << "\n" << r.out;
+        CommandResult r = run_cli("compress -q " + in + " -o " + out);
+        ASSERT_EQ(r.status, 0) << name << "\n" << r.output;
+        r = run_cli("stats " + out + " -r " + in + " --json");
+        ASSERT_EQ(r.status, 0) << name << "\n" << r.output;
         const FftFile f(out);
         const Streamlines s = decode_fibers(f, 0, f.header().fibers);
         for (float v : s.xyz) ASSERT_TRUE(std::isfinite(v)) << name;

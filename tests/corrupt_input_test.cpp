@@ -20,6 +20,7 @@
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/tck.hpp"
+#include "cli_runner.hpp"
 #include "test_util.hpp"
 
 using namespace fiblet;
@@ -52,14 +53,9 @@ int exit_code(Errc c) {
 }
 
 int cli(const std::string& args, std::string* output = nullptr) {
-    const std::string cmd = std::string(FIBLET_CLI) + " " + args + " 2>&1";
-    FILE* p = ::popen(cmd.c_str(), "r");
-    std::string out;
-    std::array<char, 4096> buf{};
-    while (std::size_t n = std::fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
-    const int status = ::pclose(p);
-    if (output) *output = out;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    test::CommandResult r = test::run_cli(args);
+    if (output) *output = std::move(r.output);
+    return r.status;
 }
 
 std::vector<std::string> listing(const std::string& dir) {
@@ -195,17 +191,7 @@ void poke(std::string& b, std::size_t off, T v) {
 
 // A valid .fft with checksums: 3 fibers of 70, 10 and 1 points (blocks 2 + 1 + 1).
 std::string valid_fft(const test::TempDir& dir) {
-    {
-        TckWriter w(dir.file("src.tck"), {}, true);
-        std::vector<Vec3f> f;
-        for (int i = 0; i < 70; ++i) f.push_back({float(i) * 0.1f, 1.0f, 2.0f});
-        w.write(f);
-        f.resize(10);
-        w.write(f);
-        f.resize(1);
-        w.write(f);
-        w.finish();
-    }
+    test::write_three_fiber_tck(dir.file("src.tck"));
     compress_tck(dir.file("src.tck"), dir.file("valid.fft"), {});
     std::string b = test::read_file(dir.file("valid.fft"));
     fs::remove(dir.file("src.tck"));

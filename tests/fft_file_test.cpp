@@ -19,15 +19,7 @@ namespace {
 
 // A small valid .fft (3 fibers, 4 blocks) as bytes.
 std::string make_valid(const test::TempDir& dir) {
-    TckWriter w(dir.file("in.tck"), {}, true);
-    std::vector<Vec3f> f;
-    for (int i = 0; i < 70; ++i) f.push_back({float(i) * 0.1f, 1.0f, 2.0f});
-    w.write(f);
-    f.resize(10);
-    w.write(f);
-    f.resize(1);
-    w.write(f);
-    w.finish();
+    test::write_three_fiber_tck(dir.file("in.tck"));
     compress_tck(dir.file("in.tck"), dir.file("ok.fft"), {.overwrite = true});
     return test::read_file(dir.file("ok.fft"));
 }

@@ -13,12 +13,7 @@
 using namespace fiblet;
 
 namespace {
-template <class T>
-T at(const std::string& b, std::size_t off) {
-    T v;
-    std::memcpy(&v, b.data() + off, sizeof v);
-    return v;
-}
+using test::at;
 std::uint8_t byte(const std::string& b, std::size_t off) { return static_cast<std::uint8_t>(b[off]); }
 }  // namespace
 

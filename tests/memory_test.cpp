@@ -19,6 +19,7 @@
 
 #include "fiblet/error_stats.hpp"
 #include "fiblet/tck.hpp"
+#include "cli_runner.hpp"
 #include "test_util.hpp"
 
 using namespace fiblet;
@@ -41,16 +42,7 @@ constexpr double kBoundMb = 256;
 
 // Runs the CLI; returns its peak RSS in MB, or -1 if it did not exit with 0.
 double peak_rss_mb(const std::vector<std::string>& args) {
-    const pid_t pid = ::fork();
-    if (pid == 0) {
-        const int null = ::open("/dev/null", O_WRONLY);
-        ::dup2(null, 1), ::dup2(null, 2);
-        std::vector<char*> argv{const_cast<char*>(FIBLET_CLI)};
-        for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-        argv.push_back(nullptr);
-        ::execv(FIBLET_CLI, argv.data());
-        ::_exit(127);
-    }
+    const pid_t pid = test::spawn_cli(args);
     int status = 0;
     rusage usage{};
     ::wait4(pid, &status, 0, &usage);

@@ -18,11 +18,14 @@
 
 #include "fiblet/error.hpp"
 #include "fiblet/tck.hpp"
+#include "cli_runner.hpp"
 #include "test_util.hpp"
 
 namespace fiblet {
 namespace {
 
+using test::CommandResult;
+using test::run_command;
 using test::TempDir;
 using Streamlines = std::vector<std::vector<Vec3f>>;
 using Properties = std::vector<std::pair<std::string, std::string>>;
@@ -243,23 +246,6 @@ TEST(TckWriter, MisuseIsReported) {
 }
 
 // ---- Interoperability (skipped when the tool is missing) ----
-
-struct CommandResult {
-    int status = -1;
-    std::string output;
-};
-
-CommandResult run_command(const std::string& cmd) {
-    CommandResult r;
-    FILE* f = ::popen(cmd.c_str(), "r");
-    if (!f) return r;
-    char buf[4096];
-    std::size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) r.output.append(buf, n);
-    const int st = ::pclose(f);
-    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-    return r;
-}
 
 bool have_nibabel() { return run_command("/usr/bin/python3 -c 'import nibabel' 2>/dev/null").status == 0; }
 bool have_tckinfo() { return run_command("command -v tckinfo >/dev/null 2>&1").status == 0; }

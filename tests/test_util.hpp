@@ -3,6 +3,7 @@
 
 #include <stdlib.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -10,6 +11,9 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <vector>
+
+#include "fiblet/tck.hpp"
 
 namespace fiblet::test {
 
@@ -56,6 +60,27 @@ inline std::string read_file(const std::string& path) {
     std::ifstream f(path, std::ios::binary);
     if (!f) throw std::runtime_error("cannot read " + path);
     return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+// The value of type T stored at byte `off` of `bytes` (host byte order).
+template <class T>
+T at(const std::string& bytes, std::size_t off) {
+    T v;
+    std::memcpy(&v, bytes.data() + off, sizeof v);
+    return v;
+}
+
+// A small .tck at `path`: straight fibers of 70, 10 and 1 points at a 0.1 mm step.
+inline void write_three_fiber_tck(const std::string& path) {
+    TckWriter w(path, {}, true);
+    std::vector<Vec3f> f;
+    for (int i = 0; i < 70; ++i) f.push_back({float(i) * 0.1f, 1.0f, 2.0f});
+    w.write(f);
+    f.resize(10);
+    w.write(f);
+    f.resize(1);
+    w.write(f);
+    w.finish();
 }
 
 }  // namespace fiblet::test

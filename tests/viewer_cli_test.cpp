@@ -1,11 +1,10 @@
 // `fiblet render` and `fiblet view` from the command line: outputs, exit
 // codes, and a clear failure where there is no display.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <cstdio>
 #include <filesystem>
 
+#include "cli_runner.hpp"
 #include "png_file.hpp"
 #include "viewer_test_util.hpp"
 
@@ -13,23 +12,6 @@ using namespace fiblet;
 using namespace fiblet::test;
 
 namespace {
-
-struct CliRun {
-    int status = -1;
-    std::string output;  // stdout and stderr
-};
-
-CliRun run_cli(const std::string& args, const std::string& env = "") {
-    const std::string cmd = env + " " + FIBLET_CLI + " " + args + " 2>&1";
-    CliRun r;
-    FILE* p = ::popen(cmd.c_str(), "r");
-    if (!p) return r;
-    char buf[4096];
-    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) r.output.append(buf, n);
-    const int st = ::pclose(p);
-    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-    return r;
-}
 
 std::size_t lit_pixels(const viewer::RgbaImage& im) {
     std::size_t n = 0;
@@ -43,7 +25,7 @@ TEST(ViewerCli, RenderWritesAPngOfTheRequestedSize) {
     FIBLET_REQUIRE_GL();
     const TempDir dir;
     const std::string fft = compress_into(dir, shared_data("bundles/CST_R.tck"), "cst.fft");
-    const CliRun r = run_cli("render " + fft + " -o " + dir.file("a.png") + " --size 120x90 --camera front");
+    const CommandResult r = run_cli("render " + fft + " -o " + dir.file("a.png") + " --size 120x90 --camera front");
     ASSERT_EQ(r.status, 0) << r.output;
     const viewer::RgbaImage im = viewer::read_png(dir.file("a.png"));
     EXPECT_EQ(im.width, 120);
@@ -51,7 +33,7 @@ TEST(ViewerCli, RenderWritesAPngOfTheRequestedSize) {
     EXPECT_GT(lit_pixels(im), 200u);
 
     // A .tck is compressed on the fly; a white background and a fixed colour.
-    const CliRun t = run_cli("render " + shared_data("bundles/CST_R.tck") + " -o " + dir.file("b.png") +
+    const CommandResult t = run_cli("render " + shared_data("bundles/CST_R.tck") + " -o " + dir.file("b.png") +
                           " --size 120x90 --camera front --background white --color 2040c0 --no-lighting");
     ASSERT_EQ(t.status, 0) << t.output;
     const viewer::RgbaImage b = viewer::read_png(dir.file("b.png"));
@@ -69,23 +51,23 @@ TEST(ViewerCli, RenderRefusesBadArgumentsAndExistingOutputs) {
     const TempDir dir;
     const std::string fft = compress_into(dir, shared_data("bundles/AF_L.tck"), "af.fft");
     write_file(dir.file("old.png"), "keep");
-    const CliRun exists = run_cli("render " + fft + " -o " + dir.file("old.png") + " --size 32x32");
+    const CommandResult exists = run_cli("render " + fft + " -o " + dir.file("old.png") + " --size 32x32");
     EXPECT_EQ(exists.status, 5) << exists.output;
     EXPECT_EQ(read_file(dir.file("old.png")), "keep");
     for (const char* bad : {"--size 100by50", "--size 0x10", "--camera 1,2", "--camera sideways", "--color purple",
                             "--fov 0", "--fibers 9:3", "--line-width 0"}) {
-        const CliRun r = run_cli("render " + fft + " -o " + dir.file("x.png") + " " + bad);
+        const CommandResult r = run_cli("render " + fft + " -o " + dir.file("x.png") + " " + bad);
         EXPECT_EQ(r.status, 2) << bad << ": " << r.output;
         EXPECT_FALSE(std::filesystem::exists(dir.file("x.png"))) << bad;
     }
-    const CliRun no_output = run_cli("render " + fft);
+    const CommandResult no_output = run_cli("render " + fft);
     EXPECT_EQ(no_output.status, 2) << no_output.output;
-    const CliRun bad_file = run_cli("render " + shared_data("conformance/no_magic_number.tck") + " -o " + dir.file("x.png"));
+    const CommandResult bad_file = run_cli("render " + shared_data("conformance/no_magic_number.tck") + " -o " + dir.file("x.png"));
     EXPECT_EQ(bad_file.status, 4) << bad_file.output;
     // 16-bit files: refused (unsupported), not drawn as 8-bit codes.
     const std::string wide = dir.file("af16.fft");
     ASSERT_EQ(run_cli("compress -q --bits 16 " + shared_data("bundles/AF_L.tck") + " -o " + wide).status, 0);
-    const CliRun r16 = run_cli("render " + wide + " -o " + dir.file("x.png") + " --size 32x32");
+    const CommandResult r16 = run_cli("render " + wide + " -o " + dir.file("x.png") + " --size 32x32");
     EXPECT_EQ(r16.status, 6) << r16.output;
     EXPECT_NE(r16.output.find("16-bit"), std::string::npos) << r16.output;
     EXPECT_FALSE(std::filesystem::exists(dir.file("x.png")));
@@ -95,7 +77,7 @@ TEST(ViewerCli, BenchPrintsEveryStageForEveryCase) {
     FIBLET_REQUIRE_GL();
     const TempDir dir;
     const std::string fft = compress_into(dir, shared_data("bundles/AF_L.tck"), "af.fft");
-    const CliRun r = run_cli("render " + fft + " --bench --frames 1 --size 64x48 --json");
+    const CommandResult r = run_cli("render " + fft + " --bench --frames 1 --size 64x48 --json");
     ASSERT_EQ(r.status, 0) << r.output;
     for (const char* key : {"\"overview\"", "\"close-up\"", "\"far\"", "\"cull_ms\"", "\"decode_ms\"", "\"draw_ms\""})
         EXPECT_NE(r.output.find(key), std::string::npos) << key << " in " << r.output;
@@ -103,7 +85,7 @@ TEST(ViewerCli, BenchPrintsEveryStageForEveryCase) {
 
 TEST(ViewerCli, ViewWithoutADisplayFailsClearly) {
     const TempDir dir;
-    const CliRun r = run_cli("view " + shared_data("reference/small-sdstream.fft"),
+    const CommandResult r = run_cli("view " + shared_data("reference/small-sdstream.fft"),
                           "env -u DISPLAY -u WAYLAND_DISPLAY");
     EXPECT_EQ(r.status, 6) << r.output;  // unsupported
     EXPECT_NE(r.output.find("display"), std::string::npos) << r.output;
