@@ -185,6 +185,23 @@ void zstd_row(const std::string& path, int level, int repeat) {
         .print();
 }
 
+// One row of a lossy baseline decoded in memory: size, speeds and errors.
+void print_lossy_row(const char* row, const fb::Tractogram& t, double bytes, double encode, double decode,
+                     double decode_cpu, const fb::PointErrors& e) {
+    Json()
+        .str("row", row)
+        .num("points", double(t.points()))
+        .num("fibers", double(t.fibers()))
+        .num("bytes", bytes)
+        .num("encode_seconds", encode)
+        .num("decode_seconds", decode)
+        .num("decode_cpu_seconds", decode_cpu)
+        .num("max_error_um", e.max_mm * 1e3)
+        .num("mean_error_um", e.mean_mm * 1e3)
+        .num("peak_rss_kib", double(peak_rss_kib()))
+        .print();
+}
+
 void float16_row(const std::string& path, int repeat) {
     fb::Tractogram t;
     fb::read_tck(path, t);
@@ -194,18 +211,8 @@ void float16_row(const std::string& path, int repeat) {
     double cpu = 0;
     const double decode = best_seconds(repeat, [&] { fb::from_half(half.data(), back.data(), half.size()); }, &cpu);
     const fb::PointErrors e = fb::point_errors(t.xyz, back);
-    Json()
-        .str("row", "float16")
-        .num("points", double(t.points()))
-        .num("fibers", double(t.fibers()))
-        .num("bytes", double(2 * half.size() + 8 * t.offsets.size()))  // + uint64 offsets, as TRX
-        .num("encode_seconds", encode)
-        .num("decode_seconds", decode)
-        .num("decode_cpu_seconds", cpu)
-        .num("max_error_um", e.max_mm * 1e3)
-        .num("mean_error_um", e.mean_mm * 1e3)
-        .num("peak_rss_kib", double(peak_rss_kib()))
-        .print();
+    print_lossy_row("float16", t, double(2 * half.size() + 8 * t.offsets.size()),  // + uint64 offsets, as TRX
+                    encode, decode, cpu, e);
 }
 
 void sequential_row(const std::string& path, int repeat) {
@@ -217,18 +224,7 @@ void sequential_row(const std::string& path, int repeat) {
     double cpu = 0;
     const double decode = best_seconds(repeat, [&] { fb::decode_sequential(coded, back.data()); }, &cpu);
     const fb::PointErrors e = fb::point_errors(t.xyz, back);
-    Json()
-        .str("row", "sequential")
-        .num("points", double(t.points()))
-        .num("fibers", double(t.fibers()))
-        .num("bytes", double(coded.bytes.size()))
-        .num("encode_seconds", encode)
-        .num("decode_seconds", decode)
-        .num("decode_cpu_seconds", cpu)
-        .num("max_error_um", e.max_mm * 1e3)
-        .num("mean_error_um", e.mean_mm * 1e3)
-        .num("peak_rss_kib", double(peak_rss_kib()))
-        .print();
+    print_lossy_row("sequential", t, double(coded.bytes.size()), encode, decode, cpu, e);
 }
 
 }  // namespace
