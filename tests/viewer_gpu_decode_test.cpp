@@ -58,19 +58,24 @@ double tolerance_mm(const std::string& fft_path) {
     return 2e-6 * FftFile(fft_path).header().scaling;
 }
 
+// Both GPU decoders against the scalar decoder on `fft` (named `name`), which
+// decodes to more than `more_points_than` points.
+void expect_gpu_decoders_match_scalar(const std::string& fft, const char* name, std::size_t more_points_than) {
+    for (const auto kind : kBothDecoders) {
+        const Comparison c = compare_decoders(fft, kind);
+        EXPECT_GT(c.points, more_points_than) << name;
+        EXPECT_LE(c.max_diff_mm, tolerance_mm(fft)) << name << " " << viewer::decoder_name(kind);
+        std::printf("%s: %zu points, GPU (%s) vs scalar decoder max %.3g mm\n", name, c.points,
+                    viewer::decoder_name(kind), c.max_diff_mm);
+    }
+}
+
 }  // namespace
 
 TEST(ViewerGpuDecode, ReferenceFilesWrittenByTheOfficialEncoder) {
     FIBLET_REQUIRE_GL();
     for (const char* name : {"reference/small-ifod1.fft", "reference/small-sdstream.fft"}) {
-        const std::string path = shared_data(name);
-        for (const auto kind : kBothDecoders) {
-            const Comparison c = compare_decoders(path, kind);
-            EXPECT_GT(c.points, 100000u) << name;
-            EXPECT_LE(c.max_diff_mm, tolerance_mm(path)) << name << " " << viewer::decoder_name(kind);
-            std::printf("%s: %zu points, GPU (%s) vs scalar decoder max %.3g mm\n", name, c.points,
-                        viewer::decoder_name(kind), c.max_diff_mm);
-        }
+        expect_gpu_decoders_match_scalar(shared_data(name), name, 100000);
     }
 }
 
@@ -81,14 +86,7 @@ TEST(ViewerGpuDecode, SharedTractogramsCompressedHere) {
          {"bundles/AF_L-step0.1.tck", "bundles/CC_ForcepsMajor-step0.1.tck", "bundles/CST_R-step0.1.tck",
           "bundles/cingulum-1-step0.1.tck", "bundles/cingulum-2-step0.1.tck", "bundles/AF_L.tck",
           "dwi-small64d-ifod1.tck", "conformance/simple.tck", "conformance/standard.tck"}) {
-        const std::string fft = compress_into(dir, shared_data(name), "f.fft");
-        for (const auto kind : kBothDecoders) {
-            const Comparison c = compare_decoders(fft, kind);
-            EXPECT_GT(c.points, 0u) << name;
-            EXPECT_LE(c.max_diff_mm, tolerance_mm(fft)) << name << " " << viewer::decoder_name(kind);
-            std::printf("%s: %zu points, GPU (%s) vs scalar decoder max %.3g mm\n", name, c.points,
-                        viewer::decoder_name(kind), c.max_diff_mm);
-        }
+        expect_gpu_decoders_match_scalar(compress_into(dir, shared_data(name), "f.fft"), name, 0);
     }
 }
 
