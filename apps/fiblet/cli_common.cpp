@@ -97,4 +97,20 @@ std::string Json::render() const {
     return out + "}";
 }
 
+FftFile open_fft_input(const std::string& path, bool ignore_trailer) {
+    FftFile file(path, {.ignore_trailer = ignore_trailer});
+    if (const std::uint64_t n = file.ignored_trailing_bytes())
+        fmt::print(stderr,
+                   "fiblet: warning: {}: --ignore-trailer: {} bytes after the last block left unread "
+                   "(no checksums, source properties or index: the blocks are not verified)\n",
+                   path, n);
+    return file;
+}
+
+void add_ignore_trailer_flag(CLI::App* cmd, bool& flag) {
+    cmd->add_flag("--ignore-trailer", flag,
+                  "Read only the header, LUT and blocks, not the trailer after them: salvages a file whose "
+                  "trailer is damaged (nothing is then verified by checksum)");
+}
+
 }  // namespace fiblet::cli

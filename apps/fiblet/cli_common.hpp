@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "fiblet/error.hpp"
+#include "fiblet/fft_file.hpp"
 
 namespace fiblet::cli {
 
@@ -61,6 +62,12 @@ private:
     std::vector<std::pair<std::string, std::string>> fields_;
 };
 std::string json_quote(const std::string& s);
+
+// Opens a .fft/.fftz input. With `ignore_trailer` (the --ignore-trailer
+// flag that add_ignore_trailer_flag() declares) the trailer is left unread,
+// and a warning says what that gives up.
+FftFile open_fft_input(const std::string& path, bool ignore_trailer);
+void add_ignore_trailer_flag(CLI::App* cmd, bool& flag);
 
 // Subcommand registration (one file each).
 void add_compress(CLI::App& app);

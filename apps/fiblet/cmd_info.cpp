@@ -12,6 +12,7 @@ namespace fiblet::cli {
 namespace {
 
 struct InfoArgs {
+    bool ignore_trailer = false;
     std::string input;
     bool json = false;
 };
@@ -51,7 +52,7 @@ void info_tck(const InfoArgs& a) {
 }
 
 void info_fft(const InfoArgs& a) {
-    const FftFile f(a.input);
+    const FftFile f = open_fft_input(a.input, a.ignore_trailer);
     const FftHeader& h = f.header();
     std::string chunks;
     for (const auto& c : f.trailer()) chunks += (chunks.empty() ? "" : " ") + std::string(c.tag.data(), 4);
@@ -97,6 +98,7 @@ void add_info(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("info", "Print the header of a .fft or .tck file");
     cmd->add_option("file", args->input, "A .fft or .tck file")->required()->check(CLI::ExistingFile);
     cmd->add_flag("--json", args->json, "Print as JSON");
+    add_ignore_trailer_flag(cmd, args->ignore_trailer);
     cmd->callback([args] { looks_like_tck(args->input) ? info_tck(*args) : info_fft(*args); });
 }
 

@@ -8,6 +8,7 @@ namespace fiblet::cli {
 namespace {
 
 struct StatsArgs {
+    bool ignore_trailer = false;
     std::string input, reference;
     bool json = false, quiet = false, allow_count_mismatch = false;
 };
@@ -32,7 +33,7 @@ void print_errors(const char* label, const ErrorStats& e) {
 }
 
 void run(const StatsArgs& a) {
-    const FftFile file(a.input);
+    const FftFile file = open_fft_input(a.input, a.ignore_trailer);
     Progress progress(a.quiet || a.json);
     const Comparison c =
         compare_to_reference(file, a.reference, a.allow_count_mismatch, [&](double f) { progress.update("stats", f); });
@@ -76,6 +77,7 @@ void add_stats(CLI::App& app) {
     cmd->add_flag("-q,--quiet", args->quiet, "No progress display");
     cmd->add_flag("--allow-count-mismatch", args->allow_count_mismatch,
                   "Accept a reference whose count: header disagrees with its data");
+    add_ignore_trailer_flag(cmd, args->ignore_trailer);
     cmd->callback([args] { run(*args); });
 }
 

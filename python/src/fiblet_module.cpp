@@ -138,7 +138,7 @@ py::dict header_dict(const FftFile& f) {
     d["scaling_mm"] = h.scaling, d["offset_mm"] = py::make_tuple(h.offset[0], h.offset[1], h.offset[2]);
     d["max_error_um"] = double(h.max_error_mm) * 1e3, d["mean_error_um"] = double(h.mean_error_mm) * 1e3;
     d["file_bytes"] = f.file_size();
-    d["resampled"] = f.find_chunk(kResampledTag) != nullptr;
+    d["resampled"] = f.resampled_step_mm().has_value();
     d["properties"] = f.properties();
     return d;
 }

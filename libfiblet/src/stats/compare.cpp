@@ -21,11 +21,8 @@ Comparison compare_to_reference(const FftFile& fft, const std::string& tck_path,
     struct stat st {};
     if (::stat(tck_path.c_str(), &st) == 0) c.reference_bytes = std::uint64_t(st.st_size);
 
-    double step = 0;
-    if (const TrailerChunk* r = fft.find_chunk(kResampledTag); r && r->payload.size() == 8) {
-        c.resampled = true;
-        std::memcpy(&step, r->payload.data(), 8);
-    }
+    const double step = fft.resampled_step_mm().value_or(0);  // validated at open: finite, > 0
+    c.resampled = fft.resampled_step_mm().has_value();
     TckReader ref(tck_path, {.allow_count_mismatch = allow_count_mismatch});
     std::vector<Vec3f> original, resampled;
     auto mismatch = [&](const std::string& what) {
