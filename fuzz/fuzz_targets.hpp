@@ -310,6 +310,9 @@ inline void fft_target(const std::uint8_t* data, std::size_t size) {
             break;  // malformed: the same without verification
         }
         check(!mode.ignore_trailer || !file->has_trailer(), "ignore_trailer read a trailer");
+        // Bytes after the blocks make a file fiblet-written: it never opens without its checksums.
+        check(mode.ignore_trailer || file->logical_size() == file->header().file_bytes() || file->checksums(),
+              "a file with a trailer opened without a CSUM chunk");
         verified_open |= verify;
         logical_size = file->logical_size();
         const FftFile& f = *file;
