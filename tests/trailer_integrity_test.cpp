@@ -256,6 +256,10 @@ TEST(TrailerIntegrity, VerifyCrossChecksWhatReadersRelyOn) {
                                             });
     EXPECT_EQ(verify_error(points), Errc::fft_format);
     EXPECT_NE(test::run_cli("verify " + points).output.find("points"), std::string::npos);
+    // decompress would report one count and write another: it fails, and writes nothing.
+    const std::string out = fx.dir.file("points.tck");
+    EXPECT_EQ(test::run_cli("decompress " + points + " -o " + out).status, 4);
+    EXPECT_FALSE(std::filesystem::exists(out));
     // Two middle blocks of a fiber swapped (same flags and counts): the block
     // index bytes give it away, with or without a checksum.
     const std::string swapped = fx.rewritten("swapped.fft", [&](std::string& b) {

@@ -82,7 +82,8 @@ std::vector<Region> parse_regions(const py::list& regions) {
 // (F+1) int64, fiber_ids (F) int64). A range without regions, the common
 // case, is decoded straight into the memory numpy gets (decode_range).
 py::tuple decode(const std::string& path, std::uint64_t begin, std::optional<std::uint64_t> end,
-                 const py::object& indices_or_none, const py::list& regions_list, unsigned threads) {
+                 const py::object& indices_or_none, const py::list& regions_list, unsigned threads,
+                 bool ignore_trailer) {
     const std::vector<Region> regions = parse_regions(regions_list);
     std::optional<std::vector<std::uint64_t>> indices;
     if (!indices_or_none.is_none()) {
@@ -95,7 +96,7 @@ py::tuple decode(const std::string& path, std::uint64_t begin, std::optional<std
     std::vector<std::uint64_t> ids;
     {
         py::gil_scoped_release release;
-        const FftFile file(path);
+        const FftFile file(path, {.ignore_trailer = ignore_trailer});
         if (indices) {
             for (std::uint64_t f : *indices)
                 if (f >= file.header().fibers)
@@ -143,7 +144,9 @@ py::dict header_dict(const FftFile& f) {
     return d;
 }
 
-py::dict info(const std::string& path) { return header_dict(FftFile(path)); }
+py::dict info(const std::string& path, bool ignore_trailer) {
+    return header_dict(FftFile(path, {.ignore_trailer = ignore_trailer}));
+}
 
 py::dict error_dict(const ErrorStats& e) {
     py::dict d;
@@ -246,8 +249,8 @@ PYBIND11_MODULE(_fiblet, m) {
     });
 
     m.def("decode", &decode, py::arg("path"), py::arg("begin"), py::arg("end"), py::arg("indices"),
-          py::arg("regions"), py::arg("threads"));
-    m.def("info", &info, py::arg("path"));
+          py::arg("regions"), py::arg("threads"), py::arg("ignore_trailer"));
+    m.def("info", &info, py::arg("path"), py::arg("ignore_trailer"));
     m.def("stats", &stats, py::arg("fft"), py::arg("reference"));
     m.def("compress", &compress, py::arg("tck"), py::arg("fft"), py::arg("step_mm"), py::arg("overwrite"),
           py::arg("threads"));

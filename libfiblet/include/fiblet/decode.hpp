@@ -128,7 +128,9 @@ std::uint64_t decode_fibers_into(const FftFile& file, std::uint64_t begin, std::
                                  std::span<std::uint64_t> offsets, const DecodeOptions& = {});
 
 // Streams the whole file in fiber order, a chunk of whole fibers at a time
-// (bounded memory): `sink(first_fiber, chunk)`.
+// (bounded memory): `sink(first_fiber, chunk)`. Throws Error{fft_format}
+// after the last chunk when the blocks hold other than header().points
+// points (a caller writing an output commits it only after this returns).
 void decode_file(const FftFile& file, const std::function<void(std::uint64_t, const Streamlines&)>& sink,
                  const DecodeOptions& = {});
 
