@@ -230,6 +230,8 @@ inline FftOutcome decode_reference(const FftFile& f) {
                 acc += block_flags(h, &blocks[b * h.block_bytes()]).point_count;
             o.s.offsets.push_back(acc);
         }
+        // A whole file must hold the header's point count (decode_file checks it too).
+        if (acc != h.points) throw Error(Errc::fft_format, "point count differs from the header's");
     } catch (const Error& e) {
         o.error = e.code();
         o.s = {};

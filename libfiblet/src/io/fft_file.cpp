@@ -127,15 +127,13 @@ FftFile::FftFile(const std::string& path, FftOpenOptions options)
 // memory), hashing its bytes for the checksum check.
 void FftFile::read_lut(std::uint64_t& lut_hash) {
     constexpr std::uint64_t kSliceEntries = 1u << 16;
-    // A plain file holds its LUT (the size was checked); a .fftz's claim is
-    // only believed as entries really arrive, doubling up to it (so it ends
-    // at 12 bytes a fiber), so a LUT frame that claims more than it holds
-    // fails before the claim is allocated.
-    auto reserve = [&](std::uint64_t n) {
-        lut_.reserve(n);
-        fiber_first_block_.reserve(n);
-    };
-    if (!fftz_) reserve(header_.fibers);
+    // A plain file holds its LUT (the size was checked against the file's);
+    // a .fftz's LUT frame is decompressed once first, in bounded memory, so
+    // that a frame claiming more than it holds fails before the claim is
+    // allocated.
+    if (fftz_) fftz_->check_lut_content();
+    lut_.resize(header_.fibers);
+    fiber_first_block_.resize(header_.fibers);
     std::vector<std::uint8_t> raw;
     Xxh64Stream hash;
     std::uint64_t next = 0;  // fibers are stored in order, their blocks contiguous
@@ -144,9 +142,6 @@ void FftFile::read_lut(std::uint64_t& lut_hash) {
         raw.resize(8 * n);
         read_at(raw.data(), raw.size(), header_.lut_offset() + 8 * s);
         hash.update(raw.data(), raw.size());
-        if (s + n > lut_.capacity()) reserve(std::max(s + n, std::min(header_.fibers, 2 * lut_.capacity())));
-        lut_.resize(s + n);
-        fiber_first_block_.resize(s + n);
         for (std::uint64_t j = 0; j < n; ++j) {
             const std::uint64_t i = s + j;
             lut_[i] = {get_le<std::uint32_t>(&raw[8 * j]), get_le<std::uint32_t>(&raw[8 * j + 4])};

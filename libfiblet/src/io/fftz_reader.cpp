@@ -214,6 +214,18 @@ void FftzReader::read_streamed(std::size_t index, std::uint64_t at, std::uint8_t
     if (stream_->position() == frames_[index].logical_size) stream_->finish(), stream_.reset();
 }
 
+void FftzReader::check_lut_content() const {
+    std::lock_guard lock(mutex_);
+    FrameStream stream(*this, kLutFrame);
+    std::vector<std::uint8_t> scratch(1u << 20);
+    for (std::uint64_t left = frames_[kLutFrame].logical_size; left > 0;) {
+        const std::uint64_t n = std::min<std::uint64_t>(left, scratch.size());
+        stream.read(scratch.data(), n);
+        left -= n;
+    }
+    stream.finish();
+}
+
 void FftzReader::read(std::uint8_t* out, std::uint64_t size, std::uint64_t offset) const {
     if (offset > logical_size_ || size > logical_size_ - offset)
         throw Error(Errc::fft_format, name_ + ": not a valid .fftz file: read past the end of the content");
@@ -230,8 +242,10 @@ void FftzReader::read(std::uint8_t* out, std::uint64_t size, std::uint64_t offse
         const auto index = std::size_t(it - frames_.begin());
         const std::uint64_t in_frame = offset - it->logical_at;
         const std::uint64_t n = std::min(size, it->logical_size - in_frame);
-        const bool group = index >= first_group_ && index < first_group_ + groups_;  // untransposed whole
-        if (it->logical_size > kMaxCachedFrame && !group) {
+        // The LUT is read once, in order, by the FftFile that opens this:
+        // streamed, it costs no copy; block groups are untransposed whole.
+        const bool group = index >= first_group_ && index < first_group_ + groups_;
+        if (index == kLutFrame || (it->logical_size > kMaxCachedFrame && !group)) {
             read_streamed(index, in_frame, out, n);
         } else {
             const auto& bytes = frame_bytes(index);

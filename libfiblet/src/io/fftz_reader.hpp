@@ -2,8 +2,8 @@
 // (formats/fftz.md). Every size read from the file is checked before it is
 // trusted; frames are decompressed on demand as streams, so memory follows
 // what a frame really holds, never what the seek table claims: frames up to
-// kMaxCachedFrame are decompressed whole (the last one is cached), larger
-// ones (the LUT of a file with many fibers) are read through in order.
+// kMaxCachedFrame are decompressed whole (the last one is cached); the LUT
+// and larger frames are read through in order without a copy.
 #pragma once
 
 #include <cstdint>
@@ -18,6 +18,7 @@
 namespace fiblet::detail {
 
 inline constexpr std::uint64_t kMaxCachedFrame = 64u << 20;
+inline constexpr std::size_t kLutFrame = 2;  // frames: descriptor, header, LUT, block groups, [trailer]
 
 class FftzReader {
 public:
@@ -34,6 +35,11 @@ public:
     // Checks the frames against the parsed header (header, LUT, one frame
     // per group of blocks, trailer) and enables reading blocks.
     void check_layout(const FftHeader& header);
+
+    // Decompresses the LUT frame once, in bounded memory, so that its size is
+    // known to be real before a reader allocates for it. Throws
+    // Error{checksum} when it holds other than it claims.
+    void check_lut_content() const;
 
     // Logical bytes [offset, offset + size).
     void read(std::uint8_t* out, std::uint64_t size, std::uint64_t offset) const;
