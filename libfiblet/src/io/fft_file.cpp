@@ -120,6 +120,8 @@ FftFile::FftFile(const std::string& path, FftOpenOptions options)
         // reported as such (fft_format) even when a checksum also fails.
         if (const TrailerChunk* c = find_chunk(kChecksumTag))
             checksums_ = FftChecksums::parse(*c, header_.blocks, path_);
+        if (const TrailerChunk* c = find_chunk(kFiberEndsTag))
+            end_fractions_ = std::make_shared<const FiberEndFractions>(parse_fiber_ends_chunk(*c, header_.fibers, path_));
         if (verifies_checksums()) {
             verify_open_checksums(std::span(head).first(std::size_t(header_.lut_offset())), lut_hash);
             const std::uint64_t words = (checksums_->group_hashes.size() + 63) / 64;
@@ -197,7 +199,8 @@ void FftFile::read_trailer() {
         if (size > stop - pos - sizeof head) bad(path_, "trailer chunk runs past the footer");
         TrailerChunk chunk;
         std::memcpy(chunk.tag.data(), head, 4);
-        const bool known = chunk.tag == kPropertiesTag || chunk.tag == kResampledTag || chunk.tag == kChecksumTag;
+        const bool known = chunk.tag == kPropertiesTag || chunk.tag == kResampledTag || chunk.tag == kChecksumTag ||
+                           chunk.tag == kFiberEndsTag;
         if (known && size > kMaxKnownChunk)
             bad(path_, "trailer chunk " + std::string(chunk.tag.data(), 4) + " of " + std::to_string(size) +
                            " bytes (at most " + std::to_string(kMaxKnownChunk) + ")");
@@ -285,6 +288,7 @@ FftFile& FftFile::operator=(FftFile&& o) noexcept {
         trailer_ = std::move(o.trailer_);
         checksum_chunk_offset_ = o.checksum_chunk_offset_;
         checksums_ = std::move(o.checksums_);
+        end_fractions_ = std::move(o.end_fractions_);
         verified_groups_ = std::move(o.verified_groups_);
         mapping_ = std::move(o.mapping_);
     }
