@@ -33,6 +33,8 @@ const std::vector<ExitCodeInfo>& exit_code_table() {
         {kExists, "the output exists and --force was not given"},
         {kUnsupported, "valid input that fiblet does not support"},
         {kChecksum, "integrity check failed"},
+        {kErrorBound, "a measured error (point, Hausdorff, endpoint or length change) exceeds --max-error; "
+                      "the report is printed and outputs are kept"},
         {130, "interrupted by SIGINT (128 + signal number for other signals); no partial output is left"},
     };
     return table;
