@@ -204,9 +204,12 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
                 throw Error(Errc::unsupported, tck_path + ": streamline " + std::to_string(f) + " (" +
                                                    std::to_string(fiber_length) + " mm) needs more than 65535 blocks at a " +
                                                    std::to_string(step) + " mm step");
-            resample_keeping_end(fiber, step, resampled);
+            const bool short_tail = resample_keeping_end(fiber, step, resampled);
             fiber_points[f++] = std::uint32_t(resampled.size());
-            turns.add_fiber(resampled);
+            // The turn towards a kept end is one step per fiber, often a
+            // noisy short one: left out of the turn statistics, so the cap
+            // (sized for the whole-step turns) stays as fine as before.
+            turns.add_fiber(std::span<const Vec3f>(resampled).first(resampled.size() - short_tail));
             for (std::size_t i = 1; i < fiber.size(); ++i)
                 scan.off_step_segments += std::fabs(length(fiber[i - 1], fiber[i]) - step) > tol * step;
             if ((f & 1023) == 0) report_progress(options, "resample-scan", reader);
