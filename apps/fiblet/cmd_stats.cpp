@@ -65,7 +65,9 @@ void run(const StatsArgs& a) {
 
 void add_stats(CLI::App& app) {
     auto args = std::make_shared<StatsArgs>();
-    CLI::App* cmd = app.add_subcommand("stats", "Measure a .fft file against its source .tck");
+    CLI::App* cmd = app.add_subcommand(
+        "stats", "Measure a .fft file against its source .tck: point error, distances both ways (Hausdorff), "
+                 "endpoint displacement, length change");
     cmd->add_option("input", args->input, "Input .fft file")->required()->check(CLI::ExistingFile);
     cmd->add_option("-r,--reference", args->reference, "The .tck file it was made from")
         ->required()
