@@ -14,6 +14,7 @@
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/fiber_ends.hpp"
+#include "fiblet/fft_subset.hpp"
 #include "fiblet/select.hpp"
 #include "fiblet/tck.hpp"
 #include "test_util.hpp"
@@ -220,6 +221,36 @@ TEST(FiberEnds, EveryDecodePathPlacesTheEnd) {
     });
     check(whole, "decode_file");
     check(select_streamlines(file, BlockIndex::load(file), Query{}), "select_streamlines");
+}
+
+// A subset written as a .fft keeps the fractions of the fibers it keeps
+// whole, and ends a fiber cut before its last block on a whole step.
+TEST(FiberEnds, SubsetFilesCarryTheFractionsOfTheirFibers) {
+    test::TempDir dir;
+    std::vector<Fiber> fibers;
+    for (int k = 0; k < 8; ++k) {
+        std::vector<double> inc(100 + 9 * k, 0.1);
+        inc.back() = 0.03 + 0.005 * k;
+        fibers.push_back(helix(inc, {float(k), 0, 0}));
+    }
+    const Encoded e = encode(dir, fibers);
+    const FftFile file(dir.file("out.fft"));
+    std::vector<SelectedRun> runs;
+    for (std::uint64_t f = 7; f-- > 0;) runs.push_back({f, file.first_block(f), file.block_count(f), 0});
+    runs.push_back({7, file.first_block(7), 1, 0});  // fiber 7 cut after its first block
+    write_fft_subset(file, runs, dir.file("subset.fft"), true);
+    const FftFile subset(dir.file("subset.fft"));
+    ASSERT_TRUE(subset.end_fractions());
+    const Streamlines s = decode_fibers(subset, 0, subset.header().fibers);
+    for (std::size_t i = 0; i < 7; ++i) {
+        const Fiber got = fiber_of(s, i), want = fiber_of(e.decoded, runs[i].fiber);
+        ASSERT_EQ(got.size(), want.size());
+        EXPECT_EQ(got.back(), want.back()) << "fiber " << runs[i].fiber;
+    }
+    const Fiber cut = fiber_of(s, 7), whole = fiber_of(e.decoded, 7);
+    ASSERT_EQ(cut.size(), 60u);
+    EXPECT_EQ(cut.back(), whole[59]);  // a middle block's last point: no fraction
+    EXPECT_EQ((*subset.end_fractions())[7], kWholeLastStep);
 }
 
 // What a reader that ignores the chunk (the official decoder) sees: the last
