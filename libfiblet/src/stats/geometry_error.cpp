@@ -2,8 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <vector>
 
-#include "fiblet/resample.hpp"
 
 namespace fiblet {
 
@@ -14,14 +15,52 @@ double distance(Vec3f a, Vec3f b) {
     return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
 
+// A segment of the polyline measured against: its start, direction and the
+// inverse squared length, computed once per fiber (no division per query).
+struct Segment {
+    double ax, ay, az, ux, uy, uz, inv_uu;
+};
+
+void segments_of(std::span<const Vec3f> line, std::vector<Segment>& out) {
+    out.clear();
+    const std::size_t n = line.size() > 1 ? line.size() - 1 : 1;  // a single point: one degenerate segment
+    for (std::size_t s = 0; s < n; ++s) {
+        const Vec3f a = line[s], b = line[std::min(s + 1, line.size() - 1)];
+        const double ux = double(b.x) - a.x, uy = double(b.y) - a.y, uz = double(b.z) - a.z;
+        const double uu = ux * ux + uy * uy + uz * uz;
+        out.push_back({a.x, a.y, a.z, ux, uy, uz, uu > 0 ? 1.0 / uu : 0.0});
+    }
+}
+
+// Squared distance from p to a segment (its start when it has no length).
+double distance2(const Segment& g, double px, double py, double pz) {
+    const double wx = px - g.ax, wy = py - g.ay, wz = pz - g.az;
+    double t = (wx * g.ux + wy * g.uy + wz * g.uz) * g.inv_uu;
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    const double dx = wx - t * g.ux, dy = wy - t * g.uy, dz = wz - t * g.uz;
+    return dx * dx + dy * dy + dz * dz;
+}
+
 // Every point of `from` against the polyline `to`, in order along both, so
-// the nearest segment moves forward with the point; the window spans the
-// segments of `to` that can correspond to one step of `from`, plus slack.
+// the nearest segment moves forward with the point: the segments within
+// reach of the last nearest one are searched (squared distances, one square
+// root per point; this runs on every point `compress` writes): two segments
+// back, and ahead the segments one step of `from` can cross plus two.
 void points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to, ErrorStats& out, std::uint64_t fiber) {
     if (from.empty() || to.empty()) return;
+    thread_local std::vector<Segment> segments;
+    segments_of(to, segments);
+    const std::size_t ahead = 2 + (to.size() + from.size() - 1) / from.size();
     std::size_t hint = 0;
-    const std::size_t window = 4 + 2 * to.size() / from.size();
-    for (const Vec3f& p : from) out.add(distance_to_polyline_near(p, to, hint, window), fiber);
+    for (const Vec3f& p : from) {
+        const std::size_t lo = hint > 2 ? hint - 2 : 0, hi = std::min(segments.size(), hint + ahead + 1);
+        double best = std::numeric_limits<double>::infinity();
+        for (std::size_t s = lo; s < hi; ++s) {
+            const double d2 = distance2(segments[s], p.x, p.y, p.z);
+            if (d2 < best) best = d2, hint = s;
+        }
+        out.add(std::sqrt(best), fiber);
+    }
 }
 
 }  // namespace
