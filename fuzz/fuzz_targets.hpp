@@ -214,7 +214,8 @@ inline std::size_t scalar_reference(const DecodeContext& ctx, const std::uint8_t
                                              : decode_blocks_scalar(ctx, blocks, count, xyz);
 }
 
-// The scalar reference over all blocks at once, fiber offsets from the LUT.
+// The scalar reference over all blocks at once, then the fibers' last-step
+// fractions (ENDS chunk), fiber offsets from the LUT.
 inline FftOutcome decode_reference(const FftFile& f) {
     FftOutcome o;
     try {
@@ -224,6 +225,7 @@ inline FftOutcome decode_reference(const FftFile& f) {
         const std::size_t n = count_block_points(ctx, blocks.data(), h.blocks);
         o.s.xyz.resize(3 * n);
         check(scalar_reference(ctx, blocks.data(), h.blocks, o.s.xyz.data()) == n, "scalar decoder count");
+        if (f.end_fractions()) apply_fiber_ends(h, *f.end_fractions(), blocks.data(), h.blocks, o.s.xyz.data());
         std::uint64_t acc = 0, b = 0;
         for (std::uint64_t fiber = 0; fiber < h.fibers; ++fiber) {
             for (std::uint32_t k = 0; k < f.block_count(fiber); ++k, ++b)

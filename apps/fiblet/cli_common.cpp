@@ -33,6 +33,8 @@ const std::vector<ExitCodeInfo>& exit_code_table() {
         {kExists, "the output exists and --force was not given"},
         {kUnsupported, "valid input that fiblet does not support"},
         {kChecksum, "integrity check failed"},
+        {kErrorBound, "a measured error (point, Hausdorff, endpoint or length change) exceeds --max-error; "
+                      "the report is printed and outputs are kept"},
         {130, "interrupted by SIGINT (128 + signal number for other signals); no partial output is left"},
     };
     return table;
@@ -102,7 +104,7 @@ FftFile open_fft_input(const std::string& path, bool ignore_trailer) {
     if (const std::uint64_t n = file.ignored_trailing_bytes())
         fmt::print(stderr,
                    "fiblet: warning: {}: --ignore-trailer: {} bytes after the last block left unread "
-                   "(no checksums, source properties or index: the blocks are not verified)\n",
+                   "(no checksums, source properties, index or kept fiber ends: the blocks are not verified)\n",
                    path, n);
     return file;
 }

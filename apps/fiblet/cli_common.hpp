@@ -22,6 +22,7 @@ enum ExitCode : int {
     kExists = 5,       // output exists, --force not given
     kUnsupported = 6,  // valid input fiblet cannot handle
     kChecksum = 7,     // integrity check failed
+    kErrorBound = 8,   // a measured error exceeds --max-error (the report is printed, outputs kept)
 };
 int exit_code_for(Errc c);
 // Every code the CLI returns, with its meaning (for `fiblet help --markdown`).

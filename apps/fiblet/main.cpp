@@ -5,6 +5,7 @@
 #include <exception>
 
 #include "cli_common.hpp"
+#include "geometry_report.hpp"
 #include "fiblet/output_file.hpp"
 
 int main(int argc, char** argv) {
@@ -35,6 +36,9 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
         app.exit(e);
         return kUsage;
+    } catch (const ErrorBoundExceeded& e) {
+        fmt::print(stderr, "fiblet: {}\n", e.what());
+        return kErrorBound;
     } catch (const fiblet::Error& e) {
         fmt::print(stderr, "fiblet: error: {}\n", e.what());
         return exit_code_for(e.code());

@@ -156,6 +156,26 @@ py::dict error_dict(const ErrorStats& e) {
     return d;
 }
 
+// Same keys as the "geometry" object of `fiblet stats --json`
+// (fiblet/geometry_error.hpp; apps/fiblet/geometry_report.cpp).
+py::dict geometry_dict(const GeometryError& g) {
+    auto fiber_max = [](const FiberMax& m) {
+        py::dict d;
+        d["max_um"] = m.max * 1e3, d["mean_um"] = m.mean() * 1e3, d["worst_fiber"] = m.worst_fiber;
+        return d;
+    };
+    py::dict length;
+    length["max_um"] = g.length_change_mm().max * 1e3, length["mean_um"] = g.length_change_mm().mean() * 1e3;
+    length["mean_signed_um"] = g.mean_length_change_mm() * 1e3;
+    length["max_percent"] = g.length_change_percent().max, length["mean_percent"] = g.length_change_percent().mean();
+    length["worst_fiber"] = g.length_change_mm().worst_fiber;
+    py::dict d;
+    d["decoded_to_input"] = error_dict(g.decoded_to_input()), d["input_to_decoded"] = error_dict(g.input_to_decoded());
+    d["hausdorff_um"] = g.hausdorff_mm() * 1e3, d["hausdorff_fiber"] = g.hausdorff_fiber();
+    d["endpoint"] = fiber_max(g.endpoint_mm()), d["length_change"] = length;
+    return d;
+}
+
 // Same keys as `fiblet stats --json`.
 py::dict stats(const std::string& fft_path, const std::string& reference) {
     std::optional<FftFile> file;
@@ -175,6 +195,7 @@ py::dict stats(const std::string& fft_path, const std::string& reference) {
     d["resampled"] = c.resampled;
     d["error"] = error_dict(c.error);
     if (c.resampled) d["error_vs_original"] = error_dict(c.error_vs_original);
+    d["geometry"] = geometry_dict(c.geometry);
     d["header_max_error_um"] = double(h.max_error_mm) * 1e3, d["header_mean_error_um"] = double(h.mean_error_mm) * 1e3;
     return d;
 }
@@ -200,6 +221,7 @@ py::dict compress(const std::string& tck_path, const std::string& fft_path, std:
     if (r.resampled)
         d["max_error_vs_original_um"] = r.error_vs_original.max_mm() * 1e3,
         d["mean_error_vs_original_um"] = r.error_vs_original.mean_mm() * 1e3;
+    d["geometry"] = geometry_dict(r.geometry);
     d["seconds"] = r.seconds;
     return d;
 }

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "fiblet/checksum.hpp"
+#include "fiblet/fiber_ends.hpp"
 #include "fiblet/fft_format.hpp"
 
 namespace fiblet {
@@ -94,6 +95,9 @@ public:
     // The parsed CSUM chunk, or nullptr for a file without checksums.
     const FftChecksums* checksums() const { return checksums_ ? &*checksums_ : nullptr; }
     bool verifies_checksums() const { return checksums_ && options_.verify_checksums; }
+    // The per-fiber last-step fractions of the ENDS chunk (fiblet/fiber_ends.hpp),
+    // validated at open; null for a file without one (every fiber whole).
+    const std::shared_ptr<const FiberEndFractions>& end_fractions() const { return end_fractions_; }
 
     // Reads blocks [first, first+count) into `out` (count * block_bytes
     // bytes), checks them against the LUT (Error{fft_format}) and the
@@ -133,6 +137,7 @@ private:
     std::optional<double> resampled_step_mm_;
     std::uint64_t checksum_chunk_offset_ = 0;  // where the CSUM chunk starts in the file
     std::optional<FftChecksums> checksums_;
+    std::shared_ptr<const FiberEndFractions> end_fractions_;
     std::unique_ptr<std::atomic<std::uint64_t>[]> verified_groups_;  // one bit per block group
     std::unique_ptr<Mapping> mapping_;                                // mapped_blocks()
 };

@@ -22,7 +22,7 @@ public:
 
     ChunkDecoder(const FftFile& file, const DecodeOptions& options)
         : file_(file),
-          ctx_(file.header()),
+          ctx_(file),
           decoder_(resolve_decoder(options.decoder)),
           threads_(options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency())),
           chunk_blocks_(options.chunk_blocks ? options.chunk_blocks : kBlocksPerThread * threads_) {}

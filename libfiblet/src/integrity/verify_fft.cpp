@@ -21,7 +21,8 @@ namespace {
 // every decoded point is finite.
 class BlockCrossCheck {
 public:
-    BlockCrossCheck(const FftFile& file, const BlockIndex* index) : file_(file), index_(index), ctx_(file.header()) {}
+    // Decoded as every reader decodes them: with the file's kept fiber ends.
+    BlockCrossCheck(const FftFile& file, const BlockIndex* index) : file_(file), index_(index), ctx_(file) {}
 
     void add(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) {
         const FftHeader& h = file_.header();

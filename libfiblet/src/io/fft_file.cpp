@@ -178,7 +178,7 @@ void FftFile::read_at(std::uint8_t* out, std::uint64_t size, std::uint64_t offse
 void FftFile::open_trailer(std::span<const std::uint8_t> head, std::uint64_t lut_hash) {
     detail::TrailerChunks t = detail::read_trailer_chunks(
         [this](std::uint8_t* out, std::uint64_t size, std::uint64_t offset) { read_at(out, size, offset); },
-        header_.file_bytes(), logical_size_, path_);
+        header_.file_bytes(), logical_size_, header_.fibers, path_);
     trailer_ = std::move(t.chunks);
     checksum_chunk_offset_ = t.checksum_chunk_at;
     if (const TrailerChunk* c = find_chunk(kChecksumTag)) checksums_ = FftChecksums::parse(*c, header_.blocks, path_);
@@ -191,6 +191,7 @@ void FftFile::open_trailer(std::span<const std::uint8_t> head, std::uint64_t lut
     detail::TrailerValues values = detail::validate_trailer_chunks(trailer_, header_, path_);
     properties_ = std::move(values.properties);
     resampled_step_mm_ = values.resampled_step_mm;
+    end_fractions_ = std::move(values.end_fractions);
 }
 
 void FftFile::verify_open_checksums(std::span<const std::uint8_t> head, std::uint64_t lut_hash) const {
@@ -245,6 +246,7 @@ FftFile& FftFile::operator=(FftFile&& o) noexcept {
         resampled_step_mm_ = o.resampled_step_mm_;
         checksum_chunk_offset_ = o.checksum_chunk_offset_;
         checksums_ = std::move(o.checksums_);
+        end_fractions_ = std::move(o.end_fractions_);
         verified_groups_ = std::move(o.verified_groups_);
         mapping_ = std::move(o.mapping_);
     }

@@ -1,5 +1,6 @@
 #include "io/fft_trailer.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -20,18 +21,24 @@ std::string tag_name(const std::array<char, 4>& tag) {
 }
 
 // Chunks fiblet reads are loaded whole up to a bound that keeps memory in
-// check (a BIDX chunk costs ~4 bytes a block: 64 MiB is 16 M blocks); unknown
+// check (a BIDX chunk costs ~4 bytes a block: 64 MiB is 16 M blocks; ENDS
+// holds 2 bytes a fiber, its bound grows with the fiber count); unknown
 // chunks above 16 MiB are skipped (they are still covered by the trailer hash).
 constexpr std::uint64_t kMaxKnownChunk = 64u << 20, kMaxUnknownChunk = 16u << 20;
 
 bool is_known(const std::array<char, 4>& tag) {
-    return tag == kPropertiesTag || tag == kResampledTag || tag == kChecksumTag || tag == kBlockIndexTag;
+    return tag == kPropertiesTag || tag == kResampledTag || tag == kChecksumTag || tag == kBlockIndexTag ||
+           tag == kFiberEndsTag;
+}
+
+std::uint64_t max_known_size(const std::array<char, 4>& tag, std::uint64_t fibers) {
+    return tag == kFiberEndsTag ? std::max(kMaxKnownChunk, 2 * fibers) : kMaxKnownChunk;
 }
 
 }  // namespace
 
 TrailerChunks read_trailer_chunks(const ReadAt& read_at, std::uint64_t end, std::uint64_t logical_size,
-                                  const std::string& name) {
+                                  std::uint64_t fibers, const std::string& name) {
     TrailerChunks t;
     if (logical_size <= end) return t;  // nothing after the blocks: an official-encoder file
     auto damaged = [&](const std::string& what) {
@@ -61,8 +68,9 @@ TrailerChunks read_trailer_chunks(const ReadAt& read_at, std::uint64_t end, std:
         if (size > stop - pos - sizeof head) damaged(what + " runs past the footer");
         if (t.checksum_chunk_at != 0) damaged(what + " follows the CSUM chunk (which must be last)");
         const bool known = is_known(chunk.tag);
-        if (known && size > kMaxKnownChunk)
-            damaged(what + " of " + std::to_string(size) + " bytes (at most " + std::to_string(kMaxKnownChunk) + ")");
+        if (known && size > max_known_size(chunk.tag, fibers))
+            damaged(what + " of " + std::to_string(size) + " bytes (at most " +
+                    std::to_string(max_known_size(chunk.tag, fibers)) + ")");
         if (chunk.tag == kChecksumTag) t.checksum_chunk_at = pos;
         if (known || size <= kMaxUnknownChunk) {
             chunk.payload.resize(size);
@@ -134,6 +142,8 @@ TrailerValues validate_trailer_chunks(const std::vector<TrailerChunk>& chunks, c
         if (c.tag == kPropertiesTag) v.properties = parse_properties(c, name);
         else if (c.tag == kResampledTag) v.resampled_step_mm = parse_resampled_step(c, header, name);
         else if (c.tag == kBlockIndexTag) (void)parse_index_chunk(c.payload, header, name);
+        else if (c.tag == kFiberEndsTag)
+            v.end_fractions = std::make_shared<const FiberEndFractions>(parse_fiber_ends_chunk(c, header.fibers, name));
     }
     return v;
 }

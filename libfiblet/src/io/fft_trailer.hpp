@@ -12,12 +12,14 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "fiblet/fft_format.hpp"
+#include "fiblet/fiber_ends.hpp"
 
 namespace fiblet::detail {
 
@@ -34,7 +36,7 @@ struct TrailerChunks {
 // naming `name` when the bytes after the blocks are not a complete fiblet
 // trailer ending with CSUM.
 TrailerChunks read_trailer_chunks(const ReadAt& read_at, std::uint64_t blocks_end, std::uint64_t logical_size,
-                                  const std::string& name);
+                                  std::uint64_t fibers, const std::string& name);
 
 // The values of the chunks fiblet reads, validated: each known chunk at most
 // once, every field in range and consistent with the header. Throws
@@ -42,6 +44,7 @@ TrailerChunks read_trailer_chunks(const ReadAt& read_at, std::uint64_t blocks_en
 struct TrailerValues {
     std::vector<std::pair<std::string, std::string>> properties;  // PROP
     std::optional<double> resampled_step_mm;                      // RSMP
+    std::shared_ptr<const FiberEndFractions> end_fractions;       // ENDS
 };
 TrailerValues validate_trailer_chunks(const std::vector<TrailerChunk>& chunks, const FftHeader& header,
                                       const std::string& name);
