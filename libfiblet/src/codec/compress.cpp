@@ -267,7 +267,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     // workers on contiguous sub-ranges, and written in order.
     struct Work {
         std::vector<std::uint8_t> blocks;
-        std::vector<Vec3f> decoded, resampled;
+        std::vector<Vec3f> decoded, decoded_exact, resampled;
         ErrorStats error, error_vs_original;
         IndexBuilder index;  // bounds of this worker's blocks (the BIDX chunk)
     };
@@ -287,12 +287,15 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             }
             const auto f = std::uint32_t(first_fiber + i);
             w.decoded.clear();
-            encoder.encode(points, f, w.blocks, &w.decoded);
+            w.decoded_exact.clear();
+            encoder.encode(points, f, w.blocks, &w.decoded, &w.decoded_exact);
             if (options.block_index) w.index.add_fiber(w.decoded);
             std::size_t hint = 0;
             const std::size_t window = 16 + 2 * original.size() / std::max<std::size_t>(points.size(), 1);
             for (std::size_t k = 0; k < points.size(); ++k) {
-                w.error.add(length(points[k], w.decoded[k]), f);
+                // The header's error holds for fiblet's float decoders and an exact one alike.
+                const double e = length(points[k], w.decoded[k]);
+                w.error.add(w.decoded_exact.empty() ? e : std::max(e, length(points[k], w.decoded_exact[k])), f);
                 if (report.resampled)
                     w.error_vs_original.add(distance_to_polyline_near(w.decoded[k], original, hint, window), f);
             }
