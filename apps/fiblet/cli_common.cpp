@@ -62,6 +62,12 @@ std::string human_bytes(std::uint64_t b) {
     return fmt::format("{:.2f} GB", b / 1e9);
 }
 
+std::string micrometres(double mm, int decimals) {
+    const double um = mm * 1e3;
+    if (std::fabs(um) < 1e6) return fmt::format("{:.{}f} µm", um, decimals);
+    return fmt::format("{:.3e} µm", um);
+}
+
 std::string json_quote(const std::string& s) {
     std::string out = "\"";
     for (unsigned char ch : s) {
