@@ -9,16 +9,6 @@ namespace {
 Vec3d cross(Vec3d a, Vec3d b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 Vec3d unit(Vec3d a) { return (1.0 / std::sqrt(dot(a, a))) * a; }
 
-// The code's direction in the cap (formats/fft.md §4, decoding side).
-Vec3d exact_code_direction(unsigned code, double ratio) {
-    const double q1 = double(code >> 4) / 7.5 - 1, q2 = double(code & 15) / 7.5 - 1;
-    const double y = 0.5 * (q1 + q2), z = 0.5 * (q1 - q2);
-    const Vec3d d = unit({1 - std::fabs(y) - std::fabs(z), y, z});
-    const double x = 1 - ratio + ratio * d.x;
-    const double lateral = std::sqrt(std::max(1 - x * x, 0.0) / std::max(1 - d.x * d.x, 1e-300));
-    return unit({x, d.y * lateral, d.z * lateral});
-}
-
 }  // namespace
 
 FrameD exact_frame_from_axis(Vec3d axis) {
@@ -38,8 +28,23 @@ Vec3d apply(const FrameD& f, Vec3d v) { return v.x * f.c[0] + v.y * f.c[1] + v.z
 Vec3d apply_transposed(const FrameD& f, Vec3d v) { return {dot(f.c[0], v), dot(f.c[1], v), dot(f.c[2], v)}; }
 FrameD compose(const FrameD& f, const FrameD& l) { return {{apply(f, l.c[0]), apply(f, l.c[1]), apply(f, l.c[2])}}; }
 
+// formats/fft.md §4, decoding side; fft16.md for 256 levels.
+Vec3d exact_code_direction(unsigned code, unsigned levels, double ratio) {
+    const double half = 0.5 * double(levels - 1);
+    const double q1 = double(code / levels) / half - 1, q2 = double(code % levels) / half - 1;
+    const double y = 0.5 * (q1 + q2), z = 0.5 * (q1 - q2);
+    const Vec3d d = unit({1 - std::fabs(y) - std::fabs(z), y, z});
+    const double x = 1 - ratio + ratio * d.x;
+    const double lateral = std::sqrt(std::max(1 - x * x, 0.0) / std::max(1 - d.x * d.x, 1e-300));
+    return unit({x, d.y * lateral, d.z * lateral});
+}
+
+FrameD exact_code_frame(unsigned code, unsigned levels, double ratio) {
+    return exact_frame_from_axis(exact_code_direction(code, levels, ratio));
+}
+
 ExactDirectionTable::ExactDirectionTable(float ratio) {
-    for (unsigned c = 0; c < 256; ++c) frames_[c] = exact_frame_from_axis(exact_code_direction(c, double(ratio)));
+    for (unsigned c = 0; c < 256; ++c) frames_[c] = exact_code_frame(c, 16, double(ratio));
 }
 
 void exact_walk(const ExactDirectionTable& table, FrameD f, Vec3d p, double step, const std::uint8_t* codes,

@@ -48,6 +48,12 @@ Vec3d apply(const FrameD& f, Vec3d v);
 Vec3d apply_transposed(const FrameD& f, Vec3d v);
 FrameD compose(const FrameD& f, const FrameD& l);
 
+// The direction of a code with `levels` levels per diagonal axis (16 for
+// 8-bit codes, 256 for 16-bit ones) in the cap of `ratio`, from the
+// format's formulas in double, and its local frame.
+Vec3d exact_code_direction(unsigned code, unsigned levels, double ratio);
+FrameD exact_code_frame(unsigned code, unsigned levels, double ratio);
+
 // The 256 local frames of a ratio, computed from the format's formulas in
 // double (not from the float table).
 class ExactDirectionTable {
