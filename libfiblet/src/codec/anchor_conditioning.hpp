@@ -32,6 +32,15 @@ DecoderStarts decoder_starts(const AnchorWords& w);
 // the reach.
 double start_divergence(const DecoderStarts& s, double reach);
 
+// An upper bound on what the walk itself adds over m steps of `step`
+// (normalized): each float step rounds the position by at most 2^-25 per
+// coordinate, and each frame product (with the table's rounded frames)
+// turns the direction by at most ~5e-7, which the later steps carry.
+inline double walk_divergence(std::size_t m, double step) {
+    const double k = double(m);
+    return k * 1.7320508 * 0x1p-25 + 5e-7 * step * k * k;
+}
+
 // The anchor words of a block whose anchors should be at n0, n1 (normalized,
 // exact): each value rounded to the nearest unorm16 — unless the decoders
 // then diverge by more than `threshold` over `reach`, which happens where

@@ -98,6 +98,16 @@ void exact_decoder_targets(const DecoderStarts& s, std::span<const Vec3f> target
 }
 
 
+// Largest squared distance of a[k] to b[k].
+float max_distance2(const Vec3f* a, const Vec3f* b, std::size_t m) {
+    float worst = 0;
+    for (std::size_t k = 0; k < m; ++k) {
+        const Vec3f d = a[k] - b[k];
+        worst = std::max(worst, dot(d, d));
+    }
+    return worst;
+}
+
 // Largest squared distance of decoded[k] to targets[k] or alt[k].
 float worst_error2(const Vec3f* decoded, const Vec3f* targets, const Vec3f* alt, std::size_t m) {
     float worst = 0;
@@ -309,9 +319,13 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
             alt.resize(m);
             exact_decoder_targets(starts[b], t, alt.data());
             float best = worst_error2(&points[i0 + 2], t.data(), alt.data(), m);
+            // What the float decoder alone gets: once the robust codes come
+            // within 10 % of it for both decoders, the wide beam is not worth its cost.
+            const float float_only = max_distance2(&points[i0 + 2], t.data(), m);
             retry_points.resize(m);
             retry_codes8.resize(m);
             for (unsigned width : {1u, robust_beam}) {
+                if (width > 1 && best <= 1.21f * float_only) break;
                 search_codes(cb, SearchParams{width, 1}, frames[b], points[i0 + 1], h.step, t, retry_codes8.data(),
                              retry_points.data(), std::span<const Vec3f>(alt));
                 const float worst = worst_error2(retry_points.data(), t.data(), alt.data(), m);
@@ -332,6 +346,10 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
         for (std::size_t k = 0; k < n_points; ++k) decoded->push_back(h.to_world(points[k].x, points[k].y, points[k].z));
     }
     if (decoded_exact && !wide) {
+        // The exact decode, block by block; a block whose float errors plus
+        // the bound on the two decoders' divergence stay below the fiber's
+        // largest float error cannot raise the max error: it gets the float
+        // points (most blocks), which keeps the cost of this pass small.
         thread_local std::vector<Vec3d> walked;
         walked.resize(ppb);
         auto world = [&](Vec3d p) {
@@ -339,10 +357,22 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
                          float((p.y - 0.5) * double(h.scaling) - double(h.offset[1])),
                          float((p.z - 0.5) * double(h.scaling) - double(h.offset[2]))};
         };
+        const double out_slack = 4 * 0x1p-24 * (1 + std::max({std::fabs(h.offset[0]), std::fabs(h.offset[1]), std::fabs(h.offset[2])}) / h.scaling);
+        auto block_error = [&](std::uint32_t blk) {
+            const std::size_t i0 = std::size_t(blk) * ppb;
+            return std::sqrt(double(max_distance2(&points[i0], &targets[i0], block_points(blk))));
+        };
+        double fiber_max = 0;
+        for (b = 0; b < n_blocks; ++b) fiber_max = std::max(fiber_max, block_error(b));
         decoded_exact->reserve(decoded_exact->size() + n_points);
         for (b = 0; b < n_blocks; ++b) {
             const DecoderStarts& e = starts[b];
-            const std::size_t n = block_points(b), m = n > 2 ? n - 2 : 0;
+            const std::size_t i0 = std::size_t(b) * ppb, n = block_points(b), m = n > 2 ? n - 2 : 0;
+            const double bound = start_divergence(e, block_reach(std::uint32_t(n))) + walk_divergence(m, double(h.step)) + out_slack;
+            if (block_error(b) + bound <= fiber_max) {
+                for (std::size_t k = 0; k < n; ++k) decoded_exact->push_back(h.to_world(points[i0 + k].x, points[i0 + k].y, points[i0 + k].z));
+                continue;
+            }
             exact_walk(*tables_->exact8, e.exact_frame, e.exact1, double(h.step), codes8_of(b), m, walked.data());
             decoded_exact->push_back(world(e.exact0));
             if (n >= 2) decoded_exact->push_back(world(e.exact1));
