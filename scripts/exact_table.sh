@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Per tractogram: compress with the default settings (one thread), then the
 # header's max error, the float64 reference decode's and fiblet's decoder's
-# errors against the encoder's targets (tests/exact_error.hpp), size and time.
+# errors against the encoder's targets (tests/exact_error.hpp), size and the
+# user CPU time of the whole compress run.
 # Usage: scripts/exact_table.sh [FIBLET_BINARY] [FILES...] (default: every shared .tck)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -13,9 +14,7 @@ data="$root/../shared/data"
 out="$build/exact_table"; mkdir -p "$out"
 for f in "${files[@]}"; do
   fft="$out/$(basename "$f" .tck).fft"
-  t0=$(date +%s.%N)
-  "$fiblet" compress -f -q -j 1 "$f" -o "$fft"
-  t1=$(date +%s.%N)
-  printf '%s: %s bytes, %.2f s; ' "${f#"$data"/}" "$(stat -c %s "$fft")" "$(echo "$t1 - $t0" | bc)"
+  cpu=$( { /usr/bin/time -f %U "$fiblet" compress -f -q -j 1 "$f" -o "$fft"; } 2>&1 )
+  printf '%s: %s bytes, %s s CPU; ' "${f#"$data"/}" "$(stat -c %s "$fft")" "$cpu"
   "$build/tests/fiblet_exact_error" "$fft" "$f"
 done
