@@ -30,7 +30,7 @@ struct ExactMeasurement {
     double header_max_mm = 0, header_mean_mm = 0;
     bool resampled = false;
     ErrorFigures exact;  // float64 reference decode vs target points
-    ErrorFigures fiblet; // the library's automatic decoder vs target points
+    ErrorFigures fiblet; // one of the library's decoders (automatic by default) vs target points
     double exact_ratio() const { return exact.max_mm / header_max_mm; }
     double fiblet_ratio() const { return fiblet.max_mm / header_max_mm; }
 };
@@ -52,7 +52,8 @@ inline double distance(const exact::V3& p, const Vec3f& t) {
 // Decodes `fft_path` both ways and measures every decoded point that has a
 // target (the first min(decoded, target) points of each fiber: a tail point
 // added beyond the fixed-step targets is not this measure's business).
-inline ExactMeasurement measure_exact(const std::string& fft_path, const std::string& tck_path) {
+inline ExactMeasurement measure_exact(const std::string& fft_path, const std::string& tck_path,
+                                      const std::string& decoder = "auto") {
     const std::string bytes = read_file(fft_path);
     const exact::Decoded dec = exact::decode(bytes);
     ExactMeasurement m;
@@ -62,7 +63,9 @@ inline ExactMeasurement measure_exact(const std::string& fft_path, const std::st
     m.resampled = step > 0;
 
     FftFile file(fft_path);
-    const Streamlines own = decode_fibers(file, 0, file.header().fibers);
+    DecodeOptions options;
+    options.decoder = parse_decoder(decoder);
+    const Streamlines own = decode_fibers(file, 0, file.header().fibers, options);
     TckReader reader(tck_path);
     std::vector<Vec3f> input, scratch;
     for (std::size_t f = 0; reader.next(input); ++f) {
