@@ -39,6 +39,7 @@ double anchor_error(const AnchorWords& w, Vec3d n0, Vec3d n1) {
 
 DecoderStarts decoder_starts(const AnchorWords& w) {
     DecoderStarts s;
+    s.words = w;
     s.a0 = to_float(float_anchor(w.a0)), s.a1 = to_float(float_anchor(w.a1));
     s.frame = frame_from_axis(anchor_axis(s.a0, s.a1));
     s.exact0 = exact_anchor(w.a0), s.exact1 = exact_anchor(w.a1);
@@ -56,7 +57,7 @@ double start_divergence(const DecoderStarts& s, double reach) {
     return std::sqrt(dot(da, da)) + std::sqrt(frame2) * reach;
 }
 
-AnchorWords condition_anchors(Vec3d n0, Vec3d n1, double reach, double threshold) {
+DecoderStarts condition_anchors(Vec3d n0, Vec3d n1, double reach, double threshold) {
     const double v[6] = {unorm16_value(n0.x), unorm16_value(n0.y), unorm16_value(n0.z),
                          unorm16_value(n1.x), unorm16_value(n1.y), unorm16_value(n1.z)};
     auto words = [&](unsigned up_mask, bool nearest) {
@@ -67,14 +68,15 @@ AnchorWords condition_anchors(Vec3d n0, Vec3d n1, double reach, double threshold
         }
         return w;
     };
-    AnchorWords best = words(0, true);
-    const double divergence = start_divergence(decoder_starts(best), reach);
-    if (!(divergence > threshold)) return best;
-    double best_cost = anchor_error(best, n0, n1) + kDivergenceWeight * divergence;
+    DecoderStarts best = decoder_starts(words(0, true));
+    best.divergence = start_divergence(best, reach);
+    if (!(best.divergence > threshold)) return best;
+    double best_cost = anchor_error(best.words, n0, n1) + kDivergenceWeight * best.divergence;
     for (unsigned mask = 0; mask < 64; ++mask) {
-        const AnchorWords w = words(mask, false);
-        const double cost = anchor_error(w, n0, n1) + kDivergenceWeight * start_divergence(decoder_starts(w), reach);
-        if (cost < best_cost) best_cost = cost, best = w;
+        DecoderStarts s = decoder_starts(words(mask, false));
+        s.divergence = start_divergence(s, reach);
+        const double cost = anchor_error(s.words, n0, n1) + kDivergenceWeight * s.divergence;
+        if (cost < best_cost) best_cost = cost, best = s;
     }
     return best;
 }

@@ -18,10 +18,12 @@ struct AnchorWords {
 
 // A block's start as both decoders compute it from the same anchor words.
 struct DecoderStarts {
+    AnchorWords words;
     Vec3f a0, a1;  // fiblet's float decoders (normalized)
     Frame frame;
     Vec3d exact0, exact1;  // an exact decoder
     FrameD exact_frame;
+    double divergence = 0;  // start_divergence over the block's reach (condition_anchors)
 };
 DecoderStarts decoder_starts(const AnchorWords& w);
 
@@ -50,6 +52,7 @@ inline double walk_divergence(std::size_t m, double step) {
 // an anchor by less than one quantum turns the first axis away from C or
 // changes its float rounding; the robust code search (code_search.hpp)
 // then splits what divergence remains between the two decoders.
-AnchorWords condition_anchors(Vec3d n0, Vec3d n1, double reach, double threshold);
+// Returns the chosen words with both decoders' starts and their divergence.
+DecoderStarts condition_anchors(Vec3d n0, Vec3d n1, double reach, double threshold);
 
 }  // namespace fiblet::detail

@@ -73,7 +73,9 @@ DecoderStarts write_block_head(const FftHeader& h, std::uint8_t* block, Vec3f p0
         s.a0 = decoded(q0), s.a1 = decoded(q1);
         return s;
     }
-    const AnchorWords w = condition_anchors(normalized_point(h, p0), normalized_point(h, p1), reach, kRobustDivergence);
+    const DecoderStarts starts =
+        condition_anchors(normalized_point(h, p0), normalized_point(h, p1), reach, kRobustDivergence);
+    const AnchorWords& w = starts.words;
     put_word(block + 0, w.a0[0], w.a0[1]);
     put_word(block + 4, w.a0[2], w.a1[0]);
     put_word(block + 8, w.a1[1], w.a1[2]);
@@ -81,7 +83,7 @@ DecoderStarts write_block_head(const FftHeader& h, std::uint8_t* block, Vec3f p0
     block[14] = std::uint8_t(fiber_id >> 8), block[15] = std::uint8_t(fiber_id);
     block[kBlockFlagsOffset] = std::uint8_t((first ? 0 : kFlagNotFirst) | (last ? 0 : kFlagNotLast) | n);
     block[kBlockIndexOffset] = std::uint8_t(b);  // modulo 256, as the format stores it
-    return decoder_starts(w);
+    return starts;
 }
 
 FrameD frame_to_double(const Frame& f) { return {{to_double(f.c[0]), to_double(f.c[1]), to_double(f.c[2])}}; }
@@ -236,7 +238,7 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
             write_block_head(h, &out[base + std::size_t(b) * bb], p0, p1, fiber_id, b, n_blocks, n, block_reach(n));
         points[i0] = head.a0;
         if (n >= 2) points[i0 + 1] = head.a1;
-        frames[b] = frame_from_axis(anchor_axis(head.a0, head.a1));
+        frames[b] = wide ? frame_from_axis(anchor_axis(head.a0, head.a1)) : head.frame;
         if (!wide) starts[b] = head;
     }
 
@@ -314,7 +316,7 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
         thread_local std::vector<Vec3f> alt;
         for (b = 0; b < n_blocks; ++b) {
             const std::size_t i0 = std::size_t(b) * ppb, m = block_points(b) > 2 ? block_points(b) - 2 : 0;
-            if (m == 0 || !(start_divergence(starts[b], block_reach(block_points(b))) > kRobustDivergence)) continue;
+            if (m == 0 || !(starts[b].divergence > kRobustDivergence)) continue;
             const std::span<const Vec3f> t(&targets[i0 + 2], m);
             alt.resize(m);
             exact_decoder_targets(starts[b], t, alt.data());
@@ -368,7 +370,7 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
         for (b = 0; b < n_blocks; ++b) {
             const DecoderStarts& e = starts[b];
             const std::size_t i0 = std::size_t(b) * ppb, n = block_points(b), m = n > 2 ? n - 2 : 0;
-            const double bound = start_divergence(e, block_reach(std::uint32_t(n))) + walk_divergence(m, double(h.step)) + out_slack;
+            const double bound = e.divergence + walk_divergence(m, double(h.step)) + out_slack;
             if (block_error(b) + bound <= fiber_max) {
                 for (std::size_t k = 0; k < n; ++k) decoded_exact->push_back(h.to_world(points[i0 + k].x, points[i0 + k].y, points[i0 + k].z));
                 continue;
