@@ -116,7 +116,7 @@ TEST(NumericRange, SinglePointAndCoincidentPoints) {
 }
 
 // Coordinates in other units print their error in scientific notation,
-// not as a 20-digit number of micrometres.
+// not as a 20-digit number of micrometres, nor as 0.00.
 TEST(NumericRange, PrintedErrorsStayReadable) {
     const test::TempDir dir;
     const std::string tck = dir.file("big.tck");
@@ -125,6 +125,12 @@ TEST(NumericRange, PrintedErrorsStayReadable) {
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_FALSE(std::regex_search(r.output, std::regex("[0-9]{10}"))) << r.output;
     EXPECT_TRUE(std::regex_search(r.output, std::regex("max [0-9.]+e\\+[0-9]+ µm"))) << r.output;
+    // And a tiny, non-zero error is not rounded to 0.00.
+    const std::string tiny = dir.file("tiny.tck");
+    write_tck(tiny, scaled_fibers(1e-20, 0));
+    const auto t = test::run_cli("compress " + tiny + " -o " + dir.file("tiny.fft"));
+    ASSERT_EQ(t.status, 0) << t.output;
+    EXPECT_TRUE(std::regex_search(t.output, std::regex("max [0-9.]+e-[0-9]+ µm"))) << t.output;
 }
 
 }  // namespace

@@ -64,7 +64,8 @@ std::string human_bytes(std::uint64_t b) {
 
 std::string micrometres(double mm, int decimals) {
     const double um = mm * 1e3;
-    if (std::fabs(um) < 1e6) return fmt::format("{:.{}f} µm", um, decimals);
+    const double smallest = std::pow(10.0, -decimals);  // below it, fixed notation would print 0.00
+    if (um == 0 || (std::fabs(um) >= smallest && std::fabs(um) < 1e6)) return fmt::format("{:.{}f} µm", um, decimals);
     return fmt::format("{:.3e} µm", um);
 }
 
