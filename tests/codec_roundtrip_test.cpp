@@ -12,6 +12,7 @@
 #include "fiblet/encode.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/tck.hpp"
+#include "exact_error.hpp"
 #include "test_util.hpp"
 
 using namespace fiblet;
@@ -95,14 +96,16 @@ TEST_P(CodecRoundTrip, PreservesStructureAndStaysWithinTheErrorBound) {
     }
 
     // Brute-force error, and the closed-loop bound per point: with anchor
-    // error ea (half a unorm16 step on each axis), step length delta, true
+    // error ea (one unorm16 step on each axis), step length delta, true
     // spacing s_k and covering angle theta of the code set over the cap,
     //   e_{k+1} <= |D - delta| + sqrt(delta * D) * theta,  D = |t_{k+1} - p_k| <= s_k + e_k
     // so b_{k+1} = b_k + |s_k - delta| + sqrt(delta * (s_k + b_k)) * theta bounds e_{k+1}.
     const DirectionTable table(h.ratio);
     const double theta = covering_angle(table);
     const double delta = double(h.step) * h.scaling;
-    const double ea = std::sqrt(3.0) * 0.5 * h.scaling / 65535.0 + 1e-6;
+    // A full quantum: the encoder may round anchors the other way where the
+    // first frame is ill-conditioned (codec/anchor_conditioning.hpp).
+    const double ea = std::sqrt(3.0) * h.scaling / 65535.0 + 1e-6;
     double max_e = 0, sum_e = 0;
     std::uint64_t n = 0, over = 0;
     for (std::uint64_t f = 0; f < h.fibers; ++f) {
@@ -121,9 +124,14 @@ TEST_P(CodecRoundTrip, PreservesStructureAndStaysWithinTheErrorBound) {
         }
     }
     EXPECT_EQ(over, 0u) << "points above the closed-loop bound";
-    EXPECT_NEAR(h.max_error_mm, max_e, 1e-3 * max_e + 1e-7);
-    EXPECT_NEAR(h.mean_error_mm, sum_e / double(n), 1e-3 * sum_e / double(n) + 1e-7);
-    EXPECT_NEAR(report.error.max_mm(), max_e, 1e-3 * max_e + 1e-7);
+    // The header records the worse of fiblet's float decode and the exact
+    // (float64) decode at each point (exact_decode_test.cpp).
+    const auto exact = test::measure_exact(out, input);
+    const double both_max = std::max(max_e, exact.exact.max_mm), mean_e = sum_e / double(n);
+    EXPECT_NEAR(h.max_error_mm, both_max, 1e-3 * both_max + 1e-7);
+    EXPECT_GE(h.mean_error_mm, std::max(mean_e, exact.exact.mean_mm()) * (1 - 1e-3));
+    EXPECT_LE(h.mean_error_mm, std::max(mean_e, exact.exact.mean_mm()) * 1.01);
+    EXPECT_NEAR(report.error.max_mm(), both_max, 1e-3 * both_max + 1e-7);
     // A sanity floor on usefulness: errors far below the step.
     EXPECT_LT(max_e, 0.25 * delta);
 }

@@ -160,12 +160,17 @@ std::vector<TckCase> tck_cases() {
          Errc::invalid_input},
         {"coordinates spanning more than the float range", tck(f32({-3e38f, 0, 0, 3e38f, 0, 0}) + kSep + kEnd),
          Errc::invalid_input, true},
+        {"a step lost against the extent (1e25 mm apart, 0.1 mm steps)",
+         tck(f32({0, 0, 0, 0.1f, 0, 0, 0.2f, 0, 0}) + kSep + f32({1e25f, 0, 0, 1e25f, 0.1f, 0}) + kSep + kEnd),
+         Errc::invalid_input, true},
         {"resampling would need more than 65535 blocks",
          tck(
              [] {
-                 std::string d;  // 40 steps of 1 um (the median), then a fiber of one 10 m segment
+                 // 40 steps of 1 um (the median), then a fiber running 5 times across
+                 // 0.9 m: 4.5 m of 1 um steps, in a box the float step still resolves
+                 std::string d;
                  for (int i = 0; i <= 40; ++i) d += f32({1e-3f * float(i), 0, 0});
-                 return d + kSep + f32({0, 1, 0, 1e4f, 1, 0}) + kSep + kEnd;
+                 return d + kSep + f32({0, 1, 0, 900, 1, 0, 0, 1, 0, 900, 1, 0, 0, 1, 0, 900, 1, 0}) + kSep + kEnd;
              }()),
          Errc::unsupported, true},
         // Valid edge cases.

@@ -88,7 +88,10 @@ test::BoundParams bound_params(const FftHeader& h, const SearchOptions& s, doubl
     const unsigned r = std::max(s.beam_width > 1 ? s.radius : 0u, s.retry_beam_width > 1 ? s.retry_radius : 0u);
     p.aim_angle = chooser + (r == 1 ? a.reach1 : r == 2 ? a.reach2 : r == 3 ? a.reach3 : 0.0) + 1e-5;
     const double ulp = std::ldexp(1.0, -24);
-    p.anchor_error = std::sqrt(3.0) * (0.5 / 65535 + ulp) * h.scaling;
+    // A full quantum, not half: where a block's first segment runs along the
+    // helper vector the encoder may round an anchor the other way to
+    // condition the first frame (codec/anchor_conditioning.hpp).
+    p.anchor_error = std::sqrt(3.0) * (1.0 / 65535 + ulp) * h.scaling;
     p.step_slack = 4 * ulp * h.scaling;
     p.point_slack = 4 * ulp * (h.scaling + max_abs_coordinate);
     return p;

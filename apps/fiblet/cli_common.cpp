@@ -64,6 +64,15 @@ std::string human_bytes(std::uint64_t b) {
     return fmt::format("{:.2f} GB", b / 1e9);
 }
 
+std::string micrometres_value(double mm, int decimals) {
+    const double um = mm * 1e3;
+    const double smallest = std::pow(10.0, -decimals);  // below it, fixed notation would print 0.00
+    if (um == 0 || (std::fabs(um) >= smallest && std::fabs(um) < 1e6)) return fmt::format("{:.{}f}", um, decimals);
+    return fmt::format("{:.3e}", um);
+}
+
+std::string micrometres(double mm, int decimals) { return micrometres_value(mm, decimals) + " µm"; }
+
 std::string json_quote(const std::string& s) {
     std::string out = "\"";
     for (unsigned char ch : s) {

@@ -47,6 +47,13 @@ private:
 };
 
 std::string human_bytes(std::uint64_t bytes);
+// A length given in mm, printed in µm with `decimals` decimals from the
+// last decimal up to 1 m (every tractogram in millimetres), outside that in
+// scientific notation (a file in other units): never a 30-digit number, nor
+// 0.00 for an error that is not zero.
+std::string micrometres(double mm, int decimals = 2);
+// The same number without its unit (for tables whose heading gives it).
+std::string micrometres_value(double mm, int decimals = 2);
 
 // Minimal JSON object builder (values are numbers, strings, bools or nested
 // objects already rendered), keys in insertion order.

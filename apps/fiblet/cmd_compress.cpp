@@ -43,8 +43,8 @@ std::string output_for(const CompressArgs& a, const std::string& in) {
 }
 
 std::string describe_errors(const ErrorStats& e) {
-    return fmt::format("max {:.2f} µm, mean {:.2f} µm, p99 {:.2f} µm", e.max_mm() * 1e3, e.mean_mm() * 1e3,
-                       e.percentile_mm(99) * 1e3);
+    return fmt::format("max {}, mean {}, p99 {}", micrometres(e.max_mm()), micrometres(e.mean_mm()),
+                       micrometres(e.percentile_mm(99)));
 }
 
 std::string report_json(const std::string& in, const std::string& out, const CompressReport& r,

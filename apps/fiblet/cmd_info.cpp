@@ -91,7 +91,7 @@ void info_fft(const InfoArgs& a) {
     fmt::print("  cap ratio              {:.6g}\n", h.ratio);
     fmt::print("  scaling, offset (mm)   {:.6g}, ({:.6g}, {:.6g}, {:.6g})\n", h.scaling, h.offset[0], h.offset[1],
                h.offset[2]);
-    fmt::print("  recorded error         max {:.3f} µm, mean {:.3f} µm\n", h.max_error_mm * 1e3, h.mean_error_mm * 1e3);
+    fmt::print("  recorded error         max {}, mean {}\n", micrometres(h.max_error_mm, 3), micrometres(h.mean_error_mm, 3));
     fmt::print("  GPU buffers            {}\n", h.buffer_ends.size());
     if (!chunks.empty()) fmt::print("  trailer chunks         {}\n", chunks);
     if (f.end_fractions())

@@ -17,12 +17,6 @@ struct StatsArgs {
     std::optional<double> max_error_um;
 };
 
-void print_errors(const char* label, const ErrorStats& e) {
-    fmt::print("{:<22} max {:.3f}  mean {:.3f}  rms {:.3f}  p50 {:.2f}  p95 {:.2f}  p99 {:.2f}  (worst fiber {})\n",
-               label, e.max_mm() * 1e3, e.mean_mm() * 1e3, e.rms_mm() * 1e3, e.percentile_mm(50) * 1e3,
-               e.percentile_mm(95) * 1e3, e.percentile_mm(99) * 1e3, e.worst_fiber());
-}
-
 void run(const StatsArgs& a) {
     const FftFile file = open_fft_input(a.input, a.ignore_trailer);
     Progress progress(a.quiet || a.json);
@@ -55,8 +49,9 @@ void run(const StatsArgs& a) {
                human_bytes(c.fft_bytes), human_bytes(c.reference_bytes), ratio,
                c.points ? double(c.fft_bytes) / double(c.points) : 0.0);
     fmt::print("error (µm)\n");
-    print_errors(c.resampled ? "  vs resampled points" : "  vs reference", c.error);
-    fmt::print("  recorded in header   max {:.3f}  mean {:.3f}\n", h.max_error_mm * 1e3, h.mean_error_mm * 1e3);
+    print_distances(c.resampled ? "  vs resampled points" : "  vs reference", c.error);
+    fmt::print("  recorded in header   max {}  mean {}\n", micrometres_value(h.max_error_mm, 3),
+               micrometres_value(h.mean_error_mm, 3));
     fmt::print("vs the reference polylines, both ways (µm)\n");
     print_geometry(c.geometry, "  ");
     check_error_bound(a.input, c.error, c.geometry, a.max_error_um);

@@ -29,13 +29,14 @@ std::string fiber_max_json(const FiberMax& m, double scale, const char* unit) {
         .render();
 }
 
-void print_distances(const std::string& label, const ErrorStats& e) {
-    fmt::print("{:<24}max {:.3f}  mean {:.3f}  rms {:.3f}  p50 {:.2f}  p95 {:.2f}  p99 {:.2f}  (worst fiber {})\n",
-               label, e.max_mm() * 1e3, e.mean_mm() * 1e3, e.rms_mm() * 1e3, e.percentile_mm(50) * 1e3,
-               e.percentile_mm(95) * 1e3, e.percentile_mm(99) * 1e3, e.worst_fiber());
-}
-
 }  // namespace
+
+void print_distances(const std::string& label, const ErrorStats& e) {
+    fmt::print("{:<22} max {}  mean {}  rms {}  p50 {}  p95 {}  p99 {}  (worst fiber {})\n", label,
+               micrometres_value(e.max_mm(), 3), micrometres_value(e.mean_mm(), 3), micrometres_value(e.rms_mm(), 3),
+               micrometres_value(e.percentile_mm(50)), micrometres_value(e.percentile_mm(95)),
+               micrometres_value(e.percentile_mm(99)), e.worst_fiber());
+}
 
 std::string geometry_json(const GeometryError& g) {
     return Json{}
@@ -58,30 +59,32 @@ std::string geometry_json(const GeometryError& g) {
 void print_geometry(const GeometryError& g, const std::string& indent) {
     print_distances(indent + "decoded -> input", g.decoded_to_input());
     print_distances(indent + "input -> decoded", g.input_to_decoded());
-    fmt::print("{}{:<22}max {:.3f}  (fiber {})\n", indent, "Hausdorff", g.hausdorff_mm() * 1e3, g.hausdorff_fiber());
-    fmt::print("{}{:<22}max {:.3f}  mean {:.3f}  (worst fiber {})\n", indent, "endpoints moved",
-               g.endpoint_mm().max * 1e3, g.endpoint_mm().mean() * 1e3, g.endpoint_mm().worst_fiber);
-    fmt::print("{}{:<22}max {:.3f} ({:.4f} %)  mean {:.3f} ({:.4f} %), signed mean {:+.3f}  (worst fiber {})\n",
-               indent, "length change", g.length_change_mm().max * 1e3, g.length_change_percent().max,
-               g.length_change_mm().mean() * 1e3, g.length_change_percent().mean(), g.mean_length_change_mm() * 1e3,
-               g.length_change_mm().worst_fiber);
+    fmt::print("{}{:<22}max {}  (fiber {})\n", indent, "Hausdorff", micrometres_value(g.hausdorff_mm(), 3),
+               g.hausdorff_fiber());
+    fmt::print("{}{:<22}max {}  mean {}  (worst fiber {})\n", indent, "endpoints moved",
+               micrometres_value(g.endpoint_mm().max, 3), micrometres_value(g.endpoint_mm().mean(), 3),
+               g.endpoint_mm().worst_fiber);
+    const double signed_mm = g.mean_length_change_mm();
+    fmt::print("{}{:<22}max {} ({:.4f} %)  mean {} ({:.4f} %), signed mean {}{}  (worst fiber {})\n", indent,
+               "length change", micrometres_value(g.length_change_mm().max, 3), g.length_change_percent().max,
+               micrometres_value(g.length_change_mm().mean(), 3), g.length_change_percent().mean(),
+               signed_mm < 0 ? "-" : "+", micrometres_value(std::fabs(signed_mm), 3), g.length_change_mm().worst_fiber);
 }
 
 void print_geometry_brief(const GeometryError& g, const std::string& indent) {
-    fmt::print("{}vs input polylines, both ways: Hausdorff {:.2f} µm; decoded -> input mean {:.2f} µm, "
-               "input -> decoded mean {:.2f} µm\n",
-               indent, g.hausdorff_mm() * 1e3, g.decoded_to_input().mean_mm() * 1e3,
-               g.input_to_decoded().mean_mm() * 1e3);
-    fmt::print("{}endpoints moved: max {:.2f} µm, mean {:.2f} µm; length change: max {:.2f} µm ({:.4f} %), "
-               "mean {:.2f} µm ({:.4f} %)\n",
-               indent, g.endpoint_mm().max * 1e3, g.endpoint_mm().mean() * 1e3, g.length_change_mm().max * 1e3,
-               g.length_change_percent().max, g.length_change_mm().mean() * 1e3, g.length_change_percent().mean());
+    fmt::print("{}vs input polylines, both ways: Hausdorff {}; decoded -> input mean {}, input -> decoded mean {}\n",
+               indent, micrometres(g.hausdorff_mm()), micrometres(g.decoded_to_input().mean_mm()),
+               micrometres(g.input_to_decoded().mean_mm()));
+    fmt::print("{}endpoints moved: max {}, mean {}; length change: max {} ({:.4f} %), mean {} ({:.4f} %)\n", indent,
+               micrometres(g.endpoint_mm().max), micrometres(g.endpoint_mm().mean()),
+               micrometres(g.length_change_mm().max), g.length_change_percent().max,
+               micrometres(g.length_change_mm().mean()), g.length_change_percent().mean());
 }
 
 std::vector<std::string> metrics_above(const ErrorStats& point_error, const GeometryError& g, double max_um) {
     std::vector<std::string> above;
     auto check = [&](const char* name, double mm) {
-        if (!(mm * 1e3 <= max_um)) above.push_back(fmt::format("{} {:.3f} µm", name, mm * 1e3));
+        if (!(mm * 1e3 <= max_um)) above.push_back(fmt::format("{} {}", name, micrometres(mm, 3)));
     };
     check("point error", point_error.max_mm());
     check("Hausdorff", g.hausdorff_mm());

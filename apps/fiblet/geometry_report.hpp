@@ -16,6 +16,9 @@ namespace fiblet::cli {
 std::string distances_json(const ErrorStats& e);
 // JSON object of every metric (distances in µm, length change in µm and %).
 std::string geometry_json(const GeometryError& g);
+// One row of distance statistics in µm after a label padded to 22
+// characters (the tables of `stats`).
+void print_distances(const std::string& label, const ErrorStats& e);
 // Text lines, each starting with `indent`.
 void print_geometry(const GeometryError& g, const std::string& indent);
 // Compact one-line-per-metric form for compress.

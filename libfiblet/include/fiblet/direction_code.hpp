@@ -41,7 +41,8 @@ std::uint8_t quantize_half_octahedron(Vec3f dir);
 Vec3f dequantize_half_octahedron(std::uint8_t code);
 
 // The 256 local frames of a file: entry k is frame_from_axis of code k's
-// direction mapped to the cap of `ratio`. Built once per file.
+// direction mapped to the cap of `ratio`, computed in double and rounded to
+// float (the float formulas lose digits in narrow caps). Built once per file.
 class DirectionTable {
 public:
     explicit DirectionTable(float ratio);

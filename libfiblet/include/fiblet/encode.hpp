@@ -55,9 +55,13 @@ public:
     FiberEncoder with_search(const SearchOptions& search) const;
 
     // Appends block_count(fiber.size()) blocks to `out`. When `decoded` is
-    // given, the points a decoder will produce (world mm) are appended to it.
+    // given, the points fiblet's (float32) decoders will produce (world mm)
+    // are appended to it; `decoded_exact` (8-bit files) gets the points an
+    // exact (float64) decoder of the format produces, rounded to float.
+    // Where a block's first frame is ill-conditioned the two differ by more
+    // than float rounding; the encoder chooses codes that suit both there.
     void encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, std::vector<std::uint8_t>& out,
-                std::vector<Vec3f>* decoded = nullptr) const;
+                std::vector<Vec3f>* decoded = nullptr, std::vector<Vec3f>* decoded_exact = nullptr) const;
 
 private:
     struct Tables;

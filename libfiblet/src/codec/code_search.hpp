@@ -14,6 +14,12 @@
 //   around its aimed code. A code is thus judged by the errors it causes
 //   later in the block too (zig-zag around a straight path, lag, turns
 //   sharper than the cap), which greedy aiming cannot see.
+// - robust (a second target sequence given): the points must suit two
+//   decoders whose first frames differ (exact_model.hpp); the second
+//   decoder's error is the distance of the same decoded point to the
+//   targets moved by the inverse of that difference. Greedy aims at the
+//   middle of the two targets; the beam's cost is the larger of the two
+//   squared errors at each point.
 #pragma once
 
 #include <algorithm>
@@ -55,17 +61,23 @@ struct Codebook16 {
     const Vec3f& direction(unsigned c) const { return table.direction(Code(c)); }
 };
 
+inline Vec3f midpoint(Vec3f a, Vec3f b) { return 0.5f * (a + b); }
+
 // Chooses codes[k] for targets[k] (normalized coordinates), starting from
 // the block's second anchor `p` and first frame `f`; writes the decoded
-// points to decoded[k].
+// points to decoded[k]. `alt_targets`, when not empty, are the second
+// decoder's targets (robust search, above).
 template <class Codebook>
 void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, float step,
-                  std::span<const Vec3f> targets, typename Codebook::Code* codes, Vec3f* decoded) {
+                  std::span<const Vec3f> targets, typename Codebook::Code* codes, Vec3f* decoded,
+                  std::span<const Vec3f> alt_targets = {}) {
     using Code = typename Codebook::Code;
     const std::size_t m = targets.size();
+    const bool robust = !alt_targets.empty();
     if (sp.beam <= 1) {
         for (std::size_t k = 0; k < m; ++k) {
-            const Code code = cb.nearest(apply_transposed(f, targets[k] - p));
+            const Vec3f aim = robust ? midpoint(targets[k], alt_targets[k]) : targets[k];
+            const Code code = cb.nearest(apply_transposed(f, aim - p));
             codes[k] = code;
             f = compose(f, cb.frame(code));
             p = p + step * f.c[0];
@@ -109,12 +121,15 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
             // the local frame is direction(code).local: three products per candidate.
             const Vec3f local = apply_transposed(st.f, targets[k] - st.p);
             const float base = st.cost + dot(local, local) + step2;
-            const unsigned aimed = cb.nearest(local);
+            const Vec3f alt_local = robust ? apply_transposed(st.f, alt_targets[k] - st.p) : local;
+            const float alt_base = st.cost + dot(alt_local, alt_local) + step2;
+            const unsigned aimed = cb.nearest(robust ? midpoint(local, alt_local) : local);
             const int h0 = int(aimed) / Codebook::kLevels, l0 = int(aimed) % Codebook::kLevels;
             for (int h = std::max(h0 - r, 0); h <= std::min(h0 + r, Codebook::kLevels - 1); ++h)
                 for (int l = std::max(l0 - r, 0); l <= std::min(l0 + r, Codebook::kLevels - 1); ++l) {
                     const auto code = std::uint32_t(h * Codebook::kLevels + l);
-                    const float cost = base - two_step * dot(cb.direction(code), local);
+                    float cost = base - two_step * dot(cb.direction(code), local);
+                    if (robust) cost = std::max(cost, alt_base - two_step * dot(cb.direction(code), alt_local));
                     if (kept == width && !(cost < cand[width - 1].cost)) continue;
                     std::size_t i = kept < width ? kept++ : width - 1;
                     for (; i > 0 && cand[i - 1].cost > cost; --i) cand[i] = cand[i - 1];

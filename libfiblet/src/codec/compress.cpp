@@ -8,6 +8,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <memory>
@@ -70,6 +71,13 @@ private:
     std::uint64_t count_ = 0, below_ = 0;
 };
 
+// A number as printf's %g writes it (std::to_string prints 1e25 in full).
+std::string fmt_g(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+}
+
 double length(Vec3f a, Vec3f b) {
     const double dx = double(b.x) - a.x, dy = double(b.y) - a.y, dz = double(b.z) - a.z;
     return std::sqrt(dx * dx + dy * dy + dz * dz);
@@ -82,6 +90,20 @@ struct Timer {
 
 void report_progress(const CompressOptions& o, const char* phase, const TckReader& r) {
     if (o.progress && r.data_bytes() > 0) o.progress(phase, double(r.bytes_consumed()) / double(r.data_bytes()));
+}
+
+// The decoder walks in float normalized coordinates and starts each block
+// from 16-bit anchors. A step below 2^-20 of the extent (points 1e25 mm
+// apart in a file stepping 0.1 mm) is lost in that arithmetic: each step's
+// rounding is 3 % of it and one anchor quantum spans 16 steps, so the
+// decoded fibers would be noise. Refuse such input rather than write it.
+constexpr double kMinNormalizedStep = 0x1p-20;
+
+void check_step_resolvable(const std::string& path, double step_mm, double extent_mm, float normalized_step) {
+    if (!(step_mm > 0) || double(normalized_step) >= kMinNormalizedStep) return;
+    throw Error(Errc::invalid_input,
+                path + ": the points span " + fmt_g(extent_mm) + " mm for a " + fmt_g(step_mm) +
+                    " mm step: beyond the 2^20 steps per extent that the format's float decoder and 16-bit anchors resolve");
 }
 
 }  // namespace
@@ -189,6 +211,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         throw Error(Errc::invalid_input, tck_path + ": coordinates span more than the float range (" +
                                              std::to_string(extent) + " mm)");
     h.step = float(step / h.scaling);
+    check_step_resolvable(tck_path, step, extent, h.step);
     step = double(h.step) * double(h.scaling);
     report.step_mm = step;
 
@@ -275,7 +298,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     FiberEndFractions end_fractions(report.resampled ? scan.fibers : 0, kWholeLastStep);
     struct Work {
         std::vector<std::uint8_t> blocks;
-        std::vector<Vec3f> decoded, resampled, scratch;
+        std::vector<Vec3f> decoded, decoded_exact, resampled, scratch;
         ErrorStats error;
         GeometryError geometry;  // both ways against the input polylines
         IndexBuilder index;  // bounds of this worker's blocks (the BIDX chunk)
@@ -292,16 +315,21 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             std::span<const Vec3f> points = original;
             const auto f = std::uint32_t(first_fiber + i);
             w.decoded.clear();
+            w.decoded_exact.clear();
             if (report.resampled) {
                 const bool short_tail = resample_keeping_end(original, step, w.resampled);
                 points = w.resampled;
                 end_fractions[f] = detail::encode_keeping_end(encoder, points, short_tail, step, f, w.blocks,
-                                                              w.decoded, w.scratch);
+                                                              w.decoded, &w.decoded_exact, w.scratch);
             } else {
-                encoder.encode(points, f, w.blocks, &w.decoded);
+                encoder.encode(points, f, w.blocks, &w.decoded, &w.decoded_exact);
             }
             if (options.block_index) w.index.add_fiber(w.decoded);
-            for (std::size_t k = 0; k < points.size(); ++k) w.error.add(length(points[k], w.decoded[k]), f);
+            for (std::size_t k = 0; k < points.size(); ++k) {
+                // The header's error holds for fiblet's float decoders and an exact one alike.
+                const double e = length(points[k], w.decoded[k]);
+                w.error.add(w.decoded_exact.empty() ? e : std::max(e, length(points[k], w.decoded_exact[k])), f);
+            }
             w.geometry.add_fiber(original, w.decoded, f);
         }
     };

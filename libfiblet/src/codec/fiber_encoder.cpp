@@ -2,7 +2,9 @@
 #include <cmath>
 #include <optional>
 
+#include "codec/anchor_conditioning.hpp"
 #include "codec/code_search.hpp"
+#include "codec/exact_model.hpp"
 #include "codec/nearest_code_lut.hpp"
 #include "core/block_geometry.hpp"
 #include "core/vec_math.hpp"
@@ -21,6 +23,11 @@ struct Quantized {
     std::uint32_t q[3];
 };
 
+Vec3d normalized_point(const FftHeader& h, Vec3f p) {
+    return {(double(p.x) + h.offset[0]) / h.scaling + 0.5, (double(p.y) + h.offset[1]) / h.scaling + 0.5,
+            (double(p.z) + h.offset[2]) / h.scaling + 0.5};
+}
+
 Quantized quantize_point(const FftHeader& h, Vec3f p, double levels) {
     auto one = [&](double v, int axis) {
         const double n = (v + h.offset[axis]) / h.scaling + 0.5;
@@ -38,11 +45,21 @@ void put_le(std::uint8_t* p, std::uint32_t v, int bytes) {
     for (int i = 0; i < bytes; ++i) p[i] = std::uint8_t(v >> (8 * i));
 }
 
+// Blocks whose two decoders may diverge by more than this share of an
+// anchor quantum (1/65535) get the robust search. The bound is 0.1 to 0.3
+// of a quantum in common blocks (the anchors' float rounding alone) and
+// grows as 1 / |F0 x C| where the first segment runs along the helper.
+// Measured on small-ifod1 (docs/encode.md): 0.5 brings the exact decode's
+// max error from 9.52 to 6.01 um for 1.1x the encode time; 0.2 and 0.05
+// lower the max and mean a little more for 1.7x and 4x.
+constexpr double kRobustDivergence = 0.5 / 65535.0;
+
 // Writes the anchors, fiber id and flags of block b (of n_blocks) holding n
-// points; returns the decoded anchors (normalized coordinates).
-std::pair<Vec3f, Vec3f> write_block_head(const FftHeader& h, std::uint8_t* block, Vec3f p0, Vec3f p1,
-                                         std::uint32_t fiber_id, std::uint32_t b, std::uint32_t n_blocks,
-                                         std::uint32_t n) {
+// points; returns where the decoders start (for 16-bit blocks, the float
+// anchors only). `reach` (normalized) is how far the block's points go from
+// its second anchor, for the choice of 8-bit anchor roundings.
+DecoderStarts write_block_head(const FftHeader& h, std::uint8_t* block, Vec3f p0, Vec3f p1, std::uint32_t fiber_id,
+                               std::uint32_t b, std::uint32_t n_blocks, std::uint32_t n, double reach) {
     const bool first = b == 0, last = b + 1 == n_blocks;
     if (h.direction_bits() == 16) {
         const Quantized q0 = quantize_point(h, p0, kUnorm24Max), q1 = quantize_point(h, p1, kUnorm24Max);
@@ -52,21 +69,55 @@ std::pair<Vec3f, Vec3f> write_block_head(const FftHeader& h, std::uint8_t* block
         auto decoded = [](const Quantized& q) {
             return Vec3f{unpack_unorm24(q.q[0]), unpack_unorm24(q.q[1]), unpack_unorm24(q.q[2])};
         };
-        return {decoded(q0), decoded(q1)};
+        DecoderStarts s;
+        s.a0 = decoded(q0), s.a1 = decoded(q1);
+        return s;
     }
-    const Quantized q0 = quantize_point(h, p0, 65535.0), q1 = quantize_point(h, p1, 65535.0);
-    put_word(block + 0, q0.q[0], q0.q[1]);
-    put_word(block + 4, q0.q[2], q1.q[0]);
-    put_word(block + 8, q1.q[1], q1.q[2]);
+    const DecoderStarts starts =
+        condition_anchors(normalized_point(h, p0), normalized_point(h, p1), reach, kRobustDivergence);
+    const AnchorWords& w = starts.words;
+    put_word(block + 0, w.a0[0], w.a0[1]);
+    put_word(block + 4, w.a0[2], w.a1[0]);
+    put_word(block + 8, w.a1[1], w.a1[2]);
     block[12] = std::uint8_t(fiber_id >> 24), block[13] = std::uint8_t(fiber_id >> 16);
     block[14] = std::uint8_t(fiber_id >> 8), block[15] = std::uint8_t(fiber_id);
     block[kBlockFlagsOffset] = std::uint8_t((first ? 0 : kFlagNotFirst) | (last ? 0 : kFlagNotLast) | n);
     block[kBlockIndexOffset] = std::uint8_t(b);  // modulo 256, as the format stores it
-    auto decoded = [](const Quantized& q) {
-        return Vec3f{unpack_unorm16(std::uint16_t(q.q[0])), unpack_unorm16(std::uint16_t(q.q[1])),
-                     unpack_unorm16(std::uint16_t(q.q[2]))};
-    };
-    return {decoded(q0), decoded(q1)};
+    return starts;
+}
+
+FrameD frame_to_double(const Frame& f) { return {{to_double(f.c[0]), to_double(f.c[1]), to_double(f.c[2])}}; }
+
+// The exact decoder's targets in the float decoder's terms: the exact decode
+// is the float decode moved rigidly (anchor a1 -> exact1, frame -> exact
+// frame), so its error at a point is the float point's distance to
+// t' = a1 + frame exact_frame^T (t - exact1).
+void exact_decoder_targets(const DecoderStarts& s, std::span<const Vec3f> targets, Vec3f* out) {
+    const FrameD fd = frame_to_double(s.frame);
+    const Vec3d a = to_double(s.a1);
+    for (std::size_t k = 0; k < targets.size(); ++k)
+        out[k] = to_float(a + apply(fd, apply_transposed(s.exact_frame, to_double(targets[k]) - s.exact1)));
+}
+
+
+// Largest squared distance of a[k] to b[k].
+float max_distance2(const Vec3f* a, const Vec3f* b, std::size_t m) {
+    float worst = 0;
+    for (std::size_t k = 0; k < m; ++k) {
+        const Vec3f d = a[k] - b[k];
+        worst = std::max(worst, dot(d, d));
+    }
+    return worst;
+}
+
+// Largest squared distance of decoded[k] to targets[k] or alt[k].
+float worst_error2(const Vec3f* decoded, const Vec3f* targets, const Vec3f* alt, std::size_t m) {
+    float worst = 0;
+    for (std::size_t k = 0; k < m; ++k) {
+        const Vec3f d = decoded[k] - targets[k], e = decoded[k] - alt[k];
+        worst = std::max({worst, dot(d, d), dot(e, e)});
+    }
+    return worst;
 }
 
 }  // namespace
@@ -76,6 +127,7 @@ struct FiberEncoder::Tables {
     std::optional<DirectionTable> table8;
     std::optional<NearestCodeLut> lut8;
     std::optional<DirectionTable16> table16;
+    std::optional<ExactDirectionTable> exact8;  // the exact decoder's frames (exact_model.hpp)
 };
 
 float compute_ratio(double scaling_mm, double step_mm, double min_dot) {
@@ -115,6 +167,7 @@ FiberEncoder::FiberEncoder(const FftHeader& header, SearchOptions search) : head
     } else {
         t->table8.emplace(header_.ratio);
         t->lut8.emplace(*t->table8);
+        t->exact8.emplace(header_.ratio);
     }
     tables_ = std::move(t);
 }
@@ -132,7 +185,7 @@ FiberEncoder FiberEncoder::with_search(const SearchOptions& search) const {
 }
 
 void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, std::vector<std::uint8_t>& out,
-                          std::vector<Vec3f>* decoded) const {
+                          std::vector<Vec3f>* decoded, std::vector<Vec3f>* decoded_exact) const {
     const FftHeader& h = header_;
     const std::uint32_t ppb = h.points_per_block, bb = h.block_bytes();
     const std::size_t n_points = fiber.size();
@@ -149,11 +202,15 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
     // blocks (8-bit) or through `codes16`.
     thread_local std::vector<Vec3f> targets, points, retry_points;
     thread_local std::vector<Frame> frames;
+    thread_local std::vector<DecoderStarts> starts;
     thread_local std::vector<std::uint16_t> codes16, retry_codes16;
     thread_local std::vector<std::uint8_t> retry_codes8;
     targets.resize(n_points);
     points.resize(n_points);
     frames.resize(n_blocks);
+    starts.resize(wide ? 0 : n_blocks);
+    // How far a block of n points reaches from its second anchor (normalized).
+    auto block_reach = [&](std::uint32_t n) { return n > 2 ? double(h.step) * double(n - 2) * 1.01 : 0.0; };
     if (wide) codes16.assign(n_points, 0);
     const double inv_scaling = 1.0 / double(h.scaling);
     for (std::size_t k = 0; k < n_points; ++k) {
@@ -177,10 +234,12 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
         } else if (i0 > 0) {
             p1 = {2 * p0.x - fiber[i0 - 1].x, 2 * p0.y - fiber[i0 - 1].y, 2 * p0.z - fiber[i0 - 1].z};
         }
-        const auto [a0, a1] = write_block_head(h, &out[base + std::size_t(b) * bb], p0, p1, fiber_id, b, n_blocks, n);
-        points[i0] = a0;
-        if (n >= 2) points[i0 + 1] = a1;
-        frames[b] = frame_from_axis(anchor_axis(a0, a1));
+        const DecoderStarts head =
+            write_block_head(h, &out[base + std::size_t(b) * bb], p0, p1, fiber_id, b, n_blocks, n, block_reach(n));
+        points[i0] = head.a0;
+        if (n >= 2) points[i0 + 1] = head.a1;
+        frames[b] = wide ? frame_from_axis(anchor_axis(head.a0, head.a1)) : head.frame;
+        if (!wide) starts[b] = head;
     }
 
     // The codes of block b: points i0 + 2 .. i0 + n.
@@ -247,6 +306,39 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
         }
     }
 
+    // Robust blocks (8-bit): where the exact decoder's first frame departs
+    // from the float one, search again for codes that suit both (aiming at
+    // the middle of the two decoders' targets), and keep whichever codes
+    // have the smaller worst error over both decoders.
+    if (!wide) {
+        const Codebook8 cb{*tables_->table8, *tables_->lut8};
+        const unsigned robust_beam = std::max({8u, search_.beam_width, search_.retry_beam_width});
+        thread_local std::vector<Vec3f> alt;
+        for (b = 0; b < n_blocks; ++b) {
+            const std::size_t i0 = std::size_t(b) * ppb, m = block_points(b) > 2 ? block_points(b) - 2 : 0;
+            if (m == 0 || !(starts[b].divergence > kRobustDivergence)) continue;
+            const std::span<const Vec3f> t(&targets[i0 + 2], m);
+            alt.resize(m);
+            exact_decoder_targets(starts[b], t, alt.data());
+            float best = worst_error2(&points[i0 + 2], t.data(), alt.data(), m);
+            // What the float decoder alone gets: once the robust codes come
+            // within 10 % of it for both decoders, the wide beam is not worth its cost.
+            const float float_only = max_distance2(&points[i0 + 2], t.data(), m);
+            retry_points.resize(m);
+            retry_codes8.resize(m);
+            for (unsigned width : {1u, robust_beam}) {
+                if (width > 1 && best <= 1.21f * float_only) break;
+                search_codes(cb, SearchParams{width, 1}, frames[b], points[i0 + 1], h.step, t, retry_codes8.data(),
+                             retry_points.data(), std::span<const Vec3f>(alt));
+                const float worst = worst_error2(retry_points.data(), t.data(), alt.data(), m);
+                if (!(worst < best)) continue;
+                best = worst;
+                std::copy(retry_points.begin(), retry_points.end(), &points[i0 + 2]);
+                std::copy(retry_codes8.begin(), retry_codes8.end(), codes8_of(b));
+            }
+        }
+    }
+
     if (wide)
         for (b = 0; b < n_blocks; ++b)
             for (std::size_t k = 0; k + 2 < block_points(b); ++k)
@@ -254,6 +346,40 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
     if (decoded) {
         decoded->reserve(decoded->size() + n_points);
         for (std::size_t k = 0; k < n_points; ++k) decoded->push_back(h.to_world(points[k].x, points[k].y, points[k].z));
+    }
+    if (decoded_exact && !wide) {
+        // The exact decode, block by block; a block whose float errors plus
+        // the bound on the two decoders' divergence stay below the fiber's
+        // largest float error cannot raise the max error: it gets the float
+        // points (most blocks), which keeps the cost of this pass small.
+        thread_local std::vector<Vec3d> walked;
+        walked.resize(ppb);
+        auto world = [&](Vec3d p) {
+            return Vec3f{float((p.x - 0.5) * double(h.scaling) - double(h.offset[0])),
+                         float((p.y - 0.5) * double(h.scaling) - double(h.offset[1])),
+                         float((p.z - 0.5) * double(h.scaling) - double(h.offset[2]))};
+        };
+        const double out_slack = 4 * 0x1p-24 * (1 + std::max({std::fabs(h.offset[0]), std::fabs(h.offset[1]), std::fabs(h.offset[2])}) / h.scaling);
+        auto block_error = [&](std::uint32_t blk) {
+            const std::size_t i0 = std::size_t(blk) * ppb;
+            return std::sqrt(double(max_distance2(&points[i0], &targets[i0], block_points(blk))));
+        };
+        double fiber_max = 0;
+        for (b = 0; b < n_blocks; ++b) fiber_max = std::max(fiber_max, block_error(b));
+        decoded_exact->reserve(decoded_exact->size() + n_points);
+        for (b = 0; b < n_blocks; ++b) {
+            const DecoderStarts& e = starts[b];
+            const std::size_t i0 = std::size_t(b) * ppb, n = block_points(b), m = n > 2 ? n - 2 : 0;
+            const double bound = e.divergence + walk_divergence(m, double(h.step)) + out_slack;
+            if (block_error(b) + bound <= fiber_max) {
+                for (std::size_t k = 0; k < n; ++k) decoded_exact->push_back(h.to_world(points[i0 + k].x, points[i0 + k].y, points[i0 + k].z));
+                continue;
+            }
+            exact_walk(*tables_->exact8, e.exact_frame, e.exact1, double(h.step), codes8_of(b), m, walked.data());
+            decoded_exact->push_back(world(e.exact0));
+            if (n >= 2) decoded_exact->push_back(world(e.exact1));
+            for (std::size_t k = 0; k < m; ++k) decoded_exact->push_back(world(walked[k]));
+        }
     }
 }
 

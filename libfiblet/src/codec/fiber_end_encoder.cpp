@@ -33,13 +33,14 @@ double projected_fraction(Vec3f a, Vec3f b, Vec3f end) {
 
 std::uint16_t encode_keeping_end(const FiberEncoder& encoder, std::span<const Vec3f> points, bool short_tail,
                                  double step_mm, std::uint32_t fiber_id, std::vector<std::uint8_t>& blocks,
-                                 std::vector<Vec3f>& decoded, std::vector<Vec3f>& scratch) {
+                                 std::vector<Vec3f>& decoded, std::vector<Vec3f>* decoded_exact,
+                                 std::vector<Vec3f>& scratch) {
     const std::size_t n = points.size();
     const std::uint32_t per_block = encoder.header().points_per_block;
     const std::uint32_t last_block_points = n == 0 ? 0 : std::uint32_t(n - per_block * (encoder.block_count(n) - 1));
-    const std::size_t first = decoded.size();
+    const std::size_t first = decoded.size(), first_exact = decoded_exact ? decoded_exact->size() : 0;
     if (n < 2 || !end_fraction_applies(last_block_points)) {
-        encoder.encode(points, fiber_id, blocks, &decoded);  // the end is an anchor: stored as is
+        encoder.encode(points, fiber_id, blocks, &decoded, decoded_exact);  // the end is an anchor: stored as is
         return kWholeLastStep;
     }
     std::span<const Vec3f> coded = points;
@@ -48,13 +49,17 @@ std::uint16_t encode_keeping_end(const FiberEncoder& encoder, std::span<const Ve
         scratch.back() = step_towards(points[n - 2], points[n - 1], step_mm);
         coded = scratch;
     }
-    encoder.encode(coded, fiber_id, blocks, &decoded);
+    encoder.encode(coded, fiber_id, blocks, &decoded, decoded_exact);
     Vec3f& last = decoded[first + n - 1];
     const Vec3f prev = decoded[first + n - 2], end = points[n - 1];
     const std::uint16_t q = quantize_end_fraction(projected_fraction(prev, last, end));
     const Vec3f placed = place_end_point(prev, last, q);
     if (q == kWholeLastStep || distance2(placed, end) >= distance2(last, end)) return kWholeLastStep;
     last = placed;
+    if (decoded_exact && decoded_exact->size() == first_exact + n) {  // an exact decoder places its own end alike
+        Vec3f& last_exact = (*decoded_exact)[first_exact + n - 1];
+        last_exact = place_end_point((*decoded_exact)[first_exact + n - 2], last_exact, q);
+    }
     return q;
 }
 

@@ -18,9 +18,11 @@ namespace fiblet::detail {
 // (a last block of one or two points) the anchor holds the end itself. Any
 // last point is also projected onto its decoded last segment when that comes
 // closer. `decoded` receives the points every fiblet decoder produces, the
-// placed end included; `scratch` is working memory.
+// placed end included, and `decoded_exact` (when given, and filled by the
+// encoder) those of an exact decoder, placed alike; `scratch` is working memory.
 std::uint16_t encode_keeping_end(const FiberEncoder& encoder, std::span<const Vec3f> points, bool short_tail,
                                  double step_mm, std::uint32_t fiber_id, std::vector<std::uint8_t>& blocks,
-                                 std::vector<Vec3f>& decoded, std::vector<Vec3f>& scratch);
+                                 std::vector<Vec3f>& decoded, std::vector<Vec3f>* decoded_exact,
+                                 std::vector<Vec3f>& scratch);
 
 }  // namespace fiblet::detail

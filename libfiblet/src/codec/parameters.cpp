@@ -9,7 +9,7 @@ namespace fiblet::detail {
 
 namespace {
 // Bins of (1 - dot) / 2 = sin^2(angle / 2) in [0, 1]: 0.013 degree wide at
-// a 15 degree turn. Float is enough: |u - v|^2 has no cancellation.
+// a 15 degree turn.
 constexpr std::size_t kTurnBins = 1u << 15;
 }  // namespace
 
@@ -17,19 +17,22 @@ TurnStatistics::TurnStatistics(std::uint32_t points_per_block, std::size_t kept_
     : bins_(kTurnBins + 1, 0), points_per_block_(std::max<std::uint32_t>(points_per_block, 1)), kept_blocks_(kept_blocks) {}
 
 void TurnStatistics::add_fiber(std::span<const Vec3f> f) {
-    float px = 0, py = 0, pz = 0;
+    // Double: a float's square overflows beyond 1e19 mm and vanishes below
+    // 1e-19 mm, and every float tractogram, whatever its units, must see
+    // its turns (a cap sized for no turn at all wrecks the encoding).
+    double px = 0, py = 0, pz = 0;
     bool have = false;
-    float fiber_max = -1;  // largest sin^2(angle / 2) of the fiber
+    double fiber_max = -1;  // largest sin^2(angle / 2) of the fiber
     std::size_t at = 0;
     for (std::size_t i = 1; i < f.size(); ++i) {
-        float dx = f[i].x - f[i - 1].x, dy = f[i].y - f[i - 1].y, dz = f[i].z - f[i - 1].z;
-        const float n2 = dx * dx + dy * dy + dz * dz;
+        double dx = double(f[i].x) - f[i - 1].x, dy = double(f[i].y) - f[i - 1].y, dz = double(f[i].z) - f[i - 1].z;
+        const double n2 = dx * dx + dy * dy + dz * dz;
         if (!(n2 > 0)) continue;
-        const float inv = 1.0f / std::sqrt(n2);
+        const double inv = 1.0 / std::sqrt(n2);
         dx *= inv, dy *= inv, dz *= inv;
         if (have) {
-            const float ex = dx - px, ey = dy - py, ez = dz - pz;
-            const float s2 = std::min(0.25f * (ex * ex + ey * ey + ez * ez), 1.0f);
+            const double ex = dx - px, ey = dy - py, ez = dz - pz;
+            const double s2 = std::min(0.25 * (ex * ex + ey * ey + ez * ez), 1.0);
             if (s2 > fiber_max) fiber_max = s2, at = i - 1;  // the turn at point i - 1
             ++bins_[std::size_t(s2 * float(kTurnBins))];
             ++count_;
@@ -37,7 +40,7 @@ void TurnStatistics::add_fiber(std::span<const Vec3f> f) {
         px = dx, py = dy, pz = dz, have = true;
     }
     if (fiber_max < 0) return;
-    const double fiber_min = 1.0 - 2.0 * double(fiber_max);  // the dot of the sharpest turn
+    const double fiber_min = 1.0 - 2.0 * fiber_max;  // the dot of the sharpest turn
     min_dot_ = std::min(min_dot_, fiber_min);
     if (kept_blocks_ == 0) return;
     auto by_dot = [](const auto& a, const auto& b) { return a.first < b.first; };

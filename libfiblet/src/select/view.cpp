@@ -108,7 +108,9 @@ Sphere block_bounding_sphere(const FftHeader& h, const std::uint8_t* bytes) {
 
 Sphere block_bounding_sphere(const FftHeader& h, Vec3f a0, Vec3f a1, std::uint32_t n) {
     if (n < 2) return {a0, 0.0f};
-    const float r = norm(a1 - a0) + float(n - 2) * h.step * h.scaling;
+    // In double: the squares of a file's extent overflow a float beyond ~1e19 mm.
+    const double dx = double(a1.x) - a0.x, dy = double(a1.y) - a0.y, dz = double(a1.z) - a0.z;
+    const auto r = float(std::sqrt(dx * dx + dy * dy + dz * dz) + double(n - 2) * h.step * h.scaling);
     return {a0, r * (1 + 1e-5f) + 1e-5f * h.scaling};
 }
 

@@ -1,0 +1,59 @@
+#include "codec/exact_model.hpp"
+
+#include <algorithm>
+
+namespace fiblet::detail {
+
+namespace {
+
+Vec3d cross(Vec3d a, Vec3d b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+Vec3d unit(Vec3d a) { return (1.0 / std::sqrt(dot(a, a))) * a; }
+
+}  // namespace
+
+FrameD exact_frame_from_axis(Vec3d axis) {
+    const Vec3d helper{kFrameHelper[0], kFrameHelper[1], kFrameHelper[2]};
+    Vec3d c1 = cross(axis, helper);
+    if (dot(c1, c1) < 1e-6) c1 = cross(axis, Vec3d{0.0, helper.z, -helper.y});
+    c1 = unit(c1);
+    return {{axis, c1, unit(cross(axis, c1))}};
+}
+
+FrameD exact_block_frame(Vec3d a0, Vec3d a1) {
+    const Vec3d d = a1 - a0;
+    return exact_frame_from_axis(dot(d, d) > 0 ? unit(d) : Vec3d{1, 0, 0});
+}
+
+Vec3d apply(const FrameD& f, Vec3d v) { return v.x * f.c[0] + v.y * f.c[1] + v.z * f.c[2]; }
+Vec3d apply_transposed(const FrameD& f, Vec3d v) { return {dot(f.c[0], v), dot(f.c[1], v), dot(f.c[2], v)}; }
+FrameD compose(const FrameD& f, const FrameD& l) { return {{apply(f, l.c[0]), apply(f, l.c[1]), apply(f, l.c[2])}}; }
+
+// formats/fft.md §4, decoding side; fft16.md for 256 levels.
+Vec3d exact_code_direction(unsigned code, unsigned levels, double ratio) {
+    const double half = 0.5 * double(levels - 1);
+    const double q1 = double(code / levels) / half - 1, q2 = double(code % levels) / half - 1;
+    const double y = 0.5 * (q1 + q2), z = 0.5 * (q1 - q2);
+    const Vec3d d = unit({1 - std::fabs(y) - std::fabs(z), y, z});
+    const double x = 1 - ratio + ratio * d.x;
+    const double lateral = std::sqrt(std::max(1 - x * x, 0.0) / std::max(1 - d.x * d.x, 1e-300));
+    return unit({x, d.y * lateral, d.z * lateral});
+}
+
+FrameD exact_code_frame(unsigned code, unsigned levels, double ratio) {
+    return exact_frame_from_axis(exact_code_direction(code, levels, ratio));
+}
+
+ExactDirectionTable::ExactDirectionTable(float ratio) {
+    for (unsigned c = 0; c < 256; ++c) frames_[c] = exact_code_frame(c, 16, double(ratio));
+}
+
+void exact_walk(const ExactDirectionTable& table, FrameD f, Vec3d p, double step, const std::uint8_t* codes,
+                std::size_t count, Vec3d* out) {
+    for (std::size_t k = 0; k < count; ++k) {
+        f = compose(f, table.frame(codes[k]));
+        p = p + step * f.c[0];
+        out[k] = p;
+    }
+}
+
+}  // namespace fiblet::detail

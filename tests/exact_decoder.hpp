@@ -1,0 +1,163 @@
+// A float64 reference decoder of version-2 .fft files, written from
+// formats/fft.md alone: it shares no code with the library's decoders (nor
+// its frame or direction-table code), so that a test comparing the two
+// checks the format, not one implementation against itself. Every formula
+// is evaluated in double, so its output is the "exact" decode any
+// conforming reader approximates.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace fiblet::test::exact {
+
+struct V3 {
+    double x = 0, y = 0, z = 0;
+};
+inline V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline V3 operator*(double s, V3 a) { return {s * a.x, s * a.y, s * a.z}; }
+inline double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+inline V3 unit(V3 a) { return (1.0 / std::sqrt(dot(a, a))) * a; }
+
+// Columns c[0] (the axis), c[1], c[2].
+struct Frame3 {
+    std::array<V3, 3> c;
+};
+
+// §4 "Local frames", with fiblet's fallback helper near ±C.
+inline Frame3 frame_of(V3 axis) {
+    const V3 helper{-0.703023156622, 0.039959276793, 0.71004344758};
+    V3 c1 = cross(axis, helper);
+    if (dot(c1, c1) < 1e-6) c1 = cross(axis, cross(helper, V3{1, 0, 0}));
+    c1 = unit(c1);
+    return {{axis, c1, unit(cross(axis, c1))}};
+}
+
+// F * v and F * L (L's columns expressed in F).
+inline V3 apply(const Frame3& f, V3 v) { return v.x * f.c[0] + v.y * f.c[1] + v.z * f.c[2]; }
+inline Frame3 compose(const Frame3& f, const Frame3& l) { return {{apply(f, l.c[0]), apply(f, l.c[1]), apply(f, l.c[2])}}; }
+
+// §4 "One byte per direction", decoding side: the code's direction in the cap.
+inline V3 code_direction(unsigned code, double ratio) {
+    const double q1 = double(code >> 4) / 7.5 - 1, q2 = double(code & 15) / 7.5 - 1;
+    const double y = (q1 + q2) / 2, z = (q1 - q2) / 2;
+    const V3 d = unit({1 - std::fabs(y) - std::fabs(z), y, z});
+    const double xc = 1 - ratio + ratio * d.x;
+    const double lateral = std::sqrt((1 - xc * xc) / (1 - d.x * d.x));
+    return unit({xc, d.y * lateral, d.z * lateral});
+}
+
+struct Header {
+    std::uint8_t version = 0;
+    std::uint64_t fibers = 0, points = 0;
+    std::uint32_t blocks = 0, points_per_block = 0;
+    float scaling = 0, offset[3] = {}, ratio = 0, step = 0, max_error = 0, mean_error = 0;
+    std::vector<std::uint64_t> buffer_ends;
+    std::size_t block_bytes() const { return (points_per_block + 16 + 3) / 4 * 4; }
+};
+
+template <class T>
+T le(const std::string& b, std::size_t at) {
+    if (at + sizeof(T) > b.size()) throw std::runtime_error("exact decoder: file too short");
+    T v;
+    std::memcpy(&v, b.data() + at, sizeof v);  // the tests run on little-endian hosts
+    return v;
+}
+
+inline Header read_header(const std::string& b) {
+    Header h;
+    h.version = le<std::uint8_t>(b, 0);
+    if (h.version != 2) throw std::runtime_error("exact decoder: version " + std::to_string(h.version));
+    h.fibers = le<std::uint64_t>(b, 1), h.points = le<std::uint64_t>(b, 9);
+    h.blocks = le<std::uint32_t>(b, 17), h.points_per_block = le<std::uint32_t>(b, 21);
+    h.scaling = le<float>(b, 25);
+    for (int a = 0; a < 3; ++a) h.offset[a] = le<float>(b, 29 + 4 * a);
+    h.ratio = le<float>(b, 41), h.step = le<float>(b, 45);
+    h.max_error = le<float>(b, 49), h.mean_error = le<float>(b, 53);
+    const unsigned buffers = le<std::uint8_t>(b, 57);
+    for (unsigned i = 0; i < buffers; ++i) h.buffer_ends.push_back(le<std::uint64_t>(b, 58 + 8 * i));
+    return h;
+}
+
+// §3: the anchors, three 32-bit words stored most-significant byte first.
+inline std::array<double, 6> anchors(const unsigned char* blk) {
+    std::array<double, 6> v{};
+    for (int w = 0; w < 3; ++w) {
+        const std::uint32_t word = std::uint32_t(blk[4 * w]) << 24 | std::uint32_t(blk[4 * w + 1]) << 16 |
+                                   std::uint32_t(blk[4 * w + 2]) << 8 | blk[4 * w + 3];
+        v[2 * w] = double(word & 0xffff) / 65535.0;
+        v[2 * w + 1] = double(word >> 16) / 65535.0;
+    }
+    return v;
+}
+
+// §5: one block's points, normalized coordinates.
+inline void decode_block(const unsigned char* blk, const std::array<Frame3, 256>& table, double step,
+                         std::vector<V3>& out) {
+    const unsigned count = blk[16] & 63;
+    const auto a = anchors(blk);
+    const V3 a0{a[0], a[1], a[2]}, a1{a[3], a[4], a[5]};
+    out.push_back(a0);
+    if (count < 2) return;
+    out.push_back(a1);
+    const V3 d = a1 - a0;
+    Frame3 f = frame_of(dot(d, d) > 0 ? unit(d) : V3{1, 0, 0});
+    V3 p = a1;
+    for (unsigned k = 0; k + 2 < count; ++k) {
+        f = compose(f, table[blk[18 + k]]);
+        p = p + step * f.c[0];
+        out.push_back(p);
+    }
+}
+
+struct Decoded {
+    Header header;
+    std::vector<std::vector<V3>> fibers;  // millimetres
+};
+
+// The whole file: fibers in LUT order, points mapped back to millimetres (§2).
+inline Decoded decode(const std::string& bytes) {
+    Decoded d;
+    Header& h = d.header = read_header(bytes);
+    std::array<Frame3, 256> table;
+    for (unsigned c = 0; c < 256; ++c) table[c] = frame_of(code_direction(c, h.ratio));
+    const std::size_t lut = 58 + 8 * h.buffer_ends.size(), blocks = lut + 8 * h.fibers;
+    std::vector<V3> normalized;
+    for (std::uint64_t i = 0; i < h.fibers; ++i) {
+        const auto x = le<std::uint32_t>(bytes, lut + 8 * i), y = le<std::uint32_t>(bytes, lut + 8 * i + 4);
+        const unsigned buffer = x >> 16, count = x & 0xffff;
+        const std::uint64_t first = y + (buffer > 0 ? h.buffer_ends.at(buffer - 1) : 0);
+        normalized.clear();
+        for (unsigned b = 0; b < count; ++b) {
+            const std::size_t at = blocks + (first + b) * h.block_bytes();
+            if (at + h.block_bytes() > bytes.size()) throw std::runtime_error("exact decoder: block past the end");
+            decode_block(reinterpret_cast<const unsigned char*>(bytes.data()) + at, table, double(h.step), normalized);
+        }
+        auto& fiber = d.fibers.emplace_back();
+        for (const V3& p : normalized)
+            fiber.push_back({(p.x - 0.5) * double(h.scaling) - double(h.offset[0]),
+                             (p.y - 0.5) * double(h.scaling) - double(h.offset[1]),
+                             (p.z - 0.5) * double(h.scaling) - double(h.offset[2])});
+    }
+    return d;
+}
+
+// §6: the payload of trailer chunk `tag`, empty when the file has none.
+inline std::string trailer_chunk(const std::string& bytes, const char* tag) {
+    if (bytes.size() < 16 || bytes.compare(bytes.size() - 8, 8, "FIBLETX1") != 0) return {};
+    for (std::size_t at = le<std::uint64_t>(bytes, bytes.size() - 16); at + 16 <= bytes.size() - 16;) {
+        const std::uint64_t size = le<std::uint64_t>(bytes, at + 8);
+        if (bytes.compare(at, 4, tag) == 0) return bytes.substr(at + 16, size);
+        at += 16 + size;
+    }
+    return {};
+}
+
+}  // namespace fiblet::test::exact
