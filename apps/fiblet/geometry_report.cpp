@@ -59,14 +59,14 @@ std::string geometry_json(const GeometryError& g) {
 void print_geometry(const GeometryError& g, const std::string& indent) {
     print_distances(indent + "decoded -> input", g.decoded_to_input());
     print_distances(indent + "input -> decoded", g.input_to_decoded());
-    fmt::print("{}{:<22}max {}  (fiber {})\n", indent, "Hausdorff", micrometres_value(g.hausdorff_mm(), 3),
+    fmt::print("{:<22} max {}  (fiber {})\n", indent + "Hausdorff", micrometres_value(g.hausdorff_mm(), 3),
                g.hausdorff_fiber());
-    fmt::print("{}{:<22}max {}  mean {}  (worst fiber {})\n", indent, "endpoints moved",
+    fmt::print("{:<22} max {}  mean {}  (worst fiber {})\n", indent + "endpoints moved",
                micrometres_value(g.endpoint_mm().max, 3), micrometres_value(g.endpoint_mm().mean(), 3),
                g.endpoint_mm().worst_fiber);
     const double signed_mm = g.mean_length_change_mm();
-    fmt::print("{}{:<22}max {} ({:.4f} %)  mean {} ({:.4f} %), signed mean {}{}  (worst fiber {})\n", indent,
-               "length change", micrometres_value(g.length_change_mm().max, 3), g.length_change_percent().max,
+    fmt::print("{:<22} max {} ({:.4f} %)  mean {} ({:.4f} %), signed mean {}{}  (worst fiber {})\n",
+               indent + "length change", micrometres_value(g.length_change_mm().max, 3), g.length_change_percent().max,
                micrometres_value(g.length_change_mm().mean(), 3), g.length_change_percent().mean(),
                signed_mm < 0 ? "-" : "+", micrometres_value(std::fabs(signed_mm), 3), g.length_change_mm().worst_fiber);
 }
