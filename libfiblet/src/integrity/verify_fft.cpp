@@ -10,6 +10,7 @@
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
+#include "select/index_chunk.hpp"
 
 namespace fiblet {
 
@@ -17,12 +18,20 @@ namespace {
 
 // Walks the blocks in file order, a fiber at a time, checking what no
 // checksum can (a file may have none, or a writer may have been wrong): the
-// header's point count, the index's per-fiber counts and boxes, and that
-// every decoded point is finite.
+// header's point count, the BIDX chunk's per-fiber counts and boxes, and
+// that every decoded point is finite. The chunk is read as parsed (2 bytes a
+// fiber, 4 a block), not as a BlockIndex, so verify's memory stays near the
+// open file's 12 bytes a fiber.
 class BlockCrossCheck {
 public:
     // Decoded as every reader decodes them: with the file's kept fiber ends.
-    BlockCrossCheck(const FftFile& file, const BlockIndex* index) : file_(file), index_(index), ctx_(file) {}
+    explicit BlockCrossCheck(const FftFile& file) : file_(file), ctx_(file) {
+        if (const TrailerChunk* c = file.find_chunk(kBlockIndexTag)) {
+            index_.emplace(detail::parse_index_chunk(c->payload, file.header(), file.path()));
+            boxes_.emplace(index_->grid);
+        }
+    }
+    bool checks_index() const { return index_.has_value(); }
 
     void add(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) {
         const FftHeader& h = file_.header();
@@ -37,8 +46,9 @@ public:
         }
     }
 
-    std::uint64_t finish() const {
+    std::uint64_t finish() {
         const FftHeader& h = file_.header();
+        for (; fiber_ < h.fibers; ++fiber_, fiber_points_ = 0) check_fiber();  // the fibers after the last block
         if (points_ != h.points)
             fail("the blocks hold " + std::to_string(points_) + " points, the header says " + std::to_string(h.points));
         return points_;
@@ -50,30 +60,37 @@ private:
     }
 
     void check_points(std::uint64_t block, const float* p, std::uint32_t n) const {
-        const Aabb box = index_ ? index_->block_box(block) : Aabb{};
+        const Aabb box = boxes_ ? boxes_->box(index_->codes[block]) : Aabb{};
         for (std::uint32_t i = 0; i < n; ++i, p += 3) {
             if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])))
                 fail("block " + std::to_string(block) + " decodes to a non-finite point");
-            if (index_ && !(p[0] >= box.min.x && p[0] <= box.max.x && p[1] >= box.min.y && p[1] <= box.max.y &&
+            if (boxes_ && !(p[0] >= box.min.x && p[0] <= box.max.x && p[1] >= box.min.y && p[1] <= box.max.y &&
                             p[2] >= box.min.z && p[2] <= box.max.z))
                 fail("block " + std::to_string(block) +
                      " decodes to points outside its box in the BIDX chunk (a selection would lose them)");
         }
     }
 
-    // Fibers in order: the LUT gives their block counts, the index (when
-    // present) their point counts.
+    // Fibers in order: the LUT gives their block counts, the index their
+    // point counts (every block but a fiber's last is full).
     void count_points(std::uint32_t n) {
-        while (block_in_fiber_ >= file_.block_count(fiber_)) ++fiber_, block_in_fiber_ = 0, fiber_points_ = 0;
+        while (block_in_fiber_ >= file_.block_count(fiber_)) check_fiber(), ++fiber_, block_in_fiber_ = 0, fiber_points_ = 0;
         fiber_points_ += n, points_ += n;
-        if (++block_in_fiber_ == file_.block_count(fiber_) && index_ && index_->fiber_points(fiber_) != fiber_points_)
+        ++block_in_fiber_;
+    }
+    void check_fiber() const {
+        if (!index_) return;
+        const std::uint64_t nb = file_.block_count(fiber_), last = index_->last_block_points[fiber_];
+        const std::uint64_t said = nb == 0 ? 0 : (nb - 1) * file_.header().points_per_block + last;
+        if ((nb == 0) != (last == 0) || said != fiber_points_)
             fail("fiber " + std::to_string(fiber_) + " holds " + std::to_string(fiber_points_) +
-                 " points, the BIDX chunk says " + std::to_string(index_->fiber_points(fiber_)));
+                 " points, the BIDX chunk says " + std::to_string(said));
     }
 
     const FftFile& file_;
-    const BlockIndex* index_;
     DecodeContext ctx_;
+    std::optional<detail::IndexChunk> index_;
+    std::optional<detail::IndexBoxDecoder> boxes_;
     std::vector<float> xyz_;
     std::uint64_t fiber_ = 0, block_in_fiber_ = 0, fiber_points_ = 0, points_ = 0;
 };
@@ -89,10 +106,8 @@ VerifyReport verify_fft_file(const std::string& path, const std::function<void(d
     r.has_checksum = file.checksums() != nullptr;
     r.blocks = h.blocks;
     r.ignored_trailing_bytes = file.ignored_trailing_bytes();
-    std::optional<BlockIndex> index;
-    if (file.find_chunk(kBlockIndexTag)) index.emplace(BlockIndex::load(file));
-    r.index_checked = index.has_value();
-    BlockCrossCheck cross(file, index ? &*index : nullptr);
+    BlockCrossCheck cross(file);
+    r.index_checked = cross.checks_index();
     // Whole checksum groups at a time, so that no block is read twice.
     const std::uint64_t group = r.has_checksum ? file.checksums()->group_blocks : kDefaultChecksumGroupBlocks;
     const std::uint64_t step = std::max<std::uint64_t>(1, (std::uint64_t{4} << 20) / h.block_bytes() / group) * group;
