@@ -20,6 +20,7 @@ namespace {
 struct ExtractArgs {
     std::string input, output;
     std::string fibers;
+    bool fibers_given = false;  // --fibers "" is an error, not "all fibers"
     std::optional<double> min_length, max_length, random_fraction;
     std::uint64_t seed = 0;
     std::vector<std::string> include, exclude;
@@ -61,9 +62,10 @@ Region region(const std::string& option, const std::string& text) {
     const auto v = numbers(option, text);
     if (v.size() == 4) return Region::sphere({float(v[0]), float(v[1]), float(v[2])}, float(v[3]));
     if (v.size() == 6) {
-        const Vec3f a{float(v[0]), float(v[1]), float(v[2])}, b{float(v[3]), float(v[4]), float(v[5])};
-        return Region::box_between({std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)},
-                                   {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)});
+        // Corners in order: a swapped pair (x0,x1,y0,...) is a mistake to report, not a box to guess.
+        if (v[0] > v[3] || v[1] > v[4] || v[2] > v[5])
+            usage(option + " " + text + ": a box is x0,y0,z0,x1,y1,z1 with x0 <= x1, y0 <= y1, z0 <= z1");
+        return Region::box_between({float(v[0]), float(v[1]), float(v[2])}, {float(v[3]), float(v[4]), float(v[5])});
     }
     usage(option + " takes x,y,z,radius (sphere) or x0,y0,z0,x1,y1,z1 (box)");
 }
@@ -89,15 +91,16 @@ std::vector<FiberRange> fiber_ranges(const std::string& text) {
             out.push_back({f, f});
         } else {
             out.push_back({id(item.substr(0, dash)), id(item.substr(dash + 1))});
+            if (out.back().first > out.back().last) usage("--fibers: '" + item + "' is an inverted range (FIRST > LAST)");
         }
     }
-    if (out.empty()) usage("--fibers: empty list");
+    if (out.empty() || text.back() == ',') usage("--fibers: empty list or empty item in '" + text + "'");
     return out;
 }
 
 Query build_query(const ExtractArgs& a) {
     Query q;
-    if (!a.fibers.empty()) q.fibers = fiber_ranges(a.fibers);
+    if (a.fibers_given) q.fibers = fiber_ranges(a.fibers);
     q.min_length_mm = a.min_length;
     q.max_length_mm = a.max_length;
     q.random_fraction = a.random_fraction;
@@ -152,7 +155,8 @@ void run(const ExtractArgs& a) {
         TckWriter writer(a.output, header.properties, a.force);
         Progress progress(a.quiet || a.json);
         stats = select(file, index, query, [&](const SelectedChunk& chunk) {
-            for (std::size_t i = 0; i < chunk.size(); ++i) writer.write(chunk.xyz_of(i), chunk.points_of(i));
+            for (std::size_t i = 0; i < chunk.size(); ++i)
+                write_decoded_fiber(writer, chunk.xyz_of(i), chunk.points_of(i), a.input, chunk.runs[i].fiber);
             if (!chunk.runs.empty() && h.fibers)
                 progress.update("extract", double(chunk.runs.back().fiber + 1) / double(h.fibers));
         });
@@ -196,7 +200,8 @@ void add_extract(CLI::App& app) {
         "extract", "Decode only part of a .fft file: fiber subset, regions of interest, view frustum, level of detail");
     cmd->add_option("input", args->input, "Input .fft file")->required()->check(CLI::ExistingFile);
     cmd->add_option("-o,--output", args->output, "Output .tck (points) or .fft (a subset file)")->required();
-    cmd->add_option("--fibers", args->fibers, "Fiber IDs and inclusive ranges, e.g. 0,5,10-20 (0-based)");
+    CLI::Option* fibers =
+        cmd->add_option("--fibers", args->fibers, "Fiber IDs and inclusive ranges, e.g. 0,5,10-20 (0-based)");
     cmd->add_option("--minlength", args->min_length, "Keep fibers at least this long (mm), as tckedit");
     cmd->add_option("--maxlength", args->max_length, "Keep fibers at most this long (mm), as tckedit");
     cmd->add_option("--random-fraction", args->random_fraction, "Keep this fraction of the fibers, at random");
@@ -220,7 +225,10 @@ void add_extract(CLI::App& app) {
     cmd->add_flag("-f,--force", args->force, "Overwrite an existing output");
     cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
     cmd->add_flag("--json", args->json, "Print the summary as JSON");
-    cmd->callback([args] { run(*args); });
+    cmd->callback([args, fibers] {
+        args->fibers_given = fibers->count() > 0;
+        run(*args);
+    });
 }
 
 }  // namespace fiblet::cli

@@ -15,6 +15,8 @@
 #include <utility>
 
 #include "codec/parameters.hpp"
+#include "core/streamline_label.hpp"
+#include "core/thread_count.hpp"
 #include "fiblet/block_index.hpp"
 #include "fiblet/checksum.hpp"
 #include "io/fft_sink.hpp"
@@ -96,6 +98,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         throw Error(Errc::invalid_argument, "points per block must be in [2, " + std::to_string(max_points_per_block) + "]");
     if (options.step_mm && !(std::isfinite(*options.step_mm) && *options.step_mm > 0))
         throw Error(Errc::invalid_argument, "--step must be a positive number of millimetres");
+    const unsigned threads = detail::resolve_threads(options.threads);  // checked before any work
 
     CompressReport report;
     TckScan& scan = report.scan;
@@ -199,7 +202,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             double fiber_length = 0;
             for (std::size_t i = 1; i < fiber.size(); ++i) fiber_length += length(fiber[i - 1], fiber[i]);
             if (!(fiber_length / step < double(max_fiber_points)))
-                throw Error(Errc::unsupported, tck_path + ": streamline " + std::to_string(f) + " (" +
+                throw Error(Errc::unsupported, tck_path + ": " + detail::streamline_label(f) + " (" +
                                                    std::to_string(fiber_length) + " mm) needs more than 65535 blocks at a " +
                                                    std::to_string(step) + " mm step");
             resample_fixed_step(fiber, step, resampled);
@@ -234,7 +237,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     for (std::size_t f = 0; f < fiber_points.size(); ++f) {
         const std::uint32_t nb = encoder.block_count(fiber_points[f]);
         if (nb > 0xffff)
-            throw Error(Errc::unsupported, tck_path + ": streamline " + std::to_string(f) + " needs more than 65535 blocks");
+            throw Error(Errc::unsupported, tck_path + ": " + detail::streamline_label(f) + " needs more than 65535 blocks");
         if (in_buffer + nb > per_buffer) h.buffer_ends.push_back(blocks), in_buffer = 0;
         if (h.buffer_ends.size() > 254)
             throw Error(Errc::unsupported, tck_path + ": more than 255 GPU buffers of blocks");
@@ -248,7 +251,6 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     h.blocks = std::uint32_t(blocks);
 
     // Pass 2: encode, measure, write.
-    const unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
     const auto out = detail::open_fft_sink(fft_path, options.overwrite, options.zstd, h.direction_bits(),
                                            h.block_bytes(), threads);
     FftChecksumBuilder checksum(h.block_bytes());  // the CSUM trailer chunk (formats/fft-checksum.md)

@@ -116,9 +116,12 @@ const std::vector<std::uint8_t>& FftzReader::frame_bytes(std::size_t index) cons
     pread_exact(fd_, stored.data(), stored.size(), f.stored_at, name_);
     std::vector<std::uint8_t> out(f.logical_size);
     const std::size_t n = ZSTD_decompress(out.data(), out.size(), stored.data(), stored.size());
+    // The seek table and frame headers were validated at open: a frame whose
+    // content does not decompress (or fails zstd's content checksum) to the
+    // size they give is damaged data, an integrity failure like a CSUM mismatch.
     if (ZSTD_isError(n) || n != f.logical_size)
-        throw Error(Errc::fft_format, name_ + ": not a valid .fftz file: frame " + std::to_string(index) + ": " +
-                                          (ZSTD_isError(n) ? ZSTD_getErrorName(n) : "wrong decompressed size"));
+        throw Error(Errc::checksum, name_ + ": frame " + std::to_string(index) + " is corrupted (zstd: " +
+                                        (ZSTD_isError(n) ? ZSTD_getErrorName(n) : "wrong decompressed size") + ")");
     const bool group = layout_checked_ && index >= first_group_ && index < first_group_ + groups_;
     if (group && descriptor_.layout == FftzLayout::transposed)
         out = untranspose_block_group(out, direction_bits_, block_bytes_);
