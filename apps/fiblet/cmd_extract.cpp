@@ -62,10 +62,10 @@ Region region(const std::string& option, const std::string& text) {
     const auto v = numbers(option, text);
     if (v.size() == 4) return Region::sphere({float(v[0]), float(v[1]), float(v[2])}, float(v[3]));
     if (v.size() == 6) {
-        // Corners in order: a swapped pair (x0,x1,y0,...) is a mistake to report, not a box to guess.
-        if (v[0] > v[3] || v[1] > v[4] || v[2] > v[5])
-            usage(option + " " + text + ": a box is x0,y0,z0,x1,y1,z1 with x0 <= x1, y0 <= y1, z0 <= z1");
-        return Region::box_between({float(v[0]), float(v[1]), float(v[2])}, {float(v[3]), float(v[4]), float(v[5])});
+        // Two opposite corners, in either order (tests/select_cli_test.cpp): never an inverted box.
+        const Vec3f a{float(v[0]), float(v[1]), float(v[2])}, b{float(v[3]), float(v[4]), float(v[5])};
+        return Region::box_between({std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)},
+                                   {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)});
     }
     usage(option + " takes x,y,z,radius (sphere) or x0,y0,z0,x1,y1,z1 (box)");
 }
