@@ -1,11 +1,13 @@
 // Exit codes and messages name the real cause (issue 12, class 8).
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <string>
 
 #include "cli_runner.hpp"
 #include "fiblet/compress.hpp"
+#include "fiblet/fft_file.hpp"
 #include "fiblet/tck.hpp"
 #include "test_util.hpp"
 
@@ -121,4 +123,22 @@ TEST(CliMessages, StreamlinesAreCountedFromZeroEverywhere) {
     EXPECT_EQ(r.status, 4) << r.output;
     EXPECT_TRUE(mentions(r, "(0-based)")) << r.output;
     EXPECT_FALSE(mentions(r, "counting from 1")) << r.output;
+}
+
+TEST(CliMessages, ANonFiniteDecodeBlamesTheInput) {
+    test::TempDir dir;
+    test::write_three_fiber_tck(dir.file("in.tck"));
+    ASSERT_EQ(test::run_cli("compress -q --no-index " + dir.file("in.tck") + " -o " + dir.file("in.fft")).status, 0);
+    // A file as the official encoder writes it (no trailer, so no checksum to
+    // stop it), whose scaling and offset are finite but overflow once combined.
+    std::string bytes = test::read_file(dir.file("in.fft"));
+    bytes.resize(FftFile(dir.file("in.fft")).header().file_bytes());
+    const float huge = 3e38f;
+    for (std::size_t off : {25, 29, 33, 37}) std::memcpy(&bytes[off], &huge, 4);  // scaling, offset x, y, z
+    test::write_file(dir.file("hostile.fft"), bytes);
+    const auto r = test::run_cli("decompress -q " + dir.file("hostile.fft") + " -o " + dir.file("out.tck"));
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_TRUE(mentions(r, dir.file("hostile.fft") + ": fiber 0 (0-based) decodes to a non-finite")) << r.output;
+    EXPECT_FALSE(mentions(r, "out.tck")) << r.output;
+    EXPECT_FALSE(fs::exists(dir.file("out.tck")));
 }
