@@ -162,3 +162,22 @@ TEST(OutputTarget, AnyLegalNameWorksDespiteTheTemporarySuffix) {
     }
     EXPECT_EQ(entries(dir.path()), 2u);
 }
+
+TEST(OutputTarget, CompressRefusesBeforeItReadsItsInput) {
+    test::TempDir dir;
+    {
+        TckWriter w(dir.file("in.tck"), {}, true);
+        for (int i = 0; i < 3000; ++i) w.write(std::vector<Vec3f>{{0, float(i), 0}, {0.1f, float(i), 0}});
+        w.finish();
+    }
+    test::write_file(dir.file("exists.fft"), "x");
+    int progress_calls = 0;
+    CompressOptions o;
+    o.progress = [&](const char*, double) { ++progress_calls; };
+    EXPECT_EQ(error_of([&] { compress_tck(dir.file("in.tck"), dir.file("exists.fft"), o); }), Errc::exists);
+    o.overwrite = true;
+    EXPECT_EQ(error_of([&] { compress_tck(dir.file("in.tck"), dir.file("in.tck"), o); }), Errc::invalid_argument);
+    EXPECT_EQ(progress_calls, 0);  // refused before the first pass, not after it
+    compress_tck(dir.file("in.tck"), dir.file("exists.fft"), o);
+    EXPECT_GT(progress_calls, 0);
+}

@@ -32,6 +32,11 @@ public:
     // cannot be created.
     AtomicOutputFile(const std::string& path, bool overwrite);
     ~AtomicOutputFile();  // removes the temporary unless commit() succeeded
+    // What the constructor would refuse (see above; an existing output without
+    // overwrite), checked now without creating anything: a long command (a
+    // compress that scans its input first) fails before its work, not after.
+    // The constructor and commit() check again.
+    static void check_destination(const std::string& path, bool overwrite);
     AtomicOutputFile(const AtomicOutputFile&) = delete;
     AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
 

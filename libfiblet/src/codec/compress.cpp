@@ -106,6 +106,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     const std::size_t max_fiber_points = std::size_t{0xffff} * points_per_block;
     TckReader reader(tck_path, {.allow_count_mismatch = options.allow_count_mismatch, .max_points = max_fiber_points});
     scan.header_step = reader.header().step_size();
+    AtomicOutputFile::check_destination(fft_path, options.overwrite);  // before the passes, not after
 
     // Pass 1: counts, bounding box, spacing, turning angles.
     std::vector<std::uint32_t> fiber_points;

@@ -74,6 +74,12 @@ void remove_pending_outputs() noexcept {
         if (s.ready.load()) ::unlink(s.path);
 }
 
+void AtomicOutputFile::check_destination(const std::string& path, bool overwrite) {
+    const detail::OutputTarget target = detail::resolve_output_target(path);
+    if (!overwrite && target.exists && !target.write_through)
+        throw Error(Errc::exists, path + ": output exists (use --force to overwrite)");
+}
+
 AtomicOutputFile::AtomicOutputFile(const std::string& path, bool overwrite) : path_(path), overwrite_(overwrite) {
     const detail::OutputTarget target = detail::resolve_output_target(path);
     target_ = target.path;
