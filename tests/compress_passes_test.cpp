@@ -106,3 +106,20 @@ TEST(CompressPasses, AnUntouchedInputCompressesAsBefore) {
     EXPECT_EQ(compress_editing(dir.file("in.tck"), dir.file("out.fft"), [] {}), "no error");
     EXPECT_TRUE(fs::exists(dir.file("out.fft")));
 }
+
+TEST(CompressPasses, AnInputCutWhileReadIsNamedAsChangedNotAsTruncated) {
+    test::TempDir dir;
+    write_tck(dir.file("in.tck"));
+    TckReader reader(dir.file("in.tck"), {.chunk_bytes = 4096});  // many reads: the cut lands between two
+    std::vector<Vec3f> fiber;
+    ASSERT_TRUE(reader.next(fiber));
+    fs::resize_file(dir.file("in.tck"), fs::file_size(dir.file("in.tck")) / 2);
+    try {
+        while (reader.next(fiber)) {
+        }
+        FAIL() << "read to the end of a file cut in half";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), Errc::io) << e.what();
+        EXPECT_NE(std::string(e.what()).find("changed while it was being read"), std::string::npos) << e.what();
+    }
+}

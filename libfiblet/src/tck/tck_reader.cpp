@@ -101,6 +101,11 @@ struct TckReader::Impl {
     std::uint64_t consumed() const { return (next_read - data_begin) - (chunk_len - chunk_pos); }
     std::uint64_t file_pos() const { return data_begin + consumed(); }
 
+    [[noreturn]] void changed(const std::string& how) const {
+        throw Error(Errc::io, path + ": the file changed while it was being read (" + how +
+                                  "): it is being written or was replaced; read it again once it is complete");
+    }
+
     [[noreturn]] void fail(const std::string& what) const {
         throw Error(Errc::tck_format, path + ": invalid .tck data: " + what);
     }
@@ -140,7 +145,14 @@ struct TckReader::Impl {
             if (n == 0) break;  // the file shrank under us: treat as its end
             got += std::size_t(n);
         }
-        if (got < want) data_end = next_read + got;
+        if (got < want) {
+            // Shorter than at open: cut by someone else, not a truncated file to diagnose.
+            struct stat now {};
+            if (::fstat(fd, &now) == 0 && now.st_size != opened.st_size)
+                changed("it is " + std::to_string(now.st_size) + " bytes now, " + std::to_string(opened.st_size) +
+                        " when opened");
+            data_end = next_read + got;
+        }
         pass_hash.update(chunk.get(), got);
         chunk_len = got;
         chunk_pos = 0;
@@ -250,11 +262,6 @@ struct TckReader::Impl {
         if (pass_checked) return;
         pass_checked = true;
         check_pass();
-    }
-
-    [[noreturn]] void changed(const std::string& how) const {
-        throw Error(Errc::io, path + ": the file changed while it was being read (" + how +
-                                  "): it is being written or was replaced; read it again once it is complete");
     }
 
     // A pass over the data just ended: the file must still be the one opened
