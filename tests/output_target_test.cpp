@@ -181,3 +181,18 @@ TEST(OutputTarget, CompressRefusesBeforeItReadsItsInput) {
     compress_tck(dir.file("in.tck"), dir.file("exists.fft"), o);
     EXPECT_GT(progress_calls, 0);
 }
+
+TEST(OutputTarget, DevStdoutIsWrittenThroughOrRefusedAsWhatItIs) {
+    test::TempDir dir;
+    test::write_three_fiber_tck(dir.file("in.tck"));
+    ASSERT_EQ(test::run_cli("compress -q " + dir.file("in.tck") + " -o " + dir.file("in.fft")).status, 0);
+    // stdout a pipe (popen): /dev/stdout -> /proc/self/fd/1 -> pipe:[N], a FIFO.
+    const auto piped = test::run_cli("decompress -q " + dir.file("in.fft") + " -o /dev/stdout");
+    EXPECT_EQ(piped.status, 2) << piped.output;
+    EXPECT_NE(piped.output.find("FIFO"), std::string::npos) << piped.output;
+    // stdout /dev/null (a character device through two links): written through.
+    const auto r = test::run_command(std::string(FIBLET_CLI) + " decompress -q " + dir.file("in.fft") +
+                                     " -o /dev/stdout >/dev/null 2>" + dir.file("err.txt"));
+    EXPECT_EQ(r.status, 0) << test::read_file(dir.file("err.txt"));
+    EXPECT_TRUE(is_char_device("/dev/null"));
+}

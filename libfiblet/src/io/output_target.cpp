@@ -46,9 +46,14 @@ OutputTarget resolve_output_target(const std::string& path) {
         throw Error(Errc::io, path + ": cannot examine the output: " + std::strerror(errno));
     }
     if (S_ISLNK(st.st_mode)) {
-        t.path = follow_link(path);
-        if (::stat(t.path.c_str(), &st) != 0)
+        if (::stat(path.c_str(), &st) != 0) {
+            if (errno == ENOENT) refuse(path, "is a symbolic link to a missing file: name the file itself");
             throw Error(Errc::io, path + ": cannot examine the output: " + std::strerror(errno));
+        }
+        // A regular file gets replaced: by its own name, so the link stays.
+        // Anything else (/dev/stdout -> a terminal or a pipe) is opened or
+        // refused through the link, which /proc's links need (pipe:[N] is no path).
+        if (S_ISREG(st.st_mode)) t.path = follow_link(path);
     }
     t.exists = true;
     if (const char* why = refused_kind(st.st_mode)) refuse(path, why);
