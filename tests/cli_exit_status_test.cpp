@@ -78,7 +78,7 @@ TEST(CliExitStatus, AFullStdoutIsAnIoError) {
 
 TEST(CliExitStatus, JsonIsValidUtf8WhateverTheHeaderBytes) {
     test::TempDir dir;
-    const std::string bad = std::string("caf\xc3\xa9 \xff\xfe \xc3( \xed\xa0\x80 \xf4\x90\x80\x80 end\x01", 33);
+    const std::string bad = "caf\xc3\xa9 \xff\xfe \xc3( \xed\xa0\x80 \xf4\x90\x80\x80 end\x01";
     {
         TckWriter w(dir.file("in.tck"), {{"comment", bad}, {"valid", "\xe2\x82\xac"}}, true);
         w.write(std::vector<Vec3f>{{0, 0, 0}, {0.1f, 0, 0}, {0.2f, 0, 0}});
