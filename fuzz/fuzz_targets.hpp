@@ -214,7 +214,8 @@ inline std::size_t scalar_reference(const DecodeContext& ctx, const std::uint8_t
                                              : decode_blocks_scalar(ctx, blocks, count, xyz);
 }
 
-// The scalar reference over all blocks at once, fiber offsets from the LUT.
+// The scalar reference over all blocks at once, then the fibers' last-step
+// fractions (ENDS chunk), fiber offsets from the LUT.
 inline FftOutcome decode_reference(const FftFile& f) {
     FftOutcome o;
     try {
@@ -224,12 +225,15 @@ inline FftOutcome decode_reference(const FftFile& f) {
         const std::size_t n = count_block_points(ctx, blocks.data(), h.blocks);
         o.s.xyz.resize(3 * n);
         check(scalar_reference(ctx, blocks.data(), h.blocks, o.s.xyz.data()) == n, "scalar decoder count");
+        if (f.end_fractions()) apply_fiber_ends(h, *f.end_fractions(), blocks.data(), h.blocks, o.s.xyz.data());
         std::uint64_t acc = 0, b = 0;
         for (std::uint64_t fiber = 0; fiber < h.fibers; ++fiber) {
             for (std::uint32_t k = 0; k < f.block_count(fiber); ++k, ++b)
                 acc += block_flags(h, &blocks[b * h.block_bytes()]).point_count;
             o.s.offsets.push_back(acc);
         }
+        // A whole file must hold the header's point count (decode_file checks it too).
+        if (acc != h.points) throw Error(Errc::fft_format, "point count differs from the header's");
     } catch (const Error& e) {
         o.error = e.code();
         o.s = {};
@@ -294,29 +298,32 @@ inline void select_target(const FftFile& f, const Streamlines& all) {
 inline void fft_target(const std::uint8_t* data, std::size_t size) {
     static MemFile input;
     const std::string path = input.set(data, size);
-    // Opened with checksums verified; when they fail, again without, so that
-    // damaged blocks still reach the decoders.
+    // Opened with checksums verified; when they fail, again without, and
+    // when the trailer itself is damaged, without it: so that damaged blocks
+    // still reach the decoders.
     bool verified_open = false;
     std::uint64_t logical_size = size;  // a .fftz holds a larger .fft
-    for (const bool verify : {true, false}) {
+    const FftOpenOptions modes[] = {{}, {.verify_checksums = false}, {.verify_checksums = false, .ignore_trailer = true}};
+    for (const FftOpenOptions& mode : modes) {
+        const bool verify = mode.verify_checksums;
         std::optional<FftFile> file;
         try {
-            file.emplace(path, FftOpenOptions{.verify_checksums = verify});
+            file.emplace(path, mode);
         } catch (const Error& e) {
-            if (verify && e.code() == Errc::checksum) continue;
+            if (e.code() == Errc::checksum && !mode.ignore_trailer) continue;
             break;  // malformed: the same without verification
         }
-        verified_open = verify;
+        check(!mode.ignore_trailer || !file->has_trailer(), "ignore_trailer read a trailer");
+        // Bytes after the blocks make a file fiblet-written: it never opens without its checksums.
+        check(mode.ignore_trailer || file->logical_size() == file->header().file_bytes() || file->checksums(),
+              "a file with a trailer opened without a CSUM chunk");
+        verified_open |= verify;
         logical_size = file->logical_size();
         const FftFile& f = *file;
         const FftHeader& h = f.header();
         check(h.file_bytes() <= f.logical_size(), "opened a file shorter than its header says");
         check(f.block_end(h.fibers) == h.blocks, "LUT does not cover the blocks");
-        try {
-            (void)f.properties();
-        } catch (const Error& e) {
-            check(e.code() == Errc::fft_format, "properties(): unexpected category");
-        }
+        if (const auto step = f.resampled_step_mm()) check(std::isfinite(*step) && *step > 0, "unvalidated RSMP step");
         const FftOutcome ref = decode_reference(f);
         DecodeOptions small_chunks;
         small_chunks.chunk_blocks = 3;

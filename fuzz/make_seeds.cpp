@@ -207,5 +207,7 @@ int main(int argc, char** argv) {
     std::printf("fiblet_fuzz_seeds: %zu .tck, %d .fft seeds in %s\n",
                 std::size_t(std::distance(fs::directory_iterator(tck_dir), fs::directory_iterator())), n_fft,
                 out.c_str());
+    // The structure-aware trailer harness starts from the same files.
+    fs::copy(fft_dir, out / "fft_trailer_fuzz", fs::copy_options::recursive | fs::copy_options::overwrite_existing);
     return 0;
 }

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Compresses every shared tractogram and prints a Markdown table: sizes,
 # ratio, max/mean error (µm, measured by `fiblet stats` against the input),
+# the symmetric metrics (Hausdorff, endpoint displacement, length change),
 # compress and decompress wall time. Usage: scripts/core_table.sh [fiblet args...]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -11,8 +12,8 @@ trap 'rm -rf "$work"' EXIT
 files=(small-ifod1.tck small-ifod1-step0.05.tck small-sdstream.tck small-ifod2.tck dwi-small64d-ifod1.tck
        bundles/AF_L-step0.1.tck bundles/CC_ForcepsMajor-step0.1.tck bundles/CST_R-step0.1.tck
        bundles/cingulum-1-step0.1.tck bundles/cingulum-2-step0.1.tck)
-echo "| file | .tck | .fft | ratio | max / mean error (µm) | compress (s) | decompress (s) |"
-echo "|---|---|---|---|---|---|---|"
+echo "| file | .tck | .fft | ratio | max / mean error (µm) | Hausdorff (µm) | endpoints max / mean (µm) | length change max / mean (µm, mean %) | compress (s) | decompress (s) |"
+echo "|---|---|---|---|---|---|---|---|---|---|"
 for f in "${files[@]}"; do
   in="$data/$f"
   [ -f "$in" ] || continue
@@ -32,7 +33,11 @@ extra = ""
 if s["resampled"]:
     o = s["error_vs_original"]
     extra = f" (resampled; vs original polyline {o['max_um']:.2f} / {o['mean_um']:.2f})"
+g = s["geometry"]
+ends, length = g["endpoint"], g["length_change"]
 print(f"| {name} | {s['reference_bytes']/1e6:.2f} MB | {s['fft_bytes']/1e6:.3f} MB | {s['ratio']:.2f}× | "
-      f"{e['max_um']:.2f} / {e['mean_um']:.2f}{extra} | {t1-t0:.2f} | {t2-t1:.2f} |")
+      f"{e['max_um']:.2f} / {e['mean_um']:.2f}{extra} | {g['hausdorff_um']:.2f} | "
+      f"{ends['max_um']:.2f} / {ends['mean_um']:.2f} | {length['max_um']:.1f} / {length['mean_um']:.1f} "
+      f"({length['mean_percent']:.3f} %) | {t1-t0:.2f} | {t2-t1:.2f} |")
 PY
 done

@@ -139,7 +139,11 @@ TEST(Cli, VariableStepInputIsResampledAndMeasuredBothWays) {
     EXPECT_NE(r.output.find("\"step_mm\": 0.5"), std::string::npos) << r.output;  // the header's step_size
     r = run_cli("stats " + dir.file("v.fft") + " -r " + in);
     ASSERT_EQ(r.status, 0) << r.output;
-    EXPECT_NE(r.output.find("vs original polyline"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("decoded -> input"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("input -> decoded"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("endpoints moved"), std::string::npos) << r.output;
+    r = run_cli("info " + dir.file("v.fft"));
+    EXPECT_NE(r.output.find("fiber ends             kept (ENDS)"), std::string::npos) << r.output;
     // --step overrides.
     r = run_cli("compress " + in + " -o " + dir.file("w.fft") + " --step 0.25 --json");
     ASSERT_EQ(r.status, 0) << r.output;

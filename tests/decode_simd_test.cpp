@@ -223,6 +223,8 @@ void expect_file_matches_reference(const std::string& path) {
         std::printf("  %-28s %-16s max deviation %.3g x step, %.2f of the bound\n",
                     std::filesystem::path(path).filename().c_str(), name.c_str(), steps, of_bound);
     }
+    // decode_fibers also places the fibers' ends (ENDS chunk): the reference then does too.
+    if (file.end_fractions()) apply_fiber_ends(h, *file.end_fractions(), blocks.data(), h.blocks, reference.data());
     const Streamlines all = decode_fibers(file, 0, h.fibers);
     ASSERT_EQ(all.point_count(), points);
     EXPECT_EQ(std::memcmp(all.xyz.data(), reference.data(), 12 * points), 0) << path;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "../fuzz/fuzz_targets.hpp"
+#include "../fuzz/structure_mutator.hpp"
 #include "test_util.hpp"
 
 using namespace fiblet;
@@ -70,6 +71,7 @@ TEST(FuzzRegression, TckTargets) {
 
 TEST(FuzzRegression, FftTargets) {
     int n = replay_regressions("fft_file_fuzz", fuzz::fft_target) +
+            replay_regressions("fft_trailer_fuzz", fuzz::fft_target) +
             replay_regressions("decode_blocks_fuzz", fuzz::blocks_target);
     if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
     test::TempDir dir;
@@ -86,6 +88,19 @@ TEST(FuzzRegression, FftTargets) {
             std::string bad = good;
             bad[i] = char(bad[i] ^ (1 << (i % 8)));
             run(fuzz::fft_target, bad, std::string(name) + " with byte " + std::to_string(i) + " flipped");
+        }
+    }
+    // The trailer harness's structure-aware mutations, one to three at a
+    // time, of a plain file and of a .fftz container.
+    CompressOptions zstd;
+    zstd.zstd = ZstdOptions{.level = 3, .group_blocks = 8, .transpose = true};
+    compress_tck(test::shared_data("bundles/AF_L.tck"), dir.file("a.fftz"), zstd);
+    for (const char* name : {"a.fft", "a.fftz"}) {
+        const std::string good = test::read_file(dir.file(name));
+        for (unsigned seed = 0; seed < 150; ++seed) {
+            std::string bad = good;
+            for (unsigned k = 0; k <= seed % 3; ++k) fuzz::mutate_structure(bad, seed * 7 + k);
+            run(fuzz::fft_target, bad, std::string(name) + " mutated with seed " + std::to_string(seed));
         }
     }
     // The blocks target on the file's blocks, under a few parameter headers.

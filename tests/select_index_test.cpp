@@ -184,14 +184,21 @@ TEST_F(SelectIndex, FrustumCandidatesCoverEveryBlockSphereThatMeetsTheFrustum) {
     }
 }
 
-// A copy of `from` whose trailer's BIDX payload is replaced by `payload`
-// (without the CSUM chunk, which would no longer match).
+// A copy of `from` whose trailer's BIDX payload is replaced by `payload`,
+// with a CSUM chunk that matches it: what a writer with a faulty index
+// builder would make.
 std::string with_index_payload(const FftFile& from, const std::vector<std::uint8_t>& payload, const std::string& to) {
     const std::string bytes = read_file(from.path());
-    const std::uint64_t end = from.header().file_bytes();
+    const FftHeader& h = from.header();
+    const std::uint64_t end = h.file_bytes();
     std::vector<TrailerChunk> chunks;
     for (const TrailerChunk& c : from.trailer())
         if (c.tag != kChecksumTag) chunks.push_back(c.tag == kBlockIndexTag ? TrailerChunk{c.tag, payload} : c);
+    FftChecksumBuilder sums(h.block_bytes());
+    sums.add_lut(bytes.data() + h.lut_offset(), h.blocks_offset() - h.lut_offset());
+    sums.add_blocks(bytes.data() + h.blocks_offset(), end - h.blocks_offset());
+    const auto* head = reinterpret_cast<const std::uint8_t*>(bytes.data());
+    chunks.push_back(sums.finish({head, std::size_t(h.lut_offset())}, chunks));
     const auto trailer = serialize_trailer(chunks, end);
     write_file(to, bytes.substr(0, end) + std::string(trailer.begin(), trailer.end()));
     return to;
@@ -201,8 +208,8 @@ TEST_F(SelectIndex, MalformedChunksAreRejected) {
     const FftFile good(fiblet_file());
     const std::vector<std::uint8_t> payload = good.find_chunk(kBlockIndexTag)->payload;
     auto rejected = [&](std::vector<std::uint8_t> p, const std::string& name) {
-        const FftFile bad(with_index_payload(good, p, dir_->file(name)));
-        try {
+        try {  // the chunk is validated when the file opens, and again when the index loads
+            const FftFile bad(with_index_payload(good, p, dir_->file(name)));
             BlockIndex::load(bad);
         } catch (const Error& e) {
             EXPECT_EQ(e.code(), Errc::fft_format);

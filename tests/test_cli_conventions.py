@@ -92,6 +92,10 @@ def test_exit_codes_are_the_documented_ones(files):
         assert result.returncode == code, (label, result.stderr)
         assert code in documented, label
         assert result.stdout == "" or code == 2, label  # errors go to stderr
+    # An error above --max-error: the report on stdout, the reason on stderr, code 8.
+    above = fiblet("stats", fft, "-r", tck, "--max-error", "0.001")
+    assert above.returncode == 8 and 8 in documented
+    assert "Hausdorff" in above.stdout and "above --max-error" in above.stderr
     # A file that is neither .tck nor .fft, given as .fft: bad input too.
     bogus = d / "bogus.fft"
     bogus.write_bytes(b"\x02" + b"\x00" * 100)

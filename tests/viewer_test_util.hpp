@@ -68,7 +68,8 @@ inline void write_tck(const std::string& path, const std::vector<std::vector<Vec
     w.finish();
 }
 
-// Every block of a file decoded by the scalar reference decoder: xyz of each
+// Every block of a file decoded by the scalar reference decoder (with the
+// file's last-step fractions, as every decoder of a file applies them): xyz of each
 // block's points one after the other, and the offset of each block's first point.
 struct CpuDecoded {
     std::vector<float> xyz;
@@ -76,11 +77,11 @@ struct CpuDecoded {
     Vec3f point(std::size_t i) const { return {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]}; }
 };
 inline CpuDecoded cpu_decode_blocks(const FftFile& f) {
-    const DecodeContext ctx(f.header());
+    const DecodeContext ctx(f);
     const auto blocks = f.read_blocks(0, f.header().blocks);
     CpuDecoded d;
     d.xyz.resize(3 * count_block_points(ctx, blocks.data(), f.header().blocks));
-    decode_blocks_scalar(ctx, blocks.data(), f.header().blocks, d.xyz.data());
+    decode_blocks(ctx, blocks.data(), f.header().blocks, d.xyz.data(), {DecoderKind::scalar});
     const std::uint32_t bb = f.header().block_bytes();
     d.block_first.push_back(0);
     for (std::uint32_t b = 0; b < f.header().blocks; ++b)

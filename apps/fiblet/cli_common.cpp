@@ -33,6 +33,8 @@ const std::vector<ExitCodeInfo>& exit_code_table() {
         {kExists, "the output exists and --force was not given"},
         {kUnsupported, "valid input that fiblet does not support"},
         {kChecksum, "integrity check failed"},
+        {kErrorBound, "a measured error (point, Hausdorff, endpoint or length change) exceeds --max-error; "
+                      "the report is printed and outputs are kept"},
         {130, "interrupted by SIGINT (128 + signal number for other signals, e.g. 153 for SIGXFSZ); no partial output is left"},
     };
     return table;
@@ -145,6 +147,22 @@ std::string Json::render() const {
     for (std::size_t i = 0; i < fields_.size(); ++i)
         out += (i ? ", " : "") + json_quote(fields_[i].first) + ": " + fields_[i].second;
     return out + "}";
+}
+
+FftFile open_fft_input(const std::string& path, bool ignore_trailer) {
+    FftFile file(path, {.ignore_trailer = ignore_trailer});
+    if (const std::uint64_t n = file.ignored_trailing_bytes())
+        fmt::print(stderr,
+                   "fiblet: warning: {}: --ignore-trailer: {} bytes after the last block left unread "
+                   "(no checksums, source properties, index or kept fiber ends: the blocks are not verified)\n",
+                   path, n);
+    return file;
+}
+
+void add_ignore_trailer_flag(CLI::App* cmd, bool& flag) {
+    cmd->add_flag("--ignore-trailer", flag,
+                  "Read only the header, LUT and blocks, not the trailer after them: salvages a file whose "
+                  "trailer is damaged (nothing is then verified by checksum)");
 }
 
 }  // namespace fiblet::cli

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "fiblet/error.hpp"
+#include "fiblet/fft_file.hpp"
 #include "fiblet/tck.hpp"
 
 namespace fiblet::cli {
@@ -22,6 +23,7 @@ enum ExitCode : int {
     kExists = 5,       // output exists, --force not given
     kUnsupported = 6,  // valid input fiblet cannot handle
     kChecksum = 7,     // integrity check failed
+    kErrorBound = 8,   // a measured error exceeds --max-error (the report is printed, outputs kept)
 };
 int exit_code_for(Errc c);
 // Every code the CLI returns, with its meaning (for `fiblet help --markdown`).
@@ -68,6 +70,12 @@ private:
     std::vector<std::pair<std::string, std::string>> fields_;
 };
 std::string json_quote(const std::string& s);
+
+// Opens a .fft/.fftz input. With `ignore_trailer` (the --ignore-trailer
+// flag that add_ignore_trailer_flag() declares) the trailer is left unread,
+// and a warning says what that gives up.
+FftFile open_fft_input(const std::string& path, bool ignore_trailer);
+void add_ignore_trailer_flag(CLI::App* cmd, bool& flag);
 
 // Subcommand registration (one file each).
 void add_compress(CLI::App& app);

@@ -7,6 +7,7 @@
 #include "cli_common.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/encode.hpp"
+#include "geometry_report.hpp"
 
 namespace fiblet::cli {
 namespace {
@@ -30,6 +31,7 @@ struct CompressArgs {
     int zstd_level = ZstdOptions{}.level;
     std::uint32_t zstd_group = ZstdOptions{}.group_blocks;
     bool force = false, quiet = false, json = false, allow_count_mismatch = false;
+    std::optional<double> max_error_um;
 };
 
 std::string output_for(const CompressArgs& a, const std::string& in) {
@@ -45,7 +47,8 @@ std::string describe_errors(const ErrorStats& e) {
                        e.percentile_mm(99) * 1e3);
 }
 
-std::string report_json(const std::string& in, const std::string& out, const CompressReport& r) {
+std::string report_json(const std::string& in, const std::string& out, const CompressReport& r,
+                        std::optional<double> a_max_error) {
     Json j;
     j.str("input", in).str("output", out);
     j.integer("fibers", r.header.fibers).integer("points", r.header.points).integer("blocks", r.header.blocks);
@@ -57,6 +60,8 @@ std::string report_json(const std::string& in, const std::string& out, const Com
     if (r.resampled)
         j.num("max_error_vs_original_um", r.error_vs_original.max_mm() * 1e3)
             .num("mean_error_vs_original_um", r.error_vs_original.mean_mm() * 1e3);
+    j.raw("geometry", geometry_json(r.geometry));
+    if (a_max_error) j.boolean("within_bound", metrics_above(r.error, r.geometry, *a_max_error).empty());
     j.num("seconds", r.seconds);
     return j.render();
 }
@@ -68,6 +73,7 @@ void run(const CompressArgs& a) {
         throw Error(Errc::invalid_argument, a.output_dir + ": --output-dir is not a directory");
     std::vector<std::string> json;
     std::optional<Error> first_failure;
+    std::size_t above_bound = 0;
     for (const std::string& in : a.inputs) {
         const std::string out = output_for(a, in);
         Progress progress(a.quiet);
@@ -94,7 +100,7 @@ void run(const CompressArgs& a) {
             const CompressReport r = compress_tck(in, out, o);
             progress.done();
             if (a.json) {
-                json.push_back(report_json(in, out, r));
+                json.push_back(report_json(in, out, r, a.max_error_um));
             } else if (!a.quiet) {
                 fmt::print("{} -> {}\n", in, out);
                 fmt::print("  {} fibers, {} points, {} blocks of {} points ({} B)\n", r.header.fibers,
@@ -105,9 +111,16 @@ void run(const CompressArgs& a) {
                 fmt::print("  {} -> {} ({:.2f}x smaller)\n", human_bytes(r.input_bytes), human_bytes(r.output_bytes),
                            double(r.input_bytes) / double(r.output_bytes));
                 fmt::print("  error vs {}: {}\n", r.resampled ? "resampled points" : "input", describe_errors(r.error));
-                if (r.resampled)
-                    fmt::print("  error vs original polyline: {}\n", describe_errors(r.error_vs_original));
+                print_geometry_brief(r.geometry, "  ");
                 fmt::print("  {:.2f} s ({:.1f} M points/s)\n", r.seconds, r.header.points / r.seconds / 1e6);
+            }
+            if (a.max_error_um && !metrics_above(r.error, r.geometry, *a.max_error_um).empty()) {
+                try {
+                    check_error_bound(out, r.error, r.geometry, a.max_error_um);
+                } catch (const ErrorBoundExceeded& e) {
+                    fmt::print(stderr, "fiblet: {}\n", e.what());
+                }
+                ++above_bound;
             }
         } catch (const Error& e) {
             progress.done();
@@ -127,6 +140,9 @@ void run(const CompressArgs& a) {
         if (a.inputs.size() == 1) throw Error(first_failure->code(), "compression failed");
         throw Error(first_failure->code(), "some inputs failed (see above)");
     }
+    if (above_bound)
+        throw ErrorBoundExceeded(std::to_string(above_bound) + " of " + std::to_string(a.inputs.size()) +
+                                 " outputs above --max-error (kept; see above)");
 }
 
 }  // namespace
@@ -165,6 +181,10 @@ void add_compress(CLI::App& app) {
         ->check(CLI::Range(1u, 1u << 24));
     cmd->add_flag("--no-transpose", args->no_transpose,
                   "Store block groups as in the .fft (zstd -d then gives back the .fft; slightly larger)");
+    cmd->add_option("--max-error", args->max_error_um,
+                    "Exit with code 8 (outputs kept) when the point error, the Hausdorff distance, an endpoint's "
+                    "displacement or a length change exceeds this many µm")
+        ->check(CLI::PositiveNumber);
     cmd->add_flag("-f,--force", args->force, "Overwrite existing outputs");
     cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
     cmd->add_flag("--json", args->json, "Print the report as JSON");

@@ -12,6 +12,7 @@ namespace fiblet::cli {
 namespace {
 
 struct DecompressArgs {
+    bool ignore_trailer = false;
     std::string input, output, decoder = "auto";
     unsigned threads = 0;
     bool force = false, quiet = false, json = false;
@@ -19,7 +20,7 @@ struct DecompressArgs {
 
 void run(const DecompressArgs& a) {
     const auto t0 = std::chrono::steady_clock::now();
-    const FftFile file(a.input);
+    const FftFile file = open_fft_input(a.input, a.ignore_trailer);
     const FftHeader& h = file.header();
     // The source's header properties (kept in the trailer), with the step
     // the points now have.
@@ -78,6 +79,7 @@ void add_decompress(CLI::App& app) {
     cmd->add_flag("-f,--force", args->force, "Overwrite an existing output");
     cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
     cmd->add_flag("--json", args->json, "Print the summary as JSON");
+    add_ignore_trailer_flag(cmd, args->ignore_trailer);
     cmd->callback([args] { run(*args); });
 }
 

@@ -18,6 +18,7 @@ namespace fiblet::cli {
 namespace {
 
 struct ExtractArgs {
+    bool ignore_trailer = false;
     std::string input, output;
     std::string fibers;
     bool fibers_given = false;  // --fibers "" is an error, not "all fibers"
@@ -140,7 +141,7 @@ void run(const ExtractArgs& a) {
     const Query query = build_query(a);
     if (ext == ".fft" && query.has_level_of_detail())
         usage("--lod produces segments that a .fft file cannot hold: write a .tck");
-    const FftFile file(a.input);
+    const FftFile file = open_fft_input(a.input, a.ignore_trailer);
     const FftHeader& h = file.header();
     const auto t_open = std::chrono::steady_clock::now();
     const BlockIndex index = a.compute_index ? BlockIndex::compute(file) : BlockIndex::load(file);
@@ -225,6 +226,7 @@ void add_extract(CLI::App& app) {
     cmd->add_flag("-f,--force", args->force, "Overwrite an existing output");
     cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
     cmd->add_flag("--json", args->json, "Print the summary as JSON");
+    add_ignore_trailer_flag(cmd, args->ignore_trailer);
     cmd->callback([args, fibers] {
         args->fibers_given = fibers->count() > 0;
         run(*args);

@@ -12,6 +12,7 @@ namespace fiblet::cli {
 namespace {
 
 struct InfoArgs {
+    bool ignore_trailer = false;
     std::string input;
     bool json = false;
 };
@@ -50,9 +51,18 @@ void info_tck(const InfoArgs& a) {
     print_properties(h.properties);
 }
 
+// Fibers whose last step the ENDS chunk shortens (formats/fft-ends.md).
+std::uint64_t partial_last_steps(const FftFile& f) {
+    std::uint64_t n = 0;
+    if (f.end_fractions())
+        for (std::uint16_t q : *f.end_fractions()) n += q != kWholeLastStep;
+    return n;
+}
+
 void info_fft(const InfoArgs& a) {
-    const FftFile f(a.input);
+    const FftFile f = open_fft_input(a.input, a.ignore_trailer);
     const FftHeader& h = f.header();
+    const std::uint64_t partial = partial_last_steps(f);
     std::string chunks;
     for (const auto& c : f.trailer()) chunks += (chunks.empty() ? "" : " ") + std::string(c.tag.data(), 4);
     if (a.json) {
@@ -66,6 +76,7 @@ void info_fft(const InfoArgs& a) {
         j.num("max_error_um", h.max_error_mm * 1e3).num("mean_error_um", h.mean_error_mm * 1e3);
         j.integer("gpu_buffers", h.buffer_ends.size()).integer("file_bytes", f.file_size());
         j.str("trailer_chunks", chunks);
+        j.boolean("ends_kept", f.end_fractions() != nullptr).integer("fibers_with_partial_last_step", partial);
         j.raw("properties", properties_json(f.properties()));
         fmt::print("{}\n", j.render());
         return;
@@ -83,6 +94,8 @@ void info_fft(const InfoArgs& a) {
     fmt::print("  recorded error         max {:.3f} µm, mean {:.3f} µm\n", h.max_error_mm * 1e3, h.mean_error_mm * 1e3);
     fmt::print("  GPU buffers            {}\n", h.buffer_ends.size());
     if (!chunks.empty()) fmt::print("  trailer chunks         {}\n", chunks);
+    if (f.end_fractions())
+        fmt::print("  fiber ends             kept (ENDS): {} of {} fibers end on a partial last step\n", partial, h.fibers);
     const auto props = f.properties();
     if (!props.empty()) {
         fmt::print("  source .tck properties:\n");
@@ -97,6 +110,7 @@ void add_info(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("info", "Print the header of a .fft or .tck file");
     cmd->add_option("file", args->input, "A .fft or .tck file")->required()->check(CLI::ExistingFile);
     cmd->add_flag("--json", args->json, "Print as JSON");
+    add_ignore_trailer_flag(cmd, args->ignore_trailer);
     cmd->callback([args] { looks_like_tck(args->input) ? info_tck(*args) : info_fft(*args); });
 }
 

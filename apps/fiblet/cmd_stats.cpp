@@ -1,29 +1,21 @@
 // fiblet stats IN.fft --reference IN.tck
 #include <fmt/core.h>
 
+#include <optional>
+
 #include "cli_common.hpp"
 #include "fiblet/compare.hpp"
+#include "geometry_report.hpp"
 
 namespace fiblet::cli {
 namespace {
 
 struct StatsArgs {
+    bool ignore_trailer = false;
     std::string input, reference;
     bool json = false, quiet = false, allow_count_mismatch = false;
+    std::optional<double> max_error_um;
 };
-
-std::string error_json(const ErrorStats& e) {
-    return Json{}
-        .num("max_um", e.max_mm() * 1e3)
-        .num("mean_um", e.mean_mm() * 1e3)
-        .num("rms_um", e.rms_mm() * 1e3)
-        .num("p50_um", e.percentile_mm(50) * 1e3)
-        .num("p95_um", e.percentile_mm(95) * 1e3)
-        .num("p99_um", e.percentile_mm(99) * 1e3)
-        .integer("worst_fiber", e.worst_fiber())
-        .integer("points", e.count())
-        .render();
-}
 
 void print_errors(const char* label, const ErrorStats& e) {
     fmt::print("{:<22} max {:.3f}  mean {:.3f}  rms {:.3f}  p50 {:.2f}  p95 {:.2f}  p99 {:.2f}  (worst fiber {})\n",
@@ -32,7 +24,7 @@ void print_errors(const char* label, const ErrorStats& e) {
 }
 
 void run(const StatsArgs& a) {
-    const FftFile file(a.input);
+    const FftFile file = open_fft_input(a.input, a.ignore_trailer);
     Progress progress(a.quiet || a.json);
     const Comparison c =
         compare_to_reference(file, a.reference, a.allow_count_mismatch, [&](double f) { progress.update("stats", f); });
@@ -46,10 +38,15 @@ void run(const StatsArgs& a) {
         j.integer("fft_bytes", c.fft_bytes).integer("reference_bytes", c.reference_bytes).num("ratio", ratio);
         j.num("bytes_per_point", c.points ? double(c.fft_bytes) / double(c.points) : 0.0);
         j.boolean("resampled", c.resampled);
-        j.raw("error", error_json(c.error));
-        if (c.resampled) j.raw("error_vs_original", error_json(c.error_vs_original));
+        j.raw("error", distances_json(c.error));
+        if (c.resampled) j.raw("error_vs_original", distances_json(c.error_vs_original));
+        j.raw("geometry", geometry_json(c.geometry));
         j.num("header_max_error_um", h.max_error_mm * 1e3).num("header_mean_error_um", h.mean_error_mm * 1e3);
+        if (a.max_error_um)
+            j.num("max_error_bound_um", *a.max_error_um)
+                .boolean("within_bound", metrics_above(c.error, c.geometry, *a.max_error_um).empty());
         fmt::print("{}\n", j.render());
+        check_error_bound(a.input, c.error, c.geometry, a.max_error_um);
         return;
     }
     fmt::print("{}: {} fibers, {} points, {} blocks of {} points\n", a.input, c.fibers, c.points, c.blocks,
@@ -59,23 +56,32 @@ void run(const StatsArgs& a) {
                c.points ? double(c.fft_bytes) / double(c.points) : 0.0);
     fmt::print("error (µm)\n");
     print_errors(c.resampled ? "  vs resampled points" : "  vs reference", c.error);
-    if (c.resampled) print_errors("  vs original polyline", c.error_vs_original);
     fmt::print("  recorded in header   max {:.3f}  mean {:.3f}\n", h.max_error_mm * 1e3, h.mean_error_mm * 1e3);
+    fmt::print("vs the reference polylines, both ways (µm)\n");
+    print_geometry(c.geometry, "  ");
+    check_error_bound(a.input, c.error, c.geometry, a.max_error_um);
 }
 
 }  // namespace
 
 void add_stats(CLI::App& app) {
     auto args = std::make_shared<StatsArgs>();
-    CLI::App* cmd = app.add_subcommand("stats", "Measure a .fft file against its source .tck");
+    CLI::App* cmd = app.add_subcommand(
+        "stats", "Measure a .fft file against its source .tck: point error, distances both ways (Hausdorff), "
+                 "endpoint displacement, length change");
     cmd->add_option("input", args->input, "Input .fft file")->required()->check(CLI::ExistingFile);
     cmd->add_option("-r,--reference", args->reference, "The .tck file it was made from")
         ->required()
         ->check(CLI::ExistingFile);
     cmd->add_flag("--json", args->json, "Print the report as JSON");
+    cmd->add_option("--max-error", args->max_error_um,
+                    "Exit with code 8 when the point error, the Hausdorff distance, an endpoint's displacement "
+                    "or a length change exceeds this many µm")
+        ->check(CLI::PositiveNumber);
     cmd->add_flag("-q,--quiet", args->quiet, "No progress display");
     cmd->add_flag("--allow-count-mismatch", args->allow_count_mismatch,
                   "Accept a reference whose count: header disagrees with its data");
+    add_ignore_trailer_flag(cmd, args->ignore_trailer);
     cmd->callback([args] { run(*args); });
 }
 

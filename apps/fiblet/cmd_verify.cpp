@@ -11,7 +11,7 @@ namespace {
 
 struct VerifyArgs {
     std::vector<std::string> inputs;
-    bool require_checksum = false, quiet = false, json = false;
+    bool require_checksum = false, quiet = false, json = false, ignore_trailer = false;
 };
 
 void run(const VerifyArgs& a) {
@@ -20,7 +20,8 @@ void run(const VerifyArgs& a) {
     for (const std::string& in : a.inputs) {
         Progress progress(a.quiet || a.json);
         try {
-            const VerifyReport r = verify_fft_file(in, [&](double f) { progress.update("verify", f); });
+            const VerifyReport r = verify_fft_file(in, [&](double f) { progress.update("verify", f); },
+                                                     {.ignore_trailer = a.ignore_trailer});
             progress.done();
             if (a.json) {
                 json.push_back(Json{}
@@ -28,19 +29,25 @@ void run(const VerifyArgs& a) {
                                    .str("status", r.has_checksum ? "ok" : "no_checksum")
                                    .integer("blocks", r.blocks)
                                    .integer("groups", r.groups)
+                                   .integer("points", r.points)
+                                   .boolean("index_checked", r.index_checked)
                                    .integer("bytes_read", r.bytes_read)
-                                   .integer("unrecognized_trailing_bytes", r.unrecognized_trailing_bytes)
+                                   .integer("ignored_trailing_bytes", r.ignored_trailing_bytes)
                                    .render());
             } else if (!a.quiet || !r.has_checksum) {
+                const std::string index = r.index_checked ? ", index boxes" : "";
                 if (r.has_checksum)
-                    fmt::print("{}: OK: structure valid; XXH64 of header, LUT, trailer and {} blocks in {} groups match\n",
-                               in, r.blocks, r.groups);
+                    fmt::print("{}: OK: structure, {} points{} valid; XXH64 of header, LUT, trailer and {} blocks in "
+                               "{} groups match\n",
+                               in, r.points, index, r.blocks, r.groups);
+                else if (r.ignored_trailing_bytes)
+                    fmt::print("{}: blocks readable ({} blocks, {} points); trailer ignored: nothing verified by "
+                               "checksum\n",
+                               in, r.blocks, r.points);
                 else
-                    fmt::print("{}: no checksum (structure valid: {} blocks; written by another encoder?)\n", in,
-                               r.blocks);
-                if (r.unrecognized_trailing_bytes)
-                    fmt::print("{}: warning: {} bytes after the last block are not a fiblet trailer (damaged?)\n", in,
-                               r.unrecognized_trailing_bytes);
+                    fmt::print("{}: no checksum (structure, {} points{} valid: {} blocks; nothing after the blocks, "
+                               "as the official encoder writes)\n",
+                               in, r.points, index, r.blocks);
             }
             if (!r.has_checksum && a.require_checksum) {
                 const Error e(Errc::checksum, in + ": no checksum and --require-checksum given");
@@ -75,6 +82,9 @@ void add_verify(CLI::App& app) {
                   "Fail (exit 7) on files that carry no checksum");
     cmd->add_flag("-q,--quiet", args->quiet, "Print only problems");
     cmd->add_flag("--json", args->json, "Print the result as JSON");
+    cmd->add_flag("--ignore-trailer", args->ignore_trailer,
+                  "Check only the header, LUT and blocks of a file whose trailer is damaged (no checksum is then "
+                  "verified; exits 7 with --require-checksum)");
     cmd->callback([args] { run(*args); });
 }
 

@@ -9,6 +9,7 @@
 #include <system_error>
 
 #include "cli_common.hpp"
+#include "geometry_report.hpp"
 #include "fiblet/output_file.hpp"
 
 namespace {
@@ -38,6 +39,9 @@ int run(CLI::App& app, int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
         app.exit(e);
         return kUsage;
+    } catch (const ErrorBoundExceeded& e) {
+        fmt::print(stderr, "fiblet: {}\n", e.what());
+        return kErrorBound;
     } catch (const fiblet::Error& e) {
         fmt::print(stderr, "fiblet: error: {}\n", e.what());
         return exit_code_for(e.code());

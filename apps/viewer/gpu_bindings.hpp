@@ -17,7 +17,8 @@ inline constexpr unsigned kCoarseList = 5;   // blocks drawn as one segment (lev
 inline constexpr unsigned kCounters = 6;     // sizes of the two lists and their segment counts
 inline constexpr unsigned kPoints = 7;       // decoded points, pointsPerBlock + 1 slots per block
 inline constexpr unsigned kDecisions = 8;    // per block culling decision (tests, statistics)
-inline constexpr unsigned kStorageCount = 9;
+inline constexpr unsigned kFiberEndFraction = 9;  // per fiber: fraction of its last step kept (ENDS chunk)
+inline constexpr unsigned kStorageCount = 10;
 // Uniform buffers.
 inline constexpr unsigned kLocalFrames = 0;  // the 256 frames of the direction code (DirectionTable)
 }  // namespace binding

@@ -104,6 +104,12 @@ GpuScene::GpuScene(const FftFile& file, const GpuPrograms& programs, std::option
     block_fiber_ = make_buffer(GLsizeiptr(block_fiber.size() * 4), block_fiber.data(), 0);
     fiber_points_buffer_ = make_buffer(GLsizeiptr(fiber_points_.size() * 4), fiber_points_.data(), 0);
     fiber_ends_ = make_buffer(GLsizeiptr(fibers * 16), nullptr, 0);
+    end_fraction_.assign(fibers, 1.0f);
+    if (const auto& ends = file.end_fractions())
+        for (std::uint64_t f = 0; f < fibers; ++f) end_fraction_[f] = end_fraction((*ends)[f]);
+    check_fits(fibers * 4, "fiber end fractions");
+    fiber_end_fraction_ = make_buffer(GLsizeiptr(std::max<std::uint64_t>(fibers, 1) * 4),
+                                      fibers ? end_fraction_.data() : nullptr, 0);
     const std::vector<float> frames = local_frames_std140(h.ratio);
     local_frames_ = make_buffer(GLsizeiptr(frames.size() * 4), frames.data(), 0);
 
@@ -119,7 +125,11 @@ GpuScene::GpuScene(const FftFile& file, const GpuPrograms& programs, std::option
 
 double GpuScene::fiber_length_mm(std::uint64_t index) const {
     const std::uint32_t n = fiber_points_[index];
-    return n > 1 ? double(n - 1) * double(header_.step) * double(header_.scaling) : 0.0;
+    // The last step is shortened to the fiber's true end (ENDS chunk) when
+    // its last block's last point is direction-coded.
+    const std::uint32_t last_block = n ? (n - 1) % header_.points_per_block + 1 : 0;
+    const double steps = n > 1 ? double(n - 2) + (last_block >= 3 ? end_fraction_[index] : 1.0) : 0.0;
+    return steps * double(header_.step) * double(header_.scaling);
 }
 
 std::vector<Vec3f> GpuScene::read_fiber_ends() const {
@@ -135,6 +145,7 @@ void GpuScene::bind(const GlProgram& program) const {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kBlockFiber, block_fiber_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberPoints, fiber_points_buffer_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberEnds, fiber_ends_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberEndFraction, fiber_end_fraction_.get());
     glBindBufferBase(GL_UNIFORM_BUFFER, binding::kLocalFrames, local_frames_.get());
     const GLuint p = program.get();
     glProgramUniform1ui(p, uniform(program, "uBlockCount"), header_.blocks);

@@ -42,7 +42,8 @@ public:
     const std::vector<Vec3f>& sample_points() const { return sample_points_; }
 
     // Fiber `index` (its position in the file): its ID as stored in its
-    // blocks, its number of points and its nominal length (points - 1) x step.
+    // blocks, its number of points and its nominal length: (points - 1) steps,
+    // the last one shortened to the fiber's true end (ENDS chunk).
     std::uint32_t fiber_id(std::uint64_t index) const { return fiber_ids_[index]; }
     std::uint32_t fiber_points(std::uint64_t index) const { return fiber_points_[index]; }
     // Points held by block `b` (its flags, validated at load).
@@ -63,7 +64,8 @@ private:
     std::uint64_t segments_ = 0;
     SceneBounds bounds_;
     std::vector<Vec3f> sample_points_;
-    GlBuffer blocks_, block_fiber_, fiber_points_buffer_, fiber_ends_, local_frames_;
+    GlBuffer blocks_, block_fiber_, fiber_points_buffer_, fiber_ends_, fiber_end_fraction_, local_frames_;
+    std::vector<float> end_fraction_;  // per fiber, kept part of the last step (ENDS chunk; 1 without)
 };
 
 // Largest shader storage buffer of the current context, in bytes.

@@ -137,7 +137,7 @@ def _threads(threads):
     return threads
 
 
-def load(path, *, roi=None, fibers=None, threads=None):
+def load(path, *, roi=None, fibers=None, threads=None, ignore_trailer=False):
     """Decodes a .fft file into a :class:`Streamlines`.
 
     fibers: None (all), a slice or range with step 1 (decoded as one range),
@@ -147,6 +147,9 @@ def load(path, *, roi=None, fibers=None, threads=None):
         ``tckedit`` semantics: a fiber is kept if it has a point inside every
         include region and none inside an exclude region.
     threads: decoding threads (None: all cores).
+    ignore_trailer: read only the header, LUT and blocks, not the trailer
+        after them: salvages a file whose trailer is damaged (which otherwise
+        raises a "checksum" FibletError); nothing is then verified.
 
     Raises FileNotFoundError, ValueError/IndexError on bad arguments, and
     fiblet.FibletError (with ``.category``, e.g. "fft_format") on bad files.
@@ -155,7 +158,7 @@ def load(path, *, roi=None, fibers=None, threads=None):
     regions = [] if roi is None else [r._spec() for r in (roi if isinstance(roi, (list, tuple)) else [roi])]
     begin, end, indices = 0, None, None
     if fibers is not None:
-        count = _fiblet.info(path)["fibers"]
+        count = _fiblet.info(path, ignore_trailer)["fibers"]
         if isinstance(fibers, (slice, range)):
             if fibers.step not in (None, 1):
                 indices = np.arange(count)[slice(fibers.start, fibers.stop, fibers.step)]
@@ -174,7 +177,7 @@ def load(path, *, roi=None, fibers=None, threads=None):
             indices = np.where(indices < 0, indices + count, indices)
         if indices is not None:
             indices = indices.astype(np.uint64)
-    points, offsets, ids = _fiblet.decode(path, begin, end, indices, regions, _threads(threads))
+    points, offsets, ids = _fiblet.decode(path, begin, end, indices, regions, _threads(threads), ignore_trailer)
     return Streamlines(points, offsets, ids)
 
 
@@ -261,11 +264,14 @@ def save(path, streamlines, step=None, *, overwrite=False, threads=None):
 
 def stats(fft, reference):
     """Measures a .fft file against the .tck it was made from; returns the
-    keys of ``fiblet stats --json`` (error in µm: max_um, mean_um, p99_um, ...)."""
+    keys of ``fiblet stats --json`` (error in µm: max_um, mean_um, p99_um, ...);
+    ``geometry`` holds the symmetric metrics against the reference polylines:
+    decoded_to_input and input_to_decoded distances, hausdorff_um, endpoint
+    displacement and length_change (µm and %)."""
     return _fiblet.stats(_existing(fft), _existing(reference))
 
 
-def info(path):
+def info(path, *, ignore_trailer=False):
     """The header of a .fft file as a dict (fibers, points, step_mm,
     max_error_um recorded by the encoder, source .tck properties, ...)."""
-    return _fiblet.info(_existing(path))
+    return _fiblet.info(_existing(path), ignore_trailer)

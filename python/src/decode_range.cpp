@@ -32,7 +32,7 @@ bool fast_block_decoder_available() { return has_fast_decoder<DecodeContext>; }
 DecodedRange decode_range(const FftFile& file, std::uint64_t begin, std::uint64_t end, unsigned threads) {
     if (begin > end || end > file.header().fibers)
         throw Error(Errc::invalid_argument, file.path() + ": fiber range past the end");
-    const DecodeContext ctx(file.header());
+    const DecodeContext ctx(file);
     const std::uint32_t bb = ctx.header.block_bytes();
     const std::uint64_t b0 = file.block_end(begin), nblocks = file.block_end(end) - b0;
     PopulatedBuffer blocks(nblocks * bb);

@@ -96,7 +96,8 @@ std::vector<Region> parse_regions(const py::list& regions) {
 // (F+1) int64, fiber_ids (F) int64). A range without regions, the common
 // case, is decoded straight into the memory numpy gets (decode_range).
 py::tuple decode(const std::string& path, std::uint64_t begin, std::optional<std::uint64_t> end,
-                 const py::object& indices_or_none, const py::list& regions_list, unsigned threads) {
+                 const py::object& indices_or_none, const py::list& regions_list, unsigned threads,
+                 bool ignore_trailer) {
     const std::vector<Region> regions = parse_regions(regions_list);
     std::optional<std::vector<std::uint64_t>> indices;
     if (!indices_or_none.is_none()) {
@@ -109,7 +110,7 @@ py::tuple decode(const std::string& path, std::uint64_t begin, std::optional<std
     std::vector<std::uint64_t> ids;
     {
         py::gil_scoped_release release;
-        const FftFile file(path);
+        const FftFile file(path, {.ignore_trailer = ignore_trailer});
         if (indices) {
             for (std::uint64_t f : *indices)
                 if (f >= file.header().fibers)
@@ -152,18 +153,40 @@ py::dict header_dict(const FftFile& f) {
     d["scaling_mm"] = h.scaling, d["offset_mm"] = py::make_tuple(h.offset[0], h.offset[1], h.offset[2]);
     d["max_error_um"] = double(h.max_error_mm) * 1e3, d["mean_error_um"] = double(h.mean_error_mm) * 1e3;
     d["file_bytes"] = f.file_size();
-    d["resampled"] = f.find_chunk(kResampledTag) != nullptr;
+    d["resampled"] = f.resampled_step_mm().has_value();
     d["properties"] = f.properties();
     return d;
 }
 
-py::dict info(const std::string& path) { return header_dict(FftFile(path)); }
+py::dict info(const std::string& path, bool ignore_trailer) {
+    return header_dict(FftFile(path, {.ignore_trailer = ignore_trailer}));
+}
 
 py::dict error_dict(const ErrorStats& e) {
     py::dict d;
     d["max_um"] = e.max_mm() * 1e3, d["mean_um"] = e.mean_mm() * 1e3, d["rms_um"] = e.rms_mm() * 1e3;
     d["p50_um"] = e.percentile_mm(50) * 1e3, d["p95_um"] = e.percentile_mm(95) * 1e3;
     d["p99_um"] = e.percentile_mm(99) * 1e3, d["worst_fiber"] = e.worst_fiber(), d["points"] = e.count();
+    return d;
+}
+
+// Same keys as the "geometry" object of `fiblet stats --json`
+// (fiblet/geometry_error.hpp; apps/fiblet/geometry_report.cpp).
+py::dict geometry_dict(const GeometryError& g) {
+    auto fiber_max = [](const FiberMax& m) {
+        py::dict d;
+        d["max_um"] = m.max * 1e3, d["mean_um"] = m.mean() * 1e3, d["worst_fiber"] = m.worst_fiber;
+        return d;
+    };
+    py::dict length;
+    length["max_um"] = g.length_change_mm().max * 1e3, length["mean_um"] = g.length_change_mm().mean() * 1e3;
+    length["mean_signed_um"] = g.mean_length_change_mm() * 1e3;
+    length["max_percent"] = g.length_change_percent().max, length["mean_percent"] = g.length_change_percent().mean();
+    length["worst_fiber"] = g.length_change_mm().worst_fiber;
+    py::dict d;
+    d["decoded_to_input"] = error_dict(g.decoded_to_input()), d["input_to_decoded"] = error_dict(g.input_to_decoded());
+    d["hausdorff_um"] = g.hausdorff_mm() * 1e3, d["hausdorff_fiber"] = g.hausdorff_fiber();
+    d["endpoint"] = fiber_max(g.endpoint_mm()), d["length_change"] = length;
     return d;
 }
 
@@ -186,6 +209,7 @@ py::dict stats(const std::string& fft_path, const std::string& reference) {
     d["resampled"] = c.resampled;
     d["error"] = error_dict(c.error);
     if (c.resampled) d["error_vs_original"] = error_dict(c.error_vs_original);
+    d["geometry"] = geometry_dict(c.geometry);
     d["header_max_error_um"] = double(h.max_error_mm) * 1e3, d["header_mean_error_um"] = double(h.mean_error_mm) * 1e3;
     return d;
 }
@@ -211,6 +235,7 @@ py::dict compress(const std::string& tck_path, const std::string& fft_path, std:
     if (r.resampled)
         d["max_error_vs_original_um"] = r.error_vs_original.max_mm() * 1e3,
         d["mean_error_vs_original_um"] = r.error_vs_original.mean_mm() * 1e3;
+    d["geometry"] = geometry_dict(r.geometry);
     d["seconds"] = r.seconds;
     return d;
 }
@@ -260,8 +285,8 @@ PYBIND11_MODULE(_fiblet, m) {
     });
 
     m.def("decode", &decode, py::arg("path"), py::arg("begin"), py::arg("end"), py::arg("indices"),
-          py::arg("regions"), py::arg("threads"));
-    m.def("info", &info, py::arg("path"));
+          py::arg("regions"), py::arg("threads"), py::arg("ignore_trailer"));
+    m.def("info", &info, py::arg("path"), py::arg("ignore_trailer"));
     m.def("stats", &stats, py::arg("fft"), py::arg("reference"));
     m.def("compress", &compress, py::arg("tck"), py::arg("fft"), py::arg("step_mm"), py::arg("overwrite"),
           py::arg("threads"));

@@ -171,3 +171,19 @@ def test_threads_and_decode_paths_give_the_same_points(compressed):
     listed = fiblet.load(fft, fibers=np.arange(len(one)))
     np.testing.assert_array_equal(one.points, listed.points)
     np.testing.assert_array_equal(one.offsets, listed.offsets)
+
+
+def test_damaged_trailer_is_an_integrity_error_unless_ignored(tmp_path, compressed):
+    fft, _ = compressed("dwi-small64d-ifod1")
+    damaged = tmp_path / "damaged.fft"
+    damaged.write_bytes(fft.read_bytes()[:-1])  # the footer is cut: no checksum can be found
+    with pytest.raises(fiblet.FibletError) as e:
+        fiblet.load(damaged)
+    assert e.value.category == "checksum"
+    with pytest.raises(fiblet.FibletError):
+        fiblet.info(damaged)
+    salvaged = fiblet.load(damaged, ignore_trailer=True)
+    whole = fiblet.load(fft)
+    np.testing.assert_array_equal(salvaged.points, whole.points)
+    np.testing.assert_array_equal(salvaged.offsets, whole.offsets)
+    assert fiblet.info(damaged, ignore_trailer=True)["properties"] == []

@@ -69,8 +69,13 @@ def test_cohort_summary(cohort):
         assert float(r["ratio"]) == pytest.approx(tck.stat().st_size / fft.stat().st_size, rel=1e-3)
         # The measured error is real and within what the encoder recorded.
         assert 0 < float(r["max_error_um"]) <= float(r["recorded_max_error_um"]) + 0.01
+        # Endpoints stay where the input has them (resampled files included),
+        # within the recorded error; the symmetric distances are real.
+        assert float(r["endpoint_max_um"]) <= float(r["recorded_max_error_um"]) + 0.01
+        assert 0 < float(r["input_to_decoded_mean_um"]) <= float(r["hausdorff_um"])
         stats = json.loads((out / r["file"].replace(".tck", ".stats.json")).read_text())
         assert stats["file"] == str(fft) and stats["reference"] == str(tck)
+        assert float(r["hausdorff_um"]) == pytest.approx(stats["geometry"]["hausdorff_um"], abs=1e-3)
         info = json.loads(subprocess.run([CLI, "info", "--json", str(fft)], check=True, capture_output=True,
                                          text=True).stdout)
         assert int(r["points"]) == info["points"]

@@ -33,6 +33,7 @@ void main() {
         barrier();
     }
     vec3 offset = hasCode ? uStep * (first * running[0]) : vec3(0.0);
+    vec3 ownStep = offset;
     for (uint d = 1u; d < 64u; d <<= 1) {
         sSteps[t] = offset;
         barrier();
@@ -40,6 +41,8 @@ void main() {
         barrier();
     }
     vec3 p = a1 + offset;  // point t + 2
+    // A fiber's last point keeps only a fraction of its step (ENDS chunk).
+    if (hasCode && t + 3u == n) p -= (1.0 - keptLastStep(block, n)) * ownStep;
 
     if (uEndsOnly) {
         vec3 last = n == 1u ? a0 : n == 2u ? a1 : p;

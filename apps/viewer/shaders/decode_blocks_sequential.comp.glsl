@@ -26,7 +26,10 @@ void main() {
     }
     for (uint k = 2u; k < n; ++k) {
         frame = frame * localFrames[blockCode(block, k - 2u)];
-        p += uStep * frame[0];
+        vec3 stepVec = uStep * frame[0];
+        p += stepVec;
+        // A fiber's last point keeps only a fraction of its step (ENDS chunk).
+        if (k + 1u == n) p -= (1.0 - keptLastStep(block, n)) * stepVec;
         if (!uEndsOnly) points[base + k] = vec4(toWorld(p), 1.0);
     }
     if (uEndsOnly)

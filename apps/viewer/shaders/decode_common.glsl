@@ -7,11 +7,21 @@ layout(std140, binding = BINDING_LOCAL_FRAMES) uniform LocalFrames { mat3 localF
 layout(std430, binding = BINDING_FINE_LIST) readonly buffer FineList { uint fineList[]; };
 layout(std430, binding = BINDING_POINTS) writeonly buffer Points { vec4 points[]; };
 layout(std430, binding = BINDING_FIBER_ENDS) writeonly buffer FiberEnds { vec4 fiberEnds[]; };
+// Per fiber, the fraction of its last step that is kept (the ENDS chunk,
+// formats/fft-ends.md; 1.0 for files without one).
+layout(std430, binding = BINDING_FIBER_END_FRACTION) readonly buffer FiberEndFraction { float fiberEndFraction[]; };
 
 uniform bool uUseList;  // blocks fineList[uFirst + slot], else blocks uFirst + slot
 uniform uint uFirst;
 uniform uint uCount;    // blocks in this pass
 uniform bool uEndsOnly; // last blocks of fibers: write only their last point to fiberEnds[fiber]
+
+// How much of its last step the last point of a block of n points keeps: the
+// fiber's ENDS fraction in its last block when that point is direction-coded
+// (n >= 3), else all of it (fiblet::apply_fiber_ends).
+float keptLastStep(uint block, uint n) {
+    return n >= 3u && isLastBlockOfFiber(block) ? fiberEndFraction[blockFiber[block]] : 1.0;
+}
 
 // kFrameHelper of direction_code.hpp.
 const vec3 kHelper = vec3(-0.703023156622, 0.039959276793, 0.71004344758);

@@ -57,8 +57,8 @@ struct FftChecksums {
     std::uint64_t group_count(std::uint64_t blocks) const { return (blocks + group_blocks - 1) / group_blocks; }
 
     // Parses a CSUM payload for a file of `blocks` blocks; throws
-    // Error{fft_format} (naming `name`) if it is malformed, Error{unsupported}
-    // for an unknown algorithm.
+    // Error{checksum} (naming `name`) if it is malformed or names an unknown
+    // algorithm: without it nothing in the file can be trusted.
     static FftChecksums parse(const TrailerChunk& chunk, std::uint64_t blocks, const std::string& name);
     TrailerChunk serialize() const;
 };
@@ -85,15 +85,24 @@ class FftFile;
 
 struct VerifyReport {
     bool has_checksum = false;
+    bool index_checked = false;  // the BIDX chunk's boxes and counts were checked against the blocks
     std::uint64_t blocks = 0, groups = 0;  // groups: checksummed groups verified
+    std::uint64_t points = 0;              // points the blocks hold (= the header's count)
     std::uint64_t bytes_read = 0;
-    // Bytes after the last block that are not a fiblet trailer (a damaged
-    // footer, or data appended by another tool): never covered by a checksum.
-    std::uint64_t unrecognized_trailing_bytes = 0;
+    // Bytes after the last block left unread (VerifyOptions::ignore_trailer).
+    std::uint64_t ignored_trailing_bytes = 0;
 };
 
-// Reads a whole .fft file, checking its structure and, when it has a CSUM
-// chunk, every hash. Throws Error{fft_format | checksum | io}.
-VerifyReport verify_fft_file(const std::string& path, const std::function<void(double)>& progress = {});
+struct VerifyOptions {
+    bool ignore_trailer = false;  // check the blocks of a file whose trailer is damaged
+};
+
+// Reads a whole .fft file and checks everything a reader relies on: its
+// structure, every hash of its CSUM chunk, each block's identity (fiber ID,
+// index in the fiber), the header's point count against the blocks', the
+// BIDX chunk's counts and boxes against the decoded blocks, and that every
+// point decodes to a finite value. Throws Error{fft_format | checksum | io}.
+VerifyReport verify_fft_file(const std::string& path, const std::function<void(double)>& progress = {},
+                             const VerifyOptions& options = {});
 
 }  // namespace fiblet

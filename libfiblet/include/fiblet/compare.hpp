@@ -7,6 +7,7 @@
 
 #include "fiblet/error_stats.hpp"
 #include "fiblet/fft_file.hpp"
+#include "fiblet/geometry_error.hpp"
 
 namespace fiblet {
 
@@ -19,6 +20,9 @@ struct Comparison {
     bool resampled = false;
     ErrorStats error;
     ErrorStats error_vs_original;
+    // Decoded vs the reference's own polylines (never resampled), both
+    // ways, endpoints and lengths (fiblet/geometry_error.hpp).
+    GeometryError geometry;
 };
 
 // Decodes every fiber and measures each decoded point against the reference.

@@ -10,6 +10,7 @@
 #include "fiblet/encode.hpp"
 #include "fiblet/error_stats.hpp"
 #include "fiblet/fft_format.hpp"
+#include "fiblet/geometry_error.hpp"
 
 namespace fiblet {
 
@@ -61,6 +62,7 @@ struct CompressReport {
     bool resampled = false;          // the input was resampled to the fixed step
     ErrorStats error;                // decoded vs the encoded points (resampled ones if resampled)
     ErrorStats error_vs_original;    // decoded vs the original polyline (only if resampled)
+    GeometryError geometry;          // decoded vs input polylines, both ways; endpoints, lengths
     std::uint64_t input_bytes = 0, output_bytes = 0;
     double seconds = 0;
 };

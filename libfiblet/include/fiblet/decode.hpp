@@ -41,6 +41,9 @@ std::shared_ptr<const DirectionTable16> make_direction_table16(const FftHeader& 
 // Per-file constants the decoders need (built once per file).
 struct DecodeContext {
     explicit DecodeContext(const FftHeader& header);
+    // With the file's ENDS fractions (fiblet/fiber_ends.hpp): what every
+    // decoder of a file's fibers uses, so their last points land on the ends.
+    explicit DecodeContext(const FftFile& file);
     FftHeader header;
     DirectionTable table;
     std::shared_ptr<const DirectionTable16> table16 = make_direction_table16(header);  // 16-bit files only
@@ -48,6 +51,10 @@ struct DecodeContext {
     // component 3 col + row of code k at [16 k + 3 col + row], zero padded.
     // What the SIMD decoders load.
     alignas(64) std::array<float, 256 * 16> frame_rows{};
+    // Last-step fractions per fiber; null: fibers end where their blocks do.
+    // decode_blocks (and everything built on it) applies them; the raw
+    // kernels (decode_blocks_scalar, ...) do not.
+    std::shared_ptr<const FiberEndFractions> end_fractions;
 };
 
 enum class DecoderKind { automatic, scalar, warp, lanes };
@@ -128,7 +135,9 @@ std::uint64_t decode_fibers_into(const FftFile& file, std::uint64_t begin, std::
                                  std::span<std::uint64_t> offsets, const DecodeOptions& = {});
 
 // Streams the whole file in fiber order, a chunk of whole fibers at a time
-// (bounded memory): `sink(first_fiber, chunk)`.
+// (bounded memory): `sink(first_fiber, chunk)`. Throws Error{fft_format}
+// after the last chunk when the blocks hold other than header().points
+// points (a caller writing an output commits it only after this returns).
 void decode_file(const FftFile& file, const std::function<void(std::uint64_t, const Streamlines&)>& sink,
                  const DecodeOptions& = {});
 

@@ -6,6 +6,11 @@
 // (12 bytes per fiber). Every block read is checked against the LUT (point
 // count, first/last flags) and, when the file carries a CSUM chunk
 // (fiblet/checksum.hpp), against its checksums.
+//
+// A file with any byte after its last block is fiblet-written: its trailer
+// must then be complete, end with a CSUM chunk, and match it, or the file
+// does not open (Error{checksum}); FftOpenOptions::ignore_trailer is the
+// explicit escape that salvages the blocks of such a file.
 #pragma once
 
 #include <atomic>
@@ -18,6 +23,7 @@
 #include <vector>
 
 #include "fiblet/checksum.hpp"
+#include "fiblet/fiber_ends.hpp"
 #include "fiblet/fft_format.hpp"
 
 namespace fiblet {
@@ -37,6 +43,10 @@ struct FftOpenOptions {
     // read) when the file has one. Off only where speed matters more than
     // detecting corruption (or to look at a damaged file).
     bool verify_checksums = true;
+    // Read nothing after the last block: no checksums, properties, index or
+    // resampling step. Salvages the blocks of a file whose trailer is damaged
+    // (a reader that opens a file this way must say so to its user).
+    bool ignore_trailer = false;
 };
 
 // Opens plain .fft files and .fftz containers (formats/fftz.md) alike: a
@@ -69,16 +79,26 @@ public:
         return fiber_end < header_.fibers ? fiber_first_block_[fiber_end] : header_.blocks;
     }
 
-    // Chunks of the fiblet trailer (empty for files without one), and the
-    // source .tck properties stored in its PROP chunk.
+    // Chunks of the fiblet trailer (empty for files without one, or opened
+    // with ignore_trailer), each validated at open (formats/fft.md §6).
     // Unknown chunks above 16 MiB are not loaded (memory stays bounded).
-    bool has_trailer() const { return has_trailer_; }
+    bool has_trailer() const { return !trailer_.empty(); }
     const std::vector<TrailerChunk>& trailer() const { return trailer_; }
     const TrailerChunk* find_chunk(std::array<char, 4> tag) const;
-    std::vector<std::pair<std::string, std::string>> properties() const;
+    // The source .tck properties (PROP chunk), and the fixed step (mm) the
+    // input was resampled to (RSMP chunk; empty when it was not resampled).
+    const std::vector<std::pair<std::string, std::string>>& properties() const { return properties_; }
+    std::optional<double> resampled_step_mm() const { return resampled_step_mm_; }
+    // Bytes after the last block that were not read (ignore_trailer).
+    std::uint64_t ignored_trailing_bytes() const {
+        return options_.ignore_trailer ? logical_size_ - header_.file_bytes() : 0;
+    }
     // The parsed CSUM chunk, or nullptr for a file without checksums.
     const FftChecksums* checksums() const { return checksums_ ? &*checksums_ : nullptr; }
     bool verifies_checksums() const { return checksums_ && options_.verify_checksums; }
+    // The per-fiber last-step fractions of the ENDS chunk (fiblet/fiber_ends.hpp),
+    // validated at open; null for a file without one (every fiber whole).
+    const std::shared_ptr<const FiberEndFractions>& end_fractions() const { return end_fractions_; }
 
     // Reads blocks [first, first+count) into `out` (count * block_bytes
     // bytes), checks them against the LUT (Error{fft_format}) and the
@@ -100,7 +120,7 @@ public:
 private:
     struct Mapping;
     void read_lut(std::uint64_t& lut_hash);
-    void read_trailer();
+    void open_trailer(std::span<const std::uint8_t> head, std::uint64_t lut_hash);
     void verify_open_checksums(std::span<const std::uint8_t> head, std::uint64_t lut_hash) const;
     void check_block_structure(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const;
     void verify_block_groups(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const;
@@ -115,10 +135,12 @@ private:
     FftHeader header_;
     std::vector<FiberLutEntry> lut_;
     std::vector<std::uint32_t> fiber_first_block_;  // block counts are 32-bit, so are first blocks
-    bool has_trailer_ = false;
     std::vector<TrailerChunk> trailer_;
+    std::vector<std::pair<std::string, std::string>> properties_;
+    std::optional<double> resampled_step_mm_;
     std::uint64_t checksum_chunk_offset_ = 0;  // where the CSUM chunk starts in the file
     std::optional<FftChecksums> checksums_;
+    std::shared_ptr<const FiberEndFractions> end_fractions_;
     std::unique_ptr<std::atomic<std::uint64_t>[]> verified_groups_;  // one bit per block group
     std::unique_ptr<Mapping> mapping_;                                // mapped_blocks()
     std::unique_ptr<detail::InputRegistration> input_;  // no output of this process may replace the file

@@ -17,6 +17,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -196,19 +197,23 @@ struct BlockView16 {
     }
 };
 
-// Point count and first/last flags of a block of either kind (8-bit
-// version-2 blocks or 16-bit blocks), for code that only walks the structure.
+// Point count, first/last flags and identity (fiber ID, and for 8-bit
+// blocks the index within the fiber modulo 256) of a block of either kind
+// (8-bit version-2 blocks or 16-bit blocks), for code that only walks the
+// structure.
 struct BlockFlags {
     std::uint32_t point_count;
     bool first, last;
+    std::uint32_t fiber_id;
+    std::optional<std::uint32_t> index_in_fiber;  // 16-bit blocks have none
 };
 inline BlockFlags block_flags(const FftHeader& h, const std::uint8_t* block) {
     if (h.direction_bits() == 16) {
         const BlockView16 v{block};
-        return {v.point_count(), v.is_first(), v.is_last()};
+        return {v.point_count(), v.is_first(), v.is_last(), v.fiber_id(), std::nullopt};
     }
     const BlockView v{block};
-    return {v.point_count(), v.is_first(), v.is_last()};
+    return {v.point_count(), v.is_first(), v.is_last(), v.fiber_id(), v.index_in_fiber()};
 }
 // The two anchors (x0 y0 z0 x1 y1 z1, normalized) of a block of either kind.
 inline std::array<float, 6> block_anchors_normalized(const FftHeader& h, const std::uint8_t* block) {

@@ -12,6 +12,8 @@
 //   decode.hpp         blocks -> points (scalar reference), fibers -> TRX-layout arrays
 //   compare.hpp        a .fft measured against its source .tck
 //   error_stats.hpp    max / mean / RMS / percentiles of position errors
+//   geometry_error.hpp decoded vs input both ways, endpoints, lengths
+//   fiber_ends.hpp     the ENDS chunk: fibers end where their input does
 //   resample.hpp       fixed-step resampling, point-to-polyline distance
 //   view.hpp           camera, frustum, level of detail, block bounding spheres
 //   block_index.hpp    per-block boxes (BIDX chunk) and a hierarchy over them
@@ -32,7 +34,9 @@
 #include "fiblet/fft_file.hpp"
 #include "fiblet/fft_format.hpp"
 #include "fiblet/fft_subset.hpp"
+#include "fiblet/fiber_ends.hpp"
 #include "fiblet/geometry.hpp"
+#include "fiblet/geometry_error.hpp"
 #include "fiblet/output_file.hpp"
 #include "fiblet/resample.hpp"
 #include "fiblet/select.hpp"

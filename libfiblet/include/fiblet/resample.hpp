@@ -15,6 +15,18 @@ namespace fiblet {
 // first). A streamline shorter than one step keeps only its first point.
 void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out);
 
+// A dropped tail shorter than this fraction of the step is not kept
+// (0.1 µm at a 0.1 mm step: far below the codec's error).
+inline constexpr double kKeptTailFraction = 1e-3;
+
+// The points the codec aims at for a resampled streamline: those of
+// resample_fixed_step, then the input's last point itself when the dropped
+// tail is longer than kKeptTailFraction of the step (straight-line distance),
+// so the streamline ends where its input does (formats/fft-ends.md).
+// Returns whether that end point was appended (the last segment is then
+// shorter than the step).
+bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out);
+
 // Distance from a point to a polyline (a single point is a degenerate
 // polyline), in the units of the inputs: the exact minimum over all segments.
 double distance_to_polyline(Vec3f p, std::span<const Vec3f> polyline);

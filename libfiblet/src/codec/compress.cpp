@@ -14,6 +14,7 @@
 #include <thread>
 #include <utility>
 
+#include "codec/fiber_end_encoder.hpp"
 #include "codec/parameters.hpp"
 #include "core/streamline_label.hpp"
 #include "core/thread_count.hpp"
@@ -22,6 +23,7 @@
 #include "io/fft_sink.hpp"
 #include "fiblet/encode.hpp"
 #include "fiblet/error.hpp"
+#include "fiblet/fiber_ends.hpp"
 #include "fiblet/output_file.hpp"
 #include "fiblet/resample.hpp"
 #include "fiblet/tck.hpp"
@@ -206,9 +208,12 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
                 throw Error(Errc::unsupported, tck_path + ": " + detail::streamline_label(f) + " (" +
                                                    std::to_string(fiber_length) + " mm) needs more than 65535 blocks at a " +
                                                    std::to_string(step) + " mm step");
-            resample_fixed_step(fiber, step, resampled);
+            const bool short_tail = resample_keeping_end(fiber, step, resampled);
             fiber_points[f++] = std::uint32_t(resampled.size());
-            turns.add_fiber(resampled);
+            // The turn towards a kept end is one step per fiber, often a
+            // noisy short one: left out of the turn statistics, so the cap
+            // (sized for the whole-step turns) stays as fine as before.
+            turns.add_fiber(std::span<const Vec3f>(resampled).first(resampled.size() - short_tail));
             for (std::size_t i = 1; i < fiber.size(); ++i)
                 scan.off_step_segments += std::fabs(length(fiber[i - 1], fiber[i]) - step) > tol * step;
             if ((f & 1023) == 0) report_progress(options, "resample-scan", reader);
@@ -268,10 +273,14 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     reader.rewind();
     // Batches of whole fibers are read in order, encoded by `threads`
     // workers on contiguous sub-ranges, and written in order.
+    // Resampled fibers keep their true end points: one last-step fraction
+    // per fiber (the ENDS chunk, formats/fft-ends.md), 2 bytes a fiber.
+    FiberEndFractions end_fractions(report.resampled ? scan.fibers : 0, kWholeLastStep);
     struct Work {
         std::vector<std::uint8_t> blocks;
-        std::vector<Vec3f> decoded, resampled;
-        ErrorStats error, error_vs_original;
+        std::vector<Vec3f> decoded, resampled, scratch;
+        ErrorStats error;
+        GeometryError geometry;  // both ways against the input polylines
         IndexBuilder index;  // bounds of this worker's blocks (the BIDX chunk)
     };
     std::vector<Work> work(threads);
@@ -284,21 +293,19 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         for (std::size_t i = begin; i < end; ++i) {
             const std::vector<Vec3f>& original = batch[i];
             std::span<const Vec3f> points = original;
-            if (report.resampled) {
-                resample_fixed_step(original, step, w.resampled);
-                points = w.resampled;
-            }
             const auto f = std::uint32_t(first_fiber + i);
             w.decoded.clear();
-            encoder.encode(points, f, w.blocks, &w.decoded);
-            if (options.block_index) w.index.add_fiber(w.decoded);
-            std::size_t hint = 0;
-            const std::size_t window = 16 + 2 * original.size() / std::max<std::size_t>(points.size(), 1);
-            for (std::size_t k = 0; k < points.size(); ++k) {
-                w.error.add(length(points[k], w.decoded[k]), f);
-                if (report.resampled)
-                    w.error_vs_original.add(distance_to_polyline_near(w.decoded[k], original, hint, window), f);
+            if (report.resampled) {
+                const bool short_tail = resample_keeping_end(original, step, w.resampled);
+                points = w.resampled;
+                end_fractions[f] = detail::encode_keeping_end(encoder, points, short_tail, step, f, w.blocks,
+                                                              w.decoded, w.scratch);
+            } else {
+                encoder.encode(points, f, w.blocks, &w.decoded);
             }
+            if (options.block_index) w.index.add_fiber(w.decoded);
+            for (std::size_t k = 0; k < points.size(); ++k) w.error.add(length(points[k], w.decoded[k]), f);
+            w.geometry.add_fiber(original, w.decoded, f);
         }
     };
     const std::size_t kBatchPoints = std::size_t(threads) << 16;  // ~0.8 MB of points per thread: stays in cache
@@ -330,7 +337,8 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         next_fiber += std::uint32_t(n);
         report_progress(options, "encode", reader);
     }
-    for (const Work& w : work) report.error.merge(w.error), report.error_vs_original.merge(w.error_vs_original);
+    for (const Work& w : work) report.error.merge(w.error), report.geometry.merge(w.geometry);
+    if (report.resampled) report.error_vs_original = report.geometry.decoded_to_input();
     h.max_error_mm = float(report.error.max_mm());
     h.mean_error_mm = float(report.error.mean_mm());
     const auto final_head = serialize_fft_header(h);
@@ -342,6 +350,8 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             TrailerChunk c{kResampledTag, std::vector<std::uint8_t>(8)};
             std::memcpy(c.payload.data(), &step, 8);
             chunks.push_back(std::move(c));
+            chunks.push_back(make_fiber_ends_chunk(end_fractions));
+            FiberEndFractions().swap(end_fractions);
         }
         // The builder goes as soon as its chunk is made (its codes are larger than the chunk).
         if (options.block_index)

@@ -56,6 +56,15 @@ void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec
     }
 }
 
+bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out) {
+    resample_fixed_step(in, step, out);
+    if (in.size() < 2) return false;
+    const V3 tail = sub(to_v3(in.back()), to_v3(out.back()));
+    if (!(std::sqrt(dot(tail, tail)) > kKeptTailFraction * step)) return false;
+    out.push_back(in.back());
+    return true;
+}
+
 double distance_to_polyline_near(Vec3f p, std::span<const Vec3f> line, std::size_t& hint, std::size_t window) {
     if (line.empty()) return std::numeric_limits<double>::infinity();
     const V3 q = to_v3(p);

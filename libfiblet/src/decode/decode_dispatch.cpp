@@ -86,13 +86,24 @@ const char* level_name(SimdLevel s) {
 
 namespace {
 
-std::size_t decode_direct(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count, float* xyz,
+std::size_t decode_kernel(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count, float* xyz,
                           Decoder d) {
+    if (ctx.header.direction_bits() == 16) return decode_blocks_scalar16(ctx, blocks, count, xyz);
     switch (d.kind) {
         case DecoderKind::lanes: return kernels(d.simd).lanes(ctx, blocks, count, xyz);
         case DecoderKind::warp: return kernels(d.simd).warp(ctx, blocks, count, xyz);
         default: return decode_blocks_scalar(ctx, blocks, count, xyz);
     }
+}
+
+// Every decode of a file's blocks goes through here: the kernel, then the
+// fibers' last-step fractions (fiblet/fiber_ends.hpp), while the points are
+// still in cache.
+std::size_t decode_direct(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count, float* xyz,
+                          Decoder d) {
+    const std::size_t n = decode_kernel(ctx, blocks, count, xyz, d);
+    if (ctx.end_fractions) apply_fiber_ends(ctx.header, *ctx.end_fractions, blocks, count, xyz);
+    return n;
 }
 
 #ifdef __SSE2__
@@ -118,7 +129,7 @@ void stream_copy(float* dst, const float* src, std::size_t n) {
 std::size_t detail::decode_resolved(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count,
                                     float* xyz, Decoder d) {
     // 16-bit files (formats/fft16.md) have only the scalar decoder.
-    if (ctx.header.direction_bits() == 16) return decode_blocks_scalar16(ctx, blocks, count, xyz);
+    if (ctx.header.direction_bits() == 16) return decode_direct(ctx, blocks, count, xyz, d);
 #ifdef __SSE2__
     // Output far larger than the caches: written straight to memory, each
     // cache line is first read (write-allocate), doubling the traffic of a

@@ -23,7 +23,7 @@ public:
 
     ChunkDecoder(const FftFile& file, const DecodeOptions& options)
         : file_(file),
-          ctx_(file.header()),
+          ctx_(file),
           decoder_(resolve_decoder(options.decoder)),
           threads_(detail::resolve_threads(options.threads)),
           chunk_blocks_(options.chunk_blocks ? options.chunk_blocks : kBlocksPerThread * threads_) {}
@@ -150,15 +150,21 @@ void decode_file(const FftFile& file, const std::function<void(std::uint64_t, co
     // Room for a usual chunk up front: growing would copy it.
     chunk.xyz.reserve(3 * std::min<std::uint64_t>(chunks.chunk_blocks(), file.header().blocks) *
                       file.header().points_per_block);
+    std::uint64_t points = 0;
     for (std::uint64_t f = 0; f < fibers;) {
         const std::uint64_t e = chunks.chunk_end(f, fibers);
         const std::uint64_t n = chunks.load(f, e);
+        points += n;
         chunk.xyz.resize(3 * n);
         chunk.offsets.resize(e - f + 1);
         chunks.decode(chunk.xyz.data(), chunk.offsets.data(), 0);
         sink(f, chunk);
         f = e;
     }
+    // A whole-file reader reports the header's count: it must be what it wrote.
+    if (points != file.header().points)
+        throw Error(Errc::fft_format, file.path() + ": not a valid .fft file: the blocks hold " + std::to_string(points) +
+                                          " points, the header says " + std::to_string(file.header().points));
 }
 
 }  // namespace fiblet

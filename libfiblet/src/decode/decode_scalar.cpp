@@ -22,6 +22,10 @@ DecodeContext::DecodeContext(const FftHeader& h) : header(h), table(h.ratio) {
     }
 }
 
+DecodeContext::DecodeContext(const FftFile& file) : DecodeContext(file.header()) {
+    end_fractions = file.end_fractions();
+}
+
 std::size_t count_block_points(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count) {
     const std::uint32_t bb = ctx.header.block_bytes();
     std::size_t total = 0;

@@ -13,15 +13,14 @@ using detail::put_le;
 FftChecksums FftChecksums::parse(const TrailerChunk& chunk, std::uint64_t blocks, const std::string& name) {
     const auto& p = chunk.payload;
     auto bad = [&](const std::string& what) {
-        throw Error(Errc::fft_format, name + ": not a valid .fft file: malformed CSUM chunk: " + what);
+        throw Error(Errc::checksum, name + ": damaged CSUM chunk: " + what);
     };
     if (p.size() < kChecksumFixedBytes) bad("only " + std::to_string(p.size()) + " bytes");
     FftChecksums s;
     s.algorithm = get_le<std::uint32_t>(&p[0]);
     s.group_blocks = get_le<std::uint32_t>(&p[4]);
     if (s.algorithm != kChecksumXxh64)
-        throw Error(Errc::unsupported, name + ": unknown checksum algorithm " + std::to_string(s.algorithm) +
-                                           " in the CSUM chunk (fiblet knows 1 = XXH64)");
+        bad("unknown checksum algorithm " + std::to_string(s.algorithm) + " (fiblet knows 1 = XXH64)");
     if (s.group_blocks == 0) bad("zero blocks per group");
     s.header_hash = get_le<std::uint64_t>(&p[8]);
     s.lut_hash = get_le<std::uint64_t>(&p[16]);

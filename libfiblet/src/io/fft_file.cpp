@@ -14,6 +14,7 @@
 
 #include "core/bytes.hpp"
 #include "fiblet/error.hpp"
+#include "io/fft_trailer.hpp"
 #include "io/fftz_reader.hpp"
 #include "io/open_inputs.hpp"
 
@@ -121,17 +122,7 @@ FftFile::FftFile(const std::string& path, FftOpenOptions options)
         if (fftz_) fftz_->check_layout(header_);
         std::uint64_t lut_hash = 0;
         read_lut(lut_hash);
-        read_trailer();
-        // Structure first, then integrity: a file that is malformed is
-        // reported as such (fft_format) even when a checksum also fails.
-        if (const TrailerChunk* c = find_chunk(kChecksumTag))
-            checksums_ = FftChecksums::parse(*c, header_.blocks, path_);
-        if (verifies_checksums()) {
-            verify_open_checksums(std::span(head).first(std::size_t(header_.lut_offset())), lut_hash);
-            const std::uint64_t words = (checksums_->group_hashes.size() + 63) / 64;
-            verified_groups_ = std::make_unique<std::atomic<std::uint64_t>[]>(words);
-            for (std::uint64_t i = 0; i < words; ++i) verified_groups_[i].store(0, std::memory_order_relaxed);
-        }
+        if (!options_.ignore_trailer) open_trailer(std::span(head).first(std::size_t(header_.lut_offset())), lut_hash);
     } catch (...) {
         close();
         throw;
@@ -142,6 +133,11 @@ FftFile::FftFile(const std::string& path, FftOpenOptions options)
 // memory), hashing its bytes for the checksum check.
 void FftFile::read_lut(std::uint64_t& lut_hash) {
     constexpr std::uint64_t kSliceEntries = 1u << 16;
+    // A plain file holds its LUT (the size was checked against the file's);
+    // a .fftz's LUT frame is decompressed once first, in bounded memory, so
+    // that a frame claiming more than it holds fails before the claim is
+    // allocated.
+    if (fftz_) fftz_->check_lut_content();
     lut_.resize(header_.fibers);
     fiber_first_block_.resize(header_.fibers);
     std::vector<std::uint8_t> raw;
@@ -182,39 +178,26 @@ void FftFile::read_at(std::uint8_t* out, std::uint64_t size, std::uint64_t offse
     else pread_all(fd_, out, size, offset, path_);
 }
 
-void FftFile::read_trailer() {
-    const std::uint64_t end = header_.file_bytes();
-    if (logical_size_ < end + kTrailerFooterBytes) return;  // no trailer: a plain version-2 file
-    std::uint8_t footer[kTrailerFooterBytes];
-    read_at(footer, sizeof footer, logical_size_ - sizeof footer);
-    if (std::memcmp(footer + 8, kTrailerMagic, 8) != 0) return;  // foreign trailing bytes: ignored
-    if (get_le<std::uint64_t>(footer) != end) bad(path_, "trailer does not start after the last block");
-    has_trailer_ = true;
-    // Chunks fiblet reads are loaded whole (up to a bound that keeps memory
-    // in check); unknown large ones are skipped.
-    constexpr std::uint64_t kMaxKnownChunk = 64u << 20, kMaxUnknownChunk = 16u << 20;
-    std::uint64_t pos = end;
-    const std::uint64_t stop = logical_size_ - kTrailerFooterBytes;
-    while (pos < stop) {
-        std::uint8_t head[16];
-        if (stop - pos < sizeof head) bad(path_, "truncated trailer chunk header");
-        read_at(head, sizeof head, pos);
-        const std::uint64_t size = get_le<std::uint64_t>(head + 8);
-        if (size > stop - pos - sizeof head) bad(path_, "trailer chunk runs past the footer");
-        TrailerChunk chunk;
-        std::memcpy(chunk.tag.data(), head, 4);
-        const bool known = chunk.tag == kPropertiesTag || chunk.tag == kResampledTag || chunk.tag == kChecksumTag;
-        if (known && size > kMaxKnownChunk)
-            bad(path_, "trailer chunk " + std::string(chunk.tag.data(), 4) + " of " + std::to_string(size) +
-                           " bytes (at most " + std::to_string(kMaxKnownChunk) + ")");
-        if (known || size <= kMaxUnknownChunk) {
-            if (chunk.tag == kChecksumTag && checksum_chunk_offset_ == 0) checksum_chunk_offset_ = pos;  // the one find_chunk() gives
-            chunk.payload.resize(size);
-            read_at(chunk.payload.data(), size, pos + sizeof head);
-            trailer_.push_back(std::move(chunk));
-        }
-        pos += sizeof head + size;
+// The trailer in three stages: its chunks (a damaged trailer is an integrity
+// failure), the checksums of everything read so far, then the values of the
+// chunks, so that damage the checksums cover is reported as damage.
+void FftFile::open_trailer(std::span<const std::uint8_t> head, std::uint64_t lut_hash) {
+    detail::TrailerChunks t = detail::read_trailer_chunks(
+        [this](std::uint8_t* out, std::uint64_t size, std::uint64_t offset) { read_at(out, size, offset); },
+        header_.file_bytes(), logical_size_, header_.fibers, path_);
+    trailer_ = std::move(t.chunks);
+    checksum_chunk_offset_ = t.checksum_chunk_at;
+    if (const TrailerChunk* c = find_chunk(kChecksumTag)) checksums_ = FftChecksums::parse(*c, header_.blocks, path_);
+    if (verifies_checksums()) {
+        verify_open_checksums(head, lut_hash);
+        const std::uint64_t words = (checksums_->group_hashes.size() + 63) / 64;
+        verified_groups_ = std::make_unique<std::atomic<std::uint64_t>[]>(words);
+        for (std::uint64_t i = 0; i < words; ++i) verified_groups_[i].store(0, std::memory_order_relaxed);
     }
+    detail::TrailerValues values = detail::validate_trailer_chunks(trailer_, header_, path_);
+    properties_ = std::move(values.properties);
+    resampled_step_mm_ = values.resampled_step_mm;
+    end_fractions_ = std::move(values.end_fractions);
 }
 
 void FftFile::verify_open_checksums(std::span<const std::uint8_t> head, std::uint64_t lut_hash) const {
@@ -242,29 +225,6 @@ const TrailerChunk* FftFile::find_chunk(std::array<char, 4> tag) const {
     return nullptr;
 }
 
-std::vector<std::pair<std::string, std::string>> FftFile::properties() const {
-    std::vector<std::pair<std::string, std::string>> props;
-    const TrailerChunk* c = find_chunk(kPropertiesTag);
-    if (!c) return props;
-    // Pairs of length-prefixed strings: u32 size, bytes (key, then value).
-    const auto& p = c->payload;
-    std::size_t pos = 0;
-    auto next_string = [&](std::string& s) {
-        if (p.size() - pos < 4) return false;
-        const std::uint32_t n = get_le<std::uint32_t>(&p[pos]);
-        if (p.size() - pos - 4 < n) return false;
-        s.assign(reinterpret_cast<const char*>(&p[pos + 4]), n);
-        pos += 4 + n;
-        return true;
-    };
-    std::string key, value;
-    while (pos < p.size()) {
-        if (!next_string(key) || !next_string(value)) bad(path_, "malformed PROP chunk");
-        props.emplace_back(key, value);
-    }
-    return props;
-}
-
 void FftFile::close() noexcept {
     fftz_.reset();
     if (fd_ >= 0) ::close(fd_);
@@ -287,10 +247,12 @@ FftFile& FftFile::operator=(FftFile&& o) noexcept {
         header_ = std::move(o.header_);
         lut_ = std::move(o.lut_);
         fiber_first_block_ = std::move(o.fiber_first_block_);
-        has_trailer_ = o.has_trailer_;
         trailer_ = std::move(o.trailer_);
+        properties_ = std::move(o.properties_);
+        resampled_step_mm_ = o.resampled_step_mm_;
         checksum_chunk_offset_ = o.checksum_chunk_offset_;
         checksums_ = std::move(o.checksums_);
+        end_fractions_ = std::move(o.end_fractions_);
         verified_groups_ = std::move(o.verified_groups_);
         mapping_ = std::move(o.mapping_);
         input_ = std::move(o.input_);
@@ -330,6 +292,12 @@ void FftFile::check_block_structure(std::uint64_t first, std::uint64_t count, co
                            std::to_string(header_.points_per_block) + ")");
         if (v.first != (k == 0) || v.last != (k + 1 == blocks_in_fiber))
             bad(path_, where() + " has first/last flags inconsistent with the fiber LUT");
+        // A block moved within or across fibers keeps its own identity bytes.
+        if (v.fiber_id != std::uint32_t(f))  // IDs are u32: fibers past 2^32 wrap
+            bad(path_, where() + " carries fiber ID " + std::to_string(v.fiber_id) + " (moved or damaged block)");
+        if (v.index_in_fiber && *v.index_in_fiber != k % 256)
+            bad(path_, where() + " carries block index " + std::to_string(*v.index_in_fiber) +
+                           " (moved or damaged block)");
     }
 }
 

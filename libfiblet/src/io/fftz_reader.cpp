@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <memory>
+#include <new>
 
 #include "core/bytes.hpp"
 #include "fiblet/error.hpp"
@@ -109,25 +111,119 @@ void FftzReader::check_layout(const FftHeader& h) {
     cached_ = SIZE_MAX;  // a group frame read with the header was not untransposed yet
 }
 
+// One frame decompressed as a stream: its stored bytes are read a slice at
+// a time and its content produced on demand. Damage (a zstd error, a content
+// checksum mismatch, content shorter or longer than the seek table says, or
+// bytes after the frame) is an integrity failure.
+class FftzReader::FrameStream {
+public:
+    FrameStream(const FftzReader& r, std::size_t index)
+        : r_(r), index_(index), frame_(r.frames_[index]), ds_(ZSTD_createDStream()) {
+        if (!ds_) throw std::bad_alloc();
+        ZSTD_initDStream(ds_);
+    }
+    ~FrameStream() { ZSTD_freeDStream(ds_); }
+    FrameStream(const FrameStream&) = delete;
+    FrameStream& operator=(const FrameStream&) = delete;
+
+    std::size_t index() const { return index_; }
+    std::uint64_t position() const { return produced_; }
+
+    // Fills out[0, size) with the next bytes of the frame's content.
+    void read(std::uint8_t* out, std::uint64_t size) {
+        if (size > frame_.logical_size - produced_) damaged("content continues past its size in the seek table");
+        ZSTD_outBuffer o{out, std::size_t(size), 0};
+        while (o.pos < o.size) {
+            if (in_.pos == in_.size) refill();
+            const std::size_t rc = ZSTD_decompressStream(ds_, &o, &in_);
+            if (ZSTD_isError(rc)) damaged(ZSTD_getErrorName(rc));
+            ended_ = rc == 0;
+            if (ended_ && o.pos < o.size) damaged("content shorter than its size in the seek table");
+        }
+        produced_ += size;
+    }
+    // After the last byte: the frame must end here, and so must its stored bytes.
+    void finish() {
+        std::uint8_t extra;
+        ZSTD_outBuffer o{&extra, 1, 0};
+        while (!ended_) {
+            if (in_.pos == in_.size && consumed_ < frame_.stored_size) refill();
+            const std::size_t rc = ZSTD_decompressStream(ds_, &o, &in_);
+            if (ZSTD_isError(rc)) damaged(ZSTD_getErrorName(rc));
+            if (o.pos > 0) damaged("content longer than its size in the seek table");
+            ended_ = rc == 0;
+            if (!ended_ && in_.pos == in_.size && consumed_ == frame_.stored_size) damaged("truncated frame");
+        }
+        if (in_.pos != in_.size || consumed_ != frame_.stored_size) damaged("bytes after the end of the zstd frame");
+    }
+
+private:
+    [[noreturn]] void damaged(const std::string& what) const {
+        throw Error(Errc::checksum, r_.name_ + ": damaged .fftz frame " + std::to_string(index_) + ": " + what);
+    }
+    void refill() {
+        if (consumed_ == frame_.stored_size) damaged("truncated frame");
+        buffer_.resize(std::size_t(std::min<std::uint64_t>(1u << 17, frame_.stored_size - consumed_)));
+        pread_exact(r_.fd_, buffer_.data(), buffer_.size(), frame_.stored_at + consumed_, r_.name_);
+        consumed_ += buffer_.size();
+        in_ = {buffer_.data(), buffer_.size(), 0};
+    }
+
+    const FftzReader& r_;
+    std::size_t index_;
+    Frame frame_;
+    ZSTD_DStream* ds_;
+    std::vector<std::uint8_t> buffer_;
+    ZSTD_inBuffer in_{nullptr, 0, 0};
+    std::uint64_t consumed_ = 0, produced_ = 0;
+    bool ended_ = false;  // the zstd frame (and its content checksum) is complete
+};
+
+FftzReader::~FftzReader() = default;
+
 const std::vector<std::uint8_t>& FftzReader::frame_bytes(std::size_t index) const {
     if (cached_ == index) return cache_;
     const Frame& f = frames_[index];
-    std::vector<std::uint8_t> stored(f.stored_size);
-    pread_exact(fd_, stored.data(), stored.size(), f.stored_at, name_);
-    std::vector<std::uint8_t> out(f.logical_size);
-    const std::size_t n = ZSTD_decompress(out.data(), out.size(), stored.data(), stored.size());
-    // The seek table and frame headers were validated at open: a frame whose
-    // content does not decompress (or fails zstd's content checksum) to the
-    // size they give is damaged data, an integrity failure like a CSUM mismatch.
-    if (ZSTD_isError(n) || n != f.logical_size)
-        throw Error(Errc::checksum, name_ + ": frame " + std::to_string(index) + " is corrupted (zstd: " +
-                                        (ZSTD_isError(n) ? ZSTD_getErrorName(n) : "wrong decompressed size") + ")");
+    // Grown as the content really arrives: a frame that claims far more
+    // than it holds fails before the claim is allocated.
+    FrameStream stream(*this, index);
+    std::vector<std::uint8_t> out;
+    while (out.size() < f.logical_size) {
+        const std::size_t at = out.size();
+        out.resize(std::size_t(std::min<std::uint64_t>(f.logical_size, std::max<std::uint64_t>(2 * at, 1u << 16))));
+        stream.read(out.data() + at, out.size() - at);
+    }
+    stream.finish();
     const bool group = layout_checked_ && index >= first_group_ && index < first_group_ + groups_;
     if (group && descriptor_.layout == FftzLayout::transposed)
         out = untranspose_block_group(out, direction_bits_, block_bytes_);
     cache_ = std::move(out);
     cached_ = index;
     return cache_;
+}
+
+void FftzReader::read_streamed(std::size_t index, std::uint64_t at, std::uint8_t* out, std::uint64_t size) const {
+    if (!stream_ || stream_->index() != index || stream_->position() > at)
+        stream_ = std::make_unique<FrameStream>(*this, index);
+    std::vector<std::uint8_t> skip;
+    while (stream_->position() < at) {
+        skip.resize(std::size_t(std::min<std::uint64_t>(at - stream_->position(), 1u << 20)));
+        stream_->read(skip.data(), skip.size());
+    }
+    stream_->read(out, size);
+    if (stream_->position() == frames_[index].logical_size) stream_->finish(), stream_.reset();
+}
+
+void FftzReader::check_lut_content() const {
+    std::lock_guard lock(mutex_);
+    FrameStream stream(*this, kLutFrame);
+    std::vector<std::uint8_t> scratch(1u << 20);
+    for (std::uint64_t left = frames_[kLutFrame].logical_size; left > 0;) {
+        const std::uint64_t n = std::min<std::uint64_t>(left, scratch.size());
+        stream.read(scratch.data(), n);
+        left -= n;
+    }
+    stream.finish();
 }
 
 void FftzReader::read(std::uint8_t* out, std::uint64_t size, std::uint64_t offset) const {
@@ -143,10 +239,18 @@ void FftzReader::read(std::uint8_t* out, std::uint64_t size, std::uint64_t offse
             ++it;
             continue;
         }
-        const auto& bytes = frame_bytes(std::size_t(it - frames_.begin()));
+        const auto index = std::size_t(it - frames_.begin());
         const std::uint64_t in_frame = offset - it->logical_at;
         const std::uint64_t n = std::min(size, it->logical_size - in_frame);
-        std::memcpy(out, bytes.data() + in_frame, n);
+        // The LUT is read once, in order, by the FftFile that opens this:
+        // streamed, it costs no copy; block groups are untransposed whole.
+        const bool group = index >= first_group_ && index < first_group_ + groups_;
+        if (index == kLutFrame || (it->logical_size > kMaxCachedFrame && !group)) {
+            read_streamed(index, in_frame, out, n);
+        } else {
+            const auto& bytes = frame_bytes(index);
+            std::memcpy(out, bytes.data() + in_frame, n);
+        }
         out += n, size -= n, offset += n;
         ++it;
     }

@@ -1,9 +1,13 @@
 // Internal: random access to the logical .fft bytes of a .fftz container
 // (formats/fftz.md). Every size read from the file is checked before it is
-// trusted; frames are decompressed on demand (the last one is cached).
+// trusted; frames are decompressed on demand as streams, so memory follows
+// what a frame really holds, never what the seek table claims: frames up to
+// kMaxCachedFrame are decompressed whole (the last one is cached); the LUT
+// and larger frames are read through in order without a copy.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -13,6 +17,9 @@
 
 namespace fiblet::detail {
 
+inline constexpr std::uint64_t kMaxCachedFrame = 64u << 20;
+inline constexpr std::size_t kLutFrame = 2;  // frames: descriptor, header, LUT, block groups, [trailer]
+
 class FftzReader {
 public:
     // True when the file starts with the FFTZ descriptor frame.
@@ -20,6 +27,7 @@ public:
 
     // Reads the seek table and the descriptor; throws Error{fft_format}.
     FftzReader(int fd, std::uint64_t file_size, std::string name);
+    ~FftzReader();
 
     std::uint64_t logical_size() const { return logical_size_; }
     const FftzDescriptor& descriptor() const { return descriptor_; }
@@ -27,6 +35,11 @@ public:
     // Checks the frames against the parsed header (header, LUT, one frame
     // per group of blocks, trailer) and enables reading blocks.
     void check_layout(const FftHeader& header);
+
+    // Decompresses the LUT frame once, in bounded memory, so that its size is
+    // known to be real before a reader allocates for it. Throws
+    // Error{checksum} when it holds other than it claims.
+    void check_lut_content() const;
 
     // Logical bytes [offset, offset + size).
     void read(std::uint8_t* out, std::uint64_t size, std::uint64_t offset) const;
@@ -36,7 +49,10 @@ private:
         std::uint64_t stored_at, stored_size;  // in the file
         std::uint64_t logical_at, logical_size;
     };
+    class FrameStream;
     const std::vector<std::uint8_t>& frame_bytes(std::size_t index) const;  // call with mutex_ held
+    // Bytes [at, at + size) of a large frame, from a stream kept between calls.
+    void read_streamed(std::size_t index, std::uint64_t at, std::uint8_t* out, std::uint64_t size) const;
 
     int fd_;
     std::string name_;
@@ -52,6 +68,7 @@ private:
     mutable std::mutex mutex_;
     mutable std::size_t cached_ = SIZE_MAX;
     mutable std::vector<std::uint8_t> cache_;
+    mutable std::unique_ptr<FrameStream> stream_;  // read_streamed()'s, positioned where it stopped
 };
 
 }  // namespace fiblet::detail

@@ -33,6 +33,19 @@ void place_block(const FftHeader& h, std::uint8_t* b, std::uint32_t id, std::uin
     b[kBlockIndexOffset] = std::uint8_t(k);  // modulo 256, as the format stores it
 }
 
+// The kept fibers' last-step fractions: a run that stops before its fiber's
+// last block ends on a whole step (its last block was a middle one).
+TrailerChunk subset_end_fractions(const FftFile& source, const std::vector<SelectedRun>& runs) {
+    const FiberEndFractions& src = *source.end_fractions();
+    FiberEndFractions kept(runs.size(), kWholeLastStep);
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+        const SelectedRun& r = runs[i];
+        if (r.first_block + r.block_count == source.first_block(r.fiber) + source.block_count(r.fiber))
+            kept[i] = src[r.fiber];
+    }
+    return make_fiber_ends_chunk(kept);
+}
+
 }  // namespace
 
 SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedRun>& runs, const std::string& path,
@@ -75,7 +88,7 @@ SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedR
         out.write(lut.data(), lut.size() * sizeof(FiberLutEntry));
         checksum.add_lut(lut.data(), lut.size() * sizeof(FiberLutEntry));
     }
-    const DecodeContext ctx(src);
+    const DecodeContext ctx(source);
     const std::uint32_t bb = h.block_bytes();
     IndexBuilder index(h);
     std::vector<std::uint8_t> raw;
@@ -105,6 +118,7 @@ SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedR
         std::vector<TrailerChunk> chunks;
         for (const auto tag : {kPropertiesTag, kResampledTag})
             if (const TrailerChunk* c = source.find_chunk(tag)) chunks.push_back(*c);
+        if (source.end_fractions()) chunks.push_back(subset_end_fractions(source, runs));
         if (auto bidx = index.finish()) chunks.push_back(std::move(*bidx));
         chunks.push_back(checksum.finish(head, chunks));  // last: it covers the chunks before it
         const auto trailer = serialize_trailer(chunks, at);

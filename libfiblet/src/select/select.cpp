@@ -271,7 +271,7 @@ private:
 class Selector {
 public:
     Selector(const FftFile& file, const BlockIndex& index, const Query& q, const SelectOptions& o)
-        : file_(file), index_(index), q_(q), options_(o), h_(file.header()), ctx_(h_), reader_(file, o.map_file),
+        : file_(file), index_(index), q_(q), options_(o), h_(file.header()), ctx_(file), reader_(file, o.map_file),
           // A stored index describes the blocks as written: trusted to say a
           // block lies wholly inside a region only when the checksums tie it
           // to the blocks read (a damaged block read unverified may be elsewhere).

@@ -14,6 +14,8 @@
 
 namespace fiblet {
 
+static_assert(sizeof(Vec3f) == 3 * sizeof(float), "decoded xyz arrays are read as Vec3f");
+
 Comparison compare_to_reference(const FftFile& fft, const std::string& tck_path, bool allow_count_mismatch,
                                 const std::function<void(double)>& progress) {
     Comparison c;
@@ -22,11 +24,9 @@ Comparison compare_to_reference(const FftFile& fft, const std::string& tck_path,
     struct stat st {};
     if (::stat(tck_path.c_str(), &st) == 0) c.reference_bytes = std::uint64_t(st.st_size);
 
-    double step = 0;
-    if (const TrailerChunk* r = fft.find_chunk(kResampledTag); r && r->payload.size() == 8) {
-        c.resampled = true;
-        std::memcpy(&step, r->payload.data(), 8);
-    }
+    const double step = fft.resampled_step_mm().value_or(0);  // validated at open: finite, > 0
+    c.resampled = fft.resampled_step_mm().has_value();
+    const bool keeps_ends = fft.end_fractions() != nullptr;
     TckReader ref(tck_path, {.allow_count_mismatch = allow_count_mismatch});
     std::vector<Vec3f> original, resampled;
     auto mismatch = [&](const std::string& what) {
@@ -38,27 +38,28 @@ Comparison compare_to_reference(const FftFile& fft, const std::string& tck_path,
             if (!ref.next(original)) mismatch("it has only " + std::to_string(fiber) + " streamlines");
             std::span<const Vec3f> target = original;
             if (c.resampled) {
-                resample_fixed_step(original, step, resampled);
+                // Files with an ENDS chunk keep each fiber's end point; older
+                // ones dropped the tail shorter than a step.
+                if (keeps_ends) resample_keeping_end(original, step, resampled);
+                else resample_fixed_step(original, step, resampled);
                 target = resampled;
             }
             const std::uint64_t n = chunk.offsets[i + 1] - chunk.offsets[i];
             if (target.size() != n)
                 mismatch(detail::streamline_label(fiber) + " has " + std::to_string(target.size()) +
                          " points, the decoded fiber " + std::to_string(n));
-            const float* p = &chunk.xyz[3 * chunk.offsets[i]];
-            std::size_t hint = 0;
-            const std::size_t window = 16 + 2 * original.size() / std::max<std::size_t>(n, 1);
-            for (std::size_t k = 0; k < n; ++k, p += 3) {
-                const double dx = double(p[0]) - target[k].x, dy = double(p[1]) - target[k].y,
-                             dz = double(p[2]) - target[k].z;
+            const std::span<const Vec3f> decoded{reinterpret_cast<const Vec3f*>(&chunk.xyz[3 * chunk.offsets[i]]), n};
+            for (std::size_t k = 0; k < n; ++k) {
+                const double dx = double(decoded[k].x) - target[k].x, dy = double(decoded[k].y) - target[k].y,
+                             dz = double(decoded[k].z) - target[k].z;
                 c.error.add(std::sqrt(dx * dx + dy * dy + dz * dz), fiber);
-                if (c.resampled)
-                    c.error_vs_original.add(distance_to_polyline_near({p[0], p[1], p[2]}, original, hint, window), fiber);
             }
+            c.geometry.add_fiber(original, decoded, fiber);
         }
         if (progress && h.fibers) progress(double(first + chunk.size()) / double(h.fibers));
     });
     if (ref.next(original)) mismatch("it has more than " + std::to_string(h.fibers) + " streamlines");
+    if (c.resampled) c.error_vs_original = c.geometry.decoded_to_input();
     return c;
 }
 

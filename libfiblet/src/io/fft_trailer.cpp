@@ -1,0 +1,151 @@
+#include "io/fft_trailer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "core/bytes.hpp"
+#include "fiblet/block_index.hpp"
+#include "fiblet/checksum.hpp"
+#include "fiblet/error.hpp"
+#include "select/index_chunk.hpp"
+
+namespace fiblet::detail {
+
+namespace {
+
+std::string tag_name(const std::array<char, 4>& tag) {
+    std::string s;
+    for (char c : tag) s += (c >= 0x20 && c < 0x7f) ? c : '?';
+    return s;
+}
+
+// Chunks fiblet reads are loaded whole up to a bound that keeps memory in
+// check (a BIDX chunk costs ~4 bytes a block: 64 MiB is 16 M blocks; ENDS
+// holds 2 bytes a fiber, its bound grows with the fiber count); unknown
+// chunks above 16 MiB are skipped (they are still covered by the trailer hash).
+constexpr std::uint64_t kMaxKnownChunk = 64u << 20, kMaxUnknownChunk = 16u << 20;
+
+bool is_known(const std::array<char, 4>& tag) {
+    return tag == kPropertiesTag || tag == kResampledTag || tag == kChecksumTag || tag == kBlockIndexTag ||
+           tag == kFiberEndsTag;
+}
+
+std::uint64_t max_known_size(const std::array<char, 4>& tag, std::uint64_t fibers) {
+    return tag == kFiberEndsTag ? std::max(kMaxKnownChunk, 2 * fibers) : kMaxKnownChunk;
+}
+
+}  // namespace
+
+TrailerChunks read_trailer_chunks(const ReadAt& read_at, std::uint64_t end, std::uint64_t logical_size,
+                                  std::uint64_t fibers, const std::string& name) {
+    TrailerChunks t;
+    if (logical_size <= end) return t;  // nothing after the blocks: an official-encoder file
+    auto damaged = [&](const std::string& what) {
+        throw Error(Errc::checksum, name + ": damaged trailer: " + what +
+                                        " (the bytes after the last block are not a complete fiblet trailer;"
+                                        " --ignore-trailer reads the blocks without it)");
+    };
+    if (logical_size - end < kTrailerFooterBytes)
+        damaged(std::to_string(logical_size - end) + " bytes after the last block, too few for a footer");
+    std::uint8_t footer[kTrailerFooterBytes];
+    read_at(footer, sizeof footer, logical_size - sizeof footer);
+    if (std::memcmp(footer + 8, kTrailerMagic, 8) != 0) damaged("no FIBLETX1 footer at the end of the file");
+    if (get_le<std::uint64_t>(footer) != end)
+        damaged("the footer says the trailer starts at byte " + std::to_string(get_le<std::uint64_t>(footer)) +
+                ", the blocks end at byte " + std::to_string(end));
+    const std::uint64_t stop = logical_size - kTrailerFooterBytes;
+    for (std::uint64_t pos = end; pos < stop;) {
+        std::uint8_t head[16];
+        if (stop - pos < sizeof head) damaged("truncated chunk header at byte " + std::to_string(pos));
+        read_at(head, sizeof head, pos);
+        TrailerChunk chunk;
+        std::memcpy(chunk.tag.data(), head, 4);
+        const std::uint32_t flags = get_le<std::uint32_t>(head + 4);
+        const std::uint64_t size = get_le<std::uint64_t>(head + 8);
+        const std::string what = "chunk " + tag_name(chunk.tag) + " at byte " + std::to_string(pos);
+        if (flags != 0) damaged(what + " has flags " + std::to_string(flags) + " (0 expected)");
+        if (size > stop - pos - sizeof head) damaged(what + " runs past the footer");
+        if (t.checksum_chunk_at != 0) damaged(what + " follows the CSUM chunk (which must be last)");
+        const bool known = is_known(chunk.tag);
+        if (known && size > max_known_size(chunk.tag, fibers))
+            damaged(what + " of " + std::to_string(size) + " bytes (at most " +
+                    std::to_string(max_known_size(chunk.tag, fibers)) + ")");
+        if (chunk.tag == kChecksumTag) t.checksum_chunk_at = pos;
+        if (known || size <= kMaxUnknownChunk) {
+            chunk.payload.resize(size);
+            read_at(chunk.payload.data(), size, pos + sizeof head);
+            t.chunks.push_back(std::move(chunk));
+        }
+        pos += sizeof head + size;
+    }
+    if (t.checksum_chunk_at == 0) damaged("no CSUM chunk (every fiblet trailer ends with one)");
+    return t;
+}
+
+namespace {
+
+[[noreturn]] void bad_chunk(const std::string& name, const std::array<char, 4>& tag, const std::string& what) {
+    throw Error(Errc::fft_format, name + ": not a valid .fft file: " + tag_name(tag) + " chunk: " + what);
+}
+
+// PROP: (key, value) string pairs that a .tck header can hold and give back.
+std::vector<std::pair<std::string, std::string>> parse_properties(const TrailerChunk& c, const std::string& name) {
+    const auto& p = c.payload;
+    std::size_t pos = 0;
+    auto next_string = [&](const char* which) {
+        if (p.size() - pos < 4) bad_chunk(name, c.tag, std::string("truncated ") + which + " length");
+        const std::uint32_t n = get_le<std::uint32_t>(&p[pos]);
+        if (p.size() - pos - 4 < n) bad_chunk(name, c.tag, std::string(which) + " runs past the chunk");
+        std::string s(reinterpret_cast<const char*>(&p[pos + 4]), n);
+        pos += 4 + std::size_t{n};
+        if (s.find('\0') != std::string::npos) bad_chunk(name, c.tag, std::string(which) + " holds a NUL byte");
+        return s;
+    };
+    std::vector<std::pair<std::string, std::string>> props;
+    while (pos < p.size()) {
+        std::string key = next_string("key");
+        if (key.find_first_of(":\n") != std::string::npos)
+            bad_chunk(name, c.tag, "key \"" + key + "\" holds ':' or a line break (no .tck header can)");
+        props.emplace_back(std::move(key), next_string("value"));
+    }
+    return props;
+}
+
+// RSMP: the step (mm) variable-step input was resampled to. The header's
+// step is that step times the decoder step scale, which compress bounds to
+// (0.5, 2); a step of 0 or NaN would make a comparison resample forever.
+double parse_resampled_step(const TrailerChunk& c, const FftHeader& h, const std::string& name) {
+    if (c.payload.size() != 8) bad_chunk(name, c.tag, std::to_string(c.payload.size()) + " bytes (8 expected)");
+    double step;
+    std::memcpy(&step, c.payload.data(), 8);
+    if (!(std::isfinite(step) && step > 0)) bad_chunk(name, c.tag, "step is not a positive finite number");
+    const double header_step_mm = double(h.step) * double(h.scaling);
+    if (!(step >= header_step_mm * 0.499 && step <= header_step_mm * 2.001))
+        bad_chunk(name, c.tag,
+                  "step " + std::to_string(step) + " mm disagrees with the header's " +
+                      std::to_string(header_step_mm) + " mm");
+    return step;
+}
+
+}  // namespace
+
+TrailerValues validate_trailer_chunks(const std::vector<TrailerChunk>& chunks, const FftHeader& header,
+                                      const std::string& name) {
+    TrailerValues v;
+    std::vector<std::array<char, 4>> seen;
+    for (const TrailerChunk& c : chunks) {
+        if (!is_known(c.tag)) continue;
+        for (const auto& s : seen)
+            if (s == c.tag) bad_chunk(name, c.tag, "appears more than once");
+        seen.push_back(c.tag);
+        if (c.tag == kPropertiesTag) v.properties = parse_properties(c, name);
+        else if (c.tag == kResampledTag) v.resampled_step_mm = parse_resampled_step(c, header, name);
+        else if (c.tag == kBlockIndexTag) (void)parse_index_chunk(c.payload, header, name);
+        else if (c.tag == kFiberEndsTag)
+            v.end_fractions = std::make_shared<const FiberEndFractions>(parse_fiber_ends_chunk(c, header.fibers, name));
+    }
+    return v;
+}
+
+}  // namespace fiblet::detail

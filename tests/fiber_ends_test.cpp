@@ -1,0 +1,311 @@
+// Fibers end where their input does (the ENDS chunk, formats/fft-ends.md):
+// endpoints and lengths of decoded fibers checked against the input .tck for
+// fixed-step input with a short last segment, variable spacing from 0.01 to
+// 10 mm, one- and two-point fibers, loops and a 10^5-point fiber; every
+// decoder and selection path; what a reader ignoring the chunk sees.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "fiblet/block_index.hpp"
+#include "fiblet/compress.hpp"
+#include "fiblet/decode.hpp"
+#include "fiblet/error.hpp"
+#include "fiblet/fiber_ends.hpp"
+#include "fiblet/fft_subset.hpp"
+#include "fiblet/select.hpp"
+#include "fiblet/tck.hpp"
+#include "test_util.hpp"
+
+namespace fiblet {
+namespace {
+
+using Fiber = std::vector<Vec3f>;
+
+double dist(Vec3f a, Vec3f b) {
+    const double dx = double(a.x) - b.x, dy = double(a.y) - b.y, dz = double(a.z) - b.z;
+    return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+double length_of(const Fiber& f) {
+    double l = 0;
+    for (std::size_t i = 1; i < f.size(); ++i) l += dist(f[i - 1], f[i]);
+    return l;
+}
+
+Fiber fiber_of(const Streamlines& s, std::size_t i) {
+    Fiber f;
+    for (std::uint64_t k = s.offsets[i]; k < s.offsets[i + 1]; ++k)
+        f.push_back({s.xyz[3 * k], s.xyz[3 * k + 1], s.xyz[3 * k + 2]});
+    return f;
+}
+
+// A smooth curve (a slow helix) sampled at the given arc-length increments.
+Fiber helix(const std::vector<double>& increments, Vec3f origin = {0, 0, 0}, double radius = 15, double pitch = 0.3) {
+    Fiber f;
+    double s = 0;
+    auto at = [&](double arc) {
+        const double t = arc / radius;
+        return Vec3f{float(origin.x + radius * std::cos(t)), float(origin.y + radius * std::sin(t)),
+                     float(origin.z + pitch * arc)};
+    };
+    f.push_back(at(0));
+    for (double d : increments) f.push_back(at(s += d));
+    return f;
+}
+
+struct Encoded {
+    CompressReport report;
+    Streamlines decoded;
+};
+
+Encoded encode(const test::TempDir& dir, const std::vector<Fiber>& fibers, CompressOptions o = {}) {
+    {
+        TckWriter w(dir.file("in.tck"), {}, true);
+        for (const Fiber& f : fibers) w.write(f);
+        w.finish();
+    }
+    o.overwrite = true;
+    Encoded e;
+    e.report = compress_tck(dir.file("in.tck"), dir.file("out.fft"), o);
+    const FftFile file(dir.file("out.fft"));
+    e.decoded = decode_fibers(file, 0, file.header().fibers);
+    return e;
+}
+
+// Every fiber starts and ends within the recorded error of its input, and
+// its length is the input's to well under one step.
+void expect_ends_and_lengths(const std::vector<Fiber>& in, const Encoded& e, double length_tolerance_steps = 0.1) {
+    ASSERT_EQ(e.decoded.size(), in.size());
+    const double bound = double(e.report.header.max_error_mm) * (1 + 1e-6) + 1e-7;
+    ASSERT_LT(bound, 0.5 * e.report.step_mm) << "the codec error itself is out of range";
+    for (std::size_t i = 0; i < in.size(); ++i) {
+        const Fiber d = fiber_of(e.decoded, i);
+        if (in[i].empty()) {
+            EXPECT_TRUE(d.empty());
+            continue;
+        }
+        ASSERT_FALSE(d.empty()) << "fiber " << i;
+        EXPECT_LE(dist(d.front(), in[i].front()), bound) << "start of fiber " << i;
+        EXPECT_LE(dist(d.back(), in[i].back()), bound) << "end of fiber " << i << " (" << in[i].size() << " points)";
+        EXPECT_LE(std::fabs(length_of(d) - length_of(in[i])), length_tolerance_steps * e.report.step_mm)
+            << "length of fiber " << i;
+    }
+}
+
+TEST(FiberEnds, FixedStepInputWithShortLastSegment) {
+    test::TempDir dir;
+    std::vector<Fiber> fibers;
+    for (int k = 0; k < 12; ++k) {
+        std::vector<double> inc(150 + 7 * k, 0.1);
+        inc.push_back(0.01 + 0.008 * k);  // the tracker stopped mid-step
+        fibers.push_back(helix(inc, {float(k), 0, 0}));
+    }
+    const Encoded e = encode(dir, fibers);
+    EXPECT_TRUE(e.report.resampled);
+    expect_ends_and_lengths(fibers, e);
+}
+
+TEST(FiberEnds, VariableSpacingFrom0_01To10Millimetres) {
+    test::TempDir dir;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> log_spacing(std::log(0.01), std::log(10.0));
+    std::vector<Fiber> fibers;
+    for (int k = 0; k < 40; ++k) {
+        std::vector<double> inc(5 + k % 30);
+        for (double& d : inc) d = std::exp(log_spacing(rng));
+        fibers.push_back(helix(inc, {0, float(k), 0}, 40));
+    }
+    CompressOptions o;
+    o.step_mm = 0.5;  // the median of such spacings means little: fix the step
+    const Encoded e = encode(dir, fibers, o);
+    EXPECT_TRUE(e.report.resampled);
+    // Chords of 0.5 mm cut the input's corners a little: lengths within a fifth of a step.
+    expect_ends_and_lengths(fibers, e, 0.2);
+}
+
+TEST(FiberEnds, OneAndTwoPointFibers) {
+    test::TempDir dir;
+    std::vector<Fiber> fibers{{{1, 2, 3}},
+                              {{0, 0, 0}, {0.03f, 0.01f, 0}},        // shorter than a step
+                              {{0, 0, 0}, {3, 4, 0}},                // several steps, straight
+                              {{5, 5, 5}, {5, 5, 5}},                // zero length
+                              {},                                    // empty
+                              helix(std::vector<double>(30, 0.25))};  // a regular one
+    fibers.back().push_back({fibers.back().back().x + 0.02f, fibers.back().back().y, fibers.back().back().z});
+    CompressOptions o;
+    o.step_mm = 0.25;
+    // The helix's segments (0.26 mm) are longer than the step: the chords cut its corners a little.
+    expect_ends_and_lengths(fibers, encode(dir, fibers, o), 0.2);
+}
+
+TEST(FiberEnds, LoopsThatComeBackToTheirStart) {
+    test::TempDir dir;
+    std::vector<Fiber> fibers;
+    for (int k = 0; k < 6; ++k) {
+        const double r = 2.0 + k;
+        Fiber f;
+        const int n = 40 + 13 * k;
+        for (int i = 0; i <= n; ++i) {  // one turn and a bit: the end passes the start
+            const double t = 2 * M_PI * (1.07 * i / n);
+            f.push_back({float(r * std::cos(t)), float(r * std::sin(t)), float(0.02 * i)});
+        }
+        fibers.push_back(f);
+    }
+    CompressOptions o;
+    o.step_mm = 0.2;
+    expect_ends_and_lengths(fibers, encode(dir, fibers, o), 0.2);
+}
+
+TEST(FiberEnds, AHundredThousandPointFiber) {
+    test::TempDir dir;
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> spacing(0.05, 0.15);
+    std::vector<double> inc(100000 - 1);
+    for (double& d : inc) d = spacing(rng);
+    std::vector<Fiber> fibers{helix(inc, {0, 0, 0}, 30, 0.002)};  // 53 turns in a 60 mm box
+    CompressOptions o;
+    o.step_mm = 0.1;
+    const Encoded e = encode(dir, fibers, o);
+    ASSERT_GT(e.decoded.point_count(), 90000u);
+    expect_ends_and_lengths(fibers, e);
+}
+
+// The last block of a resampled fiber holds 1, 2, 3 ... 60 points: the end is
+// an anchor (1-2 points) or direction-coded and placed by the fraction.
+TEST(FiberEnds, EveryLastBlockSize) {
+    test::TempDir dir;
+    std::vector<Fiber> fibers;
+    for (int k = 1; k <= 125; ++k) {
+        std::vector<double> inc(std::size_t(k), 0.1);
+        inc.back() = 0.037;
+        fibers.push_back(helix(inc, {0, 0, float(k)}));
+    }
+    const Encoded e = encode(dir, fibers);
+    expect_ends_and_lengths(fibers, e);
+}
+
+// All decoders, the whole-file decode and the selection give the same ends.
+TEST(FiberEnds, EveryDecodePathPlacesTheEnd) {
+    test::TempDir dir;
+    std::vector<Fiber> fibers;
+    for (int k = 0; k < 30; ++k) {
+        std::vector<double> inc(40 + 11 * k, 0.1);
+        inc.back() = 0.02 + 0.002 * k;
+        fibers.push_back(helix(inc, {float(k), 0, 0}));
+    }
+    const Encoded e = encode(dir, fibers);
+    const FftFile file(dir.file("out.fft"));
+    ASSERT_TRUE(file.end_fractions());
+    const double bound = double(e.report.header.max_error_mm) * (1 + 1e-6) + 1e-6;
+    auto check = [&](const Streamlines& s, const std::string& how) {
+        ASSERT_EQ(s.size(), fibers.size()) << how;
+        for (std::size_t i = 0; i < fibers.size(); ++i)
+            EXPECT_LE(dist(fiber_of(s, i).back(), fibers[i].back()), bound) << how << ", fiber " << i;
+    };
+    for (const std::string& name : available_decoders()) {
+        DecodeOptions o;
+        o.decoder = parse_decoder(name);
+        check(decode_fibers(file, 0, fibers.size(), o), name);
+    }
+    Streamlines whole;
+    decode_file(file, [&](std::uint64_t first, const Streamlines& chunk) {
+        for (std::size_t i = 0; i < chunk.size(); ++i) {
+            for (std::uint64_t k = chunk.offsets[i]; k < chunk.offsets[i + 1]; ++k)
+                whole.xyz.insert(whole.xyz.end(), &chunk.xyz[3 * k], &chunk.xyz[3 * k + 3]);
+            whole.offsets.push_back(whole.xyz.size() / 3);
+        }
+        (void)first;
+    });
+    check(whole, "decode_file");
+    check(select_streamlines(file, BlockIndex::load(file), Query{}), "select_streamlines");
+}
+
+// A subset written as a .fft keeps the fractions of the fibers it keeps
+// whole, and ends a fiber cut before its last block on a whole step.
+TEST(FiberEnds, SubsetFilesCarryTheFractionsOfTheirFibers) {
+    test::TempDir dir;
+    std::vector<Fiber> fibers;
+    for (int k = 0; k < 8; ++k) {
+        std::vector<double> inc(100 + 9 * k, 0.1);
+        inc.back() = 0.03 + 0.005 * k;
+        fibers.push_back(helix(inc, {float(k), 0, 0}));
+    }
+    const Encoded e = encode(dir, fibers);
+    const FftFile file(dir.file("out.fft"));
+    std::vector<SelectedRun> runs;
+    for (std::uint64_t f = 7; f-- > 0;) runs.push_back({f, file.first_block(f), file.block_count(f), 0});
+    runs.push_back({7, file.first_block(7), 1, 0});  // fiber 7 cut after its first block
+    write_fft_subset(file, runs, dir.file("subset.fft"), true);
+    const FftFile subset(dir.file("subset.fft"));
+    ASSERT_TRUE(subset.end_fractions());
+    const Streamlines s = decode_fibers(subset, 0, subset.header().fibers);
+    for (std::size_t i = 0; i < 7; ++i) {
+        const Fiber got = fiber_of(s, i), want = fiber_of(e.decoded, runs[i].fiber);
+        ASSERT_EQ(got.size(), want.size());
+        EXPECT_EQ(got.back(), want.back()) << "fiber " << runs[i].fiber;
+    }
+    const Fiber cut = fiber_of(s, 7), whole = fiber_of(e.decoded, 7);
+    ASSERT_EQ(cut.size(), 60u);
+    EXPECT_EQ(cut.back(), whole[59]);  // a middle block's last point: no fraction
+    EXPECT_EQ((*subset.end_fractions())[7], kWholeLastStep);
+}
+
+// What a reader that ignores the chunk (the official decoder) sees: the last
+// point one whole step from the one before, on the way to the true end.
+TEST(FiberEnds, ReadersIgnoringTheChunkSeeAtMostOneStepMore) {
+    test::TempDir dir;
+    std::vector<Fiber> fibers;
+    for (int k = 0; k < 20; ++k) {
+        std::vector<double> inc(70 + 3 * k, 0.1);
+        inc.back() = 0.005 * (k + 1);
+        fibers.push_back(helix(inc, {float(k), 0, 0}));
+    }
+    const Encoded e = encode(dir, fibers);
+    const FftFile file(dir.file("out.fft"));
+    const DecodeContext raw(file.header());  // no fractions: the blocks as they decode
+    const auto blocks = file.read_blocks(0, file.header().blocks);
+    std::vector<float> xyz(3 * count_block_points(raw, blocks.data(), file.header().blocks));
+    decode_blocks(raw, blocks.data(), file.header().blocks, xyz.data());
+    const double err = double(e.report.header.max_error_mm) + 1e-6, step = e.report.step_mm * e.report.step_scale;
+    std::size_t coded_ends = 0;
+    for (std::size_t i = 0; i < fibers.size(); ++i) {
+        const std::uint64_t last = e.decoded.offsets[i + 1] - 1;
+        const std::uint64_t n = last + 1 - e.decoded.offsets[i];
+        const Vec3f stored{xyz[3 * last], xyz[3 * last + 1], xyz[3 * last + 2]};
+        if ((n - 1) % file.header().points_per_block + 1 <= 2) {  // the end is an anchor: exact for everyone
+            EXPECT_LE(dist(stored, fibers[i].back()), err) << "fiber " << i;
+            continue;
+        }
+        ++coded_ends;
+        const Vec3f seen{xyz[3 * last], xyz[3 * last + 1], xyz[3 * last + 2]};
+        const Vec3f prev{xyz[3 * last - 3], xyz[3 * last - 2], xyz[3 * last - 1]};
+        EXPECT_LE(dist(seen, fibers[i].back()), step - dist(prev, fibers[i].back()) + 2 * err) << "fiber " << i;
+        EXPECT_GT(dist(seen, fibers[i].back()), 0.5 * (0.1 - 0.005 * (i + 1))) << "fiber " << i;
+    }
+    EXPECT_GT(coded_ends, 10u);
+}
+
+TEST(FiberEnds, FixedStepFilesCarryNoChunk) {
+    test::TempDir dir;
+    std::vector<Fiber> fibers{helix(std::vector<double>(200, 0.1)), helix(std::vector<double>(61, 0.1), {1, 1, 1})};
+    const Encoded e = encode(dir, fibers);
+    EXPECT_FALSE(e.report.resampled);
+    EXPECT_FALSE(FftFile(dir.file("out.fft")).end_fractions());
+    expect_ends_and_lengths(fibers, e);
+}
+
+TEST(FiberEnds, ChunkOfTheWrongSizeIsRejected) {
+    const TrailerChunk c = make_fiber_ends_chunk(std::vector<std::uint16_t>{1, 2, 3});
+    EXPECT_EQ(parse_fiber_ends_chunk(c, 3, "f").size(), 3u);
+    EXPECT_THROW(parse_fiber_ends_chunk(c, 4, "f"), Error);
+    EXPECT_EQ(quantize_end_fraction(2.0), kWholeLastStep);
+    EXPECT_EQ(quantize_end_fraction(-1.0), 0);
+    const Vec3f p = place_end_point({0, 0, 0}, {2, 0, 0}, quantize_end_fraction(0.25));
+    EXPECT_NEAR(p.x, 0.5, 1e-4);
+}
+
+}  // namespace
+}  // namespace fiblet

@@ -1,0 +1,154 @@
+// GeometryError (the symmetric metrics of compress / stats / Python) against
+// a brute-force O(n·m) implementation written here, independently of the
+// library: every point against every segment of the other polyline.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "fiblet/geometry_error.hpp"
+
+namespace fiblet {
+namespace {
+
+using Line = std::vector<Vec3f>;
+
+// Closest distance from p to segment [a, b], by projection, in long double.
+long double brute_segment(Vec3f p, Vec3f a, Vec3f b) {
+    const long double ux = (long double)b.x - a.x, uy = (long double)b.y - a.y, uz = (long double)b.z - a.z;
+    const long double wx = (long double)p.x - a.x, wy = (long double)p.y - a.y, wz = (long double)p.z - a.z;
+    const long double uu = ux * ux + uy * uy + uz * uz;
+    long double t = uu > 0 ? (wx * ux + wy * uy + wz * uz) / uu : 0;
+    t = std::clamp<long double>(t, 0, 1);
+    const long double dx = wx - t * ux, dy = wy - t * uy, dz = wz - t * uz;
+    return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+long double brute_to_line(Vec3f p, const Line& l) {
+    if (l.size() == 1) return brute_segment(p, l[0], l[0]);
+    long double best = INFINITY;
+    for (std::size_t s = 0; s + 1 < l.size(); ++s) best = std::min(best, brute_segment(p, l[s], l[s + 1]));
+    return best;
+}
+
+struct Brute {
+    long double max_di = 0, sum_di = 0, max_id = 0, sum_id = 0, end_max = 0, end_sum = 0, len_max = 0, len_sum = 0;
+    std::size_t n_di = 0, n_id = 0, fibers = 0;
+};
+
+long double brute_length(const Line& l) {
+    long double s = 0;
+    for (std::size_t i = 1; i < l.size(); ++i) s += brute_segment(l[i], l[i - 1], l[i - 1]);
+    return s;
+}
+
+void brute_add(Brute& b, const Line& in, const Line& dec) {
+    for (Vec3f p : dec) {
+        const long double d = brute_to_line(p, in);
+        b.max_di = std::max(b.max_di, d), b.sum_di += d, ++b.n_di;
+    }
+    for (Vec3f p : in) {
+        const long double d = brute_to_line(p, dec);
+        b.max_id = std::max(b.max_id, d), b.sum_id += d, ++b.n_id;
+    }
+    const long double e0 = brute_segment(in.front(), dec.front(), dec.front());
+    const long double e1 = brute_segment(in.back(), dec.back(), dec.back());
+    b.end_max = std::max({b.end_max, e0, e1}), b.end_sum += e0 + e1;
+    const long double dl = std::fabs(brute_length(dec) - brute_length(in));
+    b.len_max = std::max(b.len_max, dl), b.len_sum += dl;
+    ++b.fibers;
+}
+
+// A wiggly curve, optionally looping back over itself, sampled every `step`.
+Line curve(int points, double step, double loop_radius, std::mt19937& rng, double noise) {
+    std::normal_distribution<double> n(0, noise);
+    Line l;
+    for (int i = 0; i < points; ++i) {
+        const double s = i * step;
+        const double t = loop_radius > 0 ? s / loop_radius : 0;
+        l.push_back({float((loop_radius > 0 ? loop_radius * std::cos(t) : s) + n(rng)),
+                     float((loop_radius > 0 ? loop_radius * std::sin(t) : std::sin(s)) + n(rng)), float(0.05 * s + n(rng))});
+    }
+    return l;
+}
+
+void expect_matches_brute(const std::vector<std::pair<Line, Line>>& pairs) {
+    GeometryError g;
+    Brute b;
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+        g.add_fiber(pairs[i].first, pairs[i].second, i);
+        brute_add(b, pairs[i].first, pairs[i].second);
+    }
+    const double tol = 1e-9;
+    EXPECT_NEAR(g.decoded_to_input().max_mm(), double(b.max_di), tol);
+    EXPECT_NEAR(g.decoded_to_input().mean_mm(), double(b.sum_di / b.n_di), tol);
+    EXPECT_NEAR(g.input_to_decoded().max_mm(), double(b.max_id), tol);
+    EXPECT_NEAR(g.input_to_decoded().mean_mm(), double(b.sum_id / b.n_id), tol);
+    EXPECT_NEAR(g.hausdorff_mm(), double(std::max(b.max_di, b.max_id)), tol);
+    EXPECT_NEAR(g.endpoint_mm().max, double(b.end_max), tol);
+    EXPECT_NEAR(g.endpoint_mm().mean(), double(b.end_sum / (2 * b.fibers)), tol);
+    EXPECT_NEAR(g.length_change_mm().max, double(b.len_max), 1e-7);
+    EXPECT_NEAR(g.length_change_mm().mean(), double(b.len_sum / b.fibers), 1e-7);
+}
+
+TEST(GeometryError, MatchesBruteForceOnPerturbedResampledCurves) {
+    std::mt19937 rng(11);
+    std::vector<std::pair<Line, Line>> pairs;
+    for (int k = 0; k < 20; ++k) {
+        const Line in = curve(30 + k * 7, 0.1 * (1 + k % 3), 0, rng, 0);
+        Line dec = curve(int(in.size()) * (1 + k % 4), 0.1 * (1 + k % 3) / (1 + k % 4), 0, rng, 0.003);
+        pairs.emplace_back(in, dec);
+    }
+    expect_matches_brute(pairs);
+}
+
+TEST(GeometryError, MatchesBruteForceOnLoopsAndSparseInput) {
+    std::mt19937 rng(5);
+    std::vector<std::pair<Line, Line>> pairs;
+    for (int k = 0; k < 8; ++k) {
+        // 1.3 turns of a circle: the end passes near the start.
+        const double r = 1 + k;
+        const int dense = int(1.3 * 2 * M_PI * r / 0.1);
+        Line in = curve(dense / 20 + 2, 0.1 * double(dense) / double(dense / 20 + 1), r, rng, 0);  // sparse input
+        Line dec = curve(dense, 0.1, r, rng, 0.002);
+        pairs.emplace_back(in, dec);
+    }
+    expect_matches_brute(pairs);
+}
+
+TEST(GeometryError, ADroppedTailCountsOneWayOnly) {
+    Line in, dec;
+    for (int i = 0; i <= 100; ++i) in.push_back({float(0.1 * i), 0, 0});
+    for (int i = 0; i <= 90; ++i) dec.push_back({float(0.1 * i), 0, 0});
+    GeometryError g;
+    g.add_fiber(in, dec, 0);
+    EXPECT_NEAR(g.decoded_to_input().max_mm(), 0.0, 1e-6);  // what the old metric saw
+    EXPECT_NEAR(g.input_to_decoded().max_mm(), 1.0, 1e-5);
+    EXPECT_NEAR(g.hausdorff_mm(), 1.0, 1e-5);
+    EXPECT_NEAR(g.endpoint_mm().max, 1.0, 1e-5);
+    EXPECT_NEAR(g.length_change_mm().max, 1.0, 1e-5);
+    EXPECT_NEAR(g.length_change_percent().max, 10.0, 1e-3);
+    EXPECT_NEAR(g.mean_length_change_mm(), -1.0, 1e-5);
+    EXPECT_NEAR(g.worst_mm(), 1.0, 1e-5);
+}
+
+TEST(GeometryError, MergeEqualsOneAccumulator) {
+    std::mt19937 rng(2);
+    GeometryError all, a, b;
+    for (int k = 0; k < 10; ++k) {
+        const Line in = curve(50, 0.1, 0, rng, 0), dec = curve(50, 0.1, 0, rng, 0.01);
+        all.add_fiber(in, dec, k);
+        (k % 2 ? a : b).add_fiber(in, dec, k);
+    }
+    a.merge(b);
+    EXPECT_DOUBLE_EQ(a.hausdorff_mm(), all.hausdorff_mm());
+    EXPECT_EQ(a.hausdorff_fiber(), all.hausdorff_fiber());
+    EXPECT_NEAR(a.input_to_decoded().mean_mm(), all.input_to_decoded().mean_mm(), 1e-15);
+    EXPECT_DOUBLE_EQ(a.endpoint_mm().max, all.endpoint_mm().max);
+    EXPECT_NEAR(a.length_change_mm().mean(), all.length_change_mm().mean(), 1e-15);
+}
+
+}  // namespace
+}  // namespace fiblet
