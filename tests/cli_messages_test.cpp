@@ -142,3 +142,21 @@ TEST(CliMessages, ANonFiniteDecodeBlamesTheInput) {
     EXPECT_FALSE(mentions(r, "out.tck")) << r.output;
     EXPECT_FALSE(fs::exists(dir.file("out.tck")));
 }
+
+TEST(CliMessages, AFlippedChecksumAlgorithmIsAnIntegrityFailure) {
+    test::TempDir dir;
+    test::write_three_fiber_tck(dir.file("in.tck"));
+    ASSERT_EQ(test::run_cli("compress -q " + dir.file("in.tck") + " -o " + dir.file("in.fft")).status, 0);
+    const std::string bytes = test::read_file(dir.file("in.fft"));
+    const std::size_t tag = bytes.rfind("CSUM");
+    ASSERT_NE(tag, std::string::npos);
+    for (unsigned char bit : {0x01, 0x02, 0x80}) {  // the algorithm's low byte: 1 (XXH64) becomes 0, 3, 129
+        std::string damaged = bytes;
+        damaged[tag + 16] = char(damaged[tag + 16] ^ bit);
+        test::write_file(dir.file("bad.fft"), damaged);
+        for (const std::string& cmd : {"verify -q ", "info "}) {
+            const auto r = test::run_cli(cmd + dir.file("bad.fft"));
+            EXPECT_EQ(r.status, 7) << cmd << int(bit) << "\n" << r.output;
+        }
+    }
+}
