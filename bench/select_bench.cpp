@@ -156,17 +156,31 @@ void BM_SelectFullDecode(benchmark::State& state) {
 }
 BENCHMARK(BM_SelectFullDecode)->Arg(0)->Arg(65536)->Unit(benchmark::kMillisecond);
 
-void BM_SelectQuery(benchmark::State& state, Family family) {
+void select_query(benchmark::State& state, Family family, const SelectOptions& options) {
     const Query q = query_keeping(family, int(state.range(0)));
     SelectionStats stats;
     for (auto _ : state) {
         std::uint64_t points = 0;
-        stats = select(*bench_file().file, *bench_file().index, q,
-                       [&](const SelectedChunk& c) { points += c.point_count(); });
+        stats = select(
+            *bench_file().file, *bench_file().index, q, [&](const SelectedChunk& c) { points += c.point_count(); },
+            options);
         benchmark::DoNotOptimize(points);
     }
     report(state, stats);
 }
+
+// The default: blocks read with pread (safe when the file is truncated).
+void BM_SelectQuery(benchmark::State& state, Family family) { select_query(state, family, {}); }
+
+// The same through the memory mapping (SelectOptions::map_file): what the
+// default gives up for robustness (docs/select.md).
+void BM_SelectQueryMapped(benchmark::State& state, Family family) {
+    SelectOptions o;
+    o.map_file = true;
+    select_query(state, family, o);
+}
+BENCHMARK_CAPTURE(BM_SelectQueryMapped, RegionBlocks, Family::region_blocks)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SelectQueryMapped, RandomFibers, Family::random_fibers)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SelectQuery, RegionBlocks, Family::region_blocks)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SelectQuery, RegionFibers, Family::region_fibers)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SelectQuery, Frustum, Family::frustum)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);

@@ -509,15 +509,15 @@ TEST_F(TckReaderData, MissingEndMarker) {
 
 TEST_F(TckReaderData, NaNOrInfInsideACoordinate) {
     const std::string end = f32({kNaN, kNaN, kNaN, kInf, kInf, kInf});
-    const std::string first = f32({0, 0, 0, kNaN, kNaN, kNaN});  // so the bad one is streamline 2
-    expect_bad(first + f32({1, kNaN, 3}) + end, {"NaN/Inf inside a coordinate at streamline 2"});
-    expect_bad(first + f32({kNaN, 2, 3}) + end, {"NaN/Inf inside a coordinate at streamline 2"});
+    const std::string first = f32({0, 0, 0, kNaN, kNaN, kNaN});  // so the bad one is streamline 1 (0-based)
+    expect_bad(first + f32({1, kNaN, 3}) + end, {"NaN/Inf inside a coordinate at streamline 1 (0-based)"});
+    expect_bad(first + f32({kNaN, 2, 3}) + end, {"NaN/Inf inside a coordinate at streamline 1 (0-based)"});
     expect_bad(first + f32({kNaN, kNaN, 3}) + end, {"NaN/Inf inside a coordinate"});
     expect_bad(first + f32({1, 2, kInf}) + end, {"NaN/Inf inside a coordinate"});
     expect_bad(first + f32({kInf, kInf, 3}) + end, {"NaN/Inf inside a coordinate"});
     expect_bad(first + f32({kInf, kNaN, kInf}) + end, {"NaN/Inf inside a coordinate"});
     const double n = std::numeric_limits<double>::quiet_NaN();
-    expect_bad(f64({1, n, 3, n, n, n}, true), {"NaN/Inf inside a coordinate at streamline 1"}, "Float64BE");
+    expect_bad(f64({1, n, 3, n, n, n}, true), {"NaN/Inf inside a coordinate at streamline 0 (0-based)"}, "Float64BE");
 }
 
 TEST_F(TckReaderData, CountMismatch) {

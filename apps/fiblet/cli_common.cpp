@@ -35,7 +35,7 @@ const std::vector<ExitCodeInfo>& exit_code_table() {
         {kChecksum, "integrity check failed"},
         {kErrorBound, "a measured error (point, Hausdorff, endpoint or length change) exceeds --max-error; "
                       "the report is printed and outputs are kept"},
-        {130, "interrupted by SIGINT (128 + signal number for other signals); no partial output is left"},
+        {130, "interrupted by SIGINT (128 + signal number for other signals, e.g. 153 for SIGXFSZ); no partial output is left"},
     };
     return table;
 }
@@ -57,6 +57,16 @@ void Progress::done() {
     last_permille_ = -1;
 }
 
+void write_decoded_fiber(TckWriter& writer, const float* xyz, std::uint64_t n, const std::string& input,
+                         std::uint64_t fiber) {
+    for (std::uint64_t i = 0; i < 3 * n; ++i)
+        if (!std::isfinite(xyz[i]))
+            throw Error(Errc::invalid_input, input + ": fiber " + std::to_string(fiber) +
+                                                 " (0-based) decodes to a non-finite coordinate: the file is damaged or "
+                                                 "was not written by a fiblet encoder");
+    writer.write(xyz, std::size_t(n));
+}
+
 std::string human_bytes(std::uint64_t b) {
     if (b < 10000) return fmt::format("{} B", b);
     if (b < 1'000'000) return fmt::format("{:.1f} kB", b / 1e3);
@@ -73,9 +83,48 @@ std::string micrometres_value(double mm, int decimals) {
 
 std::string micrometres(double mm, int decimals) { return micrometres_value(mm, decimals) + " µm"; }
 
+namespace {
+
+// Length of the well-formed UTF-8 sequence at s[i] (RFC 3629: shortest form,
+// no surrogates, at most U+10FFFF), or 0 if the bytes there are not one.
+std::size_t utf8_sequence_length(const std::string& s, std::size_t i) {
+    const auto byte = [&](std::size_t k) { return k < s.size() ? static_cast<unsigned char>(s[k]) : 0u; };
+    const unsigned b0 = byte(i);
+    const auto cont = [&](std::size_t k) { return (byte(k) & 0xC0u) == 0x80u; };
+    if (b0 < 0x80) return 1;
+    if (b0 >= 0xC2 && b0 <= 0xDF) return cont(i + 1) ? 2 : 0;
+    if (b0 >= 0xE0 && b0 <= 0xEF) {
+        const unsigned b1 = byte(i + 1);
+        const bool ok1 = b0 == 0xE0 ? (b1 >= 0xA0 && b1 <= 0xBF) : b0 == 0xED ? (b1 >= 0x80 && b1 <= 0x9F) : cont(i + 1);
+        return ok1 && cont(i + 2) ? 3 : 0;
+    }
+    if (b0 >= 0xF0 && b0 <= 0xF4) {
+        const unsigned b1 = byte(i + 1);
+        const bool ok1 = b0 == 0xF0 ? (b1 >= 0x90 && b1 <= 0xBF) : b0 == 0xF4 ? (b1 >= 0x80 && b1 <= 0x8F) : cont(i + 1);
+        return ok1 && cont(i + 2) && cont(i + 3) ? 4 : 0;
+    }
+    return 0;
+}
+
+}  // namespace
+
+// Strings come from files (header properties, names) and may hold any
+// bytes: invalid UTF-8 becomes U+FFFD, so the output is always valid JSON.
 std::string json_quote(const std::string& s) {
     std::string out = "\"";
-    for (unsigned char ch : s) {
+    for (std::size_t i = 0; i < s.size();) {
+        const unsigned char ch = static_cast<unsigned char>(s[i]);
+        const std::size_t n = utf8_sequence_length(s, i);
+        if (n == 0) {
+            out += "\\ufffd";
+            ++i;
+            continue;
+        }
+        if (n > 1) {
+            out.append(s, i, n);
+            i += n;
+            continue;
+        }
         switch (ch) {
             case '"': out += "\\\""; break;
             case '\\': out += "\\\\"; break;
@@ -83,9 +132,10 @@ std::string json_quote(const std::string& s) {
             case '\t': out += "\\t"; break;
             case '\r': out += "\\r"; break;
             default:
-                if (ch < 0x20) out += fmt::format("\\u{:04x}", ch);
+                if (ch < 0x20 || ch == 0x7f) out += fmt::format("\\u{:04x}", ch);
                 else out += char(ch);
         }
+        ++i;
     }
     return out + "\"";
 }

@@ -9,6 +9,7 @@
 
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
+#include "fiblet/tck.hpp"
 
 namespace fiblet::cli {
 
@@ -54,6 +55,12 @@ std::string human_bytes(std::uint64_t bytes);
 std::string micrometres(double mm, int decimals = 2);
 // The same number without its unit (for tables whose heading gives it).
 std::string micrometres_value(double mm, int decimals = 2);
+
+// Writes one decoded fiber of `n` points. Decoding a valid .fft gives finite
+// points, so a NaN or Inf means the input is damaged or hostile: the error
+// (Errc::invalid_input) names `input` and the fiber, not the output.
+void write_decoded_fiber(TckWriter& writer, const float* xyz, std::uint64_t n, const std::string& input,
+                         std::uint64_t fiber);
 
 // Minimal JSON object builder (values are numbers, strings, bools or nested
 // objects already rendered), keys in insertion order.

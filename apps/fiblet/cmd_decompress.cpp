@@ -38,7 +38,8 @@ void run(const DecompressArgs& a) {
         file,
         [&](std::uint64_t first, const Streamlines& chunk) {
             for (std::size_t i = 0; i < chunk.size(); ++i)
-                writer.write(&chunk.xyz[3 * chunk.offsets[i]], chunk.offsets[i + 1] - chunk.offsets[i]);
+                write_decoded_fiber(writer, &chunk.xyz[3 * chunk.offsets[i]], chunk.offsets[i + 1] - chunk.offsets[i],
+                                    a.input, first + i);
             progress.update("decompress", h.fibers ? double(first + chunk.size()) / double(h.fibers) : 1.0);
         },
         options);

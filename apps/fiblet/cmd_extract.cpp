@@ -21,6 +21,7 @@ struct ExtractArgs {
     bool ignore_trailer = false;
     std::string input, output;
     std::string fibers;
+    bool fibers_given = false;  // --fibers "" is an error, not "all fibers"
     std::optional<double> min_length, max_length, random_fraction;
     std::uint64_t seed = 0;
     std::vector<std::string> include, exclude;
@@ -62,6 +63,7 @@ Region region(const std::string& option, const std::string& text) {
     const auto v = numbers(option, text);
     if (v.size() == 4) return Region::sphere({float(v[0]), float(v[1]), float(v[2])}, float(v[3]));
     if (v.size() == 6) {
+        // Two opposite corners, in either order (tests/select_cli_test.cpp): never an inverted box.
         const Vec3f a{float(v[0]), float(v[1]), float(v[2])}, b{float(v[3]), float(v[4]), float(v[5])};
         return Region::box_between({std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)},
                                    {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)});
@@ -90,15 +92,16 @@ std::vector<FiberRange> fiber_ranges(const std::string& text) {
             out.push_back({f, f});
         } else {
             out.push_back({id(item.substr(0, dash)), id(item.substr(dash + 1))});
+            if (out.back().first > out.back().last) usage("--fibers: '" + item + "' is an inverted range (FIRST > LAST)");
         }
     }
-    if (out.empty()) usage("--fibers: empty list");
+    if (out.empty() || text.back() == ',') usage("--fibers: empty list or empty item in '" + text + "'");
     return out;
 }
 
 Query build_query(const ExtractArgs& a) {
     Query q;
-    if (!a.fibers.empty()) q.fibers = fiber_ranges(a.fibers);
+    if (a.fibers_given) q.fibers = fiber_ranges(a.fibers);
     q.min_length_mm = a.min_length;
     q.max_length_mm = a.max_length;
     q.random_fraction = a.random_fraction;
@@ -153,7 +156,8 @@ void run(const ExtractArgs& a) {
         TckWriter writer(a.output, header.properties, a.force);
         Progress progress(a.quiet || a.json);
         stats = select(file, index, query, [&](const SelectedChunk& chunk) {
-            for (std::size_t i = 0; i < chunk.size(); ++i) writer.write(chunk.xyz_of(i), chunk.points_of(i));
+            for (std::size_t i = 0; i < chunk.size(); ++i)
+                write_decoded_fiber(writer, chunk.xyz_of(i), chunk.points_of(i), a.input, chunk.runs[i].fiber);
             if (!chunk.runs.empty() && h.fibers)
                 progress.update("extract", double(chunk.runs.back().fiber + 1) / double(h.fibers));
         });
@@ -197,7 +201,8 @@ void add_extract(CLI::App& app) {
         "extract", "Decode only part of a .fft file: fiber subset, regions of interest, view frustum, level of detail");
     cmd->add_option("input", args->input, "Input .fft file")->required()->check(CLI::ExistingFile);
     cmd->add_option("-o,--output", args->output, "Output .tck (points) or .fft (a subset file)")->required();
-    cmd->add_option("--fibers", args->fibers, "Fiber IDs and inclusive ranges, e.g. 0,5,10-20 (0-based)");
+    CLI::Option* fibers =
+        cmd->add_option("--fibers", args->fibers, "Fiber IDs and inclusive ranges, e.g. 0,5,10-20 (0-based)");
     cmd->add_option("--minlength", args->min_length, "Keep fibers at least this long (mm), as tckedit");
     cmd->add_option("--maxlength", args->max_length, "Keep fibers at most this long (mm), as tckedit");
     cmd->add_option("--random-fraction", args->random_fraction, "Keep this fraction of the fibers, at random");
@@ -222,7 +227,10 @@ void add_extract(CLI::App& app) {
     cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
     cmd->add_flag("--json", args->json, "Print the summary as JSON");
     add_ignore_trailer_flag(cmd, args->ignore_trailer);
-    cmd->callback([args] { run(*args); });
+    cmd->callback([args, fibers] {
+        args->fibers_given = fibers->count() > 0;
+        run(*args);
+    });
 }
 
 }  // namespace fiblet::cli

@@ -2,11 +2,62 @@
 // uses only the library's public API.
 #include <fmt/core.h>
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <exception>
+#include <system_error>
 
 #include "cli_common.hpp"
 #include "geometry_report.hpp"
 #include "fiblet/output_file.hpp"
+
+namespace {
+
+// Reports and returns the command's status, after making sure what it
+// printed reached stdout: a report written to a full disk or a closed pipe
+// is a failed command (exit 3), never a silent success with no output.
+int finish(int status) {
+    errno = 0;
+    if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+        const int e = errno;
+        std::fprintf(stderr, "fiblet: error: cannot write to standard output: %s\n",
+                     e ? std::strerror(e) : "write error");
+        return status == fiblet::cli::kOk ? fiblet::cli::kIo : status;
+    }
+    return status;
+}
+
+int run(CLI::App& app, int argc, char** argv) {
+    using namespace fiblet::cli;
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return kUsage;
+    } catch (const ErrorBoundExceeded& e) {
+        fmt::print(stderr, "fiblet: {}\n", e.what());
+        return kErrorBound;
+    } catch (const fiblet::Error& e) {
+        fmt::print(stderr, "fiblet: error: {}\n", e.what());
+        return exit_code_for(e.code());
+    } catch (const std::system_error& e) {
+        // fmt reports a failed write to stdout this way.
+        if (std::ferror(stdout)) return kIo;  // finish() says what failed
+        fmt::print(stderr, "fiblet: internal error: {}\n", e.what());
+        return kInternal;
+    } catch (const std::exception& e) {
+        fmt::print(stderr, "fiblet: internal error: {}\n", e.what());
+        return kInternal;
+    }
+    return kOk;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
     using namespace fiblet::cli;
@@ -27,24 +78,5 @@ int main(int argc, char** argv) {
     add_help(app);
 
     fiblet::install_signal_cleanup();
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::CallForHelp& e) {
-        return app.exit(e);
-    } catch (const CLI::CallForVersion& e) {
-        return app.exit(e);
-    } catch (const CLI::ParseError& e) {
-        app.exit(e);
-        return kUsage;
-    } catch (const ErrorBoundExceeded& e) {
-        fmt::print(stderr, "fiblet: {}\n", e.what());
-        return kErrorBound;
-    } catch (const fiblet::Error& e) {
-        fmt::print(stderr, "fiblet: error: {}\n", e.what());
-        return exit_code_for(e.code());
-    } catch (const std::exception& e) {
-        fmt::print(stderr, "fiblet: internal error: {}\n", e.what());
-        return kInternal;
-    }
-    return kOk;
+    return finish(run(app, argc, argv));
 }

@@ -7,6 +7,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <cstring>
 #include <numeric>
 #include <optional>
@@ -62,6 +63,18 @@ Streamlines decode_indices(const FftFile& file, const std::vector<std::uint64_t>
     return gather_fibers(view_of(all), run_fiber);
 }
 
+// A region that can hold no point (inverted box, negative radius, NaN)
+// would silently select nothing: refused, as the library's queries refuse it.
+void check_region(const Region& r) {
+    bool ok = true;
+    for (int k = 0; k < 3; ++k) ok = ok && std::isfinite(r.a[k]) && std::isfinite(r.b[k]);
+    if (r.shape == Region::Shape::sphere) ok = ok && r.b[0] >= 0;
+    else ok = ok && r.a[0] <= r.b[0] && r.a[1] <= r.b[1] && r.a[2] <= r.b[2];
+    if (!ok)
+        throw Error(Errc::invalid_argument, "invalid region: a sphere needs a finite centre and a radius >= 0, a box "
+                                            "finite corners with min <= max on every axis");
+}
+
 std::vector<Region> parse_regions(const py::list& regions) {
     std::vector<Region> out;
     for (const py::handle& item : regions) {
@@ -72,6 +85,7 @@ std::vector<Region> parse_regions(const py::list& regions) {
         else if (shape == "box") r.shape = Region::Shape::box;
         else throw Error(Errc::invalid_argument, "unknown region shape '" + shape + "'");
         r.a = std::get<1>(t), r.b = std::get<2>(t), r.exclude = std::get<3>(t);
+        check_region(r);
         out.push_back(r);
     }
     return out;

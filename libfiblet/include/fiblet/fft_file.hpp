@@ -30,6 +30,7 @@ namespace fiblet {
 
 namespace detail {
 class FftzReader;
+class InputRegistration;
 }
 
 // Parses and validates a header from the first bytes of a file. `file_size`
@@ -111,7 +112,9 @@ public:
     // the file (made on the first call, kept until the FftFile goes), checked
     // as read_blocks checks them: for reading scattered blocks without a
     // system call and a copy each. Empty when the file cannot be mapped (use
-    // read_blocks then). The file must not shrink while mapped (SIGBUS).
+    // read_blocks then). The file must not shrink while mapped: a truncated
+    // file kills the process with SIGBUS (no error, no cleanup). fiblet's
+    // own readers therefore use read_blocks (SelectOptions::map_file is off).
     std::span<const std::uint8_t> mapped_blocks(std::uint64_t first, std::uint64_t count) const;
 
 private:
@@ -140,6 +143,7 @@ private:
     std::shared_ptr<const FiberEndFractions> end_fractions_;
     std::unique_ptr<std::atomic<std::uint64_t>[]> verified_groups_;  // one bit per block group
     std::unique_ptr<Mapping> mapping_;                                // mapped_blocks()
+    std::unique_ptr<detail::InputRegistration> input_;  // no output of this process may replace the file
 };
 
 }  // namespace fiblet

@@ -4,6 +4,19 @@
 // destination and renames it into place only when the output is complete, so
 // a crash, an error or a signal never leaves a half-written file that a
 // pipeline could take for a good one.
+//
+// What the destination may be (decided at construction):
+//  - missing or a regular file: the temporary is renamed over it;
+//  - a symbolic link: the link is followed and its final target replaced
+//    atomically (the link stays); a dangling link is refused;
+//  - a character device (/dev/null, /dev/full): written through in place,
+//    no temporary, nothing renamed or replaced (--force not needed);
+//  - a FIFO, socket, block device or directory: refused (Error{invalid_argument}):
+//    the writers seek back to finish a file, which a pipe cannot take;
+//  - a file an open FftFile or TckReader of this process reads (the same
+//    st_dev/st_ino: the input itself, a symlink or a hard link to it):
+//    refused (Error{invalid_argument}), with or without overwrite.
+// The temporary's name is shortened to fit NAME_MAX: any legal output name works.
 #pragma once
 
 #include <cstddef>
@@ -14,10 +27,16 @@ namespace fiblet {
 
 class AtomicOutputFile {
 public:
-    // Throws Error{exists} if `path` exists and !overwrite, Error{io} if the
-    // temporary cannot be created.
+    // Throws Error{exists} if `path` exists and !overwrite, Error{invalid_argument}
+    // for a refused destination (see above), Error{io} if the temporary
+    // cannot be created.
     AtomicOutputFile(const std::string& path, bool overwrite);
     ~AtomicOutputFile();  // removes the temporary unless commit() succeeded
+    // What the constructor would refuse (see above; an existing output without
+    // overwrite), checked now without creating anything: a long command (a
+    // compress that scans its input first) fails before its work, not after.
+    // The constructor and commit() check again.
+    static void check_destination(const std::string& path, bool overwrite);
     AtomicOutputFile(const AtomicOutputFile&) = delete;
     AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
 
@@ -29,24 +48,31 @@ public:
     void commit();
 
     const std::string& path() const { return path_; }
+    // Empty when the output is written through (a character device).
     const std::string& temporary_path() const { return tmp_; }
+    bool writes_through() const { return write_through_; }
 
 private:
+    void open_in_place();
+    void create_temporary();
     void flush_buffer();
-    std::string path_, tmp_;
+    std::string path_, target_, tmp_;  // as given, with links resolved, the temporary
     int fd_ = -1;
-    bool overwrite_ = false, committed_ = false;
+    bool overwrite_ = false, committed_ = false, write_through_ = false;
     std::uint64_t written_ = 0;
     std::string buffer_;
     int registry_slot_ = -1;
 };
 
 // Removes every temporary output still pending. Async-signal-safe: a CLI calls
-// it from its SIGINT/SIGTERM/SIGHUP handler before exiting.
+// it from its fatal-signal handler before exiting.
 void remove_pending_outputs() noexcept;
 
-// Installs SIGINT/SIGTERM/SIGHUP handlers that remove pending outputs and
-// exit with 128+signal (the shell convention).
+// Installs handlers for every catchable signal that ends a process by
+// default (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE, SIGXFSZ, SIGXCPU,
+// SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF) that remove pending
+// outputs, print which signal stopped the process (not for SIGINT) and exit
+// with 128+signal (the shell convention). Signals the parent ignored stay ignored.
 void install_signal_cleanup();
 
 }  // namespace fiblet

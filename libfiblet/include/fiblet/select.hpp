@@ -132,7 +132,12 @@ struct SelectedChunk {
 struct SelectOptions {
     bool points = true;                       // decode and output points
     std::size_t chunk_points = 1u << 18;      // points per chunk handed to the sink
-    bool map_file = true;                     // read blocks through FftFile::mapped_blocks()
+    // Read blocks through FftFile::mapped_blocks() instead of pread(). Off by
+    // default: a file truncated by another process while mapped kills the
+    // whole process with SIGBUS (no error, no cleanup), where a read fails
+    // with Error{fft_format} ("unexpected end of file"). Turn it on only for
+    // files nobody modifies (docs/select.md has the cost of each way).
+    bool map_file = false;
 };
 
 // Runs a query, handing the output to `sink` in file order, a chunk of whole

@@ -17,6 +17,8 @@
 
 #include "codec/fiber_end_encoder.hpp"
 #include "codec/parameters.hpp"
+#include "core/streamline_label.hpp"
+#include "core/thread_count.hpp"
 #include "fiblet/block_index.hpp"
 #include "fiblet/checksum.hpp"
 #include "io/fft_sink.hpp"
@@ -120,6 +122,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         throw Error(Errc::invalid_argument, "points per block must be in [2, " + std::to_string(max_points_per_block) + "]");
     if (options.step_mm && !(std::isfinite(*options.step_mm) && *options.step_mm > 0))
         throw Error(Errc::invalid_argument, "--step must be a positive number of millimetres");
+    const unsigned threads = detail::resolve_threads(options.threads);  // checked before any work
 
     CompressReport report;
     TckScan& scan = report.scan;
@@ -127,6 +130,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     const std::size_t max_fiber_points = std::size_t{0xffff} * points_per_block;
     TckReader reader(tck_path, {.allow_count_mismatch = options.allow_count_mismatch, .max_points = max_fiber_points});
     scan.header_step = reader.header().step_size();
+    AtomicOutputFile::check_destination(fft_path, options.overwrite);  // before the passes, not after
 
     // Pass 1: counts, bounding box, spacing, turning angles.
     std::vector<std::uint32_t> fiber_points;
@@ -224,7 +228,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             double fiber_length = 0;
             for (std::size_t i = 1; i < fiber.size(); ++i) fiber_length += length(fiber[i - 1], fiber[i]);
             if (!(fiber_length / step < double(max_fiber_points)))
-                throw Error(Errc::unsupported, tck_path + ": streamline " + std::to_string(f) + " (" +
+                throw Error(Errc::unsupported, tck_path + ": " + detail::streamline_label(f) + " (" +
                                                    std::to_string(fiber_length) + " mm) needs more than 65535 blocks at a " +
                                                    std::to_string(step) + " mm step");
             const bool short_tail = resample_keeping_end(fiber, step, resampled);
@@ -262,7 +266,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     for (std::size_t f = 0; f < fiber_points.size(); ++f) {
         const std::uint32_t nb = encoder.block_count(fiber_points[f]);
         if (nb > 0xffff)
-            throw Error(Errc::unsupported, tck_path + ": streamline " + std::to_string(f) + " needs more than 65535 blocks");
+            throw Error(Errc::unsupported, tck_path + ": " + detail::streamline_label(f) + " needs more than 65535 blocks");
         if (in_buffer + nb > per_buffer) h.buffer_ends.push_back(blocks), in_buffer = 0;
         if (h.buffer_ends.size() > 254)
             throw Error(Errc::unsupported, tck_path + ": more than 255 GPU buffers of blocks");
@@ -276,7 +280,6 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     h.blocks = std::uint32_t(blocks);
 
     // Pass 2: encode, measure, write.
-    const unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
     const auto out = detail::open_fft_sink(fft_path, options.overwrite, options.zstd, h.direction_bits(),
                                            h.block_bytes(), threads);
     FftChecksumBuilder checksum(h.block_bytes());  // the CSUM trailer chunk (formats/fft-checksum.md)

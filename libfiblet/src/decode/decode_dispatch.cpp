@@ -12,6 +12,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "core/thread_count.hpp"
 #include "decode/decode_kernels.hpp"
 #include "decode/parallel_runs.hpp"
 #include "fiblet/decode.hpp"
@@ -208,7 +209,7 @@ std::vector<std::string> available_decoders() {
 std::size_t decode_blocks(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count, float* xyz,
                           Decoder decoder, unsigned threads) {
     const Decoder d = resolve_decoder(decoder);
-    if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+    threads = detail::resolve_threads(threads);
     // Below a few thousand blocks per thread, starting a thread costs more
     // than it saves.
     constexpr std::size_t kMinBlocksPerThread = 2048;

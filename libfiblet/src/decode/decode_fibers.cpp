@@ -7,6 +7,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/thread_count.hpp"
 #include "decode/decode_kernels.hpp"
 #include "decode/parallel_runs.hpp"
 #include "fiblet/decode.hpp"
@@ -24,7 +25,7 @@ public:
         : file_(file),
           ctx_(file),
           decoder_(resolve_decoder(options.decoder)),
-          threads_(options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency())),
+          threads_(detail::resolve_threads(options.threads)),
           chunk_blocks_(options.chunk_blocks ? options.chunk_blocks : kBlocksPerThread * threads_) {}
 
     std::size_t chunk_blocks() const { return chunk_blocks_; }

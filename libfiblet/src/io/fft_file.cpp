@@ -16,6 +16,7 @@
 #include "fiblet/error.hpp"
 #include "io/fft_trailer.hpp"
 #include "io/fftz_reader.hpp"
+#include "io/open_inputs.hpp"
 
 namespace fiblet {
 using detail::get_le;
@@ -100,9 +101,14 @@ FftFile::FftFile(const std::string& path, FftOpenOptions options)
     : path_(path), options_(options), mapping_(std::make_unique<Mapping>()) {
     fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd_ < 0) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
+    input_ = std::make_unique<detail::InputRegistration>(fd_);
     try {
         struct stat st {};
-        if (::fstat(fd_, &st) != 0 || !S_ISREG(st.st_mode)) throw Error(Errc::io, path + ": not a regular file");
+        if (::fstat(fd_, &st) != 0) throw Error(Errc::io, path + ": cannot stat: " + std::strerror(errno));
+        // Blocks are read by offset (random access): a pipe cannot be.
+        if (!S_ISREG(st.st_mode))
+            throw Error(Errc::io, path + ": not a regular file (a pipe or a device?): a .fft input is read by offset, "
+                                         "save it to a file first");
         file_size_ = logical_size_ = std::uint64_t(st.st_size);
         std::uint8_t magic[12] = {};
         if (file_size_ >= sizeof magic) pread_all(fd_, magic, sizeof magic, 0, path);
@@ -249,6 +255,7 @@ FftFile& FftFile::operator=(FftFile&& o) noexcept {
         end_fractions_ = std::move(o.end_fractions_);
         verified_groups_ = std::move(o.verified_groups_);
         mapping_ = std::move(o.mapping_);
+        input_ = std::move(o.input_);
     }
     return *this;
 }

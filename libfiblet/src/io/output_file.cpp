@@ -7,12 +7,13 @@
 
 #include <atomic>
 #include <cerrno>
-#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <random>
 
 #include "fiblet/error.hpp"
+#include "io/cleanup_signals.hpp"
+#include "io/output_target.hpp"
 
 namespace fiblet {
 namespace {
@@ -49,46 +50,22 @@ void unregister_temporary(int slot) {
 
 std::string errno_text() { return std::strerror(errno); }
 
-bool path_exists(const std::string& p) { return ::access(p.c_str(), F_OK) == 0; }
-
 // Moves `from` to `to` unless `to` exists, atomically: an output that
 // appeared while we were writing (another process) is never replaced.
-void rename_no_replace(const std::string& from, const std::string& to) {
+void rename_no_replace(const std::string& from, const std::string& to, const std::string& shown) {
     if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return;
-    if (errno == EEXIST) throw Error(Errc::exists, to + ": output exists (use --force to overwrite)");
+    if (errno == EEXIST) throw Error(Errc::exists, shown + ": output exists (use --force to overwrite)");
     if (errno != EINVAL && errno != ENOSYS)
-        throw Error(Errc::io, to + ": cannot rename temporary into place: " + errno_text());
+        throw Error(Errc::io, shown + ": cannot rename temporary into place: " + errno_text());
     // File systems without RENAME_NOREPLACE: link() fails on an existing target too.
     if (::link(from.c_str(), to.c_str()) != 0) {
-        if (errno == EEXIST) throw Error(Errc::exists, to + ": output exists (use --force to overwrite)");
-        throw Error(Errc::io, to + ": cannot move temporary into place: " + errno_text());
+        if (errno == EEXIST) throw Error(Errc::exists, shown + ": output exists (use --force to overwrite)");
+        throw Error(Errc::io, shown + ": cannot move temporary into place: " + errno_text());
     }
     ::unlink(from.c_str());
 }
 
-constexpr int kCleanupSignals[] = {SIGINT, SIGTERM, SIGHUP};
-
-// Blocks the cleanup signals in this thread for its lifetime.
-class SignalBlock {
-public:
-    SignalBlock() {
-        sigset_t set;
-        sigemptyset(&set);
-        for (int sig : kCleanupSignals) sigaddset(&set, sig);
-        ::pthread_sigmask(SIG_BLOCK, &set, &old_);
-    }
-    ~SignalBlock() { ::pthread_sigmask(SIG_SETMASK, &old_, nullptr); }
-    SignalBlock(const SignalBlock&) = delete;
-    SignalBlock& operator=(const SignalBlock&) = delete;
-
-private:
-    sigset_t old_;
-};
-
-void handle_signal(int sig) {
-    remove_pending_outputs();
-    ::_exit(128 + sig);
-}
+using detail::SignalBlock;
 
 }  // namespace
 
@@ -97,34 +74,50 @@ void remove_pending_outputs() noexcept {
         if (s.ready.load()) ::unlink(s.path);
 }
 
-void install_signal_cleanup() {
-    struct sigaction sa {};
-    sa.sa_handler = handle_signal;
-    sigemptyset(&sa.sa_mask);
-    for (int sig : kCleanupSignals) sigaddset(&sa.sa_mask, sig);  // one handler at a time
-    for (int sig : kCleanupSignals) ::sigaction(sig, &sa, nullptr);
+void AtomicOutputFile::check_destination(const std::string& path, bool overwrite) {
+    const detail::OutputTarget target = detail::resolve_output_target(path);
+    if (!overwrite && target.exists && !target.write_through)
+        throw Error(Errc::exists, path + ": output exists (use --force to overwrite)");
 }
 
 AtomicOutputFile::AtomicOutputFile(const std::string& path, bool overwrite) : path_(path), overwrite_(overwrite) {
-    if (!overwrite && path_exists(path))
-        throw Error(Errc::exists, path + ": output exists (use --force to overwrite)");
+    const detail::OutputTarget target = detail::resolve_output_target(path);
+    target_ = target.path;
+    if (target.write_through) {
+        open_in_place();
+    } else {
+        if (!overwrite && target.exists) throw Error(Errc::exists, path + ": output exists (use --force to overwrite)");
+        create_temporary();
+    }
+    buffer_.reserve(1u << 20);
+}
+
+// A character device (/dev/null): written as it is, never replaced.
+void AtomicOutputFile::open_in_place() {
+    write_through_ = true;
+    fd_ = ::open(target_.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
+    if (fd_ < 0) throw Error(Errc::io, path_ + ": cannot open the output: " + errno_text());
+}
+
+void AtomicOutputFile::create_temporary() {
     std::random_device rd;
     {
         // A signal between creating the temporary and registering it would leak it.
         const SignalBlock block;
         for (int attempt = 0; attempt < 16 && fd_ < 0; ++attempt) {
-            tmp_ = path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(rd() % 1000000);
+            const std::string suffix = ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(rd() % 1000000);
+            tmp_ = detail::temporary_name_for(target_, suffix);
             fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
             if (fd_ < 0 && errno != EEXIST) break;
         }
         if (fd_ >= 0) registry_slot_ = register_temporary(tmp_);
     }
-    if (fd_ < 0) throw Error(Errc::io, path + ": cannot create output: " + errno_text());
-    buffer_.reserve(1u << 20);
+    if (fd_ < 0) throw Error(Errc::io, path_ + ": cannot create output: " + errno_text());
 }
 
 AtomicOutputFile::~AtomicOutputFile() {
     if (fd_ >= 0) ::close(fd_);
+    if (write_through_) return;
     const SignalBlock block;  // unlink and unregister together
     if (!committed_) ::unlink(tmp_.c_str());
     unregister_temporary(registry_slot_);
@@ -179,12 +172,15 @@ void AtomicOutputFile::commit() {
         throw Error(Errc::io, path_ + ": close failed: " + errno_text());
     }
     fd_ = -1;
+    if (write_through_) return void(committed_ = true);
+    // What the name points at may have changed while we wrote (a link, a device, an input).
+    detail::recheck_output_target({target_, false, true}, path_);
     const SignalBlock block;  // the rename and the registry agree on what exists
     if (overwrite_) {
-        if (::rename(tmp_.c_str(), path_.c_str()) != 0)
+        if (::rename(tmp_.c_str(), target_.c_str()) != 0)
             throw Error(Errc::io, path_ + ": cannot rename temporary into place: " + errno_text());
     } else {
-        rename_no_replace(tmp_, path_);
+        rename_no_replace(tmp_, target_, path_);
     }
     committed_ = true;
     unregister_temporary(registry_slot_);

@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "fiblet/decode.hpp"
+#include "core/streamline_label.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/resample.hpp"
 #include "fiblet/tck.hpp"
@@ -45,7 +46,7 @@ Comparison compare_to_reference(const FftFile& fft, const std::string& tck_path,
             }
             const std::uint64_t n = chunk.offsets[i + 1] - chunk.offsets[i];
             if (target.size() != n)
-                mismatch("streamline " + std::to_string(fiber) + " has " + std::to_string(target.size()) +
+                mismatch(detail::streamline_label(fiber) + " has " + std::to_string(target.size()) +
                          " points, the decoded fiber " + std::to_string(n));
             const std::span<const Vec3f> decoded{reinterpret_cast<const Vec3f*>(&chunk.xyz[3 * chunk.offsets[i]]), n};
             for (std::size_t k = 0; k < n; ++k) {

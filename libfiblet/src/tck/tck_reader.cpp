@@ -7,9 +7,13 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <optional>
 
+#include "fiblet/checksum.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/tck.hpp"
+#include "core/streamline_label.hpp"
+#include "io/open_inputs.hpp"
 
 namespace fiblet {
 namespace {
@@ -79,6 +83,16 @@ struct TckReader::Impl {
     std::size_t chunk_cap = 0, chunk_len = 0, chunk_pos = 0;
     std::uint64_t streamlines = 0, points = 0;
     bool at_end = false;  // end marker seen (or empty data section)
+    detail::InputRegistration input;  // no output of this process may replace the file
+    // Multi-pass readers (compress) must see the same data on every pass: the
+    // file as opened, and each complete pass's bytes and counts (see check_pass).
+    struct stat opened {};
+    Xxh64Stream pass_hash;
+    struct Pass {
+        std::uint64_t digest, streamlines, points;
+    };
+    std::optional<Pass> first_pass;
+    bool pass_checked = false;
 
     ~Impl() {
         if (fd >= 0) ::close(fd);
@@ -87,13 +101,17 @@ struct TckReader::Impl {
     std::uint64_t consumed() const { return (next_read - data_begin) - (chunk_len - chunk_pos); }
     std::uint64_t file_pos() const { return data_begin + consumed(); }
 
+    [[noreturn]] void changed(const std::string& how) const {
+        throw Error(Errc::io, path + ": the file changed while it was being read (" + how +
+                                  "): it is being written or was replaced; read it again once it is complete");
+    }
+
     [[noreturn]] void fail(const std::string& what) const {
         throw Error(Errc::tck_format, path + ": invalid .tck data: " + what);
     }
 
     [[noreturn]] void fail_bad_triplet() const {
-        fail("NaN/Inf inside a coordinate at streamline " + std::to_string(streamlines + 1) + " (counting from 1)" +
-             ", byte " + std::to_string(file_pos()));
+        fail("NaN/Inf inside a coordinate at " + detail::streamline_label(streamlines) + ", byte " + std::to_string(file_pos()));
     }
 
     void check_count() const {
@@ -108,8 +126,7 @@ struct TckReader::Impl {
 
     void check_length(const std::vector<Vec3f>& out) const {
         if (options.max_points && out.size() > options.max_points)
-            throw Error(Errc::unsupported, path + ": streamline " + std::to_string(streamlines + 1) +
-                                               " (counting from 1) has more than " +
+            throw Error(Errc::unsupported, path + ": " + detail::streamline_label(streamlines) + " has more than " +
                                                std::to_string(options.max_points) + " points");
     }
 
@@ -128,7 +145,15 @@ struct TckReader::Impl {
             if (n == 0) break;  // the file shrank under us: treat as its end
             got += std::size_t(n);
         }
-        if (got < want) data_end = next_read + got;
+        if (got < want) {
+            // Shorter than at open: cut by someone else, not a truncated file to diagnose.
+            struct stat now {};
+            if (::fstat(fd, &now) == 0 && now.st_size != opened.st_size)
+                changed("it is " + std::to_string(now.st_size) + " bytes now, " + std::to_string(opened.st_size) +
+                        " when opened");
+            data_end = next_read + got;
+        }
+        pass_hash.update(chunk.get(), got);
         chunk_len = got;
         chunk_pos = 0;
         next_read += got;
@@ -164,8 +189,8 @@ struct TckReader::Impl {
         if (k == Kind::point) {
             v = Vec3f{float(d[0]), float(d[1]), float(d[2])};
             if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
-                throw Error(Errc::invalid_input, path + ": coordinate beyond the float32 range at streamline " +
-                                                     std::to_string(streamlines + 1) + ", byte " +
+                throw Error(Errc::invalid_input, path + ": coordinate beyond the float32 range at " +
+                                                     detail::streamline_label(streamlines) + ", byte " +
                                                      std::to_string(file_pos()));
         }
         return k;
@@ -174,7 +199,7 @@ struct TckReader::Impl {
     bool next(std::vector<Vec3f>& out) {
         out.clear();
         if (at_end) {
-            check_count();
+            end_pass();
             return false;
         }
         const bool fast = header.datatype == TckDataType::float32le;
@@ -182,15 +207,14 @@ struct TckReader::Impl {
             if (chunk_pos == chunk_len && !refill()) {
                 if (data_end == data_begin) {  // no data at all: a file with zero streamlines
                     at_end = true;
-                    check_count();
+                    end_pass();
                     return false;
                 }
                 fail("no end-of-data marker (Inf triplet) after " + std::to_string(streamlines) +
                      " streamlines (truncated?)");
             }
             if (chunk_len - chunk_pos < triplet)
-                fail("truncated in the middle of a point at streamline " + std::to_string(streamlines + 1) +
-                     " (counting from 1), byte " + std::to_string(file_pos()));
+                fail("truncated in the middle of a point at " + detail::streamline_label(streamlines) + ", byte " + std::to_string(file_pos()));
             if (fast) {
                 scan_float32le(out);
                 check_length(out);
@@ -216,7 +240,7 @@ struct TckReader::Impl {
                         points += out.size();
                         return true;
                     }
-                    check_count();
+                    end_pass();
                     return false;
                 case Kind::bad:
                     break;
@@ -229,6 +253,36 @@ struct TckReader::Impl {
         chunk_len = chunk_pos = 0;
         streamlines = points = 0;
         at_end = false;
+        pass_hash.reset();
+        pass_checked = false;
+    }
+
+    void end_pass() {
+        check_count();
+        if (pass_checked) return;
+        pass_checked = true;
+        check_pass();
+    }
+
+    // A pass over the data just ended: the file must still be the one opened
+    // (size, modification time, inode, also at its path: not replaced), and
+    // every pass must read the same bytes as the first one (an edit that
+    // keeps size and time, or lands between the checks). Without this, the
+    // passes of compress would disagree and write a file verify rejects.
+    void check_pass() {
+        struct stat now {};
+        if (::fstat(fd, &now) != 0 || now.st_size != opened.st_size || now.st_mtim.tv_sec != opened.st_mtim.tv_sec ||
+            now.st_mtim.tv_nsec != opened.st_mtim.tv_nsec)
+            changed("its size or modification time is not the one it had when opened");
+        if (::stat(path.c_str(), &now) != 0 || now.st_ino != opened.st_ino || now.st_dev != opened.st_dev)
+            changed("another file now has its name");
+        const Pass pass{pass_hash.digest(), streamlines, points};
+        if (!first_pass) return void(first_pass = pass);
+        if (pass.streamlines != first_pass->streamlines || pass.points != first_pass->points)
+            changed("this pass read " + std::to_string(pass.streamlines) + " streamlines and " +
+                    std::to_string(pass.points) + " points, the first " + std::to_string(first_pass->streamlines) +
+                    " and " + std::to_string(first_pass->points));
+        if (pass.digest != first_pass->digest) changed("this pass read other bytes than the first");
     }
 };
 
@@ -236,11 +290,16 @@ TckReader::TckReader(const std::string& path, TckReadOptions options) : impl_(st
     Impl& m = *impl_;
     m.path = path;
     m.options = options;
-    m.header = read_tck_header(path);
     m.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (m.fd < 0) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
-    struct stat st {};
+    struct stat& st = m.opened;
     if (::fstat(m.fd, &st) != 0) throw Error(Errc::io, path + ": cannot stat: " + std::strerror(errno));
+    // The data is read in several passes and by offset: a pipe cannot be.
+    if (!S_ISREG(st.st_mode))
+        throw Error(Errc::io, path + ": not a regular file (a pipe or a device?): a .tck input is read more than "
+                                     "once, save it to a file first");
+    m.input = detail::InputRegistration(m.fd);
+    m.header = read_tck_header(path);
     if (std::uint64_t(st.st_size) < m.header.data_offset)
         throw Error(Errc::tck_format, path + ": invalid .tck header: data offset is past the end of the file");
     m.triplet = 3 * std::size_t(tck_datatype_size(m.header.datatype));

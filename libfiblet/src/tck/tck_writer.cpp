@@ -4,6 +4,7 @@
 #include <limits>
 #include <string_view>
 
+#include "core/streamline_label.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/output_file.hpp"
 #include "fiblet/tck.hpp"
@@ -57,8 +58,8 @@ struct TckWriter::Impl {
         check_open();
         // A NaN or Inf would be read back as a separator or the end of the data.
         if (!finite)
-            throw Error(Errc::invalid_input, out.path() + ": non-finite coordinate in streamline " +
-                                                 std::to_string(count + 1) + " (counting from 1)");
+            throw Error(Errc::invalid_input, out.path() + ": cannot write a non-finite coordinate (" +
+                                                 detail::streamline_label(count) + "): a .tck cannot hold NaN or Inf");
         if (count >= kMaxCount)
             throw Error(Errc::unsupported, out.path() + ": more than " + std::to_string(kMaxCount) + " streamlines");
         if (n > 0) out.write(xyz, n * sizeof(Vec3f));
@@ -76,9 +77,13 @@ TckWriter::TckWriter(const std::string& path, const std::vector<std::pair<std::s
     for (const auto& [key, value] : properties) {
         const std::string_view k = trim(key);
         if (owned_key(k)) continue;
-        // Such a key could not be read back as the same key.
-        if (k.empty() || k.find_first_of(":\n") != std::string_view::npos)
-            throw Error(Errc::invalid_argument, path + ": invalid .tck header key \"" + key + "\"");
+        // Such a key could not be read back as the same key. (An empty key
+        // can: ": value" reads back as it, so a .tck that has one round-trips
+        // through compress and decompress.) Properties are data (usually an
+        // input file's), so a bad one is invalid input, not a bad command line.
+        if (k.find_first_of(":\n") != std::string_view::npos)
+            throw Error(Errc::invalid_input, path + ": the .tck header key \"" + key +
+                                                 "\" holds ':' or a line break: it cannot be written");
         // A multi-line value becomes repeated "key: line" entries, as MRtrix writes them.
         std::string_view v = value;
         for (;;) {

@@ -1,0 +1,68 @@
+// Fatal signals in the CLI: remove the pending temporary outputs, say which
+// signal stopped the command (a silent death after `ulimit -f` leaves the
+// user guessing), exit with 128 + signal, the shell convention.
+#include <signal.h>
+#include <unistd.h>
+
+#include <cstring>
+
+#include "fiblet/output_file.hpp"
+#include "io/cleanup_signals.hpp"
+
+namespace fiblet {
+namespace {
+
+const char* signal_text(int sig) {
+    switch (sig) {
+        case SIGINT: return "SIGINT (interrupted)";
+        case SIGTERM: return "SIGTERM (terminated)";
+        case SIGHUP: return "SIGHUP (hang-up)";
+        case SIGQUIT: return "SIGQUIT (quit)";
+        case SIGPIPE: return "SIGPIPE (the reader of a pipe went away)";
+        case SIGXFSZ: return "SIGXFSZ (file size limit reached, see ulimit -f)";
+        case SIGXCPU: return "SIGXCPU (CPU time limit reached, see ulimit -t)";
+        case SIGUSR1: return "SIGUSR1";
+        case SIGUSR2: return "SIGUSR2";
+        case SIGALRM: return "SIGALRM";
+        case SIGVTALRM: return "SIGVTALRM";
+        case SIGPROF: return "SIGPROF";
+    }
+    return "a signal";
+}
+
+// write(2) only: the handler may run in the middle of malloc or stdio.
+void say(const char* s) {
+    for (std::size_t left = std::strlen(s); left > 0;) {
+        const ssize_t n = ::write(STDERR_FILENO, s, left);
+        if (n <= 0) return;
+        s += n, left -= std::size_t(n);
+    }
+}
+
+void handle_signal(int sig) {
+    remove_pending_outputs();
+    // SIGINT is the user's own Ctrl-C: the shell already shows it.
+    if (sig != SIGINT) {
+        say("fiblet: stopped by ");
+        say(signal_text(sig));
+        say("; unfinished outputs removed\n");
+    }
+    ::_exit(128 + sig);
+}
+
+}  // namespace
+
+void install_signal_cleanup() {
+    struct sigaction sa {};
+    sa.sa_handler = handle_signal;
+    sigemptyset(&sa.sa_mask);
+    for (int sig : detail::kCleanupSignals) sigaddset(&sa.sa_mask, sig);  // one handler at a time
+    for (int sig : detail::kCleanupSignals) {
+        struct sigaction old {};
+        // A signal ignored by whoever started us (nohup: SIGHUP) stays ignored.
+        if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+        ::sigaction(sig, &sa, nullptr);
+    }
+}
+
+}  // namespace fiblet
