@@ -41,8 +41,9 @@ void say(const char* s) {
 
 void handle_signal(int sig) {
     remove_pending_outputs();
-    // SIGINT is the user's own Ctrl-C: the shell already shows it.
-    if (sig != SIGINT) {
+    // SIGINT is the user's own Ctrl-C: the shell already shows it; SIGPIPE
+    // ends `fiblet ... | head` as it ends any Unix filter, silently.
+    if (sig != SIGINT && sig != SIGPIPE) {
         say("fiblet: stopped by ");
         say(signal_text(sig));
         say("; unfinished outputs removed\n");
