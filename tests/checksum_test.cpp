@@ -68,13 +68,7 @@ struct Fixture {
 
 // Opens and decodes everything; returns the error category, or nullopt.
 std::optional<Errc> read_all(const std::string& path, FftOpenOptions o = {}) {
-    try {
-        const FftFile f(path, o);
-        decode_file(f, [](std::uint64_t, const Streamlines&) {});
-    } catch (const Error& e) {
-        return e.code();
-    }
-    return std::nullopt;
+    return test::error_of([&] { decode_file(FftFile(path, o), [](std::uint64_t, const Streamlines&) {}); });
 }
 
 }  // namespace

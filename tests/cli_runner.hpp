@@ -33,7 +33,10 @@ inline CommandResult run_cli(const std::string& args, const std::string& env = "
     return run_command(env + " " + FIBLET_CLI + " " + args + " 2>&1");
 }
 
-// Starts `fiblet args...` with its output discarded; returns its pid (the caller waits for it).
+// Starts `fiblet args...` with its output discarded; returns its pid (the
+// caller waits for it). The child's peak RSS (wait4) includes what the test
+// process had resident when it forked: memory tests measure it from a fresh
+// process (CTest runs each test in its own).
 inline pid_t spawn_cli(const std::vector<std::string>& args) {
     const pid_t pid = ::fork();
     if (pid == 0) {

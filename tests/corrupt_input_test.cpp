@@ -90,15 +90,7 @@ const std::string kEnd = f32({kInf, kInf, kInf});
 // Two fibers of 3 and 2 points at 0.5 mm spacing.
 const std::string kTwoFibers = f32({0, 0, 0, 0.5f, 0, 0, 1, 0, 0}) + kSep + f32({0, 1, 0, 0, 1.5f, 0}) + kSep + kEnd;
 
-// Runs `fn`; returns the category of the fiblet::Error it throws, if any.
-std::optional<Errc> error_of(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        return e.code();
-    }
-    return std::nullopt;
-}
+using test::error_of;
 
 std::vector<std::vector<Vec3f>> read_tck(const std::string& path) {
     TckReader r(path);

@@ -24,15 +24,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The category of the Error `fn` throws; nullopt when it throws none.
-std::optional<Errc> error_of(const std::function<void()>& fn) {
-    try {
-        fn();
-    } catch (const Error& e) {
-        return e.code();
-    }
-    return std::nullopt;
-}
+using test::error_of;
 
 void write_output(const std::string& path, bool overwrite, const std::string& bytes) {
     AtomicOutputFile out(path, overwrite);

@@ -6,16 +6,42 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <system_error>
 #include <vector>
 
+#include "fiblet/error.hpp"
 #include "fiblet/tck.hpp"
 
 namespace fiblet::test {
+
+// ASan builds: their memory use makes RSS bounds meaningless.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+inline constexpr bool kSanitized = true;
+#else
+inline constexpr bool kSanitized = false;
+#endif
+#else
+inline constexpr bool kSanitized = false;
+#endif
+
+// The category of the fiblet::Error `fn` throws; nullopt when it throws none.
+inline std::optional<Errc> error_of(const std::function<void()>& fn) {
+    try {
+        fn();
+    } catch (const Error& e) {
+        return e.code();
+    }
+    return std::nullopt;
+}
 
 // A fresh directory under /tmp, removed with its contents on destruction.
 class TempDir {

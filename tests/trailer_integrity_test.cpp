@@ -30,17 +30,7 @@ using namespace fiblet;
 
 namespace {
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
+using test::kSanitized;
 
 // Smooth curves at a fixed 0.1 mm step: `fibers` of 50..349 points.
 void write_tractogram(const std::string& path, int fibers) {
@@ -114,22 +104,11 @@ struct Fixture {
 };
 
 std::optional<Errc> open_error(const std::string& path, FftOpenOptions o = {}) {
-    try {
-        const FftFile f(path, o);
-        decode_file(f, [](std::uint64_t, const Streamlines&) {});
-    } catch (const Error& e) {
-        return e.code();
-    }
-    return std::nullopt;
+    return test::error_of([&] { decode_file(FftFile(path, o), [](std::uint64_t, const Streamlines&) {}); });
 }
 
 std::optional<Errc> verify_error(const std::string& path) {
-    try {
-        verify_fft_file(path);
-    } catch (const Error& e) {
-        return e.code();
-    }
-    return std::nullopt;
+    return test::error_of([&] { verify_fft_file(path); });
 }
 
 // Everything a reader gets from a file: every point, every offset, the
