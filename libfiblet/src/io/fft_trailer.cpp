@@ -89,7 +89,8 @@ namespace {
     throw Error(Errc::fft_format, name + ": not a valid .fft file: " + tag_name(tag) + " chunk: " + what);
 }
 
-// PROP: (key, value) string pairs that a .tck header can hold and give back.
+// PROP: (key, value) string pairs that a .tck header can hold and give back
+// (any bytes, NUL included, but a key never holds ':' or a line break).
 std::vector<std::pair<std::string, std::string>> parse_properties(const TrailerChunk& c, const std::string& name) {
     const auto& p = c.payload;
     std::size_t pos = 0;
@@ -99,7 +100,6 @@ std::vector<std::pair<std::string, std::string>> parse_properties(const TrailerC
         if (p.size() - pos - 4 < n) bad_chunk(name, c.tag, std::string(which) + " runs past the chunk");
         std::string s(reinterpret_cast<const char*>(&p[pos + 4]), n);
         pos += 4 + std::size_t{n};
-        if (s.find('\0') != std::string::npos) bad_chunk(name, c.tag, std::string(which) + " holds a NUL byte");
         return s;
     };
     std::vector<std::pair<std::string, std::string>> props;
