@@ -85,9 +85,11 @@ inline void mutate_fft(std::string& b, std::minstd_rand& rng) {
         case 7: {  // two blocks swapped (same size: the layout holds)
             const std::uint32_t ppb = peek<std::uint32_t>(b, 21), blocks = peek<std::uint32_t>(b, 17);
             const std::size_t bb = b[0] == 16 ? (24 + 2 * std::size_t(ppb) + 3) / 4 * 4 : (ppb + 16 + 3) / 4 * 4;
-            const std::size_t first = end - std::min<std::size_t>(end, std::size_t(blocks) * bb);
-            if (blocks >= 2 && bb) {
-                const std::size_t x = first + pick(blocks) * bb, y = first + pick(blocks) * bb;
+            // Only blocks that are really there (a mutated header may claim more).
+            const std::size_t present = bb ? std::min<std::size_t>(blocks, end / bb) : 0;
+            const std::size_t first = end - present * bb;
+            if (present >= 2) {
+                const std::size_t x = first + pick(present) * bb, y = first + pick(present) * bb;
                 const std::string tmp = b.substr(x, bb);
                 b.replace(x, bb, b.substr(y, bb));
                 b.replace(y, bb, tmp);
