@@ -25,7 +25,6 @@ FiberEndFractions parse_fiber_ends_chunk(const TrailerChunk& chunk, std::uint64_
 
 void apply_fiber_ends(const FftHeader& h, const FiberEndFractions& fractions, const std::uint8_t* blocks,
                       std::size_t count, float* xyz) {
-    const bool wide = h.direction_bits() == 16;
     const std::size_t bb = h.block_bytes();
     std::size_t point = 0;
     for (std::size_t b = 0; b < count; ++b) {
@@ -33,7 +32,7 @@ void apply_fiber_ends(const FftHeader& h, const FiberEndFractions& fractions, co
         const BlockFlags flags = block_flags(h, block);
         point += flags.point_count;
         if (!flags.last || !end_fraction_applies(flags.point_count)) continue;
-        const std::uint32_t id = wide ? BlockView16{block}.fiber_id() : BlockView{block}.fiber_id();
+        const std::uint32_t id = flags.fiber_id;
         if (id >= fractions.size() || fractions[id] == kWholeLastStep) continue;
         float* last = xyz + 3 * (point - 1);
         const float* prev = last - 3;
