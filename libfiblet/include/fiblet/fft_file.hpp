@@ -138,7 +138,7 @@ private:
     std::vector<TrailerChunk> trailer_;
     std::vector<std::pair<std::string, std::string>> properties_;
     std::optional<double> resampled_step_mm_;
-    std::uint64_t checksum_chunk_offset_ = 0;  // where the CSUM chunk starts in the file
+    std::uint64_t trailer_hash_ = 0;  // XXH64 of the trailer chunks before CSUM, as read
     std::optional<FftChecksums> checksums_;
     std::shared_ptr<const FiberEndFractions> end_fractions_;
     std::unique_ptr<std::atomic<std::uint64_t>[]> verified_groups_;  // one bit per block group

@@ -186,7 +186,7 @@ void FftFile::open_trailer(std::span<const std::uint8_t> head, std::uint64_t lut
         [this](std::uint8_t* out, std::uint64_t size, std::uint64_t offset) { read_at(out, size, offset); },
         header_.file_bytes(), logical_size_, header_.fibers, path_);
     trailer_ = std::move(t.chunks);
-    checksum_chunk_offset_ = t.checksum_chunk_at;
+    trailer_hash_ = t.hash_before_checksum;
     if (const TrailerChunk* c = find_chunk(kChecksumTag)) checksums_ = FftChecksums::parse(*c, header_.blocks, path_);
     if (verifies_checksums()) {
         verify_open_checksums(head, lut_hash);
@@ -207,16 +207,7 @@ void FftFile::verify_open_checksums(std::span<const std::uint8_t> head, std::uin
     };
     if (xxh64(head.data(), head.size()) != c.header_hash) fail("header");
     if (lut_hash != c.lut_hash) fail("fiber LUT");
-    // The chunks before CSUM, hashed from the file as stored.
-    Xxh64Stream hash;
-    std::vector<std::uint8_t> buf;
-    for (std::uint64_t pos = header_.file_bytes(); pos < checksum_chunk_offset_;) {
-        buf.resize(std::size_t(std::min<std::uint64_t>(1u << 20, checksum_chunk_offset_ - pos)));
-        read_at(buf.data(), buf.size(), pos);
-        hash.update(buf.data(), buf.size());
-        pos += buf.size();
-    }
-    if (hash.digest() != c.trailer_hash) fail("trailer chunks");
+    if (trailer_hash_ != c.trailer_hash) fail("trailer chunks");  // hashed as the chunks were read
 }
 
 const TrailerChunk* FftFile::find_chunk(std::array<char, 4> tag) const {
@@ -250,7 +241,7 @@ FftFile& FftFile::operator=(FftFile&& o) noexcept {
         trailer_ = std::move(o.trailer_);
         properties_ = std::move(o.properties_);
         resampled_step_mm_ = o.resampled_step_mm_;
-        checksum_chunk_offset_ = o.checksum_chunk_offset_;
+        trailer_hash_ = o.trailer_hash_;
         checksums_ = std::move(o.checksums_);
         end_fractions_ = std::move(o.end_fractions_);
         verified_groups_ = std::move(o.verified_groups_);

@@ -35,6 +35,17 @@ std::uint64_t max_known_size(const std::array<char, 4>& tag, std::uint64_t fiber
     return tag == kFiberEndsTag ? std::max(kMaxKnownChunk, 2 * fibers) : kMaxKnownChunk;
 }
 
+// Hashes a chunk payload too large to keep, a slice at a time.
+void hash_unloaded(const ReadAt& read_at, std::uint64_t at, std::uint64_t size, Xxh64Stream& hash) {
+    std::vector<std::uint8_t> slice;
+    for (std::uint64_t done = 0; done < size;) {
+        slice.resize(std::size_t(std::min<std::uint64_t>(1u << 20, size - done)));
+        read_at(slice.data(), slice.size(), at + done);
+        hash.update(slice.data(), slice.size());
+        done += slice.size();
+    }
+}
+
 }  // namespace
 
 TrailerChunks read_trailer_chunks(const ReadAt& read_at, std::uint64_t end, std::uint64_t logical_size,
@@ -55,6 +66,7 @@ TrailerChunks read_trailer_chunks(const ReadAt& read_at, std::uint64_t end, std:
         damaged("the footer says the trailer starts at byte " + std::to_string(get_le<std::uint64_t>(footer)) +
                 ", the blocks end at byte " + std::to_string(end));
     const std::uint64_t stop = logical_size - kTrailerFooterBytes;
+    Xxh64Stream before_checksum;
     for (std::uint64_t pos = end; pos < stop;) {
         std::uint8_t head[16];
         if (stop - pos < sizeof head) damaged("truncated chunk header at byte " + std::to_string(pos));
@@ -71,15 +83,21 @@ TrailerChunks read_trailer_chunks(const ReadAt& read_at, std::uint64_t end, std:
         if (known && size > max_known_size(chunk.tag, fibers))
             damaged(what + " of " + std::to_string(size) + " bytes (at most " +
                     std::to_string(max_known_size(chunk.tag, fibers)) + ")");
-        if (chunk.tag == kChecksumTag) t.checksum_chunk_at = pos;
+        const bool is_checksum = chunk.tag == kChecksumTag;
+        if (is_checksum) t.checksum_chunk_at = pos;
+        else before_checksum.update(head, sizeof head);  // CSUM's trailerHash covers the chunks before it
         if (known || size <= kMaxUnknownChunk) {
             chunk.payload.resize(size);
             read_at(chunk.payload.data(), size, pos + sizeof head);
+            if (!is_checksum) before_checksum.update(chunk.payload.data(), chunk.payload.size());
             t.chunks.push_back(std::move(chunk));
+        } else {
+            hash_unloaded(read_at, pos + sizeof head, size, before_checksum);
         }
         pos += sizeof head + size;
     }
     if (t.checksum_chunk_at == 0) damaged("no CSUM chunk (every fiblet trailer ends with one)");
+    t.hash_before_checksum = before_checksum.digest();
     return t;
 }
 

@@ -29,6 +29,7 @@ using ReadAt = std::function<void(std::uint8_t* out, std::uint64_t size, std::ui
 struct TrailerChunks {
     std::vector<TrailerChunk> chunks;       // in file order (large unknown chunks: payload not loaded)
     std::uint64_t checksum_chunk_at = 0;    // file offset of the CSUM chunk (the last one)
+    std::uint64_t hash_before_checksum = 0; // XXH64 of the chunks before it, as stored (CSUM's trailerHash)
 };
 
 // The chunks after the last block (`blocks_end`) of a file of `logical_size`
