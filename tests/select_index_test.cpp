@@ -188,19 +188,10 @@ TEST_F(SelectIndex, FrustumCandidatesCoverEveryBlockSphereThatMeetsTheFrustum) {
 // with a CSUM chunk that matches it: what a writer with a faulty index
 // builder would make.
 std::string with_index_payload(const FftFile& from, const std::vector<std::uint8_t>& payload, const std::string& to) {
-    const std::string bytes = read_file(from.path());
-    const FftHeader& h = from.header();
-    const std::uint64_t end = h.file_bytes();
     std::vector<TrailerChunk> chunks;
     for (const TrailerChunk& c : from.trailer())
         if (c.tag != kChecksumTag) chunks.push_back(c.tag == kBlockIndexTag ? TrailerChunk{c.tag, payload} : c);
-    FftChecksumBuilder sums(h.block_bytes());
-    sums.add_lut(bytes.data() + h.lut_offset(), h.blocks_offset() - h.lut_offset());
-    sums.add_blocks(bytes.data() + h.blocks_offset(), end - h.blocks_offset());
-    const auto* head = reinterpret_cast<const std::uint8_t*>(bytes.data());
-    chunks.push_back(sums.finish({head, std::size_t(h.lut_offset())}, chunks));
-    const auto trailer = serialize_trailer(chunks, end);
-    write_file(to, bytes.substr(0, end) + std::string(trailer.begin(), trailer.end()));
+    write_file(to, test::with_checksummed_trailer(read_file(from.path()), from.header(), chunks));
     return to;
 }
 

@@ -15,6 +15,7 @@
 #include <system_error>
 #include <vector>
 
+#include "fiblet/checksum.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/tck.hpp"
 
@@ -107,6 +108,20 @@ inline void write_three_fiber_tck(const std::string& path) {
     f.resize(1);
     w.write(f);
     w.finish();
+}
+
+// `body` (the header, LUT and blocks of a file whose header is `h`), then
+// `chunks` and a CSUM chunk that matches it all: what a writer would make of
+// them (tests use it to give wrong values a correct checksum).
+inline std::string with_checksummed_trailer(const std::string& body, const FftHeader& h,
+                                            std::vector<TrailerChunk> chunks) {
+    FftChecksumBuilder sums(h.block_bytes());
+    sums.add_lut(body.data() + h.lut_offset(), h.blocks_offset() - h.lut_offset());
+    sums.add_blocks(body.data() + h.blocks_offset(), h.file_bytes() - h.blocks_offset());
+    const auto* head = reinterpret_cast<const std::uint8_t*>(body.data());
+    chunks.push_back(sums.finish({head, std::size_t(h.lut_offset())}, chunks));
+    const auto trailer = serialize_trailer(chunks, h.file_bytes());
+    return body.substr(0, h.file_bytes()) + std::string(trailer.begin(), trailer.end());
 }
 
 }  // namespace fiblet::test

@@ -85,21 +85,14 @@ struct Fixture {
     // matches it all: what a faulty writer (not damage) would make.
     std::string rewritten(const std::string& name, const std::function<void(std::string&)>& edit_body,
                           const std::function<void(std::vector<TrailerChunk>&)>& edit_chunks = {}) const {
-        const std::uint64_t end = header.file_bytes();
-        std::string body = bytes.substr(0, end);
+        std::string body = bytes.substr(0, header.file_bytes());
         if (edit_body) edit_body(body);
         std::vector<TrailerChunk> chunks;
         const FftFile source(fft);
         for (const TrailerChunk& c : source.trailer())
             if (c.tag != kChecksumTag) chunks.push_back(c);
         if (edit_chunks) edit_chunks(chunks);
-        FftChecksumBuilder sums(header.block_bytes());
-        sums.add_lut(body.data() + header.lut_offset(), header.blocks_offset() - header.lut_offset());
-        sums.add_blocks(body.data() + header.blocks_offset(), end - header.blocks_offset());
-        const auto* head = reinterpret_cast<const std::uint8_t*>(body.data());
-        chunks.push_back(sums.finish({head, std::size_t(header.lut_offset())}, chunks));
-        const auto trailer = serialize_trailer(chunks, end);
-        return write(name, body + std::string(trailer.begin(), trailer.end()));
+        return write(name, test::with_checksummed_trailer(body, header, chunks));
     }
 };
 
