@@ -37,10 +37,10 @@ struct ExactMeasurement {
 
 // The points the encoder targets for one input streamline: the input itself,
 // or its fixed-step resampling when the file says so (RSMP chunk).
-inline const std::vector<Vec3f>& target_points(const std::vector<Vec3f>& input, double resample_step,
+inline const std::vector<Vec3f>& target_points(const std::vector<Vec3f>& input, const Resampling& resampling,
                                                std::vector<Vec3f>& scratch) {
-    if (!(resample_step > 0)) return input;
-    resample_fixed_step(input, resample_step, scratch);
+    if (!(resampling.step_mm > 0)) return input;
+    resample_fixed_step(input, resampling.step_mm, scratch, resampling.curve);
     return scratch;
 }
 
@@ -58,9 +58,12 @@ inline ExactMeasurement measure_exact(const std::string& fft_path, const std::st
     const exact::Decoded dec = exact::decode(bytes);
     ExactMeasurement m;
     m.header_max_mm = dec.header.max_error, m.header_mean_mm = dec.header.mean_error;
-    double step = 0;
-    if (const std::string rsmp = exact::trailer_chunk(bytes, "RSMP"); rsmp.size() == 8) std::memcpy(&step, rsmp.data(), 8);
-    m.resampled = step > 0;
+    // RSMP: f64 step, then (16-byte form) u32 curve; the 8-byte form is the polyline.
+    Resampling resampling{.step_mm = 0, .curve = ResampleCurve::polyline};
+    const std::string rsmp = exact::trailer_chunk(bytes, "RSMP");
+    if (rsmp.size() >= 8) std::memcpy(&resampling.step_mm, rsmp.data(), 8);
+    if (rsmp.size() == 16) std::memcpy(&resampling.curve, rsmp.data() + 8, 4);
+    m.resampled = resampling.step_mm > 0;
 
     FftFile file(fft_path);
     DecodeOptions options;
@@ -70,7 +73,7 @@ inline ExactMeasurement measure_exact(const std::string& fft_path, const std::st
     std::vector<Vec3f> input, scratch;
     for (std::size_t f = 0; reader.next(input); ++f) {
         if (f >= dec.fibers.size()) throw std::runtime_error(fft_path + ": fewer fibers than " + tck_path);
-        const auto& targets = target_points(input, step, scratch);
+        const auto& targets = target_points(input, resampling, scratch);
         const auto& exact_points = dec.fibers[f];
         const std::size_t n = std::min(targets.size(), exact_points.size());
         if (exact_points.size() < targets.size())

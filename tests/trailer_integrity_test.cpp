@@ -218,6 +218,23 @@ TEST(TrailerIntegrity, TrailerValuesAreValidatedForEveryReader) {
         EXPECT_FALSE(std::filesystem::exists(fx.dir.file("x.fft")));
     }
     EXPECT_EQ(open_error(with_rsmp(step_mm, "ok.fft")), std::nullopt);
+    // The curve field: 0 (polyline) or 1 (cubic), then a zero word; other
+    // sizes are not RSMP chunks.
+    auto with_curve = [&](std::vector<std::uint32_t> words, const std::string& name) {
+        return fx.rewritten(name, {}, [&](std::vector<TrailerChunk>& chunks) {
+            for (TrailerChunk& c : chunks)
+                if (c.tag == kResampledTag) {
+                    c.payload.resize(8 + 4 * words.size());
+                    std::memcpy(c.payload.data() + 8, words.data(), 4 * words.size());
+                }
+        });
+    };
+    EXPECT_EQ(FftFile(fx.fft).resampling()->curve, ResampleCurve::cubic);
+    EXPECT_EQ(FftFile(with_curve({0, 0}, "polyline.fft")).resampling()->curve, ResampleCurve::polyline);
+    for (const auto& words : std::vector<std::vector<std::uint32_t>>{{2, 0}, {1, 1}, {1}, {1, 0, 0}}) {
+        SCOPED_TRACE(words.size());
+        EXPECT_EQ(open_error(with_curve(words, "curve.fft")), Errc::fft_format);
+    }
     // A chunk twice, a PROP string running past its chunk, a key no .tck can hold.
     const std::string twice = fx.rewritten("twice.fft", {}, [](std::vector<TrailerChunk>& c) { c.push_back(c[0]); });
     EXPECT_EQ(open_error(twice), Errc::fft_format);

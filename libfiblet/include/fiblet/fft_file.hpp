@@ -25,6 +25,7 @@
 #include "fiblet/checksum.hpp"
 #include "fiblet/fiber_ends.hpp"
 #include "fiblet/fft_format.hpp"
+#include "fiblet/resample.hpp"
 
 namespace fiblet {
 
@@ -85,10 +86,13 @@ public:
     bool has_trailer() const { return !trailer_.empty(); }
     const std::vector<TrailerChunk>& trailer() const { return trailer_; }
     const TrailerChunk* find_chunk(std::array<char, 4> tag) const;
-    // The source .tck properties (PROP chunk), and the fixed step (mm) the
-    // input was resampled to (RSMP chunk; empty when it was not resampled).
+    // The source .tck properties (PROP chunk), and how variable-step input
+    // was resampled (RSMP chunk; empty when it was not resampled).
     const std::vector<std::pair<std::string, std::string>>& properties() const { return properties_; }
-    std::optional<double> resampled_step_mm() const { return resampled_step_mm_; }
+    const std::optional<Resampling>& resampling() const { return resampling_; }
+    std::optional<double> resampled_step_mm() const {
+        return resampling_ ? std::optional<double>(resampling_->step_mm) : std::nullopt;
+    }
     // Bytes after the last block that were not read (ignore_trailer).
     std::uint64_t ignored_trailing_bytes() const {
         return options_.ignore_trailer ? logical_size_ - header_.file_bytes() : 0;
@@ -137,7 +141,7 @@ private:
     std::vector<std::uint32_t> fiber_first_block_;  // block counts are 32-bit, so are first blocks
     std::vector<TrailerChunk> trailer_;
     std::vector<std::pair<std::string, std::string>> properties_;
-    std::optional<double> resampled_step_mm_;
+    std::optional<Resampling> resampling_;
     std::uint64_t trailer_hash_ = 0;  // XXH64 of the trailer chunks before CSUM, as read
     std::optional<FftChecksums> checksums_;
     std::shared_ptr<const FiberEndFractions> end_fractions_;

@@ -375,8 +375,10 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         const std::uint64_t at = out->logical_size();
         std::vector<TrailerChunk> chunks{make_properties_chunk(reader.header().properties)};
         if (report.resampled) {
-            TrailerChunk c{kResampledTag, std::vector<std::uint8_t>(8)};
+            TrailerChunk c{kResampledTag, std::vector<std::uint8_t>(16)};  // step, curve, 0
+            const auto curve = std::uint32_t(ResampleCurve::cubic);
             std::memcpy(c.payload.data(), &step, 8);
+            std::memcpy(c.payload.data() + 8, &curve, 4);
             chunks.push_back(std::move(c));
             chunks.push_back(make_fiber_ends_chunk(end_fractions));
             FiberEndFractions().swap(end_fractions);

@@ -12,6 +12,8 @@ struct V3 {
 };
 V3 to_v3(Vec3f p) { return {p.x, p.y, p.z}; }
 V3 sub(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+V3 add(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+V3 mul(V3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
 double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
 // Distance from p to the segment [a, b].
@@ -23,15 +25,86 @@ double segment_distance(V3 p, V3 a, V3 b) {
     const V3 d{ap.x - t * ab.x, ap.y - t * ab.y, ap.z - t * ab.z};
     return std::sqrt(dot(d, d));
 }
-}  // namespace
 
-void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out) {
+// Pieces per input segment when tracing the cubic: about 16 per step, so the
+// pieces' own corner cutting (~(1/16)² of a step's) is far below the codec's
+// error; segments much shorter than the step stay straight.
+std::size_t pieces_for(double segment_length, double step) {
+    const double n = std::ceil(16.0 * segment_length / step);
+    return std::size_t(std::clamp(n, 1.0, 256.0));
+}
+
+// The input's distinct points (repeated points carry no direction).
+void distinct_points(std::span<const Vec3f> in, std::vector<V3>& p) {
+    p.clear();
+    for (const Vec3f& q : in)
+        if (p.empty() || dot(sub(to_v3(q), p.back()), sub(to_v3(q), p.back())) > 0) p.push_back(to_v3(q));
+}
+
+double length(V3 a) { return std::sqrt(dot(a, a)); }
+V3 lerp(V3 a, V3 b, double w) { return add(a, mul(sub(b, a), w)); }
+
+// Unit-speed tangents at the points of a polyline (Bessel's: the derivative of
+// the parabola through each point and its neighbours, parameterised by chord
+// length); the end tangents are those of the end parabolas.
+void bessel_tangents(const std::vector<V3>& p, std::vector<V3>& m) {
+    const std::size_t n = p.size();
+    m.assign(n, {0, 0, 0});
+    auto chord = [&](std::size_t i) { return length(sub(p[i + 1], p[i])); };
+    auto unit_chord = [&](std::size_t i) { return mul(sub(p[i + 1], p[i]), 1.0 / chord(i)); };
+    for (std::size_t i = 1; i + 1 < n; ++i) {
+        const double a = chord(i - 1), b = chord(i);
+        m[i] = mul(add(mul(unit_chord(i - 1), b), mul(unit_chord(i), a)), 1.0 / (a + b));
+    }
+    m[0] = sub(mul(unit_chord(0), 2.0), m[1]);
+    m[n - 1] = sub(mul(unit_chord(n - 2), 2.0), m[n - 2]);
+}
+
+// How much of the cubic a segment gets: all of it up to two steps long, where
+// chords between its points would cut its corners; none from four steps on,
+// where the chords lie on the segment itself except across its ends (a
+// straight segment of the user's stays straight).
+double curve_weight(double segment_length, double step) {
+    return std::clamp(2.0 - 0.5 * segment_length / step, 0.0, 1.0);
+}
+
+// A dense polyline tracing the C¹ cubic (Hermite, Bessel tangents) through
+// the input points; it passes through every input point. On long segments
+// the tangents lean towards the segment (curve_weight): a Hermite segment
+// whose end tangents are its own direction is the straight segment.
+void trace_cubic(std::span<const Vec3f> in, double step, std::vector<Vec3f>& dense) {
+    thread_local std::vector<V3> p, m;
+    distinct_points(in, p);
+    dense.clear();
+    if (p.size() < 3) {
+        for (const V3& q : p) dense.push_back({float(q.x), float(q.y), float(q.z)});
+        return;
+    }
+    bessel_tangents(p, m);
+    for (std::size_t i = 0; i + 1 < p.size(); ++i) {
+        const double d = length(sub(p[i + 1], p[i]));
+        const double w = curve_weight(d, step);
+        const V3 u = mul(sub(p[i + 1], p[i]), 1.0 / d);
+        const V3 m0 = lerp(u, m[i], w), m1 = lerp(u, m[i + 1], w);
+        const std::size_t pieces = w > 0 ? pieces_for(d, step) : 1;
+        for (std::size_t k = 0; k < pieces; ++k) {
+            const double t = double(k) / double(pieces), t2 = t * t, t3 = t2 * t;
+            const V3 q = add(add(mul(p[i], 2 * t3 - 3 * t2 + 1), mul(m0, d * (t3 - 2 * t2 + t))),
+                             add(mul(p[i + 1], 3 * t2 - 2 * t3), mul(m1, d * (t3 - t2))));
+            dense.push_back({float(q.x), float(q.y), float(q.z)});
+        }
+    }
+    dense.push_back({float(p.back().x), float(p.back().y), float(p.back().z)});
+}
+
+// The chord walk: from the first point, the first point at distance `step`
+// on a later part of the polyline, again and again (a sphere-segment
+// intersection); the tail shorter than one step is dropped.
+void walk_chords(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out) {
     out.clear();
     if (in.empty()) return;
     V3 cur = to_v3(in[0]);
     out.push_back(in[0]);
-    // Find, on the segments after the current position, the first point at
-    // distance `step` from the current point (a sphere-segment intersection).
     std::size_t seg = 0;  // the current point lies on segment [seg, seg+1]
     const double r2 = step * step;
     while (seg + 1 < in.size()) {
@@ -52,19 +125,26 @@ void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec
             found = true;
             break;
         }
-        if (!found) break;  // the rest of the streamline is within one step: dropped
+        if (!found) break;
     }
 }
+}  // namespace
 
-bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out) {
-    resample_fixed_step(in, step, out);
+void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out, ResampleCurve curve) {
+    if (curve == ResampleCurve::polyline) return walk_chords(in, step, out);
+    thread_local std::vector<Vec3f> dense;
+    trace_cubic(in, step, dense);
+    walk_chords(dense, step, out);
+}
+
+bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out, ResampleCurve curve) {
+    resample_fixed_step(in, step, out, curve);
     if (in.size() < 2) return false;
     const V3 tail = sub(to_v3(in.back()), to_v3(out.back()));
     if (!(std::sqrt(dot(tail, tail)) > kKeptTailFraction * step)) return false;
     out.push_back(in.back());
     return true;
 }
-
 double distance_to_polyline_near(Vec3f p, std::span<const Vec3f> line, std::size_t& hint, std::size_t window) {
     if (line.empty()) return std::numeric_limits<double>::infinity();
     const V3 q = to_v3(p);

@@ -196,7 +196,7 @@ void FftFile::open_trailer(std::span<const std::uint8_t> head, std::uint64_t lut
     }
     detail::TrailerValues values = detail::validate_trailer_chunks(trailer_, header_, path_);
     properties_ = std::move(values.properties);
-    resampled_step_mm_ = values.resampled_step_mm;
+    resampling_ = values.resampling;
     end_fractions_ = std::move(values.end_fractions);
 }
 
@@ -240,7 +240,7 @@ FftFile& FftFile::operator=(FftFile&& o) noexcept {
         fiber_first_block_ = std::move(o.fiber_first_block_);
         trailer_ = std::move(o.trailer_);
         properties_ = std::move(o.properties_);
-        resampled_step_mm_ = o.resampled_step_mm_;
+        resampling_ = o.resampling_;
         trailer_hash_ = o.trailer_hash_;
         checksums_ = std::move(o.checksums_);
         end_fractions_ = std::move(o.end_fractions_);

@@ -130,20 +130,30 @@ std::vector<std::pair<std::string, std::string>> parse_properties(const TrailerC
     return props;
 }
 
-// RSMP: the step (mm) variable-step input was resampled to. The header's
-// step is that step times the decoder step scale, which compress bounds to
-// (0.5, 2); a step of 0 or NaN would make a comparison resample forever.
-double parse_resampled_step(const TrailerChunk& c, const FftHeader& h, const std::string& name) {
-    if (c.payload.size() != 8) bad_chunk(name, c.tag, std::to_string(c.payload.size()) + " bytes (8 expected)");
-    double step;
-    std::memcpy(&step, c.payload.data(), 8);
-    if (!(std::isfinite(step) && step > 0)) bad_chunk(name, c.tag, "step is not a positive finite number");
+// RSMP: the step (mm) variable-step input was resampled to, then (since the
+// cubic resampling) the curve it was resampled on. The header's step is that
+// step times the decoder step scale, which compress bounds to (0.5, 2); a
+// step of 0 or NaN would make a comparison resample forever.
+Resampling parse_resampling(const TrailerChunk& c, const FftHeader& h, const std::string& name) {
+    const std::size_t size = c.payload.size();
+    if (size != 8 && size != 16) bad_chunk(name, c.tag, std::to_string(size) + " bytes (8 or 16 expected)");
+    Resampling r{.curve = ResampleCurve::polyline};
+    std::memcpy(&r.step_mm, c.payload.data(), 8);
+    if (!(std::isfinite(r.step_mm) && r.step_mm > 0)) bad_chunk(name, c.tag, "step is not a positive finite number");
     const double header_step_mm = double(h.step) * double(h.scaling);
-    if (!(step >= header_step_mm * 0.499 && step <= header_step_mm * 2.001))
+    if (!(r.step_mm >= header_step_mm * 0.499 && r.step_mm <= header_step_mm * 2.001))
         bad_chunk(name, c.tag,
-                  "step " + std::to_string(step) + " mm disagrees with the header's " +
+                  "step " + std::to_string(r.step_mm) + " mm disagrees with the header's " +
                       std::to_string(header_step_mm) + " mm");
-    return step;
+    if (size == 16) {
+        std::uint32_t curve, reserved;
+        std::memcpy(&curve, c.payload.data() + 8, 4);
+        std::memcpy(&reserved, c.payload.data() + 12, 4);
+        if (curve > std::uint32_t(ResampleCurve::cubic) || reserved != 0)
+            bad_chunk(name, c.tag, "unknown resampling curve " + std::to_string(curve) + "/" + std::to_string(reserved));
+        r.curve = ResampleCurve(curve);
+    }
+    return r;
 }
 
 }  // namespace
@@ -158,7 +168,7 @@ TrailerValues validate_trailer_chunks(const std::vector<TrailerChunk>& chunks, c
             if (s == c.tag) bad_chunk(name, c.tag, "appears more than once");
         seen.push_back(c.tag);
         if (c.tag == kPropertiesTag) v.properties = parse_properties(c, name);
-        else if (c.tag == kResampledTag) v.resampled_step_mm = parse_resampled_step(c, header, name);
+        else if (c.tag == kResampledTag) v.resampling = parse_resampling(c, header, name);
         else if (c.tag == kBlockIndexTag) (void)parse_index_chunk(c.payload, header, name);
         else if (c.tag == kFiberEndsTag)
             v.end_fractions = std::make_shared<const FiberEndFractions>(parse_fiber_ends_chunk(c, header.fibers, name));

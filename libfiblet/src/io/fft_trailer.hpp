@@ -20,6 +20,7 @@
 
 #include "fiblet/fft_format.hpp"
 #include "fiblet/fiber_ends.hpp"
+#include "fiblet/resample.hpp"
 
 namespace fiblet::detail {
 
@@ -44,7 +45,7 @@ TrailerChunks read_trailer_chunks(const ReadAt& read_at, std::uint64_t blocks_en
 // Error{fft_format} naming `name`. (CSUM is parsed by FftChecksums::parse.)
 struct TrailerValues {
     std::vector<std::pair<std::string, std::string>> properties;  // PROP
-    std::optional<double> resampled_step_mm;                      // RSMP
+    std::optional<Resampling> resampling;                         // RSMP
     std::shared_ptr<const FiberEndFractions> end_fractions;       // ENDS
 };
 TrailerValues validate_trailer_chunks(const std::vector<TrailerChunk>& chunks, const FftHeader& header,

@@ -24,8 +24,8 @@ Comparison compare_to_reference(const FftFile& fft, const std::string& tck_path,
     struct stat st {};
     if (::stat(tck_path.c_str(), &st) == 0) c.reference_bytes = std::uint64_t(st.st_size);
 
-    const double step = fft.resampled_step_mm().value_or(0);  // validated at open: finite, > 0
-    c.resampled = fft.resampled_step_mm().has_value();
+    const Resampling resampling = fft.resampling().value_or(Resampling{});  // validated at open: step finite, > 0
+    c.resampled = fft.resampling().has_value();
     const bool keeps_ends = fft.end_fractions() != nullptr;
     TckReader ref(tck_path, {.allow_count_mismatch = allow_count_mismatch});
     std::vector<Vec3f> original, resampled;
@@ -40,8 +40,8 @@ Comparison compare_to_reference(const FftFile& fft, const std::string& tck_path,
             if (c.resampled) {
                 // Files with an ENDS chunk keep each fiber's end point; older
                 // ones dropped the tail shorter than a step.
-                if (keeps_ends) resample_keeping_end(original, step, resampled);
-                else resample_fixed_step(original, step, resampled);
+                if (keeps_ends) resample_keeping_end(original, resampling.step_mm, resampled, resampling.curve);
+                else resample_fixed_step(original, resampling.step_mm, resampled, resampling.curve);
                 target = resampled;
             }
             const std::uint64_t n = chunk.offsets[i + 1] - chunk.offsets[i];
