@@ -68,16 +68,53 @@ double curve_weight(double segment_length, double step) {
     return std::clamp(2.0 - 0.5 * segment_length / step, 0.0, 1.0);
 }
 
-// A dense polyline tracing the C¹ cubic (Hermite, Bessel tangents) through
-// the input points; it passes through every input point. On long segments
-// the tangents lean towards the segment (curve_weight): a Hermite segment
-// whose end tangents are its own direction is the straight segment.
-void trace_cubic(std::span<const Vec3f> in, double step, std::vector<Vec3f>& dense) {
+// The chord walk: from the first point, the first point at distance `step`
+// on a later part of the curve, again and again (a sphere-segment
+// intersection); the curve comes as consecutive straight pieces, so nothing
+// but the output is stored. The tail shorter than one step is dropped.
+class ChordWalk {
+public:
+    ChordWalk(V3 first, double step, std::vector<Vec3f>& out) : cur_(first), r2_(step * step), out_(out) {
+        out_.clear();
+        out_.push_back({float(first.x), float(first.y), float(first.z)});
+    }
+    // The next piece [a, b] of the curve (a is the previous piece's b).
+    void piece(V3 a, V3 b) {
+        const V3 d = sub(b, a);
+        const double qa = dot(d, d);
+        if (!(qa > 0)) return;
+        // While the piece's end is out of the sphere around the current
+        // point, the largest t in [0, 1] with |a + t d - cur| = step is next.
+        while (dot(sub(b, cur_), sub(b, cur_)) >= r2_) {
+            const V3 f = sub(a, cur_);
+            const double qb = 2 * dot(f, d), qc = dot(f, f) - r2_;
+            const double disc = std::max(qb * qb - 4 * qa * qc, 0.0);
+            const double t = std::clamp((-qb + std::sqrt(disc)) / (2 * qa), 0.0, 1.0);
+            cur_ = add(a, mul(d, t));
+            out_.push_back({float(cur_.x), float(cur_.y), float(cur_.z)});
+        }
+    }
+
+private:
+    V3 cur_;
+    double r2_;
+    std::vector<Vec3f>& out_;
+};
+
+// Feeds the walk the input polyline's segments.
+void walk_polyline(std::span<const Vec3f> in, ChordWalk& walk) {
+    for (std::size_t i = 0; i + 1 < in.size(); ++i) walk.piece(to_v3(in[i]), to_v3(in[i + 1]));
+}
+
+// Feeds the walk the C¹ cubic (Hermite, Bessel tangents) through the input
+// points, as short straight pieces; it passes through every input point. On
+// long segments the tangents lean towards the segment (curve_weight): a
+// Hermite segment whose end tangents are its own direction is the segment.
+void walk_cubic(std::span<const Vec3f> in, double step, ChordWalk& walk) {
     thread_local std::vector<V3> p, m;
     distinct_points(in, p);
-    dense.clear();
     if (p.size() < 3) {
-        for (const V3& q : p) dense.push_back({float(q.x), float(q.y), float(q.z)});
+        if (p.size() == 2) walk.piece(p[0], p[1]);
         return;
     }
     bessel_tangents(p, m);
@@ -87,54 +124,25 @@ void trace_cubic(std::span<const Vec3f> in, double step, std::vector<Vec3f>& den
         const V3 u = mul(sub(p[i + 1], p[i]), 1.0 / d);
         const V3 m0 = lerp(u, m[i], w), m1 = lerp(u, m[i + 1], w);
         const std::size_t pieces = w > 0 ? pieces_for(d, step) : 1;
-        for (std::size_t k = 0; k < pieces; ++k) {
+        V3 from = p[i];
+        for (std::size_t k = 1; k <= pieces; ++k) {
             const double t = double(k) / double(pieces), t2 = t * t, t3 = t2 * t;
-            const V3 q = add(add(mul(p[i], 2 * t3 - 3 * t2 + 1), mul(m0, d * (t3 - 2 * t2 + t))),
-                             add(mul(p[i + 1], 3 * t2 - 2 * t3), mul(m1, d * (t3 - t2))));
-            dense.push_back({float(q.x), float(q.y), float(q.z)});
+            const V3 to = k == pieces ? p[i + 1]
+                                      : add(add(mul(p[i], 2 * t3 - 3 * t2 + 1), mul(m0, d * (t3 - 2 * t2 + t))),
+                                            add(mul(p[i + 1], 3 * t2 - 2 * t3), mul(m1, d * (t3 - t2))));
+            walk.piece(from, to);
+            from = to;
         }
-    }
-    dense.push_back({float(p.back().x), float(p.back().y), float(p.back().z)});
-}
-
-// The chord walk: from the first point, the first point at distance `step`
-// on a later part of the polyline, again and again (a sphere-segment
-// intersection); the tail shorter than one step is dropped.
-void walk_chords(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out) {
-    out.clear();
-    if (in.empty()) return;
-    V3 cur = to_v3(in[0]);
-    out.push_back(in[0]);
-    std::size_t seg = 0;  // the current point lies on segment [seg, seg+1]
-    const double r2 = step * step;
-    while (seg + 1 < in.size()) {
-        bool found = false;
-        for (std::size_t s = seg; s + 1 < in.size(); ++s) {
-            const V3 a = to_v3(in[s]), b = to_v3(in[s + 1]);
-            if (dot(sub(b, cur), sub(b, cur)) < r2) continue;  // segment end still inside the sphere
-            // Solve |a + t (b - a) - cur|^2 = step^2 for the largest t in [0, 1].
-            const V3 d = sub(b, a), f = sub(a, cur);
-            const double qa = dot(d, d), qb = 2 * dot(f, d), qc = dot(f, f) - r2;
-            if (qa <= 0) continue;
-            const double disc = std::max(qb * qb - 4 * qa * qc, 0.0);
-            double t = (-qb + std::sqrt(disc)) / (2 * qa);
-            t = t < 0 ? 0 : (t > 1 ? 1 : t);
-            cur = {a.x + t * d.x, a.y + t * d.y, a.z + t * d.z};
-            out.push_back({float(cur.x), float(cur.y), float(cur.z)});
-            seg = s;
-            found = true;
-            break;
-        }
-        if (!found) break;
     }
 }
 }  // namespace
 
 void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out, ResampleCurve curve) {
-    if (curve == ResampleCurve::polyline) return walk_chords(in, step, out);
-    thread_local std::vector<Vec3f> dense;
-    trace_cubic(in, step, dense);
-    walk_chords(dense, step, out);
+    out.clear();
+    if (in.empty()) return;
+    ChordWalk walk(to_v3(in[0]), step, out);
+    if (curve == ResampleCurve::polyline) walk_polyline(in, walk);
+    else walk_cubic(in, step, walk);
 }
 
 bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out, ResampleCurve curve) {
@@ -145,6 +153,7 @@ bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Ve
     out.push_back(in.back());
     return true;
 }
+
 double distance_to_polyline_near(Vec3f p, std::span<const Vec3f> line, std::size_t& hint, std::size_t window) {
     if (line.empty()) return std::numeric_limits<double>::infinity();
     const V3 q = to_v3(p);
