@@ -140,3 +140,31 @@ TEST(Resample, WindowedDistanceMatchesBruteForceAlongThePolyline) {
         EXPECT_NEAR(distance_to_polyline_near(q, line, hint, 16), distance_to_polyline(q, line), 1e-9);
     }
 }
+
+TEST(Resample, PositionsSayWhereEachPointLiesOnTheInput) {
+    // Interpolating the input's own coordinates at the positions gives back
+    // the points on the polyline, and points within the cubic's distance of
+    // its chord on the cubic; positions only move forward along the input.
+    std::mt19937 rng(9);
+    std::vector<Vec3f> line = random_walk(rng, 120);
+    line.insert(line.begin() + 40, line[40]);  // a repeated point
+    const std::vector<float> coords(&line[0].x, &line[0].x + 3 * line.size());
+    for (const ResampleCurve curve : {ResampleCurve::polyline, ResampleCurve::cubic}) {
+        std::vector<Vec3f> out;
+        std::vector<PolylinePosition> at;
+        resample_keeping_end(line, 0.3, out, curve, &at);
+        ASSERT_EQ(at.size(), out.size());
+        std::vector<Vec3f> back(out.size());
+        interpolate_point_values(at, coords.data(), 3, &back[0].x);
+        for (std::size_t k = 0; k < out.size(); ++k) {
+            ASSERT_LT(at[k].segment + 1, line.size());
+            ASSERT_GE(at[k].t, 0.0);
+            ASSERT_LE(at[k].t, 1.0);
+            if (k > 0) EXPECT_TRUE(at[k].segment > at[k - 1].segment ||
+                                   (at[k].segment == at[k - 1].segment && at[k].t >= at[k - 1].t));
+            const double seg = dist(line[at[k].segment], line[at[k].segment + 1]);
+            EXPECT_LT(dist(back[k], out[k]), curve == ResampleCurve::polyline ? 1e-5 : 0.3 * seg + 1e-5) << k;
+        }
+        EXPECT_EQ(back.back(), line.back());
+    }
+}

@@ -22,6 +22,14 @@ enum class ResampleCurve : std::uint32_t {
     cubic = 1,
 };
 
+// Where a resampled point lies along its input: on input segment
+// [segment, segment + 1], at parameter t of it (its fraction of the segment
+// on the polyline, the Hermite parameter on the cubic).
+struct PolylinePosition {
+    std::size_t segment;
+    double t;
+};
+
 // How a file's variable-step input was resampled (its RSMP chunk).
 struct Resampling {
     double step_mm = 0;
@@ -33,8 +41,9 @@ struct Resampling {
 // a streamline: a fixed chord length). The tail shorter than one step is
 // dropped (at most `step` of length). Points are appended to `out` (cleared
 // first). A streamline shorter than one step keeps only its first point.
+// With `positions`, also says where each output point lies on the input.
 void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out,
-                         ResampleCurve curve = ResampleCurve::cubic);
+                         ResampleCurve curve = ResampleCurve::cubic, std::vector<PolylinePosition>* positions = nullptr);
 
 // A dropped tail shorter than this fraction of the step is not kept
 // (0.1 µm at a 0.1 mm step: far below the codec's error).
@@ -47,7 +56,13 @@ inline constexpr double kKeptTailFraction = 1e-3;
 // Returns whether that end point was appended (the last segment is then
 // shorter than the step).
 bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out,
-                          ResampleCurve curve = ResampleCurve::cubic);
+                          ResampleCurve curve = ResampleCurve::cubic, std::vector<PolylinePosition>* positions = nullptr);
+
+// Per-point values (`components` floats per input point) at resampled points:
+// linear interpolation between the two input points of the segment each
+// lies on, by the position's parameter.
+void interpolate_point_values(std::span<const PolylinePosition> positions, const float* in_values,
+                              std::size_t components, float* out_values);
 
 // Distance from a point to a polyline (a single point is a degenerate
 // polyline), in the units of the inputs: the exact minimum over all segments.

@@ -34,11 +34,13 @@ std::size_t pieces_for(double segment_length, double step) {
     return std::size_t(std::clamp(n, 1.0, 256.0));
 }
 
-// The input's distinct points (repeated points carry no direction).
-void distinct_points(std::span<const Vec3f> in, std::vector<V3>& p) {
-    p.clear();
-    for (const Vec3f& q : in)
-        if (p.empty() || dot(sub(to_v3(q), p.back()), sub(to_v3(q), p.back())) > 0) p.push_back(to_v3(q));
+// The input's distinct points (repeated points carry no direction), and the
+// input index of each.
+void distinct_points(std::span<const Vec3f> in, std::vector<V3>& p, std::vector<std::size_t>& index) {
+    p.clear(), index.clear();
+    for (std::size_t i = 0; i < in.size(); ++i)
+        if (p.empty() || dot(sub(to_v3(in[i]), p.back()), sub(to_v3(in[i]), p.back())) > 0)
+            p.push_back(to_v3(in[i])), index.push_back(i);
 }
 
 double length(V3 a) { return std::sqrt(dot(a, a)); }
@@ -74,12 +76,15 @@ double curve_weight(double segment_length, double step) {
 // but the output is stored. The tail shorter than one step is dropped.
 class ChordWalk {
 public:
-    ChordWalk(V3 first, double step, std::vector<Vec3f>& out) : cur_(first), r2_(step * step), out_(out) {
+    ChordWalk(V3 first, double step, std::vector<Vec3f>& out, std::vector<PolylinePosition>* positions)
+        : cur_(first), r2_(step * step), out_(out), positions_(positions) {
         out_.clear();
         out_.push_back({float(first.x), float(first.y), float(first.z)});
+        if (positions_) positions_->assign(1, {0, 0.0});
     }
-    // The next piece [a, b] of the curve (a is the previous piece's b).
-    void piece(V3 a, V3 b) {
+    // The next piece [a, b] of the curve (a is the previous piece's b): the
+    // part [t0, t1] of input segment `segment`.
+    void piece(V3 a, V3 b, std::size_t segment, double t0 = 0, double t1 = 1) {
         const V3 d = sub(b, a);
         const double qa = dot(d, d);
         if (!(qa > 0)) return;
@@ -92,6 +97,7 @@ public:
             const double t = std::clamp((-qb + std::sqrt(disc)) / (2 * qa), 0.0, 1.0);
             cur_ = add(a, mul(d, t));
             out_.push_back({float(cur_.x), float(cur_.y), float(cur_.z)});
+            if (positions_) positions_->push_back({segment, t0 + t * (t1 - t0)});
         }
     }
 
@@ -99,11 +105,12 @@ private:
     V3 cur_;
     double r2_;
     std::vector<Vec3f>& out_;
+    std::vector<PolylinePosition>* positions_;
 };
 
 // Feeds the walk the input polyline's segments.
 void walk_polyline(std::span<const Vec3f> in, ChordWalk& walk) {
-    for (std::size_t i = 0; i + 1 < in.size(); ++i) walk.piece(to_v3(in[i]), to_v3(in[i + 1]));
+    for (std::size_t i = 0; i + 1 < in.size(); ++i) walk.piece(to_v3(in[i]), to_v3(in[i + 1]), i);
 }
 
 // Feeds the walk the C¹ cubic (Hermite, Bessel tangents) through the input
@@ -112,9 +119,13 @@ void walk_polyline(std::span<const Vec3f> in, ChordWalk& walk) {
 // Hermite segment whose end tangents are its own direction is the segment.
 void walk_cubic(std::span<const Vec3f> in, double step, ChordWalk& walk) {
     thread_local std::vector<V3> p, m;
-    distinct_points(in, p);
+    thread_local std::vector<std::size_t> index;
+    distinct_points(in, p, index);
+    // Distinct points i and i + 1 end input segment index[i + 1] - 1 (the
+    // copies of point i before it have no length).
+    auto segment = [&](std::size_t i) { return index[i + 1] - 1; };
     if (p.size() < 3) {
-        if (p.size() == 2) walk.piece(p[0], p[1]);
+        if (p.size() == 2) walk.piece(p[0], p[1], segment(0));
         return;
     }
     bessel_tangents(p, m);
@@ -130,28 +141,43 @@ void walk_cubic(std::span<const Vec3f> in, double step, ChordWalk& walk) {
             const V3 to = k == pieces ? p[i + 1]
                                       : add(add(mul(p[i], 2 * t3 - 3 * t2 + 1), mul(m0, d * (t3 - 2 * t2 + t))),
                                             add(mul(p[i + 1], 3 * t2 - 2 * t3), mul(m1, d * (t3 - t2))));
-            walk.piece(from, to);
+            walk.piece(from, to, segment(i), double(k - 1) / double(pieces), t);
             from = to;
         }
     }
 }
 }  // namespace
 
-void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out, ResampleCurve curve) {
+void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out, ResampleCurve curve,
+                         std::vector<PolylinePosition>* positions) {
     out.clear();
+    if (positions) positions->clear();
     if (in.empty()) return;
-    ChordWalk walk(to_v3(in[0]), step, out);
+    ChordWalk walk(to_v3(in[0]), step, out, positions);
     if (curve == ResampleCurve::polyline) walk_polyline(in, walk);
     else walk_cubic(in, step, walk);
 }
 
-bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out, ResampleCurve curve) {
-    resample_fixed_step(in, step, out, curve);
+bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out, ResampleCurve curve,
+                          std::vector<PolylinePosition>* positions) {
+    resample_fixed_step(in, step, out, curve, positions);
     if (in.size() < 2) return false;
     const V3 tail = sub(to_v3(in.back()), to_v3(out.back()));
     if (!(std::sqrt(dot(tail, tail)) > kKeptTailFraction * step)) return false;
     out.push_back(in.back());
+    if (positions) positions->push_back({in.size() - 2, 1.0});
     return true;
+}
+
+void interpolate_point_values(std::span<const PolylinePosition> positions, const float* in_values,
+                              std::size_t components, float* out_values) {
+    for (std::size_t k = 0; k < positions.size(); ++k) {
+        const PolylinePosition& p = positions[k];
+        const float* a = in_values + p.segment * components;
+        const float* b = p.t > 0 ? a + components : a;  // t = 0 on a one-point line: no second point
+        for (std::size_t c = 0; c < components; ++c)
+            out_values[k * components + c] = float(double(a[c]) + p.t * (double(b[c]) - double(a[c])));
+    }
 }
 
 double distance_to_polyline_near(Vec3f p, std::span<const Vec3f> line, std::size_t& hint, std::size_t window) {
