@@ -10,6 +10,7 @@ PACKAGES=(
   python3 python3-numpy python3-nibabel python3-matplotlib
   python3-dev python3-pybind11 pybind11-dev python3-pytest snakemake
   mrtrix3 zstd time
+  slurm-wlm munge  # the cohort workflow on a single-node SLURM (ecosystem.cohort_workflow_slurm)
   clang-14 libclang-rt-14-dev  # libFuzzer harnesses (scripts/fuzz.sh)
   libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libspng-dev
 )
