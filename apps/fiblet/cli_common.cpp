@@ -3,8 +3,12 @@
 #include <fmt/core.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
 
 namespace fiblet::cli {
 
@@ -141,7 +145,11 @@ std::string json_quote(const std::string& s) {
 }
 
 Json& Json::num(const std::string& k, double v) {
-    return raw(k, std::isfinite(v) ? fmt::format("{:.9g}", v) : "null");
+    // The shortest text that reads back as the same double.
+    return raw(k, std::isfinite(v) ? fmt::format("{}", v) : "null");
+}
+Json& Json::num(const std::string& k, float v) {
+    return raw(k, std::isfinite(v) ? fmt::format("{}", v) : "null");
 }
 Json& Json::integer(const std::string& k, std::uint64_t v) { return raw(k, std::to_string(v)); }
 Json& Json::str(const std::string& k, const std::string& v) { return raw(k, json_quote(v)); }
@@ -172,6 +180,35 @@ void add_ignore_trailer_flag(CLI::App* cmd, bool& flag) {
     cmd->add_flag("--ignore-trailer", flag,
                   "Read only the header, LUT and blocks, not the trailer after them: salvages a file whose "
                   "trailer is damaged (nothing is then verified by checksum)");
+}
+
+void make_output_dir(const std::string& dir) {
+    std::error_code ec;
+    if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
+        throw Error(Errc::invalid_argument, dir + ": --output-dir names a file, not a directory");
+    std::filesystem::create_directories(dir, ec);
+    if (ec) throw Error(Errc::io, dir + ": cannot create the --output-dir directory: " + ec.message());
+}
+
+void add_threads_option(CLI::App* cmd, unsigned& threads, const std::string& what) {
+    CLI::Option* option = cmd->add_option(
+        "-j,--threads", threads, what + " threads (default: FIBLET_NTHREADS, else MRTRIX_NTHREADS, else all cores)");
+    // Read here rather than by CLI11's envname, so that a bad value names its variable.
+    cmd->parse_complete_callback([option, &threads] {
+        if (option->count() > 0) return;
+        for (const char* name : {"FIBLET_NTHREADS", "MRTRIX_NTHREADS"}) {
+            const char* value = std::getenv(name);
+            if (!value) continue;
+            char* end = nullptr;
+            errno = 0;
+            const unsigned long long n = std::strtoull(value, &end, 10);
+            if (!*value || *end || errno || value[0] == '-' || n > std::numeric_limits<unsigned>::max())
+                throw Error(Errc::invalid_argument, std::string(name) + "='" + value +
+                                                        "' is not a thread count (a whole number, 0 for all cores)");
+            threads = unsigned(n);
+            return;
+        }
+    });
 }
 
 }  // namespace fiblet::cli
