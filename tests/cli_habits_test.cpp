@@ -252,3 +252,27 @@ TEST(CliHabits, ManPageRendersWithoutWarnings) {
     for (const char* s : {"fiblet compress", "fiblet decompress", "--output-dir", "MRTRIX_NTHREADS", "EXIT STATUS"})
         EXPECT_NE(text.find(s), std::string::npos) << s << "\n" << text.substr(0, 2000);
 }
+
+TEST(CliHabits, DashIsStandardInputAndOutput) {
+    Fixture fx;
+    fs::create_directories(fx.dir.file("spool"));
+    const std::string env = "env TMPDIR=" + fx.dir.file("spool") + " ";
+    const std::string cli = env + FIBLET_CLI;
+    const auto in_dir = [&](const std::string& cmd) { return test::run_command("cd " + fx.dir.path() + " && " + cmd); };
+    ASSERT_EQ(in_dir(cli + " decompress -q in.fft -o file.tck").status, 0);
+    ASSERT_EQ(in_dir(cli + " compress -q in.tck -o file.fft -f").status, 0);
+    // The data on stdout is the file a path would get; the report goes to stderr.
+    ASSERT_EQ(in_dir(cli + " decompress in.fft -o - > piped.tck 2> report.txt").status, 0);
+    EXPECT_EQ(test::read_file(fx.dir.file("piped.tck")), test::read_file(fx.dir.file("file.tck")));
+    EXPECT_NE(test::read_file(fx.dir.file("report.txt")).find("in.fft -> -: 3 fibers"), std::string::npos);
+    ASSERT_EQ(in_dir("cat in.tck | " + cli + " compress - -o - --json > piped.fft 2> report.json").status, 0);
+    EXPECT_EQ(test::read_file(fx.dir.file("piped.fft")), test::read_file(fx.dir.file("file.fft")));
+    EXPECT_NE(test::read_file(fx.dir.file("report.json")).find("\"fibers\": 3"), std::string::npos);
+    ASSERT_EQ(in_dir("cat in.fft | " + cli + " decompress -q - -o - > twice.tck").status, 0);
+    EXPECT_EQ(test::read_file(fx.dir.file("twice.tck")), test::read_file(fx.dir.file("file.tck")));
+    // Standard input has no name to derive an output from; the spool files are gone.
+    const auto r = in_dir("cat in.tck | " + cli + " compress - 2>&1");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(mentions(r, "standard input (-) needs -o")) << r.output;
+    EXPECT_TRUE(fs::is_empty(fx.dir.file("spool")));
+}

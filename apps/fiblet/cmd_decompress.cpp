@@ -6,6 +6,7 @@
 
 #include "cli_common.hpp"
 #include "input_files.hpp"
+#include "stdio_files.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/tck.hpp"
@@ -24,7 +25,8 @@ struct DecompressArgs {
 // Decodes one file; returns its JSON report (empty without --json).
 std::string decompress_one(const DecompressArgs& a, const std::string& input, const std::string& output) {
     const auto t0 = std::chrono::steady_clock::now();
-    const FftFile file = open_fft_input(input, a.ignore_trailer);
+    std::optional<SpoolFile> stdin_spool, stdout_spool;
+    const FftFile file = open_fft_input(readable_path(input, ".fft", stdin_spool), a.ignore_trailer);
     const FftHeader& h = file.header();
     // The source's header properties (kept in the trailer), with the step
     // the points now have.
@@ -36,7 +38,8 @@ std::string decompress_one(const DecompressArgs& a, const std::string& input, co
     options.decoder = parse_decoder(a.decoder);
     options.threads = a.threads;
     const std::string decoder = decoder_name(options.decoder);
-    TckWriter writer(output, header.properties, a.force);
+    const std::string out_path = writable_path(output, ".tck", stdout_spool);
+    TckWriter writer(out_path, header.properties, a.force || stdout_spool);
     Progress progress(a.quiet);
     decode_file(
         file,
@@ -49,6 +52,7 @@ std::string decompress_one(const DecompressArgs& a, const std::string& input, co
         options);
     writer.finish();
     progress.done();
+    if (stdout_spool) stdout_spool->copy_to_stdout();
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (a.json)
         return Json{}
@@ -59,7 +63,9 @@ std::string decompress_one(const DecompressArgs& a, const std::string& input, co
             .str("decoder", decoder)
             .num("seconds", s)
             .render();
-    if (!a.quiet) fmt::print("{} -> {}: {} fibers, {} points in {:.2f} s\n", input, output, h.fibers, h.points, s);
+    if (!a.quiet)
+        fmt::print(report_stream(output), "{} -> {}: {} fibers, {} points in {:.2f} s\n", input, output, h.fibers,
+                   h.points, s);
     return {};
 }
 
@@ -81,7 +87,7 @@ void run(const DecompressArgs& a) {
     if (a.json) {
         std::string all;
         for (const std::string& j : json) all += (all.empty() ? "" : ",\n ") + j;
-        fmt::print("{}\n", jobs.size() == 1 && json.size() == 1 ? json[0] : "[" + all + "]");
+        fmt::print(report_stream(a.output), "{}\n", jobs.size() == 1 && json.size() == 1 ? json[0] : "[" + all + "]");
     }
     if (first_failure) throw Error(first_failure->code(), "some inputs failed (see above)");
 }
@@ -91,10 +97,12 @@ void run(const DecompressArgs& a) {
 void add_decompress(CLI::App& app) {
     auto args = std::make_shared<DecompressArgs>();
     CLI::App* cmd = app.add_subcommand("decompress", "Decode a .fft file back into a .tck file");
-    cmd->add_option("inputs", args->inputs, "Input .fft/.fftz files (with -r, directories)")
+    cmd->add_option("inputs", args->inputs, "Input .fft/.fftz files (with -r, directories; - for standard input)")
         ->required()
-        ->check(CLI::ExistingPath);
-    cmd->add_option("-o,--output", args->output, "Output .tck file (one input; default: the input's name with .tck)");
+        ->check(CLI::ExistingPath | CLI::IsMember({"-"}));
+    cmd->add_option("-o,--output", args->output,
+                    "Output .tck file (one input; default: the input's name with .tck; - for standard output, "
+                    "the report then on stderr)");
     cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs); created if missing");
     cmd->add_flag("-r,--recursive", args->recursive,
                   "Decompress every .fft/.fftz below the directories given (tree mirrored in --output-dir)");

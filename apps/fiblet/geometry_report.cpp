@@ -71,11 +71,11 @@ void print_geometry(const GeometryError& g, const std::string& indent) {
                signed_mm < 0 ? "-" : "+", micrometres_value(std::fabs(signed_mm), 3), g.length_change_mm().worst_fiber);
 }
 
-void print_geometry_brief(const GeometryError& g, const std::string& indent) {
-    fmt::print("{}vs input polylines, both ways: Hausdorff {}; decoded -> input mean {}, input -> decoded mean {}\n",
+void print_geometry_brief(const GeometryError& g, const std::string& indent, std::FILE* to) {
+    fmt::print(to, "{}vs input polylines, both ways: Hausdorff {}; decoded -> input mean {}, input -> decoded mean {}\n",
                indent, micrometres(g.hausdorff_mm()), micrometres(g.decoded_to_input().mean_mm()),
                micrometres(g.input_to_decoded().mean_mm()));
-    fmt::print("{}endpoints moved: max {}, mean {}; length change: max {} ({:.4f} %), mean {} ({:.4f} %)\n", indent,
+    fmt::print(to, "{}endpoints moved: max {}, mean {}; length change: max {} ({:.4f} %), mean {} ({:.4f} %)\n", indent,
                micrometres(g.endpoint_mm().max), micrometres(g.endpoint_mm().mean()),
                micrometres(g.length_change_mm().max), g.length_change_percent().max,
                micrometres(g.length_change_mm().mean()), g.length_change_percent().mean());

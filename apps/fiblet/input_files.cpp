@@ -40,6 +40,11 @@ std::vector<FileJob> plan_file_jobs(const std::vector<std::string>& operands, co
     if (!o.output_dir.empty()) make_output_dir(o.output_dir);
     std::vector<FileJob> jobs;
     for (const std::string& operand : operands) {
+        if (operand == "-") {  // standard input: no name to derive an output from
+            if (o.output.empty()) throw Error(Errc::invalid_argument, "standard input (-) needs -o (- for standard output)");
+            jobs.push_back({operand, o.output});
+            continue;
+        }
         if (!fs::is_directory(operand)) {
             jobs.push_back({operand, output_for(o, operand, fs::path(operand).filename())});
             continue;

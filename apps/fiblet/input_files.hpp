@@ -20,8 +20,8 @@ struct FileJobOptions {
     bool recursive = false;                     // -r
 };
 
-// Throws Error(Errc::invalid_argument) for a directory without -r, -o with
-// several inputs, or a directory holding no input; creates --output-dir and
+// `-` (standard input) needs -o. Throws Error(Errc::invalid_argument) for a
+// directory without -r, -o with several inputs, or a directory holding no input; creates --output-dir and
 // the folders the mirrored tree needs in it.
 std::vector<FileJob> plan_file_jobs(const std::vector<std::string>& operands, const FileJobOptions& options);
 
