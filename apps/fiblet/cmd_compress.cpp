@@ -151,7 +151,7 @@ void add_compress(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("compress", "Compress .tck tractograms into .fft fiblet files");
     cmd->add_option("inputs", args->inputs, "Input .tck files (with -r, directories; - for standard input)")
         ->required()
-        ->check(CLI::ExistingPath | CLI::IsMember({"-"}));
+        ->check(existing_path_or_stdin());
     cmd->add_flag("-r,--recursive", args->recursive, "Compress every .tck below the directories given (tree mirrored in --output-dir)");
     cmd->add_option("-o,--output", args->output, "Output .fft file (one input; - for standard output, the report then on stderr)");
     cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs); created if missing");

@@ -99,7 +99,7 @@ void add_decompress(CLI::App& app) {
     CLI::App* cmd = app.add_subcommand("decompress", "Decode a .fft file back into a .tck file");
     cmd->add_option("inputs", args->inputs, "Input .fft/.fftz files (with -r, directories; - for standard input)")
         ->required()
-        ->check(CLI::ExistingPath | CLI::IsMember({"-"}));
+        ->check(existing_path_or_stdin());
     cmd->add_option("-o,--output", args->output,
                     "Output .tck file (one input; default: the input's name with .tck; - for standard output, "
                     "the report then on stderr)");

@@ -74,6 +74,11 @@ void SpoolFile::copy_to_stdout() const {
     std::fclose(f);
 }
 
+CLI::Validator existing_path_or_stdin() {
+    return CLI::Validator([](std::string& s) { return is_stdio(s) ? std::string() : CLI::ExistingPath(s); },
+                          "PATH or -");
+}
+
 std::string readable_path(const std::string& input, const std::string& suffix, std::optional<SpoolFile>& spool) {
     if (!is_stdio(input)) return input;
     spool.emplace(suffix);

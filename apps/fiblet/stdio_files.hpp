@@ -6,6 +6,7 @@
 // to stdout once complete — a pipe never receives half a file.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -33,6 +34,9 @@ private:
 std::string readable_path(const std::string& input, const std::string& suffix, std::optional<SpoolFile>& spool);
 // The file to write for `output`: itself, or for `-` a spool (copy_to_stdout() once complete).
 std::string writable_path(const std::string& output, const std::string& suffix, std::optional<SpoolFile>& spool);
+
+// CLI11 check of an input operand: an existing path, or - (standard input).
+CLI::Validator existing_path_or_stdin();
 
 // Where a command's report goes: stdout, unless the data itself goes there.
 inline std::FILE* report_stream(const std::string& output) { return is_stdio(output) ? stderr : stdout; }
