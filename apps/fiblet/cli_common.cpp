@@ -3,6 +3,8 @@
 #include <fmt/core.h>
 #include <unistd.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -87,69 +89,19 @@ std::string micrometres_value(double mm, int decimals) {
 
 std::string micrometres(double mm, int decimals) { return micrometres_value(mm, decimals) + " µm"; }
 
-namespace {
-
-// Length of the well-formed UTF-8 sequence at s[i] (RFC 3629: shortest form,
-// no surrogates, at most U+10FFFF), or 0 if the bytes there are not one.
-std::size_t utf8_sequence_length(const std::string& s, std::size_t i) {
-    const auto byte = [&](std::size_t k) { return k < s.size() ? static_cast<unsigned char>(s[k]) : 0u; };
-    const unsigned b0 = byte(i);
-    const auto cont = [&](std::size_t k) { return (byte(k) & 0xC0u) == 0x80u; };
-    if (b0 < 0x80) return 1;
-    if (b0 >= 0xC2 && b0 <= 0xDF) return cont(i + 1) ? 2 : 0;
-    if (b0 >= 0xE0 && b0 <= 0xEF) {
-        const unsigned b1 = byte(i + 1);
-        const bool ok1 = b0 == 0xE0 ? (b1 >= 0xA0 && b1 <= 0xBF) : b0 == 0xED ? (b1 >= 0x80 && b1 <= 0x9F) : cont(i + 1);
-        return ok1 && cont(i + 2) ? 3 : 0;
-    }
-    if (b0 >= 0xF0 && b0 <= 0xF4) {
-        const unsigned b1 = byte(i + 1);
-        const bool ok1 = b0 == 0xF0 ? (b1 >= 0x90 && b1 <= 0xBF) : b0 == 0xF4 ? (b1 >= 0x80 && b1 <= 0x8F) : cont(i + 1);
-        return ok1 && cont(i + 2) && cont(i + 3) ? 4 : 0;
-    }
-    return 0;
-}
-
-}  // namespace
-
 // Strings come from files (header properties, names) and may hold any
 // bytes: invalid UTF-8 becomes U+FFFD, so the output is always valid JSON.
 std::string json_quote(const std::string& s) {
-    std::string out = "\"";
-    for (std::size_t i = 0; i < s.size();) {
-        const unsigned char ch = static_cast<unsigned char>(s[i]);
-        const std::size_t n = utf8_sequence_length(s, i);
-        if (n == 0) {
-            out += "\\ufffd";
-            ++i;
-            continue;
-        }
-        if (n > 1) {
-            out.append(s, i, n);
-            i += n;
-            continue;
-        }
-        switch (ch) {
-            case '"': out += "\\\""; break;
-            case '\\': out += "\\\\"; break;
-            case '\n': out += "\\n"; break;
-            case '\t': out += "\\t"; break;
-            case '\r': out += "\\r"; break;
-            default:
-                if (ch < 0x20 || ch == 0x7f) out += fmt::format("\\u{:04x}", ch);
-                else out += char(ch);
-        }
-        ++i;
-    }
-    return out + "\"";
+    return nlohmann::json(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
-Json& Json::num(const std::string& k, double v) {
-    // The shortest text that reads back as the same double.
-    return raw(k, std::isfinite(v) ? fmt::format("{}", v) : "null");
-}
+// nlohmann::json prints the shortest text that reads back as the same
+// double, and NaN or an infinity as null.
+Json& Json::num(const std::string& k, double v) { return raw(k, nlohmann::json(v).dump()); }
+// A float's shortest text (24.1133, not its double 24.113300323486328): the
+// double nearest to that text prints as it.
 Json& Json::num(const std::string& k, float v) {
-    return raw(k, std::isfinite(v) ? fmt::format("{}", v) : "null");
+    return num(k, std::isfinite(v) ? std::strtod(fmt::format("{}", v).c_str(), nullptr) : double(v));
 }
 Json& Json::integer(const std::string& k, std::uint64_t v) { return raw(k, std::to_string(v)); }
 Json& Json::str(const std::string& k, const std::string& v) { return raw(k, json_quote(v)); }
