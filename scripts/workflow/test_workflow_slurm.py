@@ -34,8 +34,10 @@ def test_cohort_on_slurm(cohort, tmp_path_factory):
     local_out, slurm_out = tmp_path_factory.mktemp("local"), tmp_path_factory.mktemp("slurm")
     run_workflow(cohort, f"output_dir={local_out}", timeout=WORKFLOW_TIMEOUT_S)
 
-    SLURM_ROOT.mkdir(parents=True, exist_ok=True)
-    cluster_dir = Path(tempfile.mkdtemp(prefix="slurm-", dir=SLURM_ROOT))
+    # The munge socket's path must fit a sockaddr_un (108 bytes): a deep build tree falls back to $TMPDIR.
+    root = SLURM_ROOT if len(str(SLURM_ROOT)) < 70 else Path(tempfile.gettempdir())
+    root.mkdir(parents=True, exist_ok=True)
+    cluster_dir = Path(tempfile.mkdtemp(prefix="slurm-", dir=root))
     logs = cluster_dir / "jobs"
     logs.mkdir()
     sbatch = (f"sbatch --parsable --job-name={{rule}} --cpus-per-task={{threads}} --mem={{resources.mem_mb}} "
