@@ -219,6 +219,23 @@ TEST(CliHabits, JsonKeysMeanOneThing) {
     EXPECT_EQ(info.output.find("\"ratio\""), std::string::npos) << info.output;
     EXPECT_NE(info.output.find("\"cap_ratio\": "), std::string::npos) << info.output;
     EXPECT_NE(info.output.find("\"trailer_chunks\": [\""), std::string::npos) << info.output;
+
+    // Percentiles are 0.01 µm bin edges: printed with at most 2 decimals, not as 4.500000000000001.
+    if (!test::shared_data_available()) return;
+    const std::string tck = test::shared_data_dir() + "/dwi-small64d-ifod1.tck";
+    ASSERT_EQ(test::run_cli("compress -q " + tck + " -o " + fx.dir.file("dwi.fft")).status, 0);
+    const auto stats = test::run_cli("stats --json " + fx.dir.file("dwi.fft") + " -r " + tck);
+    ASSERT_EQ(stats.status, 0) << stats.output;
+    int percentiles = 0;
+    for (std::size_t at = stats.output.find("_um\": "); at != std::string::npos; at = stats.output.find("_um\": ", at + 1)) {
+        const std::size_t key = stats.output.rfind('"', at - 1), value = at + 6;
+        if (stats.output.compare(key + 1, 1, "p") != 0) continue;
+        const std::string number = stats.output.substr(value, stats.output.find_first_of(",}", value) - value);
+        const std::size_t point = number.find('.');
+        EXPECT_TRUE(point == std::string::npos || number.size() - point - 1 <= 2) << number << "\n" << stats.output;
+        ++percentiles;
+    }
+    EXPECT_EQ(percentiles, 9);  // p50, p95, p99 of the error and of both directed distances
 }
 
 TEST(CliHabits, BashCompletionOffersEachSubcommandsOptions) {
