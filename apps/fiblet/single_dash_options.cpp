@@ -1,5 +1,6 @@
 #include "single_dash_options.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <map>
 
@@ -51,9 +52,10 @@ std::string command_name(const CLI::App& app) {
     return app.get_parent() ? "fiblet " + app.get_name() : "fiblet";
 }
 
+// `-name` or `-name=value`: fiblet's spelling, or Error(invalid_argument) saying which one is meant.
 std::string translate(const CLI::App& app, const std::string& word) {
-    const std::string name = word.substr(1, word.find('=') == std::string::npos ? std::string::npos : word.find('=') - 1);
-    const std::string value = word.find('=') == std::string::npos ? "" : word.substr(word.find('='));
+    const std::size_t equals = std::min(word.find('='), word.size());
+    const std::string name = word.substr(1, equals - 1), value = word.substr(equals);
     const auto mrtrix = mrtrix_spellings().find(name);
     if (mrtrix != mrtrix_spellings().end() && has_option(app, mrtrix->second)) return mrtrix->second + value;
     if (mrtrix != mrtrix_spellings().end())
