@@ -44,3 +44,17 @@ install(FILES ${PROJECT_BINARY_DIR}/fibletConfig.cmake ${PROJECT_BINARY_DIR}/fib
 file(RELATIVE_PATH FIBLET_PC_TO_PREFIX "/prefix/${CMAKE_INSTALL_LIBDIR}/pkgconfig" "/prefix")
 configure_file(${CMAKE_CURRENT_LIST_DIR}/fiblet.pc.in ${PROJECT_BINARY_DIR}/fiblet.pc @ONLY)
 install(FILES ${PROJECT_BINARY_DIR}/fiblet.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+
+# The man page fiblet(1) and the bash completion, generated from the CLI11
+# definitions by the CLI just built (`fiblet help --man | --bash-completion`).
+set(FIBLET_MAN_PAGE ${PROJECT_BINARY_DIR}/share/man/man1/fiblet.1)
+set(FIBLET_BASH_COMPLETION ${PROJECT_BINARY_DIR}/share/bash-completion/completions/fiblet)
+add_custom_command(OUTPUT ${FIBLET_MAN_PAGE} ${FIBLET_BASH_COMPLETION}
+  COMMAND ${CMAKE_COMMAND} -E make_directory ${PROJECT_BINARY_DIR}/share/man/man1
+          ${PROJECT_BINARY_DIR}/share/bash-completion/completions
+  COMMAND sh -c "\"$1\" help --man > \"$2\" && \"$1\" help --bash-completion > \"$3\"" sh
+          $<TARGET_FILE:fiblet_cli> ${FIBLET_MAN_PAGE} ${FIBLET_BASH_COMPLETION}
+  DEPENDS fiblet_cli VERBATIM)
+add_custom_target(fiblet_cli_reference ALL DEPENDS ${FIBLET_MAN_PAGE} ${FIBLET_BASH_COMPLETION})
+install(FILES ${FIBLET_MAN_PAGE} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
+install(FILES ${FIBLET_BASH_COMPLETION} DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions)

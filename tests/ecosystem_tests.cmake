@@ -22,7 +22,18 @@ if(DEFINED Python_EXECUTABLE)
   add_test(NAME ecosystem.cohort_workflow
     COMMAND ${Python_EXECUTABLE} -m pytest -q -p no:cacheprovider ${PROJECT_SOURCE_DIR}/scripts/workflow/test_workflow.py)
   set_tests_properties(ecosystem.cohort_workflow PROPERTIES TIMEOUT 300
-    ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA};FIBLET_CLI=$<TARGET_FILE:fiblet_cli>")
+    ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA};FIBLET_CLI=$<TARGET_FILE:fiblet_cli>;FIBLET_VERSION=${PROJECT_VERSION}")
+endif()
+
+# The same Snakefile on a single-node SLURM (slurm-wlm, munge) started on
+# localhost by the test, its state in the build tree; the test stops the
+# daemons itself (its workflow timeout is under CTest's) and they die with it
+# if it is killed.
+if(DEFINED Python_EXECUTABLE)
+  add_test(NAME ecosystem.cohort_workflow_slurm
+    COMMAND ${Python_EXECUTABLE} -m pytest -q -p no:cacheprovider ${PROJECT_SOURCE_DIR}/scripts/workflow/test_workflow_slurm.py)
+  set_tests_properties(ecosystem.cohort_workflow_slurm PROPERTIES TIMEOUT 500
+    ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA};FIBLET_CLI=$<TARGET_FILE:fiblet_cli>;FIBLET_SLURM_DIR=${PROJECT_BINARY_DIR}/slurm")
 endif()
 
 # CLI conventions: help, --version, --json, documented exit codes.

@@ -78,7 +78,7 @@ TEST_F(SelectCli, WritesWhatTheLibrarySelects) {
     q = {};
     q.random_fraction = 0.25, q.random_seed = 7;
     q.min_length_mm = 60;
-    cases.push_back({"--random-fraction 0.25 --seed 7 --minlength 60", q});
+    cases.push_back({"--random-fraction 0.25 --seed 7 --min-length 60", q});
     q = {};
     q.include = {Region::sphere({5, 3, -2}, 6), Region::box_between({-20, -10, 0}, {-5, 10, 20})};
     q.roi_mode = RoiMode::blocks;
@@ -115,19 +115,22 @@ TEST_F(SelectCli, AgreesWithTckedit) {
     };
     int nonempty = 0;
     for (int i = 0; i < 6; ++i) {
-        std::string args, ours;  // tckedit's options, and fiblet's spelling of them
-        auto both = [&](const std::string& flag, const std::string& value) {
+        // tckedit's options, and fiblet's spelling of them; fiblet also
+        // takes tckedit's own (odd cases), as an MRtrix3 user types them.
+        std::string args, ours;
+        auto both = [&](const std::string& flag, const std::string& fiblet_flag, const std::string& value) {
             args += " -" + flag + " " + value;
-            ours += " --" + flag + " " + value;
+            ours += (i % 2 ? " -" + flag : " --" + fiblet_flag) + " " + value;
         };
-        for (int k = 0; k < 1 + i % 2; ++k) both("include", spec(gen.some_point(), gen.uniform(3, 12)));
-        if (i % 3 == 2) both("exclude", spec(gen.some_point(), gen.uniform(3, 10)));
+        for (int k = 0; k < 1 + i % 2; ++k) both("include", "include", spec(gen.some_point(), gen.uniform(3, 12)));
+        if (i % 3 == 2) both("exclude", "exclude", spec(gen.some_point(), gen.uniform(3, 10)));
         // Lengths are multiples of the 0.1 mm step: thresholds between them.
-        if (i == 4) both("minlength", "70.05"), both("maxlength", "120.05");
+        if (i == 4) both("minlength", "min-length", "70.05"), both("maxlength", "max-length", "120.05");
+        if (i == 5) both("minlength", "min-length", "90.05");
         const std::string a = dir_->file("tckedit" + std::to_string(i) + ".tck");
         const std::string b = dir_->file("fiblet" + std::to_string(i) + ".tck");
         ASSERT_EQ(run("tckedit -quiet -force -nthreads 0 " + full + " " + a + args), 0) << args;
-        ASSERT_EQ(run(cli() + " extract " + fft() + " -o " + b + ours), 0) << ours;
+        ASSERT_EQ(run(cli() + " extract " + (i % 2 ? "-quiet -force " : "") + fft() + " -o " + b + ours), 0) << ours;
         const auto expected = read_tck(a);
         nonempty += !expected.empty();
         EXPECT_EQ(read_tck(b), expected) << args;
@@ -164,7 +167,7 @@ TEST_F(SelectCli, AddsAnIndexToOfficialEncoderFiles) {
 TEST_F(SelectCli, BadOptionsExitWithUsageErrorAndWriteNothing) {
     const std::string out = dir_->file("bad.tck"), out_fft = dir_->file("bad.fft");
     for (const std::string args : {" --include 1,2,3", " --include 1,2,x,4", " --fibers 5-", " --fibers 9-3",
-                                   " --random-fraction 2", " --minlength 50 --maxlength 10", " --include 0,0,0,-1",
+                                   " --random-fraction 2", " --min-length 50 --max-length 10", " --include 0,0,0,-1",
                                    " --camera-position 0,0,100", " --lod 100x100", " --mode strands",
                                    " --camera-position 0,0,100 --camera-target 0,0,0 --lod 100",
                                    " --camera-position 0,0,100 --camera-target 0,0,100"}) {

@@ -3,8 +3,14 @@
 #include <fmt/core.h>
 #include <unistd.h>
 
+#include <nlohmann/json.hpp>
+
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
 
 namespace fiblet::cli {
 
@@ -83,65 +89,19 @@ std::string micrometres_value(double mm, int decimals) {
 
 std::string micrometres(double mm, int decimals) { return micrometres_value(mm, decimals) + " µm"; }
 
-namespace {
-
-// Length of the well-formed UTF-8 sequence at s[i] (RFC 3629: shortest form,
-// no surrogates, at most U+10FFFF), or 0 if the bytes there are not one.
-std::size_t utf8_sequence_length(const std::string& s, std::size_t i) {
-    const auto byte = [&](std::size_t k) { return k < s.size() ? static_cast<unsigned char>(s[k]) : 0u; };
-    const unsigned b0 = byte(i);
-    const auto cont = [&](std::size_t k) { return (byte(k) & 0xC0u) == 0x80u; };
-    if (b0 < 0x80) return 1;
-    if (b0 >= 0xC2 && b0 <= 0xDF) return cont(i + 1) ? 2 : 0;
-    if (b0 >= 0xE0 && b0 <= 0xEF) {
-        const unsigned b1 = byte(i + 1);
-        const bool ok1 = b0 == 0xE0 ? (b1 >= 0xA0 && b1 <= 0xBF) : b0 == 0xED ? (b1 >= 0x80 && b1 <= 0x9F) : cont(i + 1);
-        return ok1 && cont(i + 2) ? 3 : 0;
-    }
-    if (b0 >= 0xF0 && b0 <= 0xF4) {
-        const unsigned b1 = byte(i + 1);
-        const bool ok1 = b0 == 0xF0 ? (b1 >= 0x90 && b1 <= 0xBF) : b0 == 0xF4 ? (b1 >= 0x80 && b1 <= 0x8F) : cont(i + 1);
-        return ok1 && cont(i + 2) && cont(i + 3) ? 4 : 0;
-    }
-    return 0;
-}
-
-}  // namespace
-
 // Strings come from files (header properties, names) and may hold any
 // bytes: invalid UTF-8 becomes U+FFFD, so the output is always valid JSON.
 std::string json_quote(const std::string& s) {
-    std::string out = "\"";
-    for (std::size_t i = 0; i < s.size();) {
-        const unsigned char ch = static_cast<unsigned char>(s[i]);
-        const std::size_t n = utf8_sequence_length(s, i);
-        if (n == 0) {
-            out += "\\ufffd";
-            ++i;
-            continue;
-        }
-        if (n > 1) {
-            out.append(s, i, n);
-            i += n;
-            continue;
-        }
-        switch (ch) {
-            case '"': out += "\\\""; break;
-            case '\\': out += "\\\\"; break;
-            case '\n': out += "\\n"; break;
-            case '\t': out += "\\t"; break;
-            case '\r': out += "\\r"; break;
-            default:
-                if (ch < 0x20 || ch == 0x7f) out += fmt::format("\\u{:04x}", ch);
-                else out += char(ch);
-        }
-        ++i;
-    }
-    return out + "\"";
+    return nlohmann::json(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
-Json& Json::num(const std::string& k, double v) {
-    return raw(k, std::isfinite(v) ? fmt::format("{:.9g}", v) : "null");
+// nlohmann::json prints the shortest text that reads back as the same
+// double, and NaN or an infinity as null.
+Json& Json::num(const std::string& k, double v) { return raw(k, nlohmann::json(v).dump()); }
+// A float's shortest text (24.1133, not its double 24.113300323486328): the
+// double nearest to that text prints as it.
+Json& Json::num(const std::string& k, float v) {
+    return num(k, std::isfinite(v) ? std::strtod(fmt::format("{}", v).c_str(), nullptr) : double(v));
 }
 Json& Json::integer(const std::string& k, std::uint64_t v) { return raw(k, std::to_string(v)); }
 Json& Json::str(const std::string& k, const std::string& v) { return raw(k, json_quote(v)); }
@@ -172,6 +132,35 @@ void add_ignore_trailer_flag(CLI::App* cmd, bool& flag) {
     cmd->add_flag("--ignore-trailer", flag,
                   "Read only the header, LUT and blocks, not the trailer after them: salvages a file whose "
                   "trailer is damaged (nothing is then verified by checksum)");
+}
+
+void make_output_dir(const std::string& dir) {
+    std::error_code ec;
+    if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
+        throw Error(Errc::invalid_argument, dir + ": --output-dir names a file, not a directory");
+    std::filesystem::create_directories(dir, ec);
+    if (ec) throw Error(Errc::io, dir + ": cannot create the --output-dir directory: " + ec.message());
+}
+
+void add_threads_option(CLI::App* cmd, unsigned& threads, const std::string& what) {
+    CLI::Option* option = cmd->add_option(
+        "-j,--threads", threads, what + " threads (default: FIBLET_NTHREADS, else MRTRIX_NTHREADS, else all cores)");
+    // Read here rather than by CLI11's envname, so that a bad value names its variable.
+    cmd->parse_complete_callback([option, &threads] {
+        if (option->count() > 0) return;
+        for (const char* name : {"FIBLET_NTHREADS", "MRTRIX_NTHREADS"}) {
+            const char* value = std::getenv(name);
+            if (!value) continue;
+            char* end = nullptr;
+            errno = 0;
+            const unsigned long long n = std::strtoull(value, &end, 10);
+            if (!*value || *end || errno || value[0] == '-' || n > std::numeric_limits<unsigned>::max())
+                throw Error(Errc::invalid_argument, std::string(name) + "='" + value +
+                                                        "' is not a thread count (a whole number, 0 for all cores)");
+            threads = unsigned(n);
+            return;
+        }
+    });
 }
 
 }  // namespace fiblet::cli

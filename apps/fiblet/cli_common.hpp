@@ -67,6 +67,7 @@ void write_decoded_fiber(TckWriter& writer, const float* xyz, std::uint64_t n, c
 class Json {
 public:
     Json& num(const std::string& key, double v);
+    Json& num(const std::string& key, float v);  // shortest text of the float, not of its double
     Json& integer(const std::string& key, std::uint64_t v);
     Json& str(const std::string& key, const std::string& v);
     Json& boolean(const std::string& key, bool v);
@@ -83,6 +84,13 @@ std::string json_quote(const std::string& s);
 // and a warning says what that gives up.
 FftFile open_fft_input(const std::string& path, bool ignore_trailer);
 void add_ignore_trailer_flag(CLI::App* cmd, bool& flag);
+
+// --output-dir DIR: created (with its parents) when missing; a file there is a usage error.
+void make_output_dir(const std::string& dir);
+
+// -j/--threads N; when not given, from FIBLET_NTHREADS, else from MRtrix3's
+// MRTRIX_NTHREADS (0 or unset: all cores). `threads` must outlive the parse.
+void add_threads_option(CLI::App* cmd, unsigned& threads, const std::string& what);
 
 // Subcommand registration (one file each).
 void add_compress(CLI::App& app);

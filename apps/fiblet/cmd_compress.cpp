@@ -1,4 +1,4 @@
-// fiblet compress IN.tck [IN2.tck ...] (-o OUT.fft | --output-dir DIR)
+// fiblet compress IN.tck [IN2.tck ...] [-o OUT.fft | --output-dir DIR] [-r DIR]
 #include <fmt/core.h>
 
 #include <filesystem>
@@ -8,6 +8,8 @@
 #include "fiblet/compress.hpp"
 #include "fiblet/encode.hpp"
 #include "geometry_report.hpp"
+#include "input_files.hpp"
+#include "stdio_files.hpp"
 
 namespace fiblet::cli {
 namespace {
@@ -30,17 +32,9 @@ struct CompressArgs {
     bool no_index = false;
     int zstd_level = ZstdOptions{}.level;
     std::uint32_t zstd_group = ZstdOptions{}.group_blocks;
-    bool force = false, quiet = false, json = false, allow_count_mismatch = false;
+    bool force = false, quiet = false, json = false, allow_count_mismatch = false, recursive = false;
     std::optional<double> max_error_um;
 };
-
-std::string output_for(const CompressArgs& a, const std::string& in) {
-    if (!a.output.empty()) return a.output;
-    std::filesystem::path p = std::filesystem::path(in).filename();
-    p.replace_extension(a.zstd ? ".fftz" : ".fft");
-    return (a.output_dir.empty() ? std::filesystem::path(in).parent_path() / p : std::filesystem::path(a.output_dir) / p)
-        .string();
-}
 
 std::string describe_errors(const ErrorStats& e) {
     return fmt::format("max {}, mean {}, p99 {}", micrometres(e.max_mm()), micrometres(e.mean_mm()),
@@ -66,16 +60,27 @@ std::string report_json(const std::string& in, const std::string& out, const Com
     return j.render();
 }
 
+void print_report(std::FILE* to, const std::string& in, const std::string& out, const CompressReport& r) {
+    fmt::print(to, "{} -> {}\n", in, out);
+    fmt::print(to, "  {} fibers, {} points, {} blocks of {} points ({} B)\n", r.header.fibers, r.header.points,
+               r.header.blocks, r.header.points_per_block, r.header.block_bytes());
+    fmt::print(to, "  step {:.6g} mm{}, decoder step x{:.5f}, cap ratio {:.4f}\n", r.step_mm,
+               r.resampled ? " (variable spacing in the input: resampled to this fixed step)" : "", r.step_scale,
+               r.header.ratio);
+    fmt::print(to, "  {} -> {} ({:.2f}x smaller)\n", human_bytes(r.input_bytes), human_bytes(r.output_bytes),
+               double(r.input_bytes) / double(r.output_bytes));
+    fmt::print(to, "  error vs {}: {}\n", r.resampled ? "resampled points" : "input", describe_errors(r.error));
+    print_geometry_brief(r.geometry, "  ", to);
+    fmt::print(to, "  {:.2f} s ({:.1f} M points/s)\n", r.seconds, r.header.points / r.seconds / 1e6);
+}
+
 void run(const CompressArgs& a) {
-    if (a.inputs.size() > 1 && !a.output.empty())
-        throw Error(Errc::invalid_argument, "-o names one output: use --output-dir DIR for several inputs");
-    if (!a.output_dir.empty() && !std::filesystem::is_directory(a.output_dir))
-        throw Error(Errc::invalid_argument, a.output_dir + ": --output-dir is not a directory");
+    const auto jobs = plan_file_jobs(
+        a.inputs, {{".tck"}, a.zstd ? ".fftz" : ".fft", a.output, a.output_dir, a.recursive});
     std::vector<std::string> json;
     std::optional<Error> first_failure;
     std::size_t above_bound = 0;
-    for (const std::string& in : a.inputs) {
-        const std::string out = output_for(a, in);
+    for (const auto& [in, out] : jobs) {
         Progress progress(a.quiet);
         CompressOptions o;
         o.step_mm = a.step;
@@ -97,22 +102,16 @@ void run(const CompressArgs& a) {
         const std::string name = std::filesystem::path(in).filename().string();
         o.progress = [&](const char* phase, double f) { progress.update(name + ": " + phase, f); };
         try {
-            const CompressReport r = compress_tck(in, out, o);
+            std::optional<SpoolFile> stdin_spool, stdout_spool;
+            const std::string out_path = writable_path(out, a.zstd ? ".fftz" : ".fft", stdout_spool);
+            o.overwrite = a.force || stdout_spool;
+            const CompressReport r = compress_tck(readable_path(in, ".tck", stdin_spool), out_path, o);
             progress.done();
+            if (stdout_spool) stdout_spool->copy_to_stdout();
             if (a.json) {
                 json.push_back(report_json(in, out, r, a.max_error_um));
             } else if (!a.quiet) {
-                fmt::print("{} -> {}\n", in, out);
-                fmt::print("  {} fibers, {} points, {} blocks of {} points ({} B)\n", r.header.fibers,
-                           r.header.points, r.header.blocks, r.header.points_per_block, r.header.block_bytes());
-                fmt::print("  step {:.6g} mm{}, decoder step x{:.5f}, cap ratio {:.4f}\n", r.step_mm,
-                           r.resampled ? " (variable spacing in the input: resampled to this fixed step)" : "",
-                           r.step_scale, r.header.ratio);
-                fmt::print("  {} -> {} ({:.2f}x smaller)\n", human_bytes(r.input_bytes), human_bytes(r.output_bytes),
-                           double(r.input_bytes) / double(r.output_bytes));
-                fmt::print("  error vs {}: {}\n", r.resampled ? "resampled points" : "input", describe_errors(r.error));
-                print_geometry_brief(r.geometry, "  ");
-                fmt::print("  {:.2f} s ({:.1f} M points/s)\n", r.seconds, r.header.points / r.seconds / 1e6);
+                print_report(report_stream(out), in, out, r);
             }
             if (a.max_error_um && !metrics_above(r.error, r.geometry, *a.max_error_um).empty()) {
                 try {
@@ -129,19 +128,19 @@ void run(const CompressArgs& a) {
         }
     }
     if (a.json) {
-        if (a.inputs.size() == 1 && json.size() == 1) fmt::print("{}\n", json[0]);
+        if (jobs.size() == 1 && json.size() == 1) fmt::print(report_stream(a.output), "{}\n", json[0]);
         else {
             std::string all = "[";
             for (std::size_t i = 0; i < json.size(); ++i) all += (i ? ",\n " : "") + json[i];
-            fmt::print("{}]\n", all);
+            fmt::print(report_stream(a.output), "{}]\n", all);
         }
     }
     if (first_failure) {
-        if (a.inputs.size() == 1) throw Error(first_failure->code(), "compression failed");
+        if (jobs.size() == 1) throw Error(first_failure->code(), "compression failed");
         throw Error(first_failure->code(), "some inputs failed (see above)");
     }
     if (above_bound)
-        throw ErrorBoundExceeded(std::to_string(above_bound) + " of " + std::to_string(a.inputs.size()) +
+        throw ErrorBoundExceeded(std::to_string(above_bound) + " of " + std::to_string(jobs.size()) +
                                  " outputs above --max-error (kept; see above)");
 }
 
@@ -150,11 +149,14 @@ void run(const CompressArgs& a) {
 void add_compress(CLI::App& app) {
     auto args = std::make_shared<CompressArgs>();
     CLI::App* cmd = app.add_subcommand("compress", "Compress .tck tractograms into .fft fiblet files");
-    cmd->add_option("inputs", args->inputs, "Input .tck files")->required()->check(CLI::ExistingFile);
-    cmd->add_option("-o,--output", args->output, "Output .fft file (one input)");
-    cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs)");
+    cmd->add_option("inputs", args->inputs, "Input .tck files (with -r, directories; - for standard input)")
+        ->required()
+        ->check(existing_path_or_stdin());
+    cmd->add_flag("-r,--recursive", args->recursive, "Compress every .tck below the directories given (tree mirrored in --output-dir)");
+    cmd->add_option("-o,--output", args->output, "Output .fft file (one input; - for standard output, the report then on stderr)");
+    cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs); created if missing");
     cmd->add_option("--step", args->step, "Fixed step in mm (default: measured; variable spacing is resampled)");
-    cmd->add_option("-j,--threads", args->threads, "Encoding threads (default: all cores)");
+    add_threads_option(cmd, args->threads, "Encoding");
     cmd->add_option("--bits", args->bits, "Bits per direction: 8 (.fft version 2) or 16 (formats/fft16.md)")
         ->check(CLI::IsMember({8u, 16u}));
     cmd->add_option("--block-points", args->block_points, "Points per block (default 60 for 8 bits, 126 for 16)");

@@ -1,9 +1,12 @@
-// fiblet decompress IN.fft -o OUT.tck [-j N] [--decoder NAME]
+// fiblet decompress IN.fft [IN2.fft ...] [-o OUT.tck | --output-dir DIR] [-r DIR] [-j N] [--decoder NAME]
 #include <fmt/core.h>
 
 #include <chrono>
+#include <optional>
 
 #include "cli_common.hpp"
+#include "input_files.hpp"
+#include "stdio_files.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/tck.hpp"
@@ -13,14 +16,17 @@ namespace {
 
 struct DecompressArgs {
     bool ignore_trailer = false;
-    std::string input, output, decoder = "auto";
+    std::vector<std::string> inputs;
+    std::string output, output_dir, decoder = "auto";
     unsigned threads = 0;
-    bool force = false, quiet = false, json = false;
+    bool force = false, quiet = false, json = false, recursive = false;
 };
 
-void run(const DecompressArgs& a) {
+// Decodes one file; returns its JSON report (empty without --json).
+std::string decompress_one(const DecompressArgs& a, const std::string& input, const std::string& output) {
     const auto t0 = std::chrono::steady_clock::now();
-    const FftFile file = open_fft_input(a.input, a.ignore_trailer);
+    std::optional<SpoolFile> stdin_spool, stdout_spool;
+    const FftFile file = open_fft_input(readable_path(input, ".fft", stdin_spool), a.ignore_trailer);
     const FftHeader& h = file.header();
     // The source's header properties (kept in the trailer), with the step
     // the points now have.
@@ -32,32 +38,58 @@ void run(const DecompressArgs& a) {
     options.decoder = parse_decoder(a.decoder);
     options.threads = a.threads;
     const std::string decoder = decoder_name(options.decoder);
-    TckWriter writer(a.output, header.properties, a.force);
+    const std::string out_path = writable_path(output, ".tck", stdout_spool);
+    TckWriter writer(out_path, header.properties, a.force || stdout_spool);
     Progress progress(a.quiet);
     decode_file(
         file,
         [&](std::uint64_t first, const Streamlines& chunk) {
             for (std::size_t i = 0; i < chunk.size(); ++i)
                 write_decoded_fiber(writer, &chunk.xyz[3 * chunk.offsets[i]], chunk.offsets[i + 1] - chunk.offsets[i],
-                                    a.input, first + i);
+                                    input, first + i);
             progress.update("decompress", h.fibers ? double(first + chunk.size()) / double(h.fibers) : 1.0);
         },
         options);
     writer.finish();
     progress.done();
+    if (stdout_spool) stdout_spool->copy_to_stdout();
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (a.json) {
-        fmt::print("{}\n", Json{}
-                               .str("input", a.input)
-                               .str("output", a.output)
-                               .integer("fibers", h.fibers)
-                               .integer("points", h.points)
-                               .str("decoder", decoder)
-                               .num("seconds", s)
-                               .render());
-    } else if (!a.quiet) {
-        fmt::print("{} -> {}: {} fibers, {} points in {:.2f} s\n", a.input, a.output, h.fibers, h.points, s);
+    if (a.json)
+        return Json{}
+            .str("input", input)
+            .str("output", output)
+            .integer("fibers", h.fibers)
+            .integer("points", h.points)
+            .str("decoder", decoder)
+            .num("seconds", s)
+            .render();
+    if (!a.quiet)
+        fmt::print(report_stream(output), "{} -> {}: {} fibers, {} points in {:.2f} s\n", input, output, h.fibers,
+                   h.points, s);
+    return {};
+}
+
+// Every input is tried; with several, a failed one is reported and the
+// first failure's code is the exit status (as compress does).
+void run(const DecompressArgs& a) {
+    const auto jobs = plan_file_jobs(a.inputs, {{".fft", ".fftz"}, ".tck", a.output, a.output_dir, a.recursive});
+    std::vector<std::string> json;
+    std::optional<Error> first_failure;
+    for (const auto& [in, out] : jobs) {
+        try {
+            json.push_back(decompress_one(a, in, out));
+        } catch (const Error& e) {
+            if (jobs.size() == 1) throw;
+            fmt::print(stderr, "fiblet: error: {}\n", e.what());
+            if (!first_failure) first_failure = e;
+        }
     }
+    if (a.json) {
+        std::string all;
+        for (const std::string& j : json) all += (all.empty() ? "" : ",\n ") + j;
+        fmt::print(report_stream(a.output), "{}\n", jobs.size() == 1 && json.size() == 1 ? json[0] : "[" + all + "]");
+    }
+    if (first_failure) throw Error(first_failure->code(), "some inputs failed (see above)");
 }
 
 }  // namespace
@@ -65,9 +97,16 @@ void run(const DecompressArgs& a) {
 void add_decompress(CLI::App& app) {
     auto args = std::make_shared<DecompressArgs>();
     CLI::App* cmd = app.add_subcommand("decompress", "Decode a .fft file back into a .tck file");
-    cmd->add_option("input", args->input, "Input .fft file")->required()->check(CLI::ExistingFile);
-    cmd->add_option("-o,--output", args->output, "Output .tck file")->required();
-    cmd->add_option("-j,--threads", args->threads, "Decoding threads (default: all cores)");
+    cmd->add_option("inputs", args->inputs, "Input .fft/.fftz files (with -r, directories; - for standard input)")
+        ->required()
+        ->check(existing_path_or_stdin());
+    cmd->add_option("-o,--output", args->output,
+                    "Output .tck file (one input; default: the input's name with .tck; - for standard output, "
+                    "the report then on stderr)");
+    cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs); created if missing");
+    cmd->add_flag("-r,--recursive", args->recursive,
+                  "Decompress every .fft/.fftz below the directories given (tree mirrored in --output-dir)");
+    add_threads_option(cmd, args->threads, "Decoding");
     cmd->add_option("--decoder", args->decoder,
                     "auto (the fastest), scalar, lanes, warp, or one with its SIMD level: " +
                         [] {

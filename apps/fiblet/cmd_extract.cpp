@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "cli_common.hpp"
+#include "fiber_ranges.hpp"
 #include "fiblet/block_index.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/fft_subset.hpp"
@@ -71,37 +72,9 @@ Region region(const std::string& option, const std::string& text) {
     usage(option + " takes x,y,z,radius (sphere) or x0,y0,z0,x1,y1,z1 (box)");
 }
 
-// "0,5,10-20": IDs and inclusive ranges.
-std::vector<FiberRange> fiber_ranges(const std::string& text) {
-    std::vector<FiberRange> out;
-    std::stringstream ss(text);
-    std::string item;
-    auto id = [&](const std::string& s) {
-        if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos)
-            usage("--fibers: '" + item + "' is not an ID or a range FIRST-LAST");
-        try {
-            return std::uint64_t(std::stoull(s));
-        } catch (const std::exception&) {
-            usage("--fibers: '" + item + "' is out of range");
-        }
-    };
-    while (std::getline(ss, item, ',')) {
-        const auto dash = item.find('-');
-        if (dash == std::string::npos) {
-            const std::uint64_t f = id(item);
-            out.push_back({f, f});
-        } else {
-            out.push_back({id(item.substr(0, dash)), id(item.substr(dash + 1))});
-            if (out.back().first > out.back().last) usage("--fibers: '" + item + "' is an inverted range (FIRST > LAST)");
-        }
-    }
-    if (out.empty() || text.back() == ',') usage("--fibers: empty list or empty item in '" + text + "'");
-    return out;
-}
-
 Query build_query(const ExtractArgs& a) {
     Query q;
-    if (a.fibers_given) q.fibers = fiber_ranges(a.fibers);
+    if (a.fibers_given) q.fibers = parse_fiber_ranges("--fibers", a.fibers);
     q.min_length_mm = a.min_length;
     q.max_length_mm = a.max_length;
     q.random_fraction = a.random_fraction;
@@ -202,9 +175,9 @@ void add_extract(CLI::App& app) {
     cmd->add_option("input", args->input, "Input .fft file")->required()->check(CLI::ExistingFile);
     cmd->add_option("-o,--output", args->output, "Output .tck (points) or .fft (a subset file)")->required();
     CLI::Option* fibers =
-        cmd->add_option("--fibers", args->fibers, "Fiber IDs and inclusive ranges, e.g. 0,5,10-20 (0-based)");
-    cmd->add_option("--minlength", args->min_length, "Keep fibers at least this long (mm), as tckedit");
-    cmd->add_option("--maxlength", args->max_length, "Keep fibers at most this long (mm), as tckedit");
+        cmd->add_option("--fibers", args->fibers, "Fiber IDs and inclusive ranges, e.g. 0,5,10-20 (0-based; FIRST:LAST also reads as a range)");
+    cmd->add_option("--min-length", args->min_length, "Keep fibers at least this long (mm), as tckedit -minlength");
+    cmd->add_option("--max-length", args->max_length, "Keep fibers at most this long (mm), as tckedit -maxlength");
     cmd->add_option("--random-fraction", args->random_fraction, "Keep this fraction of the fibers, at random");
     cmd->add_option("--seed", args->seed, "Seed of --random-fraction (default 0)");
     cmd->add_option("--include", args->include,

@@ -31,6 +31,13 @@ std::string properties_json(const std::vector<std::pair<std::string, std::string
     return out + "]";
 }
 
+// ["CSUM", "PROP", ...]: the trailer's chunk tags, in file order.
+std::string chunk_tags_json(const FftFile& f) {
+    std::string out;
+    for (const auto& c : f.trailer()) out += (out.empty() ? "" : ", ") + json_quote(std::string(c.tag.data(), 4));
+    return "[" + out + "]";
+}
+
 void print_properties(const std::vector<std::pair<std::string, std::string>>& props) {
     for (const auto& [k, v] : props) fmt::print("  {:<22} {}\n", k + ":", v);
 }
@@ -72,10 +79,10 @@ void info_fft(const InfoArgs& a) {
         j.integer("points_per_block", h.points_per_block).integer("block_bytes", h.block_bytes());
         j.num("scaling_mm", h.scaling);
         j.raw("offset_mm", fmt::format("[{:.9g}, {:.9g}, {:.9g}]", h.offset[0], h.offset[1], h.offset[2]));
-        j.num("ratio", h.ratio).num("step", h.step).num("step_mm", double(h.step) * h.scaling);
+        j.num("cap_ratio", h.ratio).num("step", h.step).num("step_mm", double(h.step) * h.scaling);
         j.num("max_error_um", h.max_error_mm * 1e3).num("mean_error_um", h.mean_error_mm * 1e3);
         j.integer("gpu_buffers", h.buffer_ends.size()).integer("file_bytes", f.file_size());
-        j.str("trailer_chunks", chunks);
+        j.raw("trailer_chunks", chunk_tags_json(f));
         j.boolean("ends_kept", f.end_fractions() != nullptr).integer("fibers_with_partial_last_step", partial);
         j.raw("properties", properties_json(f.properties()));
         fmt::print("{}\n", j.render());

@@ -1,4 +1,5 @@
-// fiblet stats IN.fft --reference IN.tck
+// fiblet stats IN.fft [--reference IN.tck]: the error against the source,
+// or without it tckstats-style length statistics of the decoded fibers.
 #include <fmt/core.h>
 
 #include <optional>
@@ -6,6 +7,7 @@
 #include "cli_common.hpp"
 #include "fiblet/compare.hpp"
 #include "geometry_report.hpp"
+#include "length_stats.hpp"
 
 namespace fiblet::cli {
 namespace {
@@ -17,8 +19,18 @@ struct StatsArgs {
     std::optional<double> max_error_um;
 };
 
+void run_lengths(const StatsArgs& a, const FftFile& file) {
+    if (a.max_error_um) throw Error(Errc::invalid_argument, "--max-error needs --reference (the source .tck)");
+    const LengthStats s = length_stats(decoded_fiber_lengths(file, 0));
+    if (a.json)
+        fmt::print("{}\n", Json{}.str("file", a.input).raw("length", length_json(s)).render());
+    else
+        fmt::print("{}", length_table(s));
+}
+
 void run(const StatsArgs& a) {
     const FftFile file = open_fft_input(a.input, a.ignore_trailer);
+    if (a.reference.empty()) return run_lengths(a, file);
     Progress progress(a.quiet || a.json);
     const Comparison c =
         compare_to_reference(file, a.reference, a.allow_count_mismatch, [&](double f) { progress.update("stats", f); });
@@ -63,10 +75,10 @@ void add_stats(CLI::App& app) {
     auto args = std::make_shared<StatsArgs>();
     CLI::App* cmd = app.add_subcommand(
         "stats", "Measure a .fft file against its source .tck: point error, distances both ways (Hausdorff), "
-                 "endpoint displacement, length change");
+                 "endpoint displacement, length change; without --reference, fiber length statistics");
     cmd->add_option("input", args->input, "Input .fft file")->required()->check(CLI::ExistingFile);
-    cmd->add_option("-r,--reference", args->reference, "The .tck file it was made from")
-        ->required()
+    cmd->add_option("-r,--reference", args->reference,
+                    "The .tck file it was made from (without it: length statistics, as MRtrix3's tckstats)")
         ->check(CLI::ExistingFile);
     cmd->add_flag("--json", args->json, "Print the report as JSON");
     cmd->add_option("--max-error", args->max_error_um,

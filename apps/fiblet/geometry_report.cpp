@@ -2,18 +2,31 @@
 
 #include <fmt/core.h>
 
+#include <cmath>
+
 #include "cli_common.hpp"
 
 namespace fiblet::cli {
+
+namespace {
+
+// A percentile is the edge of a 0.01 µm bin (or the max): in µm, a number of
+// hundredths, printed as such (4.5, not the 4.500000000000001 of mm * 1e3).
+double percentile_um(const ErrorStats& e, double p) {
+    const double mm = e.percentile_mm(p);
+    return mm == e.max_mm() ? mm * 1e3 : std::round(mm * 1e5) / 100.0;
+}
+
+}  // namespace
 
 std::string distances_json(const ErrorStats& e) {
     return Json{}
         .num("max_um", e.max_mm() * 1e3)
         .num("mean_um", e.mean_mm() * 1e3)
         .num("rms_um", e.rms_mm() * 1e3)
-        .num("p50_um", e.percentile_mm(50) * 1e3)
-        .num("p95_um", e.percentile_mm(95) * 1e3)
-        .num("p99_um", e.percentile_mm(99) * 1e3)
+        .num("p50_um", percentile_um(e, 50))
+        .num("p95_um", percentile_um(e, 95))
+        .num("p99_um", percentile_um(e, 99))
         .integer("worst_fiber", e.worst_fiber())
         .integer("points", e.count())
         .render();
@@ -71,11 +84,11 @@ void print_geometry(const GeometryError& g, const std::string& indent) {
                signed_mm < 0 ? "-" : "+", micrometres_value(std::fabs(signed_mm), 3), g.length_change_mm().worst_fiber);
 }
 
-void print_geometry_brief(const GeometryError& g, const std::string& indent) {
-    fmt::print("{}vs input polylines, both ways: Hausdorff {}; decoded -> input mean {}, input -> decoded mean {}\n",
+void print_geometry_brief(const GeometryError& g, const std::string& indent, std::FILE* to) {
+    fmt::print(to, "{}vs input polylines, both ways: Hausdorff {}; decoded -> input mean {}, input -> decoded mean {}\n",
                indent, micrometres(g.hausdorff_mm()), micrometres(g.decoded_to_input().mean_mm()),
                micrometres(g.input_to_decoded().mean_mm()));
-    fmt::print("{}endpoints moved: max {}, mean {}; length change: max {} ({:.4f} %), mean {} ({:.4f} %)\n", indent,
+    fmt::print(to, "{}endpoints moved: max {}, mean {}; length change: max {} ({:.4f} %), mean {} ({:.4f} %)\n", indent,
                micrometres(g.endpoint_mm().max), micrometres(g.endpoint_mm().mean()),
                micrometres(g.length_change_mm().max), g.length_change_percent().max,
                micrometres(g.length_change_mm().mean()), g.length_change_percent().mean());

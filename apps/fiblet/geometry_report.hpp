@@ -2,6 +2,8 @@
 // `stats` print them, and the --max-error check both share.
 #pragma once
 
+#include <cstdio>
+
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -22,7 +24,7 @@ void print_distances(const std::string& label, const ErrorStats& e);
 // Text lines, each starting with `indent`.
 void print_geometry(const GeometryError& g, const std::string& indent);
 // Compact one-line-per-metric form for compress.
-void print_geometry_brief(const GeometryError& g, const std::string& indent);
+void print_geometry_brief(const GeometryError& g, const std::string& indent, std::FILE* to = stdout);
 
 // The metrics above `max_um`: "point error", "Hausdorff", "endpoint",
 // "length change" with their values; empty when all are within it.

@@ -6,10 +6,13 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <string>
 #include <system_error>
+#include <vector>
 
 #include "cli_common.hpp"
 #include "geometry_report.hpp"
+#include "single_dash_options.hpp"
 #include "fiblet/output_file.hpp"
 
 namespace {
@@ -31,7 +34,10 @@ int finish(int status) {
 int run(CLI::App& app, int argc, char** argv) {
     using namespace fiblet::cli;
     try {
-        app.parse(argc, argv);
+        std::vector<std::string> args = translate_single_dash_options(app, {argv + 1, argv + argc});
+        std::vector<char*> translated{argv[0]};
+        for (std::string& a : args) translated.push_back(a.data());
+        app.parse(int(translated.size()), translated.data());
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);
     } catch (const CLI::CallForVersion& e) {

@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <limits>
 
+#include "fiber_ranges.hpp"
 #include "fiblet/error.hpp"
 
 namespace fiblet::cli {
@@ -23,12 +24,10 @@ std::array<float, 3> parse_color(std::string text, const char* option) {
     return {float((v >> 16) & 255) / 255.0f, float((v >> 8) & 255) / 255.0f, float(v & 255) / 255.0f};
 }
 
-std::uint32_t parse_u32(const std::string& text, const char* what) {
-    char* end = nullptr;
-    const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
-    if (text.empty() || *end != '\0' || text[0] == '-' || v > std::numeric_limits<std::uint32_t>::max())
-        throw Error(Errc::invalid_argument, std::string(what) + ": '" + text + "' is not a fiber ID");
-    return std::uint32_t(v);
+std::uint32_t fiber_id(std::uint64_t id) {
+    if (id > std::numeric_limits<std::uint32_t>::max())
+        throw Error(Errc::invalid_argument, "--fibers: " + std::to_string(id) + " is not a fiber ID (at most 2^32-1)");
+    return std::uint32_t(id);
 }
 
 }  // namespace
@@ -51,7 +50,7 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
     cmd->add_flag("--no-lod", a.no_lod, "Draw every block in full, however small on screen");
     cmd->add_option("--lod-pixels", a.lod_pixels, "Blocks smaller than this on screen (diameter) are one segment")
         ->capture_default_str();
-    cmd->add_option("--fibers", a.fibers, "Only fibers whose ID is in FIRST:LAST (inclusive)");
+    cmd->add_option("--fibers", a.fibers, "Only fibers whose ID is in FIRST-LAST (inclusive, 0-based; FIRST:LAST too)");
     cmd->add_option("--min-length", a.min_length, "Only fibers at least this long (mm)");
     cmd->add_option("--max-length", a.max_length, "Only fibers at most this long (mm)");
     cmd->add_option("--decoder", a.decoder,
@@ -87,11 +86,10 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
     if (!o.color_by_direction) o.fixed_color = parse_color(a.color, "--color");
     o.background = parse_color(a.background, "--background");
     if (!a.fibers.empty()) {
-        const std::size_t colon = a.fibers.find(':');
-        if (colon == std::string::npos) throw Error(Errc::invalid_argument, "--fibers takes FIRST:LAST");
-        o.id_min = parse_u32(a.fibers.substr(0, colon), "--fibers");
-        o.id_max = parse_u32(a.fibers.substr(colon + 1), "--fibers");
-        if (o.id_min > o.id_max) throw Error(Errc::invalid_argument, "--fibers: FIRST is after LAST");
+        // The same syntax as extract's; the GPU filter holds one range.
+        const std::vector<FiberRange> ranges = parse_fiber_ranges("--fibers", a.fibers);
+        if (ranges.size() != 1) throw Error(Errc::invalid_argument, "--fibers: the viewer takes one range FIRST-LAST");
+        o.id_min = fiber_id(ranges[0].first), o.id_max = fiber_id(ranges[0].last);
     }
     if (a.min_length < 0 || a.max_length < 0) throw Error(Errc::invalid_argument, "fiber lengths must be positive");
     o.min_length_mm = a.min_length;

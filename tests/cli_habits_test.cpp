@@ -1,0 +1,295 @@
+// What MRtrix3 and zstd users type (issue 13, "CLI habits"): MRtrix3's
+// single-dash options, thread counts from the environment, an --output-dir
+// that does not exist yet, one --fibers syntax.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_runner.hpp"
+#include "fiblet/fft_file.hpp"
+#include "fiblet/tck.hpp"
+#include "test_util.hpp"
+
+using namespace fiblet;
+namespace fs = std::filesystem;
+
+namespace {
+
+bool mentions(const test::CommandResult& r, const std::string& text) {
+    return r.output.find(text) != std::string::npos;
+}
+
+std::vector<std::vector<Vec3f>> read_tck(const std::string& path) {
+    TckReader r(path);
+    std::vector<std::vector<Vec3f>> all;
+    for (std::vector<Vec3f> s; r.next(s);) all.push_back(s);
+    return all;
+}
+
+// `fiblet ARGS` run inside `dir` (where a split `-force` would leave a file "rce").
+test::CommandResult run_in(const test::TempDir& dir, const std::string& args, const std::string& env = "") {
+    return test::run_command("cd " + dir.path() + " && " + env + " " + FIBLET_CLI + " " + args + " 2>&1");
+}
+
+struct Fixture {
+    test::TempDir dir;
+    Fixture() {
+        test::write_three_fiber_tck(dir.file("in.tck"));
+        const auto r = test::run_cli("compress -q " + dir.file("in.tck") + " -o " + dir.file("in.fft"));
+        if (r.status != 0) throw std::runtime_error(r.output);
+    }
+};
+
+}  // namespace
+
+TEST(CliHabits, MrtrixSpellingsMeanTheirFibletOptions) {
+    Fixture fx;
+    { std::ofstream(fx.dir.file("out.fft")) << "old"; }
+    // -force overwrites (it was -f -o rce), -quiet prints nothing, -nthreads N takes its value.
+    const auto r = run_in(fx.dir, "compress in.tck -o out.fft -force -quiet -nthreads 1");
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(r.output, "");
+    EXPECT_FALSE(fs::exists(fx.dir.file("rce")));
+    EXPECT_EQ(FftFile(fx.dir.file("out.fft")).header().fibers, 3u);
+    // Without -force the existing output is kept (exit 5), as with --force absent.
+    EXPECT_EQ(run_in(fx.dir, "compress in.tck -o out.fft -quiet").status, 5);
+
+    const auto d = run_in(fx.dir, "decompress in.fft -o out.tck -nthreads 2 -quiet");
+    EXPECT_EQ(d.status, 0) << d.output;
+    EXPECT_EQ(d.output, "");
+    EXPECT_EQ(read_tck(fx.dir.file("out.tck")).size(), 3u);
+    EXPECT_TRUE(mentions(run_in(fx.dir, "-version"), "fiblet "));
+    EXPECT_TRUE(mentions(run_in(fx.dir, "decompress -help"), "--output"));
+}
+
+TEST(CliHabits, OtherSingleDashWordsAreRejectedNamingTheOption) {
+    Fixture fx;
+    struct Case {
+        std::string args, message;
+    };
+    for (const Case& c : {Case{"compress in.tck -o x.fft -json", "long options take two dashes: --json"},
+                          Case{"compress in.tck -o x.fft -info", "MRtrix3's -info has no counterpart"},
+                          Case{"compress in.tck -o x.fft -fq", "not an option of fiblet compress"},
+                          Case{"compress in.tck -ox.fft", "not an option of fiblet compress"},
+                          Case{"extract in.fft -o x.tck -nthreads 2", "fiblet extract has no --threads option"},
+                          Case{"info in.fft -quiet", "fiblet info has no --quiet option"},
+                          Case{"-bogus", "not an option of fiblet "}}) {
+        const auto r = run_in(fx.dir, c.args);
+        EXPECT_EQ(r.status, 2) << c.args << "\n" << r.output;
+        EXPECT_TRUE(mentions(r, c.message)) << c.args << "\n" << r.output;
+        EXPECT_FALSE(fs::exists(fx.dir.file("x.fft")) || fs::exists(fx.dir.file("x.tck"))) << c.args;
+    }
+    // Nothing but in.tck, in.fft: no file named after the letters of a split word.
+    EXPECT_EQ(std::distance(fs::directory_iterator(fx.dir.path()), fs::directory_iterator{}), 2);
+}
+
+TEST(CliHabits, ValuesAndOperandsThatLookLikeOptionsAreLeftAlone) {
+    Fixture fx;
+    // An option's value, an operand after --, a short option with its number
+    // attached, and a negative number are not single-dash options.
+    EXPECT_EQ(run_in(fx.dir, "compress -q in.tck -o -odd.fft").status, 0);
+    EXPECT_EQ(FftFile(fx.dir.file("-odd.fft")).header().fibers, 3u);
+    fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("-in.tck"));
+    EXPECT_EQ(run_in(fx.dir, "compress -q -j1 -o two.fft -- -in.tck").status, 0);
+    EXPECT_TRUE(fs::exists(fx.dir.file("two.fft")));
+    const auto r = run_in(fx.dir, "extract -q in.fft -o box.tck --include -1,0,0,8,3,3");
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(read_tck(fx.dir.file("box.tck")).size(), 3u);
+}
+
+TEST(CliHabits, ThreadCountFromTheEnvironment) {
+    Fixture fx;
+    const std::string cmd = "compress -q -f in.tck -o e.fft";
+    // An absurd count from either variable is refused as it is on the command line.
+    for (const char* env : {"FIBLET_NTHREADS=4294967295", "MRTRIX_NTHREADS=4294967295"}) {
+        const auto r = run_in(fx.dir, cmd, std::string("env -u FIBLET_NTHREADS -u MRTRIX_NTHREADS ") + env);
+        EXPECT_EQ(r.status, 2) << env << "\n" << r.output;
+        EXPECT_TRUE(mentions(r, "at most 1024")) << r.output;
+    }
+    const auto bad = run_in(fx.dir, cmd, "env -u MRTRIX_NTHREADS FIBLET_NTHREADS=many");
+    EXPECT_EQ(bad.status, 2) << bad.output;
+    EXPECT_TRUE(mentions(bad, "FIBLET_NTHREADS='many' is not a thread count")) << bad.output;
+    // fiblet's own variable wins over MRtrix3's; the command line over both.
+    EXPECT_EQ(run_in(fx.dir, cmd, "env FIBLET_NTHREADS=1 MRTRIX_NTHREADS=4294967295").status, 0);
+    EXPECT_EQ(run_in(fx.dir, cmd + " -j 1", "env FIBLET_NTHREADS=4294967295").status, 0);
+    EXPECT_EQ(run_in(fx.dir, "decompress -q in.fft -o e.tck", "env -u FIBLET_NTHREADS MRTRIX_NTHREADS=2").status, 0);
+    EXPECT_EQ(read_tck(fx.dir.file("e.tck")).size(), 3u);
+}
+
+TEST(CliHabits, OutputDirIsCreated) {
+    Fixture fx;
+    const auto r = run_in(fx.dir, "compress -q in.tck --output-dir new/nested");
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(FftFile(fx.dir.file("new/nested/in.fft")).header().fibers, 3u);
+    const auto file = run_in(fx.dir, "compress -q in.tck --output-dir in.fft");
+    EXPECT_EQ(file.status, 2) << file.output;
+    EXPECT_TRUE(mentions(file, "names a file, not a directory")) << file.output;
+}
+
+TEST(CliHabits, FibersTakeOneSyntaxWithMrtrixRanges) {
+    Fixture fx;
+    ASSERT_EQ(run_in(fx.dir, "extract -q in.fft -o dash.tck --fibers 1-2").status, 0);
+    ASSERT_EQ(run_in(fx.dir, "extract -q in.fft -o colon.tck --fibers 1:2").status, 0);
+    const auto dash = read_tck(fx.dir.file("dash.tck")), colon = read_tck(fx.dir.file("colon.tck"));
+    EXPECT_EQ(dash.size(), 2u);
+    EXPECT_EQ(dash, colon);
+    EXPECT_EQ(run_in(fx.dir, "extract -q in.fft -o bad.tck --fibers 2:1").status, 2);
+}
+
+TEST(CliHabits, DecompressSeveralInputsAndFolderTrees) {
+    Fixture fx;
+    fs::create_directories(fx.dir.file("tree/sub-01/dwi"));
+    fs::create_directories(fx.dir.file("tree/sub-02/dwi"));
+    fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("tree/sub-01/dwi/a.tck"));
+    fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("tree/sub-02/dwi/b.tck"));
+    { std::ofstream(fx.dir.file("tree/README")) << "not a tractogram"; }
+    // A directory needs -r; with it, every .tck below, the tree mirrored.
+    const auto no_r = run_in(fx.dir, "compress -q tree --output-dir out");
+    EXPECT_EQ(no_r.status, 2) << no_r.output;
+    EXPECT_TRUE(mentions(no_r, "is a directory (-r")) << no_r.output;
+    const auto r = run_in(fx.dir, "compress -q -r tree --output-dir out");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(fs::exists(fx.dir.file("out/sub-01/dwi/a.fft")) && fs::exists(fx.dir.file("out/sub-02/dwi/b.fft")));
+    EXPECT_FALSE(fs::exists(fx.dir.file("out/README")));
+    // decompress: several inputs at once, next to each (as zstd -d), or -r into --output-dir.
+    const auto two = run_in(fx.dir, "decompress -q out/sub-01/dwi/a.fft out/sub-02/dwi/b.fft");
+    ASSERT_EQ(two.status, 0) << two.output;
+    const auto original = read_tck(fx.dir.file("in.tck"));
+    EXPECT_EQ(read_tck(fx.dir.file("out/sub-01/dwi/a.tck")).size(), original.size());
+    EXPECT_EQ(read_tck(fx.dir.file("out/sub-02/dwi/b.tck")), read_tck(fx.dir.file("out/sub-01/dwi/a.tck")));
+    const auto tree = run_in(fx.dir, "decompress -q -r out --output-dir back");
+    ASSERT_EQ(tree.status, 0) << tree.output;
+    EXPECT_EQ(read_tck(fx.dir.file("back/sub-02/dwi/b.tck")), read_tck(fx.dir.file("out/sub-02/dwi/b.tck")));
+    // -o names one output; one bad input among several fails the run, the others are written.
+    EXPECT_EQ(run_in(fx.dir, "decompress -q out/sub-01/dwi/a.fft out/sub-02/dwi/b.fft -o x.tck").status, 2);
+    fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("bad.fft"));
+    const auto mixed = run_in(fx.dir, "decompress -q bad.fft in.fft --output-dir mixed");
+    EXPECT_EQ(mixed.status, 4) << mixed.output;
+    EXPECT_TRUE(mentions(mixed, "bad.fft") && mentions(mixed, "some inputs failed")) << mixed.output;
+    EXPECT_FALSE(fs::exists(fx.dir.file("mixed/bad.tck")));
+    EXPECT_EQ(read_tck(fx.dir.file("mixed/in.tck")).size(), original.size());
+}
+
+namespace {
+
+// The numbers of the second line of a tckstats-style table (mean median std min max count).
+std::vector<double> table_values(const std::string& text) {
+    std::istringstream lines(text);
+    std::string header, values;
+    std::getline(lines, header), std::getline(lines, values);
+    std::istringstream in(values);
+    std::vector<double> v;
+    for (double x; in >> x;) v.push_back(x);
+    return v;
+}
+
+}  // namespace
+
+TEST(CliHabits, StatsWithoutReferenceAgreesWithTckstats) {
+    if (!test::shared_data_available()) GTEST_SKIP() << "shared data not found";
+    if (test::run_command("tckstats -version >/dev/null 2>&1").status != 0) GTEST_SKIP() << "MRtrix3 not installed";
+    test::TempDir dir;
+    const std::string source = test::shared_data_dir() + "/bundles/cingulum-1-step0.1.tck";
+    ASSERT_EQ(test::run_cli("compress -q " + source + " -o " + dir.file("c.fft")).status, 0);
+    ASSERT_EQ(test::run_cli("decompress -q " + dir.file("c.fft") + " -o " + dir.file("c.tck")).status, 0);
+    // MRtrix3 measures the decoded fibers (written out as .tck); fiblet measures them in the .fft.
+    const auto mrtrix = test::run_command("tckstats -quiet " + dir.file("c.tck"));
+    const auto ours = test::run_cli("stats " + dir.file("c.fft"));
+    ASSERT_EQ(ours.status, 0) << ours.output;
+    const auto expected = table_values(mrtrix.output), got = table_values(ours.output);
+    ASSERT_EQ(expected.size(), 6u) << mrtrix.output;
+    ASSERT_EQ(got.size(), 6u) << ours.output;
+    for (std::size_t i = 0; i < 5; ++i) EXPECT_NEAR(got[i], expected[i], 2e-5 * expected[i]) << i << "\n" << ours.output;
+    EXPECT_EQ(got[5], expected[5]);
+    const auto json = test::run_cli("stats --json " + dir.file("c.fft"));
+    EXPECT_NE(json.output.find("\"count\": " + std::to_string(std::uint64_t(expected[5]))), std::string::npos)
+        << json.output;
+    EXPECT_EQ(test::run_cli("stats --max-error 5 " + dir.file("c.fft")).status, 2);
+}
+
+TEST(CliHabits, JsonKeysMeanOneThing) {
+    Fixture fx;
+    const auto info = test::run_cli("info --json " + fx.dir.file("in.fft"));
+    ASSERT_EQ(info.status, 0) << info.output;
+    // "ratio" is the compression ratio (compress, stats); the direction code's is "cap_ratio".
+    EXPECT_EQ(info.output.find("\"ratio\""), std::string::npos) << info.output;
+    EXPECT_NE(info.output.find("\"cap_ratio\": "), std::string::npos) << info.output;
+    EXPECT_NE(info.output.find("\"trailer_chunks\": [\""), std::string::npos) << info.output;
+
+    // Percentiles are 0.01 µm bin edges: printed with at most 2 decimals, not as 4.500000000000001.
+    if (!test::shared_data_available()) return;
+    const std::string tck = test::shared_data_dir() + "/dwi-small64d-ifod1.tck";
+    ASSERT_EQ(test::run_cli("compress -q " + tck + " -o " + fx.dir.file("dwi.fft")).status, 0);
+    const auto stats = test::run_cli("stats --json " + fx.dir.file("dwi.fft") + " -r " + tck);
+    ASSERT_EQ(stats.status, 0) << stats.output;
+    int percentiles = 0;
+    for (std::size_t at = stats.output.find("_um\": "); at != std::string::npos; at = stats.output.find("_um\": ", at + 1)) {
+        const std::size_t key = stats.output.rfind('"', at - 1), value = at + 6;
+        if (stats.output.compare(key + 1, 1, "p") != 0) continue;
+        const std::string number = stats.output.substr(value, stats.output.find_first_of(",}", value) - value);
+        const std::size_t point = number.find('.');
+        EXPECT_TRUE(point == std::string::npos || number.size() - point - 1 <= 2) << number << "\n" << stats.output;
+        ++percentiles;
+    }
+    EXPECT_EQ(percentiles, 9);  // p50, p95, p99 of the error and of both directed distances
+}
+
+TEST(CliHabits, BashCompletionOffersEachSubcommandsOptions) {
+    Fixture fx;
+    const std::string script = fx.dir.file("completion.bash");
+    ASSERT_EQ(test::run_cli("help --bash-completion > " + script).status, 0);
+    auto complete = [&](const std::string& words, int cword) {
+        return test::run_command("bash -c 'source " + script + " && COMP_WORDS=(" + words + ") && COMP_CWORD=" +
+                                 std::to_string(cword) + " && _fiblet && printf \"%s\\n\" \"${COMPREPLY[@]}\"'")
+            .output;
+    };
+    EXPECT_EQ(complete("fiblet decomp", 1), "decompress\n");
+    EXPECT_EQ(complete("fiblet help ext", 2), "extract\n");
+    // Every long option `fiblet compress --help` lists (CLI11's own help) is offered.
+    const std::string help = test::run_cli("compress --help").output, offered = complete("fiblet compress --", 2);
+    int checked = 0;
+    for (std::size_t at = help.find("  --"); at != std::string::npos; at = help.find("  --", at + 1), ++checked) {
+        const std::string option = help.substr(at + 2, help.find_first_of(" ,=\n", at + 2) - at - 2);
+        EXPECT_NE(offered.find(option + "\n"), std::string::npos) << option << "\n" << offered;
+    }
+    EXPECT_GT(checked, 10);
+}
+
+TEST(CliHabits, ManPageRendersWithoutWarnings) {
+    Fixture fx;
+    const std::string page = fx.dir.file("fiblet.1");
+    ASSERT_EQ(test::run_cli("help --man > " + page).status, 0);
+    const auto warnings = test::run_command("MANWIDTH=100 man --warnings -l " + page + " 2>&1 >/dev/null");
+    EXPECT_EQ(warnings.output, "");
+    const auto text = test::run_command("MANWIDTH=100 man -l " + page + " | col -b").output;
+    for (const char* s : {"fiblet compress", "fiblet decompress", "--output-dir", "MRTRIX_NTHREADS", "EXIT STATUS"})
+        EXPECT_NE(text.find(s), std::string::npos) << s << "\n" << text.substr(0, 2000);
+}
+
+TEST(CliHabits, DashIsStandardInputAndOutput) {
+    Fixture fx;
+    fs::create_directories(fx.dir.file("spool"));
+    const std::string env = "env TMPDIR=" + fx.dir.file("spool") + " ";
+    const std::string cli = env + FIBLET_CLI;
+    const auto in_dir = [&](const std::string& cmd) { return test::run_command("cd " + fx.dir.path() + " && " + cmd); };
+    ASSERT_EQ(in_dir(cli + " decompress -q in.fft -o file.tck").status, 0);
+    ASSERT_EQ(in_dir(cli + " compress -q in.tck -o file.fft -f").status, 0);
+    // The data on stdout is the file a path would get; the report goes to stderr.
+    ASSERT_EQ(in_dir(cli + " decompress in.fft -o - > piped.tck 2> report.txt").status, 0);
+    EXPECT_EQ(test::read_file(fx.dir.file("piped.tck")), test::read_file(fx.dir.file("file.tck")));
+    EXPECT_NE(test::read_file(fx.dir.file("report.txt")).find("in.fft -> -: 3 fibers"), std::string::npos);
+    ASSERT_EQ(in_dir("cat in.tck | " + cli + " compress - -o - --json > piped.fft 2> report.json").status, 0);
+    EXPECT_EQ(test::read_file(fx.dir.file("piped.fft")), test::read_file(fx.dir.file("file.fft")));
+    EXPECT_NE(test::read_file(fx.dir.file("report.json")).find("\"fibers\": 3"), std::string::npos);
+    ASSERT_EQ(in_dir("cat in.fft | " + cli + " decompress -q - -o - > twice.tck").status, 0);
+    EXPECT_EQ(test::read_file(fx.dir.file("twice.tck")), test::read_file(fx.dir.file("file.tck")));
+    // Standard input has no name to derive an output from; the spool files are gone.
+    const auto r = in_dir("cat in.tck | " + cli + " compress - 2>&1");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_TRUE(mentions(r, "standard input (-) needs -o")) << r.output;
+    EXPECT_TRUE(fs::is_empty(fx.dir.file("spool")));
+}
