@@ -1,0 +1,18 @@
+// How fibers are drawn: one technique module each (techniques/).
+#pragma once
+
+#include <optional>
+#include <string>
+
+namespace fiblet::viewer {
+
+enum class DrawStyle {
+    lines,  // illuminated lines (techniques/lines)
+};
+
+const char* draw_style_name(DrawStyle style);
+std::optional<DrawStyle> parse_draw_style(const std::string& name);
+// "lines, tubes" for messages and help.
+std::string draw_style_names();
+
+}  // namespace fiblet::viewer
