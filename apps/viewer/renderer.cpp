@@ -140,11 +140,11 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const R
         const std::uint32_t count = std::min<std::uint32_t>(decoder_->capacity(), std::uint32_t(stats.fine_blocks) - first);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, fine_list_.get());
         timer.begin(Stage::decode);
-        decoder_->decode(scene, decoder, select, first, count);
+        decoder_->decode(scene, decoder, select, first, count, draw.needs_tangents());
         timer.end();
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         timer.begin(Stage::draw);
-        draw.draw_batch(in, {decoder_->points_buffer(), 0, first, count});
+        draw.draw_batch(in, {decoder_->points_buffer(), decoder_->tangents_buffer(), first, count});
         timer.end();
         // The next batch overwrites the points this draw reads.
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
