@@ -41,7 +41,7 @@ std::string stats_json(const viewer::FrameStats& s) {
 
 void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::string& device, int width, int height,
                  const std::vector<viewer::BenchCase>& cases, double scan_ms, double sequential_ms,
-                 viewer::DecoderKind decoder) {
+                 viewer::DecoderKind decoder, viewer::DrawStyle style) {
     if (a.json) {
         std::string list = "[";
         for (std::size_t i = 0; i < cases.size(); ++i) {
@@ -63,6 +63,8 @@ void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::
                                .integer("fibers", scene.fiber_count())
                                .integer("blocks", scene.block_count())
                                .str("decoder", viewer::decoder_name(decoder))
+                               .str("style", viewer::draw_style_name(style))
+                               .num("radius_mm", a.view.radius)
                                .num("decode_all_scan_ms", scan_ms)
                                .num("decode_all_sequential_ms", sequential_ms)
                                .raw("cases", list + "]")
@@ -72,6 +74,8 @@ void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::
     fmt::print("{}: {} fibers, {} blocks, {} segments; {}x{}, median of {} frames\n", a.view.input,
                scene.fiber_count(), scene.block_count(), scene.segment_count(), width, height, a.frames);
     fmt::print("device: {}; stage times by {}\n", device, viewer::timing_method_name(viewer::default_timing_method()));
+    fmt::print("style: {}{}\n", viewer::draw_style_name(style),
+               style == viewer::DrawStyle::tubes ? fmt::format(", radius {} mm", a.view.radius) : "");
     fmt::print("decoding all {} blocks: scan {:.2f} ms, sequential {:.2f} ms; frames below use the {} decoder\n",
                scene.block_count(), scan_ms, sequential_ms, viewer::decoder_name(decoder));
     fmt::print("{:<9} {:<12} {:>10} {:>10} {:>11} {:>9} {:>10} {:>9} {:>10} {:>9}\n", "view", "culling+LoD",
@@ -114,7 +118,7 @@ void run(const RenderArgs& a) {
         const double scan_ms = viewer::time_full_decode(scene, programs, viewer::DecoderKind::scan, a.frames);
         const double sequential_ms = viewer::time_full_decode(scene, programs, viewer::DecoderKind::sequential, a.frames);
         print_bench(a, scene, context.description(), width, height, cases, scan_ms, sequential_ms,
-                    options.decoder.value_or(viewer::default_decoder()));
+                    options.decoder.value_or(viewer::default_decoder()), options.style);
     }
     if (a.output.empty()) return;
     const viewer::FrameStats stats = renderer.render(scene, camera_for(1.0f), options, target);

@@ -47,6 +47,10 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
         ->capture_default_str();
     cmd->add_flag("--no-lighting", a.no_lighting, "Flat colours instead of illuminated lines");
     cmd->add_option("--line-width", a.line_width, "Line width in pixels")->capture_default_str();
+    cmd->add_option("--style", a.style, "How fibers are drawn: " + viewer::draw_style_names() +
+                                            " (ray-cast spline tubes, docs/viewer.md)")
+        ->capture_default_str();
+    cmd->add_option("--radius", a.radius, "Tube radius in mm (--style tubes)")->capture_default_str();
     cmd->add_flag("--no-culling", a.no_culling, "Do not skip blocks outside the view frustum");
     cmd->add_flag("--no-lod", a.no_lod, "Draw every block in full, however small on screen");
     cmd->add_option("--lod-pixels", a.lod_pixels, "Blocks smaller than this on screen (diameter) are one segment")
@@ -83,6 +87,11 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
     if (!(a.line_width >= 1 && a.line_width <= 64)) throw Error(Errc::invalid_argument, "--line-width must be in 1..64");
     o.line_width = a.line_width;
     o.lighting = !a.no_lighting;
+    const auto style = viewer::parse_draw_style(a.style);
+    if (!style) throw Error(Errc::invalid_argument, "--style: '" + a.style + "' is not one of " + viewer::draw_style_names());
+    o.style = *style;
+    if (!(a.radius > 0 && a.radius <= 100)) throw Error(Errc::invalid_argument, "--radius must be in (0, 100] mm");
+    o.tube_radius_mm = a.radius;
     o.color_by_direction = a.color == "direction";
     if (!o.color_by_direction) o.fixed_color = parse_color(a.color, "--color");
     o.background = parse_color(a.background, "--background");

@@ -16,6 +16,8 @@ struct ViewerArgs {
     std::string color = "direction", background = "black", fibers, decoder = "auto";
     bool no_lighting = false, no_culling = false, no_lod = false;
     float lod_pixels = 4, line_width = 1;
+    std::string style = "lines";
+    float radius = 0.25f;
     double min_length = 0, max_length = 0;
 };
 

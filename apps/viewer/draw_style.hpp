@@ -8,6 +8,7 @@ namespace fiblet::viewer {
 
 enum class DrawStyle {
     lines,  // illuminated lines (techniques/lines)
+    tubes,  // ray-cast spline tubes (techniques/tubes)
 };
 
 const char* draw_style_name(DrawStyle style);

@@ -3,11 +3,12 @@
 #include <array>
 
 #include "techniques/lines/lines_technique.hpp"
+#include "techniques/tubes/tubes_technique.hpp"
 
 namespace fiblet::viewer {
 
 namespace {
-constexpr std::array kStyles{std::pair{DrawStyle::lines, "lines"}};
+constexpr std::array kStyles{std::pair{DrawStyle::lines, "lines"}, std::pair{DrawStyle::tubes, "tubes"}};
 }  // namespace
 
 const char* draw_style_name(DrawStyle style) {
@@ -31,6 +32,7 @@ std::string draw_style_names() {
 std::unique_ptr<DrawTechnique> make_technique(DrawStyle style) {
     switch (style) {
         case DrawStyle::lines: return std::make_unique<LinesTechnique>();
+        case DrawStyle::tubes: return std::make_unique<TubesTechnique>();
     }
     return nullptr;
 }
