@@ -73,7 +73,7 @@ TEST(ViewerCli, RenderRefusesBadArgumentsAndExistingOutputs) {
     EXPECT_EQ(read_file(dir.file("old.png")), "keep");
     for (const char* bad : {"--size 100by50", "--size 0x10", "--camera 1,2", "--camera sideways", "--color purple",
                             "--fov 0", "--fibers 9:3", "--line-width 0", "--style ribbons", "--radius 0",
-                            "--radius -1"}) {
+                            "--radius -1", "--supersample 0", "--supersample 9"}) {
         const CommandResult r = run_cli("render " + fft + " -o " + dir.file("x.png") + " " + bad);
         EXPECT_EQ(r.status, 2) << bad << ": " << r.output;
         EXPECT_FALSE(std::filesystem::exists(dir.file("x.png"))) << bad;

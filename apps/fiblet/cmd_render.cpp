@@ -16,6 +16,7 @@
 #include "render_target.hpp"
 #include "renderer.hpp"
 #include "scene_file.hpp"
+#include "supersampling.hpp"
 #include "viewer_options.hpp"
 
 namespace fiblet::cli {
@@ -121,8 +122,10 @@ void run(const RenderArgs& a) {
                     options.decoder.value_or(viewer::default_decoder()), options.style);
     }
     if (a.output.empty()) return;
-    const viewer::FrameStats stats = renderer.render(scene, camera_for(1.0f), options, target);
-    viewer::write_png(a.output, {width, height, target.read_rgba()}, a.force);
+    const viewer::SupersampledFrame frame =
+        viewer::render_supersampled(renderer, scene, camera_for(1.0f), options, width, height, a.view.supersample);
+    const viewer::FrameStats& stats = frame.stats;
+    viewer::write_png(a.output, frame.image, a.force);
     if (a.json && !a.bench) {
         fmt::print("{}\n", Json{}
                                .str("input", a.view.input)

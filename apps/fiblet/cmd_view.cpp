@@ -11,6 +11,7 @@ void run(const ViewerArgs& a) {
     parse_size(a.size, o.width, o.height);
     o.render = render_options_from(a);
     o.camera = a.camera, o.fov_y_deg = a.fov, o.zoom = a.zoom;
+    o.screenshot_supersample = a.supersample;
     viewer::run_viewer_window(a.input, o);
 }
 

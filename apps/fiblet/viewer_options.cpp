@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "fiblet/error.hpp"
+#include "supersampling.hpp"
 
 namespace fiblet::cli {
 
@@ -51,6 +52,10 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
                                             " (ray-cast spline tubes, docs/viewer.md)")
         ->capture_default_str();
     cmd->add_option("--radius", a.radius, "Tube radius in mm (--style tubes)")->capture_default_str();
+    cmd->add_option("--supersample", a.supersample,
+                    "Anti-aliasing of the PNG (render) or screenshots (view): draw N times larger per axis and "
+                    "average, 1..8")
+        ->capture_default_str();
     cmd->add_flag("--no-culling", a.no_culling, "Do not skip blocks outside the view frustum");
     cmd->add_flag("--no-lod", a.no_lod, "Draw every block in full, however small on screen");
     cmd->add_option("--lod-pixels", a.lod_pixels, "Blocks smaller than this on screen (diameter) are one segment")
@@ -92,6 +97,8 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
     o.style = *style;
     if (!(a.radius > 0 && a.radius <= 100)) throw Error(Errc::invalid_argument, "--radius must be in (0, 100] mm");
     o.tube_radius_mm = a.radius;
+    if (a.supersample < 1 || a.supersample > viewer::kMaxSupersample)
+        throw Error(Errc::invalid_argument, "--supersample must be in 1.." + std::to_string(viewer::kMaxSupersample));
     o.color_by_direction = a.color == "direction";
     if (!o.color_by_direction) o.fixed_color = parse_color(a.color, "--color");
     o.background = parse_color(a.background, "--background");

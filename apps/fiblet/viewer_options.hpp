@@ -18,6 +18,7 @@ struct ViewerArgs {
     float lod_pixels = 4, line_width = 1;
     std::string style = "lines";
     float radius = 0.25f;
+    int supersample = 1;
     double min_length = 0, max_length = 0;
 };
 

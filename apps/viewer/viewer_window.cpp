@@ -22,6 +22,7 @@
 #include "png_file.hpp"
 #include "render_target.hpp"
 #include "renderer.hpp"
+#include "supersampling.hpp"
 #include "scene_file.hpp"
 #include "vec_ops.hpp"
 
@@ -239,7 +240,14 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
         if (s.screenshot) {
             s.screenshot = false;
             const std::string name = next_screenshot_name(options.screenshot_prefix);
-            write_png(name, {target.width(), target.height(), target.read_rgba()}, false);
+            if (options.screenshot_supersample > 1)
+                write_png(name,
+                          render_supersampled(renderer, scene, camera, s.render, target.width(), target.height(),
+                                              options.screenshot_supersample)
+                              .image,
+                          false);
+            else
+                write_png(name, {target.width(), target.height(), target.read_rgba()}, false);
             fmt::print("screenshot: {}\n", name);
             std::fflush(stdout);
         }

@@ -14,6 +14,7 @@ struct WindowOptions {
     float fov_y_deg = 35, zoom = 1;
     RenderOptions render;
     std::string screenshot_prefix = "fiblet-screenshot";  // + "-NNN.png" in the working directory
+    int screenshot_supersample = 1;  // screenshots drawn again, supersampled (supersampling.hpp)
 };
 
 // The key and mouse bindings, for --help and the H key.
