@@ -46,21 +46,22 @@ TEST(ViewerCli, RenderWritesAPngOfTheRequestedSize) {
     EXPECT_GT(fixed, 200u);
 }
 
-// Tubes a few pixels wide cover more of the image than one-pixel lines of the
+// Tubes (and capsules) a few pixels wide cover more of the image than one-pixel lines of the
 // same fibers (their exact shape: viewer_tubes_test).
 TEST(ViewerCli, RenderDrawsTubes) {
     FIBLET_REQUIRE_GL();
     const TempDir dir;
     const std::string fft = compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft");
-    std::size_t lit[2] = {};
-    const char* styles[2] = {"--style lines", "--style tubes --radius 0.5"};
-    for (int i = 0; i < 2; ++i) {
+    std::size_t lit[3] = {};
+    const char* styles[3] = {"--style lines", "--style tubes --radius 0.5", "--style capsules --radius 0.5"};
+    for (int i = 0; i < 3; ++i) {
         const std::string png = dir.file(std::to_string(i) + ".png");
         const CommandResult r = run_cli("render " + fft + " -o " + png + " --size 160x120 --camera left --zoom 2 " + styles[i]);
         ASSERT_EQ(r.status, 0) << r.output;
         lit[i] = lit_pixels(viewer::read_png(png));
     }
     EXPECT_GT(lit[1], lit[0] * 6 / 5);  // measured: 1.31
+    EXPECT_GT(lit[2], lit[0] * 6 / 5);
 }
 
 TEST(ViewerCli, RenderRefusesBadArgumentsAndExistingOutputs) {

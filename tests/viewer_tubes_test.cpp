@@ -166,6 +166,22 @@ std::vector<Piece> reference_pieces(const FftFile& file, double radius, double c
     return out;
 }
 
+// Every decoded segment (those joining blocks included) as a capsule: a
+// straight piece (control point at the middle), swept by the radius.
+std::vector<Piece> reference_capsules(const FftFile& file, double radius) {
+    const CpuDecoded d = cpu_decode_blocks(file);
+    std::vector<Piece> out;
+    for (std::uint64_t f = 0; f < file.header().fibers; ++f) {
+        const std::uint64_t first = file.first_block(f), count = file.block_count(f);
+        const std::size_t begin = d.block_first[first], end = d.block_first[first + count];
+        for (std::size_t i = begin; i + 1 < end; ++i) {
+            const D3 a = d3(d.point(i)), b = d3(d.point(i + 1));
+            out.push_back({a, 0.5 * (a + b), b, radius, std::uint32_t(f)});
+        }
+    }
+    return out;
+}
+
 // Distance along the unit ray (o, d) to where it enters the union of the
 // piece's spheres, or +inf: dense sampling of f(t), then golden-section
 // refinement around the best sample.
@@ -349,12 +365,13 @@ struct TubeRender {
     std::vector<std::uint32_t> fibers;
 };
 TubeRender render_tubes(const viewer::GpuScene& scene, std::unique_ptr<viewer::DrawTechnique> technique,
-                        const Camera& cam, float radius, int w, int h) {
+                        const Camera& cam, float radius, int w, int h,
+                        viewer::DrawStyle style = viewer::DrawStyle::tubes) {
     viewer::Renderer renderer(*viewer_gl().programs);
-    renderer.use_technique(viewer::DrawStyle::tubes, std::move(technique));
+    if (technique) renderer.use_technique(style, std::move(technique));
     viewer::RenderTarget target(w, h);
     viewer::RenderOptions o;
-    o.style = viewer::DrawStyle::tubes;
+    o.style = style;
     o.tube_radius_mm = radius;
     o.level_of_detail = false;
     renderer.render(scene, cam, o, target);
@@ -391,6 +408,28 @@ TEST(ViewerTubes, RayCastingMatchesADoublePrecisionOracle) {
     const TubeAgreement b = compare_tubes(ref, third.depth, third.fibers, cam, w, h, tol);
     std::printf("with c = 1/3: hit/miss %.5f, depth within 1e-3 r %.5f\n", b.hit_rate(), b.depth_rate());
     EXPECT_TRUE(b.hit_rate() < 0.999 || b.depth_rate() < 0.99);
+}
+
+TEST(ViewerCapsules, RayCastingMatchesADoublePrecisionOracle) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    write_tck(dir.file("s.tck"), synthetic_fibers());
+    const FftFile file(compress_into(dir, dir.file("s.tck"), "s.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const int w = 200, h = 200;
+    const Camera cam = test_camera();
+    const double radius = 0.4, tol = 1e-3 * radius;
+    const auto ref = oracle_image(reference_capsules(file, radius), cam, w, h);
+    const TubeRender gpu = render_tubes(scene, nullptr, cam, float(radius), w, h, viewer::DrawStyle::capsules);
+    const TubeAgreement a = compare_tubes(ref, gpu.depth, gpu.fibers, cam, w, h, tol);
+    std::printf("capsules vs oracle: %zu pixels outside the silhouette band, hit/miss %.5f, %zu hit: depth within "
+                "1e-3 r %.5f (median %.2e mm, max %.2e mm), fiber %.5f\n",
+                a.compared, a.hit_rate(), a.both_hit, a.depth_rate(), a.median_depth_error, a.max_depth_error,
+                a.fiber_rate());
+    EXPECT_GT(a.both_hit, 1500u);
+    EXPECT_GE(a.hit_rate(), 0.999);
+    EXPECT_GE(a.depth_rate(), 0.99);
+    EXPECT_GE(a.fiber_rate(), 0.99);
 }
 
 TEST(ViewerTubes, TubesHideLinesBehindTheirSurface) {

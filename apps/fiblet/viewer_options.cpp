@@ -49,9 +49,10 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
     cmd->add_flag("--no-lighting", a.no_lighting, "Flat colours instead of illuminated lines");
     cmd->add_option("--line-width", a.line_width, "Line width in pixels")->capture_default_str();
     cmd->add_option("--style", a.style, "How fibers are drawn: " + viewer::draw_style_names() +
-                                            " (ray-cast spline tubes, docs/viewer.md)")
+                                            " (tubes: ray-cast spline tubes; capsules: a ray-cast capsule per "
+                                            "segment; docs/viewer.md)")
         ->capture_default_str();
-    cmd->add_option("--radius", a.radius, "Tube radius in mm (--style tubes)")->capture_default_str();
+    cmd->add_option("--radius", a.radius, "Tube and capsule radius in mm (--style tubes, capsules)")->capture_default_str();
     cmd->add_option("--supersample", a.supersample,
                     "Anti-aliasing of the PNG (render) or screenshots (view): draw N times larger per axis and "
                     "average, 1..8")

@@ -8,7 +8,8 @@ namespace fiblet::viewer {
 
 enum class DrawStyle {
     lines,  // illuminated lines (techniques/lines)
-    tubes,  // ray-cast spline tubes (techniques/tubes)
+    tubes,     // ray-cast spline tubes (techniques/tubes)
+    capsules,  // ray-cast capsules, one per decoded segment (techniques/capsules)
 };
 
 const char* draw_style_name(DrawStyle style);

@@ -25,7 +25,7 @@ struct RenderOptions {
 
     // Drawing style (techniques/) and shading.
     DrawStyle style = DrawStyle::lines;
-    float tube_radius_mm = 0.25f;                      // tubes
+    float tube_radius_mm = 0.25f;                      // tubes and capsules
     bool color_by_direction = true;                    // |direction| as RGB, else fixed_color
     std::array<float, 3> fixed_color{0.95f, 0.85f, 0.6f};
     bool lighting = true;                              // illuminated lines

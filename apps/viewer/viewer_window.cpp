@@ -32,7 +32,7 @@ const char* window_controls_help() {
     return "  left drag: orbit    right/middle drag or shift+left drag: pan    wheel: zoom\n"
            "  click: print the fiber under the cursor (ID, points, length)\n"
            "  R: reset view    S: screenshot (PNG)    C: culling on/off    L: level of detail on/off\n"
-           "  D: colour by direction / fixed    I: lighting on/off    +/-: line width    T: lines / tubes\n"
+           "  D: colour by direction / fixed    I: lighting on/off    +/-: line width    T: lines / tubes / capsules\n"
            "  H: help    Q, Esc: quit\n";
 }
 
@@ -89,7 +89,9 @@ void on_key(GLFWwindow* w, int key, int, int action, int) {
         case GLFW_KEY_MINUS:
         case GLFW_KEY_KP_SUBTRACT: s.render.line_width = std::max(s.render.line_width - 1, 1.0f); break;
         case GLFW_KEY_T:
-            s.render.style = s.render.style == DrawStyle::lines ? DrawStyle::tubes : DrawStyle::lines;
+            s.render.style = s.render.style == DrawStyle::lines   ? DrawStyle::tubes
+                             : s.render.style == DrawStyle::tubes ? DrawStyle::capsules
+                                                                  : DrawStyle::lines;
             break;
         case GLFW_KEY_H: fmt::print("{}", window_controls_help()); break;
         default: return;

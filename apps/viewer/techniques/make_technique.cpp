@@ -2,13 +2,15 @@
 
 #include <array>
 
+#include "techniques/capsules/capsules_technique.hpp"
 #include "techniques/lines/lines_technique.hpp"
 #include "techniques/tubes/tubes_technique.hpp"
 
 namespace fiblet::viewer {
 
 namespace {
-constexpr std::array kStyles{std::pair{DrawStyle::lines, "lines"}, std::pair{DrawStyle::tubes, "tubes"}};
+constexpr std::array kStyles{std::pair{DrawStyle::lines, "lines"}, std::pair{DrawStyle::tubes, "tubes"},
+                             std::pair{DrawStyle::capsules, "capsules"}};
 }  // namespace
 
 const char* draw_style_name(DrawStyle style) {
@@ -33,6 +35,7 @@ std::unique_ptr<DrawTechnique> make_technique(DrawStyle style) {
     switch (style) {
         case DrawStyle::lines: return std::make_unique<LinesTechnique>();
         case DrawStyle::tubes: return std::make_unique<TubesTechnique>();
+        case DrawStyle::capsules: return std::make_unique<CapsulesTechnique>();
     }
     return nullptr;
 }

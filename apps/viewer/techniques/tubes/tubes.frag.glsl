@@ -12,6 +12,7 @@
 // skipped and none is left half-converged (the paper's joint artefacts).
 // Writes the hit's depth, Lambert + Blinn-Phong shading, and the fiber.
 #include "tube_piece.glsl"
+#include "surface_shading.glsl"
 
 layout(std430, binding = BINDING_TUBE_PIECES) readonly buffer Pieces { TubePiece pieces[]; };
 
@@ -22,17 +23,6 @@ layout(location = 0) out vec4 outColor;
 layout(location = 1) out uint outFiber;
 // Front faces are drawn: the hit lies behind them.
 layout(depth_greater) out float gl_FragDepth;
-
-uniform mat4 uViewProjection;
-uniform bool uColorByDirection;
-uniform vec3 uFixedColor;
-uniform bool uLighting;
-uniform vec3 uCameraPosition;
-uniform vec3 uLightDirection;  // unit, towards the light
-uniform float uAmbient;
-uniform float uDiffuse;
-uniform float uSpecular;
-uniform float uShininess;
 
 // h and its derivatives, ascending powers: derivative k (degree 6 - k)
 // starts at kOffset[k].
@@ -154,21 +144,12 @@ void main() {
     if (bestT < 0.0) discard;
 
     vec3 hit = origin + best * unit * dir;
-    vec4 clip = uViewProjection * vec4(hit, 1.0);
-    gl_FragDepth = clamp(0.5 * clip.z / clip.w + 0.5, 0.0, 1.0);
+    gl_FragDepth = windowDepth(hit);
 
     float t = bestT;
     vec3 centre = (1.0 - t) * (1.0 - t) * q.c0.xyz + 2.0 * t * (1.0 - t) * q.c1.xyz + t * t * q.c2.xyz;
     vec3 normal = normalize(hit - centre);
     vec3 tangent = 2.0 * (1.0 - t) * (q.c1.xyz - q.c0.xyz) + 2.0 * t * (q.c2.xyz - q.c1.xyz);
-    vec3 base = uColorByDirection && dot(tangent, tangent) > 0.0 ? abs(normalize(tangent)) : uFixedColor;
-    vec3 color = base;
-    if (uLighting) {
-        vec3 view = -dir;
-        float diffuse = max(dot(normal, uLightDirection), 0.0);
-        float specular = pow(max(dot(normal, normalize(uLightDirection + view)), 0.0), uShininess);
-        color = base * (uAmbient + uDiffuse * diffuse) + vec3(uSpecular * specular);
-    }
-    outColor = vec4(min(color, vec3(1.0)), 1.0);
+    outColor = vec4(shadeSurface(normal, tangent, -dir), 1.0);
     outFiber = floatBitsToUint(q.center.w) + 1u;
 }
