@@ -2,7 +2,10 @@
 // (EGL; Mesa's llvmpipe where there is no GPU), and its frame-time benchmark.
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "cli_common.hpp"
 #include "fiblet/error.hpp"
@@ -27,7 +30,18 @@ struct RenderArgs {
     std::string output;
     bool force = false, quiet = false, bench = false, json = false;
     int frames = 5;
+    int orbit = 0;  // turntable frames (0: one image)
 };
+
+// Frame i of n of "dir/name.png": "dir/name-007.png" (at least three digits).
+std::string frame_path(const std::string& output, int i, int n) {
+    const std::filesystem::path p(output);
+    const int digits = std::max(3, int(std::to_string(std::max(n - 1, 0)).size()));
+    std::filesystem::path name = p.stem();
+    name += fmt::format("-{:0{}}", i, digits);
+    name += p.extension();
+    return (p.parent_path() / name).string();
+}
 
 std::string stats_json(const viewer::FrameStats& s) {
     return Json{}
@@ -99,8 +113,13 @@ void run(const RenderArgs& a) {
     parse_size(a.view.size, width, height);
     const viewer::RenderOptions options = render_options_from(a.view);
     if (!a.bench && a.output.empty()) throw Error(Errc::invalid_argument, "-o OUT.png is required (or --bench)");
-    if (!a.output.empty() && !a.force && std::filesystem::exists(a.output))
-        throw Error(Errc::exists, a.output + " exists (use --force to overwrite)");
+    if (a.orbit < 0 || a.orbit > 100000) throw Error(Errc::invalid_argument, "--orbit must be in 0..100000 frames");
+    if (a.orbit > 0 && a.output.empty()) throw Error(Errc::invalid_argument, "--orbit needs -o OUT.png");
+    std::vector<std::string> outputs;
+    if (!a.output.empty())
+        for (int i = 0; i < std::max(a.orbit, 1); ++i) outputs.push_back(a.orbit ? frame_path(a.output, i, a.orbit) : a.output);
+    for (const std::string& out : outputs)
+        if (!a.force && std::filesystem::exists(out)) throw Error(Errc::exists, out + " exists (use --force to overwrite)");
     if (a.frames < 1) throw Error(Errc::invalid_argument, "--frames must be at least 1");
 
     const viewer::HeadlessContext context;
@@ -122,10 +141,23 @@ void run(const RenderArgs& a) {
                     options.decoder.value_or(viewer::default_decoder()), options.style);
     }
     if (a.output.empty()) return;
-    const viewer::SupersampledFrame frame =
-        viewer::render_supersampled(renderer, scene, camera_for(1.0f), options, width, height, a.view.supersample);
-    const viewer::FrameStats& stats = frame.stats;
-    viewer::write_png(a.output, frame.image, a.force);
+    // One image, or a turntable: frame i turned 360 i / n degrees about the camera's up axis.
+    viewer::FrameStats stats;
+    const Camera start = camera_for(1.0f);
+    for (std::size_t i = 0; i < outputs.size(); ++i) {
+        const float degrees = 360.0f * float(i) / float(outputs.size());
+        const viewer::SupersampledFrame frame =
+            viewer::render_supersampled(renderer, scene, viewer::turned_about_up(start, degrees, scene.bounds()),
+                                        options, width, height, a.view.supersample);
+        if (i == 0) stats = frame.stats;
+        viewer::write_png(outputs[i], frame.image, a.force);
+    }
+    if (a.orbit > 0) {
+        if (!a.quiet)
+            fmt::print("{} -> {} .. {} ({} frames, {}x{})\n", a.view.input, outputs.front(), outputs.back(),
+                       outputs.size(), width, height);
+        return;
+    }
     if (a.json && !a.bench) {
         fmt::print("{}\n", Json{}
                                .str("input", a.view.input)
@@ -155,6 +187,9 @@ void add_render(CLI::App& app) {
                   "Time frames (cull / decode / draw: GL timer queries, glFinish on software renderers) "
                   "from three distances, with and without culling + LoD");
     cmd->add_option("--frames", args->frames, "Timed frames per benchmark case")->capture_default_str();
+    cmd->add_option("--orbit", args->orbit,
+                    "Write N frames turning once around the target about the camera's up axis, OUT-000.png "
+                    "... (a turntable movie)");
     cmd->callback([args] { run(*args); });
 }
 
