@@ -183,9 +183,12 @@ std::vector<Piece> reference_capsules(const FftFile& file, double radius) {
 }
 
 // Distance along the unit ray (o, d) to where it enters the union of the
-// piece's spheres, or +inf: dense sampling of f(t), then golden-section
-// refinement around the best sample.
-double oracle_hit(const Piece& p, D3 o, D3 d) {
+// piece's spheres (+inf: none) and the sphere's parameter t there: dense
+// sampling of f(t), then golden-section refinement around the best sample.
+struct OracleHit {
+    double distance = HUGE_VAL, t = 0;
+};
+OracleHit oracle_hit(const Piece& p, D3 o, D3 d) {
     auto f = [&](double t) {
         const D3 v = bezier(p.c0, p.c1, p.c2, t) - o;
         const double along = dot(v, d), g = p.r * p.r - (dot(v, v) - along * along);
@@ -198,20 +201,22 @@ double oracle_hit(const Piece& p, D3 o, D3 d) {
         const double v = f(double(i) / kSamples);
         if (v < best_f) best_f = v, best = i;
     }
-    if (best < 0) return HUGE_VAL;
+    if (best < 0) return {};
     double a = std::max(0, best - 1) / double(kSamples), b = std::min(kSamples, best + 1) / double(kSamples);
     const double phi = (std::sqrt(5.0) - 1) / 2;
     for (int it = 0; it < 60; ++it) {
         const double x1 = b - phi * (b - a), x2 = a + phi * (b - a);
         if (f(x1) < f(x2)) b = x2; else a = x1;
     }
-    return std::min(best_f, f(0.5 * (a + b)));
+    const double refined = 0.5 * (a + b);
+    return f(refined) < best_f ? OracleHit{f(refined), refined} : OracleHit{best_f, double(best) / kSamples};
 }
 
 struct OraclePixel {
     double distance = HUGE_VAL;  // along the ray
     double second = HUGE_VAL;    // the nearest hit of another fiber
     std::uint32_t fiber = 0;     // index + 1, 0 = miss
+    D3 normal;                   // unit, of the nearest hit
 };
 
 struct Ray {
@@ -232,6 +237,8 @@ std::vector<OraclePixel> oracle_image(const std::vector<Piece>& pieces, const Ca
             const Ray ray = pixel_ray(cam, w, h, x, y);
             OraclePixel& px = img[std::size_t(y) * std::size_t(w) + std::size_t(x)];
             std::vector<std::pair<double, std::uint32_t>> hits;
+            double nearest = HUGE_VAL;
+            D3 centre;  // of the sphere the ray enters first
             for (const Piece& p : pieces) {
                 // Bounding sphere first.
                 const D3 c = (1.0 / 3.0) * (p.c0 + p.c1 + p.c2);
@@ -239,9 +246,12 @@ std::vector<OraclePixel> oracle_image(const std::vector<Piece>& pieces, const Ca
                 const D3 v = c - ray.origin;
                 const double along = dot(v, ray.dir);
                 if (dot(v, v) - along * along > rad * rad) continue;
-                const double t = oracle_hit(p, ray.origin, ray.dir);
-                if (t < HUGE_VAL) hits.emplace_back(t, p.fiber);
+                const OracleHit hit = oracle_hit(p, ray.origin, ray.dir);
+                if (hit.distance == HUGE_VAL) continue;
+                hits.emplace_back(hit.distance, p.fiber);
+                if (hit.distance < nearest) nearest = hit.distance, centre = bezier(p.c0, p.c1, p.c2, hit.t);
             }
+            if (nearest < HUGE_VAL) px.normal = unit(ray.origin + nearest * ray.dir - centre);
             for (const auto& [t, fiber] : hits)
                 if (t < px.distance) px.distance = t, px.fiber = fiber + 1;
             for (const auto& [t, fiber] : hits)
@@ -251,17 +261,20 @@ std::vector<OraclePixel> oracle_image(const std::vector<Piece>& pieces, const Ca
 }
 
 struct TubeAgreement {
-    std::size_t compared = 0, hit_agree = 0, both_hit = 0, depth_ok = 0, fiber_compared = 0, fiber_ok = 0;
+    std::size_t compared = 0, hit_agree = 0, both_hit = 0, depth_ok = 0, fiber_compared = 0, fiber_ok = 0, normal_ok = 0;
     double max_depth_error = 0, median_depth_error = 0;
     double hit_rate() const { return compared ? double(hit_agree) / double(compared) : 0; }
     double depth_rate() const { return both_hit ? double(depth_ok) / double(both_hit) : 0; }
     double fiber_rate() const { return fiber_compared ? double(fiber_ok) / double(fiber_compared) : 0; }
+    double normal_rate() const { return both_hit ? double(normal_ok) / double(both_hit) : 0; }
 };
 
 // Per pixel outside the oracle's one-pixel silhouette band: hit/miss,
 // distance along the ray (GPU depth unprojected) and fiber.
+// Normals from an image drawn with RenderOptions::color_by_normal.
 TubeAgreement compare_tubes(const std::vector<OraclePixel>& ref, const std::vector<float>& depth,
-                            const std::vector<std::uint32_t>& fibers, const Camera& cam, int w, int h, double tol) {
+                            const std::vector<std::uint32_t>& fibers, const std::vector<std::uint8_t>& normals,
+                            const Camera& cam, int w, int h, double tol) {
     TubeAgreement a;
     auto at = [&](int x, int y) { return std::size_t(y) * std::size_t(w) + std::size_t(x); };
     const double n = cam.near_mm, f = cam.far_mm;
@@ -288,6 +301,9 @@ TubeAgreement compare_tubes(const std::vector<OraclePixel>& ref, const std::vect
             errors.push_back(err);
             a.depth_ok += err <= tol + 2 * quantum;
             a.max_depth_error = std::max(a.max_depth_error, err);
+            const std::size_t i = 4 * at(x, y);
+            const D3 n = unit({normals[i] / 127.5 - 1, normals[i + 1] / 127.5 - 1, normals[i + 2] / 127.5 - 1});
+            a.normal_ok += dot(n, ref[at(x, y)].normal) >= std::cos(M_PI / 180);
             if (ref[at(x, y)].second - ref[at(x, y)].distance > 10 * tol) {
                 ++a.fiber_compared;
                 a.fiber_ok += fibers[at(x, y)] == ref[at(x, y)].fiber;
@@ -363,6 +379,7 @@ namespace {
 struct TubeRender {
     std::vector<float> depth;
     std::vector<std::uint32_t> fibers;
+    std::vector<std::uint8_t> normals;  // color_by_normal
 };
 TubeRender render_tubes(const viewer::GpuScene& scene, std::unique_ptr<viewer::DrawTechnique> technique,
                         const Camera& cam, float radius, int w, int h,
@@ -374,8 +391,9 @@ TubeRender render_tubes(const viewer::GpuScene& scene, std::unique_ptr<viewer::D
     o.style = style;
     o.tube_radius_mm = radius;
     o.level_of_detail = false;
+    o.color_by_normal = true;
     renderer.render(scene, cam, o, target);
-    return {target.read_depth(), target.read_fibers()};
+    return {target.read_depth(), target.read_fibers(), target.read_rgba()};
 }
 
 }  // namespace
@@ -392,20 +410,21 @@ TEST(ViewerTubes, RayCastingMatchesADoublePrecisionOracle) {
     const auto ref = oracle_image(reference_pieces(file, radius, 0.25), cam, w, h);
 
     const TubeRender gpu = render_tubes(scene, std::make_unique<viewer::TubesTechnique>(), cam, float(radius), w, h);
-    const TubeAgreement a = compare_tubes(ref, gpu.depth, gpu.fibers, cam, w, h, tol);
+    const TubeAgreement a = compare_tubes(ref, gpu.depth, gpu.fibers, gpu.normals, cam, w, h, tol);
     std::printf("tubes vs oracle: %zu pixels outside the silhouette band, hit/miss %.5f, %zu hit: depth within "
-                "1e-3 r %.5f (median %.2e mm, max %.2e mm), fiber %.5f\n",
+                "1e-3 r %.5f (median %.2e mm, max %.2e mm), fiber %.5f, normal within 1 degree %.5f\n",
                 a.compared, a.hit_rate(), a.both_hit, a.depth_rate(), a.median_depth_error, a.max_depth_error,
-                a.fiber_rate());
+                a.fiber_rate(), a.normal_rate());
     EXPECT_GT(a.both_hit, 1500u);
     EXPECT_GE(a.hit_rate(), 0.999);
     EXPECT_GE(a.depth_rate(), 0.99);
     EXPECT_GE(a.fiber_rate(), 0.99);
+    EXPECT_GE(a.normal_rate(), 0.99);
 
     // The paper's c = 1/3 draws another curve: the same comparison fails.
     const TubeRender third =
         render_tubes(scene, std::make_unique<viewer::TubesTechnique>(1.0f / 3.0f), cam, float(radius), w, h);
-    const TubeAgreement b = compare_tubes(ref, third.depth, third.fibers, cam, w, h, tol);
+    const TubeAgreement b = compare_tubes(ref, third.depth, third.fibers, third.normals, cam, w, h, tol);
     std::printf("with c = 1/3: hit/miss %.5f, depth within 1e-3 r %.5f\n", b.hit_rate(), b.depth_rate());
     EXPECT_TRUE(b.hit_rate() < 0.999 || b.depth_rate() < 0.99);
 }
@@ -421,15 +440,16 @@ TEST(ViewerCapsules, RayCastingMatchesADoublePrecisionOracle) {
     const double radius = 0.4, tol = 1e-3 * radius;
     const auto ref = oracle_image(reference_capsules(file, radius), cam, w, h);
     const TubeRender gpu = render_tubes(scene, nullptr, cam, float(radius), w, h, viewer::DrawStyle::capsules);
-    const TubeAgreement a = compare_tubes(ref, gpu.depth, gpu.fibers, cam, w, h, tol);
+    const TubeAgreement a = compare_tubes(ref, gpu.depth, gpu.fibers, gpu.normals, cam, w, h, tol);
     std::printf("capsules vs oracle: %zu pixels outside the silhouette band, hit/miss %.5f, %zu hit: depth within "
-                "1e-3 r %.5f (median %.2e mm, max %.2e mm), fiber %.5f\n",
+                "1e-3 r %.5f (median %.2e mm, max %.2e mm), fiber %.5f, normal within 1 degree %.5f\n",
                 a.compared, a.hit_rate(), a.both_hit, a.depth_rate(), a.median_depth_error, a.max_depth_error,
-                a.fiber_rate());
+                a.fiber_rate(), a.normal_rate());
     EXPECT_GT(a.both_hit, 1500u);
     EXPECT_GE(a.hit_rate(), 0.999);
     EXPECT_GE(a.depth_rate(), 0.99);
     EXPECT_GE(a.fiber_rate(), 0.99);
+    EXPECT_GE(a.normal_rate(), 0.99);
 }
 
 TEST(ViewerTubes, TubesHideLinesBehindTheirSurface) {

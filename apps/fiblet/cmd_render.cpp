@@ -125,7 +125,8 @@ void run(const RenderArgs& a) {
     const viewer::HeadlessContext context;
     const viewer::GpuPrograms programs;
     const FftFile file = viewer::open_scene_file(a.view.input);
-    const viewer::GpuScene scene(file, programs);
+    viewer::GpuScene scene(file, programs);
+    viewer::load_fiber_colors(fiber_color_source(a.view), scene);
     viewer::RenderTarget target(width, height);
     viewer::Renderer renderer(programs);
     const float aspect = float(width) / float(height);

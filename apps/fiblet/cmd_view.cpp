@@ -12,6 +12,7 @@ void run(const ViewerArgs& a) {
     o.render = render_options_from(a);
     o.camera = a.camera, o.fov_y_deg = a.fov, o.zoom = a.zoom;
     o.screenshot_supersample = a.supersample;
+    o.fiber_colors = fiber_color_source(a);
     viewer::run_viewer_window(a.input, o);
 }
 

@@ -44,6 +44,16 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
     cmd->add_option("--fov", a.fov, "Vertical field of view, degrees")->capture_default_str();
     cmd->add_option("--zoom", a.zoom, "Move a named view closer (>1) or farther (<1)")->capture_default_str();
     cmd->add_option("--color", a.color, "Line colour: direction (|direction| as RGB) or RRGGBB")->capture_default_str();
+    cmd->add_option("--fiber-colors", a.fiber_colors,
+                    "Colour each streamline from a text file: RRGGBB per streamline, in file order ('#' lines "
+                    "ignored)")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--fiber-values", a.fiber_values,
+                    "Colour each streamline by a value from a text file (one number per streamline, as MRtrix3's "
+                    "per-streamline files), through viridis")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--value-range", a.value_range, "MIN:MAX of --fiber-values mapped to the colour map (default: "
+                                                    "the values' range)");
     cmd->add_option("--background", a.background, "Background colour: RRGGBB, black, white, gray")
         ->capture_default_str();
     cmd->add_flag("--no-lighting", a.no_lighting, "Flat colours instead of illuminated lines");
@@ -117,7 +127,26 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
         if (!o.decoder) throw Error(Errc::invalid_argument, "--decoder: '" + a.decoder + "' is not auto, scan or sequential");
     }
     if (a.max_length > 0) o.max_length_mm = a.max_length;
+    o.fiber_colors = !fiber_color_source(a).empty();
     return o;
+}
+
+viewer::FiberColorSource fiber_color_source(const ViewerArgs& a) {
+    if (!a.fiber_colors.empty() && !a.fiber_values.empty())
+        throw Error(Errc::invalid_argument, "--fiber-colors and --fiber-values exclude each other");
+    if (!a.value_range.empty() && a.fiber_values.empty())
+        throw Error(Errc::invalid_argument, "--value-range needs --fiber-values");
+    viewer::FiberColorSource s{a.fiber_colors, a.fiber_values, std::nullopt};
+    if (!a.value_range.empty()) {
+        const std::size_t colon = a.value_range.find(':');
+        char *e1 = nullptr, *e2 = nullptr;
+        const std::string lo = a.value_range.substr(0, colon), hi = colon == std::string::npos ? "" : a.value_range.substr(colon + 1);
+        const float low = std::strtof(lo.c_str(), &e1), high = std::strtof(hi.c_str(), &e2);
+        if (colon == std::string::npos || lo.empty() || hi.empty() || *e1 != '\0' || *e2 != '\0' || !(low < high))
+            throw Error(Errc::invalid_argument, "--value-range: '" + a.value_range + "' is not MIN:MAX with MIN < MAX");
+        s.value_range = std::array<float, 2>{low, high};
+    }
+    return s;
 }
 
 }  // namespace fiblet::cli

@@ -5,6 +5,7 @@
 // level of detail needs, is decoded once on the GPU at load.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -54,6 +55,12 @@ public:
     // uniforms (scene_buffers.glsl) of `program`.
     void bind(const GlProgram& program) const;
 
+    // Per-fiber colours (fiber_colors.hpp; one per fiber, file order) for
+    // RenderOptions::fiber_colors. Throws fiblet::Error{invalid_argument}
+    // on a count that is not fiber_count().
+    void set_fiber_colors(const std::vector<std::array<float, 3>>& rgb);
+    bool has_fiber_colors() const { return has_fiber_colors_; }
+
     // The last point of every fiber as decoded on the GPU at load (world mm).
     std::vector<Vec3f> read_fiber_ends() const;
 
@@ -66,6 +73,8 @@ private:
     std::vector<Vec3f> sample_points_;
     GlBuffer blocks_, block_fiber_, fiber_points_buffer_, fiber_ends_, fiber_end_fraction_, local_frames_;
     std::vector<float> end_fraction_;  // per fiber, kept part of the last step (ENDS chunk; 1 without)
+    GlBuffer fiber_colors_;            // one vec4 when there are none (a binding must hold a buffer)
+    bool has_fiber_colors_ = false;
 };
 
 // Largest shader storage buffer of the current context, in bytes.

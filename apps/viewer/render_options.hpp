@@ -28,7 +28,9 @@ struct RenderOptions {
     float tube_radius_mm = 0.25f;                      // tubes and capsules
     bool color_by_direction = true;                    // |direction| as RGB, else fixed_color
     std::array<float, 3> fixed_color{0.95f, 0.85f, 0.6f};
+    bool fiber_colors = false;                         // the scene's per-fiber colours (GpuScene::set_fiber_colors), when it has them
     bool lighting = true;                              // illuminated lines
+    bool color_by_normal = false;                      // ray-cast styles: unit normal n as RGB (n + 1) / 2 (checks)
     float line_width = 1;                              // pixels
     std::array<float, 3> background{0, 0, 0};
     bool clear = true;  // clear the target first (false: draw over what it holds, depth included)

@@ -98,8 +98,10 @@ DrawTechnique& Renderer::technique(DrawStyle style) {
     return *t;
 }
 
-FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const RenderOptions& o,
+FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const RenderOptions& options,
                             RenderTarget& target) {
+    RenderOptions o = options;
+    o.fiber_colors = options.fiber_colors && scene.has_fiber_colors();
     ensure_buffers(scene, o.record_decisions);
     DrawTechnique& draw = technique(o.style);
     const Viewport viewport{target.width(), target.height()};

@@ -16,8 +16,10 @@ void set_shading_uniforms(const GlProgram& p, const Camera& camera, const Render
     const Mat4 vp = view_projection_matrix(camera);
     glProgramUniformMatrix4fv(id, uniform(p, "uViewProjection"), 1, GL_FALSE, vp.data());
     glProgramUniform1i(id, uniform(p, "uColorByDirection"), o.color_by_direction ? 1 : 0);
+    glProgramUniform1i(id, uniform(p, "uFiberColors"), o.fiber_colors ? 1 : 0);
     glProgramUniform3f(id, uniform(p, "uFixedColor"), o.fixed_color[0], o.fixed_color[1], o.fixed_color[2]);
     glProgramUniform1i(id, uniform(p, "uLighting"), o.lighting ? 1 : 0);
+    glProgramUniform1i(id, uniform(p, "uShowNormals"), o.color_by_normal ? 1 : 0);
     glProgramUniform3f(id, uniform(p, "uCameraPosition"), camera.position.x, camera.position.y, camera.position.z);
     // A headlight a little above and to the left of the eye, so that lines
     // facing the viewer are not all equally lit.

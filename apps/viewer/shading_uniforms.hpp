@@ -1,5 +1,5 @@
 // The lighting and colour uniforms every drawing style's fragment shader
-// shares (uViewProjection, uColorByDirection, uFixedColor, uLighting,
+// shares (uViewProjection, uColorByDirection, uFiberColors, uFixedColor, uLighting,
 // uCameraPosition, uLightDirection, uAmbient, uDiffuse, uSpecular,
 // uShininess): one headlight, set the same way for every technique.
 #pragma once

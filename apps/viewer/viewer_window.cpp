@@ -180,7 +180,8 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
     require_gl45();
 
     const GpuPrograms programs;
-    const GpuScene scene(open_scene_file(path), programs);
+    GpuScene scene(open_scene_file(path), programs);
+    load_fiber_colors(options.fiber_colors, scene);
     Renderer renderer(programs);
     int fb_width = 0, fb_height = 0;
     glfwGetFramebufferSize(w, &fb_width, &fb_height);

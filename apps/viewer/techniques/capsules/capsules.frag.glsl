@@ -54,6 +54,6 @@ void main() {
     if (best >= 1e30 || along + best <= 0.0) discard;
     vec3 hit = o + best * dir;
     gl_FragDepth = windowDepth(hit);
-    outColor = vec4(shadeSurface(normalize(normal), ba, -dir), 1.0);
+    outColor = vec4(shadeSurface(normalize(normal), ba, -dir, vFiber), 1.0);
     outFiber = vFiber + 1u;
 }

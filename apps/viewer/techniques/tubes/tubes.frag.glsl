@@ -150,6 +150,7 @@ void main() {
     vec3 centre = (1.0 - t) * (1.0 - t) * q.c0.xyz + 2.0 * t * (1.0 - t) * q.c1.xyz + t * t * q.c2.xyz;
     vec3 normal = normalize(hit - centre);
     vec3 tangent = 2.0 * (1.0 - t) * (q.c1.xyz - q.c0.xyz) + 2.0 * t * (q.c2.xyz - q.c1.xyz);
-    outColor = vec4(shadeSurface(normal, tangent, -dir), 1.0);
-    outFiber = floatBitsToUint(q.center.w) + 1u;
+    uint fiber = floatBitsToUint(q.center.w);
+    outColor = vec4(shadeSurface(normal, tangent, -dir, fiber), 1.0);
+    outFiber = fiber + 1u;
 }
