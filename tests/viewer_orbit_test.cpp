@@ -62,3 +62,26 @@ TEST(ViewerOrbit, RenderWritesNumberedFramesStartingAtThePlainView) {
     EXPECT_FALSE(std::filesystem::exists(dir.file("turn-000.png")));
     EXPECT_EQ(run_cli(common + " --orbit -2 -o " + dir.file("x.png")).status, 2);
 }
+
+TEST(ViewerOrbit, CameraPathFileGivesOneFramePerCamera) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const std::string fft = compress_into(dir, shared_data("bundles/AF_L.tck"), "af.fft");
+    const std::string common = "render " + fft + " --size 64x48";
+    ASSERT_EQ(run_cli(common + " --camera left -o " + dir.file("left.png")).status, 0);
+    ASSERT_EQ(run_cli(common + " --camera top -o " + dir.file("top.png")).status, 0);
+    write_file(dir.file("path.txt"), "# a two-frame path\nleft\n\n  top  \n");
+    const CommandResult r = run_cli(common + " --camera-path " + dir.file("path.txt") + " -o " + dir.file("p.png"));
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(viewer::read_png(dir.file("p-000.png")).rgba, viewer::read_png(dir.file("left.png")).rgba);
+    EXPECT_EQ(viewer::read_png(dir.file("p-001.png")).rgba, viewer::read_png(dir.file("top.png")).rgba);
+    EXPECT_FALSE(std::filesystem::exists(dir.file("p-002.png")));
+    // A bad camera anywhere in the path: nothing written.
+    write_file(dir.file("bad.txt"), "left\nsideways\n");
+    const CommandResult bad = run_cli(common + " --camera-path " + dir.file("bad.txt") + " -o " + dir.file("b.png"));
+    EXPECT_EQ(bad.status, 2) << bad.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("b-000.png")));
+    write_file(dir.file("empty.txt"), "# nothing\n");
+    EXPECT_EQ(run_cli(common + " --camera-path " + dir.file("empty.txt") + " -o " + dir.file("e.png")).status, 2);
+    EXPECT_EQ(run_cli(common + " --camera-path " + dir.file("path.txt") + " --orbit 3 -o " + dir.file("e.png")).status, 2);
+}

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -31,7 +32,23 @@ struct RenderArgs {
     bool force = false, quiet = false, bench = false, json = false;
     int frames = 5;
     int orbit = 0;  // turntable frames (0: one image)
+    std::string camera_path;  // a file of --camera specs, one frame each
 };
+
+// The camera specs of a camera-path file: one per line, blank and '#' lines skipped.
+std::vector<std::string> read_camera_path(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw Error(Errc::io, path + ": cannot be read");
+    std::vector<std::string> specs;
+    std::string line;
+    while (std::getline(in, line)) {
+        const std::size_t first = line.find_first_not_of(" \t\r"), last = line.find_last_not_of(" \t\r");
+        if (first == std::string::npos || line[first] == '#') continue;
+        specs.push_back(line.substr(first, last - first + 1));
+    }
+    if (specs.empty()) throw Error(Errc::invalid_argument, "--camera-path: " + path + " holds no camera");
+    return specs;
+}
 
 // Frame i of n of "dir/name.png": "dir/name-007.png" (at least three digits).
 std::string frame_path(const std::string& output, int i, int n) {
@@ -114,10 +131,15 @@ void run(const RenderArgs& a) {
     const viewer::RenderOptions options = render_options_from(a.view);
     if (!a.bench && a.output.empty()) throw Error(Errc::invalid_argument, "-o OUT.png is required (or --bench)");
     if (a.orbit < 0 || a.orbit > 100000) throw Error(Errc::invalid_argument, "--orbit must be in 0..100000 frames");
-    if (a.orbit > 0 && a.output.empty()) throw Error(Errc::invalid_argument, "--orbit needs -o OUT.png");
+    if ((a.orbit > 0 || !a.camera_path.empty()) && a.output.empty())
+        throw Error(Errc::invalid_argument, "--orbit and --camera-path need -o OUT.png");
+    if (a.orbit > 0 && !a.camera_path.empty())
+        throw Error(Errc::invalid_argument, "--orbit and --camera-path exclude each other");
+    const std::vector<std::string> path_specs = a.camera_path.empty() ? std::vector<std::string>{} : read_camera_path(a.camera_path);
+    const int movie = a.orbit > 0 ? a.orbit : int(path_specs.size());  // frames of a movie, 0: one image
     std::vector<std::string> outputs;
     if (!a.output.empty())
-        for (int i = 0; i < std::max(a.orbit, 1); ++i) outputs.push_back(a.orbit ? frame_path(a.output, i, a.orbit) : a.output);
+        for (int i = 0; i < std::max(movie, 1); ++i) outputs.push_back(movie ? frame_path(a.output, i, movie) : a.output);
     for (const std::string& out : outputs)
         if (!a.force && std::filesystem::exists(out)) throw Error(Errc::exists, out + " exists (use --force to overwrite)");
     if (a.frames < 1) throw Error(Errc::invalid_argument, "--frames must be at least 1");
@@ -142,18 +164,25 @@ void run(const RenderArgs& a) {
                     options.decoder.value_or(viewer::default_decoder()), options.style);
     }
     if (a.output.empty()) return;
-    // One image, or a turntable: frame i turned 360 i / n degrees about the camera's up axis.
+    // One image; a turntable (frame i turned 360 i / n degrees about the
+    // camera's up axis); or the cameras of a path file. Every camera is
+    // made (and checked) before the first frame is written.
+    std::vector<Camera> cameras;
+    for (const std::string& spec : path_specs)
+        cameras.push_back(viewer::camera_from_spec(spec, scene, aspect, a.view.fov, a.view.zoom));
+    if (cameras.empty()) {
+        const Camera start = camera_for(1.0f);
+        for (std::size_t i = 0; i < outputs.size(); ++i)
+            cameras.push_back(viewer::turned_about_up(start, 360.0f * float(i) / float(outputs.size()), scene.bounds()));
+    }
     viewer::FrameStats stats;
-    const Camera start = camera_for(1.0f);
     for (std::size_t i = 0; i < outputs.size(); ++i) {
-        const float degrees = 360.0f * float(i) / float(outputs.size());
         const viewer::SupersampledFrame frame =
-            viewer::render_supersampled(renderer, scene, viewer::turned_about_up(start, degrees, scene.bounds()),
-                                        options, width, height, a.view.supersample);
+            viewer::render_supersampled(renderer, scene, cameras[i], options, width, height, a.view.supersample);
         if (i == 0) stats = frame.stats;
         viewer::write_png(outputs[i], frame.image, a.force);
     }
-    if (a.orbit > 0) {
+    if (movie > 0) {
         if (!a.quiet)
             fmt::print("{} -> {} .. {} ({} frames, {}x{})\n", a.view.input, outputs.front(), outputs.back(),
                        outputs.size(), width, height);
@@ -191,6 +220,10 @@ void add_render(CLI::App& app) {
     cmd->add_option("--orbit", args->orbit,
                     "Write N frames turning once around the target about the camera's up axis, OUT-000.png "
                     "... (a turntable movie)");
+    cmd->add_option("--camera-path", args->camera_path,
+                    "A file of cameras, one --camera spec a line ('#' lines skipped): one frame each, "
+                    "OUT-000.png ...")
+        ->check(CLI::ExistingFile);
     cmd->callback([args] { run(*args); });
 }
 
