@@ -15,6 +15,9 @@
 
 namespace fiblet::viewer {
 
+// Vertices of the box proxy of the ray-cast styles (shaders/box_proxy.glsl).
+inline constexpr unsigned kBoxProxyVertices = 36;
+
 // What a technique draws from in one frame.
 struct FrameInputs {
     const GpuScene& scene;

@@ -23,7 +23,7 @@ void CapsulesTechnique::draw_batch(const FrameInputs& in, const DecodedBatch& ba
     glProgramUniform1ui(draw_.get(), uniform(draw_, "uFirst"), batch.first);
     glEnable(GL_CULL_FACE);
     glCullFace(GL_BACK);
-    glDrawArrays(GL_TRIANGLES, 0, GLsizei(36 * in.scene.header().points_per_block * batch.count));
+    glDrawArrays(GL_TRIANGLES, 0, GLsizei(kBoxProxyVertices * in.scene.header().points_per_block * batch.count));
     glDisable(GL_CULL_FACE);
 }
 

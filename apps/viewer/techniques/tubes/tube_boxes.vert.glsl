@@ -1,8 +1,8 @@
 #version 450
-// The proxy of each tube piece: its oriented box as 12 triangles (36
-// vertices per piece, outward counter-clockwise; the back faces are culled).
-// Empty pieces are sent outside the clip volume.
+// The proxy of each tube piece: its oriented box (box_proxy.glsl). Empty
+// pieces are sent outside the clip volume.
 #include "tube_piece.glsl"
+#include "box_proxy.glsl"
 
 layout(std430, binding = BINDING_TUBE_PIECES) readonly buffer Pieces { TubePiece pieces[]; };
 
@@ -11,13 +11,9 @@ uniform mat4 uViewProjection;
 layout(location = 0) flat out uint vPiece;
 layout(location = 1) out vec3 vWorld;
 
-// Corners: bit 0 x, bit 1 y, bit 2 z (0: -half, 1: +half).
-const uint kCorners[36] = uint[36](4u, 6u, 2u, 4u, 2u, 0u, 1u, 3u, 7u, 1u, 7u, 5u, 0u, 1u, 5u, 0u, 5u, 4u,
-                                   6u, 7u, 3u, 6u, 3u, 2u, 2u, 3u, 1u, 2u, 1u, 0u, 4u, 5u, 7u, 4u, 7u, 6u);
-
 void main() {
     uint v = uint(gl_VertexID);
-    uint piece = v / 36u;
+    uint piece = v / kBoxVertices;
     TubePiece q = pieces[piece];
     vPiece = piece;
     if (q.c0.w < 0.0) {
@@ -25,8 +21,6 @@ void main() {
         gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
         return;
     }
-    uint c = kCorners[v % 36u];
-    vec3 s = vec3(float(c & 1u), float((c >> 1) & 1u), float((c >> 2) & 1u)) * 2.0 - 1.0;
-    vWorld = q.center.xyz + s.x * q.axisX.w * q.axisX.xyz + s.y * q.axisY.w * q.axisY.xyz + s.z * q.axisZ.w * q.axisZ.xyz;
+    vWorld = boxCorner(v, q.center.xyz, q.axisX.xyz, q.axisY.xyz, q.axisZ.xyz, vec3(q.axisX.w, q.axisY.w, q.axisZ.w));
     gl_Position = uViewProjection * vec4(vWorld, 1.0);
 }

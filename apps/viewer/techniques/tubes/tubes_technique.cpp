@@ -8,7 +8,6 @@ namespace fiblet::viewer {
 
 namespace {
 constexpr std::uint64_t kPieceBytes = 7 * 16;  // TubePiece: seven vec4
-constexpr GLuint kVerticesPerPiece = 36;
 }  // namespace
 
 TubesTechnique::TubesTechnique(float tangent_scale)
@@ -54,7 +53,7 @@ void TubesTechnique::draw_batch(const FrameInputs& in, const DecodedBatch& batch
     glUseProgram(draw_.get());
     glEnable(GL_CULL_FACE);
     glCullFace(GL_BACK);
-    glDrawArrays(GL_TRIANGLES, 0, GLsizei(pieces * kVerticesPerPiece));
+    glDrawArrays(GL_TRIANGLES, 0, GLsizei(pieces * kBoxProxyVertices));
     glDisable(GL_CULL_FACE);
 }
 
