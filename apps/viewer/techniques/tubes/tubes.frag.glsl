@@ -103,6 +103,21 @@ float[5] square(vec3 p) {
     return float[5](p.z * p.z, 2.0 * p.y * p.z, p.y * p.y + 2.0 * p.x * p.z, 2.0 * p.x * p.y, p.x * p.x);
 }
 
+// Distance from the origin to the triangle a, b, c (2D).
+float distanceToTriangle(vec2 a, vec2 b, vec2 c) {
+    float ab = (b.x - a.x) * (-a.y) - (b.y - a.y) * (-a.x), bc = (c.x - b.x) * (-b.y) - (c.y - b.y) * (-b.x),
+          ca = (a.x - c.x) * (-c.y) - (a.y - c.y) * (-c.x);
+    if ((ab >= 0.0 && bc >= 0.0 && ca >= 0.0) || (ab <= 0.0 && bc <= 0.0 && ca <= 0.0)) return 0.0;
+    vec2 e[3] = vec2[3](b - a, c - b, a - c), p[3] = vec2[3](a, b, c);
+    float d = 1e30;
+    for (int i = 0; i < 3; ++i) {
+        float len2 = dot(e[i], e[i]);
+        float t = len2 > 0.0 ? clamp(-dot(p[i], e[i]) / len2, 0.0, 1.0) : 0.0;
+        d = min(d, length(p[i] + t * e[i]));
+    }
+    return d;
+}
+
 void main() {
     TubePiece q = pieces[vPiece];
     vec3 dir = normalize(vWorld - uCameraPosition);
@@ -114,6 +129,9 @@ void main() {
     float unit = max(max(q.c0.w, q.c1.w), q.c2.w);
     mat3 toRay = transpose(mat3(dir, ey, ez)) * (1.0 / unit);
     vec3 b0 = toRay * (q.c0.xyz - origin), b1 = toRay * (q.c1.xyz - origin), b2 = toRay * (q.c2.xyz - origin);
+    // The curve lies in its control triangle: a ray farther from it than
+    // the largest radius (1 here) misses, before any root finding.
+    if (distanceToTriangle(b0.yz, b1.yz, b2.yz) > 1.0) discard;
     vec3 X = power(b0.x, b1.x, b2.x), Y = power(b0.y, b1.y, b2.y), Z = power(b0.z, b1.z, b2.z);
     vec3 R = power(q.c0.w / unit, q.c1.w / unit, q.c2.w / unit);
 
