@@ -1,5 +1,6 @@
 // Per-fiber colours: the text files (colours, values through viridis) and
-// renders where every pixel shows its own fiber's colour.
+// renders where every pixel shows its own fiber's colour; the command
+// line's checks of the per-fiber files (colours, values, radii).
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -112,6 +113,15 @@ TEST(ViewerFiberColors, CommandLineChecksTheFiles) {
     const CommandResult count = run_cli(common + " -f --fiber-values " + dir.file("short.txt"));
     EXPECT_EQ(count.status, 4) << count.output;
     EXPECT_NE(count.output.find("streamlines"), std::string::npos) << count.output;
+    // Radii: one positive number per streamline.
+    std::string radii;
+    for (std::uint64_t f = 0; f < file.header().fibers; ++f) radii += "0.3\n";
+    write_file(dir.file("r.txt"), radii);
+    const CommandResult tubes = run_cli(common + " -f --style tubes --fiber-radii " + dir.file("r.txt"));
+    EXPECT_EQ(tubes.status, 0) << tubes.output;
+    const CommandResult zero = run_cli(common + " -f --style tubes --fiber-radii " + dir.file("v.txt"));  // 0, 1, ...
+    EXPECT_EQ(zero.status, 4) << zero.output;
+    EXPECT_NE(zero.output.find("not positive"), std::string::npos) << zero.output;
     for (const std::string bad : {" --fiber-values " + dir.file("v.txt") + " --fiber-colors " + dir.file("v.txt"),
                                   std::string(" --value-range 0:10"),
                                   " --fiber-values " + dir.file("v.txt") + " --value-range 5:1"}) {

@@ -129,11 +129,13 @@ std::vector<std::vector<Vec3f>> synthetic_fibers() {
 }
 
 // The tube pieces of a file as tube_pieces.comp.glsl builds them, in
-// double precision from the CPU decoder's points.
-std::vector<Piece> reference_pieces(const FftFile& file, double radius, double c) {
+// double precision from the CPU decoder's points: fiber f of radius
+// radii[f] (or `radius` for all), nodes spaced for the smallest radius.
+std::vector<Piece> reference_pieces(const FftFile& file, double radius, double c, const std::vector<double>& radii = {}) {
     const CpuDecoded d = cpu_decode_blocks(file);
     const FftHeader& h = file.header();
-    const std::uint32_t s = viewer::tube_node_spacing(float(radius), h.step * h.scaling);
+    const double spacing_radius = radii.empty() ? radius : *std::min_element(radii.begin(), radii.end());
+    const std::uint32_t s = viewer::tube_node_spacing(float(spacing_radius), h.step * h.scaling);
     std::vector<Piece> out;
     for (std::uint64_t f = 0; f < h.fibers; ++f) {
         const std::uint64_t first = file.first_block(f), count = file.block_count(f);
@@ -158,7 +160,7 @@ std::vector<Piece> reference_pieces(const FftFile& file, double radius, double c
                 const std::size_t k1 = std::min<std::size_t>(k0 + s, last);
                 const double len = norm(pts[k1] - pts[k0]);
                 for (const Piece& p : split_hermite(pts[k0], len * direction(k0), pts[k1], len * direction(k1), c,
-                                                    radius, std::uint32_t(f)))
+                                                    radii.empty() ? radius : radii[f], std::uint32_t(f)))
                     out.push_back(p);
             }
         }
@@ -168,7 +170,7 @@ std::vector<Piece> reference_pieces(const FftFile& file, double radius, double c
 
 // Every decoded segment (those joining blocks included) as a capsule: a
 // straight piece (control point at the middle), swept by the radius.
-std::vector<Piece> reference_capsules(const FftFile& file, double radius) {
+std::vector<Piece> reference_capsules(const FftFile& file, double radius, const std::vector<double>& radii = {}) {
     const CpuDecoded d = cpu_decode_blocks(file);
     std::vector<Piece> out;
     for (std::uint64_t f = 0; f < file.header().fibers; ++f) {
@@ -176,7 +178,7 @@ std::vector<Piece> reference_capsules(const FftFile& file, double radius) {
         const std::size_t begin = d.block_first[first], end = d.block_first[first + count];
         for (std::size_t i = begin; i + 1 < end; ++i) {
             const D3 a = d3(d.point(i)), b = d3(d.point(i + 1));
-            out.push_back({a, 0.5 * (a + b), b, radius, std::uint32_t(f)});
+            out.push_back({a, 0.5 * (a + b), b, radii.empty() ? radius : radii[f], std::uint32_t(f)});
         }
     }
     return out;
@@ -450,6 +452,46 @@ TEST(ViewerCapsules, RayCastingMatchesADoublePrecisionOracle) {
     EXPECT_GE(a.depth_rate(), 0.99);
     EXPECT_GE(a.fiber_rate(), 0.99);
     EXPECT_GE(a.normal_rate(), 0.99);
+}
+
+// Per-fiber radii (GpuScene::set_fiber_radii), for tubes and capsules.
+TEST(ViewerTubes, PerFiberRadiiMatchTheOracle) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    write_tck(dir.file("s.tck"), synthetic_fibers());
+    const FftFile file(compress_into(dir, dir.file("s.tck"), "s.fft"));
+    viewer::GpuScene scene(file, *viewer_gl().programs);
+    const std::vector<double> radii{0.2, 0.55, 0.3, 0.45, 0.25};
+    scene.set_fiber_radii(std::vector<float>(radii.begin(), radii.end()));
+    const int w = 200, h = 200;
+    const Camera cam = test_camera();
+    const double tol = 1e-3 * 0.2;
+    for (const auto style : {viewer::DrawStyle::tubes, viewer::DrawStyle::capsules}) {
+        SCOPED_TRACE(viewer::draw_style_name(style));
+        const auto ref = oracle_image(style == viewer::DrawStyle::tubes ? reference_pieces(file, 0, 0.25, radii)
+                                                                       : reference_capsules(file, 0, radii),
+                                      cam, w, h);
+        viewer::Renderer renderer(*viewer_gl().programs);
+        viewer::RenderTarget target(w, h);
+        viewer::RenderOptions o;
+        o.style = style;
+        o.tube_radius_mm = 3;  // not used: the scene's radii are
+        o.fiber_radii = true;
+        o.level_of_detail = false;
+        o.color_by_normal = true;
+        renderer.render(scene, cam, o, target);
+        const TubeAgreement a =
+            compare_tubes(ref, target.read_depth(), target.read_fibers(), target.read_rgba(), cam, w, h, tol);
+        std::printf("%s with per-fiber radii: hit/miss %.5f, depth %.5f, fiber %.5f, normal %.5f\n",
+                    viewer::draw_style_name(style), a.hit_rate(), a.depth_rate(), a.fiber_rate(), a.normal_rate());
+        EXPECT_GT(a.both_hit, 1500u);
+        EXPECT_GE(a.hit_rate(), 0.999);
+        EXPECT_GE(a.depth_rate(), 0.99);
+        EXPECT_GE(a.fiber_rate(), 0.99);
+        EXPECT_GE(a.normal_rate(), 0.99);
+    }
+    EXPECT_THROW(scene.set_fiber_radii({1, 2}), Error);
+    EXPECT_THROW(scene.set_fiber_radii({0.2f, 0.2f, 0.0f, 0.2f, 0.2f}), Error);
 }
 
 TEST(ViewerTubes, TubesHideLinesBehindTheirSurface) {

@@ -20,6 +20,7 @@
 #include "render_target.hpp"
 #include "renderer.hpp"
 #include "scene_file.hpp"
+#include "fiber_radii.hpp"
 #include "supersampling.hpp"
 #include "viewer_options.hpp"
 
@@ -149,6 +150,7 @@ void run(const RenderArgs& a) {
     const FftFile file = viewer::open_scene_file(a.view.input);
     viewer::GpuScene scene(file, programs);
     viewer::load_fiber_colors(fiber_color_source(a.view), scene);
+    if (!a.view.fiber_radii.empty()) viewer::load_fiber_radii(a.view.fiber_radii, scene);
     viewer::RenderTarget target(width, height);
     viewer::Renderer renderer(programs);
     const float aspect = float(width) / float(height);

@@ -63,6 +63,10 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
                                             "segment; docs/viewer.md)")
         ->capture_default_str();
     cmd->add_option("--radius", a.radius, "Tube and capsule radius in mm (--style tubes, capsules)")->capture_default_str();
+    cmd->add_option("--fiber-radii", a.fiber_radii,
+                    "Tube and capsule radius per streamline from a text file (mm, one per streamline, in file "
+                    "order), instead of --radius")
+        ->check(CLI::ExistingFile);
     cmd->add_option("--supersample", a.supersample,
                     "Anti-aliasing of the PNG (render) or screenshots (view): draw N times larger per axis and "
                     "average, 1..8")
@@ -128,6 +132,7 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
     }
     if (a.max_length > 0) o.max_length_mm = a.max_length;
     o.fiber_colors = !fiber_color_source(a).empty();
+    o.fiber_radii = !a.fiber_radii.empty();
     return o;
 }
 

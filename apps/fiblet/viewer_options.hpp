@@ -20,7 +20,7 @@ struct ViewerArgs {
     std::string style = "lines";
     float radius = 0.25f;
     int supersample = 1;
-    std::string fiber_colors, fiber_values, value_range;
+    std::string fiber_colors, fiber_values, value_range, fiber_radii;
     double min_length = 0, max_length = 0;
 };
 

@@ -21,7 +21,8 @@ inline constexpr unsigned kFiberEndFraction = 9;  // per fiber: fraction of its 
 inline constexpr unsigned kTangents = 10;    // unit tangent of each decoded point, laid out as kPoints
 inline constexpr unsigned kTubePieces = 11;  // techniques/tubes: quadratic pieces and their boxes
 inline constexpr unsigned kFiberColors = 12;  // per fiber: RGB (vec4), when the scene has colours
-inline constexpr unsigned kStorageCount = 13;
+inline constexpr unsigned kFiberRadii = 13;   // per fiber: tube radius (mm), when the scene has radii
+inline constexpr unsigned kStorageCount = 14;
 // Uniform buffers.
 inline constexpr unsigned kLocalFrames = 0;  // the 256 frames of the direction code (DirectionTable)
 }  // namespace binding

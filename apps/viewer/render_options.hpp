@@ -26,6 +26,7 @@ struct RenderOptions {
     // Drawing style (techniques/) and shading.
     DrawStyle style = DrawStyle::lines;
     float tube_radius_mm = 0.25f;                      // tubes and capsules
+    bool fiber_radii = false;                          // the scene's per-fiber radii instead (GpuScene::set_fiber_radii), when it has them
     bool color_by_direction = true;                    // |direction| as RGB, else fixed_color
     std::array<float, 3> fixed_color{0.95f, 0.85f, 0.6f};
     bool fiber_colors = false;                         // the scene's per-fiber colours (GpuScene::set_fiber_colors), when it has them

@@ -71,7 +71,7 @@ DrawCounters Renderer::select_blocks(const GpuScene& scene, const Camera& camera
     glProgramUniform1i(id, uniform(p, "uFrustumCulling"), o.frustum_culling ? 1 : 0);
     glProgramUniform4fv(id, uniform(p, "uPlanes"), 6, planes);
     // Spheres grow by what the style draws beyond the centre lines (a tube's radius).
-    glProgramUniform1f(id, uniform(p, "uSphereMargin"), technique(o.style).reach_mm(o));
+    glProgramUniform1f(id, uniform(p, "uSphereMargin"), technique(o.style).reach_mm(scene, o));
     const CameraBasis basis = camera_basis(camera);
     glProgramUniform1i(id, uniform(p, "uLevelOfDetail"), o.level_of_detail ? 1 : 0);
     glProgramUniform1f(id, uniform(p, "uLodPixels"), o.lod_pixels);
@@ -102,6 +102,7 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const R
                             RenderTarget& target) {
     RenderOptions o = options;
     o.fiber_colors = options.fiber_colors && scene.has_fiber_colors();
+    o.fiber_radii = options.fiber_radii && scene.has_fiber_radii();
     ensure_buffers(scene, o.record_decisions);
     DrawTechnique& draw = technique(o.style);
     const Viewport viewport{target.width(), target.height()};

@@ -22,6 +22,7 @@
 #include "png_file.hpp"
 #include "render_target.hpp"
 #include "renderer.hpp"
+#include "fiber_radii.hpp"
 #include "supersampling.hpp"
 #include "scene_file.hpp"
 #include "vec_ops.hpp"
@@ -182,6 +183,7 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
     const GpuPrograms programs;
     GpuScene scene(open_scene_file(path), programs);
     load_fiber_colors(options.fiber_colors, scene);
+    if (!options.fiber_radii_path.empty()) load_fiber_radii(options.fiber_radii_path, scene);
     Renderer renderer(programs);
     int fb_width = 0, fb_height = 0;
     glfwGetFramebufferSize(w, &fb_width, &fb_height);

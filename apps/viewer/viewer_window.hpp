@@ -16,7 +16,8 @@ struct WindowOptions {
     RenderOptions render;
     std::string screenshot_prefix = "fiblet-screenshot";  // + "-NNN.png" in the working directory
     int screenshot_supersample = 1;
-    FiberColorSource fiber_colors;  // render.fiber_colors turns them on  // screenshots drawn again, supersampled (supersampling.hpp)
+    FiberColorSource fiber_colors;  // render.fiber_colors turns them on
+    std::string fiber_radii_path;   // fiber_radii.hpp; render.fiber_radii turns them on  // screenshots drawn again, supersampled (supersampling.hpp)
 };
 
 // The key and mouse bindings, for --help and the H key.

@@ -40,7 +40,7 @@ public:
 
     // How far (mm) what it draws reaches beyond the fibers' centre lines:
     // culling spheres grow by this much.
-    virtual float reach_mm(const RenderOptions&) const { return 0; }
+    virtual float reach_mm(const GpuScene&, const RenderOptions&) const { return 0; }
     // Whether the decoder must also write each point's unit tangent.
     virtual bool needs_tangents() const { return false; }
 

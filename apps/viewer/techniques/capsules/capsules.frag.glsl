@@ -1,6 +1,6 @@
 #version 450
 // Exact ray–capsule intersection: the capsule (a segment swept by a sphere
-// of radius uRadius) is the union of a cylinder and two end spheres, so the
+// of the fiber's radius) is the union of a cylinder and two end spheres, so the
 // ray enters it at the least of their entries (the cylinder's counted only
 // between the end planes). Computed from a point near the capsule on the
 // ray, for precision. Writes depth, shading and the fiber.
@@ -10,12 +10,11 @@ layout(location = 0) flat in vec3 vEnd0;
 layout(location = 1) flat in vec3 vEnd1;
 layout(location = 2) flat in uint vFiber;
 layout(location = 3) in vec3 vWorld;
+layout(location = 4) flat in float vRadius;
 
 layout(location = 0) out vec4 outColor;
 layout(location = 1) out uint outFiber;
 layout(depth_greater) out float gl_FragDepth;
-
-uniform float uRadius;
 
 // Entry distance of the unit ray (o, d) into the sphere (c, r), or -1.
 float sphereEntry(vec3 o, vec3 d, vec3 c, float r) {
@@ -29,7 +28,7 @@ void main() {
     float along = dot(0.5 * (vEnd0 + vEnd1) - uCameraPosition, dir);
     vec3 o = uCameraPosition + along * dir;  // origin near the capsule
     vec3 a = vEnd0, ba = vEnd1 - vEnd0, oa = o - a;
-    float r = uRadius, baba = dot(ba, ba), bard = dot(ba, dir), baoa = dot(ba, oa);
+    float r = vRadius, baba = dot(ba, ba), bard = dot(ba, dir), baoa = dot(ba, oa);
     float best = 1e30;
     vec3 normal = vec3(0.0);
     // The cylinder: |(p - a) x ba|² = r² |ba|², p = o + t d.

@@ -12,6 +12,7 @@ CapsulesTechnique::CapsulesTechnique()
 void CapsulesTechnique::begin_frame(const FrameInputs& in) {
     set_shading_uniforms(draw_, in.camera, in.options);
     glProgramUniform1f(draw_.get(), uniform(draw_, "uRadius"), in.options.tube_radius_mm);
+    glProgramUniform1i(draw_.get(), uniform(draw_, "uFiberRadii"), in.options.fiber_radii ? 1 : 0);
     coarse_lines_.begin_frame(in);
 }
 

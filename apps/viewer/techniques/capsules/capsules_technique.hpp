@@ -7,6 +7,7 @@
 
 #include "techniques/draw_technique.hpp"
 #include "techniques/lines/lines_technique.hpp"
+#include "techniques/tubes/tube_spline.hpp"
 
 namespace fiblet::viewer {
 
@@ -14,7 +15,7 @@ class CapsulesTechnique final : public DrawTechnique {
 public:
     CapsulesTechnique();
 
-    float reach_mm(const RenderOptions& o) const override { return o.tube_radius_mm; }
+    float reach_mm(const GpuScene& scene, const RenderOptions& o) const override { return tube_radius_reach(scene, o); }
     void begin_frame(const FrameInputs& in) override;
     void draw_batch(const FrameInputs& in, const DecodedBatch& batch) override;
     void draw_coarse(const FrameInputs& in, std::uint32_t count) override;

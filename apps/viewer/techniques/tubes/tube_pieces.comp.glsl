@@ -7,6 +7,7 @@ layout(local_size_x = 64) in;
 
 #include "scene_buffers.glsl"
 #include "tube_piece.glsl"
+#include "fiber_radii.glsl"
 
 layout(std430, binding = BINDING_FINE_LIST) readonly buffer FineList { uint fineList[]; };
 layout(std430, binding = BINDING_POINTS) readonly buffer Points { vec4 points[]; };
@@ -18,7 +19,6 @@ uniform uint uFirst;
 uniform uint uCount;            // slots in the batch
 uniform uint uNodeSpacing;      // points between nodes
 uniform uint uSegmentsPerSlot;  // tube_segments_per_slot
-uniform float uRadius;          // mm
 uniform float uTangentScale;    // c of tube_spline.hpp (1/4)
 
 // The node's unit direction: the mean of the tangents arriving at and
@@ -100,6 +100,7 @@ void main() {
     vec3 m0 = len * nodeDirection(base, k0, last, block), m1 = len * nodeDirection(base, k1, last, block);
     vec3 a2 = n0 + uTangentScale * m0, b2 = n1 - uTangentScale * m1, join = 0.5 * (a2 + b2);
     uint fiber = blockFiber[block];
-    pieces[2u * id] = makePiece(n0, a2, join, uRadius, fiber);
-    pieces[2u * id + 1u] = makePiece(join, b2, n1, uRadius, fiber);
+    float radius = fiberRadius(fiber);
+    pieces[2u * id] = makePiece(n0, a2, join, radius, fiber);
+    pieces[2u * id + 1u] = makePiece(join, b2, n1, radius, fiber);
 }

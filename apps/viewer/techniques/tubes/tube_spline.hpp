@@ -16,6 +16,9 @@
 #include <cmath>
 #include <cstdint>
 
+#include "gpu_scene.hpp"
+#include "render_options.hpp"
+
 namespace fiblet::viewer {
 
 inline constexpr float kBezierTangentScale = 0.25f;  // also in tube_pieces.comp.glsl
@@ -31,6 +34,16 @@ inline std::uint32_t tube_node_spacing(float radius_mm, float step_mm) {
     if (!(step_mm > 0) || !(radius_mm > 0)) return 1;
     const float s = std::round(4.0f * radius_mm / step_mm);
     return std::uint32_t(std::clamp(s, 1.0f, 20.0f));
+}
+
+// The largest radius drawn (what culling spheres grow by), and the
+// smallest (what the node spacing follows, so that no tube is drawn with
+// nodes farther apart than its radius asks).
+inline float tube_radius_reach(const GpuScene& scene, const RenderOptions& o) {
+    return o.fiber_radii && scene.has_fiber_radii() ? scene.max_fiber_radius() : o.tube_radius_mm;
+}
+inline float tube_radius_for_spacing(const GpuScene& scene, const RenderOptions& o) {
+    return o.fiber_radii && scene.has_fiber_radii() ? scene.min_fiber_radius() : o.tube_radius_mm;
 }
 
 // Hermite segments (two pieces each) of a points-buffer slot of up to

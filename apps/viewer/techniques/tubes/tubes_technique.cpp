@@ -22,7 +22,7 @@ void TubesTechnique::begin_frame(const FrameInputs& in) {
 
 std::uint32_t TubesTechnique::build_pieces(const FrameInputs& in, const DecodedBatch& batch) {
     const FftHeader& h = in.scene.header();
-    const std::uint32_t s = tube_node_spacing(in.options.tube_radius_mm, h.step * h.scaling);
+    const std::uint32_t s = tube_node_spacing(tube_radius_for_spacing(in.scene, in.options), h.step * h.scaling);
     const std::uint32_t segments_per_slot = tube_segments_per_slot(h.points_per_block, s);
     const std::uint64_t segments = std::uint64_t(batch.count) * segments_per_slot;
     if (pieces_capacity_ < 2 * segments) {
@@ -41,6 +41,7 @@ std::uint32_t TubesTechnique::build_pieces(const FrameInputs& in, const DecodedB
     glProgramUniform1ui(id, uniform(build_, "uNodeSpacing"), s);
     glProgramUniform1ui(id, uniform(build_, "uSegmentsPerSlot"), segments_per_slot);
     glProgramUniform1f(id, uniform(build_, "uRadius"), in.options.tube_radius_mm);
+    glProgramUniform1i(id, uniform(build_, "uFiberRadii"), in.options.fiber_radii ? 1 : 0);
     glProgramUniform1f(id, uniform(build_, "uTangentScale"), tangent_scale_);
     glDispatchCompute(GLuint((segments + 63) / 64), 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);

@@ -19,7 +19,7 @@ public:
     // tests that the renderer's agreement depends on it.
     explicit TubesTechnique(float tangent_scale = kBezierTangentScale);
 
-    float reach_mm(const RenderOptions& o) const override { return o.tube_radius_mm; }
+    float reach_mm(const GpuScene& scene, const RenderOptions& o) const override { return tube_radius_reach(scene, o); }
     bool needs_tangents() const override { return true; }
     void begin_frame(const FrameInputs& in) override;
     void draw_batch(const FrameInputs& in, const DecodedBatch& batch) override;
