@@ -224,9 +224,9 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
         glfwSwapBuffers(w);
         glfwSetWindowTitle(
             w, fmt::format("{} | {:.1f} ms (GPU cull {:.1f} decode {:.1f} draw {:.1f}) | {} blocks ({} coarse), {} "
-                           "segments | culling {} LoD {}",
+                           "segments | {} | culling {} LoD {}",
                            title, frame_ms, st.cull_ms, st.decode_ms, st.draw_ms, st.drawn_blocks(), st.coarse_blocks,
-                           st.drawn_segments(), s.render.frustum_culling ? "on" : "off",
+                           st.drawn_segments(), draw_style_name(s.render.style), s.render.frustum_culling ? "on" : "off",
                            s.render.level_of_detail ? "on" : "off")
                    .c_str());
 
