@@ -13,6 +13,7 @@ PACKAGES=(
   slurm-wlm munge  # the cohort workflow on a single-node SLURM (ecosystem.cohort_workflow_slurm)
   clang-14 libclang-rt-14-dev  # libFuzzer harnesses (scripts/fuzz.sh)
   libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libspng-dev
+  libembree-dev  # test-only: the independent ray tracer the viewer's capsules are checked against
 )
 
 missing=()

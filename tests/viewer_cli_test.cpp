@@ -46,6 +46,24 @@ TEST(ViewerCli, RenderWritesAPngOfTheRequestedSize) {
     EXPECT_GT(fixed, 200u);
 }
 
+// Tubes (and capsules) a few pixels wide cover more of the image than one-pixel lines of the
+// same fibers (their exact shape: viewer_tubes_test).
+TEST(ViewerCli, RenderDrawsTubes) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const std::string fft = compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft");
+    std::size_t lit[3] = {};
+    const char* styles[3] = {"--style lines", "--style tubes --radius 0.5", "--style capsules --radius 0.5"};
+    for (int i = 0; i < 3; ++i) {
+        const std::string png = dir.file(std::to_string(i) + ".png");
+        const CommandResult r = run_cli("render " + fft + " -o " + png + " --size 160x120 --camera left --zoom 2 " + styles[i]);
+        ASSERT_EQ(r.status, 0) << r.output;
+        lit[i] = lit_pixels(viewer::read_png(png));
+    }
+    EXPECT_GT(lit[1], lit[0] * 6 / 5);  // measured: 1.31
+    EXPECT_GT(lit[2], lit[0] * 6 / 5);
+}
+
 TEST(ViewerCli, RenderRefusesBadArgumentsAndExistingOutputs) {
     FIBLET_REQUIRE_GL();
     const TempDir dir;
@@ -55,7 +73,8 @@ TEST(ViewerCli, RenderRefusesBadArgumentsAndExistingOutputs) {
     EXPECT_EQ(exists.status, 5) << exists.output;
     EXPECT_EQ(read_file(dir.file("old.png")), "keep");
     for (const char* bad : {"--size 100by50", "--size 0x10", "--camera 1,2", "--camera sideways", "--color purple",
-                            "--fov 0", "--fibers 9:3", "--line-width 0"}) {
+                            "--fov 0", "--fibers 9:3", "--line-width 0", "--style ribbons", "--radius 0",
+                            "--radius -1", "--supersample 0", "--supersample 9"}) {
         const CommandResult r = run_cli("render " + fft + " -o " + dir.file("x.png") + " " + bad);
         EXPECT_EQ(r.status, 2) << bad << ": " << r.output;
         EXPECT_FALSE(std::filesystem::exists(dir.file("x.png"))) << bad;

@@ -113,3 +113,40 @@ TEST(ViewerGpuDecode, EveryBlockBoundaryCase) {
         EXPECT_LE(c.max_diff_mm, tolerance_mm(fft)) << viewer::decoder_name(kind);
     }
 }
+
+// The unit tangents the decoders emit for the tubes: the direction of the
+// step arriving at each point (F0), the first point taking its first step's.
+TEST(ViewerGpuDecode, TangentsAreTheUnitStepDirections) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("bundles/AF_L-step0.1.tck"), "af.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CpuDecoded cpu = cpu_decode_blocks(file);
+    for (const auto kind : {viewer::DecoderKind::sequential, viewer::DecoderKind::scan}) {
+        SCOPED_TRACE(viewer::decoder_name(kind));
+        const auto t = viewer::decode_tangents_on_gpu(scene, *viewer_gl().programs, kind, 0, scene.block_count());
+        ASSERT_EQ(t.size(), cpu.xyz.size());
+        double worst = 0;
+        std::size_t checked = 0;
+        for (std::uint32_t b = 0; b < scene.block_count(); ++b) {
+            const std::size_t first = cpu.block_first[b], n = cpu.block_first[b + 1] - first;
+            if (n < 2) continue;
+            for (std::size_t k = 0; k < n; ++k) {
+                // Point 0 takes the first step's direction, point k the step arriving at it.
+                const std::size_t i = first + std::max<std::size_t>(k, 1);
+                const Vec3f p0 = cpu.point(i - 1), p1 = cpu.point(i);
+                const double dx = double(p1.x) - p0.x, dy = double(p1.y) - p0.y, dz = double(p1.z) - p0.z;
+                const double length = std::sqrt(dx * dx + dy * dy + dz * dz);
+                const double ex = t[3 * (first + k)] - dx / length, ey = t[3 * (first + k) + 1] - dy / length,
+                             ez = t[3 * (first + k) + 2] - dz / length;
+                // The CPU direction is a difference of float points (about
+                // 1e-5 mm rounding near 100 mm), over a step of 0.1 mm or,
+                // for a fiber's shortened last step (ENDS), much less.
+                worst = std::max(worst, std::sqrt(ex * ex + ey * ey + ez * ez) / (1e-4 + 2e-5 / length));
+                ++checked;
+            }
+        }
+        EXPECT_GT(checked, 10000u);
+        EXPECT_LE(worst, 1.0);  // error / tolerance
+    }
+}

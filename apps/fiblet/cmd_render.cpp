@@ -2,7 +2,11 @@
 // (EGL; Mesa's llvmpipe where there is no GPU), and its frame-time benchmark.
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
 
 #include "cli_common.hpp"
 #include "fiblet/error.hpp"
@@ -16,6 +20,8 @@
 #include "render_target.hpp"
 #include "renderer.hpp"
 #include "scene_file.hpp"
+#include "fiber_radii.hpp"
+#include "supersampling.hpp"
 #include "viewer_options.hpp"
 
 namespace fiblet::cli {
@@ -26,7 +32,34 @@ struct RenderArgs {
     std::string output;
     bool force = false, quiet = false, bench = false, json = false;
     int frames = 5;
+    int orbit = 0;  // turntable frames (0: one image)
+    std::string camera_path;  // a file of --camera specs, one frame each
 };
+
+// The camera specs of a camera-path file: one per line, blank and '#' lines skipped.
+std::vector<std::string> read_camera_path(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw Error(Errc::io, path + ": cannot be read");
+    std::vector<std::string> specs;
+    std::string line;
+    while (std::getline(in, line)) {
+        const std::size_t first = line.find_first_not_of(" \t\r"), last = line.find_last_not_of(" \t\r");
+        if (first == std::string::npos || line[first] == '#') continue;
+        specs.push_back(line.substr(first, last - first + 1));
+    }
+    if (specs.empty()) throw Error(Errc::invalid_argument, "--camera-path: " + path + " holds no camera");
+    return specs;
+}
+
+// Frame i of n of "dir/name.png": "dir/name-007.png" (at least three digits).
+std::string frame_path(const std::string& output, int i, int n) {
+    const std::filesystem::path p(output);
+    const int digits = std::max(3, int(std::to_string(std::max(n - 1, 0)).size()));
+    std::filesystem::path name = p.stem();
+    name += fmt::format("-{:0{}}", i, digits);
+    name += p.extension();
+    return (p.parent_path() / name).string();
+}
 
 std::string stats_json(const viewer::FrameStats& s) {
     return Json{}
@@ -41,7 +74,7 @@ std::string stats_json(const viewer::FrameStats& s) {
 
 void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::string& device, int width, int height,
                  const std::vector<viewer::BenchCase>& cases, double scan_ms, double sequential_ms,
-                 viewer::DecoderKind decoder) {
+                 viewer::DecoderKind decoder, viewer::DrawStyle style) {
     if (a.json) {
         std::string list = "[";
         for (std::size_t i = 0; i < cases.size(); ++i) {
@@ -63,6 +96,8 @@ void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::
                                .integer("fibers", scene.fiber_count())
                                .integer("blocks", scene.block_count())
                                .str("decoder", viewer::decoder_name(decoder))
+                               .str("style", viewer::draw_style_name(style))
+                               .num("radius_mm", a.view.radius)
                                .num("decode_all_scan_ms", scan_ms)
                                .num("decode_all_sequential_ms", sequential_ms)
                                .raw("cases", list + "]")
@@ -72,6 +107,8 @@ void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::
     fmt::print("{}: {} fibers, {} blocks, {} segments; {}x{}, median of {} frames\n", a.view.input,
                scene.fiber_count(), scene.block_count(), scene.segment_count(), width, height, a.frames);
     fmt::print("device: {}; stage times by {}\n", device, viewer::timing_method_name(viewer::default_timing_method()));
+    fmt::print("style: {}{}\n", viewer::draw_style_name(style),
+               style == viewer::DrawStyle::tubes ? fmt::format(", radius {} mm", a.view.radius) : "");
     fmt::print("decoding all {} blocks: scan {:.2f} ms, sequential {:.2f} ms; frames below use the {} decoder\n",
                scene.block_count(), scan_ms, sequential_ms, viewer::decoder_name(decoder));
     fmt::print("{:<9} {:<12} {:>10} {:>10} {:>11} {:>9} {:>10} {:>9} {:>10} {:>9}\n", "view", "culling+LoD",
@@ -94,14 +131,26 @@ void run(const RenderArgs& a) {
     parse_size(a.view.size, width, height);
     const viewer::RenderOptions options = render_options_from(a.view);
     if (!a.bench && a.output.empty()) throw Error(Errc::invalid_argument, "-o OUT.png is required (or --bench)");
-    if (!a.output.empty() && !a.force && std::filesystem::exists(a.output))
-        throw Error(Errc::exists, a.output + " exists (use --force to overwrite)");
+    if (a.orbit < 0 || a.orbit > 100000) throw Error(Errc::invalid_argument, "--orbit must be in 0..100000 frames");
+    if ((a.orbit > 0 || !a.camera_path.empty()) && a.output.empty())
+        throw Error(Errc::invalid_argument, "--orbit and --camera-path need -o OUT.png");
+    if (a.orbit > 0 && !a.camera_path.empty())
+        throw Error(Errc::invalid_argument, "--orbit and --camera-path exclude each other");
+    const std::vector<std::string> path_specs = a.camera_path.empty() ? std::vector<std::string>{} : read_camera_path(a.camera_path);
+    const int movie = a.orbit > 0 ? a.orbit : int(path_specs.size());  // frames of a movie, 0: one image
+    std::vector<std::string> outputs;
+    if (!a.output.empty())
+        for (int i = 0; i < std::max(movie, 1); ++i) outputs.push_back(movie ? frame_path(a.output, i, movie) : a.output);
+    for (const std::string& out : outputs)
+        if (!a.force && std::filesystem::exists(out)) throw Error(Errc::exists, out + " exists (use --force to overwrite)");
     if (a.frames < 1) throw Error(Errc::invalid_argument, "--frames must be at least 1");
 
     const viewer::HeadlessContext context;
     const viewer::GpuPrograms programs;
     const FftFile file = viewer::open_scene_file(a.view.input);
-    const viewer::GpuScene scene(file, programs);
+    viewer::GpuScene scene(file, programs);
+    viewer::load_fiber_colors(fiber_color_source(a.view), scene);
+    if (!a.view.fiber_radii.empty()) viewer::load_fiber_radii(a.view.fiber_radii, scene);
     viewer::RenderTarget target(width, height);
     viewer::Renderer renderer(programs);
     const float aspect = float(width) / float(height);
@@ -114,11 +163,33 @@ void run(const RenderArgs& a) {
         const double scan_ms = viewer::time_full_decode(scene, programs, viewer::DecoderKind::scan, a.frames);
         const double sequential_ms = viewer::time_full_decode(scene, programs, viewer::DecoderKind::sequential, a.frames);
         print_bench(a, scene, context.description(), width, height, cases, scan_ms, sequential_ms,
-                    options.decoder.value_or(viewer::default_decoder()));
+                    options.decoder.value_or(viewer::default_decoder()), options.style);
     }
     if (a.output.empty()) return;
-    const viewer::FrameStats stats = renderer.render(scene, camera_for(1.0f), options, target);
-    viewer::write_png(a.output, {width, height, target.read_rgba()}, a.force);
+    // One image; a turntable (frame i turned 360 i / n degrees about the
+    // camera's up axis); or the cameras of a path file. Every camera is
+    // made (and checked) before the first frame is written.
+    std::vector<Camera> cameras;
+    for (const std::string& spec : path_specs)
+        cameras.push_back(viewer::camera_from_spec(spec, scene, aspect, a.view.fov, a.view.zoom));
+    if (cameras.empty()) {
+        const Camera start = camera_for(1.0f);
+        for (std::size_t i = 0; i < outputs.size(); ++i)
+            cameras.push_back(viewer::turned_about_up(start, 360.0f * float(i) / float(outputs.size()), scene.bounds()));
+    }
+    viewer::FrameStats stats;
+    for (std::size_t i = 0; i < outputs.size(); ++i) {
+        const viewer::SupersampledFrame frame =
+            viewer::render_supersampled(renderer, scene, cameras[i], options, width, height, a.view.supersample);
+        if (i == 0) stats = frame.stats;
+        viewer::write_png(outputs[i], frame.image, a.force);
+    }
+    if (movie > 0) {
+        if (!a.quiet)
+            fmt::print("{} -> {} .. {} ({} frames, {}x{})\n", a.view.input, outputs.front(), outputs.back(),
+                       outputs.size(), width, height);
+        return;
+    }
     if (a.json && !a.bench) {
         fmt::print("{}\n", Json{}
                                .str("input", a.view.input)
@@ -148,6 +219,13 @@ void add_render(CLI::App& app) {
                   "Time frames (cull / decode / draw: GL timer queries, glFinish on software renderers) "
                   "from three distances, with and without culling + LoD");
     cmd->add_option("--frames", args->frames, "Timed frames per benchmark case")->capture_default_str();
+    cmd->add_option("--orbit", args->orbit,
+                    "Write N frames turning once around the target about the camera's up axis, OUT-000.png "
+                    "... (a turntable movie)");
+    cmd->add_option("--camera-path", args->camera_path,
+                    "A file of cameras, one --camera spec a line ('#' lines skipped): one frame each, "
+                    "OUT-000.png ...")
+        ->check(CLI::ExistingFile);
     cmd->callback([args] { run(*args); });
 }
 

@@ -11,6 +11,9 @@ void run(const ViewerArgs& a) {
     parse_size(a.size, o.width, o.height);
     o.render = render_options_from(a);
     o.camera = a.camera, o.fov_y_deg = a.fov, o.zoom = a.zoom;
+    o.screenshot_supersample = a.supersample;
+    o.fiber_colors = fiber_color_source(a);
+    o.fiber_radii_path = a.fiber_radii;
     viewer::run_viewer_window(a.input, o);
 }
 

@@ -5,6 +5,7 @@
 
 #include "fiber_ranges.hpp"
 #include "fiblet/error.hpp"
+#include "supersampling.hpp"
 
 namespace fiblet::cli {
 
@@ -42,10 +43,33 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
     cmd->add_option("--fov", a.fov, "Vertical field of view, degrees")->capture_default_str();
     cmd->add_option("--zoom", a.zoom, "Move a named view closer (>1) or farther (<1)")->capture_default_str();
     cmd->add_option("--color", a.color, "Line colour: direction (|direction| as RGB) or RRGGBB")->capture_default_str();
+    cmd->add_option("--fiber-colors", a.fiber_colors,
+                    "Colour each streamline from a text file: RRGGBB per streamline, in file order ('#' lines "
+                    "ignored)")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--fiber-values", a.fiber_values,
+                    "Colour each streamline by a value from a text file (one number per streamline, as MRtrix3's "
+                    "per-streamline files), through viridis")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--value-range", a.value_range, "MIN:MAX of --fiber-values mapped to the colour map (default: "
+                                                    "the values' range)");
     cmd->add_option("--background", a.background, "Background colour: RRGGBB, black, white, gray")
         ->capture_default_str();
     cmd->add_flag("--no-lighting", a.no_lighting, "Flat colours instead of illuminated lines");
     cmd->add_option("--line-width", a.line_width, "Line width in pixels")->capture_default_str();
+    cmd->add_option("--style", a.style, "How fibers are drawn: " + viewer::draw_style_names() +
+                                            " (tubes: ray-cast spline tubes; capsules: a ray-cast capsule per "
+                                            "segment; docs/viewer.md)")
+        ->capture_default_str();
+    cmd->add_option("--radius", a.radius, "Tube and capsule radius in mm (--style tubes, capsules)")->capture_default_str();
+    cmd->add_option("--fiber-radii", a.fiber_radii,
+                    "Tube and capsule radius per streamline from a text file (mm, one per streamline, in file "
+                    "order), instead of --radius")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--supersample", a.supersample,
+                    "Anti-aliasing of the PNG (render) or screenshots (view): draw N times larger per axis and "
+                    "average, 1..8")
+        ->capture_default_str();
     cmd->add_flag("--no-culling", a.no_culling, "Do not skip blocks outside the view frustum");
     cmd->add_flag("--no-lod", a.no_lod, "Draw every block in full, however small on screen");
     cmd->add_option("--lod-pixels", a.lod_pixels, "Blocks smaller than this on screen (diameter) are one segment")
@@ -82,6 +106,13 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
     if (!(a.line_width >= 1 && a.line_width <= 64)) throw Error(Errc::invalid_argument, "--line-width must be in 1..64");
     o.line_width = a.line_width;
     o.lighting = !a.no_lighting;
+    const auto style = viewer::parse_draw_style(a.style);
+    if (!style) throw Error(Errc::invalid_argument, "--style: '" + a.style + "' is not one of " + viewer::draw_style_names());
+    o.style = *style;
+    if (!(a.radius > 0 && a.radius <= 100)) throw Error(Errc::invalid_argument, "--radius must be in (0, 100] mm");
+    o.tube_radius_mm = a.radius;
+    if (a.supersample < 1 || a.supersample > viewer::kMaxSupersample)
+        throw Error(Errc::invalid_argument, "--supersample must be in 1.." + std::to_string(viewer::kMaxSupersample));
     o.color_by_direction = a.color == "direction";
     if (!o.color_by_direction) o.fixed_color = parse_color(a.color, "--color");
     o.background = parse_color(a.background, "--background");
@@ -98,7 +129,27 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
         if (!o.decoder) throw Error(Errc::invalid_argument, "--decoder: '" + a.decoder + "' is not auto, scan or sequential");
     }
     if (a.max_length > 0) o.max_length_mm = a.max_length;
+    o.fiber_colors = !fiber_color_source(a).empty();
+    o.fiber_radii = !a.fiber_radii.empty();
     return o;
+}
+
+viewer::FiberColorSource fiber_color_source(const ViewerArgs& a) {
+    if (!a.fiber_colors.empty() && !a.fiber_values.empty())
+        throw Error(Errc::invalid_argument, "--fiber-colors and --fiber-values exclude each other");
+    if (!a.value_range.empty() && a.fiber_values.empty())
+        throw Error(Errc::invalid_argument, "--value-range needs --fiber-values");
+    viewer::FiberColorSource s{a.fiber_colors, a.fiber_values, std::nullopt};
+    if (!a.value_range.empty()) {
+        const std::size_t colon = a.value_range.find(':');
+        char *e1 = nullptr, *e2 = nullptr;
+        const std::string lo = a.value_range.substr(0, colon), hi = colon == std::string::npos ? "" : a.value_range.substr(colon + 1);
+        const float low = std::strtof(lo.c_str(), &e1), high = std::strtof(hi.c_str(), &e2);
+        if (colon == std::string::npos || lo.empty() || hi.empty() || *e1 != '\0' || *e2 != '\0' || !(low < high))
+            throw Error(Errc::invalid_argument, "--value-range: '" + a.value_range + "' is not MIN:MAX with MIN < MAX");
+        s.value_range = std::array<float, 2>{low, high};
+    }
+    return s;
 }
 
 }  // namespace fiblet::cli

@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "fiber_colors.hpp"
 #include "render_options.hpp"
 
 namespace fiblet::cli {
@@ -16,6 +17,10 @@ struct ViewerArgs {
     std::string color = "direction", background = "black", fibers, decoder = "auto";
     bool no_lighting = false, no_culling = false, no_lod = false;
     float lod_pixels = 4, line_width = 1;
+    std::string style = "lines";
+    float radius = 0.25f;
+    int supersample = 1;
+    std::string fiber_colors, fiber_values, value_range, fiber_radii;
     double min_length = 0, max_length = 0;
 };
 
@@ -27,5 +32,9 @@ void parse_size(const std::string& text, int& width, int& height);
 
 // The render options the arguments describe; throws fiblet::Error{invalid_argument}.
 viewer::RenderOptions render_options_from(const ViewerArgs& args);
+
+// Where --fiber-colors / --fiber-values take the colours from; throws
+// fiblet::Error{invalid_argument}.
+viewer::FiberColorSource fiber_color_source(const ViewerArgs& args);
 
 }  // namespace fiblet::cli

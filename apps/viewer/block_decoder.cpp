@@ -28,12 +28,13 @@ constexpr std::uint32_t kPointBytes = 16;  // vec4
 }  // namespace
 
 void dispatch_decode(const GpuPrograms& programs, DecoderKind kind, const GpuScene& scene, bool use_list,
-                     std::uint32_t first, std::uint32_t count, bool ends_only) {
+                     std::uint32_t first, std::uint32_t count, bool ends_only, bool tangents) {
     const GlProgram& p = kind == DecoderKind::scan ? programs.decode_scan : programs.decode_sequential;
     glUseProgram(p.get());
     scene.bind(p);
     glProgramUniform1i(p.get(), uniform(p, "uUseList"), use_list ? 1 : 0);
     glProgramUniform1i(p.get(), uniform(p, "uEndsOnly"), ends_only ? 1 : 0);
+    glProgramUniform1i(p.get(), uniform(p, "uWriteTangents"), tangents && !ends_only ? 1 : 0);
     for (std::uint32_t done = 0; done < count;) {
         const std::uint32_t n = std::min(kMaxPassBlocks, count - done);
         glProgramUniform1ui(p.get(), uniform(p, "uFirst"), first + done);
@@ -52,24 +53,33 @@ BlockDecoder::BlockDecoder(const GpuPrograms& programs, std::uint32_t points_per
 }
 
 void BlockDecoder::decode(const GpuScene& scene, DecoderKind kind, bool use_list, std::uint32_t first,
-                          std::uint32_t count) const {
+                          std::uint32_t count, bool tangents) const {
     if (count == 0) return;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kPoints, points_.get());
-    dispatch_decode(programs_, kind, scene, use_list, first, std::min(count, capacity_), false);
+    if (tangents && !tangents_) {
+        const std::uint64_t slot_bytes = std::uint64_t(points_per_block_ + 1) * kPointBytes;
+        tangents_ = make_buffer(GLsizeiptr(capacity_ * slot_bytes), nullptr, 0);
+    }
+    if (tangents) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kTangents, tangents_.get());
+    dispatch_decode(programs_, kind, scene, use_list, first, std::min(count, capacity_), false, tangents);
 }
 
-std::vector<float> decode_blocks_on_gpu(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind,
-                                        std::uint32_t first, std::uint32_t count) {
+namespace {
+// Decodes blocks [first, first + count) and reads back the points (or the
+// tangents) of each block, xyz one after the other.
+std::vector<float> decode_and_read(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind,
+                                   std::uint32_t first, std::uint32_t count, bool tangents) {
     const std::uint32_t ppb = scene.header().points_per_block;
     const BlockDecoder decoder(programs, ppb);
     std::vector<float> xyz;
     std::vector<float> slots;
     for (std::uint32_t done = 0; done < count;) {
         const std::uint32_t batch = std::min(decoder.capacity(), count - done);
-        decoder.decode(scene, kind, false, first + done, batch);
+        decoder.decode(scene, kind, false, first + done, batch, tangents);
         glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
         slots.resize(std::size_t(batch) * (ppb + 1) * 4);
-        glGetNamedBufferSubData(decoder.points_buffer(), 0, GLsizeiptr(slots.size() * 4), slots.data());
+        const GLuint buffer = tangents ? decoder.tangents_buffer() : decoder.points_buffer();
+        glGetNamedBufferSubData(buffer, 0, GLsizeiptr(slots.size() * 4), slots.data());
         for (std::uint32_t i = 0; i < batch; ++i) {
             const float* slot = &slots[std::size_t(i) * (ppb + 1) * 4];
             for (std::uint32_t k = 0; k < scene.block_points(first + done + i); ++k)
@@ -78,6 +88,17 @@ std::vector<float> decode_blocks_on_gpu(const GpuScene& scene, const GpuPrograms
         done += batch;
     }
     return xyz;
+}
+}  // namespace
+
+std::vector<float> decode_blocks_on_gpu(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind,
+                                        std::uint32_t first, std::uint32_t count) {
+    return decode_and_read(scene, programs, kind, first, count, false);
+}
+
+std::vector<float> decode_tangents_on_gpu(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind,
+                                          std::uint32_t first, std::uint32_t count) {
+    return decode_and_read(scene, programs, kind, first, count, true);
 }
 
 }  // namespace fiblet::viewer

@@ -19,6 +19,10 @@ std::string gpu_binding_defines() {
     def("BINDING_POINTS", binding::kPoints);
     def("BINDING_DECISIONS", binding::kDecisions);
     def("BINDING_FIBER_END_FRACTION", binding::kFiberEndFraction);
+    def("BINDING_TANGENTS", binding::kTangents);
+    def("BINDING_TUBE_PIECES", binding::kTubePieces);
+    def("BINDING_FIBER_COLORS", binding::kFiberColors);
+    def("BINDING_FIBER_RADII", binding::kFiberRadii);
     def("BINDING_LOCAL_FRAMES", binding::kLocalFrames);
     def_uint("DECISION_OUTSIDE_FRUSTUM", unsigned(BlockDecision::outside_frustum));
     def_uint("DECISION_COARSE", unsigned(BlockDecision::coarse));

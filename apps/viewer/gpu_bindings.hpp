@@ -18,7 +18,11 @@ inline constexpr unsigned kCounters = 6;     // sizes of the two lists and their
 inline constexpr unsigned kPoints = 7;       // decoded points, pointsPerBlock + 1 slots per block
 inline constexpr unsigned kDecisions = 8;    // per block culling decision (tests, statistics)
 inline constexpr unsigned kFiberEndFraction = 9;  // per fiber: fraction of its last step kept (ENDS chunk)
-inline constexpr unsigned kStorageCount = 10;
+inline constexpr unsigned kTangents = 10;    // unit tangent of each decoded point, laid out as kPoints
+inline constexpr unsigned kTubePieces = 11;  // techniques/tubes: quadratic pieces and their boxes
+inline constexpr unsigned kFiberColors = 12;  // per fiber: RGB (vec4), when the scene has colours
+inline constexpr unsigned kFiberRadii = 13;   // per fiber: tube radius (mm), when the scene has radii
+inline constexpr unsigned kStorageCount = 14;
 // Uniform buffers.
 inline constexpr unsigned kLocalFrames = 0;  // the 256 frames of the direction code (DirectionTable)
 }  // namespace binding

@@ -27,8 +27,6 @@ GpuPrograms::GpuPrograms() {
     cull = build_program({"cull_blocks.comp.glsl"}, defines);
     decode_scan = build_program({"decode_blocks.comp.glsl"}, defines);
     decode_sequential = build_program({"decode_blocks_sequential.comp.glsl"}, defines);
-    fine_lines = build_program({"fine_lines.vert.glsl", "lines.frag.glsl"}, defines);
-    coarse_lines = build_program({"coarse_lines.vert.glsl", "lines.frag.glsl"}, defines);
 }
 
 }  // namespace fiblet::viewer

@@ -1,4 +1,5 @@
-// The viewer's GL programs, compiled once per context.
+// The GL programs of the shared selection and decode, compiled once per
+// context (the drawing styles compile their own: techniques/).
 #pragma once
 
 #include "gl_objects.hpp"
@@ -13,8 +14,6 @@ struct GpuPrograms {
     GlProgram cull;         // cull_blocks.comp.glsl
     GlProgram decode_scan;        // decode_blocks.comp.glsl
     GlProgram decode_sequential;  // decode_blocks_sequential.comp.glsl
-    GlProgram fine_lines;   // fine_lines.vert.glsl + lines.frag.glsl
-    GlProgram coarse_lines; // coarse_lines.vert.glsl + lines.frag.glsl
 };
 
 }  // namespace fiblet::viewer

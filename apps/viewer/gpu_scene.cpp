@@ -110,6 +110,9 @@ GpuScene::GpuScene(const FftFile& file, const GpuPrograms& programs, std::option
     check_fits(fibers * 4, "fiber end fractions");
     fiber_end_fraction_ = make_buffer(GLsizeiptr(std::max<std::uint64_t>(fibers, 1) * 4),
                                       fibers ? end_fraction_.data() : nullptr, 0);
+    const float no_colors[4] = {1, 1, 1, 1};
+    fiber_colors_ = make_buffer(16, no_colors, 0);
+    fiber_radii_ = make_buffer(16, no_colors, 0);
     const std::vector<float> frames = local_frames_std140(h.ratio);
     local_frames_ = make_buffer(GLsizeiptr(frames.size() * 4), frames.data(), 0);
 
@@ -132,6 +135,31 @@ double GpuScene::fiber_length_mm(std::uint64_t index) const {
     return steps * double(header_.step) * double(header_.scaling);
 }
 
+void GpuScene::set_fiber_colors(const std::vector<std::array<float, 3>>& rgb) {
+    if (rgb.size() != fiber_count())
+        throw Error(Errc::invalid_argument, fmt::format("{} fiber colours for {} fibers", rgb.size(), fiber_count()));
+    if (rgb.empty()) return;
+    check_fits(rgb.size() * 16, "fiber colours");
+    std::vector<float> rgba;
+    rgba.reserve(rgb.size() * 4);
+    for (const auto& c : rgb) rgba.insert(rgba.end(), {c[0], c[1], c[2], 1.0f});
+    fiber_colors_ = make_buffer(GLsizeiptr(rgba.size() * 4), rgba.data(), 0);
+    has_fiber_colors_ = true;
+}
+
+void GpuScene::set_fiber_radii(const std::vector<float>& mm) {
+    if (mm.size() != fiber_count())
+        throw Error(Errc::invalid_argument, fmt::format("{} fiber radii for {} fibers", mm.size(), fiber_count()));
+    for (const float r : mm)
+        if (!(r > 0) || !std::isfinite(r)) throw Error(Errc::invalid_argument, fmt::format("fiber radius {} is not positive", r));
+    if (mm.empty()) return;
+    check_fits(mm.size() * 4, "fiber radii");
+    fiber_radii_ = make_buffer(GLsizeiptr(mm.size() * 4), mm.data(), 0);
+    fiber_radii_mm_ = mm;
+    const auto [lo, hi] = std::minmax_element(mm.begin(), mm.end());
+    min_radius_ = *lo, max_radius_ = *hi;
+}
+
 std::vector<Vec3f> GpuScene::read_fiber_ends() const {
     std::vector<float> xyzw(fiber_count() * 4);
     if (!xyzw.empty()) glGetNamedBufferSubData(fiber_ends_.get(), 0, GLsizeiptr(xyzw.size() * 4), xyzw.data());
@@ -146,6 +174,8 @@ void GpuScene::bind(const GlProgram& program) const {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberPoints, fiber_points_buffer_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberEnds, fiber_ends_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberEndFraction, fiber_end_fraction_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberColors, fiber_colors_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberRadii, fiber_radii_.get());
     glBindBufferBase(GL_UNIFORM_BUFFER, binding::kLocalFrames, local_frames_.get());
     const GLuint p = program.get();
     glProgramUniform1ui(p, uniform(program, "uBlockCount"), header_.blocks);

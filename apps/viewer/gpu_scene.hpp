@@ -5,6 +5,7 @@
 // level of detail needs, is decoded once on the GPU at load.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -54,6 +55,18 @@ public:
     // uniforms (scene_buffers.glsl) of `program`.
     void bind(const GlProgram& program) const;
 
+    // Per-fiber colours (fiber_colors.hpp; one per fiber, file order) for
+    // RenderOptions::fiber_colors. Throws fiblet::Error{invalid_argument}
+    // on a count that is not fiber_count().
+    void set_fiber_colors(const std::vector<std::array<float, 3>>& rgb);
+    bool has_fiber_colors() const { return has_fiber_colors_; }
+    // Per-fiber tube radii in mm (> 0, one per fiber) for
+    // RenderOptions::fiber_radii; throws fiblet::Error{invalid_argument}.
+    void set_fiber_radii(const std::vector<float>& mm);
+    bool has_fiber_radii() const { return !fiber_radii_mm_.empty(); }
+    float min_fiber_radius() const { return min_radius_; }
+    float max_fiber_radius() const { return max_radius_; }
+
     // The last point of every fiber as decoded on the GPU at load (world mm).
     std::vector<Vec3f> read_fiber_ends() const;
 
@@ -66,6 +79,11 @@ private:
     std::vector<Vec3f> sample_points_;
     GlBuffer blocks_, block_fiber_, fiber_points_buffer_, fiber_ends_, fiber_end_fraction_, local_frames_;
     std::vector<float> end_fraction_;  // per fiber, kept part of the last step (ENDS chunk; 1 without)
+    GlBuffer fiber_colors_;            // one vec4 when there are none (a binding must hold a buffer)
+    bool has_fiber_colors_ = false;
+    GlBuffer fiber_radii_;             // one float when there are none
+    std::vector<float> fiber_radii_mm_;
+    float min_radius_ = 0, max_radius_ = 0;
 };
 
 // Largest shader storage buffer of the current context, in bytes.

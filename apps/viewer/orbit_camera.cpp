@@ -136,4 +136,16 @@ Camera camera_from_spec(const std::string& spec, const GpuScene& scene, float as
     return c;
 }
 
+Camera turned_about_up(const Camera& camera, float degrees, const SceneBounds& bounds) {
+    if (degrees == 0) return camera;
+    // Rodrigues' rotation of the eye around the target.
+    const Vec3f k = normalized(camera.up), v = sub(camera.position, camera.target);
+    const float a = degrees * float(M_PI) / 180.0f, c = std::cos(a), s = std::sin(a);
+    const Vec3f turned = add(add(scale(c, v), scale(s, cross(k, v))), scale(dot(k, v) * (1 - c), k));
+    Camera out = camera;
+    out.position = add(camera.target, turned);
+    set_clip_planes(out, bounds);
+    return out;
+}
+
 }  // namespace fiblet::viewer

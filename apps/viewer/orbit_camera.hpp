@@ -44,6 +44,12 @@ void set_clip_planes(Camera& camera, const SceneBounds& bounds);
 // `zoom` > 1 moves a named view closer. Throws fiblet::Error{invalid_argument}.
 Camera camera_from_spec(const std::string& spec, const GpuScene& scene, float aspect, float fov_y_deg, float zoom);
 
+// `camera` turned by `degrees` around the axis through its target along its
+// up vector (right-handed), with near and far planes for `bounds`; 0
+// degrees returns it unchanged. Frame i of n of a turntable movie is
+// turned_about_up(start, 360 i / n, bounds).
+Camera turned_about_up(const Camera& camera, float degrees, const SceneBounds& bounds);
+
 // The named view's (azimuth, elevation), or false for an unknown name.
 bool named_view(const std::string& name, float& azimuth_deg, float& elevation_deg);
 

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "decoder_kind.hpp"
+#include "draw_style.hpp"
 #include "fiblet/view.hpp"
 
 namespace fiblet::viewer {
@@ -22,12 +23,18 @@ struct RenderOptions {
 
     std::optional<DecoderKind> decoder;  // unset: default_decoder()
 
-    // Shading.
+    // Drawing style (techniques/) and shading.
+    DrawStyle style = DrawStyle::lines;
+    float tube_radius_mm = 0.25f;                      // tubes and capsules
+    bool fiber_radii = false;                          // the scene's per-fiber radii instead (GpuScene::set_fiber_radii), when it has them
     bool color_by_direction = true;                    // |direction| as RGB, else fixed_color
     std::array<float, 3> fixed_color{0.95f, 0.85f, 0.6f};
+    bool fiber_colors = false;                         // the scene's per-fiber colours (GpuScene::set_fiber_colors), when it has them
     bool lighting = true;                              // illuminated lines
+    bool color_by_normal = false;                      // ray-cast styles: unit normal n as RGB (n + 1) / 2 (checks)
     float line_width = 1;                              // pixels
     std::array<float, 3> background{0, 0, 0};
+    bool clear = true;  // clear the target first (false: draw over what it holds, depth included)
 
     bool time_stages = false;       // time cull / decode / draw (GpuTimer, default_timing_method)
     bool record_decisions = false;  // keep each block's culling decision (Renderer::read_decisions)

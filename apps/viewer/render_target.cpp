@@ -72,4 +72,15 @@ std::vector<std::uint32_t> RenderTarget::read_fibers(int x, int y, int w, int h)
     return out;
 }
 
+std::vector<float> RenderTarget::read_depth() const {
+    std::vector<float> bottom_up(std::size_t(width_) * std::size_t(height_));
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glGetTextureImage(depth_.get(), 0, GL_DEPTH_COMPONENT, GL_FLOAT, GLsizei(bottom_up.size() * 4), bottom_up.data());
+    std::vector<float> out(bottom_up.size());
+    for (int r = 0; r < height_; ++r)
+        std::copy_n(&bottom_up[std::size_t(height_ - 1 - r) * std::size_t(width_)], width_,
+                    &out[std::size_t(r) * std::size_t(width_)]);
+    return out;
+}
+
 }  // namespace fiblet::viewer

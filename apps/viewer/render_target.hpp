@@ -24,6 +24,8 @@ public:
     // from the top-left, which must lie inside the target; rows from the top.
     std::vector<std::uint32_t> read_fibers(int x, int y, int width, int height) const;
     std::vector<std::uint32_t> read_fibers() const { return read_fibers(0, 0, width_, height_); }
+    // Window depth (0 near .. 1 far) of every pixel, rows from the top.
+    std::vector<float> read_depth() const;
 
 private:
     void allocate();

@@ -5,20 +5,13 @@
 
 #include "gpu_timer.hpp"
 #include "shader_program.hpp"
+#include "shading_uniforms.hpp"
+#include "techniques/make_technique.hpp"
 #include "vec_ops.hpp"
 
 namespace fiblet::viewer {
 
 namespace {
-
-struct CameraBasis {
-    Vec3f right, up, back;  // as view.hpp builds them; the camera looks along -back
-};
-CameraBasis camera_basis(const Camera& c) {
-    const Vec3f back = normalized(sub(c.position, c.target));
-    const Vec3f right = normalized(cross(c.up, back));
-    return {right, cross(back, right), back};
-}
 
 // Points of a fiber of `mm` length at the file's step: length = (points - 1) step.
 std::uint32_t points_for_length(double mm, double step_mm, bool round_up) {
@@ -77,6 +70,8 @@ DrawCounters Renderer::select_blocks(const GpuScene& scene, const Camera& camera
     }
     glProgramUniform1i(id, uniform(p, "uFrustumCulling"), o.frustum_culling ? 1 : 0);
     glProgramUniform4fv(id, uniform(p, "uPlanes"), 6, planes);
+    // Spheres grow by what the style draws beyond the centre lines (a tube's radius).
+    glProgramUniform1f(id, uniform(p, "uSphereMargin"), technique(o.style).reach_mm(scene, o));
     const CameraBasis basis = camera_basis(camera);
     glProgramUniform1i(id, uniform(p, "uLevelOfDetail"), o.level_of_detail ? 1 : 0);
     glProgramUniform1f(id, uniform(p, "uLodPixels"), o.lod_pixels);
@@ -97,41 +92,33 @@ DrawCounters Renderer::select_blocks(const GpuScene& scene, const Camera& camera
     return c;
 }
 
-void Renderer::set_shading(const GlProgram& p, const Camera& camera, const RenderOptions& o) const {
-    const GLuint id = p.get();
-    const Mat4 vp = view_projection_matrix(camera);
-    glProgramUniformMatrix4fv(id, uniform(p, "uViewProjection"), 1, GL_FALSE, vp.data());
-    glProgramUniform1i(id, uniform(p, "uColorByDirection"), o.color_by_direction ? 1 : 0);
-    glProgramUniform3f(id, uniform(p, "uFixedColor"), o.fixed_color[0], o.fixed_color[1], o.fixed_color[2]);
-    glProgramUniform1i(id, uniform(p, "uLighting"), o.lighting ? 1 : 0);
-    glProgramUniform3f(id, uniform(p, "uCameraPosition"), camera.position.x, camera.position.y, camera.position.z);
-    // A headlight a little above and to the left of the eye, so that lines
-    // facing the viewer are not all equally lit.
-    const CameraBasis b = camera_basis(camera);
-    const Vec3f light = normalized(add(add(b.back, scale(0.5f, b.up)), scale(-0.35f, b.right)));
-    glProgramUniform3f(id, uniform(p, "uLightDirection"), light.x, light.y, light.z);
-    glProgramUniform1f(id, uniform(p, "uAmbient"), 0.25f);
-    glProgramUniform1f(id, uniform(p, "uDiffuse"), 0.75f);
-    glProgramUniform1f(id, uniform(p, "uSpecular"), 0.35f);
-    glProgramUniform1f(id, uniform(p, "uShininess"), 24.0f);
+DrawTechnique& Renderer::technique(DrawStyle style) {
+    auto& t = techniques_[style];
+    if (!t) t = make_technique(style);
+    return *t;
 }
 
-FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const RenderOptions& o,
+FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const RenderOptions& options,
                             RenderTarget& target) {
+    RenderOptions o = options;
+    o.fiber_colors = options.fiber_colors && scene.has_fiber_colors();
+    o.fiber_radii = options.fiber_radii && scene.has_fiber_radii();
     ensure_buffers(scene, o.record_decisions);
+    DrawTechnique& draw = technique(o.style);
     const Viewport viewport{target.width(), target.height()};
     const GLuint fb = target.framebuffer();
     glBindFramebuffer(GL_FRAMEBUFFER, fb);
     glViewport(0, 0, viewport.width, viewport.height);
-    const float background[4] = {o.background[0], o.background[1], o.background[2], 1.0f};
-    const GLuint no_fiber[4] = {0, 0, 0, 0};
-    const float far_depth = 1.0f;
-    glClearNamedFramebufferfv(fb, GL_COLOR, 0, background);
-    glClearNamedFramebufferuiv(fb, GL_COLOR, 1, no_fiber);
-    glClearNamedFramebufferfv(fb, GL_DEPTH, 0, &far_depth);
+    if (o.clear) {
+        const float background[4] = {o.background[0], o.background[1], o.background[2], 1.0f};
+        const GLuint no_fiber[4] = {0, 0, 0, 0};
+        const float far_depth = 1.0f;
+        glClearNamedFramebufferfv(fb, GL_COLOR, 0, background);
+        glClearNamedFramebufferuiv(fb, GL_COLOR, 1, no_fiber);
+        glClearNamedFramebufferfv(fb, GL_DEPTH, 0, &far_depth);
+    }
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
-    glLineWidth(o.line_width);
     glBindVertexArray(empty_vertex_array_.get());
 
     GpuTimer timer(o.time_stages ? default_timing_method() : TimingMethod::none);
@@ -149,24 +136,18 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const R
         stats.fine_segments = scene.segment_count();
     }
 
+    const FrameInputs in{scene, camera, o, select};
+    draw.begin_frame(in);
     // Full blocks, a batch at a time: decode into the points buffer, draw it.
-    const GlProgram& fine = programs_.fine_lines;
-    set_shading(fine, camera, o);
-    const std::uint32_t ppb = scene.header().points_per_block;
     for (std::uint32_t first = 0; first < stats.fine_blocks; first += decoder_->capacity()) {
         const std::uint32_t count = std::min<std::uint32_t>(decoder_->capacity(), std::uint32_t(stats.fine_blocks) - first);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, fine_list_.get());
         timer.begin(Stage::decode);
-        decoder_->decode(scene, decoder, select, first, count);
+        decoder_->decode(scene, decoder, select, first, count, draw.needs_tangents());
         timer.end();
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         timer.begin(Stage::draw);
-        glUseProgram(fine.get());
-        scene.bind(fine);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kPoints, decoder_->points_buffer());
-        glProgramUniform1i(fine.get(), uniform(fine, "uUseList"), select ? 1 : 0);
-        glProgramUniform1ui(fine.get(), uniform(fine, "uFirst"), first);
-        glDrawArrays(GL_LINES, 0, GLsizei(2 * ppb * count));
+        draw.draw_batch(in, {decoder_->points_buffer(), decoder_->tangents_buffer(), first, count});
         timer.end();
         // The next batch overwrites the points this draw reads.
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -174,13 +155,9 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const R
 
     // Coarse blocks: one segment each, straight from the raw blocks.
     if (stats.coarse_blocks > 0) {
-        const GlProgram& coarse = programs_.coarse_lines;
-        set_shading(coarse, camera, o);
         timer.begin(Stage::draw);
-        glUseProgram(coarse.get());
-        scene.bind(coarse);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCoarseList, coarse_list_.get());
-        glDrawArrays(GL_LINES, 0, GLsizei(2 * stats.coarse_blocks));
+        draw.draw_coarse(in, std::uint32_t(stats.coarse_blocks));
         timer.end();
     }
 

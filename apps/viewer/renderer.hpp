@@ -1,10 +1,11 @@
 // One frame: select blocks on the GPU (fiber subset, frustum culling, level
 // of detail), decode the selected blocks on the GPU a batch at a time and
-// draw them as illuminated lines, then draw the coarse blocks as one segment
-// each. Everything stays on the GPU except four counters read back per frame
+// hand each batch to the drawing style's technique (techniques/), then the
+// coarse blocks (one segment each). Everything stays on the GPU except four counters read back per frame
 // (the list sizes, which size the batches and are shown to the user).
 #pragma once
 
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "gpu_scene.hpp"
 #include "render_options.hpp"
 #include "render_target.hpp"
+#include "techniques/draw_technique.hpp"
 
 namespace fiblet::viewer {
 
@@ -32,16 +34,24 @@ public:
     DrawCounters select_blocks(const GpuScene& scene, const Camera& camera, const Viewport& viewport,
                                const RenderOptions& options);
 
+    // Draws `style` with `technique` from now on instead of its default
+    // module (tests: a technique built with other parameters).
+    void use_technique(DrawStyle style, std::unique_ptr<DrawTechnique> technique) {
+        techniques_[style] = std::move(technique);
+    }
+
     // Each block's decision in the last selection pass run with
     // options.record_decisions.
     std::vector<BlockDecision> read_decisions(const GpuScene& scene) const;
 
 private:
     void ensure_buffers(const GpuScene& scene, bool decisions);
-    void set_shading(const GlProgram& p, const Camera& camera, const RenderOptions& options) const;
+    // The style's technique, compiled on first use.
+    DrawTechnique& technique(DrawStyle style);
 
     const GpuPrograms& programs_;
     std::unique_ptr<BlockDecoder> decoder_;
+    std::map<DrawStyle, std::unique_ptr<DrawTechnique>> techniques_;
     GlBuffer fine_list_, coarse_list_, counters_, decisions_;
     std::uint32_t list_capacity_ = 0, decisions_capacity_ = 0;
     GlVertexArray empty_vertex_array_;  // core profile draws need one bound

@@ -22,6 +22,8 @@
 #include "png_file.hpp"
 #include "render_target.hpp"
 #include "renderer.hpp"
+#include "fiber_radii.hpp"
+#include "supersampling.hpp"
 #include "scene_file.hpp"
 #include "vec_ops.hpp"
 
@@ -31,7 +33,8 @@ const char* window_controls_help() {
     return "  left drag: orbit    right/middle drag or shift+left drag: pan    wheel: zoom\n"
            "  click: print the fiber under the cursor (ID, points, length)\n"
            "  R: reset view    S: screenshot (PNG)    C: culling on/off    L: level of detail on/off\n"
-           "  D: colour by direction / fixed    I: lighting on/off    +/-: line width    H: help    Q, Esc: quit\n";
+           "  D: colour by direction / fixed    I: lighting on/off    +/-: line width    T: lines / tubes / capsules\n"
+           "  H: help    Q, Esc: quit\n";
 }
 
 namespace {
@@ -86,6 +89,11 @@ void on_key(GLFWwindow* w, int key, int, int action, int) {
         case GLFW_KEY_KP_ADD: s.render.line_width = std::min(s.render.line_width + 1, 16.0f); break;
         case GLFW_KEY_MINUS:
         case GLFW_KEY_KP_SUBTRACT: s.render.line_width = std::max(s.render.line_width - 1, 1.0f); break;
+        case GLFW_KEY_T:
+            s.render.style = s.render.style == DrawStyle::lines   ? DrawStyle::tubes
+                             : s.render.style == DrawStyle::tubes ? DrawStyle::capsules
+                                                                  : DrawStyle::lines;
+            break;
         case GLFW_KEY_H: fmt::print("{}", window_controls_help()); break;
         default: return;
     }
@@ -173,7 +181,9 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
     require_gl45();
 
     const GpuPrograms programs;
-    const GpuScene scene(open_scene_file(path), programs);
+    GpuScene scene(open_scene_file(path), programs);
+    load_fiber_colors(options.fiber_colors, scene);
+    if (!options.fiber_radii_path.empty()) load_fiber_radii(options.fiber_radii_path, scene);
     Renderer renderer(programs);
     int fb_width = 0, fb_height = 0;
     glfwGetFramebufferSize(w, &fb_width, &fb_height);
@@ -214,9 +224,9 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
         glfwSwapBuffers(w);
         glfwSetWindowTitle(
             w, fmt::format("{} | {:.1f} ms (GPU cull {:.1f} decode {:.1f} draw {:.1f}) | {} blocks ({} coarse), {} "
-                           "segments | culling {} LoD {}",
+                           "segments | {} | culling {} LoD {}",
                            title, frame_ms, st.cull_ms, st.decode_ms, st.draw_ms, st.drawn_blocks(), st.coarse_blocks,
-                           st.drawn_segments(), s.render.frustum_culling ? "on" : "off",
+                           st.drawn_segments(), draw_style_name(s.render.style), s.render.frustum_culling ? "on" : "off",
                            s.render.level_of_detail ? "on" : "off")
                    .c_str());
 
@@ -235,7 +245,14 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
         if (s.screenshot) {
             s.screenshot = false;
             const std::string name = next_screenshot_name(options.screenshot_prefix);
-            write_png(name, {target.width(), target.height(), target.read_rgba()}, false);
+            if (options.screenshot_supersample > 1)
+                write_png(name,
+                          render_supersampled(renderer, scene, camera, s.render, target.width(), target.height(),
+                                              options.screenshot_supersample)
+                              .image,
+                          false);
+            else
+                write_png(name, {target.width(), target.height(), target.read_rgba()}, false);
             fmt::print("screenshot: {}\n", name);
             std::fflush(stdout);
         }

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "fiber_colors.hpp"
 #include "render_options.hpp"
 
 namespace fiblet::viewer {
@@ -14,6 +15,9 @@ struct WindowOptions {
     float fov_y_deg = 35, zoom = 1;
     RenderOptions render;
     std::string screenshot_prefix = "fiblet-screenshot";  // + "-NNN.png" in the working directory
+    int screenshot_supersample = 1;
+    FiberColorSource fiber_colors;  // render.fiber_colors turns them on
+    std::string fiber_radii_path;   // fiber_radii.hpp; render.fiber_radii turns them on  // screenshots drawn again, supersampled (supersampling.hpp)
 };
 
 // The key and mouse bindings, for --help and the H key.

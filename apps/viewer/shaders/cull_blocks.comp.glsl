@@ -31,6 +31,7 @@ uniform float uViewportHeight;
 uniform uvec2 uFiberIdRange;  // inclusive
 uniform uvec2 uPointRange;    // inclusive, points per fiber
 uniform bool uWriteDecisions;
+uniform float uSphereMargin;  // mm the drawing style reaches beyond the centre lines
 
 shared uint sFine, sCoarse, sFineSegments, sCoarseSegments;
 shared uint sFineBase, sCoarseBase;
@@ -64,6 +65,7 @@ void main() {
         uint points = fiberPoints[blockFiber[block]];
         if (id >= uFiberIdRange.x && id <= uFiberIdRange.y && points >= uPointRange.x && points <= uPointRange.y) {
             vec4 sphere = blockBoundingSphere(block);
+            sphere.w += uSphereMargin;
             if (uFrustumCulling && !sphereIntersectsFrustum(sphere)) {
                 decision = DECISION_OUTSIDE_FRUSTUM;
             } else if (uLevelOfDetail && blockIsCoarse(sphere)) {

@@ -54,4 +54,13 @@ void main() {
     if (t == 1u && n >= 2u) points[base + 1u] = vec4(toWorld(a1), 1.0);
     if (hasCode) points[base + t + 2u] = vec4(toWorld(p), 1.0);
     if (t == 63u && !isLastBlockOfFiber(block)) points[base + n] = vec4(toWorld(blockAnchor0(block + 1u)), 1.0);
+    if (!uWriteTangents) return;
+    if (t == 0u) tangents[base] = vec4(first[0], 0.0);
+    if (t == 1u && n >= 2u) tangents[base + 1u] = vec4(first[0], 0.0);
+    if (hasCode) tangents[base + t + 2u] = vec4(normalize(first * running[0]), 0.0);
+    if (t == 63u && !isLastBlockOfFiber(block)) {
+        // Invocation 63 summed every step: p is the block's last point when it has codes.
+        vec3 last = n >= 3u ? p : n == 2u ? a1 : a0;
+        tangents[base + n] = vec4(directionOr(toWorld(last), toWorld(blockAnchor0(block + 1u)), first[0]), 0.0);
+    }
 }

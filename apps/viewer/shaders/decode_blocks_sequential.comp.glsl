@@ -20,9 +20,14 @@ void main() {
     mat3 frame = frameFromAxis(anchorAxis(a0, a1));
     vec3 p = n == 1u ? a0 : a1;
     uint base = slot * (uPointsPerBlock + 1u);
+    vec3 tangent = frame[0];
     if (!uEndsOnly) {
         points[base] = vec4(toWorld(a0), 1.0);
         if (n >= 2u) points[base + 1u] = vec4(toWorld(a1), 1.0);
+        if (uWriteTangents) {
+            tangents[base] = vec4(tangent, 0.0);
+            if (n >= 2u) tangents[base + 1u] = vec4(tangent, 0.0);
+        }
     }
     for (uint k = 2u; k < n; ++k) {
         frame = frame * localFrames[blockCode(block, k - 2u)];
@@ -31,9 +36,14 @@ void main() {
         // A fiber's last point keeps only a fraction of its step (ENDS chunk).
         if (k + 1u == n) p -= (1.0 - keptLastStep(block, n)) * stepVec;
         if (!uEndsOnly) points[base + k] = vec4(toWorld(p), 1.0);
+        if (!uEndsOnly && uWriteTangents) tangents[base + k] = vec4(normalize(frame[0]), 0.0);
+        tangent = frame[0];
     }
     if (uEndsOnly)
         fiberEnds[blockFiber[block]] = vec4(toWorld(p), 1.0);
-    else if (!isLastBlockOfFiber(block))
-        points[base + n] = vec4(toWorld(blockAnchor0(block + 1u)), 1.0);
+    else if (!isLastBlockOfFiber(block)) {
+        vec3 next = toWorld(blockAnchor0(block + 1u));
+        points[base + n] = vec4(next, 1.0);
+        if (uWriteTangents) tangents[base + n] = vec4(directionOr(toWorld(p), next, normalize(tangent)), 0.0);
+    }
 }

@@ -6,6 +6,11 @@
 layout(std140, binding = BINDING_LOCAL_FRAMES) uniform LocalFrames { mat3 localFrames[256]; };
 layout(std430, binding = BINDING_FINE_LIST) readonly buffer FineList { uint fineList[]; };
 layout(std430, binding = BINDING_POINTS) writeonly buffer Points { vec4 points[]; };
+// The unit tangent of each point, same layout, when uWriteTangents: the
+// direction of the step that arrives at the point (the running frame's first
+// column F0), the block's first point taking its first step's direction, the
+// point joining the next block the direction towards that block's first point.
+layout(std430, binding = BINDING_TANGENTS) writeonly buffer Tangents { vec4 tangents[]; };
 layout(std430, binding = BINDING_FIBER_ENDS) writeonly buffer FiberEnds { vec4 fiberEnds[]; };
 // Per fiber, the fraction of its last step that is kept (the ENDS chunk,
 // formats/fft-ends.md; 1.0 for files without one).
@@ -15,6 +20,14 @@ uniform bool uUseList;  // blocks fineList[uFirst + slot], else blocks uFirst + 
 uniform uint uFirst;
 uniform uint uCount;    // blocks in this pass
 uniform bool uEndsOnly; // last blocks of fibers: write only their last point to fiberEnds[fiber]
+uniform bool uWriteTangents;
+
+// The unit direction from p to q (mm), or `fallback` when they coincide.
+vec3 directionOr(vec3 p, vec3 q, vec3 fallback) {
+    vec3 d = q - p;
+    float n2 = dot(d, d);
+    return n2 > 0.0 ? d * inversesqrt(n2) : fallback;
+}
 
 // How much of its last step the last point of a block of n points keeps: the
 // fiber's ENDS fraction in its last block when that point is direction-coded

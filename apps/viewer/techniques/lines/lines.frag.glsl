@@ -8,11 +8,11 @@ layout(location = 0) flat in vec3 vTangent;
 layout(location = 1) in vec3 vWorld;
 layout(location = 2) flat in uint vFiber;
 
+#include "fiber_colors.glsl"
+
 layout(location = 0) out vec4 outColor;
 layout(location = 1) out uint outFiber;
 
-uniform bool uColorByDirection;
-uniform vec3 uFixedColor;
 uniform bool uLighting;
 uniform vec3 uCameraPosition;
 uniform vec3 uLightDirection;  // unit, towards the light
@@ -22,7 +22,7 @@ uniform float uSpecular;
 uniform float uShininess;
 
 void main() {
-    vec3 base = uColorByDirection ? abs(vTangent) : uFixedColor;
+    vec3 base = baseColor(vTangent, vFiber);
     vec3 color = base;
     if (uLighting) {
         vec3 view = normalize(uCameraPosition - vWorld);

@@ -1,0 +1,42 @@
+// Per-fiber colours read from text files, one entry per streamline in file
+// order (as MRtrix3's per-streamline files: whitespace-separated, lines
+// starting with '#' ignored):
+//   colours: RRGGBB per streamline (no '#': it starts a comment line);
+//   values:  one number per streamline (e.g. tcksift2 weights, tckstats
+//            -dump lengths), mapped through a colour map.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace fiblet::viewer {
+
+using Rgb = std::array<float, 3>;  // 0..1
+
+// Throws fiblet::Error{io} when unreadable, {invalid_input} on a bad token
+// or when the file does not hold exactly `fibers` entries.
+std::vector<Rgb> read_fiber_colors(const std::string& path, std::uint64_t fibers);
+std::vector<float> read_fiber_values(const std::string& path, std::uint64_t fibers);
+
+// Values mapped through viridis over [low, high] (default: the values'
+// range), clamped.
+std::vector<Rgb> colors_from_values(const std::vector<float>& values, std::optional<std::array<float, 2>> range = {});
+
+// Where a scene's per-fiber colours come from (at most one file).
+struct FiberColorSource {
+    std::string colors_path, values_path;
+    std::optional<std::array<float, 2>> value_range;
+    bool empty() const { return colors_path.empty() && values_path.empty(); }
+};
+
+class GpuScene;
+// Reads the source's file for `scene` and sets its colours (nothing when empty).
+void load_fiber_colors(const FiberColorSource& source, GpuScene& scene);
+
+// Viridis at t in [0, 1] (clamped), from 9 samples of matplotlib's table.
+Rgb viridis(float t);
+
+}  // namespace fiblet::viewer

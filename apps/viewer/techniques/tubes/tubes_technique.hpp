@@ -1,0 +1,42 @@
+// Tubes: each fiber a sphere of the option's radius swept along a C¹
+// spline through every s-th decoded point (tube_spline.hpp), ray cast per
+// quadratic piece inside its oriented box (tube_pieces.comp.glsl,
+// tube_boxes.vert.glsl, tubes.frag.glsl). Coarse blocks (level of detail,
+// a few pixels on screen) stay lines.
+#pragma once
+
+#include <memory>
+
+#include "techniques/draw_technique.hpp"
+#include "techniques/lines/lines_technique.hpp"
+#include "techniques/tubes/tube_spline.hpp"
+
+namespace fiblet::viewer {
+
+class TubesTechnique final : public DrawTechnique {
+public:
+    // `tangent_scale`: c of tube_spline.hpp; other values only to show in
+    // tests that the renderer's agreement depends on it.
+    explicit TubesTechnique(float tangent_scale = kBezierTangentScale);
+
+    float reach_mm(const GpuScene& scene, const RenderOptions& o) const override { return tube_radius_reach(scene, o); }
+    bool needs_tangents() const override { return true; }
+    void begin_frame(const FrameInputs& in) override;
+    void draw_batch(const FrameInputs& in, const DecodedBatch& batch) override;
+    void draw_coarse(const FrameInputs& in, std::uint32_t count) override;
+
+    // The pieces of a batch (first step of draw_batch), left in
+    // pieces_buffer() and bound at binding::kTubePieces; returns how many
+    // pieces the buffer holds (empty ones included).
+    std::uint32_t build_pieces(const FrameInputs& in, const DecodedBatch& batch);
+    GLuint pieces_buffer() const { return pieces_.get(); }
+
+private:
+    float tangent_scale_;
+    GlProgram build_, draw_;
+    GlBuffer pieces_;
+    std::uint64_t pieces_capacity_ = 0;
+    LinesTechnique coarse_lines_;
+};
+
+}  // namespace fiblet::viewer
