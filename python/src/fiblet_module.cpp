@@ -7,6 +7,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numeric>
@@ -14,15 +15,18 @@
 #include <string>
 #include <vector>
 
+#include "fiblet/block_index.hpp"
 #include "fiblet/compare.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
+#include "fiblet/image_mask.hpp"
+#include "fiblet/select.hpp"
 #include "fiblet/tck.hpp"
 #include "decode_range.hpp"
 #include "owned_array.hpp"
-#include "roi_filter.hpp"
+#include "gather_fibers.hpp"
 
 namespace py = pybind11;
 
@@ -63,30 +67,58 @@ Streamlines decode_indices(const FftFile& file, const std::vector<std::uint64_t>
     return gather_fibers(view_of(all), run_fiber);
 }
 
-// A region that can hold no point (inverted box, negative radius, NaN)
-// would silently select nothing: refused, as the library's queries refuse it.
-void check_region(const Region& r) {
-    bool ok = true;
-    for (int k = 0; k < 3; ++k) ok = ok && std::isfinite(r.a[k]) && std::isfinite(r.b[k]);
-    if (r.shape == Region::Shape::sphere) ok = ok && r.b[0] >= 0;
-    else ok = ok && r.a[0] <= r.b[0] && r.a[1] <= r.b[1] && r.a[2] <= r.b[2];
-    if (!ok)
-        throw Error(Errc::invalid_argument, "invalid region: a sphere needs a finite centre and a radius >= 0, a box "
-                                            "finite corners with min <= max on every axis");
+// Regions as the Python package passes them: ("sphere", centre, (radius, 0,
+// 0), exclude), ("box", min, max, exclude) or ("mask", path, None, exclude).
+struct Regions {
+    std::vector<Region> include, exclude;
+    bool empty() const { return include.empty() && exclude.empty(); }
+};
+
+Regions parse_regions(const py::list& regions) {
+    Regions out;
+    for (const py::handle& item : regions) {
+        const auto t = item.cast<py::tuple>();
+        if (t.size() != 4) throw Error(Errc::invalid_argument, "a region is (shape, a, b, exclude)");
+        const auto shape = t[0].cast<std::string>();
+        const bool exclude = t[3].cast<bool>();
+        Region r;
+        if (shape == "mask") {
+            const auto path = t[1].cast<std::string>();
+            py::gil_scoped_release release;
+            r = Region::image(ImageMask::read(path));
+        } else {
+            const auto a = t[1].cast<std::array<double, 3>>(), b = t[2].cast<std::array<double, 3>>();
+            const Vec3f va{float(a[0]), float(a[1]), float(a[2])}, vb{float(b[0]), float(b[1]), float(b[2])};
+            if (shape == "sphere") r = Region::sphere(va, float(b[0]));
+            else if (shape == "box") r = Region::box_between(va, vb);
+            else throw Error(Errc::invalid_argument, "unknown region shape '" + shape + "'");
+        }
+        (exclude ? out.exclude : out.include).push_back(std::move(r));
+    }
+    return out;
 }
 
-std::vector<Region> parse_regions(const py::list& regions) {
-    std::vector<Region> out;
-    for (const py::handle& item : regions) {
-        const auto t = item.cast<std::tuple<std::string, std::array<double, 3>, std::array<double, 3>, bool>>();
-        Region r;
-        const std::string& shape = std::get<0>(t);
-        if (shape == "sphere") r.shape = Region::Shape::sphere;
-        else if (shape == "box") r.shape = Region::Shape::box;
-        else throw Error(Errc::invalid_argument, "unknown region shape '" + shape + "'");
-        r.a = std::get<1>(t), r.b = std::get<2>(t), r.exclude = std::get<3>(t);
-        check_region(r);
-        out.push_back(r);
+// The fibers among `candidates` (ascending, or all fibers when null) that
+// the regions keep, found through the block index: only the blocks near a
+// region are decoded (fiblet/select.hpp, tckedit's semantics).
+std::vector<std::uint8_t> kept_by_regions(const FftFile& file, const Regions& regions,
+                                          const std::vector<FiberRange>& candidates) {
+    const BlockIndex index = BlockIndex::load(file);
+    Query q;
+    q.fibers = candidates;
+    q.include = regions.include, q.exclude = regions.exclude;
+    std::vector<std::uint8_t> kept(file.header().fibers, 0);
+    for (const SelectedRun& run : select_runs(file, index, q)) kept[run.fiber] = 1;
+    return kept;
+}
+
+// Sorted, merged ranges of a list of fiber indices.
+std::vector<FiberRange> ranges_of(std::vector<std::uint64_t> ids) {
+    std::sort(ids.begin(), ids.end());
+    std::vector<FiberRange> out;
+    for (const std::uint64_t f : ids) {
+        if (!out.empty() && f <= out.back().last + 1) out.back().last = std::max(out.back().last, f);
+        else out.push_back({f, f});
     }
     return out;
 }
@@ -98,7 +130,7 @@ std::vector<Region> parse_regions(const py::list& regions) {
 py::tuple decode(const std::string& path, std::uint64_t begin, std::optional<std::uint64_t> end,
                  const py::object& indices_or_none, const py::list& regions_list, unsigned threads,
                  bool ignore_trailer) {
-    const std::vector<Region> regions = parse_regions(regions_list);
+    const Regions regions = parse_regions(regions_list);
     std::optional<std::vector<std::uint64_t>> indices;
     if (!indices_or_none.is_none()) {
         const auto a = py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>::ensure(indices_or_none);
@@ -111,29 +143,39 @@ py::tuple decode(const std::string& path, std::uint64_t begin, std::optional<std
     {
         py::gil_scoped_release release;
         const FftFile file(path, {.ignore_trailer = ignore_trailer});
+        const std::uint64_t nfibers = file.header().fibers;
         if (indices) {
             for (std::uint64_t f : *indices)
-                if (f >= file.header().fibers)
+                if (f >= nfibers)
                     throw Error(Errc::invalid_argument, path + ": fiber " + std::to_string(f) + " out of range (" +
-                                                            std::to_string(file.header().fibers) + " fibers)");
+                                                            std::to_string(nfibers) + " fibers)");
+        }
+        const std::uint64_t e = std::min(end.value_or(nfibers), nfibers);
+        if (!regions.empty()) {
+            // The regions decide first (from the index); only kept fibers are decoded.
+            const std::vector<FiberRange> candidates =
+                indices ? ranges_of(*indices) : std::vector<FiberRange>{{begin, e ? e - 1 : 0}};
+            const bool none = indices ? indices->empty() : begin >= e;
+            std::vector<std::uint64_t> keep;
+            if (!none) {
+                const std::vector<std::uint8_t> kept = kept_by_regions(file, regions, candidates);
+                if (indices) {
+                    for (const std::uint64_t f : *indices)
+                        if (kept[f]) keep.push_back(f);
+                } else {
+                    for (std::uint64_t f = begin; f < e; ++f)
+                        if (kept[f]) keep.push_back(f);
+                }
+            }
+            indices = std::move(keep);
+        }
+        if (indices) {
             s = decode_indices(file, *indices, decode_options<DecodeOptions>(threads));
             ids = std::move(*indices);
         } else {
-            const std::uint64_t e = end.value_or(file.header().fibers);
             range = decode_range(file, begin, e, threads);
             ids.resize(range->offsets.size() - 1);
             std::iota(ids.begin(), ids.end(), begin);
-        }
-        if (!regions.empty()) {
-            const FibersView all = range ? FibersView{range->xyz.as<const float>(), range->offsets} : view_of(s);
-            const std::vector<std::uint64_t> keep = fibers_kept(all, regions);
-            if (keep.size() != all.size()) {
-                s = gather_fibers(all, keep);
-                range.reset();
-                std::vector<std::uint64_t> kept_ids(keep.size());
-                for (std::size_t i = 0; i < keep.size(); ++i) kept_ids[i] = ids[keep[i]];
-                ids = std::move(kept_ids);
-            }
         }
     }
     const auto fibers = py::ssize_t(ids.size());

@@ -1,38 +1,8 @@
-#include "roi_filter.hpp"
+#include "gather_fibers.hpp"
 
 #include <algorithm>
-#include <cstring>
 
 namespace fiblet::python {
-
-bool Region::contains(const float* p) const {
-    if (shape == Shape::sphere) {
-        const double dx = p[0] - a[0], dy = p[1] - a[1], dz = p[2] - a[2];
-        return dx * dx + dy * dy + dz * dz <= b[0] * b[0];
-    }
-    for (int k = 0; k < 3; ++k)
-        if (!(p[k] >= a[k] && p[k] <= b[k])) return false;
-    return true;
-}
-
-std::vector<std::uint64_t> fibers_kept(FibersView s, const std::vector<Region>& regions) {
-    std::vector<std::uint64_t> keep;
-    for (std::uint64_t f = 0; f < s.size(); ++f) {
-        const float* begin = s.xyz + 3 * s.offsets[f];
-        const float* end = s.xyz + 3 * s.offsets[f + 1];
-        bool kept = true;
-        for (const Region& r : regions) {
-            bool hit = false;
-            for (const float* p = begin; p != end && !hit; p += 3) hit = r.contains(p);
-            if (hit == r.exclude) {
-                kept = false;
-                break;
-            }
-        }
-        if (kept) keep.push_back(f);
-    }
-    return keep;
-}
 
 Streamlines gather_fibers(FibersView s, const std::vector<std::uint64_t>& keep) {
     Streamlines out;
