@@ -7,12 +7,19 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <sys/stat.h>
+
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <numeric>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "fiblet/block_index.hpp"
@@ -98,18 +105,94 @@ Regions parse_regions(const py::list& regions) {
     return out;
 }
 
-// The fibers among `candidates` (ascending, or all fibers when null) that
-// the regions keep, found through the block index: only the blocks near a
-// region are decoded (fiblet/select.hpp, tckedit's semantics).
-std::vector<std::uint8_t> kept_by_regions(const FftFile& file, const Regions& regions,
-                                          const std::vector<FiberRange>& candidates) {
-    const BlockIndex index = BlockIndex::load(file);
+// The block index of the last file queried with roi=, kept for the next
+// query on the same file (same device, inode, size and modification time):
+// loading it (parsing the BIDX chunk, sorting 800 k boxes on the medium
+// file) costs about as much as the selection itself.
+std::shared_ptr<const BlockIndex> block_index_of(const FftFile& file) {
+    struct stat st {};
+    if (::stat(file.path().c_str(), &st) != 0) return std::make_shared<const BlockIndex>(BlockIndex::load(file));
+    const std::array<std::int64_t, 5> key{std::int64_t(st.st_dev), std::int64_t(st.st_ino), std::int64_t(st.st_size),
+                                          std::int64_t(st.st_mtim.tv_sec), std::int64_t(st.st_mtim.tv_nsec)};
+    static std::mutex mutex;
+    static std::array<std::int64_t, 5> cached_key{};
+    static std::shared_ptr<const BlockIndex> cached;
+    {
+        const std::lock_guard<std::mutex> lock(mutex);
+        if (cached && cached_key == key && cached->blocks() == file.header().blocks) return cached;
+    }
+    auto index = std::make_shared<const BlockIndex>(BlockIndex::load(file));
+    const std::lock_guard<std::mutex> lock(mutex);
+    cached_key = key, cached = index;
+    return index;
+}
+
+// Above this share of blocks near the include regions, roi= decodes
+// everything and tests points (measured on the medium tractogram, 2 cores:
+// docs/ecosystem.md).
+constexpr double kDecodeAllShare = 0.25;
+
+// Share of the file's blocks near the most selective include region (1
+// without one): what the index-driven selection would decode to test points.
+double share_near_regions(const BlockIndex& index, const Regions& regions) {
+    double share = 1.0;
+    for (const Region& r : regions.include) {
+        std::vector<std::uint64_t> bits;
+        if (r.shape == Region::Shape::sphere) index.blocks_near_sphere(r.center, r.radius, bits);
+        else if (r.shape == Region::Shape::box) index.blocks_near_box(r.box, bits);
+        else index.blocks_near_mask(*r.mask, bits);
+        std::uint64_t n = 0;
+        for (const std::uint64_t w : bits) n += std::uint64_t(std::popcount(w));
+        share = std::min(share, index.blocks() ? double(n) / double(index.blocks()) : 0.0);
+    }
+    return share;
+}
+
+// Positions (in `s`) of the fibers the regions keep, by testing every point
+// (Region::contains: the rules the library's selection applies), on
+// `threads` threads (0: all cores), each a contiguous share of the fibers.
+std::vector<std::uint64_t> kept_by_points(FibersView s, const Regions& regions, unsigned threads) {
+    auto meets = [&](const Region& r, std::uint64_t f) {
+        for (std::uint64_t p = s.offsets[f]; p < s.offsets[f + 1]; ++p)
+            if (r.contains({s.xyz[3 * p], s.xyz[3 * p + 1], s.xyz[3 * p + 2]})) return true;
+        return false;
+    };
+    std::vector<std::uint8_t> kept(s.size(), 0);
+    auto test = [&](std::uint64_t first, std::uint64_t last) {
+        for (std::uint64_t f = first; f < last; ++f) {
+            bool k = s.offsets[f + 1] > s.offsets[f];  // as the selection: a fiber without points is never output
+            for (const Region& r : regions.include) k = k && meets(r, f);
+            for (const Region& r : regions.exclude) k = k && !meets(r, f);
+            kept[f] = k;
+        }
+    };
+    if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+    const std::uint64_t n = s.size(), parts = std::max<std::uint64_t>(1, std::min<std::uint64_t>(threads, n / 256));
+    std::vector<std::thread> pool;
+    for (std::uint64_t t = 1; t < parts; ++t) pool.emplace_back(test, n * t / parts, n * (t + 1) / parts);
+    test(0, n / parts);
+    for (std::thread& t : pool) t.join();
+    std::vector<std::uint64_t> keep;
+    for (std::uint64_t f = 0; f < n; ++f)
+        if (kept[f]) keep.push_back(f);
+    return keep;
+}
+
+// The fibers among `candidates` that the regions keep, in file order, and
+// their IDs: the library's selection decides through the block index (only
+// the blocks near a region are decoded to test their points), then decodes
+// the kept fibers with the fast block decoders.
+Streamlines select_by_regions(const FftFile& file, const Regions& regions, const std::vector<FiberRange>& candidates,
+                              std::vector<std::uint64_t>& ids) {
+    const std::shared_ptr<const BlockIndex> index = block_index_of(file);
     Query q;
     q.fibers = candidates;
     q.include = regions.include, q.exclude = regions.exclude;
-    std::vector<std::uint8_t> kept(file.header().fibers, 0);
-    for (const SelectedRun& run : select_runs(file, index, q)) kept[run.fiber] = 1;
-    return kept;
+    std::vector<SelectedRun> runs;
+    Streamlines s = select_streamlines(file, *index, q, &runs);
+    ids.clear();
+    for (const SelectedRun& run : runs) ids.push_back(run.fiber);  // fibers mode: one run per kept fiber
+    return s;
 }
 
 // Sorted, merged ranges of a list of fiber indices.
@@ -121,6 +204,39 @@ std::vector<FiberRange> ranges_of(std::vector<std::uint64_t> ids) {
         else out.push_back({f, f});
     }
     return out;
+}
+
+// roi=: the fibers among [begin, end), or among `indices` (any order,
+// repeats), that the regions keep, in that order, and their IDs; in `range`
+// when they were decoded as one, else in `s`.
+void decode_with_regions(const FftFile& file, const Regions& regions, std::uint64_t begin, std::uint64_t end,
+                         const std::optional<std::vector<std::uint64_t>>& indices, unsigned threads,
+                         std::optional<DecodedRange>& range, Streamlines& s, std::vector<std::uint64_t>& ids) {
+    ids.clear();
+    if (indices ? indices->empty() : begin >= end) return;
+    // Regions near most of the file: decoding everything on all threads,
+    // then testing the points, beats the one-thread selection (which decodes
+    // the near blocks, then the kept fibers).
+    if (share_near_regions(*block_index_of(file), regions) > kDecodeAllShare) {
+        if (indices) s = decode_indices(file, *indices, decode_options<DecodeOptions>(threads));
+        else range = decode_range(file, begin, end, threads);
+        const FibersView view = range ? FibersView{range->xyz.as<const float>(), range->offsets} : view_of(s);
+        const std::vector<std::uint64_t> keep = kept_by_points(view, regions, threads);
+        for (const std::uint64_t k : keep) ids.push_back(indices ? (*indices)[k] : begin + k);
+        if (range) keep_fibers(*range, keep);
+        else s = gather_fibers(view, keep);
+        return;
+    }
+    const std::vector<FiberRange> candidates = indices ? ranges_of(*indices) : std::vector<FiberRange>{{begin, end - 1}};
+    s = select_by_regions(file, regions, candidates, ids);
+    if (!indices) return;
+    // The kept fibers in the order (and with the repeats) asked for.
+    std::vector<std::uint64_t> position(file.header().fibers, UINT64_MAX), want, order;
+    for (std::size_t i = 0; i < ids.size(); ++i) position[ids[i]] = i;
+    for (const std::uint64_t f : *indices)
+        if (position[f] != UINT64_MAX) want.push_back(f), order.push_back(position[f]);
+    if (want != ids) s = gather_fibers(view_of(s), order);
+    ids = std::move(want);
 }
 
 // Decodes a file (all fibers, [begin, end), or a list of indices), keeps the
@@ -152,24 +268,8 @@ py::tuple decode(const std::string& path, std::uint64_t begin, std::optional<std
         }
         const std::uint64_t e = std::min(end.value_or(nfibers), nfibers);
         if (!regions.empty()) {
-            // The regions decide first (from the index); only kept fibers are decoded.
-            const std::vector<FiberRange> candidates =
-                indices ? ranges_of(*indices) : std::vector<FiberRange>{{begin, e ? e - 1 : 0}};
-            const bool none = indices ? indices->empty() : begin >= e;
-            std::vector<std::uint64_t> keep;
-            if (!none) {
-                const std::vector<std::uint8_t> kept = kept_by_regions(file, regions, candidates);
-                if (indices) {
-                    for (const std::uint64_t f : *indices)
-                        if (kept[f]) keep.push_back(f);
-                } else {
-                    for (std::uint64_t f = begin; f < e; ++f)
-                        if (kept[f]) keep.push_back(f);
-                }
-            }
-            indices = std::move(keep);
-        }
-        if (indices) {
+            decode_with_regions(file, regions, begin, e, indices, threads, range, s, ids);
+        } else if (indices) {
             s = decode_indices(file, *indices, decode_options<DecodeOptions>(threads));
             ids = std::move(*indices);
         } else {

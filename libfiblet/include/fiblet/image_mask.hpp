@@ -39,12 +39,11 @@ public:
         const float x = p.x, y = p.y, z = p.z;
         const auto& m = to_voxel_;
         // Eigen's order in MRtrix (linear part, then the translation), no FMA.
-        const float vi = std::round(m[0][0] * x + m[0][1] * y + m[0][2] * z + m[0][3]);
-        const float vj = std::round(m[1][0] * x + m[1][1] * y + m[1][2] * z + m[1][3]);
-        const float vk = std::round(m[2][0] * x + m[2][1] * y + m[2][2] * z + m[2][3]);
-        if (!(vi >= 0 && vj >= 0 && vk >= 0 && vi < float(size_[0]) && vj < float(size_[1]) && vk < float(size_[2])))
-            return false;
-        return inside_[std::size_t(vi) + std::size_t(size_[0]) * (std::size_t(vj) + std::size_t(size_[1]) * std::size_t(vk))];
+        std::size_t i, j, k;
+        return voxel_index(m[0][0] * x + m[0][1] * y + m[0][2] * z + m[0][3], size_[0], i) &&
+               voxel_index(m[1][0] * x + m[1][1] * y + m[1][2] * z + m[1][3], size_[1], j) &&
+               voxel_index(m[2][0] * x + m[2][1] * y + m[2][2] * z + m[2][3], size_[2], k) &&
+               inside_[i + std::size_t(size_[0]) * (j + std::size_t(size_[1]) * k)];
     }
 
     enum class Overlap { outside, partial, inside };
@@ -53,6 +52,17 @@ public:
     Overlap classify(const Aabb& box) const;
 
 private:
+    // std::round(v) (halves away from zero) when it is an index below
+    // `size`: MRtrix's rounding, without a call into libm.
+    static bool voxel_index(float v, std::int64_t size, std::size_t& index) {
+        if (!(v > -1.0f && v < float(size) + 1.0f)) return false;  // NaN too
+        const auto t = std::int64_t(v);  // toward zero
+        const float frac = v - float(t);  // exact: |v| is small
+        const std::int64_t r = t + (frac >= 0.5f) - (frac <= -0.5f);
+        if (r < 0 || r >= size) return false;
+        index = std::size_t(r);
+        return true;
+    }
     std::int64_t occupied(const std::array<std::int64_t, 3>& lo, const std::array<std::int64_t, 3>& hi) const;
 
     std::string path_;
