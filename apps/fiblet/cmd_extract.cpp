@@ -219,7 +219,7 @@ void add_extract(CLI::App& app) {
     cmd->add_option("--seed", args->seed, "Seed of --random-fraction (default 0)");
     cmd->add_option("--include", args->include,
                     "Include region: x,y,z,radius (sphere), x0,y0,z0,x1,y1,z1 (box) or a mask image "
-                    "(.nii, .nii.gz, .mif; tckedit's rule: nearest voxel, value >= 0.5); repeatable");
+                    "(.nii, .nii.gz, .mif; tckedit's rule: the nearest voxel's value rounds to non-zero); repeatable");
     cmd->add_option("--exclude", args->exclude, "Exclude region, same forms; repeatable");
     cmd->add_option("--mode", args->mode, "fibers: keep whole fibers (tckedit); blocks: keep the blocks in the regions")
         ->check(CLI::IsMember({"fibers", "blocks"}));
