@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <sstream>
 
 #include "fiblet/error.hpp"
@@ -225,6 +226,40 @@ TEST_F(ImageReader, MalformedImagesAreRefused) {
     const std::string complex_nii = dir_.file("complex.nii");
     ASSERT_TRUE(mrconvert(source, complex_nii, "-datatype cfloat32"));
     EXPECT_EQ(error_of([&] { read_image(complex_nii); }), Errc::unsupported);
+}
+
+// Damaged images (cut anywhere, header bytes changed) are read or refused
+// with a fiblet::Error, never a crash, a hang or another exception.
+TEST_F(ImageReader, DamagedImagesThrowOnlyFibletErrors) {
+    const SourceImage src = oblique_source({6, 5, 4, 2});
+    const std::string source = dir_.file("good.mif");
+    src.write_mif(source);
+    std::mt19937 rng(5);
+    for (const std::string name : {"good.nii", "good2.nii", "good.nii.gz", "strided.mif"}) {
+        const std::string path = dir_.file(name);
+        if (name == "good2.nii") ASSERT_TRUE(mrconvert(source, path, "-config NIfTIAlwaysUseVer2 true"));
+        else if (name == "strided.mif") ASSERT_TRUE(mrconvert(source, path, "-strides -3,1,-2,4 -datatype int16be"));
+        else ASSERT_TRUE(mrconvert(source, path));
+        const std::string good = read_file(path);
+        const std::size_t header = name.ends_with(".mif") ? good.find("END") + 4 : std::min<std::size_t>(good.size(), 560);
+        auto survives = [&](const std::string& bytes, const std::string& what) {
+            const std::string damaged = dir_.file("damaged-" + name);
+            write_file(damaged, bytes);
+            try {
+                read_image(damaged);
+            } catch (const Error&) {
+            } catch (const std::exception& e) {
+                ADD_FAILURE() << what << ": " << e.what();
+            }
+        };
+        for (std::size_t cut = 0; cut < good.size(); cut += 1 + good.size() / 97) survives(good.substr(0, cut), name + " cut");
+        for (int n = 0; n < 300; ++n) {
+            std::string bad = good;
+            const std::size_t at = std::uniform_int_distribution<std::size_t>(0, header - 1)(rng);
+            bad[at] = char(std::uniform_int_distribution<int>(0, 255)(rng));
+            survives(bad, name + " byte " + std::to_string(at));
+        }
+    }
 }
 
 }  // namespace

@@ -20,6 +20,40 @@ struct NiftiFree {
 };
 using NiftiPtr = std::unique_ptr<nifti_image, NiftiFree>;
 
+template <class T>
+T field(const std::uint8_t* p, bool swap) {
+    std::uint8_t b[sizeof(T)];
+    std::memcpy(b, p, sizeof(T));
+    if (swap) std::reverse(b, b + sizeof(T));
+    T v;
+    std::memcpy(&v, b, sizeof(T));
+    return v;
+}
+
+// The header fields libnifti trusts, checked first: libnifti 3.0.1 crashes
+// on a NIfTI-2 dim[0] out of 1..7, and prints its own messages on stderr
+// for a short header or an unknown datatype.
+void check_header(const std::string& path, bool gz) {
+    std::uint8_t h[540] = {};
+    znzFile f = znzopen(path.c_str(), "rb", gz ? 1 : 0);
+    if (znz_isnull(f)) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
+    const std::size_t got = znzread(h, 1, sizeof h, f);
+    znzclose(f);
+    auto bad = [&](const std::string& why) { throw Error(Errc::image_format, path + ": not a valid NIfTI image: " + why); };
+    if (got < 4) bad("the file is too short");
+    const auto size = field<std::int32_t>(h, false), swapped = field<std::int32_t>(h, true);
+    const bool swap = size != 348 && size != 540;
+    const std::int32_t header_bytes = swap ? swapped : size;
+    if (header_bytes != 348 && header_bytes != 540)
+        bad("sizeof_hdr is " + std::to_string(size) + " (348 for NIfTI-1, 540 for NIfTI-2)");
+    if (got < std::size_t(header_bytes)) bad("the header is cut short");
+    const bool v2 = header_bytes == 540;
+    const std::int64_t ndim = v2 ? field<std::int64_t>(h + 16, swap) : field<std::int16_t>(h + 40, swap);
+    if (ndim < 1 || ndim > 7) bad("dim[0] is " + std::to_string(ndim) + " (1 to 7 axes)");
+    const int datatype = field<std::int16_t>(h + (v2 ? 12 : 70), swap);
+    if (!nifti_is_valid_datatype(datatype)) bad("unknown datatype code " + std::to_string(datatype));
+}
+
 // The voxel bytes of `path` itself, read through znzlib (gzip or not).
 // libnifti's own loader is not used: with both X.nii and X.nii.gz present it
 // reads the data of X.nii for X.nii.gz (libnifti 3.0.1).
@@ -121,6 +155,8 @@ Affine3x4 rotation_and_spacing(const nifti_image& nim, std::array<double, 3>& sp
 Image read_nifti(const std::string& path) {
     struct stat st {};
     if (::stat(path.c_str(), &st) != 0) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
+    const bool gz = path.size() > 3 && path.compare(path.size() - 3, 3, ".gz") == 0;
+    check_header(path, gz);
     nifti_set_debug_level(0);  // libnifti's messages would go to stderr; ours are clearer
     NiftiPtr header(nifti_image_read(path.c_str(), 0));
     if (!header) throw Error(Errc::image_format, path + ": not a valid NIfTI-1/NIfTI-2 image (unreadable header)");
@@ -133,7 +169,6 @@ Image read_nifti(const std::string& path) {
     const std::size_t n = voxel_count(path, img.dims);
     // Data larger than the file could hold (deflate compresses at most
     // 1032:1) is a lying header, refused before libnifti allocates it.
-    const bool gz = path.size() > 3 && path.compare(path.size() - 3, 3, ".gz") == 0;
     const double room = double(st.st_size) * (gz ? 1032.0 : 1.0);
     if (h.nbyper <= 0 || double(n) * double(h.nbyper) > room)
         throw Error(Errc::image_format, path + ": the header describes " + std::to_string(n) +
