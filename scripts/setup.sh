@@ -7,8 +7,10 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libcli11-dev libeigen3-dev libfmt-dev libzstd-dev libxxhash-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libhwy-dev
+  libnifti2-dev  # NIfTI images (masks)
   python3 python3-numpy python3-nibabel python3-matplotlib
   python3-dev python3-pybind11 pybind11-dev python3-pytest snakemake
+  python3-dipy  # fiblet.load_sft() and its test
   mrtrix3 zstd time
   slurm-wlm munge  # the cohort workflow on a single-node SLURM (ecosystem.cohort_workflow_slurm)
   clang-14 libclang-rt-14-dev  # libFuzzer harnesses (scripts/fuzz.sh)

@@ -57,7 +57,9 @@ inline Vec3f point_at(const DecodedFile& d, std::size_t i) {
 }
 
 // Region membership written out again from its definition.
+// (Image masks: ImageMask::contains, checked against tckedit in select_mask_test.cpp.)
 inline bool inside(const Region& r, Vec3f p) {
+    if (r.shape == Region::Shape::mask) return r.mask->contains(p);
     if (r.shape == Region::Shape::sphere) {
         const float dx = p.x - r.center.x, dy = p.y - r.center.y, dz = p.z - r.center.z;
         return dx * dx + dy * dy + dz * dz <= r.radius * r.radius;

@@ -19,7 +19,8 @@ int exit_code_for(Errc c) {
         case Errc::io: return kIo;
         case Errc::tck_format:
         case Errc::fft_format:
-        case Errc::invalid_input: return kBadInput;
+        case Errc::invalid_input:
+        case Errc::image_format: return kBadInput;
         case Errc::invalid_argument: return kUsage;
         case Errc::exists: return kExists;
         case Errc::unsupported: return kUnsupported;
@@ -35,7 +36,7 @@ const std::vector<ExitCodeInfo>& exit_code_table() {
         {kInternal, "internal error (a bug: please report it)"},
         {kUsage, "bad command line or option value"},
         {kIo, "a file cannot be read or written"},
-        {kBadInput, "malformed or inconsistent input file (.tck or .fft)"},
+        {kBadInput, "malformed or inconsistent input file (.tck, .fft or image)"},
         {kExists, "the output exists and --force was not given"},
         {kUnsupported, "valid input that fiblet does not support"},
         {kChecksum, "integrity check failed"},

@@ -12,6 +12,7 @@
 #include "fiblet/block_index.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/fft_subset.hpp"
+#include "fiblet/image_mask.hpp"
 #include "fiblet/select.hpp"
 #include "fiblet/tck.hpp"
 
@@ -59,8 +60,17 @@ Vec3f vec3(const std::string& option, const std::string& text) {
     return {float(v[0]), float(v[1]), float(v[2])};
 }
 
-// x,y,z,r: a sphere (as tckedit); x0,y0,z0,x1,y1,z1: a box.
+bool looks_like_image(const std::string& text) {
+    for (const char* ext : {".nii", ".nii.gz", ".mif", ".mih", ".mif.gz"})
+        if (text.ends_with(ext)) return true;
+    return std::filesystem::exists(text);
+}
+
+// x,y,z,r: a sphere (as tckedit); x0,y0,z0,x1,y1,z1: a box; an image path: a
+// mask (as tckedit, which also tries numbers first, then an image).
 Region region(const std::string& option, const std::string& text) {
+    if (text.find_first_not_of("0123456789+-.,eE ") != std::string::npos && looks_like_image(text))
+        return Region::image(ImageMask::read(text));
     const auto v = numbers(option, text);
     if (v.size() == 4) return Region::sphere({float(v[0]), float(v[1]), float(v[2])}, float(v[3]));
     if (v.size() == 6) {
@@ -69,7 +79,7 @@ Region region(const std::string& option, const std::string& text) {
         return Region::box_between({std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)},
                                    {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)});
     }
-    usage(option + " takes x,y,z,radius (sphere) or x0,y0,z0,x1,y1,z1 (box)");
+    usage(option + " takes x,y,z,radius (sphere), x0,y0,z0,x1,y1,z1 (box) or a mask image (.nii, .nii.gz, .mif)");
 }
 
 Query build_query(const ExtractArgs& a) {
@@ -181,7 +191,8 @@ void add_extract(CLI::App& app) {
     cmd->add_option("--random-fraction", args->random_fraction, "Keep this fraction of the fibers, at random");
     cmd->add_option("--seed", args->seed, "Seed of --random-fraction (default 0)");
     cmd->add_option("--include", args->include,
-                    "Include region: x,y,z,radius (sphere) or x0,y0,z0,x1,y1,z1 (box); repeatable");
+                    "Include region: x,y,z,radius (sphere), x0,y0,z0,x1,y1,z1 (box) or a mask image "
+                    "(.nii, .nii.gz, .mif; tckedit's rule: the nearest voxel's value rounds to non-zero); repeatable");
     cmd->add_option("--exclude", args->exclude, "Exclude region, same forms; repeatable");
     cmd->add_option("--mode", args->mode, "fibers: keep whole fibers (tckedit); blocks: keep the blocks in the regions")
         ->check(CLI::IsMember({"fibers", "blocks"}));

@@ -6,6 +6,10 @@
     s.offsets       # (F + 1,) int64: fiber i is points[offsets[i]:offsets[i + 1]]
     s.lengths       # (F,) int64 points per fiber
     s[i]            # the (n_i, 3) points of fiber i (a view)
+    s[10:20], s[[3, 1]], s[s.lengths > 100]   # Streamlines, as ArraySequence
+    fiblet.load("t.fft", roi=(0, 0, 0, 10))       # sphere x,y,z,r (or a box, a mask)
+    fiblet.load("t.fft", roi=fiblet.Mask("wm.nii.gz"))
+    sft = fiblet.load_sft("t.fft", "t1.nii.gz")   # DIPY StatefulTractogram
 
     tractogram = fiblet.load_tractogram("tracks.fft")   # nibabel Tractogram
     fiblet.save("out.fft", tractogram.streamlines)      # from nibabel, lists, ...
@@ -15,19 +19,21 @@ The decoded points are handed to numpy without a copy: the arrays own the
 decoder's buffers.
 """
 
-import os
-import tempfile
-from dataclasses import dataclass
+# Imports under private names: the package's namespace is its API (__all__).
+import numbers as _numbers
+import os as _os
+import tempfile as _tempfile
+from dataclasses import dataclass as _dataclass
 
-import numpy as np
+import numpy as _np
 
 from . import _fiblet
 from ._fiblet import FibletError
 
 __version__ = _fiblet.version
 __all__ = [
-    "Streamlines", "Sphere", "Box", "FibletError",
-    "load", "load_array_sequence", "load_tractogram", "save", "stats", "info",
+    "Streamlines", "Sphere", "Box", "Mask", "FibletError",
+    "load", "load_array_sequence", "load_tractogram", "load_sft", "save", "stats", "info",
 ]
 
 
@@ -43,25 +49,44 @@ class Streamlines:
     def __init__(self, points, offsets, fiber_ids=None):
         self.points = points
         self.offsets = offsets
-        self.fiber_ids = np.arange(len(offsets) - 1) if fiber_ids is None else fiber_ids
+        self.fiber_ids = _np.arange(len(offsets) - 1) if fiber_ids is None else fiber_ids
         self._lengths = None
 
     @property
     def lengths(self):
         """Points per fiber, (F,) int64."""
         if self._lengths is None:
-            self._lengths = np.diff(self.offsets)
+            self._lengths = _np.diff(self.offsets)
         return self._lengths
 
     def __len__(self):
         return len(self.offsets) - 1
 
-    def __getitem__(self, i):
-        n = len(self)
-        if not -n <= i < n:
-            raise IndexError(f"fiber {i} out of range ({n} fibers)")
-        i %= n
-        return self.points[self.offsets[i]:self.offsets[i + 1]]
+    def __getitem__(self, key):
+        """An int gives the (n, 3) points of one fiber (a view); a slice, a
+        sequence of ints or a boolean mask gives a Streamlines (as nibabel's
+        ArraySequence does), whose fiber_ids follow."""
+        if isinstance(key, (_numbers.Integral, _np.integer)) and not isinstance(key, (bool, _np.bool_)):
+            n = len(self)
+            if not -n <= key < n:
+                raise IndexError(f"fiber {key} out of range ({n} fibers)")
+            i = int(key) % n
+            return self.points[self.offsets[i]:self.offsets[i + 1]]
+        return self._select(_fiber_indices(key, len(self)))
+
+    def _select(self, ids):
+        """The fibers `ids` (an int64 array) as a new Streamlines."""
+        if isinstance(ids, slice):  # a step-1 slice: a view of the points
+            first, last = self.offsets[ids.start], self.offsets[ids.stop]
+            return Streamlines(self.points[first:last], self.offsets[ids.start:ids.stop + 1] - first,
+                               self.fiber_ids[ids])
+        lengths = self.lengths[ids]
+        offsets = _np.zeros(len(ids) + 1, dtype=_np.int64)
+        _np.cumsum(lengths, out=offsets[1:])
+        starts = self.offsets[:-1][ids]
+        # Point k of output fiber i comes from starts[i] + k.
+        source = _np.repeat(starts - offsets[:-1], lengths) + _np.arange(offsets[-1], dtype=_np.int64)
+        return Streamlines(self.points[source], offsets, self.fiber_ids[ids])
 
     def __iter__(self):
         for i in range(len(self)):
@@ -83,7 +108,7 @@ class Streamlines:
         return seq
 
 
-@dataclass(frozen=True)
+@_dataclass(frozen=True)
 class Sphere:
     """A spherical region (centre and radius in mm) for ``load(roi=...)``."""
 
@@ -99,7 +124,7 @@ class Sphere:
         return ("sphere", c, (r, 0.0, 0.0), bool(self.exclude))
 
 
-@dataclass(frozen=True)
+@_dataclass(frozen=True)
 class Box:
     """An axis-aligned box (min and max corners in mm) for ``load(roi=...)``."""
 
@@ -114,16 +139,95 @@ class Box:
         return ("box", lo, hi, bool(self.exclude))
 
 
+@_dataclass(frozen=True)
+class Mask:
+    """An image mask (.nii, .nii.gz, .mif) for ``load(roi=...)``, with
+    MRtrix3 ``tckedit``'s rule: a point is inside when the voxel nearest to
+    it holds a value that rounds to non-zero (>= 0.5)."""
+
+    path: str
+    exclude: bool = False
+
+    def _spec(self):
+        return ("mask", _existing(self.path), None, bool(self.exclude))
+
+
+def _region_from_numbers(values):
+    """x,y,z,r: a sphere; x0,y0,z0,x1,y1,z1: a box (corners in any order)."""
+    a = _np.asarray(values, dtype=_np.float64).reshape(-1)
+    if a.size == 4:
+        return Sphere(tuple(a[:3]), float(a[3]))._spec()
+    if a.size == 6:
+        return Box(tuple(_np.minimum(a[:3], a[3:])), tuple(_np.maximum(a[:3], a[3:])))._spec()
+    raise ValueError(f"a region given as numbers needs 4 (x, y, z, radius) or 6 (two box corners), got {a.size}")
+
+
+def _is_number(x):
+    return isinstance(x, (_numbers.Real, _np.number)) and not isinstance(x, (bool, _np.bool_))
+
+
+def _region_spec(r):
+    if isinstance(r, (Sphere, Box, Mask)):
+        return r._spec()
+    if isinstance(r, (str, _os.PathLike)):
+        return Mask(r)._spec()
+    if isinstance(r, (_np.ndarray, list, tuple)) and all(_is_number(x) for x in _np.asarray(r).reshape(-1)):
+        return _region_from_numbers(r)
+    raise TypeError(f"a region is a fiblet.Sphere, Box or Mask, an image path, or 4 or 6 numbers; got {r!r}")
+
+
+def _regions(roi):
+    """The (shape, a, b, exclude) tuples the compiled module takes."""
+    if roi is None:
+        return []
+    if isinstance(roi, _np.ndarray):
+        if roi.ndim == 1:
+            return [_region_from_numbers(roi)]
+        if roi.ndim == 2:
+            return [_region_from_numbers(row) for row in roi]
+        raise ValueError(f"roi as an array must be 1-D (one region) or 2-D (one per row), got shape {roi.shape}")
+    if isinstance(roi, (list, tuple)):
+        if roi and all(_is_number(x) for x in roi):
+            return [_region_from_numbers(roi)]
+        return [_region_spec(r) for r in roi]
+    return [_region_spec(roi)]
+
+
+def _fiber_indices(key, count):
+    """Fiber positions for a slice, a sequence of ints or a boolean mask:
+    a step-1 slice stays a slice (start, stop normalised), else an int64 array."""
+    if isinstance(key, (slice, range)):
+        start, stop, step = slice(key.start, key.stop, key.step).indices(count)
+        if step == 1:
+            return slice(start, max(start, stop))
+        return _np.arange(start, stop, step, dtype=_np.int64)
+    a = _np.asarray(key)
+    if a.ndim == 0:
+        a = a.reshape(1)
+    if a.ndim != 1:
+        raise IndexError(f"fiber selection must be 1-D, got shape {a.shape}")
+    if a.dtype == bool:
+        if len(a) != count:
+            raise IndexError(f"boolean mask of {len(a)} values for {count} fibers")
+        return _np.flatnonzero(a).astype(_np.int64)
+    if a.size and not _np.issubdtype(a.dtype, _np.integer):
+        raise TypeError(f"fibers are selected by ints, a slice or a boolean mask, got {a.dtype} values")
+    a = a.astype(_np.int64, copy=False)
+    if a.size and (a.min() < -count or a.max() >= count):
+        raise IndexError(f"fiber index out of range ({count} fibers)")
+    return _np.where(a < 0, a + count, a)
+
+
 def _vec3(v, what):
-    a = np.asarray(v, dtype=np.float64).reshape(-1)
-    if a.shape != (3,) or not np.all(np.isfinite(a)):
+    a = _np.asarray(v, dtype=_np.float64).reshape(-1)
+    if a.shape != (3,) or not _np.all(_np.isfinite(a)):
         raise ValueError(f"{what} must be 3 finite numbers, got {v!r}")
     return tuple(float(x) for x in a)
 
 
 def _existing(path):
-    path = os.fspath(path)
-    if not os.path.exists(path):
+    path = _os.fspath(path)
+    if not _os.path.exists(path):
         raise FileNotFoundError(f"{path}: no such file")
     return path
 
@@ -140,43 +244,38 @@ def _threads(threads):
 def load(path, *, roi=None, fibers=None, threads=None, ignore_trailer=False):
     """Decodes a .fft file into a :class:`Streamlines`.
 
-    fibers: None (all), a slice or range with step 1 (decoded as one range),
-        an int, or a sequence/array of fiber indices (any order; negative
-        indices count from the end, as in numpy).
-    roi: a :class:`Sphere` or :class:`Box`, or a list of them, with MRtrix3
-        ``tckedit`` semantics: a fiber is kept if it has a point inside every
-        include region and none inside an exclude region.
+    fibers: None (all), an int, a slice or range, a sequence/array of fiber
+        indices (any order; negative indices count from the end, as in
+        numpy), or a boolean mask with one value per fiber.
+    roi: a region or a list of regions, with MRtrix3 ``tckedit`` semantics:
+        a fiber is kept if it has a point inside every include region and
+        none inside an exclude region. A region is a :class:`Sphere`,
+        :class:`Box` or :class:`Mask` (those three take ``exclude=True``),
+        4 numbers (x, y, z, radius: a sphere), 6 numbers (two box corners),
+        or an image path (an include mask); a 2-D array is one region per
+        row. The block index finds the blocks near the regions: only those
+        are decoded to decide, then only the kept fibers.
     threads: decoding threads (None: all cores).
     ignore_trailer: read only the header, LUT and blocks, not the trailer
         after them: salvages a file whose trailer is damaged (which otherwise
         raises a "checksum" FibletError); nothing is then verified.
 
-    Raises FileNotFoundError, ValueError/IndexError on bad arguments, and
-    fiblet.FibletError (with ``.category``, e.g. "fft_format") on bad files.
+    Raises FileNotFoundError, ValueError/IndexError/TypeError on bad
+    arguments, and fiblet.FibletError (with ``.category``, e.g.
+    "fft_format", "image_format") on bad files.
     """
     path = _existing(path)
-    regions = [] if roi is None else [r._spec() for r in (roi if isinstance(roi, (list, tuple)) else [roi])]
+    regions = _regions(roi)
     begin, end, indices = 0, None, None
     if fibers is not None:
         count = _fiblet.info(path, ignore_trailer)["fibers"]
-        if isinstance(fibers, (slice, range)):
-            if fibers.step not in (None, 1):
-                indices = np.arange(count)[slice(fibers.start, fibers.stop, fibers.step)]
-            else:
-                begin, end, _ = slice(fibers.start, fibers.stop).indices(count)
-                end = max(begin, end)
+        if isinstance(fibers, (_numbers.Integral, _np.integer)) and not isinstance(fibers, bool):
+            fibers = [fibers]
+        chosen = _fiber_indices(fibers, count)
+        if isinstance(chosen, slice):
+            begin, end = chosen.start, chosen.stop
         else:
-            indices = np.asarray(fibers)
-            if indices.ndim == 0:
-                indices = indices.reshape(1)
-            if indices.size and not np.issubdtype(indices.dtype, np.integer):
-                raise TypeError(f"fibers must be integers, a slice or a range, got {indices.dtype}")
-            indices = indices.astype(np.int64, copy=False)
-            if indices.size and (indices.min() < -count or indices.max() >= count):
-                raise IndexError(f"fiber index out of range ({count} fibers)")
-            indices = np.where(indices < 0, indices + count, indices)
-        if indices is not None:
-            indices = indices.astype(np.uint64)
+            indices = chosen.astype(_np.uint64)
     points, offsets, ids = _fiblet.decode(path, begin, end, indices, regions, _threads(threads), ignore_trailer)
     return Streamlines(points, offsets, ids)
 
@@ -191,15 +290,33 @@ def load_tractogram(path, **options):
     (RAS+, ``affine_to_rasmm`` identity), as nibabel gives for a .tck file."""
     from nibabel.streamlines import Tractogram
 
-    return Tractogram(load_array_sequence(path, **options), affine_to_rasmm=np.eye(4))
+    return Tractogram(load_array_sequence(path, **options), affine_to_rasmm=_np.eye(4))
+
+
+def load_sft(path, reference, **options):
+    """Decodes a .fft file into DIPY's StatefulTractogram (world millimetres,
+    ``Space.RASMM``), as ``dipy.io.streamline.load_tractogram`` gives for a
+    .tck file. reference: what DIPY accepts as one (a NIfTI path or image, a
+    .trk file, a header dict), giving the voxel grid of the tractogram.
+    options: those of :func:`load`. Needs DIPY (Debian: python3-dipy)."""
+    try:
+        from dipy.io.stateful_tractogram import Space, StatefulTractogram
+    except ImportError as e:
+        raise ImportError("fiblet.load_sft needs DIPY (pip install dipy, or Debian's python3-dipy)") from e
+    if isinstance(reference, _os.PathLike):
+        reference = _os.fspath(reference)
+    return StatefulTractogram(load_array_sequence(path, **options), reference, Space.RASMM)
 
 
 def _flatten(streamlines):
     """(points float32 (N,3), offsets int64 (F+1)) from the accepted inputs."""
+    if isinstance(streamlines, (str, bytes, _os.PathLike)):
+        raise TypeError(f"save(path, streamlines): streamlines must be points, not a file name ({streamlines!r}); "
+                        "load the file first (fiblet.load, nibabel.streamlines.load) or run `fiblet compress`")
     if isinstance(streamlines, Streamlines):
         return streamlines.points, streamlines.offsets
     if isinstance(streamlines, tuple) and len(streamlines) == 2 and all(
-            isinstance(a, np.ndarray) for a in streamlines):
+            isinstance(a, _np.ndarray) for a in streamlines):
         return streamlines
     try:  # nibabel objects, imported only when nibabel is there
         from nibabel.streamlines.array_sequence import ArraySequence
@@ -211,21 +328,30 @@ def _flatten(streamlines):
         streamlines = streamlines.tractogram
     if isinstance(streamlines, Tractogram):
         affine = streamlines.affine_to_rasmm
-        if affine is not None and not np.allclose(affine, np.eye(4)):
+        if affine is not None and not _np.allclose(affine, _np.eye(4)):
             streamlines = streamlines.copy().to_world()
         streamlines = streamlines.streamlines
     if isinstance(streamlines, ArraySequence):
-        lengths = np.asarray(streamlines._lengths, dtype=np.int64)
-        points = streamlines.get_data() if len(lengths) else np.zeros((0, 3), np.float32)
+        lengths = _np.asarray(streamlines._lengths, dtype=_np.int64)
+        points = streamlines.get_data() if len(lengths) else _np.zeros((0, 3), _np.float32)
     else:
-        fibers = [np.asarray(f, dtype=np.float32) for f in streamlines]
-        for i, f in enumerate(fibers):
-            if f.ndim != 2 or f.shape[1] != 3:
-                raise ValueError(f"streamline {i} has shape {f.shape}, expected (n, 3)")
-        lengths = np.array([len(f) for f in fibers], dtype=np.int64)
-        points = np.concatenate(fibers) if fibers else np.zeros((0, 3), np.float32)
-    offsets = np.zeros(len(lengths) + 1, dtype=np.int64)
-    np.cumsum(lengths, out=offsets[1:])
+        try:
+            items = list(streamlines)
+        except TypeError:
+            raise TypeError(f"streamlines must be a fiblet.Streamlines, a nibabel ArraySequence or Tractogram, "
+                            f"a list of (n, 3) arrays or (points, offsets); got {type(streamlines).__name__}") from None
+        fibers = []
+        for i, f in enumerate(items):
+            try:
+                fibers.append(_np.asarray(f, dtype=_np.float32))
+            except (TypeError, ValueError) as e:
+                raise TypeError(f"streamline {i} is not an (n, 3) array of numbers ({e})") from None
+            if fibers[-1].ndim != 2 or fibers[-1].shape[1] != 3:
+                raise ValueError(f"streamline {i} has shape {fibers[-1].shape}, expected (n, 3)")
+        lengths = _np.array([len(f) for f in fibers], dtype=_np.int64)
+        points = _np.concatenate(fibers) if fibers else _np.zeros((0, 3), _np.float32)
+    offsets = _np.zeros(len(lengths) + 1, dtype=_np.int64)
+    _np.cumsum(lengths, out=offsets[1:])
     return points, offsets
 
 
@@ -243,19 +369,21 @@ def save(path, streamlines, step=None, *, overwrite=False, threads=None):
     directory, see ``tempfile``), which is removed afterwards; the .fft is
     written atomically.
     """
-    path = os.fspath(path)
-    if os.path.exists(path) and not overwrite:
+    if not isinstance(path, (str, _os.PathLike)):
+        raise TypeError(f"save(path, streamlines): path must be a file name, got {type(path).__name__}")
+    path = _os.fspath(path)
+    if _os.path.exists(path) and not overwrite:
         raise FileExistsError(f"{path} exists (pass overwrite=True)")
     points, offsets = _flatten(streamlines)
-    points = np.ascontiguousarray(points, dtype=np.float32)
+    points = _np.ascontiguousarray(points, dtype=_np.float32)
     if points.ndim != 2 or points.shape[1] != 3:
         raise ValueError(f"points must be (N, 3), got {points.shape}")
-    if not np.all(np.isfinite(points)):
+    if not _np.all(_np.isfinite(points)):
         raise ValueError("points must be finite (no NaN or Inf)")
     properties = [] if step is None else [("step_size", repr(float(step)))]
-    with tempfile.TemporaryDirectory(prefix="fiblet-save-") as tmp:
-        tck = os.path.join(tmp, "streamlines.tck")
-        _fiblet.write_tck(tck, points, np.ascontiguousarray(offsets, dtype=np.int64), properties, False)
+    with _tempfile.TemporaryDirectory(prefix="fiblet-save-") as tmp:
+        tck = _os.path.join(tmp, "streamlines.tck")
+        _fiblet.write_tck(tck, points, _np.ascontiguousarray(offsets, dtype=_np.int64), properties, False)
         report = _fiblet.compress(tck, path, None if step is None else float(step), bool(overwrite),
                                   _threads(threads))
     report["input"] = None  # the temporary .tck is gone

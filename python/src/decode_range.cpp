@@ -1,6 +1,7 @@
 #include "decode_range.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <exception>
 #include <string>
 #include <thread>
@@ -79,6 +80,20 @@ DecodedRange decode_range(const FftFile& file, std::uint64_t begin, std::uint64_
         out.offsets.push_back(acc);
     }
     return out;
+}
+
+void keep_fibers(DecodedRange& range, const std::vector<std::uint64_t>& keep) {
+    float* xyz = range.xyz.as<float>();
+    std::vector<std::uint64_t> offsets{0};
+    offsets.reserve(keep.size() + 1);
+    for (const std::uint64_t f : keep) {
+        const std::uint64_t first = range.offsets[f], n = range.offsets[f + 1] - first;
+        if (n) std::memmove(xyz + 3 * offsets.back(), xyz + 3 * first, 12 * n);  // ascending: never ahead of its source
+        offsets.push_back(offsets.back() + n);
+    }
+    range.offsets = std::move(offsets);
+    range.points = range.offsets.back();
+    range.xyz.shrink(12 * range.points);
 }
 
 }  // namespace fiblet::python

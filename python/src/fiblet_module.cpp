@@ -7,22 +7,33 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <numeric>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include "fiblet/block_index.hpp"
 #include "fiblet/compare.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
+#include "fiblet/image_mask.hpp"
+#include "fiblet/select.hpp"
 #include "fiblet/tck.hpp"
 #include "decode_range.hpp"
 #include "owned_array.hpp"
-#include "roi_filter.hpp"
+#include "gather_fibers.hpp"
 
 namespace py = pybind11;
 
@@ -63,32 +74,169 @@ Streamlines decode_indices(const FftFile& file, const std::vector<std::uint64_t>
     return gather_fibers(view_of(all), run_fiber);
 }
 
-// A region that can hold no point (inverted box, negative radius, NaN)
-// would silently select nothing: refused, as the library's queries refuse it.
-void check_region(const Region& r) {
-    bool ok = true;
-    for (int k = 0; k < 3; ++k) ok = ok && std::isfinite(r.a[k]) && std::isfinite(r.b[k]);
-    if (r.shape == Region::Shape::sphere) ok = ok && r.b[0] >= 0;
-    else ok = ok && r.a[0] <= r.b[0] && r.a[1] <= r.b[1] && r.a[2] <= r.b[2];
-    if (!ok)
-        throw Error(Errc::invalid_argument, "invalid region: a sphere needs a finite centre and a radius >= 0, a box "
-                                            "finite corners with min <= max on every axis");
-}
+// Regions as the Python package passes them: ("sphere", centre, (radius, 0,
+// 0), exclude), ("box", min, max, exclude) or ("mask", path, None, exclude).
+struct Regions {
+    std::vector<Region> include, exclude;
+    bool empty() const { return include.empty() && exclude.empty(); }
+};
 
-std::vector<Region> parse_regions(const py::list& regions) {
-    std::vector<Region> out;
+Regions parse_regions(const py::list& regions) {
+    Regions out;
     for (const py::handle& item : regions) {
-        const auto t = item.cast<std::tuple<std::string, std::array<double, 3>, std::array<double, 3>, bool>>();
+        const auto t = item.cast<py::tuple>();
+        if (t.size() != 4) throw Error(Errc::invalid_argument, "a region is (shape, a, b, exclude)");
+        const auto shape = t[0].cast<std::string>();
+        const bool exclude = t[3].cast<bool>();
         Region r;
-        const std::string& shape = std::get<0>(t);
-        if (shape == "sphere") r.shape = Region::Shape::sphere;
-        else if (shape == "box") r.shape = Region::Shape::box;
-        else throw Error(Errc::invalid_argument, "unknown region shape '" + shape + "'");
-        r.a = std::get<1>(t), r.b = std::get<2>(t), r.exclude = std::get<3>(t);
-        check_region(r);
-        out.push_back(r);
+        if (shape == "mask") {
+            const auto path = t[1].cast<std::string>();
+            py::gil_scoped_release release;
+            r = Region::image(ImageMask::read(path));
+        } else {
+            const auto a = t[1].cast<std::array<double, 3>>(), b = t[2].cast<std::array<double, 3>>();
+            const Vec3f va{float(a[0]), float(a[1]), float(a[2])}, vb{float(b[0]), float(b[1]), float(b[2])};
+            if (shape == "sphere") r = Region::sphere(va, float(b[0]));
+            else if (shape == "box") r = Region::box_between(va, vb);
+            else throw Error(Errc::invalid_argument, "unknown region shape '" + shape + "'");
+        }
+        (exclude ? out.exclude : out.include).push_back(std::move(r));
     }
     return out;
+}
+
+// The block index of the last file queried with roi=, kept for the next
+// query on the same file (same device, inode, size and modification time):
+// loading it (parsing the BIDX chunk, sorting 800 k boxes on the medium
+// file) costs about as much as the selection itself.
+std::shared_ptr<const BlockIndex> block_index_of(const FftFile& file) {
+    struct stat st {};
+    if (::stat(file.path().c_str(), &st) != 0) return std::make_shared<const BlockIndex>(BlockIndex::load(file));
+    const std::array<std::int64_t, 5> key{std::int64_t(st.st_dev), std::int64_t(st.st_ino), std::int64_t(st.st_size),
+                                          std::int64_t(st.st_mtim.tv_sec), std::int64_t(st.st_mtim.tv_nsec)};
+    static std::mutex mutex;
+    static std::array<std::int64_t, 5> cached_key{};
+    static std::shared_ptr<const BlockIndex> cached;
+    {
+        const std::lock_guard<std::mutex> lock(mutex);
+        if (cached && cached_key == key && cached->blocks() == file.header().blocks) return cached;
+    }
+    auto index = std::make_shared<const BlockIndex>(BlockIndex::load(file));
+    const std::lock_guard<std::mutex> lock(mutex);
+    cached_key = key, cached = index;
+    return index;
+}
+
+// Above this share of blocks near the include regions, roi= decodes
+// everything and tests points (measured on the medium tractogram, 2 cores:
+// docs/ecosystem.md).
+constexpr double kDecodeAllShare = 0.25;
+
+// Share of the file's blocks near the most selective include region (1
+// without one): what the index-driven selection would decode to test points.
+double share_near_regions(const BlockIndex& index, const Regions& regions) {
+    double share = 1.0;
+    for (const Region& r : regions.include) {
+        std::vector<std::uint64_t> bits;
+        if (r.shape == Region::Shape::sphere) index.blocks_near_sphere(r.center, r.radius, bits);
+        else if (r.shape == Region::Shape::box) index.blocks_near_box(r.box, bits);
+        else index.blocks_near_mask(*r.mask, bits);
+        std::uint64_t n = 0;
+        for (const std::uint64_t w : bits) n += std::uint64_t(std::popcount(w));
+        share = std::min(share, index.blocks() ? double(n) / double(index.blocks()) : 0.0);
+    }
+    return share;
+}
+
+// Positions (in `s`) of the fibers the regions keep, by testing every point
+// (Region::contains: the rules the library's selection applies), on
+// `threads` threads (0: all cores), each a contiguous share of the fibers.
+std::vector<std::uint64_t> kept_by_points(FibersView s, const Regions& regions, unsigned threads) {
+    auto meets = [&](const Region& r, std::uint64_t f) {
+        for (std::uint64_t p = s.offsets[f]; p < s.offsets[f + 1]; ++p)
+            if (r.contains({s.xyz[3 * p], s.xyz[3 * p + 1], s.xyz[3 * p + 2]})) return true;
+        return false;
+    };
+    std::vector<std::uint8_t> kept(s.size(), 0);
+    auto test = [&](std::uint64_t first, std::uint64_t last) {
+        for (std::uint64_t f = first; f < last; ++f) {
+            bool k = s.offsets[f + 1] > s.offsets[f];  // as the selection: a fiber without points is never output
+            for (const Region& r : regions.include) k = k && meets(r, f);
+            for (const Region& r : regions.exclude) k = k && !meets(r, f);
+            kept[f] = k;
+        }
+    };
+    if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
+    const std::uint64_t n = s.size(), parts = std::max<std::uint64_t>(1, std::min<std::uint64_t>(threads, n / 256));
+    std::vector<std::thread> pool;
+    for (std::uint64_t t = 1; t < parts; ++t) pool.emplace_back(test, n * t / parts, n * (t + 1) / parts);
+    test(0, n / parts);
+    for (std::thread& t : pool) t.join();
+    std::vector<std::uint64_t> keep;
+    for (std::uint64_t f = 0; f < n; ++f)
+        if (kept[f]) keep.push_back(f);
+    return keep;
+}
+
+// The fibers among `candidates` that the regions keep, in file order, and
+// their IDs: the library's selection decides through the block index (only
+// the blocks near a region are decoded to test their points), then decodes
+// the kept fibers with the fast block decoders.
+Streamlines select_by_regions(const FftFile& file, const Regions& regions, const std::vector<FiberRange>& candidates,
+                              std::vector<std::uint64_t>& ids) {
+    const std::shared_ptr<const BlockIndex> index = block_index_of(file);
+    Query q;
+    q.fibers = candidates;
+    q.include = regions.include, q.exclude = regions.exclude;
+    std::vector<SelectedRun> runs;
+    Streamlines s = select_streamlines(file, *index, q, &runs);
+    ids.clear();
+    for (const SelectedRun& run : runs) ids.push_back(run.fiber);  // fibers mode: one run per kept fiber
+    return s;
+}
+
+// Sorted, merged ranges of a list of fiber indices.
+std::vector<FiberRange> ranges_of(std::vector<std::uint64_t> ids) {
+    std::sort(ids.begin(), ids.end());
+    std::vector<FiberRange> out;
+    for (const std::uint64_t f : ids) {
+        if (!out.empty() && f <= out.back().last + 1) out.back().last = std::max(out.back().last, f);
+        else out.push_back({f, f});
+    }
+    return out;
+}
+
+// roi=: the fibers among [begin, end), or among `indices` (any order,
+// repeats), that the regions keep, in that order, and their IDs; in `range`
+// when they were decoded as one, else in `s`.
+void decode_with_regions(const FftFile& file, const Regions& regions, std::uint64_t begin, std::uint64_t end,
+                         const std::optional<std::vector<std::uint64_t>>& indices, unsigned threads,
+                         std::optional<DecodedRange>& range, Streamlines& s, std::vector<std::uint64_t>& ids) {
+    ids.clear();
+    if (indices ? indices->empty() : begin >= end) return;
+    // Regions near most of the file: decoding everything on all threads,
+    // then testing the points, beats the one-thread selection (which decodes
+    // the near blocks, then the kept fibers).
+    if (share_near_regions(*block_index_of(file), regions) > kDecodeAllShare) {
+        if (indices) s = decode_indices(file, *indices, decode_options<DecodeOptions>(threads));
+        else range = decode_range(file, begin, end, threads);
+        const FibersView view = range ? FibersView{range->xyz.as<const float>(), range->offsets} : view_of(s);
+        const std::vector<std::uint64_t> keep = kept_by_points(view, regions, threads);
+        for (const std::uint64_t k : keep) ids.push_back(indices ? (*indices)[k] : begin + k);
+        if (range) keep_fibers(*range, keep);
+        else s = gather_fibers(view, keep);
+        return;
+    }
+    const std::vector<FiberRange> candidates = indices ? ranges_of(*indices) : std::vector<FiberRange>{{begin, end - 1}};
+    s = select_by_regions(file, regions, candidates, ids);
+    if (!indices) return;
+    // The kept fibers in the order (and with the repeats) asked for.
+    std::vector<std::uint64_t> position(file.header().fibers, UINT64_MAX), want, order;
+    for (std::size_t i = 0; i < ids.size(); ++i) position[ids[i]] = i;
+    for (const std::uint64_t f : *indices)
+        if (position[f] != UINT64_MAX) want.push_back(f), order.push_back(position[f]);
+    if (want != ids) s = gather_fibers(view_of(s), order);
+    ids = std::move(want);
 }
 
 // Decodes a file (all fibers, [begin, end), or a list of indices), keeps the
@@ -98,7 +246,7 @@ std::vector<Region> parse_regions(const py::list& regions) {
 py::tuple decode(const std::string& path, std::uint64_t begin, std::optional<std::uint64_t> end,
                  const py::object& indices_or_none, const py::list& regions_list, unsigned threads,
                  bool ignore_trailer) {
-    const std::vector<Region> regions = parse_regions(regions_list);
+    const Regions regions = parse_regions(regions_list);
     std::optional<std::vector<std::uint64_t>> indices;
     if (!indices_or_none.is_none()) {
         const auto a = py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>::ensure(indices_or_none);
@@ -111,29 +259,23 @@ py::tuple decode(const std::string& path, std::uint64_t begin, std::optional<std
     {
         py::gil_scoped_release release;
         const FftFile file(path, {.ignore_trailer = ignore_trailer});
+        const std::uint64_t nfibers = file.header().fibers;
         if (indices) {
             for (std::uint64_t f : *indices)
-                if (f >= file.header().fibers)
+                if (f >= nfibers)
                     throw Error(Errc::invalid_argument, path + ": fiber " + std::to_string(f) + " out of range (" +
-                                                            std::to_string(file.header().fibers) + " fibers)");
+                                                            std::to_string(nfibers) + " fibers)");
+        }
+        const std::uint64_t e = std::min(end.value_or(nfibers), nfibers);
+        if (!regions.empty()) {
+            decode_with_regions(file, regions, begin, e, indices, threads, range, s, ids);
+        } else if (indices) {
             s = decode_indices(file, *indices, decode_options<DecodeOptions>(threads));
             ids = std::move(*indices);
         } else {
-            const std::uint64_t e = end.value_or(file.header().fibers);
             range = decode_range(file, begin, e, threads);
             ids.resize(range->offsets.size() - 1);
             std::iota(ids.begin(), ids.end(), begin);
-        }
-        if (!regions.empty()) {
-            const FibersView all = range ? FibersView{range->xyz.as<const float>(), range->offsets} : view_of(s);
-            const std::vector<std::uint64_t> keep = fibers_kept(all, regions);
-            if (keep.size() != all.size()) {
-                s = gather_fibers(all, keep);
-                range.reset();
-                std::vector<std::uint64_t> kept_ids(keep.size());
-                for (std::size_t i = 0; i < keep.size(); ++i) kept_ids[i] = ids[keep[i]];
-                ids = std::move(kept_ids);
-            }
         }
     }
     const auto fibers = py::ssize_t(ids.size());

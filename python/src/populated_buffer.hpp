@@ -5,6 +5,7 @@
 #pragma once
 
 #include <sys/mman.h>
+#include <unistd.h>
 
 #include <cstddef>
 #include <new>
@@ -35,6 +36,15 @@ public:
 
     template <typename T>
     T* as() const { return static_cast<T*>(data_); }
+    // Keeps the first `bytes` (whole pages) and gives the rest back.
+    void shrink(std::size_t bytes) {
+        const auto page = std::size_t(::sysconf(_SC_PAGESIZE));
+        const std::size_t keep = (bytes + page - 1) / page * page;
+        if (!data_ || keep >= bytes_) return;
+        ::munmap(static_cast<char*>(data_) + keep, bytes_ - keep);
+        bytes_ = keep;
+        if (keep == 0) data_ = nullptr;
+    }
     std::size_t bytes() const { return bytes_; }
 
 private:

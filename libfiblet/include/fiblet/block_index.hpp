@@ -18,6 +18,7 @@
 
 #include "fiblet/fft_file.hpp"
 #include "fiblet/fft_format.hpp"
+#include "fiblet/image_mask.hpp"
 #include "fiblet/view.hpp"
 
 namespace fiblet {
@@ -104,6 +105,8 @@ public:
                             std::vector<std::uint64_t>* inside = nullptr) const;
     void blocks_near_box(const Aabb& box, std::vector<std::uint64_t>& bits,
                          std::vector<std::uint64_t>* inside = nullptr) const;
+    void blocks_near_mask(const ImageMask& mask, std::vector<std::uint64_t>& bits,
+                          std::vector<std::uint64_t>* inside = nullptr) const;
     void blocks_near_frustum(const Frustum& frustum, float margin, std::vector<std::uint64_t>& bits) const;
 
 private:

@@ -21,6 +21,7 @@ enum class Errc : int {
     unsupported = 7,   // valid but not supported (e.g. an unknown datatype)
     checksum = 8,      // integrity check failed
     interrupted = 9,   // stopped by a signal
+    image_format = 10, // malformed voxel image (NIfTI, .mif)
 };
 
 // Short stable name of a category ("tck_format", ...), for --json output.

@@ -10,7 +10,8 @@
 //    subset keeps fiber f when in_random_subset(f, fraction, seed).
 //  - regions (fibers mode, MRtrix3 tckedit -include / -exclude): a fiber is
 //    kept when, for every include region, one of its points lies inside it,
-//    and none of its points lies inside any exclude region.
+//    and none of its points lies inside any exclude region. Image masks
+//    test the voxel nearest to each point, as tckedit does.
 //  - regions (blocks mode): a block is kept when one of its points lies
 //    inside some include region (or there is none) and none lies inside an
 //    exclude region; the fiber-level criteria still apply first.
@@ -25,6 +26,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -33,22 +35,27 @@
 #include "fiblet/block_index.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/fft_file.hpp"
+#include "fiblet/image_mask.hpp"
 #include "fiblet/view.hpp"
 
 namespace fiblet {
 
-// A region of interest: a sphere (inside when |p - center| <= radius) or a
-// box (inside when min <= p <= max on every axis), world mm.
+// A region of interest: a sphere (inside when |p - center| <= radius), a
+// box (inside when min <= p <= max on every axis), world mm, or an image
+// mask (fiblet/image_mask.hpp: tckedit's rule for images).
 struct Region {
-    enum class Shape { sphere, box };
+    enum class Shape { sphere, box, mask };
     Shape shape = Shape::sphere;
     Vec3f center{};
     float radius = 0;
     Aabb box{};
+    std::shared_ptr<const ImageMask> mask;
 
     static Region sphere(Vec3f center, float radius);
     static Region box_between(Vec3f min, Vec3f max);
+    static Region image(std::shared_ptr<const ImageMask> mask);
     bool contains(Vec3f p) const {
+        if (shape == Shape::mask) return mask->contains(p);
         if (shape == Shape::sphere) {
             const float dx = p.x - center.x, dy = p.y - center.y, dz = p.z - center.z;
             return dx * dx + dy * dy + dz * dz <= radius * radius;

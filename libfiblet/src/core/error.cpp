@@ -13,6 +13,7 @@ const char* errc_name(Errc c) noexcept {
         case Errc::unsupported: return "unsupported";
         case Errc::checksum: return "checksum";
         case Errc::interrupted: return "interrupted";
+        case Errc::image_format: return "image_format";
     }
     return "unknown";
 }

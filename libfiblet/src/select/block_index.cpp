@@ -260,6 +260,20 @@ void BlockIndex::blocks_near_box(const Aabb& r, std::vector<std::uint64_t>& bits
         bits, inside);
 }
 
+void BlockIndex::blocks_near_mask(const ImageMask& mask, std::vector<std::uint64_t>& bits,
+                                  std::vector<std::uint64_t>* inside) const {
+    collect(
+        [&](const Aabb& b) {
+            switch (mask.classify(b)) {
+                case ImageMask::Overlap::outside: return Overlap::outside;
+                case ImageMask::Overlap::inside: return Overlap::inside;
+                case ImageMask::Overlap::partial: break;
+            }
+            return Overlap::partial;
+        },
+        bits, inside);
+}
+
 void BlockIndex::blocks_near_frustum(const Frustum& f, float margin, std::vector<std::uint64_t>& bits) const {
     collect(
         [&](const Aabb& b) {

@@ -26,6 +26,13 @@ Region Region::box_between(Vec3f min, Vec3f max) {
     return r;
 }
 
+Region Region::image(std::shared_ptr<const ImageMask> mask) {
+    Region r;
+    r.shape = Shape::mask;
+    r.mask = std::move(mask);
+    return r;
+}
+
 std::uint64_t splitmix64(std::uint64_t x) {
     x += 0x9e3779b97f4a7c15ull;
     x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -49,7 +56,9 @@ namespace {
 bool finite(Vec3f v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 void check_region(const Region& r) {
-    if (r.shape == Region::Shape::sphere) {
+    if (r.shape == Region::Shape::mask) {
+        if (!r.mask) bad_query("an image region needs its mask");
+    } else if (r.shape == Region::Shape::sphere) {
         if (!finite(r.center) || !(std::isfinite(r.radius) && r.radius >= 0))
             bad_query("a sphere needs a finite centre and a radius >= 0");
     } else if (!finite(r.box.min) || !finite(r.box.max) || r.box.min.x > r.box.max.x || r.box.min.y > r.box.max.y ||

@@ -122,6 +122,12 @@ bool any_point_in(const Region& r, const float* p, std::uint32_t n) {
             if (inside(p + 3 * k)) return true;
         return false;
     };
+    if (r.shape == Region::Shape::mask) {
+        const ImageMask& m = *r.mask;
+        for (std::uint32_t k = 0; k < n; ++k)
+            if (m.contains({p[3 * k], p[3 * k + 1], p[3 * k + 2]})) return true;
+        return false;
+    }
     if (r.shape == Region::Shape::sphere) {
         const float cx = r.center.x, cy = r.center.y, cz = r.center.z, r2 = r.radius * r.radius;
         return scan([&](const float* q) {
@@ -296,6 +302,8 @@ private:
         Bits* whole = trust_inside_ ? inside : nullptr;  // otherwise none: their points are tested
         if (r.shape == Region::Shape::sphere)
             index_.blocks_near_sphere(r.center, r.radius, bits, whole);
+        else if (r.shape == Region::Shape::mask)
+            index_.blocks_near_mask(*r.mask, bits, whole);
         else
             index_.blocks_near_box(r.box, bits, whole);
         bits.resize((h_.blocks + 63) / 64, 0);

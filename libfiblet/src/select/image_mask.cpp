@@ -1,0 +1,133 @@
+// An image as a region (fiblet/image_mask.hpp): the voxels that count,
+// cropped as tckedit crops them, and a summed-area table for box tests.
+#include "fiblet/image_mask.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "fiblet/error.hpp"
+
+namespace fiblet {
+namespace {
+
+// MRtrix reads a mask as bool: round(value) != 0, NaN and Inf as 0.
+bool counts(float v) { return std::isfinite(v) && std::round(v) != 0; }
+
+}  // namespace
+
+ImageMask::ImageMask(const Image& image) : path_(image.path) {
+    std::array<std::int64_t, 3> lo{std::numeric_limits<std::int64_t>::max(), std::numeric_limits<std::int64_t>::max(),
+                                   std::numeric_limits<std::int64_t>::max()},
+        hi{-1, -1, -1};
+    const std::int64_t nx = image.dims[0], ny = image.dims[1], nz = image.dims[2];
+    for (std::int64_t k = 0; k < nz; ++k)
+        for (std::int64_t j = 0; j < ny; ++j)
+            for (std::int64_t i = 0; i < nx; ++i)
+                if (counts(image.at(i, j, k))) {
+                    const std::array<std::int64_t, 3> v{i, j, k};
+                    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], v[a]), hi[a] = std::max(hi[a], v[a]);
+                }
+    if (hi[0] < 0) throw Error(Errc::invalid_argument, image.path + ": cannot use the image as a region: it is empty");
+
+    // tckedit keeps one voxel of margin below the occupied box; the same
+    // origin gives the same float transform.
+    std::array<std::int64_t, 3> bottom{};
+    for (int a = 0; a < 3; ++a) {
+        bottom[a] = std::max<std::int64_t>(0, lo[a] - 1);
+        size_[a] = std::min(image.dims[a] - 1, hi[a] + 1) - bottom[a] + 1;
+    }
+    inside_.assign(std::size_t(size_[0] * size_[1] * size_[2]), 0);
+    const std::int64_t sx = size_[0] + 1, sy = size_[1] + 1;
+    prefix_.assign(std::size_t(sx * sy * (size_[2] + 1)), 0);
+    auto sat = [&](std::int64_t i, std::int64_t j, std::int64_t k) -> std::uint32_t& {
+        return prefix_[std::size_t(i + sx * (j + sy * k))];
+    };
+    for (std::int64_t k = 0; k < size_[2]; ++k)
+        for (std::int64_t j = 0; j < size_[1]; ++j)
+            for (std::int64_t i = 0; i < size_[0]; ++i) {
+                const bool in = counts(image.at(i + bottom[0], j + bottom[1], k + bottom[2]));
+                inside_[std::size_t(i + size_[0] * (j + size_[1] * k))] = in;
+                inside_count_ += in;
+                sat(i + 1, j + 1, k + 1) = std::uint32_t(in) + sat(i, j + 1, k + 1) + sat(i + 1, j, k + 1) +
+                                           sat(i + 1, j + 1, k) - sat(i, j, k + 1) - sat(i, j + 1, k) -
+                                           sat(i + 1, j, k) + sat(i, j, k);
+            }
+
+    Affine3x4 cropped = image.voxel_to_world;
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) cropped[r][3] += double(bottom[c]) * image.voxel_to_world[r][c];
+    to_voxel_exact_ = inverse(cropped);
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 4; ++c) to_voxel_[r][c] = float(to_voxel_exact_[r][c]);
+
+    // World box of the occupied voxels' cells, grown for float rounding.
+    const float inf = std::numeric_limits<float>::infinity();
+    bounds_ = {{inf, inf, inf}, {-inf, -inf, -inf}};
+    double diagonal = 0;
+    for (int corner = 0; corner < 8; ++corner) {
+        std::array<double, 3> v{};
+        for (int a = 0; a < 3; ++a)
+            v[a] = double((corner >> a & 1) ? hi[a] - bottom[a] : lo[a] - bottom[a]) + ((corner >> a & 1) ? 0.5 : -0.5);
+        const auto w = transform_point(cropped, v);
+        bounds_.min = Vec3f{std::min(bounds_.min.x, float(w[0])), std::min(bounds_.min.y, float(w[1])),
+                       std::min(bounds_.min.z, float(w[2]))};
+        bounds_.max = Vec3f{std::max(bounds_.max.x, float(w[0])), std::max(bounds_.max.y, float(w[1])),
+                       std::max(bounds_.max.z, float(w[2]))};
+        diagonal = std::max(diagonal, std::abs(w[0]) + std::abs(w[1]) + std::abs(w[2]));
+    }
+    const float pad = float(1e-4 + 1e-5 * diagonal);
+    bounds_.min = Vec3f{bounds_.min.x - pad, bounds_.min.y - pad, bounds_.min.z - pad};
+    bounds_.max = Vec3f{bounds_.max.x + pad, bounds_.max.y + pad, bounds_.max.z + pad};
+}
+
+std::shared_ptr<const ImageMask> ImageMask::read(const std::string& path) {
+    return std::make_shared<const ImageMask>(read_image(path));
+}
+
+std::int64_t ImageMask::occupied(const std::array<std::int64_t, 3>& lo, const std::array<std::int64_t, 3>& hi) const {
+    const std::int64_t sx = size_[0] + 1, sy = size_[1] + 1;
+    auto s = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
+        return std::int64_t(prefix_[std::size_t(i + sx * (j + sy * k))]);
+    };
+    const std::int64_t x0 = lo[0], y0 = lo[1], z0 = lo[2], x1 = hi[0] + 1, y1 = hi[1] + 1, z1 = hi[2] + 1;
+    return s(x1, y1, z1) - s(x0, y1, z1) - s(x1, y0, z1) - s(x1, y1, z0) + s(x0, y0, z1) + s(x0, y1, z0) +
+           s(x1, y0, z0) - s(x0, y0, z0);
+}
+
+ImageMask::Overlap ImageMask::classify(const Aabb& box) const {
+    if (box.max.x < bounds_.min.x || box.min.x > bounds_.max.x || box.max.y < bounds_.min.y ||
+        box.min.y > bounds_.max.y || box.max.z < bounds_.min.z || box.min.z > bounds_.max.z)
+        return Overlap::outside;
+    // Clamped to the mask's bounds: finite even for an unbounded block box.
+    const bool clamped = box.min.x < bounds_.min.x || box.min.y < bounds_.min.y || box.min.z < bounds_.min.z ||
+                         box.max.x > bounds_.max.x || box.max.y > bounds_.max.y || box.max.z > bounds_.max.z;
+    const std::array<double, 3> bmin{std::max(box.min.x, bounds_.min.x), std::max(box.min.y, bounds_.min.y),
+                                     std::max(box.min.z, bounds_.min.z)},
+        bmax{std::min(box.max.x, bounds_.max.x), std::min(box.max.y, bounds_.max.y), std::min(box.max.z, bounds_.max.z)};
+    // Voxel-space box of the world box's corners, grown by a margin that
+    // covers the float arithmetic of contains().
+    std::array<double, 3> vmin{HUGE_VAL, HUGE_VAL, HUGE_VAL}, vmax{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (int corner = 0; corner < 8; ++corner) {
+        const std::array<double, 3> w{(corner & 1) ? bmax[0] : bmin[0], (corner & 2) ? bmax[1] : bmin[1],
+                                      (corner & 4) ? bmax[2] : bmin[2]};
+        const auto v = transform_point(to_voxel_exact_, w);
+        for (int a = 0; a < 3; ++a) vmin[a] = std::min(vmin[a], v[a]), vmax[a] = std::max(vmax[a], v[a]);
+    }
+    std::array<std::int64_t, 3> lo{}, hi{};
+    bool whole_grid = !clamped;  // every point of the box rounds to a voxel of the grid
+    for (int a = 0; a < 3; ++a) {
+        const double margin = 1e-3 + 1e-6 * std::max(std::abs(vmin[a]), std::abs(vmax[a]));
+        const auto first = std::int64_t(std::floor(vmin[a] - margin + 0.5));
+        const auto last = std::int64_t(std::floor(vmax[a] + margin + 0.5));
+        if (first < 0 || last >= size_[a]) whole_grid = false;
+        lo[a] = std::max<std::int64_t>(first, 0), hi[a] = std::min<std::int64_t>(last, size_[a] - 1);
+        if (lo[a] > hi[a]) return Overlap::outside;
+    }
+    const std::int64_t count = occupied(lo, hi);
+    if (count == 0) return Overlap::outside;
+    const std::int64_t cells = (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
+    return whole_grid && count == cells ? Overlap::inside : Overlap::partial;
+}
+
+}  // namespace fiblet
