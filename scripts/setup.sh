@@ -6,6 +6,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libcli11-dev libeigen3-dev libfmt-dev libzstd-dev libxxhash-dev
+  libzip-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libhwy-dev
   python3 python3-numpy python3-nibabel python3-matplotlib
   python3-dev python3-pybind11 pybind11-dev python3-pytest snakemake

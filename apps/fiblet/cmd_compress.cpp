@@ -1,4 +1,4 @@
-// fiblet compress IN.tck [IN2.tck ...] (-o OUT.fft | --output-dir DIR)
+// fiblet compress IN.tck|IN.trk|IN.trx [IN2 ...] (-o OUT.fft | --output-dir DIR)
 #include <fmt/core.h>
 
 #include <filesystem>
@@ -36,9 +36,11 @@ struct CompressArgs {
 
 std::string output_for(const CompressArgs& a, const std::string& in) {
     if (!a.output.empty()) return a.output;
-    std::filesystem::path p = std::filesystem::path(in).filename();
+    std::string name = in;
+    while (name.size() > 1 && name.back() == '/') name.pop_back();  // a TRX directory given as "x.trx/"
+    std::filesystem::path p = std::filesystem::path(name).filename();
     p.replace_extension(a.zstd ? ".fftz" : ".fft");
-    return (a.output_dir.empty() ? std::filesystem::path(in).parent_path() / p : std::filesystem::path(a.output_dir) / p)
+    return (a.output_dir.empty() ? std::filesystem::path(name).parent_path() / p : std::filesystem::path(a.output_dir) / p)
         .string();
 }
 
@@ -149,8 +151,10 @@ void run(const CompressArgs& a) {
 
 void add_compress(CLI::App& app) {
     auto args = std::make_shared<CompressArgs>();
-    CLI::App* cmd = app.add_subcommand("compress", "Compress .tck tractograms into .fft fiblet files");
-    cmd->add_option("inputs", args->inputs, "Input .tck files")->required()->check(CLI::ExistingFile);
+    CLI::App* cmd = app.add_subcommand("compress", "Compress tractograms (.tck, .trk, TRX) into .fft fiblet files");
+    cmd->add_option("inputs", args->inputs, "Input .tck, .trk or .trx files (TRX: a zip or a directory)")
+        ->required()
+        ->check(CLI::ExistingPath);
     cmd->add_option("-o,--output", args->output, "Output .fft file (one input)");
     cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs)");
     cmd->add_option("--step", args->step, "Fixed step in mm (default: measured; variable spacing is resampled)");
@@ -189,7 +193,7 @@ void add_compress(CLI::App& app) {
     cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
     cmd->add_flag("--json", args->json, "Print the report as JSON");
     cmd->add_flag("--allow-count-mismatch", args->allow_count_mismatch,
-                  "Accept a .tck whose count: header disagrees with its data");
+                  "Accept a .tck whose count: (a .trk whose n_count) disagrees with its data");
     cmd->callback([args] { run(*args); });
 }
 

@@ -1,4 +1,4 @@
-// fiblet decompress IN.fft -o OUT.tck [-j N] [--decoder NAME]
+// fiblet decompress IN.fft -o OUT.tck|OUT.trk|OUT.trx [-j N] [--decoder NAME]
 #include <fmt/core.h>
 
 #include <chrono>
@@ -6,6 +6,7 @@
 #include "cli_common.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/fft_file.hpp"
+#include "fiblet/streamline_io.hpp"
 #include "fiblet/tck.hpp"
 
 namespace fiblet::cli {
@@ -28,22 +29,29 @@ void run(const DecompressArgs& a) {
     TckHeader header;
     header.properties = props;
     header.set("step_size", fmt::format("{:.9g}", double(h.step) * double(h.scaling)));
+    SinkHeader sink_header{header.properties, space_from_properties(props, a.input), file.streamline_fields(),
+                           h.fibers, h.points};
+    const bool points_only = format_from_extension(a.output) == TractogramFormat::tck;
+    if (points_only && !sink_header.fields.empty() && !a.quiet)
+        fmt::print(stderr, "fiblet: note: {} data arrays of {} not written: a .tck holds points only (write a .trk or .trx)\n",
+                   sink_header.fields.size(), a.input);
+    if (points_only) sink_header.fields.clear();
     DecodeOptions options;
     options.decoder = parse_decoder(a.decoder);
     options.threads = a.threads;
     const std::string decoder = decoder_name(options.decoder);
-    TckWriter writer(a.output, header.properties, a.force);
+    const auto sink = open_streamline_sink(a.output, sink_header, a.force);
     Progress progress(a.quiet);
     decode_file(
         file,
         [&](std::uint64_t first, const Streamlines& chunk) {
             for (std::size_t i = 0; i < chunk.size(); ++i)
-                write_decoded_fiber(writer, &chunk.xyz[3 * chunk.offsets[i]], chunk.offsets[i + 1] - chunk.offsets[i],
+                write_decoded_fiber(*sink, &chunk.xyz[3 * chunk.offsets[i]], chunk.offsets[i + 1] - chunk.offsets[i],
                                     a.input, first + i);
             progress.update("decompress", h.fibers ? double(first + chunk.size()) / double(h.fibers) : 1.0);
         },
         options);
-    writer.finish();
+    sink->finish();
     progress.done();
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (a.json) {
@@ -64,9 +72,11 @@ void run(const DecompressArgs& a) {
 
 void add_decompress(CLI::App& app) {
     auto args = std::make_shared<DecompressArgs>();
-    CLI::App* cmd = app.add_subcommand("decompress", "Decode a .fft file back into a .tck file");
+    CLI::App* cmd = app.add_subcommand("decompress", "Decode a .fft file back into a .tck, .trk or .trx file");
     cmd->add_option("input", args->input, "Input .fft file")->required()->check(CLI::ExistingFile);
-    cmd->add_option("-o,--output", args->output, "Output .tck file")->required();
+    cmd->add_option("-o,--output", args->output,
+                    "Output .tck, .trk or .trx file (by its extension; .trk/.trx get the source's space and data)")
+        ->required();
     cmd->add_option("-j,--threads", args->threads, "Decoding threads (default: all cores)");
     cmd->add_option("--decoder", args->decoder,
                     "auto (the fastest), scalar, lanes, warp, or one with its SIMD level: " +

@@ -21,6 +21,8 @@ enum class Errc : int {
     unsupported = 7,   // valid but not supported (e.g. an unknown datatype)
     checksum = 8,      // integrity check failed
     interrupted = 9,   // stopped by a signal
+    trk_format = 10,   // malformed TrackVis .trk header or data
+    trx_format = 11,   // malformed TRX archive, header.json or array
 };
 
 // Short stable name of a category ("tck_format", ...), for --json output.

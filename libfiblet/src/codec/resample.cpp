@@ -25,11 +25,14 @@ double segment_distance(V3 p, V3 a, V3 b) {
 }
 }  // namespace
 
-void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out) {
+void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out,
+                         std::vector<PolylinePosition>* positions) {
     out.clear();
+    if (positions) positions->clear();
     if (in.empty()) return;
     V3 cur = to_v3(in[0]);
     out.push_back(in[0]);
+    if (positions) positions->push_back({0, 0.0});
     // Find, on the segments after the current position, the first point at
     // distance `step` from the current point (a sphere-segment intersection).
     std::size_t seg = 0;  // the current point lies on segment [seg, seg+1]
@@ -48,6 +51,7 @@ void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec
             t = t < 0 ? 0 : (t > 1 ? 1 : t);
             cur = {a.x + t * d.x, a.y + t * d.y, a.z + t * d.z};
             out.push_back({float(cur.x), float(cur.y), float(cur.z)});
+            if (positions) positions->push_back({s, t});
             seg = s;
             found = true;
             break;
@@ -56,13 +60,26 @@ void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec
     }
 }
 
-bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out) {
-    resample_fixed_step(in, step, out);
+bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out,
+                          std::vector<PolylinePosition>* positions) {
+    resample_fixed_step(in, step, out, positions);
     if (in.size() < 2) return false;
     const V3 tail = sub(to_v3(in.back()), to_v3(out.back()));
     if (!(std::sqrt(dot(tail, tail)) > kKeptTailFraction * step)) return false;
     out.push_back(in.back());
+    if (positions) positions->push_back({in.size() - 2, 1.0});
     return true;
+}
+
+void interpolate_point_values(std::span<const PolylinePosition> positions, const float* in_values,
+                              std::size_t components, float* out_values) {
+    for (std::size_t k = 0; k < positions.size(); ++k) {
+        const PolylinePosition& p = positions[k];
+        const float* a = in_values + p.segment * components;
+        const float* b = p.t > 0 ? a + components : a;  // t = 0 on a one-point line: no second point
+        for (std::size_t c = 0; c < components; ++c)
+            out_values[k * components + c] = float(double(a[c]) + p.t * (double(b[c]) - double(a[c])));
+    }
 }
 
 double distance_to_polyline_near(Vec3f p, std::span<const Vec3f> line, std::size_t& hint, std::size_t window) {

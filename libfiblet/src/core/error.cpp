@@ -13,6 +13,8 @@ const char* errc_name(Errc c) noexcept {
         case Errc::unsupported: return "unsupported";
         case Errc::checksum: return "checksum";
         case Errc::interrupted: return "interrupted";
+        case Errc::trk_format: return "trk_format";
+        case Errc::trx_format: return "trx_format";
     }
     return "unknown";
 }
