@@ -41,6 +41,8 @@ int exit_code(Errc c) {
     switch (c) {
         case Errc::io: return 3;
         case Errc::tck_format:
+        case Errc::trk_format:
+        case Errc::trx_format:
         case Errc::fft_format:
         case Errc::invalid_input: return 4;
         case Errc::invalid_argument: return 2;

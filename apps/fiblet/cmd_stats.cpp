@@ -1,4 +1,4 @@
-// fiblet stats IN.fft --reference IN.tck
+// fiblet stats IN.fft --reference IN.tck|IN.trk|IN.trx
 #include <fmt/core.h>
 
 #include <optional>
@@ -62,12 +62,12 @@ void run(const StatsArgs& a) {
 void add_stats(CLI::App& app) {
     auto args = std::make_shared<StatsArgs>();
     CLI::App* cmd = app.add_subcommand(
-        "stats", "Measure a .fft file against its source .tck: point error, distances both ways (Hausdorff), "
+        "stats", "Measure a .fft file against its source (.tck, .trk, TRX): point error, distances both ways (Hausdorff), "
                  "endpoint displacement, length change");
     cmd->add_option("input", args->input, "Input .fft file")->required()->check(CLI::ExistingFile);
-    cmd->add_option("-r,--reference", args->reference, "The .tck file it was made from")
+    cmd->add_option("-r,--reference", args->reference, "The .tck, .trk or TRX file it was made from")
         ->required()
-        ->check(CLI::ExistingFile);
+        ->check(CLI::ExistingPath);
     cmd->add_flag("--json", args->json, "Print the report as JSON");
     cmd->add_option("--max-error", args->max_error_um,
                     "Exit with code 8 when the point error, the Hausdorff distance, an endpoint's displacement "

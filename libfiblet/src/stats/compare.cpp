@@ -10,7 +10,7 @@
 #include "core/streamline_label.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/resample.hpp"
-#include "fiblet/tck.hpp"
+#include "fiblet/streamline_io.hpp"
 
 namespace fiblet {
 
@@ -27,7 +27,8 @@ Comparison compare_to_reference(const FftFile& fft, const std::string& tck_path,
     const double step = fft.resampled_step_mm().value_or(0);  // validated at open: finite, > 0
     c.resampled = fft.resampled_step_mm().has_value();
     const bool keeps_ends = fft.end_fractions() != nullptr;
-    TckReader ref(tck_path, {.allow_count_mismatch = allow_count_mismatch});
+    const auto source = open_streamline_source(tck_path, {.allow_count_mismatch = allow_count_mismatch});
+    StreamlineSource& ref = *source;  // a .tck, .trk or TRX
     std::vector<Vec3f> original, resampled;
     auto mismatch = [&](const std::string& what) {
         throw Error(Errc::invalid_input, tck_path + " is not the source of " + fft.path() + ": " + what);
