@@ -31,7 +31,8 @@ void run(const DecompressArgs& a) {
     header.set("step_size", fmt::format("{:.9g}", double(h.step) * double(h.scaling)));
     SinkHeader sink_header{header.properties, space_from_properties(props, a.input), file.streamline_fields(),
                            h.fibers, h.points};
-    const bool points_only = format_from_extension(a.output) == TractogramFormat::tck;
+    const TractogramFormat out_format = format_from_extension(a.output);  // .trk, .trx; else a .tck
+    const bool points_only = out_format != TractogramFormat::trk && out_format != TractogramFormat::trx;
     if (points_only && !sink_header.fields.empty() && !a.quiet)
         fmt::print(stderr, "fiblet: note: {} data arrays of {} not written: a .tck holds points only (write a .trk or .trx)\n",
                    sink_header.fields.size(), a.input);

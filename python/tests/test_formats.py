@@ -349,6 +349,10 @@ def test_formats_are_named(tmp_path, shared, cli):
             run(cli, "compress", "-q", shared / "conformance/simple.trk", "-o", tmp_path / "s.fft") and tmp_path / "s.fft",
             check=False)
     assert r.returncode == 6 and ".trk and .trx" in r.stderr
+    with zipfile.ZipFile(tmp_path / "notes.zip", "w") as z:
+        z.writestr("a.txt", "not a tractogram")
+    r = run(cli, "compress", tmp_path / "notes.zip", "-o", tmp_path / "n.fft", check=False)
+    assert r.returncode == 6 and "without TRX's header.json" in r.stderr, r.stderr
     (tmp_path / "junk.bin").write_bytes(b"\x07" * 100)
     r = run(cli, "compress", tmp_path / "junk.bin", "-o", tmp_path / "j.fft", check=False)
     assert r.returncode == 4 and "not a tractogram" in r.stderr

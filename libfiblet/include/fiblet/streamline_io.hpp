@@ -52,10 +52,12 @@ struct SourceOptions {
     std::size_t max_points = 0;         // longest streamline accepted (0: no limit)
 };
 
-// Opens `path` as the format its content says. Throws Error{unsupported}
+// Opens `path` as the format its content says (content of no known kind:
+// as its extension says, so that the .tck, .trk or TRX reader reports what
+// is wrong). Throws Error{io} when it cannot be read, Error{unsupported}
 // naming the format when it is recognised but not a streamline format fiblet
-// reads (a .fft, a VTK file, a gzip stream...), Error{invalid_input} when it
-// is not recognised at all.
+// reads (a .fft, a VTK file, a gzip stream...), Error{invalid_input} when
+// neither its content nor its name is recognised.
 std::unique_ptr<StreamlineSource> open_streamline_source(const std::string& path, const SourceOptions& options = {});
 
 // What a sink needs besides the points.
@@ -75,10 +77,12 @@ public:
     virtual void finish() = 0;
 };
 
-// A sink for the format of `path`'s extension (.tck, .trk, .trx); a .tck
-// holds points only and ignores the header's fields and space. Throws
-// Error{unsupported} for any other, Error{exists} if `path` exists and
-// !overwrite, Error{invalid_input} for fields the format cannot hold.
+// A sink for the format of `path`'s extension: .trk, .trx, and .tck for any
+// other name (/dev/stdout...) but those of formats fiblet recognises and
+// does not write (.vtk, .vtp, .nii, .mif: Error{unsupported}). A .tck holds
+// points only and ignores the header's fields and space. Throws
+// Error{exists} if `path` exists and !overwrite, Error{invalid_input} or
+// Error{unsupported} for fields the format cannot hold.
 std::unique_ptr<StreamlineSink> open_streamline_sink(const std::string& path, const SinkHeader& header, bool overwrite);
 
 }  // namespace fiblet

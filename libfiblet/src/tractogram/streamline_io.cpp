@@ -2,6 +2,12 @@
 // extension for outputs. The .tck reader and writer are adapted here.
 #include "fiblet/streamline_io.hpp"
 
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
 #include "fiblet/error.hpp"
 #include "fiblet/tck.hpp"
 #include "fiblet/trk.hpp"
@@ -37,14 +43,32 @@ private:
     TckWriter writer_;
 };
 
+// An input that cannot be opened is an I/O error (errno's text), not a format.
+void check_readable(const std::string& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
+    if (S_ISDIR(st.st_mode))
+        throw Error(Errc::io, path + ": is a directory (a TRX directory holds header.json)");
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
+    std::fclose(f);
+}
+
 }  // namespace
 
 std::unique_ptr<StreamlineSource> open_streamline_source(const std::string& path, const SourceOptions& options) {
-    const TractogramFormat f = detect_tractogram_format(path);
+    TractogramFormat f = detect_tractogram_format(path);
+    if (f == TractogramFormat::unknown) {
+        check_readable(path);
+        // Content of no known kind: the reader its name asks for says what is wrong with it.
+        const TractogramFormat named = format_from_extension(path);
+        if (is_streamline_format(named)) f = named;
+    }
     switch (f) {
         case TractogramFormat::tck: return std::make_unique<TckSource>(path, options);
         case TractogramFormat::trk: return std::make_unique<TrkReader>(path, options);
-        case TractogramFormat::trx: return std::make_unique<TrxReader>(path, options);
+        case TractogramFormat::trx:
+        case TractogramFormat::zip_other: return std::make_unique<TrxReader>(path, options);  // TRX if it holds header.json
         case TractogramFormat::unknown:
             throw Error(Errc::invalid_input, path + ": not a tractogram fiblet recognises (.tck, .trk or TRX expected)");
         default:
@@ -56,12 +80,15 @@ std::unique_ptr<StreamlineSource> open_streamline_source(const std::string& path
 std::unique_ptr<StreamlineSink> open_streamline_sink(const std::string& path, const SinkHeader& header, bool overwrite) {
     const TractogramFormat f = format_from_extension(path);
     switch (f) {
-        case TractogramFormat::tck: return std::make_unique<TckSink>(path, header, overwrite);  // points only
         case TractogramFormat::trk: return std::make_unique<TrkWriter>(path, header, overwrite);
         case TractogramFormat::trx: return std::make_unique<TrxWriter>(path, header, overwrite);
-        default:
+        case TractogramFormat::vtk:
+        case TractogramFormat::vtp:
+        case TractogramFormat::nifti:
+        case TractogramFormat::tck_image:
             throw Error(Errc::unsupported, path + ": fiblet writes streamlines to .tck, .trk and .trx files (" +
                                                tractogram_format_description(f) + " asked for by its name)");
+        default: return std::make_unique<TckSink>(path, header, overwrite);  // .tck, and any other name (/dev/stdout)
     }
 }
 

@@ -8,6 +8,7 @@
 
 #include "core/streamline_label.hpp"
 #include "fiblet/error.hpp"
+#include "fiblet/tractogram_format.hpp"
 #include "fiblet/trx.hpp"
 #include "trx/trx_archive.hpp"
 
@@ -165,7 +166,13 @@ TrxReader::TrxReader(const std::string& path, const SourceOptions& options) : im
     m.options = options;
     m.archive = detail::TrxArchive::open(path);
     const auto entries = m.archive->entries();
-    if (std::find(entries.begin(), entries.end(), "header.json") == entries.end()) bad(path, "no header.json");
+    if (std::find(entries.begin(), entries.end(), "header.json") == entries.end()) {
+        // A zip of another kind, unless it says it is TRX (by its name, or as a directory given to the reader).
+        if (detect_tractogram_format(path) == TractogramFormat::zip_other)
+            throw Error(Errc::unsupported, path + ": " + tractogram_format_description(TractogramFormat::zip_other) +
+                                               ": not a TRX tractogram");
+        bad(path, "no header.json");
+    }
     m.header = parse_header(m.archive->read_all("header.json"), path);
     m.space = TractogramSpace::from_affine(m.header.affine, m.header.dimensions);
     m.read_entries();
