@@ -5,6 +5,7 @@
 // instead of a parse error from the wrong reader.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 namespace fiblet {
@@ -34,6 +35,10 @@ const char* tractogram_format_description(TractogramFormat f) noexcept;
 
 // Whether compress can read it / decompress can write it.
 bool is_streamline_format(TractogramFormat f) noexcept;  // tck, trk, trx
+
+// Bytes on disk: a file's size, or the sum over a (TRX) directory's files; 0
+// when it cannot be read.
+std::uint64_t tractogram_bytes(const std::string& path);
 
 // The format an output name asks for, from its extension (.tck, .trk, .trx,
 // .fft, .fftz, .vtk, ...); unknown for anything else.

@@ -3,8 +3,6 @@
 // at a time); the output is written atomically.
 #include "fiblet/compress.hpp"
 
-#include <sys/stat.h>
-
 #include <bit>
 #include <chrono>
 #include <cmath>
@@ -30,6 +28,7 @@
 #include "fiblet/resample.hpp"
 #include "fiblet/streamline_data_chunk.hpp"
 #include "fiblet/streamline_io.hpp"
+#include "fiblet/tractogram_format.hpp"
 
 namespace fiblet {
 
@@ -461,8 +460,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     out->commit();
     if (options.progress) options.progress("encode", 1.0);
 
-    struct stat st {};
-    if (::stat(tck_path.c_str(), &st) == 0) report.input_bytes = std::uint64_t(st.st_size);
+    report.input_bytes = tractogram_bytes(tck_path);  // a TRX directory: its files
     report.seconds = timer.seconds();
     return report;
 }

@@ -1,7 +1,5 @@
 #include "fiblet/compare.hpp"
 
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -11,6 +9,7 @@
 #include "fiblet/error.hpp"
 #include "fiblet/resample.hpp"
 #include "fiblet/streamline_io.hpp"
+#include "fiblet/tractogram_format.hpp"
 
 namespace fiblet {
 
@@ -21,8 +20,7 @@ Comparison compare_to_reference(const FftFile& fft, const std::string& tck_path,
     Comparison c;
     const FftHeader& h = fft.header();
     c.fibers = h.fibers, c.points = h.points, c.blocks = h.blocks, c.fft_bytes = fft.file_size();
-    struct stat st {};
-    if (::stat(tck_path.c_str(), &st) == 0) c.reference_bytes = std::uint64_t(st.st_size);
+    c.reference_bytes = tractogram_bytes(tck_path);  // a TRX directory: its files
 
     const double step = fft.resampled_step_mm().value_or(0);  // validated at open: finite, > 0
     c.resampled = fft.resampled_step_mm().has_value();

@@ -8,6 +8,7 @@
 #include <cctype>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <string_view>
 
 namespace fiblet {
@@ -85,6 +86,19 @@ TractogramFormat detect_tractogram_format(const std::string& path) {
     if (t == TractogramFormat::zip_other && lower_extension(path) == ".trx") t = TractogramFormat::trx;
     if (t == TractogramFormat::unknown && n == 0) t = format_from_extension(path);
     return t;
+}
+
+std::uint64_t tractogram_bytes(const std::string& path) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (!fs::is_directory(path, ec)) {
+        const auto n = fs::file_size(path, ec);
+        return ec ? 0 : n;
+    }
+    std::uint64_t total = 0;
+    for (fs::recursive_directory_iterator it(path, ec), end; !ec && it != end; it.increment(ec))
+        if (it->is_regular_file(ec)) total += it->file_size(ec);
+    return total;
 }
 
 const char* tractogram_format_description(TractogramFormat f) noexcept {

@@ -53,8 +53,13 @@ public:
             if (err == ZIP_ER_OPEN || err == ZIP_ER_READ) throw Error(Errc::io, path + ": cannot open: " + what);
             bad(path, "not a readable zip archive (" + what + ")");
         }
+        std::error_code ec;
+        file_size_ = fs::file_size(path, ec);
+        if (ec) file_size_ = 0;
     }
     ~ZipArchive() override { zip_discard(zip_); }
+    ZipArchive(const ZipArchive&) = delete;
+    ZipArchive& operator=(const ZipArchive&) = delete;
 
     std::vector<std::string> entries() const override {
         std::vector<std::string> names;
@@ -65,7 +70,16 @@ public:
         }
         return names;
     }
-    std::uint64_t size(const std::string& entry) const override { return stat(entry).size; }
+    // The uncompressed size an entry claims, if the archive can hold it: a
+    // central directory may claim anything, and a reader allocates what it claims.
+    std::uint64_t size(const std::string& entry) const override {
+        const zip_stat_t st = stat(entry);
+        if (!(st.valid & ZIP_STAT_COMP_SIZE) || st.comp_size > file_size_ ||
+            st.size > kMaxDeflateRatio * st.comp_size + (1u << 20))
+            bad(path_, "entry " + entry + " claims " + std::to_string(st.size) + " bytes from " +
+                           std::to_string(st.comp_size) + " stored in a " + std::to_string(file_size_) + "-byte archive");
+        return st.size;
+    }
     std::vector<std::uint8_t> read_all(const std::string& entry) const override {
         std::vector<std::uint8_t> bytes(size(entry));
         if (!bytes.empty()) stream(entry)->read(bytes.data(), bytes.size());
@@ -85,8 +99,10 @@ private:
             bad(path_, "no entry " + entry);
         return st;
     }
+    static constexpr std::uint64_t kMaxDeflateRatio = 1032;  // deflate's best: 258 bytes from 2 bits
     std::string path_;
     zip_t* zip_ = nullptr;
+    std::uint64_t file_size_ = 0;
 };
 
 class FileStream final : public TrxEntryStream {

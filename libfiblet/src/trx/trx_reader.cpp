@@ -84,8 +84,12 @@ struct TrxReader::Impl {
         const FieldType t = dtype(n, entry, path);
         if ((t != FieldType::uint32 && t != FieldType::uint64) || n.components != 1)
             bad(path, entry + ": offsets must be uint32 or uint64");
-        const auto bytes = archive->read_all(entry);
         const std::size_t size = field_type_size(t);
+        const std::uint64_t stored = archive->size(entry);
+        if (stored != header.streamlines * size && stored != (header.streamlines + 1) * size)
+            bad(path, entry + " holds " + std::to_string(stored) + " bytes for NB_STREAMLINES = " +
+                          std::to_string(header.streamlines));
+        const auto bytes = archive->read_all(entry);
         const std::uint64_t count = bytes.size() / size;
         if (bytes.size() % size || (count != header.streamlines && count != header.streamlines + 1))
             bad(path, entry + " holds " + std::to_string(bytes.size()) + " bytes for NB_STREAMLINES = " +
@@ -102,6 +106,20 @@ struct TrxReader::Impl {
         for (std::size_t i = 1; i < offsets.size(); ++i)
             if (offsets[i] < offsets[i - 1])
                 bad(path, entry + ": offsets decrease at " + detail::streamline_label(i - 1));
+    }
+
+    // Before reading an array: the size its rows must have (dps, dpv), or a
+    // bound (a group lists each streamline at most once; per-group values
+    // are few), so that a damaged entry is refused rather than allocated.
+    void check_plausible_size(const StreamlineField& f, const std::string& entry) const {
+        const std::uint64_t stored = archive->size(entry), row = f.value_size() * f.components;
+        const auto scope = *f.scope();
+        const std::uint64_t rows = scope == FieldScope::streamline ? header.streamlines : header.vertices;
+        const bool ok = scope == FieldScope::group        ? stored <= 4 * header.streamlines
+                        : scope == FieldScope::group_data ? stored <= (64u << 20)
+                                                          : stored / row == rows && stored % row == 0;
+        if (!ok) bad(path, entry + ": " + std::to_string(stored) + " bytes do not fit NB_STREAMLINES = " +
+                               std::to_string(header.streamlines) + ", NB_VERTICES = " + std::to_string(header.vertices));
     }
 
     void read_entries() {
@@ -122,8 +140,10 @@ struct TrxReader::Impl {
                 if (!offsets_entry.empty()) bad(path, "more than one offsets array");
                 offsets_entry = entry, offsets_name = *n;
             } else {
-                StreamlineField f{n->name, dtype(*n, entry, path), n->components, archive->read_all(entry)};
+                StreamlineField f{n->name, dtype(*n, entry, path), n->components, {}};
                 if (!f.scope()) throw Error(Errc::unsupported, path + ": TRX entry " + entry + " is not one fiblet reads");
+                check_plausible_size(f, entry);
+                f.bytes = archive->read_all(entry);
                 const std::string problem = check_streamline_field(f, header.streamlines, header.vertices);
                 if (!problem.empty()) bad(path, problem);
                 fields.push_back(std::move(f));
@@ -173,6 +193,7 @@ TrxReader::TrxReader(const std::string& path, const SourceOptions& options) : im
                                                ": not a TRX tractogram");
         bad(path, "no header.json");
     }
+    if (m.archive->size("header.json") > (16u << 20)) bad(path, "header.json is larger than 16 MiB");
     m.header = parse_header(m.archive->read_all("header.json"), path);
     m.space = TractogramSpace::from_affine(m.header.affine, m.header.dimensions);
     m.read_entries();
