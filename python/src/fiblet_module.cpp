@@ -283,7 +283,7 @@ py::dict read_streamlines(const std::string& path) {
         const auto source = open_streamline_source(path);
         std::vector<Vec3f> fiber;
         while (source->next(fiber)) {
-            xyz.insert(xyz.end(), &fiber.data()->x, &fiber.data()->x + 3 * fiber.size());
+            for (const Vec3f& p : fiber) xyz.insert(xyz.end(), {p.x, p.y, p.z});
             offsets.push_back(offsets.back() + std::int64_t(fiber.size()));
         }
         fields = source->take_fields();

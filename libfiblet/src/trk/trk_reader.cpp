@@ -103,7 +103,7 @@ struct TrkReader::Impl {
         // A count larger than the rest of the file is damage, not a reason to allocate.
         if (header.file_bytes && 4 * std::uint64_t(total) > header.file_bytes) bad(detail::streamline_label(streamlines) + " claims " + std::to_string(n) + " points, more than the file holds");
         values.resize(total);
-        read(values.data(), 4 * total, false, "points");
+        if (total > 0) read(values.data(), 4 * total, false, "points");
         swap_floats(values.data(), total);
         points.resize(std::size_t(n));
         const Affine& a = to_ras;
@@ -112,10 +112,10 @@ struct TrkReader::Impl {
             points[i] = {float(a[0] * x + a[1] * y + a[2] * z + a[3]), float(a[4] * x + a[5] * y + a[6] * z + a[7]),
                          float(a[8] * x + a[9] * y + a[10] * z + a[11])};
         }
-        if (first_pass) {
+        if (first_pass && header.n_scalars > 0 && n > 0)
             append(scalars, header.scalars, values.data() + 3, stride, points.size());
+        if (first_pass && header.n_properties > 0)
             append(properties, header.properties, values.data() + std::size_t(n) * stride, 0, 1);
-        }
         ++streamlines;
         return true;
     }

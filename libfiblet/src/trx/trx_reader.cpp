@@ -171,6 +171,7 @@ struct TrxReader::Impl {
         raw.resize(std::size_t(n) * 3 * size);
         if (!raw.empty()) positions->read(raw.data(), raw.size());
         points.resize(std::size_t(n));
+        if (n == 0) return ++next_fiber, true;
         float* out = &points.data()->x;
         if (positions_type == FieldType::float32) std::memcpy(out, raw.data(), raw.size());
         else
