@@ -50,6 +50,10 @@ struct StreamlineField {
     }
 };
 
+// A part of a field name ("fa" in "dpv/fa"): non-empty, printable UTF-8,
+// no '/' or '\\', never "." or "..".
+bool is_valid_field_name_part(std::string_view part);
+
 // Checks a field against a tractogram of `fibers` streamlines and `points`
 // points: a known scope, a name TRX can store, rows matching the scope,
 // group indices below `fibers`. Returns an empty string or what is wrong.

@@ -28,12 +28,28 @@ T load(const std::uint8_t* p) {
     return v;
 }
 
-// A name part TRX can hold as a file name.
-bool valid_part(std::string_view s) {
-    return !s.empty() && s != "." && s != ".." && s.find_first_of(std::string_view("/\\\0", 3)) == std::string_view::npos;
+// Well-formed UTF-8 without control characters (names reach JSON, Python
+// strings and file names).
+bool printable_utf8(std::string_view s) {
+    for (std::size_t i = 0; i < s.size();) {
+        const auto c = static_cast<unsigned char>(s[i]);
+        if (c < 0x20 || c == 0x7f) return false;
+        const int extra = c < 0x80 ? 0 : (c >> 5) == 6 ? 1 : (c >> 4) == 14 ? 2 : (c >> 3) == 30 ? 3 : -1;
+        if (extra < 0 || (extra == 1 && c < 0xc2) || i + std::size_t(extra) >= s.size()) return false;
+        for (int k = 1; k <= extra; ++k)
+            if ((static_cast<unsigned char>(s[i + std::size_t(k)]) >> 6) != 2) return false;
+        i += std::size_t(extra) + 1;
+    }
+    return true;
 }
 
+bool valid_part(std::string_view s) { return is_valid_field_name_part(s); }
+
 }  // namespace
+
+bool is_valid_field_name_part(std::string_view s) {
+    return !s.empty() && s != "." && s != ".." && s.find_first_of("/\\") == std::string_view::npos && printable_utf8(s);
+}
 
 std::optional<FieldType> field_type_from_name(std::string_view name) {
     for (const TypeInfo& t : kTypes)

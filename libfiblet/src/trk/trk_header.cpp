@@ -53,13 +53,20 @@ std::vector<TrkHeader::Named> decode_names(const std::uint8_t* p, int total, con
     for (std::size_t i = 0; i < kMaxNames && total > 0; ++i) {
         TrkHeader::Named n = decode_name(p + i * kNameBytes, path);
         if (n.count == 0) continue;
-        if (n.name.find('/') != std::string::npos) bad(path, "field name \"" + n.name + "\" holds '/'");
+        if (!is_valid_field_name_part(n.name))
+            bad(path, "field name \"" + n.name + "\" is not printable UTF-8 without '/', '\\', \".\" or \"..\"");
+        for (const auto& earlier : names)
+            if (earlier.name == n.name) bad(path, "field name \"" + n.name + "\" appears twice");
         named += n.count;
         names.push_back(std::move(n));
     }
     if (named > total)
         bad(path, "field names count " + std::to_string(named) + " values, the header " + std::to_string(total));
-    if (named < total) names.push_back({rest, total - named});
+    if (named < total) {
+        for (const auto& earlier : names)
+            if (earlier.name == rest) bad(path, std::string("a named field is called \"") + rest + "\", the name of the unnamed values");
+        names.push_back({rest, total - named});
+    }
     return names;
 }
 
