@@ -58,31 +58,31 @@ std::string fields_text(const std::vector<StreamlineField>& fields) {
 // A .trk or TRX: streamline count, space, data arrays (its header and sizes).
 void info_streamlines(const InfoArgs& a, TractogramFormat format) {
     std::unique_ptr<StreamlineSource> source = open_streamline_source(a.input);
-    std::string what, count;
-    if (format == TractogramFormat::trk) {
-        const TrkHeader& h = static_cast<TrkReader&>(*source).header();
-        what = fmt::format("TrackVis .trk version {}, {}-endian", h.version, h.big_endian ? "big" : "little");
-        count = h.n_count ? std::to_string(h.n_count) : "not recorded";
-    } else {
-        const auto& r = static_cast<TrxReader&>(*source);
-        what = "TRX tractogram";
-        count = fmt::format("{} ({} points)", r.streamline_count(), r.point_count());
-    }
-    std::vector<Vec3f> points;
-    while (source->next(points)) {}  // checks the data; .trk fields are gathered on the way
+    const std::string what = format == TractogramFormat::trk
+                                 ? fmt::format("TrackVis .trk version {}, {}-endian",
+                                               static_cast<TrkReader&>(*source).header().version,
+                                               static_cast<TrkReader&>(*source).header().big_endian ? "big" : "little")
+                                 : "TRX tractogram";
+    // Counted from the data (which this also checks); .trk fields are gathered on the way.
+    std::uint64_t streamlines = 0, points = 0;
+    std::vector<Vec3f> fiber;
+    while (source->next(fiber)) ++streamlines, points += fiber.size();
     const auto fields = source->take_fields();
     const auto props = source->properties();
     if (a.json) {
+        std::string names = "[";
+        for (std::size_t i = 0; i < fields.size(); ++i) names += (i ? ", " : "") + json_quote(fields[i].name);
         fmt::print("{}\n", Json{}
                                .str("file", a.input)
                                .str("format", format == TractogramFormat::trk ? "trk" : "trx")
-                               .str("streamlines", count)
-                               .str("fields", fields_text(fields))
+                               .integer("streamlines", streamlines)
+                               .integer("points", points)
+                               .raw("data", names + "]")
                                .raw("properties", properties_json(props))
                                .render());
         return;
     }
-    fmt::print("{}: {}\n  streamlines            {}\n", a.input, what, count);
+    fmt::print("{}: {}\n  streamlines            {} ({} points)\n", a.input, what, streamlines, points);
     if (!fields.empty()) fmt::print("  data                   {}\n", fields_text(fields));
     print_properties(props);
 }

@@ -339,6 +339,12 @@ def test_formats_are_named(tmp_path, shared, cli):
     # A .trk given to info reads as a .trk; a .tck given to load is named.
     r = run(cli, "info", shared / "conformance/standard.LPS.trk")
     assert "TrackVis .trk" in r.stdout and "LPS" in r.stdout
+    j = json.loads(run(cli, "info", "--json", shared / "conformance/complex_big_endian.trk").stdout)
+    ref = nib.streamlines.load(str(shared / "conformance/complex_big_endian.trk"))
+    assert j["format"] == "trk" and j["streamlines"] == len(ref.streamlines)
+    assert j["points"] == len(ref.streamlines.get_data())
+    assert sorted(j["data"]) == sorted([f"dpv/{k}" for k in ref.tractogram.data_per_point] +
+                                       [f"dps/{k}" for k in ref.tractogram.data_per_streamline])
     with pytest.raises(fiblet.FibletError, match="MRtrix3 .tck tractogram, not a .fft") as e:
         fiblet.load(shared / "conformance/simple.tck")
     assert e.value.category == "unsupported"
