@@ -8,6 +8,7 @@
 // "dpg/CST_L/mean_fa". The first part says what a row is.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -28,6 +29,12 @@ std::size_t field_type_size(FieldType t) noexcept;
 // One little-endian value of type `t` at `p`, as a double (float16 included).
 double field_value(FieldType t, const std::uint8_t* p) noexcept;
 float half_to_float(std::uint16_t h) noexcept;
+// A double as float32, out-of-range values to ±infinity (a plain cast of
+// them is undefined behaviour).
+inline float narrow_to_float(double v) noexcept {
+    constexpr double kMax = 3.4028234663852886e38;
+    return v > kMax ? INFINITY : v < -kMax ? -INFINITY : float(v);
+}
 
 enum class FieldScope { streamline, point, group, group_data };
 

@@ -126,7 +126,7 @@ public:
             original_offsets_[i + 1] = original_offsets_[i] + original_points[i];
         for (StreamlineField* f : point_fields_) {
             std::vector<float> v(std::size_t(f->values()));
-            for (std::uint64_t k = 0; k < v.size(); ++k) v[k] = float(field_value(f->type, &f->bytes[k * f->value_size()]));
+            for (std::uint64_t k = 0; k < v.size(); ++k) v[k] = narrow_to_float(field_value(f->type, &f->bytes[k * f->value_size()]));
             input_.push_back(std::move(v));
         }
     }

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "fiblet/error.hpp"
+#include "fiblet/streamline_field.hpp"
 
 namespace fiblet {
 namespace {
@@ -151,7 +152,7 @@ Affine trk_voxmm_to_rasmm(const TractogramSpace& s) {
     if (!to) throw Error(Errc::invalid_input, "the voxel-to-RAS affine has no clear axis directions");
     const Mat4 full = to_matrix(s.voxel_to_rasmm) * reorient(*from, *to, s.dimensions) * m;
     Affine a = to_affine(full);
-    for (double& v : a) v = double(float(v));  // nibabel returns it as float32
+    for (double& v : a) v = double(narrow_to_float(v));  // nibabel returns it as float32
     return a;
 }
 

@@ -109,8 +109,9 @@ struct TrkReader::Impl {
         const Affine& a = to_ras;
         for (std::size_t i = 0; i < points.size(); ++i) {
             const double x = values[i * stride], y = values[i * stride + 1], z = values[i * stride + 2];
-            points[i] = {float(a[0] * x + a[1] * y + a[2] * z + a[3]), float(a[4] * x + a[5] * y + a[6] * z + a[7]),
-                         float(a[8] * x + a[9] * y + a[10] * z + a[11])};
+            points[i] = {narrow_to_float(a[0] * x + a[1] * y + a[2] * z + a[3]),
+                         narrow_to_float(a[4] * x + a[5] * y + a[6] * z + a[7]),
+                         narrow_to_float(a[8] * x + a[9] * y + a[10] * z + a[11])};
         }
         if (first_pass && header.n_scalars > 0 && n > 0)
             append(scalars, header.scalars, values.data() + 3, stride, points.size());

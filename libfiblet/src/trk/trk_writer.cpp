@@ -83,7 +83,7 @@ struct TrkWriter::Impl {
 
     void append_values(const std::vector<const StreamlineField*>& fields, std::uint64_t row) {
         for (const StreamlineField* f : fields)
-            for (std::uint32_t c = 0; c < f->components; ++c) buffer.push_back(float(f->at(row, c)));
+            for (std::uint32_t c = 0; c < f->components; ++c) buffer.push_back(narrow_to_float(f->at(row, c)));
     }
 
     void write(const float* xyz, std::size_t n) {
@@ -96,9 +96,9 @@ struct TrkWriter::Impl {
         const Affine& a = to_voxmm;
         for (std::size_t i = 0; i < n; ++i) {
             const double x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2];
-            buffer.push_back(float(a[0] * x + a[1] * y + a[2] * z + a[3]));
-            buffer.push_back(float(a[4] * x + a[5] * y + a[6] * z + a[7]));
-            buffer.push_back(float(a[8] * x + a[9] * y + a[10] * z + a[11]));
+            buffer.push_back(narrow_to_float(a[0] * x + a[1] * y + a[2] * z + a[3]));
+            buffer.push_back(narrow_to_float(a[4] * x + a[5] * y + a[6] * z + a[7]));
+            buffer.push_back(narrow_to_float(a[8] * x + a[9] * y + a[10] * z + a[11]));
             append_values(scalars, points + i);
         }
         append_values(properties, fibers);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "core/bytes.hpp"
 #include "core/streamline_label.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/tractogram_format.hpp"
@@ -95,9 +96,10 @@ struct TrxReader::Impl {
             bad(path, entry + " holds " + std::to_string(bytes.size()) + " bytes for NB_STREAMLINES = " +
                           std::to_string(header.streamlines));
         offsets.resize(count);
-        for (std::uint64_t i = 0; i < count; ++i) offsets[i] = std::uint64_t(field_value(t, &bytes[i * size]));
-        if (t == FieldType::uint64)  // exact above 2^53
-            for (std::uint64_t i = 0; i < count; ++i) std::memcpy(&offsets[i], &bytes[i * 8], 8);
+        for (std::uint64_t i = 0; i < count; ++i) {  // integers as stored (a double is not exact above 2^53)
+            if (t == FieldType::uint64) std::memcpy(&offsets[i], &bytes[i * 8], 8);
+            else offsets[i] = detail::get_le<std::uint32_t>(&bytes[i * 4]);
+        }
         if (count == header.streamlines) offsets.push_back(header.vertices);  // no sentinel (older writers)
         if (offsets.back() != header.vertices)
             bad(path, entry + ": the last offset is " + std::to_string(offsets.back()) + ", NB_VERTICES " +
@@ -175,7 +177,7 @@ struct TrxReader::Impl {
         float* out = &points.data()->x;
         if (positions_type == FieldType::float32) std::memcpy(out, raw.data(), raw.size());
         else
-            for (std::size_t i = 0; i < 3 * n; ++i) out[i] = float(field_value(positions_type, &raw[i * size]));
+            for (std::size_t i = 0; i < 3 * n; ++i) out[i] = narrow_to_float(field_value(positions_type, &raw[i * size]));
         ++next_fiber;
         return true;
     }
