@@ -30,6 +30,7 @@
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/select.hpp"
+#include "fiblet/streamline_io.hpp"
 #include "fiblet/tck.hpp"
 
 namespace fiblet::fuzz {
@@ -129,6 +130,36 @@ inline void tck_target(const std::uint8_t* data, std::size_t size) {
     const TckOutcome whole = read_tck(path, {});
     check(read_tck(path, small_reads, true) == whole, "result depends on the chunk size or rewind");
     if (!whole.error) check(read_tck(path, lenient) == whole, "allow_count_mismatch changed a valid read");
+}
+
+// ---------------------------------------------------------------- .trk, TRX
+
+// Any file through open_streamline_source (a .trk, a TRX zip, or whatever
+// the bytes are): only fiblet::Error; a second pass after rewind() reads the
+// same points; the fields match the streamlines read (rows, names, groups).
+inline void streamline_source_target(const std::uint8_t* data, std::size_t size) {
+    static MemFile input;
+    const std::string path = input.set(data, size);
+    try {
+        const auto source = open_streamline_source(path, {.max_points = 1u << 20});
+        std::vector<std::uint32_t> sizes[2];
+        std::uint64_t points = 0;
+        std::vector<Vec3f> f;
+        for (int pass = 0; pass < 2; ++pass) {
+            if (pass == 1) source->rewind();
+            while (source->next(f)) {
+                sizes[pass].push_back(std::uint32_t(f.size()));
+                if (pass == 0) points += f.size();
+            }
+            if (pass == 0)
+                for (const StreamlineField& field : source->take_fields())
+                    check(check_streamline_field(field, sizes[0].size(), points).empty(),
+                          "a field does not match the streamlines read");
+        }
+        check(sizes[0] == sizes[1], "a second pass read other streamlines");
+    } catch (const Error&) {
+        // any category: the input is malformed, unsupported or unreadable
+    }
 }
 
 // The whole compression of small valid .tck inputs, and a decode of what it

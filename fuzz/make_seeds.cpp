@@ -5,7 +5,8 @@
 // edge files;
 // OUT_DIR/fft_file_fuzz: those compressed, in several layouts (8- and 16-bit
 // codes), with and without the fiblet trailer; OUT_DIR/decode_blocks_fuzz: their blocks with
-// the parameters header of that target.
+// the parameters header of that target; OUT_DIR/streamline_source_fuzz: the
+// shared .trk files and TRX zips written from them.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -20,6 +21,8 @@
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/tck.hpp"
+#include "fiblet/trk.hpp"
+#include "fiblet/trx.hpp"
 
 namespace fs = std::filesystem;
 using namespace fiblet;
@@ -141,6 +144,30 @@ std::string blocks_seed(const fs::path& fft) {
     return s;
 }
 
+// The shared .trk files, and each as a TRX zip (TrxWriter) holding its data.
+int trk_and_trx_seeds(const fs::path& shared, const fs::path& dir) {
+    fs::create_directories(dir);
+    int n = 0;
+    if (!fs::is_directory(shared / "conformance")) return n;
+    for (const auto& e : fs::directory_iterator(shared / "conformance")) {
+        if (e.path().extension() != ".trk") continue;
+        fs::copy_file(e.path(), dir / e.path().filename(), fs::copy_options::overwrite_existing);
+        TrkReader in(e.path().string());
+        std::vector<std::vector<Vec3f>> fibers;
+        std::vector<Vec3f> f;
+        SinkHeader h;
+        while (in.next(f)) fibers.push_back(f), h.points += f.size();
+        h.fibers = fibers.size();
+        h.fields = in.take_fields();
+        h.space = in.header().space;
+        TrxWriter out((dir / (e.path().stem().string() + ".trx")).string(), h, true);
+        for (const auto& fiber : fibers) out.write(&fiber.data()->x, fiber.size());
+        out.finish();
+        n += 2;
+    }
+    return n;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -207,6 +234,7 @@ int main(int argc, char** argv) {
     std::printf("fiblet_fuzz_seeds: %zu .tck, %d .fft seeds in %s\n",
                 std::size_t(std::distance(fs::directory_iterator(tck_dir), fs::directory_iterator())), n_fft,
                 out.c_str());
+    std::printf("fiblet_fuzz_seeds: %d .trk/.trx seeds\n", trk_and_trx_seeds(shared, out / "streamline_source_fuzz"));
     // The structure-aware trailer harness starts from the same files.
     fs::copy(fft_dir, out / "fft_trailer_fuzz", fs::copy_options::recursive | fs::copy_options::overwrite_existing);
     return 0;

@@ -5,7 +5,8 @@ set -euo pipefail
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config
-  libcli11-dev libeigen3-dev libfmt-dev libzstd-dev libxxhash-dev nlohmann-json3-dev
+  libcli11-dev libeigen3-dev libfmt-dev libzstd-dev libxxhash-dev
+  libzip-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libhwy-dev
   libnifti2-dev  # NIfTI images (masks)
   python3 python3-numpy python3-nibabel python3-matplotlib

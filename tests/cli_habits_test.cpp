@@ -168,7 +168,7 @@ TEST(CliHabits, DecompressSeveralInputsAndFolderTrees) {
     EXPECT_EQ(run_in(fx.dir, "decompress -q out/sub-01/dwi/a.fft out/sub-02/dwi/b.fft -o x.tck").status, 2);
     fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("bad.fft"));
     const auto mixed = run_in(fx.dir, "decompress -q bad.fft in.fft --output-dir mixed");
-    EXPECT_EQ(mixed.status, 4) << mixed.output;
+    EXPECT_EQ(mixed.status, 6) << mixed.output;  // a .tck named .fft: recognised, not what decompress reads
     EXPECT_TRUE(mentions(mixed, "bad.fft") && mentions(mixed, "some inputs failed")) << mixed.output;
     EXPECT_FALSE(fs::exists(fx.dir.file("mixed/bad.tck")));
     EXPECT_EQ(read_tck(fx.dir.file("mixed/in.tck")).size(), original.size());

@@ -108,8 +108,11 @@ TEST(Cli, BadInputExitsNonZeroAndLeavesNoOutput) {
         EXPECT_FALSE(fs::exists(dir.file("out.fft"))) << c.input;
     }
     EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"trunc.tck"}) << "temporary files left behind";
-    // A .tck given where a .fft is expected, and a reference that does not match.
-    EXPECT_EQ(run_cli("decompress " + test::shared_data("conformance/simple.tck") + " -o " + dir.file("x.tck")).status, 4);
+    // A .tck given where a .fft is expected (recognised, named, exit 6), and a reference that does not match.
+    const CommandResult tck_for_fft =
+        run_cli("decompress " + test::shared_data("conformance/simple.tck") + " -o " + dir.file("x.tck"));
+    EXPECT_EQ(tck_for_fft.status, 6);
+    EXPECT_NE(tck_for_fft.output.find("an MRtrix3 .tck tractogram, not a .fft file"), std::string::npos) << tck_for_fft.output;
     EXPECT_FALSE(fs::exists(dir.file("x.tck")));
     EXPECT_EQ(run_cli("stats " + test::shared_data("reference/small-ifod1.fft") + " -r " +
                   test::shared_data("small-sdstream.tck"))

@@ -41,6 +41,8 @@ int exit_code(Errc c) {
     switch (c) {
         case Errc::io: return 3;
         case Errc::tck_format:
+        case Errc::trk_format:
+        case Errc::trx_format:
         case Errc::fft_format:
         case Errc::invalid_input: return 4;
         case Errc::invalid_argument: return 2;
@@ -200,7 +202,8 @@ std::vector<FftCase> fft_cases() {
     const std::size_t lut = kFftFixedHeaderBytes + 8, blocks = lut + 3 * 8, bb = 76;
     return {
         {"empty file", [](std::string& b) { b.clear(); }, Errc::fft_format},
-        {"a .tck file", [](std::string& b) { b = tck(kTwoFibers); }, Errc::fft_format},
+        // Recognised and named (tractogram_format.hpp), not parsed as a .fft.
+        {"a .tck file", [](std::string& b) { b = tck(kTwoFibers); }, Errc::unsupported},
         {"wrong version", [](std::string& b) { b[0] = 1; }, Errc::fft_format},
         {"truncated header", [](std::string& b) { b.resize(40); }, Errc::fft_format},
         {"truncated buffer table", [](std::string& b) { b.resize(kFftFixedHeaderBytes + 4); }, Errc::fft_format},

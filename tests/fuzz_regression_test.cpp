@@ -69,6 +69,24 @@ TEST(FuzzRegression, TckTargets) {
     RecordProperty("regressions", n);
 }
 
+TEST(FuzzRegression, StreamlineSourceTarget) {
+    const int n = replay_regressions("streamline_source_fuzz", fuzz::streamline_source_target);
+    if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
+    for (const char* name : {"conformance/complex.trk", "conformance/complex_big_endian.trk", "conformance/standard.LPS.trk",
+                             "bundles/AF_L.trk"}) {
+        const std::string good = test::read_file(test::shared_data(name));
+        run(fuzz::streamline_source_target, good, name);
+        // Cut anywhere in the header or data, and bytes flipped: the same invariants.
+        for (std::size_t cut = 0; cut < good.size(); cut += 37) run(fuzz::streamline_source_target, good.substr(0, cut), name);
+        for (std::size_t i = 0; i < good.size(); i += 29) {
+            std::string bad = good;
+            bad[i] = char(bad[i] ^ (1 << (i % 8)));
+            run(fuzz::streamline_source_target, bad, std::string(name) + " with byte " + std::to_string(i) + " flipped");
+        }
+    }
+    RecordProperty("regressions", n);
+}
+
 TEST(FuzzRegression, FftTargets) {
     int n = replay_regressions("fft_file_fuzz", fuzz::fft_target) +
             replay_regressions("fft_trailer_fuzz", fuzz::fft_target) +

@@ -18,6 +18,8 @@ int exit_code_for(Errc c) {
     switch (c) {
         case Errc::io: return kIo;
         case Errc::tck_format:
+        case Errc::trk_format:
+        case Errc::trx_format:
         case Errc::fft_format:
         case Errc::invalid_input:
         case Errc::image_format: return kBadInput;
@@ -64,14 +66,26 @@ void Progress::done() {
     last_permille_ = -1;
 }
 
-void write_decoded_fiber(TckWriter& writer, const float* xyz, std::uint64_t n, const std::string& input,
-                         std::uint64_t fiber) {
+namespace {
+void check_decoded_finite(const float* xyz, std::uint64_t n, const std::string& input, std::uint64_t fiber) {
     for (std::uint64_t i = 0; i < 3 * n; ++i)
         if (!std::isfinite(xyz[i]))
             throw Error(Errc::invalid_input, input + ": fiber " + std::to_string(fiber) +
                                                  " (0-based) decodes to a non-finite coordinate: the file is damaged or "
                                                  "was not written by a fiblet encoder");
+}
+}  // namespace
+
+void write_decoded_fiber(TckWriter& writer, const float* xyz, std::uint64_t n, const std::string& input,
+                         std::uint64_t fiber) {
+    check_decoded_finite(xyz, n, input, fiber);
     writer.write(xyz, std::size_t(n));
+}
+
+void write_decoded_fiber(StreamlineSink& sink, const float* xyz, std::uint64_t n, const std::string& input,
+                         std::uint64_t fiber) {
+    check_decoded_finite(xyz, n, input, fiber);
+    sink.write(xyz, std::size_t(n));
 }
 
 std::string human_bytes(std::uint64_t b) {

@@ -9,6 +9,7 @@
 
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
+#include "fiblet/streamline_io.hpp"
 #include "fiblet/tck.hpp"
 
 namespace fiblet::cli {
@@ -60,6 +61,8 @@ std::string micrometres_value(double mm, int decimals = 2);
 // points, so a NaN or Inf means the input is damaged or hostile: the error
 // (Errc::invalid_input) names `input` and the fiber, not the output.
 void write_decoded_fiber(TckWriter& writer, const float* xyz, std::uint64_t n, const std::string& input,
+                         std::uint64_t fiber);
+void write_decoded_fiber(StreamlineSink& sink, const float* xyz, std::uint64_t n, const std::string& input,
                          std::uint64_t fiber);
 
 // Minimal JSON object builder (values are numbers, strings, bools or nested

@@ -1,4 +1,4 @@
-// fiblet compress IN.tck [IN2.tck ...] [-o OUT.fft | --output-dir DIR] [-r DIR]
+// fiblet compress IN.tck|IN.trk|IN.trx [IN2 ...] [-o OUT.fft | --output-dir DIR] [-r DIR]
 #include <fmt/core.h>
 
 #include <filesystem>
@@ -76,7 +76,7 @@ void print_report(std::FILE* to, const std::string& in, const std::string& out, 
 
 void run(const CompressArgs& a) {
     const auto jobs = plan_file_jobs(
-        a.inputs, {{".tck"}, a.zstd ? ".fftz" : ".fft", a.output, a.output_dir, a.recursive});
+        a.inputs, {{".tck", ".trk", ".trx"}, {".trx"}, a.zstd ? ".fftz" : ".fft", a.output, a.output_dir, a.recursive});
     std::vector<std::string> json;
     std::optional<Error> first_failure;
     std::size_t above_bound = 0;
@@ -148,11 +148,13 @@ void run(const CompressArgs& a) {
 
 void add_compress(CLI::App& app) {
     auto args = std::make_shared<CompressArgs>();
-    CLI::App* cmd = app.add_subcommand("compress", "Compress .tck tractograms into .fft fiblet files");
-    cmd->add_option("inputs", args->inputs, "Input .tck files (with -r, directories; - for standard input)")
+    CLI::App* cmd = app.add_subcommand("compress", "Compress tractograms (.tck, .trk, TRX) into .fft fiblet files");
+    cmd->add_option("inputs", args->inputs,
+                    "Input .tck, .trk or .trx files (TRX: a zip or a directory; with -r, directories; - for standard input)")
         ->required()
         ->check(existing_path_or_stdin());
-    cmd->add_flag("-r,--recursive", args->recursive, "Compress every .tck below the directories given (tree mirrored in --output-dir)");
+    cmd->add_flag("-r,--recursive", args->recursive,
+                  "Compress every .tck, .trk and .trx below the directories given (tree mirrored in --output-dir)");
     cmd->add_option("-o,--output", args->output, "Output .fft file (one input; - for standard output, the report then on stderr)");
     cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs); created if missing");
     cmd->add_option("--step", args->step, "Fixed step in mm (default: measured; variable spacing is resampled)");
@@ -191,7 +193,7 @@ void add_compress(CLI::App& app) {
     cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
     cmd->add_flag("--json", args->json, "Print the report as JSON");
     cmd->add_flag("--allow-count-mismatch", args->allow_count_mismatch,
-                  "Accept a .tck whose count: header disagrees with its data");
+                  "Accept a .tck whose count: (a .trk whose n_count) disagrees with its data");
     cmd->callback([args] { run(*args); });
 }
 

@@ -1,4 +1,4 @@
-// fiblet decompress IN.fft [IN2.fft ...] [-o OUT.tck | --output-dir DIR] [-r DIR] [-j N] [--decoder NAME]
+// fiblet decompress IN.fft [IN2.fft ...] [-o OUT.tck|OUT.trk|OUT.trx | --output-dir DIR] [-r DIR] [-j N] [--decoder NAME]
 #include <fmt/core.h>
 
 #include <chrono>
@@ -9,6 +9,7 @@
 #include "stdio_files.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/fft_file.hpp"
+#include "fiblet/streamline_io.hpp"
 #include "fiblet/tck.hpp"
 
 namespace fiblet::cli {
@@ -34,23 +35,31 @@ std::string decompress_one(const DecompressArgs& a, const std::string& input, co
     TckHeader header;
     header.properties = props;
     header.set("step_size", fmt::format("{:.9g}", double(h.step) * double(h.scaling)));
+    SinkHeader sink_header{header.properties, space_from_properties(props, input), file.streamline_fields(),
+                           h.fibers, h.points};
+    const TractogramFormat out_format = format_from_extension(output);  // .trk, .trx; else a .tck
+    const bool points_only = out_format != TractogramFormat::trk && out_format != TractogramFormat::trx;
+    if (points_only && !sink_header.fields.empty() && !a.quiet)
+        fmt::print(stderr, "fiblet: note: {} data arrays of {} not written: a .tck holds points only (write a .trk or .trx)\n",
+                   sink_header.fields.size(), input);
+    if (points_only) sink_header.fields.clear();
     DecodeOptions options;
     options.decoder = parse_decoder(a.decoder);
     options.threads = a.threads;
     const std::string decoder = decoder_name(options.decoder);
     const std::string out_path = writable_path(output, ".tck", stdout_spool);
-    TckWriter writer(out_path, header.properties, a.force || stdout_spool);
+    const auto sink = open_streamline_sink(out_path, sink_header, a.force || stdout_spool);
     Progress progress(a.quiet);
     decode_file(
         file,
         [&](std::uint64_t first, const Streamlines& chunk) {
             for (std::size_t i = 0; i < chunk.size(); ++i)
-                write_decoded_fiber(writer, &chunk.xyz[3 * chunk.offsets[i]], chunk.offsets[i + 1] - chunk.offsets[i],
+                write_decoded_fiber(*sink, &chunk.xyz[3 * chunk.offsets[i]], chunk.offsets[i + 1] - chunk.offsets[i],
                                     input, first + i);
             progress.update("decompress", h.fibers ? double(first + chunk.size()) / double(h.fibers) : 1.0);
         },
         options);
-    writer.finish();
+    sink->finish();
     progress.done();
     if (stdout_spool) stdout_spool->copy_to_stdout();
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -72,7 +81,7 @@ std::string decompress_one(const DecompressArgs& a, const std::string& input, co
 // Every input is tried; with several, a failed one is reported and the
 // first failure's code is the exit status (as compress does).
 void run(const DecompressArgs& a) {
-    const auto jobs = plan_file_jobs(a.inputs, {{".fft", ".fftz"}, ".tck", a.output, a.output_dir, a.recursive});
+    const auto jobs = plan_file_jobs(a.inputs, {{".fft", ".fftz"}, {}, ".tck", a.output, a.output_dir, a.recursive});
     std::vector<std::string> json;
     std::optional<Error> first_failure;
     for (const auto& [in, out] : jobs) {
@@ -96,13 +105,14 @@ void run(const DecompressArgs& a) {
 
 void add_decompress(CLI::App& app) {
     auto args = std::make_shared<DecompressArgs>();
-    CLI::App* cmd = app.add_subcommand("decompress", "Decode a .fft file back into a .tck file");
+    CLI::App* cmd = app.add_subcommand("decompress", "Decode a .fft file back into a .tck, .trk or .trx file");
     cmd->add_option("inputs", args->inputs, "Input .fft/.fftz files (with -r, directories; - for standard input)")
         ->required()
         ->check(existing_path_or_stdin());
     cmd->add_option("-o,--output", args->output,
-                    "Output .tck file (one input; default: the input's name with .tck; - for standard output, "
-                    "the report then on stderr)");
+                    "Output .tck, .trk or .trx file (one input; by its extension, .trk/.trx get the source's space and "
+                    "data; default: the input's name with .tck; - for standard output as .tck, the report then on "
+                    "stderr)");
     cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs); created if missing");
     cmd->add_flag("-r,--recursive", args->recursive,
                   "Decompress every .fft/.fftz below the directories given (tree mirrored in --output-dir)");

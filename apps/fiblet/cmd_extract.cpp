@@ -126,6 +126,9 @@ void run(const ExtractArgs& a) {
         usage("--lod produces segments that a .fft file cannot hold: write a .tck");
     const FftFile file = open_fft_input(a.input, a.ignore_trailer);
     const FftHeader& h = file.header();
+    if (!file.streamline_fields().empty() && !a.quiet)  // formats/fft-data.md: not subset yet
+        fmt::print(stderr, "fiblet: note: the {} data arrays of {} (DATA chunk) are not carried into extracted files\n",
+                   file.streamline_fields().size(), a.input);
     const auto t_open = std::chrono::steady_clock::now();
     const BlockIndex index = a.compute_index ? BlockIndex::compute(file) : BlockIndex::load(file);
     const auto t_index = std::chrono::steady_clock::now();

@@ -1,4 +1,4 @@
-// fiblet info FILE — the header of a .fft or .tck file.
+// fiblet info FILE — the header of a .fft, .tck, .trk or TRX file.
 #include <fmt/core.h>
 
 #include <cstdio>
@@ -7,6 +7,9 @@
 #include "cli_common.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/tck.hpp"
+#include "fiblet/tractogram_format.hpp"
+#include "fiblet/trk.hpp"
+#include "fiblet/trx.hpp"
 
 namespace fiblet::cli {
 namespace {
@@ -16,13 +19,6 @@ struct InfoArgs {
     std::string input;
     bool json = false;
 };
-
-bool looks_like_tck(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    char magic[13] = {};
-    f.read(magic, 13);
-    return f.gcount() == 13 && std::string(magic, 13) == "mrtrix tracks";
-}
 
 std::string properties_json(const std::vector<std::pair<std::string, std::string>>& props) {
     std::string out = "[";
@@ -56,6 +52,46 @@ void info_tck(const InfoArgs& a) {
     }
     fmt::print("{}: MRtrix3 tracks file, {}, data at byte {}\n", a.input, tck_datatype_name(h.datatype), h.data_offset);
     print_properties(h.properties);
+}
+
+std::string fields_text(const std::vector<StreamlineField>& fields) {
+    std::string s;
+    for (const StreamlineField& f : fields)
+        s += (s.empty() ? "" : ", ") + f.name + (f.components > 1 ? fmt::format(" ({} x {})", f.components, field_type_name(f.type))
+                                                                  : fmt::format(" ({})", field_type_name(f.type)));
+    return s;
+}
+
+// A .trk or TRX: streamline count, space, data arrays (its header and sizes).
+void info_streamlines(const InfoArgs& a, TractogramFormat format) {
+    std::unique_ptr<StreamlineSource> source = open_streamline_source(a.input);
+    const std::string what = format == TractogramFormat::trk
+                                 ? fmt::format("TrackVis .trk version {}, {}-endian",
+                                               static_cast<TrkReader&>(*source).header().version,
+                                               static_cast<TrkReader&>(*source).header().big_endian ? "big" : "little")
+                                 : "TRX tractogram";
+    // Counted from the data (which this also checks); .trk fields are gathered on the way.
+    std::uint64_t streamlines = 0, points = 0;
+    std::vector<Vec3f> fiber;
+    while (source->next(fiber)) ++streamlines, points += fiber.size();
+    const auto fields = source->take_fields();
+    const auto props = source->properties();
+    if (a.json) {
+        std::string names = "[";
+        for (std::size_t i = 0; i < fields.size(); ++i) names += (i ? ", " : "") + json_quote(fields[i].name);
+        fmt::print("{}\n", Json{}
+                               .str("file", a.input)
+                               .str("format", format == TractogramFormat::trk ? "trk" : "trx")
+                               .integer("streamlines", streamlines)
+                               .integer("points", points)
+                               .raw("data", names + "]")
+                               .raw("properties", properties_json(props))
+                               .render());
+        return;
+    }
+    fmt::print("{}: {}\n  streamlines            {} ({} points)\n", a.input, what, streamlines, points);
+    if (!fields.empty()) fmt::print("  data                   {}\n", fields_text(fields));
+    print_properties(props);
 }
 
 // Fibers whose last step the ENDS chunk shortens (formats/fft-ends.md).
@@ -101,11 +137,12 @@ void info_fft(const InfoArgs& a) {
     fmt::print("  recorded error         max {}, mean {}\n", micrometres(h.max_error_mm, 3), micrometres(h.mean_error_mm, 3));
     fmt::print("  GPU buffers            {}\n", h.buffer_ends.size());
     if (!chunks.empty()) fmt::print("  trailer chunks         {}\n", chunks);
+    if (!f.streamline_fields().empty()) fmt::print("  data (DATA)            {}\n", fields_text(f.streamline_fields()));
     if (f.end_fractions())
         fmt::print("  fiber ends             kept (ENDS): {} of {} fibers end on a partial last step\n", partial, h.fibers);
     const auto props = f.properties();
     if (!props.empty()) {
-        fmt::print("  source .tck properties:\n");
+        fmt::print("  source properties:\n");
         print_properties(props);
     }
 }
@@ -114,11 +151,16 @@ void info_fft(const InfoArgs& a) {
 
 void add_info(CLI::App& app) {
     auto args = std::make_shared<InfoArgs>();
-    CLI::App* cmd = app.add_subcommand("info", "Print the header of a .fft or .tck file");
-    cmd->add_option("file", args->input, "A .fft or .tck file")->required()->check(CLI::ExistingFile);
+    CLI::App* cmd = app.add_subcommand("info", "Print the header of a .fft, .tck, .trk or TRX file");
+    cmd->add_option("file", args->input, "A .fft, .tck, .trk or TRX file")->required()->check(CLI::ExistingPath);
     cmd->add_flag("--json", args->json, "Print as JSON");
     add_ignore_trailer_flag(cmd, args->ignore_trailer);
-    cmd->callback([args] { looks_like_tck(args->input) ? info_tck(*args) : info_fft(*args); });
+    cmd->callback([args] {
+        const TractogramFormat f = detect_tractogram_format(args->input);
+        if (f == TractogramFormat::tck) info_tck(*args);
+        else if (f == TractogramFormat::trk || f == TractogramFormat::trx) info_streamlines(*args, f);
+        else info_fft(*args);  // a .fft, or a message naming what the file is
+    });
 }
 
 }  // namespace fiblet::cli

@@ -208,7 +208,7 @@ void run(const RenderArgs& a) {
 
 void add_render(CLI::App& app) {
     auto args = std::make_shared<RenderArgs>();
-    CLI::App* cmd = app.add_subcommand("render", "Render a .fft (or .tck) file to a PNG without a window (EGL)");
+    CLI::App* cmd = app.add_subcommand("render", "Render a .fft (or .tck, .trk, TRX) file to a PNG without a window (EGL)");
     add_viewer_options(cmd, args->view);
     cmd->add_option("-o,--output", args->output, "Output PNG");
     cmd->add_option("--size", args->view.size, "Image size WIDTHxHEIGHT")->capture_default_str();

@@ -1,5 +1,5 @@
-// fiblet stats IN.fft [--reference IN.tck]: the error against the source,
-// or without it tckstats-style length statistics of the decoded fibers.
+// fiblet stats IN.fft [--reference IN.tck|IN.trk|IN.trx]: the error against
+// the source, or without it tckstats-style length statistics of the decoded fibers.
 #include <fmt/core.h>
 
 #include <optional>
@@ -20,7 +20,7 @@ struct StatsArgs {
 };
 
 void run_lengths(const StatsArgs& a, const FftFile& file) {
-    if (a.max_error_um) throw Error(Errc::invalid_argument, "--max-error needs --reference (the source .tck)");
+    if (a.max_error_um) throw Error(Errc::invalid_argument, "--max-error needs --reference (the source tractogram)");
     const LengthStats s = length_stats(decoded_fiber_lengths(file, 0));
     if (a.json)
         fmt::print("{}\n", Json{}.str("file", a.input).raw("length", length_json(s)).render());
@@ -74,12 +74,12 @@ void run(const StatsArgs& a) {
 void add_stats(CLI::App& app) {
     auto args = std::make_shared<StatsArgs>();
     CLI::App* cmd = app.add_subcommand(
-        "stats", "Measure a .fft file against its source .tck: point error, distances both ways (Hausdorff), "
+        "stats", "Measure a .fft file against its source (.tck, .trk, TRX): point error, distances both ways (Hausdorff), "
                  "endpoint displacement, length change; without --reference, fiber length statistics");
     cmd->add_option("input", args->input, "Input .fft file")->required()->check(CLI::ExistingFile);
     cmd->add_option("-r,--reference", args->reference,
-                    "The .tck file it was made from (without it: length statistics, as MRtrix3's tckstats)")
-        ->check(CLI::ExistingFile);
+                    "The .tck, .trk or TRX file it was made from (without it: length statistics, as MRtrix3's tckstats)")
+        ->check(CLI::ExistingPath);
     cmd->add_flag("--json", args->json, "Print the report as JSON");
     cmd->add_option("--max-error", args->max_error_um,
                     "Exit with code 8 when the point error, the Hausdorff distance, an endpoint's displacement "

@@ -1,7 +1,8 @@
 // Which files a compress/decompress run reads and writes, as zstd names
 // them: -o for one input, else the input's name with the new extension, next
 // to it or in --output-dir; with -r, a directory stands for the files below
-// it (the tree mirrored in --output-dir).
+// it (the tree mirrored in --output-dir), except a directory that is itself
+// an input (a TRX directory).
 #pragma once
 
 #include <string>
@@ -15,6 +16,7 @@ struct FileJob {
 
 struct FileJobOptions {
     std::vector<std::string> input_extensions;  // what -r picks up below a directory, e.g. {".tck"}
+    std::vector<std::string> directory_inputs;  // directories that are themselves inputs (TRX: {".trx"})
     std::string output_extension;               // e.g. ".fft"
     std::string output, output_dir;             // -o, --output-dir
     bool recursive = false;                     // -r

@@ -34,9 +34,9 @@ std::uint32_t fiber_id(std::uint64_t id) {
 }  // namespace
 
 void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
-    cmd->add_option("input", a.input, "A .fft file (or a .tck file, compressed on the fly)")
+    cmd->add_option("input", a.input, "A .fft file (or a .tck, .trk or TRX file, compressed on the fly)")
         ->required()
-        ->check(CLI::ExistingFile);
+        ->check(CLI::ExistingPath);
     cmd->add_option("--camera", a.camera,
                     "View: left, right, front, back, top, bottom, oblique; or EX,EY,EZ[,TX,TY,TZ[,UX,UY,UZ]] in mm")
         ->capture_default_str();

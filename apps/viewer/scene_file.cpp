@@ -5,22 +5,15 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 
 #include "fiblet/compress.hpp"
 #include "fiblet/error.hpp"
+#include "fiblet/tractogram_format.hpp"
 
 namespace fiblet::viewer {
 
-bool looks_like_tck(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    char magic[13] = {};
-    f.read(magic, 13);
-    return f.gcount() == 13 && std::string(magic, 13) == "mrtrix tracks";
-}
-
 FftFile open_scene_file(const std::string& path) {
-    if (!looks_like_tck(path)) return FftFile(path);
+    if (!is_streamline_format(detect_tractogram_format(path))) return FftFile(path);  // a .tck, .trk or TRX is compressed
     const char* tmp = std::getenv("TMPDIR");
     std::string dir = std::string(tmp && *tmp ? tmp : "/tmp") + "/fiblet-view-XXXXXX";
     if (!::mkdtemp(dir.data())) throw Error(Errc::io, "cannot create a temporary directory in " + dir);

@@ -1,5 +1,5 @@
-// Opening what the viewer draws: a .fft file as it is, or a .tck file
-// compressed on the fly (into a temporary .fft, removed once open).
+// Opening what the viewer draws: a .fft file as it is, or a .tck, .trk or
+// TRX file compressed on the fly (into a temporary .fft, removed once open).
 #pragma once
 
 #include <string>
@@ -7,8 +7,6 @@
 #include "fiblet/fft_file.hpp"
 
 namespace fiblet::viewer {
-
-bool looks_like_tck(const std::string& path);
 
 // Throws fiblet::Error like FftFile / compress_tck.
 FftFile open_scene_file(const std::string& path);

@@ -33,7 +33,7 @@ from ._fiblet import FibletError
 __version__ = _fiblet.version
 __all__ = [
     "Streamlines", "Sphere", "Box", "Mask", "FibletError",
-    "load", "load_array_sequence", "load_tractogram", "load_sft", "save", "stats", "info",
+    "load", "load_array_sequence", "load_tractogram", "load_sft", "read_streamlines", "save", "stats", "info",
 ]
 
 
@@ -355,13 +355,25 @@ def _flatten(streamlines):
     return points, offsets
 
 
+def read_streamlines(path):
+    """Reads a .tck, .trk or TRX file through the readers ``fiblet compress``
+    uses; returns ``(Streamlines, data)``: points in world RAS+ mm (for a
+    .trk exactly as nibabel's ``load(path).streamlines``), and a dict of the
+    per-streamline ("dps/NAME"), per-point ("dpv/NAME") and group arrays,
+    each (rows, components)."""
+    r = _fiblet.read_streamlines(_existing(path))
+    return Streamlines(r["points"], r["offsets"]), r["data"]
+
+
 def save(path, streamlines, step=None, *, overwrite=False, threads=None):
     """Compresses streamlines into a .fft file; returns the compression report
     (the keys of ``fiblet compress --json``: ratio, max_error_um, ...).
 
     streamlines: a :class:`Streamlines`, a nibabel ArraySequence, Tractogram or
         loaded tractogram file, a list of (n, 3) arrays, or (points, offsets).
-        Coordinates are world millimetres.
+        Coordinates are world millimetres. Or the path of a .tck, .trk or
+        TRX file, compressed directly by the same readers as
+        ``fiblet compress`` (its per-streamline and per-point data kept).
     step: the fixed step in mm (default: measured; input with variable
         spacing is resampled to it).
 
@@ -374,6 +386,9 @@ def save(path, streamlines, step=None, *, overwrite=False, threads=None):
     path = _os.fspath(path)
     if _os.path.exists(path) and not overwrite:
         raise FileExistsError(f"{path} exists (pass overwrite=True)")
+    if isinstance(streamlines, (str, _os.PathLike)):
+        return _fiblet.compress(_existing(streamlines), path, None if step is None else float(step),
+                                bool(overwrite), _threads(threads))
     points, offsets = _flatten(streamlines)
     points = _np.ascontiguousarray(points, dtype=_np.float32)
     if points.ndim != 2 or points.shape[1] != 3:

@@ -30,6 +30,7 @@
 #include "fiblet/fft_file.hpp"
 #include "fiblet/image_mask.hpp"
 #include "fiblet/select.hpp"
+#include "fiblet/streamline_io.hpp"
 #include "fiblet/tck.hpp"
 #include "decode_range.hpp"
 #include "owned_array.hpp"
@@ -403,6 +404,46 @@ void write_tck(const std::string& path, py::array_t<float, py::array::c_style | 
     writer.finish();
 }
 
+// numpy's dtype name for a field type ("float16", "uint32", ...: the same names).
+py::array field_array(const StreamlineField& f) {
+    py::array a(py::dtype(field_type_name(f.type)), std::vector<py::ssize_t>{py::ssize_t(f.rows()), py::ssize_t(f.components)});
+    std::memcpy(a.mutable_data(), f.bytes.data(), f.bytes.size());
+    return a;
+}
+
+// Reads a .tck, .trk or TRX file through the same readers as compress:
+// points (N, 3) float32 in RAS+ mm, offsets (F+1), fields {name: (rows,
+// components) array}, header properties, format name.
+py::dict read_streamlines(const std::string& path) {
+    std::vector<float> xyz;
+    std::vector<std::int64_t> offsets{0};
+    std::vector<StreamlineField> fields;
+    Properties properties;
+    TractogramFormat format;
+    {
+        py::gil_scoped_release release;
+        const auto source = open_streamline_source(path);
+        std::vector<Vec3f> fiber;
+        while (source->next(fiber)) {
+            for (const Vec3f& p : fiber) xyz.insert(xyz.end(), {p.x, p.y, p.z});
+            offsets.push_back(offsets.back() + std::int64_t(fiber.size()));
+        }
+        fields = source->take_fields();
+        properties = source->properties();
+        format = source->format();
+    }
+    py::dict d, data;
+    const auto n = py::ssize_t(xyz.size() / 3);
+    d["points"] = to_numpy<float>(std::move(xyz), {n, 3});
+    const auto f = py::ssize_t(offsets.size());
+    d["offsets"] = to_numpy<std::int64_t>(std::move(offsets), {f});
+    for (const StreamlineField& field : fields) data[py::str(field.name)] = field_array(field);
+    d["data"] = data;
+    d["properties"] = properties;
+    d["format"] = format == TractogramFormat::tck ? "tck" : format == TractogramFormat::trk ? "trk" : "trx";
+    return d;
+}
+
 }  // namespace
 }  // namespace fiblet::python
 
@@ -432,6 +473,7 @@ PYBIND11_MODULE(_fiblet, m) {
     m.def("stats", &stats, py::arg("fft"), py::arg("reference"));
     m.def("compress", &compress, py::arg("tck"), py::arg("fft"), py::arg("step_mm"), py::arg("overwrite"),
           py::arg("threads"));
+    m.def("read_streamlines", &read_streamlines, py::arg("path"));
     m.def("write_tck", &write_tck, py::arg("path"), py::arg("points"), py::arg("offsets"), py::arg("properties"),
           py::arg("overwrite"));
 }

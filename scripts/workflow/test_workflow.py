@@ -113,4 +113,33 @@ def test_no_input_is_an_error(tmp_path):
         pytest.fail("snakemake not found")
     with pytest.raises(subprocess.CalledProcessError) as e:
         run_workflow(tmp_path)
-    assert "no .tck file matches" in e.value.stderr + e.value.stdout
+    assert "no .tck, .trk or .trx file matches" in e.value.stderr + e.value.stdout
+
+
+def test_trk_and_trx_inputs(tmp_path):
+    """A .trk (nibabel's TrackVis file) and a TRX made from it by fiblet are
+    picked up next to a .tck; each row's size is its own source file's."""
+    if SNAKEMAKE is None:
+        pytest.fail("snakemake not found")
+    if not SHARED.is_dir():
+        pytest.skip(f"shared data not found at {SHARED}")
+    dwi = tmp_path / "sub-01" / "dwi"
+    dwi.mkdir(parents=True)
+    (dwi / "sub-01_desc-cst_tracks.trk").symlink_to(SHARED / "bundles/CST_R.trk")
+    (dwi / "sub-01_desc-simple_tracks.tck").symlink_to(SHARED / "conformance/simple.tck")
+    work = tmp_path.parent / (tmp_path.name + "-work")
+    work.mkdir()
+    subprocess.run([CLI, "compress", "-q", str(SHARED / "conformance/complex.trk"), "-o", str(work / "c.fft")], check=True)
+    subprocess.run([CLI, "decompress", "-q", str(work / "c.fft"), "-o", str(dwi / "sub-01_desc-complex_tracks.trx")],
+                   check=True)
+    run_workflow(tmp_path)
+    out = tmp_path / "derivatives" / "fiblet"
+    with open(out / "summary.csv") as f:
+        rows = {r["file"]: r for r in csv.DictReader(f)}
+    assert set(rows) == {"sub-01/dwi/sub-01_desc-cst_tracks.trk", "sub-01/dwi/sub-01_desc-simple_tracks.tck",
+                         "sub-01/dwi/sub-01_desc-complex_tracks.trx"}
+    for name, r in rows.items():
+        assert int(r["tck_bytes"]) == (tmp_path / name).stat().st_size
+        assert (out / name).with_suffix(".fft").is_file()
+    assert rows["sub-01/dwi/sub-01_desc-cst_tracks.trk"]["fibers"] == "50"
+    assert rows["sub-01/dwi/sub-01_desc-complex_tracks.trx"]["fibers"] == "3"

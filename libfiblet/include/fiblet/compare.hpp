@@ -25,7 +25,8 @@ struct Comparison {
     GeometryError geometry;
 };
 
-// Decodes every fiber and measures each decoded point against the reference.
+// Decodes every fiber and measures each decoded point against the reference
+// (a .tck, .trk or TRX file: open_streamline_source).
 // Throws Error{invalid_input} if the reference does not have the same
 // fibers (count, or points per fiber).
 Comparison compare_to_reference(const FftFile& fft, const std::string& tck_path, bool allow_count_mismatch = false,

@@ -1,4 +1,4 @@
-// fiblet — compressing a .tck file into a .fft file (the whole pipeline).
+// fiblet — compressing a tractogram (.tck, .trk or TRX) into a .fft file (the whole pipeline).
 #pragma once
 
 #include <array>
@@ -67,7 +67,9 @@ struct CompressReport {
     double seconds = 0;
 };
 
-// Compresses `tck_path` into `fft_path` (atomically; see AtomicOutputFile).
+// Compresses `tck_path` (a .tck, .trk or TRX: open_streamline_source) into
+// `fft_path` (atomically; see AtomicOutputFile). Per-streamline and per-point
+// data go to the DATA chunk (formats/fft-data.md); the input header to PROP.
 CompressReport compress_tck(const std::string& tck_path, const std::string& fft_path, const CompressOptions& options);
 
 }  // namespace fiblet

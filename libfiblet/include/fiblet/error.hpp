@@ -22,6 +22,8 @@ enum class Errc : int {
     checksum = 8,      // integrity check failed
     interrupted = 9,   // stopped by a signal
     image_format = 10, // malformed voxel image (NIfTI, .mif)
+    trk_format = 11,   // malformed TrackVis .trk header or data
+    trx_format = 12,   // malformed TRX archive, header.json or array
 };
 
 // Short stable name of a category ("tck_format", ...), for --json output.

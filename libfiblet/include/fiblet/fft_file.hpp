@@ -24,6 +24,7 @@
 
 #include "fiblet/checksum.hpp"
 #include "fiblet/fiber_ends.hpp"
+#include "fiblet/streamline_field.hpp"
 #include "fiblet/fft_format.hpp"
 #include "fiblet/resample.hpp"
 
@@ -103,6 +104,9 @@ public:
     // The per-fiber last-step fractions of the ENDS chunk (fiblet/fiber_ends.hpp),
     // validated at open; null for a file without one (every fiber whole).
     const std::shared_ptr<const FiberEndFractions>& end_fractions() const { return end_fractions_; }
+    // Per-streamline, per-point and group arrays of the source (DATA chunk,
+    // formats/fft-data.md), validated at open; empty when it had none.
+    const std::vector<StreamlineField>& streamline_fields() const;
 
     // Reads blocks [first, first+count) into `out` (count * block_bytes
     // bytes), checks them against the LUT (Error{fft_format}) and the
@@ -145,6 +149,7 @@ private:
     std::uint64_t trailer_hash_ = 0;  // XXH64 of the trailer chunks before CSUM, as read
     std::optional<FftChecksums> checksums_;
     std::shared_ptr<const FiberEndFractions> end_fractions_;
+    std::shared_ptr<const std::vector<StreamlineField>> fields_;
     std::unique_ptr<std::atomic<std::uint64_t>[]> verified_groups_;  // one bit per block group
     std::unique_ptr<Mapping> mapping_;                                // mapped_blocks()
     std::unique_ptr<detail::InputRegistration> input_;  // no output of this process may replace the file

@@ -1,9 +1,7 @@
-// The compression pipeline: .tck -> scan -> (resample) -> encode -> .fft.
+// The compression pipeline: .tck/.trk/TRX -> scan -> (resample) -> encode -> .fft.
 // Streams the input (two or three passes over it, one streamline in memory
 // at a time); the output is written atomically.
 #include "fiblet/compress.hpp"
-
-#include <sys/stat.h>
 
 #include <bit>
 #include <chrono>
@@ -12,6 +10,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <span>
 #include <thread>
 #include <utility>
 
@@ -27,7 +26,9 @@
 #include "fiblet/fiber_ends.hpp"
 #include "fiblet/output_file.hpp"
 #include "fiblet/resample.hpp"
-#include "fiblet/tck.hpp"
+#include "fiblet/streamline_data_chunk.hpp"
+#include "fiblet/streamline_io.hpp"
+#include "fiblet/tractogram_format.hpp"
 
 namespace fiblet {
 
@@ -90,7 +91,7 @@ struct Timer {
     double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); }
 };
 
-void report_progress(const CompressOptions& o, const char* phase, const TckReader& r) {
+void report_progress(const CompressOptions& o, const char* phase, const StreamlineSource& r) {
     if (o.progress && r.data_bytes() > 0) o.progress(phase, double(r.bytes_consumed()) / double(r.data_bytes()));
 }
 
@@ -107,6 +108,58 @@ void check_step_resolvable(const std::string& path, double step_mm, double exten
                 path + ": the points span " + fmt_g(extent_mm) + " mm for a " + fmt_g(step_mm) +
                     " mm step: beyond the 2^20 steps per extent that the format's float decoder and 16-bit anchors resolve");
 }
+
+// Per-point fields of resampled input, re-made at the resampled points
+// (float32, linear between the two input points of the piece each lies on:
+// interpolate_point_values);
+// the other fields are kept as read.
+class PointFieldResampler {
+public:
+    // `fields`: null when the input is not resampled; `original_points`:
+    // each fiber's input point count.
+    PointFieldResampler(std::vector<StreamlineField>* fields, const std::vector<std::uint32_t>& original_points) {
+        if (!fields) return;
+        for (StreamlineField& f : *fields)
+            if (f.scope() == FieldScope::point) point_fields_.push_back(&f);
+        if (point_fields_.empty()) return;
+        original_offsets_.resize(original_points.size() + 1);
+        for (std::size_t i = 0; i < original_points.size(); ++i)
+            original_offsets_[i + 1] = original_offsets_[i] + original_points[i];
+        for (StreamlineField* f : point_fields_) {
+            std::vector<float> v(std::size_t(f->values()));
+            for (std::uint64_t k = 0; k < v.size(); ++k) v[k] = narrow_to_float(field_value(f->type, &f->bytes[k * f->value_size()]));
+            input_.push_back(std::move(v));
+        }
+    }
+    bool active() const { return !point_fields_.empty(); }
+    // The resampled point counts are known: size the outputs.
+    void set_resampled_points(const std::vector<std::uint32_t>& points) {
+        if (!active()) return;
+        offsets_.assign(points.size() + 1, 0);
+        for (std::size_t i = 0; i < points.size(); ++i) offsets_[i + 1] = offsets_[i] + points[i];
+        for (StreamlineField* f : point_fields_) output_.emplace_back(std::size_t(offsets_.back()) * f->components);
+    }
+    // Fiber f was resampled at `positions` (threads write disjoint fibers).
+    void resample(std::uint32_t f, std::span<const PolylinePosition> positions) {
+        for (std::size_t i = 0; i < point_fields_.size(); ++i) {
+            const std::size_t c = point_fields_[i]->components;
+            interpolate_point_values(positions, &input_[i][original_offsets_[f] * c], c, &output_[i][offsets_[f] * c]);
+        }
+    }
+    void finish() {
+        for (std::size_t i = 0; i < point_fields_.size(); ++i) {
+            StreamlineField& f = *point_fields_[i];
+            f.type = FieldType::float32;
+            f.bytes.resize(output_[i].size() * 4);
+            std::memcpy(f.bytes.data(), output_[i].data(), f.bytes.size());
+        }
+    }
+
+private:
+    std::vector<StreamlineField*> point_fields_;
+    std::vector<std::uint64_t> original_offsets_, offsets_;
+    std::vector<std::vector<float>> input_, output_;
+};
 
 }  // namespace
 
@@ -128,8 +181,10 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     TckScan& scan = report.scan;
     // The longest streamline a file can hold bounds the one in memory too.
     const std::size_t max_fiber_points = std::size_t{0xffff} * points_per_block;
-    TckReader reader(tck_path, {.allow_count_mismatch = options.allow_count_mismatch, .max_points = max_fiber_points});
-    scan.header_step = reader.header().step_size();
+    const auto source = open_streamline_source(
+        tck_path, {.allow_count_mismatch = options.allow_count_mismatch, .max_points = max_fiber_points});
+    StreamlineSource& reader = *source;
+    scan.header_step = reader.step_size();
     AtomicOutputFile::check_destination(fft_path, options.overwrite);  // before the passes, not after
 
     // Pass 1: counts, bounding box, spacing, turning angles.
@@ -173,6 +228,10 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         sample.offer(fiber);
         if ((scan.fibers & 1023) == 0) report_progress(options, "scan", reader);
     }
+    std::vector<StreamlineField> fields = reader.take_fields();
+    for (const StreamlineField& f : fields)
+        if (const std::string problem = check_streamline_field(f, scan.fibers, scan.points); !problem.empty())
+            throw Error(Errc::invalid_input, tck_path + ": " + problem);
     if (scan.points == 0) scan.min = scan.max = {0, 0, 0};
     if (scan.segments == 0) scan.step_min = 0;
     scan.step_mean = scan.segments ? length_sum / double(scan.segments) : 0.0;
@@ -220,6 +279,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     report.step_mm = step;
 
     // Pass 1b (resampling only): the counts and turning angles change.
+    PointFieldResampler point_fields(report.resampled ? &fields : nullptr, fiber_points);
     if (report.resampled) {
         reader.rewind();
         turns = detail::TurnStatistics(points_per_block, kSharpBlocks);
@@ -243,6 +303,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         }
     }
 
+    point_fields.set_resampled_points(fiber_points);
     // Header: the encoder's choices (parameters.cpp), block layout and buffer table.
     scan.min_dot = turns.min_dot();
     if (options.cap_ratio && !(*options.cap_ratio > 0 && *options.cap_ratio <= 2))
@@ -302,6 +363,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     struct Work {
         std::vector<std::uint8_t> blocks;
         std::vector<Vec3f> decoded, decoded_exact, resampled, scratch;
+        std::vector<PolylinePosition> positions;  // of the resampled points on the input
         ErrorStats error;
         GeometryError geometry;  // both ways against the input polylines
         IndexBuilder index;  // bounds of this worker's blocks (the BIDX chunk)
@@ -320,7 +382,9 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             w.decoded.clear();
             w.decoded_exact.clear();
             if (report.resampled) {
-                const bool short_tail = resample_keeping_end(original, step, w.resampled);
+                const bool short_tail = resample_keeping_end(original, step, w.resampled, ResampleCurve::cubic,
+                                                             point_fields.active() ? &w.positions : nullptr);
+                if (point_fields.active()) point_fields.resample(f, w.positions);
                 points = w.resampled;
                 end_fractions[f] = detail::encode_keeping_end(encoder, points, short_tail, step, f, w.blocks,
                                                               w.decoded, &w.decoded_exact, w.scratch);
@@ -373,7 +437,12 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     std::vector<std::uint8_t> trailer;
     {
         const std::uint64_t at = out->logical_size();
-        std::vector<TrailerChunk> chunks{make_properties_chunk(reader.header().properties)};
+        std::vector<TrailerChunk> chunks{make_properties_chunk(reader.properties())};
+        if (!fields.empty()) {
+            point_fields.finish();
+            chunks.push_back(make_streamline_data_chunk(fields));
+            std::vector<StreamlineField>().swap(fields);
+        }
         if (report.resampled) {
             TrailerChunk c{kResampledTag, std::vector<std::uint8_t>(16)};  // step, curve, 0
             const auto curve = std::uint32_t(ResampleCurve::cubic);
@@ -394,8 +463,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     out->commit();
     if (options.progress) options.progress("encode", 1.0);
 
-    struct stat st {};
-    if (::stat(tck_path.c_str(), &st) == 0) report.input_bytes = std::uint64_t(st.st_size);
+    report.input_bytes = tractogram_bytes(tck_path);  // a TRX directory: its files
     report.seconds = timer.seconds();
     return report;
 }

@@ -14,6 +14,8 @@ const char* errc_name(Errc c) noexcept {
         case Errc::checksum: return "checksum";
         case Errc::interrupted: return "interrupted";
         case Errc::image_format: return "image_format";
+        case Errc::trk_format: return "trk_format";
+        case Errc::trx_format: return "trx_format";
     }
     return "unknown";
 }

@@ -15,6 +15,7 @@
 #include "core/bytes.hpp"
 #include "fiblet/error.hpp"
 #include "io/fft_trailer.hpp"
+#include "fiblet/tractogram_format.hpp"
 #include "io/fftz_reader.hpp"
 #include "io/open_inputs.hpp"
 
@@ -44,8 +45,13 @@ FftHeader parse_fft_header(std::span<const std::uint8_t> b, std::uint64_t file_s
     FftHeader h;
     const std::uint8_t* p = b.data();
     h.version = p[0];
-    if (h.version != kFftVersion && h.version != kFft16Version)
+    if (h.version != kFftVersion && h.version != kFft16Version) {
+        const TractogramFormat other = detect_tractogram_format(name);  // a .trk, .tck... given for a .fft
+        if (other != TractogramFormat::unknown && other != TractogramFormat::fft && other != TractogramFormat::fftz)
+            throw Error(Errc::unsupported, name + ": " + tractogram_format_description(other) +
+                                               ", not a .fft file (compress it into one first)");
         bad(name, "unsupported version " + std::to_string(h.version) + " (fiblet reads versions 2 and 16)");
+    }
     h.fibers = get_le<std::uint64_t>(p + 1);
     h.points = get_le<std::uint64_t>(p + 9);
     h.blocks = get_le<std::uint32_t>(p + 17);
@@ -198,6 +204,12 @@ void FftFile::open_trailer(std::span<const std::uint8_t> head, std::uint64_t lut
     properties_ = std::move(values.properties);
     resampling_ = values.resampling;
     end_fractions_ = std::move(values.end_fractions);
+    fields_ = std::move(values.fields);
+}
+
+const std::vector<StreamlineField>& FftFile::streamline_fields() const {
+    static const std::vector<StreamlineField> none;
+    return fields_ ? *fields_ : none;
 }
 
 void FftFile::verify_open_checksums(std::span<const std::uint8_t> head, std::uint64_t lut_hash) const {
@@ -244,6 +256,7 @@ FftFile& FftFile::operator=(FftFile&& o) noexcept {
         trailer_hash_ = o.trailer_hash_;
         checksums_ = std::move(o.checksums_);
         end_fractions_ = std::move(o.end_fractions_);
+        fields_ = std::move(o.fields_);
         verified_groups_ = std::move(o.verified_groups_);
         mapping_ = std::move(o.mapping_);
         input_ = std::move(o.input_);

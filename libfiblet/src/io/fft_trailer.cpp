@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "core/bytes.hpp"
 #include "fiblet/block_index.hpp"
 #include "fiblet/checksum.hpp"
 #include "fiblet/error.hpp"
+#include "fiblet/streamline_data_chunk.hpp"
 #include "select/index_chunk.hpp"
 
 namespace fiblet::detail {
@@ -28,10 +30,12 @@ constexpr std::uint64_t kMaxKnownChunk = 64u << 20, kMaxUnknownChunk = 16u << 20
 
 bool is_known(const std::array<char, 4>& tag) {
     return tag == kPropertiesTag || tag == kResampledTag || tag == kChecksumTag || tag == kBlockIndexTag ||
-           tag == kFiberEndsTag;
+           tag == kFiberEndsTag || tag == kStreamlineDataTag;
 }
 
 std::uint64_t max_known_size(const std::array<char, 4>& tag, std::uint64_t fibers) {
+    // DATA holds what its source held (per point, any type): only the file bounds it.
+    if (tag == kStreamlineDataTag) return std::numeric_limits<std::uint64_t>::max();
     return tag == kFiberEndsTag ? std::max(kMaxKnownChunk, 2 * fibers) : kMaxKnownChunk;
 }
 
@@ -172,6 +176,9 @@ TrailerValues validate_trailer_chunks(const std::vector<TrailerChunk>& chunks, c
         else if (c.tag == kBlockIndexTag) (void)parse_index_chunk(c.payload, header, name);
         else if (c.tag == kFiberEndsTag)
             v.end_fractions = std::make_shared<const FiberEndFractions>(parse_fiber_ends_chunk(c, header.fibers, name));
+        else if (c.tag == kStreamlineDataTag)
+            v.fields = std::make_shared<const std::vector<StreamlineField>>(
+                parse_streamline_data_chunk(c, header.fibers, header.points, name));
     }
     return v;
 }

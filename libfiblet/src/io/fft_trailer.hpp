@@ -21,6 +21,7 @@
 #include "fiblet/fft_format.hpp"
 #include "fiblet/fiber_ends.hpp"
 #include "fiblet/resample.hpp"
+#include "fiblet/streamline_field.hpp"
 
 namespace fiblet::detail {
 
@@ -47,6 +48,7 @@ struct TrailerValues {
     std::vector<std::pair<std::string, std::string>> properties;  // PROP
     std::optional<Resampling> resampling;                         // RSMP
     std::shared_ptr<const FiberEndFractions> end_fractions;       // ENDS
+    std::shared_ptr<const std::vector<StreamlineField>> fields;   // DATA
 };
 TrailerValues validate_trailer_chunks(const std::vector<TrailerChunk>& chunks, const FftHeader& header,
                                       const std::string& name);

@@ -1,7 +1,5 @@
 #include "fiblet/compare.hpp"
 
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -10,7 +8,8 @@
 #include "core/streamline_label.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/resample.hpp"
-#include "fiblet/tck.hpp"
+#include "fiblet/streamline_io.hpp"
+#include "fiblet/tractogram_format.hpp"
 
 namespace fiblet {
 
@@ -21,13 +20,13 @@ Comparison compare_to_reference(const FftFile& fft, const std::string& tck_path,
     Comparison c;
     const FftHeader& h = fft.header();
     c.fibers = h.fibers, c.points = h.points, c.blocks = h.blocks, c.fft_bytes = fft.file_size();
-    struct stat st {};
-    if (::stat(tck_path.c_str(), &st) == 0) c.reference_bytes = std::uint64_t(st.st_size);
+    c.reference_bytes = tractogram_bytes(tck_path);  // a TRX directory: its files
 
     const Resampling resampling = fft.resampling().value_or(Resampling{});  // validated at open: step finite, > 0
     c.resampled = fft.resampling().has_value();
     const bool keeps_ends = fft.end_fractions() != nullptr;
-    TckReader ref(tck_path, {.allow_count_mismatch = allow_count_mismatch});
+    const auto source = open_streamline_source(tck_path, {.allow_count_mismatch = allow_count_mismatch});
+    StreamlineSource& ref = *source;  // a .tck, .trk or TRX
     std::vector<Vec3f> original, resampled;
     auto mismatch = [&](const std::string& what) {
         throw Error(Errc::invalid_input, tck_path + " is not the source of " + fft.path() + ": " + what);
