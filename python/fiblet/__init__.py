@@ -310,9 +310,9 @@ def load_sft(path, reference, **options):
 
 def _flatten(streamlines):
     """(points float32 (N,3), offsets int64 (F+1)) from the accepted inputs."""
-    if isinstance(streamlines, (str, bytes, _os.PathLike)):
-        raise TypeError(f"save(path, streamlines): streamlines must be points, not a file name ({streamlines!r}); "
-                        "load the file first (fiblet.load, nibabel.streamlines.load) or run `fiblet compress`")
+    if isinstance(streamlines, bytes):  # (str and path objects name a tractogram: save() compresses it)
+        raise TypeError(f"save(path, streamlines): streamlines must be points or a file name (str, os.PathLike), "
+                        f"not bytes ({streamlines!r})")
     if isinstance(streamlines, Streamlines):
         return streamlines.points, streamlines.offsets
     if isinstance(streamlines, tuple) and len(streamlines) == 2 and all(

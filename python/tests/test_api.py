@@ -124,8 +124,8 @@ def test_roi_as_numbers_arrays_and_image_masks(dwi, tmp_path, cli):
 
 def test_clear_argument_errors(dwi, tmp_path):
     fft, _, _ = dwi
-    with pytest.raises(TypeError, match="not a file name"):
-        fiblet.save(tmp_path / "a.fft", "x.trk")
+    with pytest.raises(FileNotFoundError, match="x.trk"):  # a file name is a tractogram to compress
+        fiblet.save(tmp_path / "a.fft", tmp_path / "x.trk")
     with pytest.raises(TypeError, match="streamlines must be"):
         fiblet.save(tmp_path / "a.fft", 5)
     with pytest.raises(TypeError, match="streamline 0"):
