@@ -1,4 +1,5 @@
 // read_image(): the format by the file name; geometry helpers.
+#include <Eigen/Dense>
 #include <cmath>
 #include <limits>
 
@@ -35,22 +36,23 @@ std::array<double, 3> transform_point(const Affine3x4& m, const std::array<doubl
     return out;
 }
 
+// Eigen's closed-form 3x3 inverse, as MRtrix3's transforms use (so a
+// world-to-voxel rounding matches tckedit's).
 Affine3x4 inverse(const Affine3x4& m) {
-    auto a = [&](int r, int c) { return m[r][c]; };
-    const double det = a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)) -
-                       a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0)) +
-                       a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
+    Eigen::Matrix3d linear;
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) linear(r, c) = m[r][c];
+    const double det = linear.determinant();
     if (!std::isfinite(det) || det == 0)
         throw Error(Errc::image_format, "the image's voxel-to-world transform is singular or not finite");
-    Affine3x4 inv{};
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) {
-            // Cofactor of (c, r), transposed.
-            const int r1 = (c + 1) % 3, r2 = (c + 2) % 3, c1 = (r + 1) % 3, c2 = (r + 2) % 3;
-            inv[r][c] = (a(r1, c1) * a(r2, c2) - a(r1, c2) * a(r2, c1)) / det;
-        }
-    for (int r = 0; r < 3; ++r) inv[r][3] = -(inv[r][0] * m[0][3] + inv[r][1] * m[1][3] + inv[r][2] * m[2][3]);
-    return inv;
+    const Eigen::Matrix3d inv = linear.inverse();
+    const Eigen::Vector3d shift = -(inv * Eigen::Vector3d(m[0][3], m[1][3], m[2][3]));
+    Affine3x4 out{};
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) out[r][c] = inv(r, c);
+        out[r][3] = shift(r);
+    }
+    return out;
 }
 
 namespace detail {
