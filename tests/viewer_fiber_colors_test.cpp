@@ -3,10 +3,14 @@
 // line's checks of the per-fiber files (colours, values, radii).
 #include <gtest/gtest.h>
 
+#include <fmt/core.h>
+
 #include <cstdlib>
 
 #include "cli_runner.hpp"
 #include "fiber_colors.hpp"
+#include "fiblet/fft_file.hpp"
+#include "fiblet/streamline_field.hpp"
 #include "gpu_scene.hpp"
 #include "orbit_camera.hpp"
 #include "render_target.hpp"
@@ -128,4 +132,34 @@ TEST(ViewerFiberColors, CommandLineChecksTheFiles) {
         const CommandResult r = run_cli(common + " -f" + bad);
         EXPECT_EQ(r.status, 2) << bad << ": " << r.output;
     }
+}
+
+TEST(ViewerFiberColors, ValuesFromTheFilesOwnPerStreamlineData) {
+    // complex.trk carries properties (mean_curvature, ...): through a .fft
+    // they colour the render exactly as the same numbers in a text file do.
+    FIBLET_REQUIRE_GL();
+    if (!shared_data_available()) GTEST_SKIP() << "no shared data";
+    const TempDir dir;
+    const std::string fft = dir.file("c.fft");
+    const CommandResult made = run_cli("compress -q " + shared_data("conformance/complex.trk") + " -o " + fft);
+    ASSERT_EQ(made.status, 0) << made.output;
+    const FftFile file(fft);
+    std::string values;
+    for (const StreamlineField& f : file.streamline_fields())
+        if (f.name == "dps/mean_curvature")
+            for (std::uint64_t r = 0; r < f.rows(); ++r) values += fmt::format("{:.9g}\n", f.at(r, 0));
+    ASSERT_FALSE(values.empty()) << "complex.trk lost its properties";
+    write_file(dir.file("v.txt"), values);
+    const std::string common = "render " + fft + " --size 64x48 --fiber-values ";
+    const CommandResult from_data = run_cli(common + "dps/mean_curvature -o " + dir.file("data.png"));
+    ASSERT_EQ(from_data.status, 0) << from_data.output;
+    const CommandResult from_text = run_cli(common + dir.file("v.txt") + " -o " + dir.file("text.png"));
+    ASSERT_EQ(from_text.status, 0) << from_text.output;
+    EXPECT_EQ(read_file(dir.file("data.png")), read_file(dir.file("text.png")));
+    // A name the file does not carry: a usage error listing what it has.
+    const CommandResult missing = run_cli(common + "dps/nothing -o " + dir.file("m.png"));
+    EXPECT_EQ(missing.status, 2) << missing.output;
+    EXPECT_NE(missing.output.find("dps/mean_torsion"), std::string::npos) << missing.output;
+    // mean_colors has three values per streamline: not one colour-map value.
+    EXPECT_EQ(run_cli(common + "dps/mean_colors -o " + dir.file("m.png")).status, 4);
 }

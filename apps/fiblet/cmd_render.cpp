@@ -149,7 +149,7 @@ void run(const RenderArgs& a) {
     const viewer::GpuPrograms programs;
     const FftFile file = viewer::open_scene_file(a.view.input);
     viewer::GpuScene scene(file, programs);
-    viewer::load_fiber_colors(fiber_color_source(a.view), scene);
+    viewer::load_fiber_colors(fiber_color_source(a.view), file, scene);
     if (!a.view.fiber_radii.empty()) viewer::load_fiber_radii(a.view.fiber_radii, scene);
     viewer::RenderTarget target(width, height);
     viewer::Renderer renderer(programs);

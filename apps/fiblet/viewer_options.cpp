@@ -48,9 +48,15 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
                     "ignored)")
         ->check(CLI::ExistingFile);
     cmd->add_option("--fiber-values", a.fiber_values,
-                    "Colour each streamline by a value from a text file (one number per streamline, as MRtrix3's "
-                    "per-streamline files), through viridis")
-        ->check(CLI::ExistingFile);
+                    "Colour each streamline by a value, through viridis: a text file (one number per streamline, as "
+                    "MRtrix3's per-streamline files) or dps/NAME, the per-streamline data the .fft carries (a .trk's "
+                    "properties, a TRX's dps/)")
+        ->check(CLI::ExistingFile | CLI::Validator(
+                                        [](const std::string& v) {
+                                            return v.rfind("dps/", 0) == 0 && v.size() > 4 ? std::string()
+                                                                                           : std::string("not dps/NAME");
+                                        },
+                                        "dps/NAME"));
     cmd->add_option("--value-range", a.value_range, "MIN:MAX of --fiber-values mapped to the colour map (default: "
                                                     "the values' range)");
     cmd->add_option("--background", a.background, "Background colour: RRGGBB, black, white, gray")

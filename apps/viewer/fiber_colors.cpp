@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "fiblet/error.hpp"
+#include "fiblet/fft_file.hpp"
+#include "fiblet/streamline_field.hpp"
 #include "gpu_scene.hpp"
 
 namespace fiblet::viewer {
@@ -92,12 +95,44 @@ std::vector<Rgb> colors_from_values(const std::vector<float>& values, std::optio
     return out;
 }
 
-void load_fiber_colors(const FiberColorSource& source, GpuScene& scene) {
-    if (!source.colors_path.empty())
+std::vector<float> fiber_values_from_data(const FftFile& file, const std::string& name) {
+    std::string available;
+    for (const StreamlineField& f : file.streamline_fields()) {
+        if (f.scope() != FieldScope::streamline) continue;
+        if (f.name != name) {
+            available += (available.empty() ? "" : ", ") + f.name;
+            continue;
+        }
+        if (f.components != 1 || f.rows() != file.header().fibers)
+            throw Error(Errc::invalid_input, file.path() + ": " + name + " holds " + std::to_string(f.components) +
+                                                 " values per streamline (one is needed for a colour map)");
+        std::vector<float> out(f.rows());
+        for (std::uint64_t r = 0; r < f.rows(); ++r) {
+            out[r] = narrow_to_float(f.at(r, 0));
+            if (!std::isfinite(out[r]))
+                throw Error(Errc::invalid_input, file.path() + ": " + name + " of streamline " + std::to_string(r) +
+                                                     " is not a finite number");
+        }
+        return out;
+    }
+    throw Error(Errc::invalid_argument, file.path() + " carries no per-streamline data " + name + " (" +
+                                            (available.empty() ? "it has none" : "it has: " + available) + ")");
+}
+
+// "dps/NAME" names the file's own data unless a file of that name exists.
+static bool names_file_data(const std::string& values) {
+    return values.rfind("dps/", 0) == 0 && !std::filesystem::exists(values);
+}
+
+void load_fiber_colors(const FiberColorSource& source, const FftFile& file, GpuScene& scene) {
+    if (!source.colors_path.empty()) {
         scene.set_fiber_colors(read_fiber_colors(source.colors_path, scene.fiber_count()));
-    else if (!source.values_path.empty())
-        scene.set_fiber_colors(
-            colors_from_values(read_fiber_values(source.values_path, scene.fiber_count()), source.value_range));
+    } else if (!source.values_path.empty()) {
+        const std::vector<float> values = names_file_data(source.values_path)
+                                              ? fiber_values_from_data(file, source.values_path)
+                                              : read_fiber_values(source.values_path, scene.fiber_count());
+        scene.set_fiber_colors(colors_from_values(values, source.value_range));
+    }
 }
 
 }  // namespace fiblet::viewer

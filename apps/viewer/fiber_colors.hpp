@@ -12,6 +12,10 @@
 #include <string>
 #include <vector>
 
+namespace fiblet {
+class FftFile;
+}
+
 namespace fiblet::viewer {
 
 using Rgb = std::array<float, 3>;  // 0..1
@@ -21,11 +25,18 @@ using Rgb = std::array<float, 3>;  // 0..1
 std::vector<Rgb> read_fiber_colors(const std::string& path, std::uint64_t fibers);
 std::vector<float> read_fiber_values(const std::string& path, std::uint64_t fibers);
 
+// The per-streamline values the .fft carries in its DATA chunk (from a .trk's
+// properties or a TRX's dps/), by name ("dps/weight"): one component, every
+// value finite. Throws Error{invalid_argument} naming the file's dps fields
+// when there is no such field, {invalid_input} for a bad one.
+std::vector<float> fiber_values_from_data(const FftFile& file, const std::string& name);
+
 // Values mapped through viridis over [low, high] (default: the values'
 // range), clamped.
 std::vector<Rgb> colors_from_values(const std::vector<float>& values, std::optional<std::array<float, 2>> range = {});
 
-// Where a scene's per-fiber colours come from (at most one file).
+// Where a scene's per-fiber colours come from (at most one source): a text
+// file, or for values "dps/NAME", the file's own per-streamline data.
 struct FiberColorSource {
     std::string colors_path, values_path;
     std::optional<std::array<float, 2>> value_range;
@@ -33,8 +44,9 @@ struct FiberColorSource {
 };
 
 class GpuScene;
-// Reads the source's file for `scene` and sets its colours (nothing when empty).
-void load_fiber_colors(const FiberColorSource& source, GpuScene& scene);
+// Reads the source for `scene` (made from `file`) and sets its colours
+// (nothing when empty).
+void load_fiber_colors(const FiberColorSource& source, const FftFile& file, GpuScene& scene);
 
 // Viridis at t in [0, 1] (clamped), from 9 samples of matplotlib's table.
 Rgb viridis(float t);

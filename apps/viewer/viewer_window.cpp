@@ -181,8 +181,9 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
     require_gl45();
 
     const GpuPrograms programs;
-    GpuScene scene(open_scene_file(path), programs);
-    load_fiber_colors(options.fiber_colors, scene);
+    const FftFile file = open_scene_file(path);
+    GpuScene scene(file, programs);
+    load_fiber_colors(options.fiber_colors, file, scene);
     if (!options.fiber_radii_path.empty()) load_fiber_radii(options.fiber_radii_path, scene);
     Renderer renderer(programs);
     int fb_width = 0, fb_height = 0;
