@@ -293,3 +293,22 @@ TEST(CliHabits, DashIsStandardInputAndOutput) {
     EXPECT_TRUE(mentions(r, "standard input (-) needs -o")) << r.output;
     EXPECT_TRUE(fs::is_empty(fx.dir.file("spool")));
 }
+
+TEST(CliHabits, ATrxDirectoryIsOneInputWithOrWithoutRecursion) {
+    // TRX may be a directory: it is one tractogram (x.trx/ too), and -r
+    // takes it whole instead of walking into it.
+    Fixture fx;
+    ASSERT_EQ(run_in(fx.dir, "decompress -q in.fft -o zip.trx").status, 0);
+    fs::create_directories(fx.dir.file("tree/sub-01/dwi.trx"));
+    const auto unzip = test::run_command("cd " + fx.dir.path() +
+                                         " && python3 -c \"import zipfile; zipfile.ZipFile('zip.trx')"
+                                         ".extractall('tree/sub-01/dwi.trx')\" 2>&1");
+    ASSERT_EQ(unzip.status, 0) << unzip.output;
+    const auto one = run_in(fx.dir, "compress -q tree/sub-01/dwi.trx/ -o one.fft");
+    ASSERT_EQ(one.status, 0) << one.output;
+    EXPECT_EQ(FftFile(fx.dir.file("one.fft")).header().fibers, 3u);
+    const auto tree = run_in(fx.dir, "compress -q -r tree --output-dir out");
+    ASSERT_EQ(tree.status, 0) << tree.output;
+    EXPECT_EQ(FftFile(fx.dir.file("out/sub-01/dwi.fft")).header().fibers, 3u);
+    EXPECT_EQ(test::read_file(fx.dir.file("out/sub-01/dwi.fft")), test::read_file(fx.dir.file("one.fft")));
+}
