@@ -19,15 +19,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using test::read_tck_fibers;
+
 bool mentions(const test::CommandResult& r, const std::string& text) {
     return r.output.find(text) != std::string::npos;
-}
-
-std::vector<std::vector<Vec3f>> read_tck(const std::string& path) {
-    TckReader r(path);
-    std::vector<std::vector<Vec3f>> all;
-    for (std::vector<Vec3f> s; r.next(s);) all.push_back(s);
-    return all;
 }
 
 // `fiblet ARGS` run inside `dir` (where a split `-force` would leave a file "rce").
@@ -61,7 +56,7 @@ TEST(CliHabits, MrtrixSpellingsMeanTheirFibletOptions) {
     const auto d = run_in(fx.dir, "decompress in.fft -o out.tck -nthreads 2 -quiet");
     EXPECT_EQ(d.status, 0) << d.output;
     EXPECT_EQ(d.output, "");
-    EXPECT_EQ(read_tck(fx.dir.file("out.tck")).size(), 3u);
+    EXPECT_EQ(read_tck_fibers(fx.dir.file("out.tck")).size(), 3u);
     EXPECT_TRUE(mentions(run_in(fx.dir, "-version"), "fiblet "));
     EXPECT_TRUE(mentions(run_in(fx.dir, "decompress -help"), "--output"));
 }
@@ -98,7 +93,7 @@ TEST(CliHabits, ValuesAndOperandsThatLookLikeOptionsAreLeftAlone) {
     EXPECT_TRUE(fs::exists(fx.dir.file("two.fft")));
     const auto r = run_in(fx.dir, "extract -q in.fft -o box.tck --include -1,0,0,8,3,3");
     EXPECT_EQ(r.status, 0) << r.output;
-    EXPECT_EQ(read_tck(fx.dir.file("box.tck")).size(), 3u);
+    EXPECT_EQ(read_tck_fibers(fx.dir.file("box.tck")).size(), 3u);
 }
 
 TEST(CliHabits, ThreadCountFromTheEnvironment) {
@@ -117,7 +112,7 @@ TEST(CliHabits, ThreadCountFromTheEnvironment) {
     EXPECT_EQ(run_in(fx.dir, cmd, "env FIBLET_NTHREADS=1 MRTRIX_NTHREADS=4294967295").status, 0);
     EXPECT_EQ(run_in(fx.dir, cmd + " -j 1", "env FIBLET_NTHREADS=4294967295").status, 0);
     EXPECT_EQ(run_in(fx.dir, "decompress -q in.fft -o e.tck", "env -u FIBLET_NTHREADS MRTRIX_NTHREADS=2").status, 0);
-    EXPECT_EQ(read_tck(fx.dir.file("e.tck")).size(), 3u);
+    EXPECT_EQ(read_tck_fibers(fx.dir.file("e.tck")).size(), 3u);
 }
 
 TEST(CliHabits, OutputDirIsCreated) {
@@ -134,7 +129,8 @@ TEST(CliHabits, FibersTakeOneSyntaxWithMrtrixRanges) {
     Fixture fx;
     ASSERT_EQ(run_in(fx.dir, "extract -q in.fft -o dash.tck --fibers 1-2").status, 0);
     ASSERT_EQ(run_in(fx.dir, "extract -q in.fft -o colon.tck --fibers 1:2").status, 0);
-    const auto dash = read_tck(fx.dir.file("dash.tck")), colon = read_tck(fx.dir.file("colon.tck"));
+    const auto dash = read_tck_fibers(fx.dir.file("dash.tck"));
+    const auto colon = read_tck_fibers(fx.dir.file("colon.tck"));
     EXPECT_EQ(dash.size(), 2u);
     EXPECT_EQ(dash, colon);
     EXPECT_EQ(run_in(fx.dir, "extract -q in.fft -o bad.tck --fibers 2:1").status, 2);
@@ -158,12 +154,14 @@ TEST(CliHabits, DecompressSeveralInputsAndFolderTrees) {
     // decompress: several inputs at once, next to each (as zstd -d), or -r into --output-dir.
     const auto two = run_in(fx.dir, "decompress -q out/sub-01/dwi/a.fft out/sub-02/dwi/b.fft");
     ASSERT_EQ(two.status, 0) << two.output;
-    const auto original = read_tck(fx.dir.file("in.tck"));
-    EXPECT_EQ(read_tck(fx.dir.file("out/sub-01/dwi/a.tck")).size(), original.size());
-    EXPECT_EQ(read_tck(fx.dir.file("out/sub-02/dwi/b.tck")), read_tck(fx.dir.file("out/sub-01/dwi/a.tck")));
+    const auto original = read_tck_fibers(fx.dir.file("in.tck"));
+    EXPECT_EQ(read_tck_fibers(fx.dir.file("out/sub-01/dwi/a.tck")).size(), original.size());
+    EXPECT_EQ(read_tck_fibers(fx.dir.file("out/sub-02/dwi/b.tck")),
+              read_tck_fibers(fx.dir.file("out/sub-01/dwi/a.tck")));
     const auto tree = run_in(fx.dir, "decompress -q -r out --output-dir back");
     ASSERT_EQ(tree.status, 0) << tree.output;
-    EXPECT_EQ(read_tck(fx.dir.file("back/sub-02/dwi/b.tck")), read_tck(fx.dir.file("out/sub-02/dwi/b.tck")));
+    EXPECT_EQ(read_tck_fibers(fx.dir.file("back/sub-02/dwi/b.tck")),
+              read_tck_fibers(fx.dir.file("out/sub-02/dwi/b.tck")));
     // -o names one output; one bad input among several fails the run, the others are written.
     EXPECT_EQ(run_in(fx.dir, "decompress -q out/sub-01/dwi/a.fft out/sub-02/dwi/b.fft -o x.tck").status, 2);
     fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("bad.fft"));
@@ -171,7 +169,7 @@ TEST(CliHabits, DecompressSeveralInputsAndFolderTrees) {
     EXPECT_EQ(mixed.status, 6) << mixed.output;  // a .tck named .fft: recognised, not what decompress reads
     EXPECT_TRUE(mentions(mixed, "bad.fft") && mentions(mixed, "some inputs failed")) << mixed.output;
     EXPECT_FALSE(fs::exists(fx.dir.file("mixed/bad.tck")));
-    EXPECT_EQ(read_tck(fx.dir.file("mixed/in.tck")).size(), original.size());
+    EXPECT_EQ(read_tck_fibers(fx.dir.file("mixed/in.tck")).size(), original.size());
 }
 
 namespace {

@@ -19,14 +19,6 @@ using namespace fiblet;
 
 namespace {
 
-std::vector<std::vector<Vec3f>> read_all(const std::string& path) {
-    TckReader r(path);
-    std::vector<std::vector<Vec3f>> all;
-    std::vector<Vec3f> f;
-    while (r.next(f)) all.push_back(f);
-    return all;
-}
-
 double dist(const float* p, Vec3f q) {
     const double dx = double(p[0]) - q.x, dy = double(p[1]) - q.y, dz = double(p[2]) - q.z;
     return std::sqrt(dx * dx + dy * dy + dz * dz);
@@ -74,7 +66,7 @@ TEST_P(CodecRoundTrip, PreservesStructureAndStaysWithinTheErrorBound) {
 
     const FftFile file(out);
     const FftHeader& h = file.header();
-    const auto ref = read_all(input);
+    const auto ref = test::read_tck_fibers(input);
     ASSERT_EQ(h.fibers, ref.size());
     const Streamlines s = decode_fibers(file, 0, h.fibers);
     ASSERT_EQ(s.size(), ref.size());

@@ -94,14 +94,6 @@ const std::string kTwoFibers = f32({0, 0, 0, 0.5f, 0, 0, 1, 0, 0}) + kSep + f32(
 
 using test::error_of;
 
-std::vector<std::vector<Vec3f>> read_tck(const std::string& path) {
-    TckReader r(path);
-    std::vector<std::vector<Vec3f>> out;
-    std::vector<Vec3f> f;
-    while (r.next(f)) out.push_back(f);
-    return out;
-}
-
 // What `fiblet decompress` does, through the API.
 void decompress(const std::string& in, const std::string& out) {
     const FftFile f(in);
@@ -261,15 +253,15 @@ TEST(CorruptTck, EachCaseFailsWithItsCategoryAndLeavesNoOutput) {
         const std::string in = dir.file("in.tck"), out = dir.file("out.fft");
         test::write_file(in, c.bytes);
         // API: reading, then the whole compression.
-        EXPECT_EQ(error_of([&] { read_tck(in); }), c.readable ? std::nullopt : c.error);
+        EXPECT_EQ(error_of([&] { test::read_tck_fibers(in); }), c.readable ? std::nullopt : c.error);
         EXPECT_EQ(error_of([&] { compress_tck(in, out, {}); }), c.error);
         if (c.error) {
             EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"in.tck"});
         } else {
             // A valid edge case: the fibers come back with their point counts.
-            const auto original = read_tck(in);
+            const auto original = test::read_tck_fibers(in);
             EXPECT_EQ(error_of([&] { decompress(out, dir.file("back.tck")); }), std::nullopt);
-            const auto back = read_tck(dir.file("back.tck"));
+            const auto back = test::read_tck_fibers(dir.file("back.tck"));
             ASSERT_EQ(back.size(), original.size());
             for (std::size_t i = 0; i < back.size(); ++i) {
                 ASSERT_EQ(back[i].size(), original[i].size()) << "fiber " << i;

@@ -25,14 +25,6 @@ int run(const std::string& cmd) {
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-std::vector<std::vector<Vec3f>> read_tck(const std::string& path) {
-    TckReader r(path);
-    std::vector<std::vector<Vec3f>> all;
-    std::vector<Vec3f> s;
-    while (r.next(s)) all.push_back(s);
-    return all;
-}
-
 std::vector<std::vector<Vec3f>> as_fibers(const Streamlines& s) {
     std::vector<std::vector<Vec3f>> all(s.size());
     for (std::size_t i = 0; i < s.size(); ++i)
@@ -97,7 +89,7 @@ TEST_F(SelectCli, WritesWhatTheLibrarySelects) {
         ASSERT_EQ(run(cli() + " extract " + fft() + " -o " + out + " " + cases[i].args), 0) << cases[i].args;
         const auto expected = as_fibers(select_streamlines(file, index, cases[i].query));
         EXPECT_FALSE(expected.empty()) << cases[i].args;
-        EXPECT_EQ(read_tck(out), expected) << cases[i].args;
+        EXPECT_EQ(test::read_tck_fibers(out), expected) << cases[i].args;
     }
 }
 
@@ -131,9 +123,9 @@ TEST_F(SelectCli, AgreesWithTckedit) {
         const std::string b = dir_->file("fiblet" + std::to_string(i) + ".tck");
         ASSERT_EQ(run("tckedit -quiet -force -nthreads 0 " + full + " " + a + args), 0) << args;
         ASSERT_EQ(run(cli() + " extract " + (i % 2 ? "-quiet -force " : "") + fft() + " -o " + b + ours), 0) << ours;
-        const auto expected = read_tck(a);
+        const auto expected = test::read_tck_fibers(a);
         nonempty += !expected.empty();
-        EXPECT_EQ(read_tck(b), expected) << args;
+        EXPECT_EQ(test::read_tck_fibers(b), expected) << args;
     }
     EXPECT_GT(nonempty, 2);
 }
@@ -145,13 +137,13 @@ TEST_F(SelectCli, FftOutputIsAValidSubset) {
     ASSERT_EQ(run(cli() + " info " + sub), 0);
     ASSERT_EQ(run(cli() + " decompress " + sub + " -o " + a), 0);
     ASSERT_EQ(run(cli() + " extract " + fft() + " -o " + b + args), 0);
-    const auto got = read_tck(a);
+    const auto got = test::read_tck_fibers(a);
     EXPECT_FALSE(got.empty());
-    EXPECT_EQ(got, read_tck(b));
+    EXPECT_EQ(got, test::read_tck_fibers(b));
     // The subset has its own index: extracting everything from it reads it back.
     const std::string c = dir_->file("sub-c.tck");
     ASSERT_EQ(run(cli() + " extract " + sub + " -o " + c), 0);
-    EXPECT_EQ(read_tck(c), got);
+    EXPECT_EQ(test::read_tck_fibers(c), got);
 }
 
 TEST_F(SelectCli, AddsAnIndexToOfficialEncoderFiles) {

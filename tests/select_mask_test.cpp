@@ -21,14 +21,6 @@ using namespace fiblet::test;
 
 namespace {
 
-std::vector<std::vector<Vec3f>> read_tck(const std::string& path) {
-    TckReader r(path);
-    std::vector<std::vector<Vec3f>> all;
-    std::vector<Vec3f> s;
-    while (r.next(s)) all.push_back(s);
-    return all;
-}
-
 // An oblique grid of 2.5 x 2 x 3 mm voxels whose values exercise the
 // rounding rule: 0, ±0.3, 0.5, 0.7, 1, -1, NaN, Inf.
 SourceImage probe_mask() {
@@ -83,7 +75,7 @@ TEST_F(ImageMaskTest, VoxelRuleIsTckedits) {
         const std::string path = dir_.file(name);
         const std::string out = dir_.file(name + ".tck");
         ASSERT_EQ(run_command("tckedit -quiet -force -nthreads 0 " + tck + " " + out + " -include " + path + " 2>&1").status, 0);
-        const auto kept = read_tck(out);
+        const auto kept = test::read_tck_fibers(out);
         const auto mask = ImageMask::read(path);
         std::vector<Vec3f> ours;
         for (const Vec3f& p : probes)
@@ -230,9 +222,9 @@ TEST_F(MaskSelection, ExtractEqualsTckedit) {
         ASSERT_EQ(run_command("tckedit -quiet -force -nthreads 0 " + full + " " + a + cases[i] + " 2>&1").status, 0)
             << cases[i];
         ASSERT_EQ(run_cli("extract -q " + fft() + " -o " + b + ours).status, 0) << ours;
-        const auto expected = read_tck(a);
+        const auto expected = test::read_tck_fibers(a);
         EXPECT_FALSE(expected.empty()) << cases[i];
-        EXPECT_EQ(read_tck(b), expected) << cases[i];
+        EXPECT_EQ(test::read_tck_fibers(b), expected) << cases[i];
     }
 }
 

@@ -98,6 +98,14 @@ T at(const std::string& bytes, std::size_t off) {
 }
 
 // A small .tck at `path`: straight fibers of 70, 10 and 1 points at a 0.1 mm step.
+// Every streamline of a .tck, in file order.
+inline std::vector<std::vector<Vec3f>> read_tck_fibers(const std::string& path) {
+    TckReader r(path);
+    std::vector<std::vector<Vec3f>> all;
+    for (std::vector<Vec3f> f; r.next(f);) all.push_back(f);
+    return all;
+}
+
 inline void write_three_fiber_tck(const std::string& path) {
     TckWriter w(path, {}, true);
     std::vector<Vec3f> f;
