@@ -53,8 +53,7 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
                     "properties, a TRX's dps/)")
         ->check(CLI::ExistingFile | CLI::Validator(
                                         [](const std::string& v) {
-                                            return v.rfind("dps/", 0) == 0 && v.size() > 4 ? std::string()
-                                                                                           : std::string("not dps/NAME");
+                                            return viewer::is_data_field_name(v) ? std::string() : "not dps/NAME";
                                         },
                                         "dps/NAME"));
     cmd->add_option("--value-range", a.value_range, "MIN:MAX of --fiber-values mapped to the colour map (default: "

@@ -119,16 +119,14 @@ std::vector<float> fiber_values_from_data(const FftFile& file, const std::string
                                             (available.empty() ? "it has none" : "it has: " + available) + ")");
 }
 
-// "dps/NAME" names the file's own data unless a file of that name exists.
-static bool names_file_data(const std::string& values) {
-    return values.rfind("dps/", 0) == 0 && !std::filesystem::exists(values);
-}
+bool is_data_field_name(const std::string& values) { return values.rfind("dps/", 0) == 0 && values.size() > 4; }
 
 void load_fiber_colors(const FiberColorSource& source, const FftFile& file, GpuScene& scene) {
     if (!source.colors_path.empty()) {
         scene.set_fiber_colors(read_fiber_colors(source.colors_path, scene.fiber_count()));
     } else if (!source.values_path.empty()) {
-        const std::vector<float> values = names_file_data(source.values_path)
+        const bool from_data = is_data_field_name(source.values_path) && !std::filesystem::exists(source.values_path);
+        const std::vector<float> values = from_data
                                               ? fiber_values_from_data(file, source.values_path)
                                               : read_fiber_values(source.values_path, scene.fiber_count());
         scene.set_fiber_colors(colors_from_values(values, source.value_range));

@@ -30,6 +30,9 @@ std::vector<float> read_fiber_values(const std::string& path, std::uint64_t fibe
 // value finite. Throws Error{invalid_argument} naming the file's dps fields
 // when there is no such field, {invalid_input} for a bad one.
 std::vector<float> fiber_values_from_data(const FftFile& file, const std::string& name);
+// Whether a values source is such a name ("dps/" and more); a file of that
+// name, when one exists, is read instead.
+bool is_data_field_name(const std::string& values);
 
 // Values mapped through viridis over [low, high] (default: the values'
 // range), clamped.
