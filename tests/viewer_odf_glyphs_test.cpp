@@ -24,6 +24,8 @@
 #include "overlays/odf_glyphs/glyph_set.hpp"
 #include "overlays/odf_glyphs/odf_glyphs_overlay.hpp"
 #include "overlays/sh_basis/sh_basis.hpp"
+#include "cli_runner.hpp"
+#include "png_file.hpp"
 #include "render_target.hpp"
 #include "renderer.hpp"
 #include "shader_program.hpp"
@@ -460,4 +462,80 @@ TEST(ImageSlice, PixelsShowTheVoxelsUnderAKnownCamera) {
     EXPECT_GT(compared, 10000);
     EXPECT_EQ(matched, compared);
     EXPECT_EQ(outside_black, outside);
+}
+
+TEST(OdfCli, RenderDrawsGlyphsOverASliceAndChecksItsOptions) {
+    FIBLET_REQUIRE_PHANTOM_FOD();
+    FIBLET_REQUIRE_GL();
+    if (!shared_data_available()) GTEST_SKIP() << "no shared data";
+    const TempDir dir;
+    const std::string fft = compress_into(dir, shared_data("bundles/CST_R.tck"), "cst.fft");
+    const std::string crop = phantom_file("phantom-fod-crop.nii"), png = dir.file("g.png");
+    // The crop's middle coronal slice from the front, its glyphs over its first volume.
+    const CommandResult r = run_cli("render " + fft + " --odf " + crop + " --odf-slice y:6 --image " + crop +
+                                    " --slice y:6 --slab 4 --camera 0.5,-25,0.5,0.5,0.5,0.5,0,0,1 --size 160x160 -o " + png);
+    ASSERT_EQ(r.status, 0) << r.output;
+    const viewer::RgbaImage im = viewer::read_png(png);
+    std::size_t grey = 0, coloured = 0;
+    for (std::size_t i = 0; i < im.rgba.size(); i += 4) {
+        const int red = im.rgba[i], green = im.rgba[i + 1], blue = im.rgba[i + 2];
+        grey += red == green && green == blue && red > 0;
+        coloured += std::max({red, green, blue}) - std::min({red, green, blue}) > 40;
+    }
+    EXPECT_GT(grey, 5000u);
+    EXPECT_GT(coloured, 500u);
+
+    const auto fails_with = [&](const std::string& options, const std::string& message) {
+        const CommandResult bad = run_cli("render " + fft + " -f -o " + png + " " + options);
+        EXPECT_NE(bad.status, 0) << options;
+        EXPECT_NE(bad.output.find(message), std::string::npos) << options << ": " << bad.output;
+    };
+    fails_with("--slab 3", "--slab needs");
+    fails_with("--odf " + phantom_file("phantom-mask.nii"), "not an SH image");
+    fails_with("--odf " + crop + " --odf-slice z:12", "outside 0..11");
+    fails_with("--odf " + crop + " --odf-lmax 10", "at most the image's lmax 8");
+    fails_with("--odf " + crop + " --sh-basis tournier07", "not mrtrix or descoteaux07");
+    fails_with("--image " + crop + " --slice w:3", "not AXIS:INDEX");
+}
+
+// --slab: every fiber pixel drawn, in each style, lies within the slab.
+TEST(ViewerSlab, OnlyFibersWithinTheSlabAreDrawn) {
+    FIBLET_REQUIRE_GL();
+    if (!shared_data_available()) GTEST_SKIP() << "no shared data";
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("bundles/CST_R.tck"), "cst.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const Vec3f c = scene.bounds().center();
+    Camera cam;
+    cam.position = {c.x + 30, c.y - 60, c.z + 20};
+    cam.target = c;
+    cam.up = {0, 0, 1};
+    cam.fov_y_deg = 50, cam.aspect = 1, cam.near_mm = 5, cam.far_mm = 300;
+    for (const viewer::DrawStyle style : {viewer::DrawStyle::lines, viewer::DrawStyle::tubes, viewer::DrawStyle::capsules}) {
+        viewer::Renderer renderer(*viewer_gl().programs);
+        viewer::RenderOptions o;
+        o.style = style;
+        o.level_of_detail = false;
+        viewer::RenderTarget all(128, 128), slab(128, 128);
+        renderer.render(scene, cam, o, all);
+        o.slab_plane = {0, 0, 1, c.z};
+        o.slab_half_width_mm = 2;
+        renderer.render(scene, cam, o, slab);
+        const auto fibers_all = all.read_fibers(), fibers = slab.read_fibers();
+        const auto depth = slab.read_depth();
+        std::size_t drawn = 0, drawn_all = 0, outside = 0;
+        for (int y = 0; y < 128; ++y)
+            for (int x = 0; x < 128; ++x) {
+                const std::size_t i = std::size_t(y * 128 + x);
+                drawn_all += fibers_all[i] != 0;
+                if (fibers[i] == 0) continue;
+                ++drawn;
+                const Ray ray = pixel_ray(cam, 128, 128, x, y);
+                const V3 p = add(ray.origin, mul(depth_to_distance(cam, depth[i], ray), ray.dir));
+                outside += std::abs(p[2] - c.z) > 2 + 0.05;
+            }
+        EXPECT_GT(drawn, 20u) << viewer::draw_style_name(style);
+        EXPECT_LT(drawn, drawn_all / 2) << viewer::draw_style_name(style);
+        EXPECT_EQ(outside, 0u) << viewer::draw_style_name(style);
+    }
 }
