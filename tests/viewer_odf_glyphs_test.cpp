@@ -539,3 +539,89 @@ TEST(ViewerSlab, OnlyFibersWithinTheSlabAreDrawn) {
         EXPECT_EQ(outside, 0u) << viewer::draw_style_name(style);
     }
 }
+
+// Glyphs and fibers share the depth buffer: a fiber through the glyph's
+// centre is hidden where the glyph lies in front of it, one in front of
+// the glyph is drawn over it.
+TEST(OdfGlyphs, GlyphsAndFibersOccludeEachOther) {
+    FIBLET_REQUIRE_PHANTOM_FOD();
+    FIBLET_REQUIRE_GL();
+    static const std::vector<float> crossing = crossing_voxel(phantom_fod());
+    viewer::GlyphSet set;
+    set.lmax = 8;
+    set.coefficients_per_glyph = 45;
+    const double bound = viewer::sh_amplitude_bound(crossing.data(), 8);
+    for (int i = 0; i < 45; ++i) set.coefficients.push_back(float(crossing[std::size_t(i)] / bound));
+    set.centers.push_back({0, 0, 0, 1});
+    const auto glyph = std::make_shared<viewer::OdfGlyphsOverlay>(set);
+    Camera cam;
+    cam.position = {0.3f, -0.2f, 6};
+    cam.target = {0, 0, 0};
+    cam.up = {0, 1, 0};
+    cam.fov_y_deg = 25, cam.aspect = 1, cam.near_mm = 1, cam.far_mm = 20;
+    const int w = 128, h = 128;
+    const OverlayFrame alone = render_overlays({glyph}, cam, w, h);
+    for (const float z : {0.0f, 2.0f}) {
+        const TempDir dir;
+        // Fibers across the whole view, in the plane z, along x and y.
+        std::vector<std::vector<Vec3f>> fibers;
+        for (int f = -4; f <= 4; ++f) {
+            std::vector<Vec3f> along_x, along_y;
+            for (int i = -30; i <= 30; ++i) {
+                along_x.push_back({0.1f * float(i), 0.25f * float(f), z});
+                along_y.push_back({0.25f * float(f), 0.1f * float(i), z});
+            }
+            fibers.push_back(along_x), fibers.push_back(along_y);
+        }
+        write_tck(dir.file("grid.tck"), fibers);
+        const FftFile file(compress_into(dir, dir.file("grid.tck"), "grid.fft"));
+        const viewer::GpuScene scene(file, *viewer_gl().programs);
+        viewer::Renderer renderer(*viewer_gl().programs);
+        renderer.set_overlays({glyph});
+        viewer::RenderTarget target(w, h);
+        viewer::RenderOptions o;
+        o.level_of_detail = false;
+        renderer.render(scene, cam, o, target);
+        const auto ids = target.read_fibers();
+        std::size_t over_glyph = 0, beside = 0, glyph_in_front = 0, on_silhouette = 0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const std::size_t i = std::size_t(y * w + x);
+                const bool fiber = ids[i] != 0;
+                if (alone.depth[i] >= 1.0f) {
+                    beside += fiber;
+                    continue;
+                }
+                on_silhouette += fiber;
+                const Ray ray = pixel_ray(cam, w, h, x, y);
+                const double hit_z = add(ray.origin, mul(depth_to_distance(cam, alone.depth[i], ray), ray.dir))[2];
+                if (hit_z > z + 0.02) glyph_in_front += 1, over_glyph += fiber;
+            }
+        std::printf("fibers at z = %.0f: %zu fiber pixels beside the glyph, %zu on it; %zu of %zu glyph pixels in front "
+                    "of the fibers' plane show a fiber\n", double(z), beside, on_silhouette, over_glyph, glyph_in_front);
+        EXPECT_GT(beside, 200u);
+        if (z == 0.0f) {
+            EXPECT_GT(glyph_in_front, 100u);
+            EXPECT_EQ(over_glyph, 0u);
+        } else {
+            EXPECT_EQ(glyph_in_front, 0u);  // the glyph lies below z = 1
+            EXPECT_GT(on_silhouette, 10u);  // lines over the glyph are drawn
+        }
+    }
+}
+
+// The same SH image as MRtrix .mif (mrconvert) gives the same glyphs.
+TEST(OdfGlyphs, MifAndNiftiGiveTheSameGlyphs) {
+    FIBLET_REQUIRE_PHANTOM_FOD();
+    if (std::system("command -v mrconvert >/dev/null 2>&1") != 0) GTEST_SKIP() << "no mrconvert (Debian mrtrix3)";
+    const TempDir dir;
+    const std::string cmd = "mrconvert -quiet -force " + phantom_file("phantom-fod-crop.nii") + " " + dir.file("crop.mif");
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    viewer::GlyphSetOptions o;
+    o.axis = 1, o.index = 6;
+    const viewer::GlyphSet nii = viewer::make_glyph_set(read_image(phantom_file("phantom-fod-crop.nii")), o);
+    const viewer::GlyphSet mif = viewer::make_glyph_set(read_image(dir.file("crop.mif")), o);
+    ASSERT_GT(nii.centers.size(), 50u);
+    EXPECT_EQ(nii.centers, mif.centers);
+    EXPECT_EQ(nii.coefficients, mif.coefficients);
+}
