@@ -202,6 +202,8 @@ GlyphAgreement compare_single_glyph(const std::vector<float>& coefficients, int 
     const double bound = viewer::sh_amplitude_bound(coefficients.data(), lmax);
     for (int i = 0; i < set.coefficients_per_glyph; ++i) set.coefficients.push_back(float(coefficients[std::size_t(i)] / bound));
     set.centers.push_back({0, 0, 0, 1});
+    set.extents.push_back(viewer::glyph_box_extents(set.coefficients, lmax, viewer::fibonacci_half_sphere(512)));
+    const auto box = set.extents[0];
     const auto overlay = std::make_shared<viewer::OdfGlyphsOverlay>(set);
     Camera cam;
     cam.position = {2.2f, -2.9f, 1.7f};
@@ -233,7 +235,7 @@ GlyphAgreement compare_single_glyph(const std::vector<float>& coefficients, int 
             const V3 u = unit(p);
             a.max_radius_error = std::max(a.max_radius_error,
                                           std::abs(norm(p) - std::abs(viewer::sh_value<double>(ref_coefficients, lmax, u[0], u[1], u[2]))));
-            a.max_box_excess = std::max({a.max_box_excess, std::abs(p[0]) - 1, std::abs(p[1]) - 1, std::abs(p[2]) - 1});
+            a.max_box_excess = std::max({a.max_box_excess, std::abs(p[0]) - box[0], std::abs(p[1]) - box[1], std::abs(p[2]) - box[2]});
             if (!ref) continue;
             ++a.both;
             dts.push_back(std::abs(t - (along + ref->t)));
@@ -353,17 +355,26 @@ TEST(OdfGlyphs, BoundingBoxesHoldTheSurface) {
     std::mt19937 rng(17);
     std::uniform_int_distribution<std::size_t> glyph(0, set.centers.size() - 1);
     std::normal_distribution<double> n(0, 1);
-    double worst = 0;
+    ASSERT_EQ(set.extents.size(), set.centers.size());
+    double worst_cube = 0, worst_tight = 0;
     for (int i = 0; i < 100000; ++i) {
         const std::size_t g = glyph(rng);
         const V3 u = unit(V3{n(rng), n(rng), n(rng)});
         const std::vector<float> c(set.coefficients.begin() + long(g) * set.coefficients_per_glyph,
                                    set.coefficients.begin() + long(g + 1) * set.coefficients_per_glyph);
         const double r = std::abs(viewer::sh_value<double>(c, set.lmax, u[0], u[1], u[2]));
-        worst = std::max({worst, std::abs(r * u[0]), std::abs(r * u[1]), std::abs(r * u[2])});
+        for (int a = 0; a < 3; ++a) {
+            worst_cube = std::max(worst_cube, std::abs(r * u[std::size_t(a)]));
+            worst_tight = std::max(worst_tight, std::abs(r * u[std::size_t(a)]) / double(set.extents[g][std::size_t(a)]));
+        }
     }
-    std::printf("10^5 surface points of %zu glyphs: largest |coordinate| %.4f of the box's 1\n", set.centers.size(), worst);
-    EXPECT_LE(worst, 1.0);
+    double volume = 0;
+    for (const auto& e : set.extents) volume += double(e[0]) * e[1] * e[2] / double(set.extents.size());
+    std::printf("10^5 surface points of %zu glyphs: largest |coordinate| %.4f of the bound's cube (1), %.4f of the tight "
+                "box's half size; tight boxes hold %.1f %% of the cube's volume on average\n",
+                set.centers.size(), worst_cube, worst_tight, 100 * volume);
+    EXPECT_LE(worst_cube, 1.0);
+    EXPECT_LE(worst_tight, 1.0);
 }
 
 TEST(OdfGlyphs, PeaksFollowTheDecodedFibers) {

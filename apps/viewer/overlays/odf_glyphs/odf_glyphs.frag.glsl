@@ -6,7 +6,7 @@
 #include "surface_shading.glsl"
 
 layout(std430, binding = BINDING_GLYPH_COEFFICIENTS) readonly buffer GlyphCoefficients { float glyphCoefficients[]; };
-layout(std430, binding = BINDING_GLYPH_CENTERS) readonly buffer GlyphCenters { vec4 glyphCenters[]; };
+#include "glyph_boxes.glsl"
 float shCoefficient(uint i) { return glyphCoefficients[i]; }
 #include "sh_basis.glsl"
 #include "polynomial_roots.glsl"
@@ -23,7 +23,7 @@ layout(location = 1) out uint outFiber;
 layout(depth_greater) out float gl_FragDepth;
 
 void main() {
-    vec4 g = glyphCenters[vGlyph];
+    vec4 g = glyphBoxes[vGlyph].centerRadius;
     vec3 dir = normalize(vWorld - uCameraPosition);
     float along = dot(g.xyz - uCameraPosition, dir);  // camera to the ray's point nearest the centre
     vec3 o = (uCameraPosition + along * dir - g.xyz) / g.w;

@@ -19,8 +19,14 @@ OdfGlyphsOverlay::OdfGlyphsOverlay(const GlyphSet& g)
     const float none[4] = {0, 0, 0, 0};
     coefficients_ = g.coefficients.empty() ? make_buffer(sizeof none, none, 0)
                                            : make_buffer(GLsizeiptr(g.coefficients.size() * sizeof(float)), g.coefficients.data(), 0);
-    centers_ = g.centers.empty() ? make_buffer(sizeof none, none, 0)
-                                 : make_buffer(GLsizeiptr(g.centers.size() * sizeof g.centers[0]), g.centers.data(), 0);
+    // glyph_boxes.glsl: centre and radius, then the box's extents (the cube without them).
+    std::vector<float> boxes;
+    for (std::size_t i = 0; i < g.centers.size(); ++i) {
+        const auto e = g.extents.empty() ? std::array<float, 3>{1, 1, 1} : g.extents[i];
+        boxes.insert(boxes.end(), {g.centers[i][0], g.centers[i][1], g.centers[i][2], g.centers[i][3], e[0], e[1], e[2], 0.0f});
+    }
+    centers_ = boxes.empty() ? make_buffer(sizeof none, none, 0)
+                             : make_buffer(GLsizeiptr(boxes.size() * sizeof(float)), boxes.data(), 0);
     const std::vector<double> inv = glyph_inverse_vandermonde(lmax_);
     const std::vector<float> inv_f(inv.begin(), inv.end());
     const GLuint id = program_.get();
