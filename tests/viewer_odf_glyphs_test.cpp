@@ -122,13 +122,13 @@ struct OverlayFrame {
     std::vector<std::uint8_t> rgba;
 };
 OverlayFrame render_overlays(const std::vector<std::shared_ptr<viewer::Overlay>>& overlays, const Camera& cam, int w, int h,
-                      bool lighting = true) {
+                             bool color_by_normal = false) {
     static EmptyScene empty;
     viewer::Renderer renderer(*viewer_gl().programs);
     renderer.set_overlays(overlays);
     viewer::RenderTarget target(w, h);
     viewer::RenderOptions o;
-    o.lighting = lighting;
+    o.color_by_normal = color_by_normal;
     renderer.render(*empty.scene, cam, o, target);
     return {target.read_depth(), target.read_rgba()};
 }
@@ -190,7 +190,15 @@ std::vector<float> crossing_voxel(const Image& fod) {
 struct GlyphAgreement {
     int pixels = 0, agree = 0, both = 0;
     double p99_dt = 0, max_dt = 0, max_radius_error = 0, max_box_excess = 0;
+    double p99_normal_deg = 0;   // GPU normal (8-bit colour) vs the CPU's closed form
+    double p99_cpu_normal_deg = 0;  // the CPU's normal vs a central difference of F in double
 };
+
+// F(x) = f_h(x)² − ‖x‖^{2k+2} (glyph_ray.hpp), for a normal by differences.
+double glyph_function(const std::vector<double>& c, int k, const V3& x) {
+    const double h = viewer::homogenized<double>(c, k, x);
+    return h * h - std::pow(viewer::dot3(x, x), k + 1);
+}
 
 // One glyph of `coefficients` truncated to `lmax` at the origin (radius 1
 // mm: glyph units are mm) drawn at 256² from an oblique camera, against
@@ -214,11 +222,12 @@ GlyphAgreement compare_single_glyph(const std::vector<float>& coefficients, int 
     cam.near_mm = 2, cam.far_mm = 6;
     const int w = 256, h = 256;
     const OverlayFrame frame = render_overlays({overlay}, cam, w, h);
+    const OverlayFrame normals = render_overlays({overlay}, cam, w, h, true);
     std::vector<double> ref_coefficients(set.coefficients.begin(), set.coefficients.end());
     // The CPU gets the float coefficients the GPU has.
     const auto minv = viewer::glyph_inverse_vandermonde(lmax);
     GlyphAgreement a;
-    std::vector<double> dts;
+    std::vector<double> dts, normal_deg, cpu_normal_deg;
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             const Ray ray = pixel_ray(cam, w, h, x, y);
@@ -239,11 +248,29 @@ GlyphAgreement compare_single_glyph(const std::vector<float>& coefficients, int 
             if (!ref) continue;
             ++a.both;
             dts.push_back(std::abs(t - (along + ref->t)));
+            const std::size_t i = std::size_t(4 * (y * w + x));
+            const V3 gpu_normal = unit({normals.rgba[i] / 127.5 - 1, normals.rgba[i + 1] / 127.5 - 1, normals.rgba[i + 2] / 127.5 - 1});
+            const auto angle = [](const V3& u, const V3& v) {
+                return std::acos(std::clamp(viewer::dot3(u, v), -1.0, 1.0)) * 180 / M_PI;
+            };
+            normal_deg.push_back(angle(gpu_normal, ref->normal));
+            const V3 q = add(o, mul(ref->t, ray.dir));
+            V3 gradient;
+            for (int axis = 0; axis < 3; ++axis) {
+                V3 e{0, 0, 0};
+                e[std::size_t(axis)] = 1e-6;
+                gradient[std::size_t(axis)] = glyph_function(ref_coefficients, lmax, sub(q, e)) - glyph_function(ref_coefficients, lmax, add(q, e));
+            }
+            cpu_normal_deg.push_back(angle(unit(gradient), ref->normal));  // outward: −∇F
         }
     if (!dts.empty()) {
         std::sort(dts.begin(), dts.end());
         a.p99_dt = dts[std::size_t(0.99 * double(dts.size() - 1))];
         a.max_dt = dts.back();
+        std::sort(normal_deg.begin(), normal_deg.end());
+        std::sort(cpu_normal_deg.begin(), cpu_normal_deg.end());
+        a.p99_normal_deg = normal_deg[std::size_t(0.99 * double(normal_deg.size() - 1))];
+        a.p99_cpu_normal_deg = cpu_normal_deg[std::size_t(0.99 * double(cpu_normal_deg.size() - 1))];
     }
     return a;
 }
@@ -335,14 +362,17 @@ TEST_P(OdfGlyphsSingle, GpuMatchesCpuRootFindingInDouble) {
     static const std::vector<float> crossing = crossing_voxel(phantom_fod());
     const GlyphAgreement a = compare_single_glyph(crossing, lmax);
     std::printf("lmax %d, 256x256: hit/miss agree %.4f%% (%d of %d), both hit %d, |dt| p99 %.3g max %.3g (glyph units = "
-                "mm, bounding radius 1), max | |p| - |f(p^)| | %.3g, max box excess %.3g\n",
+                "mm, bounding radius 1), max | |p| - |f(p^)| | %.3g, max box excess %.3g; normals p99: GPU vs CPU %.2f deg, "
+                "CPU vs a difference of F %.3f deg\n",
                 lmax, 100.0 * a.agree / a.pixels, a.agree, a.pixels, a.both, a.p99_dt, a.max_dt, a.max_radius_error,
-                a.max_box_excess);
+                a.max_box_excess, a.p99_normal_deg, a.p99_cpu_normal_deg);
     EXPECT_GT(a.both, 2000);
     EXPECT_GE(double(a.agree) / a.pixels, 0.999);
     EXPECT_LE(a.p99_dt, 1e-4);
     EXPECT_LE(a.max_radius_error, 1e-3);
     EXPECT_LE(a.max_box_excess, 1e-4);  // no hit outside the box
+    EXPECT_LE(a.p99_normal_deg, 2.0);     // 8-bit colour holds about 0.5°
+    EXPECT_LE(a.p99_cpu_normal_deg, 0.1);
 }
 INSTANTIATE_TEST_SUITE_P(OdfLmax, OdfGlyphsSingle, ::testing::Values(4, 8));
 
