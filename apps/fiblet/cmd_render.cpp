@@ -129,7 +129,8 @@ void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::
 void run(const RenderArgs& a) {
     int width = 0, height = 0;
     parse_size(a.view.size, width, height);
-    const viewer::RenderOptions options = render_options_from(a.view);
+    viewer::RenderOptions options = render_options_from(a.view);
+    const viewer::OverlaySources overlay_sources = overlay_sources_from(a.view);
     if (!a.bench && a.output.empty()) throw Error(Errc::invalid_argument, "-o OUT.png is required (or --bench)");
     if (a.orbit < 0 || a.orbit > 100000) throw Error(Errc::invalid_argument, "--orbit must be in 0..100000 frames");
     if ((a.orbit > 0 || !a.camera_path.empty()) && a.output.empty())
@@ -153,6 +154,7 @@ void run(const RenderArgs& a) {
     if (!a.view.fiber_radii.empty()) viewer::load_fiber_radii(a.view.fiber_radii, scene);
     viewer::RenderTarget target(width, height);
     viewer::Renderer renderer(programs);
+    renderer.set_overlays(viewer::make_overlays(overlay_sources, options));
     const float aspect = float(width) / float(height);
     auto camera_for = [&](float zoom) {
         return viewer::camera_from_spec(a.view.camera, scene, aspect, a.view.fov, a.view.zoom * zoom);

@@ -86,6 +86,47 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
                     "GPU decoder: scan (prefix product, a workgroup per block), sequential (an invocation per "
                     "block), or auto (sequential on software renderers, else scan)")
         ->capture_default_str();
+    cmd->add_option("--odf", a.odf,
+                    "Draw ODF glyphs of a slice of this SH image (NIfTI or .mif, 4-D, lmax 0..12; e.g. FODs), "
+                    "ray traced (docs/viewer.md)")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--odf-slice", a.odf_slice, "Slice of the --odf image: AXIS:INDEX (voxel axis x, y or z; default "
+                                                "the middle z slice)");
+    cmd->add_option("--odf-scale", a.odf_scale, "Glyph size: the largest glyph of the slice spans this many voxels")
+        ->capture_default_str();
+    cmd->add_option("--odf-lmax", a.odf_lmax, "Draw the glyphs up to this even SH degree (default: the image's)");
+    cmd->add_option("--sh-basis", a.sh_basis, "SH basis of the --odf image: mrtrix (MRtrix3, tournier) or "
+                                              "descoteaux07 (dipy's legacy)")
+        ->capture_default_str();
+    cmd->add_option("--image", a.image, "Draw a greyscale slice of this image under the fibers (NIfTI or .mif; the "
+                                        "first volume of a 4-D image)")
+        ->check(CLI::ExistingFile);
+    cmd->add_option("--slice", a.slice, "Slice of the --image: AXIS:INDEX (voxel axis x, y or z; default the middle "
+                                        "z slice)");
+    cmd->add_option("--slab", a.slab, "Only fibers within a slab this thick (mm) around the slice (--image's, else "
+                                      "--odf's)");
+}
+
+viewer::OverlaySources overlay_sources_from(const ViewerArgs& a) {
+    viewer::OverlaySources s;
+    s.odf_path = a.odf, s.image_path = a.image;
+    if (!a.odf_slice.empty()) s.odf_slice = viewer::parse_slice_spec(a.odf_slice, "--odf-slice");
+    if (!a.slice.empty()) s.image_slice = viewer::parse_slice_spec(a.slice, "--slice");
+    if (!(a.odf_scale > 0 && a.odf_scale <= 100)) throw Error(Errc::invalid_argument, "--odf-scale must be in (0, 100]");
+    s.odf_scale = a.odf_scale;
+    if (a.odf_lmax != -1 && (a.odf_lmax < 0 || a.odf_lmax % 2 || a.odf_lmax > viewer::kMaxShLmax))
+        throw Error(Errc::invalid_argument, "--odf-lmax must be even, 0..12");
+    s.odf_lmax = a.odf_lmax;
+    const auto basis = viewer::parse_sh_basis(a.sh_basis);
+    if (!basis) throw Error(Errc::invalid_argument, "--sh-basis: '" + a.sh_basis + "' is not mrtrix or descoteaux07");
+    s.sh_basis = *basis;
+    if (!(a.slab >= 0)) throw Error(Errc::invalid_argument, "--slab must be a thickness in mm");
+    s.slab_mm = a.slab;
+    if (s.odf_path.empty() && (!a.odf_slice.empty() || a.odf_lmax != -1))
+        throw Error(Errc::invalid_argument, "--odf-slice and --odf-lmax need --odf");
+    if (s.image_path.empty() && !a.slice.empty()) throw Error(Errc::invalid_argument, "--slice needs --image");
+    if (s.slab_mm > 0 && !s.any()) throw Error(Errc::invalid_argument, "--slab needs --image or --odf");
+    return s;
 }
 
 void parse_size(const std::string& text, int& width, int& height) {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "fiber_colors.hpp"
+#include "overlays/overlay_sources.hpp"
 #include "render_options.hpp"
 
 namespace fiblet::cli {
@@ -22,6 +23,10 @@ struct ViewerArgs {
     int supersample = 1;
     std::string fiber_colors, fiber_values, value_range, fiber_radii;
     double min_length = 0, max_length = 0;
+    // Overlays: ODF glyphs of an SH image, a background image slice, a fiber slab.
+    std::string odf, odf_slice, sh_basis = "mrtrix", image, slice;
+    float odf_scale = 1, slab = 0;
+    int odf_lmax = -1;
 };
 
 // Adds the input file and the camera, shading and selection options.
@@ -32,6 +37,9 @@ void parse_size(const std::string& text, int& width, int& height);
 
 // The render options the arguments describe; throws fiblet::Error{invalid_argument}.
 viewer::RenderOptions render_options_from(const ViewerArgs& args);
+
+// The overlays --odf, --image and --slab ask for; throws fiblet::Error{invalid_argument}.
+viewer::OverlaySources overlay_sources_from(const ViewerArgs& args);
 
 // Where --fiber-colors / --fiber-values take the colours from; throws
 // fiblet::Error{invalid_argument}.

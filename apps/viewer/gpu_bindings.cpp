@@ -19,6 +19,8 @@ std::string gpu_binding_defines() {
     def("BINDING_POINTS", binding::kPoints);
     def("BINDING_DECISIONS", binding::kDecisions);
     def("BINDING_FIBER_END_FRACTION", binding::kFiberEndFraction);
+    def("BINDING_GLYPH_COEFFICIENTS", binding::kGlyphCoefficients);
+    def("BINDING_GLYPH_CENTERS", binding::kGlyphCenters);
     def("BINDING_TANGENTS", binding::kTangents);
     def("BINDING_TUBE_PIECES", binding::kTubePieces);
     def("BINDING_FIBER_COLORS", binding::kFiberColors);

@@ -22,7 +22,9 @@ inline constexpr unsigned kTangents = 10;    // unit tangent of each decoded poi
 inline constexpr unsigned kTubePieces = 11;  // techniques/tubes: quadratic pieces and their boxes
 inline constexpr unsigned kFiberColors = 12;  // per fiber: RGB (vec4), when the scene has colours
 inline constexpr unsigned kFiberRadii = 13;   // per fiber: tube radius (mm), when the scene has radii
-inline constexpr unsigned kStorageCount = 14;
+inline constexpr unsigned kGlyphCoefficients = 14;  // overlays/odf_glyphs: SH coefficients, glyph units
+inline constexpr unsigned kGlyphCenters = 15;       // overlays/odf_glyphs: centre, radius (mm) and box (glyph_boxes.glsl)
+inline constexpr unsigned kStorageCount = 16;
 // Uniform buffers.
 inline constexpr unsigned kLocalFrames = 0;  // the 256 frames of the direction code (DirectionTable)
 }  // namespace binding

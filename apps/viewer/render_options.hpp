@@ -34,6 +34,10 @@ struct RenderOptions {
     bool color_by_normal = false;                      // ray-cast styles: unit normal n as RGB (n + 1) / 2 (checks)
     float line_width = 1;                              // pixels
     std::array<float, 3> background{0, 0, 0};
+    // --slab: only fibers within slab_half_width_mm of the plane n·x = d
+    // (slab_plane = n, d; world mm); 0: no slab.
+    std::array<float, 4> slab_plane{0, 0, 1, 0};
+    float slab_half_width_mm = 0;
     bool clear = true;  // clear the target first (false: draw over what it holds, depth included)
 
     bool time_stages = false;       // time cull / decode / draw (GpuTimer, default_timing_method)

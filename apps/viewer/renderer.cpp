@@ -161,6 +161,14 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const R
         timer.end();
     }
 
+    // Overlays share the depth buffer: glyphs, slices and fibers occlude each other.
+    if (!overlays_.empty()) {
+        timer.begin(Stage::draw);
+        for (const auto& overlay : overlays_) overlay->draw(camera, o);
+        glBindVertexArray(empty_vertex_array_.get());
+        timer.end();
+    }
+
     const auto ms = timer.collect();
     stats.cull_ms = ms[0], stats.decode_ms = ms[1], stats.draw_ms = ms[2];
     return stats;

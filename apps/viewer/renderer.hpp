@@ -3,6 +3,7 @@
 // hand each batch to the drawing style's technique (techniques/), then the
 // coarse blocks (one segment each). Everything stays on the GPU except four counters read back per frame
 // (the list sizes, which size the batches and are shown to the user).
+// Overlays (overlays/) follow the fibers in the same frame.
 #pragma once
 
 #include <map>
@@ -15,6 +16,7 @@
 #include "gpu_bindings.hpp"
 #include "gpu_programs.hpp"
 #include "gpu_scene.hpp"
+#include "overlays/overlay.hpp"
 #include "render_options.hpp"
 #include "render_target.hpp"
 #include "techniques/draw_technique.hpp"
@@ -40,6 +42,10 @@ public:
         techniques_[style] = std::move(technique);
     }
 
+    // Overlays (glyphs, image slices) drawn after the fibers of every frame,
+    // in this order, with depth.
+    void set_overlays(std::vector<std::shared_ptr<Overlay>> overlays) { overlays_ = std::move(overlays); }
+
     // Each block's decision in the last selection pass run with
     // options.record_decisions.
     std::vector<BlockDecision> read_decisions(const GpuScene& scene) const;
@@ -54,6 +60,7 @@ private:
     std::map<DrawStyle, std::unique_ptr<DrawTechnique>> techniques_;
     GlBuffer fine_list_, coarse_list_, counters_, decisions_;
     std::uint32_t list_capacity_ = 0, decisions_capacity_ = 0;
+    std::vector<std::shared_ptr<Overlay>> overlays_;
     GlVertexArray empty_vertex_array_;  // core profile draws need one bound
 };
 

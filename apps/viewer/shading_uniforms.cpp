@@ -30,6 +30,9 @@ void set_shading_uniforms(const GlProgram& p, const Camera& camera, const Render
     glProgramUniform1f(id, uniform(p, "uDiffuse"), 0.75f);
     glProgramUniform1f(id, uniform(p, "uSpecular"), 0.35f);
     glProgramUniform1f(id, uniform(p, "uShininess"), 24.0f);
+    const auto& s = o.slab_plane;
+    glProgramUniform4f(id, uniform(p, "uSlabPlane"), s[0], s[1], s[2], s[3]);
+    glProgramUniform1f(id, uniform(p, "uSlabHalfWidth"), o.slab_half_width_mm);
 }
 
 }  // namespace fiblet::viewer

@@ -1,7 +1,8 @@
 // The lighting and colour uniforms every drawing style's fragment shader
 // shares (uViewProjection, uColorByDirection, uFiberColors, uFixedColor, uLighting,
 // uCameraPosition, uLightDirection, uAmbient, uDiffuse, uSpecular,
-// uShininess): one headlight, set the same way for every technique.
+// uShininess) and the --slab clip (uSlabPlane, uSlabHalfWidth): one
+// headlight, set the same way for every technique.
 #pragma once
 
 #include "fiblet/view.hpp"

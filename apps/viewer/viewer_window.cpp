@@ -193,6 +193,7 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
     Interaction s;
     s.render = options.render;
     s.render.time_stages = true;
+    renderer.set_overlays(make_overlays(options.overlays, s.render));
     s.home = s.orbit = initial_orbit(options, scene, float(target.width()) / float(target.height()));
     glfwSetWindowUserPointer(w, &s);
     glfwSetKeyCallback(w, on_key);

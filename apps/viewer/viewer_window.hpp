@@ -5,6 +5,7 @@
 #include <string>
 
 #include "fiber_colors.hpp"
+#include "overlays/overlay_sources.hpp"
 #include "render_options.hpp"
 
 namespace fiblet::viewer {
@@ -17,6 +18,7 @@ struct WindowOptions {
     std::string screenshot_prefix = "fiblet-screenshot";  // + "-NNN.png" in the working directory
     int screenshot_supersample = 1;
     FiberColorSource fiber_colors;  // render.fiber_colors turns them on
+    OverlaySources overlays;        // glyphs and slices over the fibers
     std::string fiber_radii_path;   // fiber_radii.hpp; render.fiber_radii turns them on  // screenshots drawn again, supersampled (supersampling.hpp)
 };
 

@@ -5,6 +5,7 @@
 // between the end planes). Computed from a point near the capsule on the
 // ray, for precision. Writes depth, shading and the fiber.
 #include "surface_shading.glsl"
+#include "slab_clip.glsl"
 
 layout(location = 0) flat in vec3 vEnd0;
 layout(location = 1) flat in vec3 vEnd1;
@@ -52,6 +53,7 @@ void main() {
     }
     if (best >= 1e30 || along + best <= 0.0) discard;
     vec3 hit = o + best * dir;
+    if (outsideSlab(hit)) discard;
     gl_FragDepth = windowDepth(hit);
     outColor = vec4(shadeSurface(normalize(normal), ba, -dir, vFiber), 1.0);
     outFiber = vFiber + 1u;

@@ -9,6 +9,7 @@ layout(location = 1) in vec3 vWorld;
 layout(location = 2) flat in uint vFiber;
 
 #include "fiber_colors.glsl"
+#include "slab_clip.glsl"
 
 layout(location = 0) out vec4 outColor;
 layout(location = 1) out uint outFiber;
@@ -22,6 +23,7 @@ uniform float uSpecular;
 uniform float uShininess;
 
 void main() {
+    if (outsideSlab(vWorld)) discard;
     vec3 base = baseColor(vTangent, vFiber);
     vec3 color = base;
     if (uLighting) {

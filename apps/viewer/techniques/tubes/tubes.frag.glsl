@@ -13,6 +13,7 @@
 // Writes the hit's depth, Lambert + Blinn-Phong shading, and the fiber.
 #include "tube_piece.glsl"
 #include "surface_shading.glsl"
+#include "slab_clip.glsl"
 
 layout(std430, binding = BINDING_TUBE_PIECES) readonly buffer Pieces { TubePiece pieces[]; };
 
@@ -163,6 +164,7 @@ void main() {
     if (bestT < 0.0) discard;
 
     vec3 hit = origin + best * unit * dir;
+    if (outsideSlab(hit)) discard;
     gl_FragDepth = windowDepth(hit);
 
     float t = bestT;

@@ -1,0 +1,36 @@
+#include "overlays/overlay_sources.hpp"
+
+#include "fiblet/error.hpp"
+#include "overlays/image_slice/image_slice_overlay.hpp"
+#include "overlays/odf_glyphs/glyph_set.hpp"
+#include "overlays/odf_glyphs/odf_glyphs_overlay.hpp"
+
+namespace fiblet::viewer {
+
+std::vector<std::shared_ptr<Overlay>> make_overlays(const OverlaySources& s, RenderOptions& options) {
+    std::vector<std::shared_ptr<Overlay>> overlays;
+    std::optional<WorldPlane> plane;
+    if (!s.image_path.empty()) {
+        const Image image = read_image(s.image_path);
+        const std::int64_t index = slice_index(s.image_slice, image, "--slice");
+        overlays.push_back(std::make_shared<ImageSliceOverlay>(make_slice_image(image, s.image_slice.axis, index)));
+        plane = slice_plane(image, s.image_slice.axis, index);
+    }
+    if (!s.odf_path.empty()) {
+        const Image image = read_image(s.odf_path);
+        GlyphSetOptions g;
+        g.axis = s.odf_slice.axis;
+        g.index = slice_index(s.odf_slice, image, "--odf-slice");
+        g.lmax = s.odf_lmax, g.basis = s.sh_basis, g.scale = s.odf_scale;
+        overlays.push_back(std::make_shared<OdfGlyphsOverlay>(make_glyph_set(image, g)));
+        if (!plane) plane = slice_plane(image, g.axis, g.index);
+    }
+    if (s.slab_mm > 0) {
+        if (!plane) throw Error(Errc::invalid_argument, "--slab needs a slice: --image or --odf");
+        options.slab_plane = {float(plane->normal[0]), float(plane->normal[1]), float(plane->normal[2]), float(plane->offset)};
+        options.slab_half_width_mm = 0.5f * s.slab_mm;
+    }
+    return overlays;
+}
+
+}  // namespace fiblet::viewer

@@ -1,0 +1,73 @@
+// Real spherical harmonics of even degree, as MRtrix3 3.0 stores FOD images
+// (its default `tournier` convention): coefficient l(l+1)/2 + m for
+// l = 0, 2, ..., lmax and m = -l..l;
+//   m = 0:  N_l P_l(cos θ)
+//   m > 0:  √2 N_lm P_l^m(cos θ) cos(mφ)
+//   m < 0:  √2 N_l|m| P_l^|m|(cos θ) sin(|m|φ)
+// with orthonormal N and P_l^m carrying the Condon–Shortley phase (−1)^m,
+// as MRtrix3's Legendre functions and scipy's lpmv do (sh2amp agrees; the
+// shared phantom script's docstring says otherwise, its code has the phase). One recurrence, written
+// twice: here (templated, double for the CPU references) and in
+// sh_basis.glsl (the glyph shaders), so that tests can compare the two.
+#pragma once
+
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace fiblet::viewer {
+
+enum class ShBasis { mrtrix, descoteaux07 };
+std::optional<ShBasis> parse_sh_basis(const std::string& name);  // "mrtrix" (or "tournier"), "descoteaux07"
+
+inline constexpr int kMaxShLmax = 12;
+inline constexpr int sh_coefficient_count(int lmax) { return (lmax + 1) * (lmax + 2) / 2; }
+inline constexpr int sh_index(int l, int m) { return l * (l + 1) / 2 + m; }
+// The lmax of an image with `count` coefficients, or -1 when no even lmax <= 12 has that many.
+int sh_lmax_for_count(long count);
+
+// Σ c_i Y_i(u) for a unit direction u, coefficients `c` up to `lmax`.
+// Associated Legendre functions by the normalised three-term recurrence with
+// sin^m θ · e^{imφ} carried as (x + iy)^m, so that no trigonometry is needed.
+template <class T, class Coefficients>
+T sh_value(const Coefficients& c, int lmax, T x, T y, T z) {
+    const T sqrt2 = std::sqrt(T(2));
+    T pmm = T(0.28209479177387814347);  // N_00 = 1 / sqrt(4π)
+    T re = 1, im = 0;                   // (x + iy)^m
+    T sum = 0;
+    for (int m = 0; m <= lmax; ++m) {
+        if (m > 0) {
+            pmm *= -std::sqrt(T(2 * m + 1) / T(2 * m));  // − : the Condon–Shortley phase
+            const T r = re * x - im * y;
+            im = re * y + im * x, re = r;
+        }
+        T p2 = 0, p1 = 0;  // the values at l - 2 and l - 1
+        for (int l = m; l <= lmax; ++l) {
+            T p;
+            if (l == m) p = pmm;
+            else if (l == m + 1) p = std::sqrt(T(2 * m + 3)) * z * pmm;
+            else {
+                const T ll = T(l), mm = T(m);
+                const T a = std::sqrt((4 * ll * ll - 1) / (ll * ll - mm * mm));
+                const T b = std::sqrt(((ll - 1) * (ll - 1) - mm * mm) / (4 * (ll - 1) * (ll - 1) - 1));
+                p = a * (z * p1 - b * p2);
+            }
+            p2 = p1, p1 = p;
+            if (l % 2) continue;
+            if (m == 0) sum += T(c[sh_index(l, 0)]) * p;
+            else sum += sqrt2 * p * (re * T(c[sh_index(l, m)]) + im * T(c[sh_index(l, -m)]));
+        }
+    }
+    return sum;
+}
+
+// Coefficients of dipy's legacy `descoteaux07` basis (m > 0 ↔ sin, m < 0 ↔
+// cos, the same phase) rewritten in MRtrix3's basis, in place: ±m swapped.
+void descoteaux07_to_mrtrix(std::vector<float>& c, int lmax);
+
+// max over the sphere of |Σ c_i Y_i| is at most Σ_l ‖c_l‖ sqrt((2l+1)/4π)
+// (Cauchy–Schwarz and the addition theorem): the glyphs' bounding radius.
+double sh_amplitude_bound(const float* c, int lmax);
+
+}  // namespace fiblet::viewer
