@@ -22,6 +22,8 @@ struct ViewerArgs {
     int supersample = 1;
     std::string fiber_colors, fiber_values, value_range, fiber_radii;
     double min_length = 0, max_length = 0;
+    float opacity = 1;
+    std::string transparency;  // empty: sorted (lines) / unsorted (tubes, capsules)
 };
 
 // Adds the input file and the camera, shading and selection options.

@@ -23,6 +23,15 @@ inline constexpr unsigned kTubePieces = 11;  // techniques/tubes: quadratic piec
 inline constexpr unsigned kFiberColors = 12;  // per fiber: RGB (vec4), when the scene has colours
 inline constexpr unsigned kFiberRadii = 13;   // per fiber: tube radius (mm), when the scene has radii
 inline constexpr unsigned kStorageCount = 14;
+// Transparent frames (transparency/) reuse the binding points of buffers they
+// never bind (no level of detail, no tangents, no tubes, no decisions), so
+// that the viewer asks the driver for no more bindings.
+inline constexpr unsigned kChunkKeys = kCoarseList;      // per chunk: its depth bucket
+inline constexpr unsigned kChunkHistogram = kCounters;   // chunks per (bucket, lane), then their offsets
+inline constexpr unsigned kSortedChunks = kDecisions;    // per sorted slot: chunk index in its block
+inline constexpr unsigned kSortedBlocks = kTubePieces;   // per sorted slot: its block
+inline constexpr unsigned kVoxlineSegments = kTangents;  // voxlines: both ends of every segment
+inline constexpr unsigned kVoxlineOrders = kTubePieces;  // voxlines: the three axis orders of every voxel
 // Uniform buffers.
 inline constexpr unsigned kLocalFrames = 0;  // the 256 frames of the direction code (DirectionTable)
 }  // namespace binding

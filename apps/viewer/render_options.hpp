@@ -9,6 +9,7 @@
 #include "decoder_kind.hpp"
 #include "draw_style.hpp"
 #include "fiblet/view.hpp"
+#include "transparency/transparency_mode.hpp"
 
 namespace fiblet::viewer {
 
@@ -34,11 +35,16 @@ struct RenderOptions {
     bool color_by_normal = false;                      // ray-cast styles: unit normal n as RGB (n + 1) / 2 (checks)
     float line_width = 1;                              // pixels
     std::array<float, 3> background{0, 0, 0};
+    // Transparency: every fragment blends with this opacity (0 < opacity <= 1),
+    // ordered by `transparency` (transparency/); 1 draws opaque.
+    float opacity = 1.0f;
+    TransparencyMode transparency = TransparencyMode::sorted;
     bool clear = true;  // clear the target first (false: draw over what it holds, depth included)
 
     bool time_stages = false;       // time cull / decode / draw (GpuTimer, default_timing_method)
     bool record_decisions = false;  // keep each block's culling decision (Renderer::read_decisions)
 
+    bool transparent() const { return opacity < 1.0f; }
     bool subset_active() const {
         return id_min > 0 || id_max < std::numeric_limits<std::uint32_t>::max() || min_length_mm > 0 ||
                max_length_mm < std::numeric_limits<double>::infinity();

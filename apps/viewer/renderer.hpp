@@ -15,9 +15,14 @@
 #include "gpu_bindings.hpp"
 #include "gpu_programs.hpp"
 #include "gpu_scene.hpp"
+#include "gpu_timer.hpp"
 #include "render_options.hpp"
 #include "render_target.hpp"
 #include "techniques/draw_technique.hpp"
+#include "transparency/blend_target.hpp"
+#include "transparency/sorted_chunks.hpp"
+#include "transparency/transparent_lines.hpp"
+#include "transparency/voxlines.hpp"
 
 namespace fiblet::viewer {
 
@@ -48,13 +53,26 @@ private:
     void ensure_buffers(const GpuScene& scene, bool decisions);
     // The style's technique, compiled on first use.
     DrawTechnique& technique(DrawStyle style);
+    // What draws the frame's fine blocks: the style's technique, or the
+    // transparent lines when lines blend.
+    DrawTechnique& block_technique(const RenderOptions& o);
+    // The fine blocks decoded and drawn a batch at a time, in list order.
+    void draw_blocks(const FrameInputs& in, DrawTechnique& draw, DecoderKind decoder, std::uint32_t blocks,
+                     GpuTimer& timer);
+    // A transparent frame's lines in the order of o.transparency (transparency/).
+    void draw_ordered_lines(const FrameInputs& in, DecoderKind decoder, std::uint32_t blocks);
 
     const GpuPrograms& programs_;
     std::unique_ptr<BlockDecoder> decoder_;
     std::map<DrawStyle, std::unique_ptr<DrawTechnique>> techniques_;
     GlBuffer fine_list_, coarse_list_, counters_, decisions_;
     std::uint32_t list_capacity_ = 0, decisions_capacity_ = 0;
-    GlVertexArray empty_vertex_array_;  // core profile draws need one bound
+    GlVertexArray empty_vertex_array_;
+    // Transparency (transparency/), made on first use.
+    BlendTarget blend_target_;
+    std::unique_ptr<TransparentLines> transparent_lines_;
+    std::unique_ptr<SortedChunks> sorted_chunks_;
+    std::unique_ptr<Voxlines> voxlines_;  // core profile draws need one bound
 };
 
 }  // namespace fiblet::viewer
