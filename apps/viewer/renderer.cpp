@@ -200,6 +200,11 @@ void Renderer::draw_ordered_lines(const FrameInputs& in, DecoderKind decoder, st
     sorted_chunks_->draw(in, *decoder_, decoder, fine_list_.get(), blocks, lines);
 }
 
+std::uint64_t Renderer::transparency_bytes() const {
+    return blend_target_.gpu_bytes() + (sorted_chunks_ ? sorted_chunks_->gpu_bytes() : 0) +
+           (voxlines_ ? voxlines_->gpu_bytes() : 0);
+}
+
 std::vector<BlockDecision> Renderer::read_decisions(const GpuScene& scene) const {
     std::vector<BlockDecision> out(scene.block_count());
     if (!decisions_ || out.empty()) return out;

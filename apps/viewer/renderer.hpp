@@ -45,6 +45,9 @@ public:
         techniques_[style] = std::move(technique);
     }
 
+    // GPU memory held for transparency (blend image, sort buffers, voxlines).
+    std::uint64_t transparency_bytes() const;
+
     // Each block's decision in the last selection pass run with
     // options.record_decisions.
     std::vector<BlockDecision> read_decisions(const GpuScene& scene) const;

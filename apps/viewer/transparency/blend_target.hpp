@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 
 #include "gl_objects.hpp"
 #include "render_target.hpp"
@@ -22,6 +23,7 @@ public:
     // Writes the blended image into the target's colours (its fiber indices
     // are left as cleared) and restores opaque drawing.
     void resolve(RenderTarget& target);
+    std::uint64_t gpu_bytes() const { return std::uint64_t(width_) * std::uint64_t(height_) * 16; }
 
 private:
     void ensure_size(int width, int height);

@@ -29,6 +29,8 @@ public:
     void draw(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind, GLuint fine_list,
               std::uint32_t blocks, TransparentLines& lines);
 
+    std::uint64_t gpu_bytes() const { return std::uint64_t(capacity_) * 12 + std::uint64_t(kBuckets) * kLanes * 4; }
+
 private:
     void ensure_buffers(std::uint32_t chunks);
     void key_chunks(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind, GLuint fine_list,
