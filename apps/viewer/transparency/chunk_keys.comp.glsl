@@ -3,7 +3,10 @@
 // every chunk (uChunkSegments consecutive segments) of the batch's blocks,
 // from the decoded points: the depth bucket of the chunk's mean point,
 // bucket 0 the farthest. Chunks without segments take bucket 0 (drawn first,
-// they draw nothing).
+// they draw nothing). Keys are stored by block index, not by place in the
+// fine list (whose order the culling pass's atomics make vary), so that the
+// sort's order does not depend on scheduling; blocks not drawn keep the
+// "no key" mark.
 layout(local_size_x = 64) in;
 
 #include "scene_buffers.glsl"
@@ -39,5 +42,5 @@ void main() {
         float farness = (uFarDepth - depth) / max(uFarDepth - uNearDepth, 1e-6);
         key = uint(clamp(farness * float(uBuckets), 0.0, float(uBuckets - 1u)));
     }
-    chunkKeys[uFirst * uChunksPerBlock + i] = key;
+    chunkKeys[block * uChunksPerBlock + i % uChunksPerBlock] = key;
 }

@@ -30,8 +30,9 @@ void emitSegmentQuadVertex(vec3 p0, vec3 p1, uint corner, uint fiber) {
     }
     vec2 a = toWindow(c0), b = toWindow(c1);
     // Every pixel whose diamond the segment meets has its centre within 1/2 of
-    // the segment's box; 3/4 leaves a margin for the rasterizer's snapping.
-    vec2 lo = min(a, b) - 0.75, hi = max(a, b) + 0.75;
+    // the segment's box; 1/32 more is a margin for the rasterizer's snapping
+    // of the corners (8 subpixel bits or more).
+    vec2 lo = min(a, b) - 0.53125, hi = max(a, b) + 0.53125;
     const vec2 kCorners[6] = vec2[6](vec2(0, 0), vec2(1, 0), vec2(1, 1), vec2(0, 0), vec2(1, 1), vec2(0, 1));
     vec2 w = mix(lo, hi, kCorners[corner]);
     vec3 d = p1 - p0;

@@ -34,9 +34,9 @@ SortedChunks::SortedChunks()
     histogram_ = make_buffer(GLsizeiptr(kBuckets) * kLanes * 4, nullptr, GL_DYNAMIC_STORAGE_BIT);
 }
 
-void SortedChunks::ensure_buffers(std::uint32_t chunks) {
-    if (capacity_ >= chunks) return;
-    capacity_ = std::max(chunks, 1u);
+void SortedChunks::ensure_buffers(std::uint32_t scene_chunks) {
+    if (capacity_ >= scene_chunks) return;
+    capacity_ = std::max(scene_chunks, 1u);
     chunk_keys_ = make_buffer(GLsizeiptr(capacity_) * 4, nullptr, 0);
     sorted_blocks_ = make_buffer(GLsizeiptr(capacity_) * 4, nullptr, 0);
     sorted_chunks_ = make_buffer(GLsizeiptr(capacity_) * 4, nullptr, 0);
@@ -46,11 +46,11 @@ void SortedChunks::draw(const FrameInputs& in, const BlockDecoder& decoder, Deco
                         std::uint32_t blocks, TransparentLines& lines) {
     if (blocks == 0) return;
     chunks_per_block_ = (in.scene.header().points_per_block + kChunkSegments - 1) / kChunkSegments;
-    const std::uint32_t chunks = blocks * chunks_per_block_;
-    ensure_buffers(chunks);
+    const std::uint32_t scene_chunks = in.scene.block_count() * chunks_per_block_;
+    ensure_buffers(scene_chunks);
     key_chunks(in, decoder, kind, fine_list, blocks);
-    sort_chunks(in.use_list, fine_list, chunks);
-    draw_sorted(in, decoder, kind, chunks, lines);
+    sort_chunks(scene_chunks);
+    draw_sorted(in, decoder, kind, blocks * chunks_per_block_, lines);
 }
 
 void SortedChunks::key_chunks(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind,
@@ -67,6 +67,9 @@ void SortedChunks::key_chunks(const FrameInputs& in, const BlockDecoder& decoder
     glProgramUniform1f(id, uniform(keys_, "uNearDepth"), near_depth);
     glProgramUniform1f(id, uniform(keys_, "uFarDepth"), far_depth);
     glProgramUniform1ui(id, uniform(keys_, "uBuckets"), kBuckets);
+    const GLuint no_key = 0xffffffffu;  // chunk_count.comp.glsl's NO_KEY: blocks this frame does not draw
+    glClearNamedBufferData(chunk_keys_.get(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &no_key);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
     for (std::uint32_t first = 0; first < blocks; first += decoder.capacity()) {
         const std::uint32_t count = std::min(decoder.capacity(), blocks - first);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, fine_list);
@@ -84,7 +87,7 @@ void SortedChunks::key_chunks(const FrameInputs& in, const BlockDecoder& decoder
     }
 }
 
-void SortedChunks::sort_chunks(bool use_list, GLuint fine_list, std::uint32_t chunks) {
+void SortedChunks::sort_chunks(std::uint32_t chunks) {
     const GLuint zero = 0;
     glClearNamedBufferData(histogram_.get(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kChunkKeys, chunk_keys_.get());
@@ -103,10 +106,8 @@ void SortedChunks::sort_chunks(bool use_list, GLuint fine_list, std::uint32_t ch
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 
     glUseProgram(scatter_.get());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, fine_list);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kSortedBlocks, sorted_blocks_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kSortedChunks, sorted_chunks_.get());
-    glProgramUniform1i(scatter_.get(), uniform(scatter_, "uUseList"), use_list ? 1 : 0);
     glProgramUniform1ui(scatter_.get(), uniform(scatter_, "uChunks"), chunks);
     glProgramUniform1ui(scatter_.get(), uniform(scatter_, "uLanes"), kLanes);
     glProgramUniform1ui(scatter_.get(), uniform(scatter_, "uChunksPerBlock"), chunks_per_block_);

@@ -3,7 +3,8 @@
 // in that order. Nothing per segment is kept between frames: a first pass
 // decodes the blocks a batch at a time and keys every chunk by its depth
 // bucket (chunk_keys.comp.glsl); a stable counting sort (chunk_count,
-// chunk_scan, chunk_scatter) orders the chunks; a second pass decodes the
+// chunk_scan, chunk_scatter) orders the chunks, by block index within a
+// bucket (not by the fine list's order, which the culling's atomics vary); a second pass decodes the
 // sorted chunks' blocks a batch at a time and draws each chunk
 // (TransparentLines::draw_chunks). GL blends in the order the primitives
 // are drawn, and the sort has no atomics, so a frame is deterministic.
@@ -32,17 +33,17 @@ public:
     std::uint64_t gpu_bytes() const { return std::uint64_t(capacity_) * 12 + std::uint64_t(kBuckets) * kLanes * 4; }
 
 private:
-    void ensure_buffers(std::uint32_t chunks);
+    void ensure_buffers(std::uint32_t scene_chunks);
     void key_chunks(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind, GLuint fine_list,
                     std::uint32_t blocks);
-    void sort_chunks(bool use_list, GLuint fine_list, std::uint32_t chunks);
+    void sort_chunks(std::uint32_t scene_chunks);
     void draw_sorted(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind, std::uint32_t chunks,
                      TransparentLines& lines);
 
     std::uint32_t chunks_per_block_ = 0;
     GlProgram keys_, count_, scan_, scatter_;
     GlBuffer chunk_keys_, histogram_, sorted_blocks_, sorted_chunks_;
-    std::uint32_t capacity_ = 0;  // chunks
+    std::uint32_t capacity_ = 0;  // chunks: of the scene (keys), of a frame (sorted places)
 };
 
 }  // namespace fiblet::viewer
