@@ -1,8 +1,10 @@
 // One frame: select blocks on the GPU (fiber subset, frustum culling, level
 // of detail), decode the selected blocks on the GPU a batch at a time and
 // hand each batch to the drawing style's technique (techniques/), then the
-// coarse blocks (one segment each). Everything stays on the GPU except four counters read back per frame
-// (the list sizes, which size the batches and are shown to the user).
+// coarse blocks (one segment each). With opacity < 1 the frame blends, in
+// the order of transparency/ (RenderOptions::transparency). Everything stays
+// on the GPU except four counters read back per frame (the list sizes,
+// which size the batches and are shown to the user).
 #pragma once
 
 #include <map>
@@ -70,12 +72,12 @@ private:
     std::map<DrawStyle, std::unique_ptr<DrawTechnique>> techniques_;
     GlBuffer fine_list_, coarse_list_, counters_, decisions_;
     std::uint32_t list_capacity_ = 0, decisions_capacity_ = 0;
-    GlVertexArray empty_vertex_array_;
+    GlVertexArray empty_vertex_array_;  // core profile draws need one bound
     // Transparency (transparency/), made on first use.
     BlendTarget blend_target_;
     std::unique_ptr<TransparentLines> transparent_lines_;
     std::unique_ptr<SortedChunks> sorted_chunks_;
-    std::unique_ptr<Voxlines> voxlines_;  // core profile draws need one bound
+    std::unique_ptr<Voxlines> voxlines_;
 };
 
 }  // namespace fiblet::viewer
