@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -72,9 +73,20 @@ std::string stats_json(const viewer::FrameStats& s) {
         .render();
 }
 
+std::string transparency_json(const viewer::TransparencyBench& t, const viewer::RenderOptions& o) {
+    return Json{}
+        .str("mode", viewer::transparency_mode_name(o.transparency))
+        .num("opacity", o.opacity)
+        .num("opaque_frame_ms", t.opaque_ms)
+        .num("frame_ms", t.transparent_ms)
+        .integer("gpu_bytes", t.extra_bytes)
+        .render();
+}
+
 void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::string& device, int width, int height,
                  const std::vector<viewer::BenchCase>& cases, double scan_ms, double sequential_ms,
-                 viewer::DecoderKind decoder, viewer::DrawStyle style) {
+                 viewer::DecoderKind decoder, viewer::DrawStyle style,
+                 const std::optional<viewer::TransparencyBench>& transparency, const viewer::RenderOptions& options) {
     if (a.json) {
         std::string list = "[";
         for (std::size_t i = 0; i < cases.size(); ++i) {
@@ -101,6 +113,7 @@ void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::
                                .num("decode_all_scan_ms", scan_ms)
                                .num("decode_all_sequential_ms", sequential_ms)
                                .raw("cases", list + "]")
+                               .raw("transparency", transparency ? transparency_json(*transparency, options) : "null")
                                .render());
         return;
     }
@@ -119,6 +132,13 @@ void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::
                    c.selection ? "on" : "off", s.fine_blocks, s.coarse_blocks, s.drawn_segments(), s.cull_ms,
                    s.decode_ms, s.draw_ms, s.cull_ms + s.decode_ms + s.draw_ms, c.frame_ms);
     }
+    if (transparency)
+        fmt::print("transparency {} at opacity {}: overview frame {:.2f} ms vs opaque {:.2f} ms ({:.2f}x); {:.1f} MB "
+                   "of GPU memory for it\n",
+                   viewer::transparency_mode_name(options.transparency), options.opacity, transparency->transparent_ms,
+                   transparency->opaque_ms,
+                   transparency->opaque_ms > 0 ? transparency->transparent_ms / transparency->opaque_ms : 0.0,
+                   double(transparency->extra_bytes) / 1e6);
     for (std::size_t i = 0; i + 1 < cases.size(); i += 2) {
         const auto gpu = [](const viewer::BenchCase& c) { return c.median.cull_ms + c.median.decode_ms + c.median.draw_ms; };
         fmt::print("{}: culling+LoD makes the GPU frame {:.2f}x faster ({:.2f} -> {:.2f} ms)\n", cases[i].view,
@@ -164,8 +184,11 @@ void run(const RenderArgs& a) {
         const auto cases = viewer::run_render_bench(scene, renderer, target, camera_for, options, a.frames);
         const double scan_ms = viewer::time_full_decode(scene, programs, viewer::DecoderKind::scan, a.frames);
         const double sequential_ms = viewer::time_full_decode(scene, programs, viewer::DecoderKind::sequential, a.frames);
+        std::optional<viewer::TransparencyBench> transparency;
+        if (options.transparent())
+            transparency = viewer::run_transparency_bench(scene, renderer, target, camera_for(1), options, a.frames);
         print_bench(a, scene, context.description(), width, height, cases, scan_ms, sequential_ms,
-                    options.decoder.value_or(viewer::default_decoder()), options.style);
+                    options.decoder.value_or(viewer::default_decoder()), options.style, transparency, options);
     }
     if (a.output.empty()) return;
     // One image; a turntable (frame i turned 360 i / n degrees about the

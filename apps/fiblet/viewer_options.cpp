@@ -31,6 +31,26 @@ std::uint32_t fiber_id(std::uint64_t id) {
     return std::uint32_t(id);
 }
 
+// --opacity and --transparency: the lines' default order is sorted; the
+// ray-cast styles blend unsorted only.
+void set_transparency(const ViewerArgs& a, viewer::RenderOptions& o) {
+    if (!(a.opacity > 0 && a.opacity <= 1)) throw Error(Errc::invalid_argument, "--opacity must be in (0, 1]");
+    o.opacity = a.opacity;
+    const bool lines = o.style == viewer::DrawStyle::lines;
+    if (a.transparency.empty()) {
+        o.transparency = lines ? viewer::TransparencyMode::sorted : viewer::TransparencyMode::unsorted;
+        return;
+    }
+    const auto mode = viewer::parse_transparency_mode(a.transparency);
+    if (!mode)
+        throw Error(Errc::invalid_argument, "--transparency: '" + a.transparency + "' is not one of " +
+                                                viewer::transparency_mode_names());
+    if (!lines && *mode != viewer::TransparencyMode::unsorted)
+        throw Error(Errc::invalid_argument, "--transparency " + a.transparency + " draws lines; --style " +
+                                                std::string(viewer::draw_style_name(o.style)) + " blends unsorted only");
+    o.transparency = *mode;
+}
+
 }  // namespace
 
 void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
@@ -71,6 +91,13 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
                     "Tube and capsule radius per streamline from a text file (mm, one per streamline, in file "
                     "order), instead of --radius")
         ->check(CLI::ExistingFile);
+    cmd->add_option("--opacity", a.opacity,
+                    "Opacity of every streamline, in (0, 1]; below 1 they blend, ordered by --transparency")
+        ->capture_default_str();
+    cmd->add_option("--transparency", a.transparency,
+                    "How streamlines blend when --opacity < 1: sorted (~1 mm chunks sorted back to front on the "
+                    "GPU; the default), voxlines (10 mm voxels back to front, precomputed axis orders inside), "
+                    "unsorted (plain blending); tubes and capsules blend unsorted");
     cmd->add_option("--supersample", a.supersample,
                     "Anti-aliasing of the PNG (render) or screenshots (view): draw N times larger per axis and "
                     "average, 1..8")
@@ -175,6 +202,7 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
         if (!o.decoder) throw Error(Errc::invalid_argument, "--decoder: '" + a.decoder + "' is not auto, scan or sequential");
     }
     if (a.max_length > 0) o.max_length_mm = a.max_length;
+    set_transparency(a, o);
     o.fiber_colors = !fiber_color_source(a).empty();
     o.fiber_radii = !a.fiber_radii.empty();
     return o;

@@ -27,6 +27,8 @@ struct ViewerArgs {
     std::string odf, odf_slice, sh_basis = "mrtrix", image, slice;
     float odf_scale = 1, slab = 0;
     int odf_lmax = -1;
+    float opacity = 1;
+    std::string transparency;  // empty: sorted (lines) / unsorted (tubes, capsules)
 };
 
 // Adds the input file and the camera, shading and selection options.

@@ -25,6 +25,12 @@ std::string gpu_binding_defines() {
     def("BINDING_TUBE_PIECES", binding::kTubePieces);
     def("BINDING_FIBER_COLORS", binding::kFiberColors);
     def("BINDING_FIBER_RADII", binding::kFiberRadii);
+    def("BINDING_CHUNK_KEYS", binding::kChunkKeys);
+    def("BINDING_CHUNK_HISTOGRAM", binding::kChunkHistogram);
+    def("BINDING_SORTED_CHUNKS", binding::kSortedChunks);
+    def("BINDING_SORTED_BLOCKS", binding::kSortedBlocks);
+    def("BINDING_VOXLINE_SEGMENTS", binding::kVoxlineSegments);
+    def("BINDING_VOXLINE_ORDERS", binding::kVoxlineOrders);
     def("BINDING_LOCAL_FRAMES", binding::kLocalFrames);
     def_uint("DECISION_OUTSIDE_FRUSTUM", unsigned(BlockDecision::outside_frustum));
     def_uint("DECISION_COARSE", unsigned(BlockDecision::coarse));

@@ -25,6 +25,15 @@ inline constexpr unsigned kFiberRadii = 13;   // per fiber: tube radius (mm), wh
 inline constexpr unsigned kGlyphCoefficients = 14;  // overlays/odf_glyphs: SH coefficients, glyph units
 inline constexpr unsigned kGlyphCenters = 15;       // overlays/odf_glyphs: centre, radius (mm) and box (glyph_boxes.glsl)
 inline constexpr unsigned kStorageCount = 16;
+// Transparent frames (transparency/) reuse the binding points of buffers they
+// never bind (no level of detail, no tangents, no tubes, no decisions), so
+// that the viewer asks the driver for no more bindings.
+inline constexpr unsigned kChunkKeys = kCoarseList;      // per chunk: its depth bucket
+inline constexpr unsigned kChunkHistogram = kCounters;   // chunks per (bucket, lane), then their offsets
+inline constexpr unsigned kSortedChunks = kDecisions;    // per sorted slot: chunk index in its block
+inline constexpr unsigned kSortedBlocks = kTubePieces;   // per sorted slot: its block
+inline constexpr unsigned kVoxlineSegments = kTangents;  // voxlines: both ends of every segment
+inline constexpr unsigned kVoxlineOrders = kTubePieces;  // voxlines: the three axis orders of every voxel
 // Uniform buffers.
 inline constexpr unsigned kLocalFrames = 0;  // the 256 frames of the direction code (DirectionTable)
 }  // namespace binding

@@ -54,6 +54,32 @@ std::vector<BenchCase> run_render_bench(const GpuScene& scene, Renderer& rendere
     return out;
 }
 
+namespace {
+// Median wall time (ms) of `frames` frames after a warm-up one, glFinish included.
+double median_frame_ms(const GpuScene& scene, Renderer& renderer, RenderTarget& target, const Camera& camera,
+                       const RenderOptions& o, int frames) {
+    std::vector<double> wall;
+    for (int f = -1; f < frames; ++f) {
+        const auto t0 = std::chrono::steady_clock::now();
+        renderer.render(scene, camera, o, target);
+        glFinish();
+        if (f >= 0) wall.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+    return median(wall);
+}
+}  // namespace
+
+TransparencyBench run_transparency_bench(const GpuScene& scene, Renderer& renderer, RenderTarget& target,
+                                         const Camera& camera, const RenderOptions& transparent, int frames) {
+    RenderOptions opaque = transparent;
+    opaque.opacity = 1;
+    TransparencyBench b;
+    b.opaque_ms = median_frame_ms(scene, renderer, target, camera, opaque, frames);
+    b.transparent_ms = median_frame_ms(scene, renderer, target, camera, transparent, frames);
+    b.extra_bytes = renderer.transparency_bytes();
+    return b;
+}
+
 double time_full_decode(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind, int frames) {
     const BlockDecoder decoder(programs, scene.header().points_per_block);
     std::vector<double> ms;

@@ -28,6 +28,15 @@ std::vector<BenchCase> run_render_bench(const GpuScene& scene, Renderer& rendere
                                         const std::function<Camera(float zoom)>& camera_for,
                                         const RenderOptions& base, int frames);
 
+// A transparent frame against the opaque one (the overview, culling on):
+// median wall times of both, and the GPU memory transparency added.
+struct TransparencyBench {
+    double opaque_ms = 0, transparent_ms = 0;
+    std::uint64_t extra_bytes = 0;
+};
+TransparencyBench run_transparency_bench(const GpuScene& scene, Renderer& renderer, RenderTarget& target,
+                                         const Camera& camera, const RenderOptions& transparent, int frames);
+
 // Median time (ms) to decode every block of the scene with `kind`, in
 // batches as the renderer does, without drawing.
 double time_full_decode(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind, int frames);

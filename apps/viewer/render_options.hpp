@@ -9,6 +9,7 @@
 #include "decoder_kind.hpp"
 #include "draw_style.hpp"
 #include "fiblet/view.hpp"
+#include "transparency/transparency_mode.hpp"
 
 namespace fiblet::viewer {
 
@@ -38,11 +39,16 @@ struct RenderOptions {
     // (slab_plane = n, d; world mm); 0: no slab.
     std::array<float, 4> slab_plane{0, 0, 1, 0};
     float slab_half_width_mm = 0;
+    // Transparency: every fragment blends with this opacity (0 < opacity <= 1),
+    // ordered by `transparency` (transparency/); 1 draws opaque.
+    float opacity = 1.0f;
+    TransparencyMode transparency = TransparencyMode::sorted;
     bool clear = true;  // clear the target first (false: draw over what it holds, depth included)
 
     bool time_stages = false;       // time cull / decode / draw (GpuTimer, default_timing_method)
     bool record_decisions = false;  // keep each block's culling decision (Renderer::read_decisions)
 
+    bool transparent() const { return opacity < 1.0f; }
     bool subset_active() const {
         return id_min > 0 || id_max < std::numeric_limits<std::uint32_t>::max() || min_length_mm > 0 ||
                max_length_mm < std::numeric_limits<double>::infinity();

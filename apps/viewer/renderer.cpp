@@ -101,10 +101,11 @@ DrawTechnique& Renderer::technique(DrawStyle style) {
 FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const RenderOptions& options,
                             RenderTarget& target) {
     RenderOptions o = options;
+    // A transparent frame blends every segment of what it selects: no coarse blocks.
+    if (o.transparent()) o.level_of_detail = false;
     o.fiber_colors = options.fiber_colors && scene.has_fiber_colors();
     o.fiber_radii = options.fiber_radii && scene.has_fiber_radii();
     ensure_buffers(scene, o.record_decisions);
-    DrawTechnique& draw = technique(o.style);
     const Viewport viewport{target.width(), target.height()};
     const GLuint fb = target.framebuffer();
     glBindFramebuffer(GL_FRAMEBUFFER, fb);
@@ -137,31 +138,29 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const R
     }
 
     const FrameInputs in{scene, camera, o, select};
-    draw.begin_frame(in);
-    // Full blocks, a batch at a time: decode into the points buffer, draw it.
-    for (std::uint32_t first = 0; first < stats.fine_blocks; first += decoder_->capacity()) {
-        const std::uint32_t count = std::min<std::uint32_t>(decoder_->capacity(), std::uint32_t(stats.fine_blocks) - first);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, fine_list_.get());
-        timer.begin(Stage::decode);
-        decoder_->decode(scene, decoder, select, first, count, draw.needs_tangents());
-        timer.end();
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    if (o.transparent()) blend_target_.begin(target, o.clear, o.background, o.opacity);
+    if (o.transparent() && o.style == DrawStyle::lines && o.transparency != TransparencyMode::unsorted) {
         timer.begin(Stage::draw);
-        draw.draw_batch(in, {decoder_->points_buffer(), decoder_->tangents_buffer(), first, count});
+        draw_ordered_lines(in, decoder, std::uint32_t(stats.fine_blocks));
         timer.end();
-        // The next batch overwrites the points this draw reads.
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    } else {
+        DrawTechnique& draw = block_technique(o);
+        draw.begin_frame(in);
+        draw_blocks(in, draw, decoder, std::uint32_t(stats.fine_blocks), timer);
     }
 
     // Coarse blocks: one segment each, straight from the raw blocks.
     if (stats.coarse_blocks > 0) {
         timer.begin(Stage::draw);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCoarseList, coarse_list_.get());
-        draw.draw_coarse(in, std::uint32_t(stats.coarse_blocks));
+        technique(o.style).draw_coarse(in, std::uint32_t(stats.coarse_blocks));
         timer.end();
     }
 
-    // Overlays share the depth buffer: glyphs, slices and fibers occlude each other.
+    if (o.transparent()) blend_target_.resolve(target);
+
+    // Overlays share the depth buffer: glyphs, slices and opaque fibers
+    // occlude each other (transparent fibers leave no depth: drawn under them).
     if (!overlays_.empty()) {
         timer.begin(Stage::draw);
         for (const auto& overlay : overlays_) overlay->draw(camera, o);
@@ -172,6 +171,48 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const R
     const auto ms = timer.collect();
     stats.cull_ms = ms[0], stats.decode_ms = ms[1], stats.draw_ms = ms[2];
     return stats;
+}
+
+DrawTechnique& Renderer::block_technique(const RenderOptions& o) {
+    if (!o.transparent() || o.style != DrawStyle::lines) return technique(o.style);
+    if (!transparent_lines_) transparent_lines_ = std::make_unique<TransparentLines>();
+    return *transparent_lines_;
+}
+
+void Renderer::draw_blocks(const FrameInputs& in, DrawTechnique& draw, DecoderKind decoder, std::uint32_t blocks,
+                           GpuTimer& timer) {
+    for (std::uint32_t first = 0; first < blocks; first += decoder_->capacity()) {
+        const std::uint32_t count = std::min<std::uint32_t>(decoder_->capacity(), blocks - first);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, fine_list_.get());
+        timer.begin(Stage::decode);
+        decoder_->decode(in.scene, decoder, in.use_list, first, count, draw.needs_tangents());
+        timer.end();
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        timer.begin(Stage::draw);
+        draw.draw_batch(in, {decoder_->points_buffer(), decoder_->tangents_buffer(), first, count});
+        timer.end();
+        // The next batch overwrites the points this draw reads.
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
+}
+
+void Renderer::draw_ordered_lines(const FrameInputs& in, DecoderKind decoder, std::uint32_t blocks) {
+    if (in.options.transparency == TransparencyMode::voxlines) {
+        // Voxlines keep their own copy of every segment, built once per scene.
+        if (!voxlines_ || &voxlines_->scene() != &in.scene)
+            voxlines_ = std::make_unique<Voxlines>(in.scene, programs_, decoder);
+        voxlines_->draw(in);
+        return;
+    }
+    if (!sorted_chunks_) sorted_chunks_ = std::make_unique<SortedChunks>();
+    auto& lines = static_cast<TransparentLines&>(block_technique(in.options));
+    lines.begin_frame(in);
+    sorted_chunks_->draw(in, *decoder_, decoder, fine_list_.get(), blocks, lines);
+}
+
+std::uint64_t Renderer::transparency_bytes() const {
+    return blend_target_.gpu_bytes() + (sorted_chunks_ ? sorted_chunks_->gpu_bytes() : 0) +
+           (voxlines_ ? voxlines_->gpu_bytes() : 0);
 }
 
 std::vector<BlockDecision> Renderer::read_decisions(const GpuScene& scene) const {

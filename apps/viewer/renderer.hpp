@@ -1,8 +1,10 @@
 // One frame: select blocks on the GPU (fiber subset, frustum culling, level
 // of detail), decode the selected blocks on the GPU a batch at a time and
 // hand each batch to the drawing style's technique (techniques/), then the
-// coarse blocks (one segment each). Everything stays on the GPU except four counters read back per frame
-// (the list sizes, which size the batches and are shown to the user).
+// coarse blocks (one segment each). With opacity < 1 the frame blends, in
+// the order of transparency/ (RenderOptions::transparency). Everything stays
+// on the GPU except four counters read back per frame (the list sizes,
+// which size the batches and are shown to the user).
 // Overlays (overlays/) follow the fibers in the same frame.
 #pragma once
 
@@ -17,9 +19,14 @@
 #include "gpu_programs.hpp"
 #include "gpu_scene.hpp"
 #include "overlays/overlay.hpp"
+#include "gpu_timer.hpp"
 #include "render_options.hpp"
 #include "render_target.hpp"
 #include "techniques/draw_technique.hpp"
+#include "transparency/blend_target.hpp"
+#include "transparency/sorted_chunks.hpp"
+#include "transparency/transparent_lines.hpp"
+#include "transparency/voxlines.hpp"
 
 namespace fiblet::viewer {
 
@@ -45,6 +52,8 @@ public:
     // Overlays (glyphs, image slices) drawn after the fibers of every frame,
     // in this order, with depth.
     void set_overlays(std::vector<std::shared_ptr<Overlay>> overlays) { overlays_ = std::move(overlays); }
+    // GPU memory held for transparency (blend image, sort buffers, voxlines).
+    std::uint64_t transparency_bytes() const;
 
     // Each block's decision in the last selection pass run with
     // options.record_decisions.
@@ -54,6 +63,14 @@ private:
     void ensure_buffers(const GpuScene& scene, bool decisions);
     // The style's technique, compiled on first use.
     DrawTechnique& technique(DrawStyle style);
+    // What draws the frame's fine blocks: the style's technique, or the
+    // transparent lines when lines blend.
+    DrawTechnique& block_technique(const RenderOptions& o);
+    // The fine blocks decoded and drawn a batch at a time, in list order.
+    void draw_blocks(const FrameInputs& in, DrawTechnique& draw, DecoderKind decoder, std::uint32_t blocks,
+                     GpuTimer& timer);
+    // A transparent frame's lines in the order of o.transparency (transparency/).
+    void draw_ordered_lines(const FrameInputs& in, DecoderKind decoder, std::uint32_t blocks);
 
     const GpuPrograms& programs_;
     std::unique_ptr<BlockDecoder> decoder_;
@@ -62,6 +79,11 @@ private:
     std::uint32_t list_capacity_ = 0, decisions_capacity_ = 0;
     std::vector<std::shared_ptr<Overlay>> overlays_;
     GlVertexArray empty_vertex_array_;  // core profile draws need one bound
+    // Transparency (transparency/), made on first use.
+    BlendTarget blend_target_;
+    std::unique_ptr<TransparentLines> transparent_lines_;
+    std::unique_ptr<SortedChunks> sorted_chunks_;
+    std::unique_ptr<Voxlines> voxlines_;
 };
 
 }  // namespace fiblet::viewer

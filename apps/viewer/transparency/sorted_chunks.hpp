@@ -1,0 +1,49 @@
+// Sorted transparency, fiblet's own: the frame's decoded blocks cut into
+// chunks of ~1 mm (10 segments), sorted back to front on the GPU and drawn
+// in that order. Nothing per segment is kept between frames: a first pass
+// decodes the blocks a batch at a time and keys every chunk by its depth
+// bucket (chunk_keys.comp.glsl); a stable counting sort (chunk_count,
+// chunk_scan, chunk_scatter) orders the chunks, by block index within a
+// bucket (not by the fine list's order, which the culling's atomics vary); a second pass decodes the
+// sorted chunks' blocks a batch at a time and draws each chunk
+// (TransparentLines::draw_chunks). GL blends in the order the primitives
+// are drawn, and the sort has no atomics, so a frame is deterministic.
+#pragma once
+
+#include <cstdint>
+
+#include "block_decoder.hpp"
+#include "transparency/transparent_lines.hpp"
+
+namespace fiblet::viewer {
+
+class SortedChunks {
+public:
+    static constexpr std::uint32_t kChunkSegments = 10;  // ~1 mm at 0.1 mm steps
+    static constexpr std::uint32_t kBuckets = 1024;      // depth buckets across the scene's box
+    static constexpr std::uint32_t kLanes = 1024;        // counting sort lanes (chunk_count.comp.glsl)
+
+    SortedChunks();
+
+    // Draws `blocks` blocks: the fine list's first ones (bound by the caller
+    // to `fine_list`) when in.use_list, else blocks 0..blocks-1.
+    void draw(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind, GLuint fine_list,
+              std::uint32_t blocks, TransparentLines& lines);
+
+    std::uint64_t gpu_bytes() const { return std::uint64_t(capacity_) * 12 + std::uint64_t(kBuckets) * kLanes * 4; }
+
+private:
+    void ensure_buffers(std::uint32_t scene_chunks);
+    void key_chunks(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind, GLuint fine_list,
+                    std::uint32_t blocks);
+    void sort_chunks(std::uint32_t scene_chunks);
+    void draw_sorted(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind, std::uint32_t chunks,
+                     TransparentLines& lines);
+
+    std::uint32_t chunks_per_block_ = 0;
+    GlProgram keys_, count_, scan_, scatter_;
+    GlBuffer chunk_keys_, histogram_, sorted_blocks_, sorted_chunks_;
+    std::uint32_t capacity_ = 0;  // chunks: of the scene (keys), of a frame (sorted places)
+};
+
+}  // namespace fiblet::viewer

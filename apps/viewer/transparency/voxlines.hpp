@@ -1,0 +1,47 @@
+// Voxlines (Osman, Pereira, van de Wetering, Chamberland): the segments
+// binned into voxels of 10 mm by their first point (a streamline's run of
+// points in a voxel, plus the step into the next one: a voxline), and inside
+// every voxel three precomputed orders, by (p0 + p1) . axis for x, y and z.
+// A frame draws the voxels back to front, each in the order (forwards or
+// backwards) of the axis closest to the direction from the voxel to the eye.
+// Built once per scene from the GPU decoder's points (it keeps every segment:
+// 44 bytes each on the GPU), drawn as TransparentLines are.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "gpu_programs.hpp"
+#include "techniques/draw_technique.hpp"
+
+namespace fiblet::viewer {
+
+class Voxlines {
+public:
+    static constexpr float kVoxelMm = 10;  // the paper's voxel size
+
+    Voxlines(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind);
+
+    const GpuScene& scene() const { return *scene_; }
+    std::uint64_t gpu_bytes() const { return gpu_bytes_; }
+    void draw(const FrameInputs& in);
+
+private:
+    struct Voxel {
+        std::uint32_t index;         // x + nx (y + ny z)
+        std::uint32_t first, count;  // its range in each axis order
+    };
+    std::vector<std::uint32_t> back_to_front(const Camera& camera) const;  // indices into voxels_
+    Vec3f voxel_center(std::uint32_t index) const;
+
+    const GpuScene* scene_;
+    Vec3f origin_;
+    std::uint32_t nx_ = 1, ny_ = 1, nz_ = 1;
+    std::uint32_t segments_ = 0;
+    std::vector<Voxel> voxels_;  // the non-empty ones
+    GlBuffer segment_ends_, orders_;
+    std::uint64_t gpu_bytes_ = 0;
+    GlProgram program_;
+};
+
+}  // namespace fiblet::viewer
