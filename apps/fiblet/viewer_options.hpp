@@ -22,6 +22,11 @@ struct ViewerArgs {
     int supersample = 1;
     std::string fiber_colors, fiber_values, value_range, fiber_radii;
     double min_length = 0, max_length = 0;
+    // The voxel ray tracer (--engine voxel-rt).
+    std::string engine = "raster";
+    int grid = 128;
+    bool ao = false, shadows = false;
+    float opacity = 1.0f;
 };
 
 // Adds the input file and the camera, shading and selection options.

@@ -8,11 +8,14 @@
 
 #include "decoder_kind.hpp"
 #include "draw_style.hpp"
+#include "render_engine.hpp"
 #include "fiblet/view.hpp"
 
 namespace fiblet::viewer {
 
 struct RenderOptions {
+    RenderEngine engine = RenderEngine::raster;
+
     // Per-frame selection on the GPU (fiblet/view.hpp definitions).
     bool frustum_culling = true;
     bool level_of_detail = true;
@@ -34,6 +37,11 @@ struct RenderOptions {
     bool color_by_normal = false;                      // ray-cast styles: unit normal n as RGB (n + 1) / 2 (checks)
     float line_width = 1;                              // pixels
     std::array<float, 3> background{0, 0, 0};
+    // Voxel ray tracer (engine voxel_rt; capsules of tube_radius_mm).
+    int voxel_grid = 128;            // voxels along each side of its cubic grid
+    bool ambient_occlusion = false;  // 12 cones through the occupancy pyramid
+    bool shadows = false;            // one shadow ray towards the headlight
+    float opacity = 1.0f;            // < 1: every capsule composited with this alpha
     bool clear = true;  // clear the target first (false: draw over what it holds, depth included)
 
     bool time_stages = false;       // time cull / decode / draw (GpuTimer, default_timing_method)

@@ -98,8 +98,14 @@ DrawTechnique& Renderer::technique(DrawStyle style) {
     return *t;
 }
 
+voxel_rt::VoxelRayTracer& Renderer::voxel_ray_tracer() {
+    if (!voxel_ray_tracer_) voxel_ray_tracer_ = std::make_unique<voxel_rt::VoxelRayTracer>(programs_);
+    return *voxel_ray_tracer_;
+}
+
 FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const RenderOptions& options,
                             RenderTarget& target) {
+    if (options.engine == RenderEngine::voxel_rt) return voxel_ray_tracer().render(scene, camera, options, target);
     RenderOptions o = options;
     o.fiber_colors = options.fiber_colors && scene.has_fiber_colors();
     o.fiber_radii = options.fiber_radii && scene.has_fiber_radii();

@@ -18,6 +18,7 @@
 #include "render_options.hpp"
 #include "render_target.hpp"
 #include "techniques/draw_technique.hpp"
+#include "voxel_rt/voxel_ray_tracer.hpp"
 
 namespace fiblet::viewer {
 
@@ -25,8 +26,13 @@ class Renderer {
 public:
     explicit Renderer(const GpuPrograms& programs);
 
+    // Draws with options.engine: the raster pipeline below, or the voxel
+    // ray tracer (voxel_rt/), which does its own selection and decoding.
     FrameStats render(const GpuScene& scene, const Camera& camera, const RenderOptions& options,
                       RenderTarget& target);
+
+    // The voxel ray tracer render() uses (made on first use; tests).
+    voxel_rt::VoxelRayTracer& voxel_ray_tracer();
 
     // The selection pass alone (what render() runs first when culling, LoD
     // or a subset is on): fills the fine and coarse lists and returns their
@@ -50,6 +56,7 @@ private:
     DrawTechnique& technique(DrawStyle style);
 
     const GpuPrograms& programs_;
+    std::unique_ptr<voxel_rt::VoxelRayTracer> voxel_ray_tracer_;  // made on first use
     std::unique_ptr<BlockDecoder> decoder_;
     std::map<DrawStyle, std::unique_ptr<DrawTechnique>> techniques_;
     GlBuffer fine_list_, coarse_list_, counters_, decisions_;
