@@ -43,9 +43,11 @@ public:
     };
 
     EmbreeCapsules(const FftFile& file, float radius) {
-        const CpuDecoded d = cpu_decode_blocks(file);
+        d_ = cpu_decode_blocks(file);
+        const CpuDecoded& d = d_;
         device_ = rtcNewDevice(nullptr);
         scene_ = rtcNewScene(device_);
+        rtcSetSceneFlags(scene_, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);  // all(): the filter in the context
         RTCGeometry curves = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
         const std::size_t points = d.xyz.size() / 3;
         auto* v = static_cast<float*>(
@@ -89,6 +91,14 @@ public:
         return a->second + 1 == b->second || b->second + 1 == a->second;
     }
 
+    // Unit direction of a segment (CPU-decoded points).
+    std::array<float, 3> direction(unsigned segment) const {
+        const unsigned i = start_of_segment_.at(segment);
+        const Vec3f a = d_.point(i), b = d_.point(i + 1);
+        const float dx = b.x - a.x, dy = b.y - a.y, dz = b.z - a.z, n = std::sqrt(dx * dx + dy * dy + dz * dz);
+        return {dx / n, dy / n, dz / n};
+    }
+
     // The nearest hit (t = +inf: none).
     Hit nearest(const Vec3f& org, const std::array<double, 3>& dir) const {
         RTCRayHit rh = ray(org, dir);
@@ -99,33 +109,40 @@ public:
         return {rh.ray.tfar, segment_[rh.hit.primID]};
     }
 
-    // Every capsule the ray enters (its nearest hit each), nearest first:
-    // an intersection filter records each hit and rejects it, so that the
-    // traversal goes on.
+    // Every entry of the ray into a fiber's tube, nearest first: an
+    // intersection filter records each front-facing hit (the geometric
+    // normal against the ray) and rejects it, so that the traversal goes on;
+    // hits of one fiber at the same distance (a joint's shared surface) are
+    // one entry.
     std::vector<Hit> all(const Vec3f& org, const std::array<double, 3>& dir) const {
         struct Context {
             RTCIntersectContext base;
             std::vector<Hit>* hits;
             const std::vector<unsigned>* segment;
+            std::array<double, 3> dir;
         } context;
         rtcInitIntersectContext(&context.base);
         std::vector<Hit> hits;
-        context.hits = &hits, context.segment = &segment_;
+        context.hits = &hits, context.segment = &segment_, context.dir = dir;
         context.base.filter = [](const RTCFilterFunctionNArguments* args) {
             auto* c = reinterpret_cast<Context*>(args->context);
-            const RTCRayN* r = args->ray;
-            const RTCHitN* h = args->hit;
-            c->hits->push_back({RTCRayN_tfar(const_cast<RTCRayN*>(r), args->N, 0),
-                                (*c->segment)[RTCHitN_primID(const_cast<RTCHitN*>(h), args->N, 0)]});
+            auto* r = const_cast<RTCRayN*>(args->ray);
+            auto* h = const_cast<RTCHitN*>(args->hit);
+            const double facing = RTCHitN_Ng_x(h, args->N, 0) * c->dir[0] + RTCHitN_Ng_y(h, args->N, 0) * c->dir[1] +
+                                  RTCHitN_Ng_z(h, args->N, 0) * c->dir[2];
+            if (facing < 0) c->hits->push_back({RTCRayN_tfar(r, args->N, 0), (*c->segment)[RTCHitN_primID(h, args->N, 0)]});
             args->valid[0] = 0;
         };
         RTCRayHit rh = ray(org, dir);
         rtcIntersect1(scene_, &context.base, &rh);
-        std::sort(hits.begin(), hits.end(), [](const Hit& a, const Hit& b) { return a.segment != b.segment ? a.segment < b.segment : a.t < b.t; });
+        std::sort(hits.begin(), hits.end(), [](const Hit& a, const Hit& b) { return a.t < b.t; });
         std::vector<Hit> entries;
-        for (const Hit& h : hits)
-            if (entries.empty() || entries.back().segment != h.segment) entries.push_back(h);
-        std::sort(entries.begin(), entries.end(), [](const Hit& a, const Hit& b) { return a.t < b.t; });
+        for (const Hit& h : hits) {
+            bool same = false;
+            for (std::size_t k = entries.size(); k-- > 0 && h.t - entries[k].t < 1e-4f * (1 + h.t);)
+                same |= entries[k].segment == h.segment || consecutive(entries[k].segment, h.segment);
+            if (!same) entries.push_back(h);
+        }
         return entries;
     }
 
@@ -139,6 +156,7 @@ private:
         return rh;
     }
 
+    CpuDecoded d_;
     RTCDevice device_ = nullptr;
     RTCScene scene_ = nullptr;
     std::vector<unsigned> segment_;  // per Embree primitive

@@ -120,11 +120,11 @@ bool firstOfFiber(uint s) {
     return uAllSegmentsValid || (s == slot * uSegmentsPerSlot && (slot == 0u || blockFiber[slot - 1u] != blockFiber[slot]));
 }
 
-// capsuleEntry of segment s.
+// capsuleEntry of segment s (transparent: every capsule whole, each entered once).
 float segmentEntry(vec3 o, vec3 d, uint s, out vec3 normal) {
     vec3 a, b;
     segmentEnds(s, a, b);
-    return capsuleEntry(o, d, a, b, uRadiusMm, firstOfFiber(s), normal);
+    return capsuleEntry(o, d, a, b, uRadiusMm, uOpacity < 1.0 || firstOfFiber(s), normal);
 }
 
 // The nearest hit beyond tMin (anyHit: the first found, for shadows).
@@ -176,6 +176,34 @@ vec3 shadeHit(vec3 o, vec3 d, Hit h) {
     return min((base * (uAmbient + uDiffuse * diffuse) + vec3(uSpecular * specular)) * (1.0 - ao), vec3(1.0));
 }
 
+vec3 slotPoint(uint slot, uint k) { return vrtPoints[slot * (uSegmentsPerSlot + 1u) + k].xyz; }
+
+// Whether the capsule of segment s entered at p is where the ray enters the
+// fiber's tube: p between the planes at the segment's joints normal to the
+// central-difference tangents there (the capsules of one fiber overlap at
+// joints; the planes split the tube into pieces that do not). A fiber's
+// ends keep their round caps.
+bool insideClipPlanes(uint s, vec3 p) {
+    if (uAllSegmentsValid) return true;
+    uint slot = segmentSlot(s), seg = s - slot * uSegmentsPerSlot, count = blockPointCount(slot);
+    vec3 a, b;
+    segmentEnds(s, a, b);
+    // The point before a.
+    if (seg > 0u) {
+        if (dot(p - a, b - slotPoint(slot, seg - 1u)) < 0.0) return false;
+    } else if (!firstOfFiber(s)) {
+        if (dot(p - a, b - slotPoint(slot - 1u, blockPointCount(slot - 1u) - 1u)) < 0.0) return false;
+    }
+    // The point after b: in this slot (the next block's first point at
+    // index count), or the next block's second.
+    if (seg + 2u < count || (seg + 2u == count && !isLastBlockOfFiber(slot))) {
+        if (dot(p - b, slotPoint(slot, seg + 2u) - a) > 0.0) return false;
+    } else if (seg + 1u == count && blockSegmentCount(slot + 1u) >= 1u) {
+        if (dot(p - b, slotPoint(slot + 1u, 1u) - a) > 0.0) return false;
+    }
+    return true;
+}
+
 uint keyOf(float t, Walk w, uint local) {
     float f = clamp((t - w.tEnter) / max(w.tExit - w.tEnter, 1e-30), 0.0, 1.0);
     return (uint(f * 65535.0) << 16) | local;
@@ -202,6 +230,7 @@ vec4 traceTransparent(vec3 o, vec3 d, out Hit nearest) {
                 float t = segmentEntry(o, d, fragments[first + k], normal);
                 // Each capsule is entered in one voxel: [tEnter, tExit).
                 if (t < w.tEnter || t >= w.tExit || t <= 0.0) continue;
+                if (!insideClipPlanes(fragments[first + k], o + t * d)) continue;
                 uint key = keyOf(t, w, k);
                 if (started && key <= lastKey) continue;
                 if (n == kSortedHits && key >= keys[n - 1]) continue;
