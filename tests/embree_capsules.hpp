@@ -91,6 +91,23 @@ public:
         return a->second + 1 == b->second || b->second + 1 == a->second;
     }
 
+    // The end points of a segment (CPU-decoded).
+    std::array<Vec3f, 2> ends(unsigned segment) const {
+        const unsigned i = start_of_segment_.at(segment);
+        return {d_.point(i), d_.point(i + 1)};
+    }
+
+    // Whether the ray from org along the unit dir hits a capsule between
+    // distances near and far (a ray starting inside a capsule hits it).
+    bool occluded(const Vec3f& org, const std::array<double, 3>& dir, float near, float far) const {
+        RTCRay r = ray(org, dir).ray;
+        r.tnear = near, r.tfar = far;
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        rtcOccluded1(scene_, &context, &r);
+        return r.tfar < 0;  // set to -inf when occluded
+    }
+
     // Unit direction of a segment (CPU-decoded points).
     std::array<float, 3> direction(unsigned segment) const {
         const unsigned i = start_of_segment_.at(segment);

@@ -276,3 +276,128 @@ TEST(VoxelRtTrace, TransparencyMatchesEmbreeCompositingEveryHit) {
     EXPECT_GE(rate, 0.999);
 #endif
 }
+
+namespace {
+
+// The ambient occlusion volume sampled trilinearly at a point (voxel
+// units), as the trace shader's texture lookup.
+float sample_volume(const std::vector<float>& v, int n, std::array<float, 3> p) {
+    float out = 0;
+    const float x = p[0] - 0.5f, y = p[1] - 0.5f, z = p[2] - 0.5f;
+    const int x0 = int(std::floor(x)), y0 = int(std::floor(y)), z0 = int(std::floor(z));
+    for (int dz = 0; dz < 2; ++dz)
+        for (int dy = 0; dy < 2; ++dy)
+            for (int dx = 0; dx < 2; ++dx) {
+                const int xi = std::clamp(x0 + dx, 0, n - 1), yi = std::clamp(y0 + dy, 0, n - 1),
+                          zi = std::clamp(z0 + dz, 0, n - 1);
+                const float wx = dx ? x - float(x0) : 1 - (x - float(x0)), wy = dy ? y - float(y0) : 1 - (y - float(y0)),
+                            wz = dz ? z - float(z0) : 1 - (z - float(z0));
+                out += wx * wy * wz * v[std::size_t((zi * n + yi) * n + xi)];
+            }
+    return out;
+}
+
+// The ambient occlusion volume of capsules of radius r (voxel units) in
+// the 64³ test grid.
+std::vector<float> ambient_occlusion_of(const std::vector<Capsule>& capsules, float r) {
+    const vrt::VoxelRtPrograms programs;
+    vrt::VoxelGrid grid;
+    grid.n = kGrid, grid.voxel_mm = 1, grid.origin = {0, 0, 0};
+    std::vector<float> points;
+    for (const Capsule& c : capsules) points.insert(points.end(), {c.a[0], c.a[1], c.a[2], 1, c.b[0], c.b[1], c.b[2], 1});
+    const viewer::GlBuffer buffer = viewer::make_buffer(GLsizeiptr(points.size() * 4), points.data(), 0);
+    const vrt::VoxelStructure structure(programs, grid, {buffer.get(), std::uint32_t(capsules.size()), 1, nullptr}, r,
+                                        true);
+    return structure.read_ambient_occlusion();
+}
+
+}  // namespace
+
+TEST(VoxelRtAmbientOcclusion, HalfSpaceSlabIsHalfOccludedAnIsolatedLineNot) {
+    FIBLET_REQUIRE_GL();
+    // A slab of touching lines along x filling z < 32 (surface at z = 32).
+    std::vector<Capsule> slab;
+    for (float z = 0.5f; z <= 31.5f; z += 0.5f)
+        for (float y = 0.5f; y <= 63.5f; y += 0.5f) slab.push_back({{0.5f, y, z}, {63.5f, y, z}});
+    const auto ao = ambient_occlusion_of(slab, 0.5f);
+    // On the surface, looked up half a voxel out along the normal (as the trace shader).
+    const float surface = sample_volume(ao, kGrid, {32, 32, 32.5f});
+    // One line of radius 0.2 voxel through the middle.
+    const auto line_ao = ambient_occlusion_of({{{4.5f, 30.3f, 31.7f}, {59.5f, 33.1f, 32.2f}}}, 0.2f);
+    const float line = sample_volume(line_ao, kGrid, {32, 31.6f + 0.7f, 31.95f});
+    std::printf("ambient occlusion: half-space slab surface %.4f, isolated line %.4f\n", surface, line);
+    EXPECT_NEAR(surface, 0.5f, 0.05f);
+    EXPECT_LT(line, 0.05f);
+}
+
+TEST(VoxelRtAmbientOcclusion, CorrelatesWithMonteCarloOcclusionRays) {
+#if !FIBLET_HAS_EMBREE
+    GTEST_SKIP() << "built without Embree (libembree-dev, scripts/setup.sh)";
+#else
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const float radius = 0.3f;
+    const EmbreeCapsules oracle(file, radius);
+    viewer::Renderer renderer(*viewer_gl().programs);
+    viewer::RenderOptions o;
+    o.engine = viewer::RenderEngine::voxel_rt;
+    o.voxel_grid = 64, o.tube_radius_mm = radius, o.ambient_occlusion = true;
+    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 2.0f);
+    viewer::RenderTarget target(8, 8);
+    renderer.render(scene, cam, o, target);
+    const vrt::VoxelStructure& structure = *renderer.voxel_ray_tracer().structure();
+    const auto ao = structure.read_ambient_occlusion();
+    const vrt::VoxelGrid& grid = structure.grid();
+    // Surface points: Embree's hits of a coarse image; per point, the cone
+    // estimate against the fraction of 256 uniform directions blocked
+    // between the cones' start and reach (1 and 16 voxels,
+    // cone_occlusion.glsl), both from the lookup point half a voxel out
+    // along the normal.
+    std::mt19937 rng(3);
+    std::normal_distribution<double> g;
+    const float reach = 16 * grid.voxel_mm;
+    std::vector<double> cones, rays;
+    const int w = 48, h = 48;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const auto dir = pixel_ray(cam, x, y, w, h);
+            const auto hit = oracle.nearest(cam.position, dir);
+            if (!std::isfinite(hit.t)) continue;
+            const Vec3f p{cam.position.x + float(hit.t * dir[0]), cam.position.y + float(hit.t * dir[1]),
+                          cam.position.z + float(hit.t * dir[2])};
+            const auto [a, b] = oracle.ends(hit.segment);
+            const float abx = b.x - a.x, aby = b.y - a.y, abz = b.z - a.z;
+            const float u = std::clamp(((p.x - a.x) * abx + (p.y - a.y) * aby + (p.z - a.z) * abz) /
+                                           std::max(abx * abx + aby * aby + abz * abz, 1e-12f), 0.0f, 1.0f);
+            float nx = p.x - (a.x + u * abx), ny = p.y - (a.y + u * aby), nz = p.z - (a.z + u * abz);
+            const float nn = std::sqrt(nx * nx + ny * ny + nz * nz);
+            nx /= nn, ny /= nn, nz /= nn;
+            auto gp = grid.to_grid({p.x, p.y, p.z});
+            cones.push_back(sample_volume(ao, grid.n, {gp[0] + 0.5f * nx, gp[1] + 0.5f * ny, gp[2] + 0.5f * nz}));
+            const float out = 0.5f * grid.voxel_mm;
+            const Vec3f start{p.x + out * nx, p.y + out * ny, p.z + out * nz};
+            int blocked = 0;
+            for (int k = 0; k < 256; ++k) {
+                double v[3] = {g(rng), g(rng), g(rng)};
+                const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+                blocked += oracle.occluded(start, {v[0] / n, v[1] / n, v[2] / n}, grid.voxel_mm, reach);
+            }
+            rays.push_back(blocked / 256.0);
+        }
+    const double n = double(cones.size());
+    double mc = 0, mr = 0;
+    for (std::size_t i = 0; i < cones.size(); ++i) mc += cones[i] / n, mr += rays[i] / n;
+    double scc = 0, srr = 0, scr = 0;
+    for (std::size_t i = 0; i < cones.size(); ++i)
+        scc += (cones[i] - mc) * (cones[i] - mc), srr += (rays[i] - mr) * (rays[i] - mr),
+            scr += (cones[i] - mc) * (rays[i] - mr);
+    const double correlation = scr / std::sqrt(scc * srr);
+    std::printf("ambient occlusion at %zu surface points: cones mean %.3f, Monte-Carlo rays mean %.3f, "
+                "correlation %.4f\n",
+                cones.size(), mc, mr, correlation);
+    EXPECT_GT(cones.size(), 200u);
+    EXPECT_GE(correlation, 0.9);
+#endif
+}

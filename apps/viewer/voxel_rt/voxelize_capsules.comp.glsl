@@ -28,13 +28,15 @@ float gRadius, gEffective;   // radius and the anti-aliasing radius (>= half a v
 // Occupancy of the voxel by the capsule: one voxel of soft edge around the
 // signed distance at the voxel's centre, the capsule clipped by the planes
 // at its joints (consecutive capsules would count their overlap twice);
-// thin capsules are widened to half a voxel and scaled down by area.
+// thin capsules are widened to half a voxel and scaled down by their width
+// (what blocks a ray through a voxel of thin lines is their projected
+// width, not their cross-section's area).
 float occupancy(ivec3 v) {
     vec3 p = vec3(v) + 0.5, ab = gB - gA;
     if (dot(p - gA, gClipA) < 0.0 || dot(p - gB, gClipB) > 0.0) return 0.0;
     float h = clamp(dot(p - gA, ab) / max(dot(ab, ab), 1e-20), 0.0, 1.0);
     float distance = length(p - gA - h * ab) - gEffective;
-    float scale = (gRadius / gEffective) * (gRadius / gEffective);
+    float scale = gRadius / gEffective;
     return clamp(0.5 - distance, 0.0, 1.0) * scale;
 }
 
