@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <numeric>
 #include <random>
@@ -400,4 +401,50 @@ TEST(VoxelRtAmbientOcclusion, CorrelatesWithMonteCarloOcclusionRays) {
     EXPECT_GT(cones.size(), 200u);
     EXPECT_GE(correlation, 0.9);
 #endif
+}
+
+TEST(VoxelRtAmbientOcclusion, OneChordPerBlockMatchesEverySegment) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("small-ifod1.tck"), "small.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    viewer::Renderer renderer(*viewer_gl().programs);
+    viewer::RenderOptions o;
+    o.engine = viewer::RenderEngine::voxel_rt;
+    o.ambient_occlusion = true;
+    // 64³ in CI; FIBLET_VOXEL_RT_GRID=128 for the figure.
+    o.voxel_grid = std::getenv("FIBLET_VOXEL_RT_GRID") ? std::atoi(std::getenv("FIBLET_VOXEL_RT_GRID")) : 64;
+    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 2.0f);
+    viewer::RenderTarget target(8, 8);
+    renderer.render(scene, cam, o, target);
+    auto& tracer = renderer.voxel_ray_tracer();
+    const auto full = tracer.structure()->read_ambient_occlusion();
+    const auto cells = tracer.structure()->read_cells();
+    tracer.chord_occlusion(scene, o);
+    const auto chords = tracer.chord_occlusion_structure()->structure().read_ambient_occlusion();
+    ASSERT_EQ(full.size(), chords.size());
+    // Over the voxels the fibers occupy (where surfaces are shaded).
+    std::vector<double> diff;
+    double mf = 0, mc = 0;
+    std::vector<std::size_t> used;
+    for (std::size_t v = 0; v < full.size(); ++v)
+        if (cells[v] & 0xffffu) used.push_back(v), mf += full[v], mc += chords[v];
+    const double n = double(used.size());
+    mf /= n, mc /= n;
+    double sff = 0, scc = 0, sfc = 0, mean_abs = 0;
+    for (std::size_t v : used) {
+        const double f = full[v] - mf, c = chords[v] - mc;
+        sff += f * f, scc += c * c, sfc += f * c;
+        diff.push_back(std::fabs(double(full[v]) - double(chords[v])));
+        mean_abs += diff.back() / n;
+    }
+    std::sort(diff.begin(), diff.end());
+    const double p99 = diff[std::size_t(0.99 * double(diff.size() - 1))];
+    const double correlation = sfc / std::sqrt(sff * scc);
+    std::printf("small-ifod1, %d³: chord vs full-segment ambient occlusion over %zu occupied voxels: |dAO| mean %.4f, "
+                "p99 %.4f, correlation %.4f (means %.3f / %.3f)\n",
+                o.voxel_grid, used.size(), mean_abs, p99, correlation, mf, mc);
+    EXPECT_LE(mean_abs, 0.02);
+    EXPECT_LE(p99, 0.08);
+    EXPECT_GE(correlation, 0.98);
 }

@@ -75,7 +75,9 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
         ->capture_default_str();
     cmd->add_option("--grid", a.grid, "Voxels per side of the voxel ray tracer's cubic grid, 4..512 (--engine voxel-rt)")
         ->capture_default_str();
-    cmd->add_flag("--ao", a.ao, "Ambient occlusion from 12 cones through the occupancy (--engine voxel-rt)");
+    cmd->add_flag("--ao", a.ao,
+                  "Ambient occlusion from 12 cones through a voxel occupancy (--engine voxel-rt: of every segment; "
+                  "raster: of one chord per block, nothing decoded)");
     cmd->add_flag("--shadows", a.shadows, "A shadow ray towards the light (--engine voxel-rt)");
     cmd->add_option("--opacity", a.opacity,
                     "Opacity of each fiber surface, (0, 1]; below 1 every capsule a ray enters is composited in "
@@ -136,8 +138,8 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
     o.engine = *engine;
     if (a.grid < 4 || a.grid > 512) throw Error(Errc::invalid_argument, "--grid must be in 4..512");
     if (!(a.opacity > 0 && a.opacity <= 1)) throw Error(Errc::invalid_argument, "--opacity must be in (0, 1]");
-    if (o.engine != viewer::RenderEngine::voxel_rt && (a.ao || a.shadows || a.opacity < 1))
-        throw Error(Errc::invalid_argument, "--ao, --shadows and --opacity need --engine voxel-rt");
+    if (o.engine != viewer::RenderEngine::voxel_rt && (a.shadows || a.opacity < 1))
+        throw Error(Errc::invalid_argument, "--shadows and --opacity need --engine voxel-rt");
     o.voxel_grid = a.grid;
     o.ambient_occlusion = a.ao;
     o.shadows = a.shadows;

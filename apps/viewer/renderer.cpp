@@ -110,6 +110,9 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const R
     o.fiber_colors = options.fiber_colors && scene.has_fiber_colors();
     o.fiber_radii = options.fiber_radii && scene.has_fiber_radii();
     ensure_buffers(scene, o.record_decisions);
+    // --ao: occlusion from one chord per block, built once per scene and grid.
+    OcclusionVolume occlusion;
+    if (o.ambient_occlusion) occlusion = voxel_ray_tracer().chord_occlusion(scene, o);
     DrawTechnique& draw = technique(o.style);
     const Viewport viewport{target.width(), target.height()};
     const GLuint fb = target.framebuffer();
@@ -142,7 +145,7 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const R
         stats.fine_segments = scene.segment_count();
     }
 
-    const FrameInputs in{scene, camera, o, select};
+    const FrameInputs in{scene, camera, o, select, o.ambient_occlusion ? &occlusion : nullptr};
     draw.begin_frame(in);
     // Full blocks, a batch at a time: decode into the points buffer, draw it.
     for (std::uint32_t first = 0; first < stats.fine_blocks; first += decoder_->capacity()) {

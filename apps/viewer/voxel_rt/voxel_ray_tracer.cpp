@@ -32,6 +32,16 @@ void VoxelRayTracer::ensure_structure(const GpuScene& scene, const RenderOptions
     built_grid_ = o.voxel_grid, built_radius_ = o.tube_radius_mm;
 }
 
+OcclusionVolume VoxelRayTracer::chord_occlusion(const GpuScene& scene, const RenderOptions& o) {
+    if (!chords_ || chords_scene_ != &scene || chords_grid_ != o.voxel_grid || chords_radius_ != o.tube_radius_mm) {
+        chords_.reset();
+        chords_ = std::make_unique<ChordOcclusion>(
+            programs_, scene, grid_around(scene.bounds(), o.voxel_grid, o.tube_radius_mm), o.tube_radius_mm);
+        chords_scene_ = &scene, chords_grid_ = o.voxel_grid, chords_radius_ = o.tube_radius_mm;
+    }
+    return chords_->volume();
+}
+
 void VoxelRayTracer::trace(const GpuScene& scene, const Camera& camera, const RenderOptions& o, RenderTarget& target) {
     const GlProgram& p = programs_.trace;
     const GLuint id = p.get();

@@ -13,6 +13,7 @@
 #include "gpu_scene.hpp"
 #include "render_options.hpp"
 #include "render_target.hpp"
+#include "voxel_rt/chord_occlusion.hpp"
 #include "voxel_rt/resident_segments.hpp"
 #include "voxel_rt/voxel_rt_programs.hpp"
 #include "voxel_rt/voxel_structure.hpp"
@@ -29,6 +30,12 @@ public:
     // holds that preprocessing, draw_ms the trace (with time_stages).
     FrameStats render(const GpuScene& scene, const Camera& camera, const RenderOptions& options,
                       RenderTarget& target);
+
+    // The chord-based ambient occlusion of the scene on options' grid, for
+    // the rasterized styles' --ao (built on first use, kept while the scene,
+    // grid and radius stay the same).
+    OcclusionVolume chord_occlusion(const GpuScene& scene, const RenderOptions& options);
+    const ChordOcclusion* chord_occlusion_structure() const { return chords_.get(); }
 
     // Tests: the fiber buffer gets segment + 1 (segment s = block ×
     // points_per_block + its index in the block) instead of fiber + 1.
@@ -48,6 +55,10 @@ private:
     const GpuScene* built_scene_ = nullptr;
     int built_grid_ = 0;
     float built_radius_ = 0;
+    std::unique_ptr<ChordOcclusion> chords_;
+    const GpuScene* chords_scene_ = nullptr;
+    int chords_grid_ = 0;
+    float chords_radius_ = 0;
     GlVertexArray empty_vertex_array_;
     bool write_segment_ids_ = false;
 };

@@ -5,6 +5,7 @@
 // between the end planes). Computed from a point near the capsule on the
 // ray, for precision. Writes depth, shading and the fiber.
 #include "surface_shading.glsl"
+#include "occlusion_lookup.glsl"
 
 layout(location = 0) flat in vec3 vEnd0;
 layout(location = 1) flat in vec3 vEnd1;
@@ -53,6 +54,7 @@ void main() {
     if (best >= 1e30 || along + best <= 0.0) discard;
     vec3 hit = o + best * dir;
     gl_FragDepth = windowDepth(hit);
-    outColor = vec4(shadeSurface(normalize(normal), ba, -dir, vFiber), 1.0);
+    vec3 n = normalize(normal);
+    outColor = vec4(shadeSurface(n, ba, -dir, vFiber) * (1.0 - rasterOcclusion(hit, n)), 1.0);
     outFiber = vFiber + 1u;
 }

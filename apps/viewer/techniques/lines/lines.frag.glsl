@@ -9,6 +9,7 @@ layout(location = 1) in vec3 vWorld;
 layout(location = 2) flat in uint vFiber;
 
 #include "fiber_colors.glsl"
+#include "occlusion_lookup.glsl"
 
 layout(location = 0) out vec4 outColor;
 layout(location = 1) out uint outFiber;
@@ -31,6 +32,6 @@ void main() {
         float specular = pow(max(diffuse * sqrt(max(1.0 - vt * vt, 0.0)) - lt * vt, 0.0), uShininess);
         color = base * (uAmbient + uDiffuse * diffuse) + vec3(uSpecular * specular);
     }
-    outColor = vec4(min(color, vec3(1.0)), 1.0);
+    outColor = vec4(min(color, vec3(1.0)) * (1.0 - rasterOcclusion(vWorld, vec3(0.0))), 1.0);
     outFiber = vFiber + 1u;
 }
