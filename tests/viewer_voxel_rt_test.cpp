@@ -448,3 +448,40 @@ TEST(VoxelRtAmbientOcclusion, OneChordPerBlockMatchesEverySegment) {
     EXPECT_LE(p99, 0.08);
     EXPECT_GE(correlation, 0.98);
 }
+
+TEST(VoxelRtCulling, ImagesWithAndWithoutCullingAgree) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("small-ifod1.tck"), "small.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const int w = 256, h = 192;
+    for (const char* view : {"oblique", "top"}) {
+        SCOPED_TRACE(view);
+        const Camera cam = viewer::camera_from_spec(view, scene, float(w) / float(h), 35, 1.0f);
+        viewer::Renderer renderer(*viewer_gl().programs);
+        renderer.voxel_ray_tracer().write_segment_ids(true);
+        viewer::RenderTarget target(w, h);
+        viewer::RenderOptions o;
+        o.engine = viewer::RenderEngine::voxel_rt;
+        o.voxel_grid = 64;
+        o.frustum_culling = false;
+        renderer.render(scene, cam, o, target);
+        const auto off = target.read_fibers();
+        o.frustum_culling = true;
+        renderer.render(scene, cam, o, target);
+        const auto on = target.read_fibers();
+        const auto& tracer = renderer.voxel_ray_tracer();
+        const std::uint64_t visible = tracer.culling()->visible_voxels();
+        std::uint64_t occupied = 0;
+        for (auto c : tracer.structure()->read_cells()) occupied += (c & 0xffffu) != 0;
+        std::size_t same = 0;
+        for (std::size_t i = 0; i < on.size(); ++i) same += on[i] == off[i];
+        const double rate = double(same) / double(on.size());
+        std::printf("%s: culling keeps %llu of %llu occupied voxels (%.1f %%; %.1f ms); images agree on %.5f of "
+                    "pixels (same segment)\n",
+                    view, static_cast<unsigned long long>(visible), static_cast<unsigned long long>(occupied),
+                    100.0 * double(visible) / double(occupied), tracer.culling()->last_update_ms(), rate);
+        EXPECT_LT(visible, occupied);
+        EXPECT_GE(rate, 0.999);
+    }
+}

@@ -33,6 +33,7 @@ public:
 
     // The voxel ray tracer render() uses (made on first use; tests).
     voxel_rt::VoxelRayTracer& voxel_ray_tracer();
+    const voxel_rt::VoxelRayTracer* voxel_ray_tracer_if_made() const { return voxel_ray_tracer_.get(); }
 
     // The selection pass alone (what render() runs first when culling, LoD
     // or a subset is on): fills the fine and coarse lists and returns their

@@ -16,6 +16,7 @@
 layout(std430, binding = BINDING_VRT_CELLS) readonly buffer Cells { uint cells[]; };
 layout(std430, binding = BINDING_VRT_OFFSETS) readonly buffer Offsets { uint offsets[]; };
 layout(std430, binding = BINDING_VRT_FRAGMENTS) readonly buffer Fragments { uint fragments[]; };
+layout(std430, binding = BINDING_VRT_VISIBLE) readonly buffer Visible { uint visible[]; };  // voxel_culling.hpp
 layout(binding = 1) uniform sampler3D uAmbientOcclusion;
 
 uniform vec3 uCameraRight, uCameraUp, uCameraForward;
@@ -24,6 +25,10 @@ uniform vec2 uViewportSize;
 uniform bool uUseAmbientOcclusion, uUseShadows;
 uniform bool uWriteSegments;  // tests: segment + 1 in the fiber buffer instead of fiber + 1
 uniform float uOpacity;
+// Culling (opaque primary rays): skip invisible voxels, and invisible
+// blocks of 2^uSkipLevel voxels at once.
+uniform bool uCulling, uSkipBlocks;
+uniform uint uSkipLevel, uSkipN, uSkipOffset;
 
 layout(location = 0) out vec4 outColor;
 layout(location = 1) out uint outFiber;
@@ -127,15 +132,36 @@ float segmentEntry(vec3 o, vec3 d, uint s, out vec3 normal) {
     return capsuleEntry(o, d, a, b, uRadiusMm, uOpacity < 1.0 || firstOfFiber(s), normal);
 }
 
-// The nearest hit beyond tMin (anyHit: the first found, for shadows).
+// Distance at which the ray leaves the culling block holding the walk's voxel.
+float blockExit(vec3 o, vec3 d, Walk w) {
+    vec3 g = toGrid(o), dg = d / uVoxelMm;
+    float size = float(1u << uSkipLevel);
+    vec3 lo = vec3(w.voxel >> int(uSkipLevel)) * size, hi = lo + size;
+    vec3 bound = mix(lo, hi, step(vec3(0.0), dg));
+    vec3 t = vec3(dg.x != 0.0 ? (bound.x - g.x) / dg.x : 1e30, dg.y != 0.0 ? (bound.y - g.y) / dg.y : 1e30,
+                  dg.z != 0.0 ? (bound.z - g.z) / dg.z : 1e30);
+    return min(min(t.x, t.y), t.z);
+}
+
+// The nearest hit beyond tMin (anyHit: the first found, for shadows, which
+// ignore culling).
 bool traceNearest(vec3 o, vec3 d, float tMin, bool anyHit, out Hit hit) {
     Walk w;
     hit.t = 1e30, hit.segment = 0u, hit.normal = vec3(0.0);
     if (!startWalk(o, d, tMin, w)) return false;
     float eps = 1e-4 * uVoxelMm;
+    bool cull = uCulling && !anyHit;
     for (int i = 0; i < 4 * int(uGridN); ++i) {
+        if (cull && uSkipBlocks) {
+            ivec3 b = w.voxel >> int(uSkipLevel);
+            if (visible[uSkipOffset + (uint(b.z) * uSkipN + uint(b.y)) * uSkipN + uint(b.x)] == 0u) {
+                // Past the block (a hair beyond, so that the walk restarts outside it).
+                if (!startWalk(o, d, max(blockExit(o, d, w), w.tEnter) + 1e-3 * uVoxelMm, w)) break;
+                continue;
+            }
+        }
         uint cell = voxelIndex(w.voxel);
-        uint count = cells[cell] & 0xffffu;
+        uint count = cull && visible[cell] == 0u ? 0u : cells[cell] & 0xffffu;
         if (count != 0u) {
             uint first = offsets[cell];
             for (uint k = first; k < first + count; ++k) {

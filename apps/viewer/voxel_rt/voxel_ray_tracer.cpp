@@ -5,6 +5,7 @@
 
 #include "shader_program.hpp"
 #include "shading_uniforms.hpp"
+#include "voxel_rt/voxel_rt_bindings.hpp"
 
 namespace fiblet::viewer::voxel_rt {
 
@@ -26,6 +27,7 @@ void VoxelRayTracer::ensure_structure(const GpuScene& scene, const RenderOptions
     if (structure_ && built_grid_ == o.voxel_grid && built_radius_ == o.tube_radius_mm &&
         (!ao || structure_->has_ambient_occlusion()))
         return;
+    culling_.reset();
     structure_.reset();  // its memory first
     const VoxelGrid grid = grid_around(scene.bounds(), o.voxel_grid, o.tube_radius_mm);
     structure_ = std::make_unique<VoxelStructure>(programs_, grid, segments_->segments(), o.tube_radius_mm, ao);
@@ -49,7 +51,21 @@ void VoxelRayTracer::trace(const GpuScene& scene, const Camera& camera, const Re
     set_shading_uniforms(p, camera, o);
     bind_segments(p, segments_->segments(), structure_->grid(), o.tube_radius_mm);
     (void)scene;
+    // Culling: opaque frames (nothing hides what lies behind a transparent
+    // surface); --no-culling turns it off as it does the raster selection.
+    const bool cull = o.frustum_culling && o.opacity >= 1.0f;
+    if (cull) {
+        if (!culling_) culling_ = std::make_unique<VoxelCulling>(programs_, *structure_);
+        culling_->update(programs_, *structure_, camera);
+        glUseProgram(id);
+        culling_->bind(p);
+    } else {
+        glProgramUniform1i(id, uniform(p, "uCulling"), 0);
+        glProgramUniform1i(id, uniform(p, "uSkipBlocks"), 0);
+        // A binding must hold a buffer: the cells stand in for the pyramid.
+    }
     structure_->bind();
+    if (!cull) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kVisible, structure_->cells_buffer());
     const CameraBasis b = camera_basis(camera);
     glProgramUniform3f(id, uniform(p, "uCameraRight"), b.right.x, b.right.y, b.right.z);
     glProgramUniform3f(id, uniform(p, "uCameraUp"), b.up.x, b.up.y, b.up.z);

@@ -15,6 +15,7 @@
 #include "render_target.hpp"
 #include "voxel_rt/chord_occlusion.hpp"
 #include "voxel_rt/resident_segments.hpp"
+#include "voxel_rt/voxel_culling.hpp"
 #include "voxel_rt/voxel_rt_programs.hpp"
 #include "voxel_rt/voxel_structure.hpp"
 
@@ -42,6 +43,8 @@ public:
     void write_segment_ids(bool on) { write_segment_ids_ = on; }
     // The structure the last frame traced (null before the first).
     const VoxelStructure* structure() const { return structure_.get(); }
+    // The culling of the last opaque frame with culling on (null before).
+    const VoxelCulling* culling() const { return culling_.get(); }
     double last_decode_ms() const { return segments_ ? segments_->decode_ms() : 0; }
 
 private:
@@ -52,6 +55,7 @@ private:
     VoxelRtPrograms programs_;
     std::unique_ptr<SceneSegments> segments_;
     std::unique_ptr<VoxelStructure> structure_;
+    std::unique_ptr<VoxelCulling> culling_;  // of structure_
     const GpuScene* built_scene_ = nullptr;
     int built_grid_ = 0;
     float built_radius_ = 0;

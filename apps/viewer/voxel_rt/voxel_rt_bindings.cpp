@@ -15,6 +15,8 @@ std::string voxel_rt_defines() {
     def("BINDING_VRT_FRAGMENTS", binding::kFragments);
     def("BINDING_VRT_CURSOR", binding::kCursor);
     def("BINDING_VRT_CHUNKS", binding::kChunks);
+    def("BINDING_VRT_SOLID", binding::kSolid);
+    def("BINDING_VRT_VISIBLE", binding::kVisible);
     return s;
 }
 

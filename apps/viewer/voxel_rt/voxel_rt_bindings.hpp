@@ -14,7 +14,9 @@ inline constexpr unsigned kOffsets = 22;    // per voxel: first entry of its fra
 inline constexpr unsigned kFragments = 23;  // fragment lists: segment indices
 inline constexpr unsigned kCursor = 24;     // per voxel: fill cursor of the second voxelization pass
 inline constexpr unsigned kChunks = 25;     // prefix sum: per chunk of voxels
-inline constexpr unsigned kHighest = kChunks;
+inline constexpr unsigned kSolid = 26;      // culling: per voxel, eroded occupancy full (1) or not (0)
+inline constexpr unsigned kVisible = 27;    // culling: visibility pyramid, every level (finest first)
+inline constexpr unsigned kHighest = kVisible;
 }  // namespace binding
 
 // gpu_binding_defines() and BINDING_VRT_* for this module's bindings.

@@ -21,6 +21,7 @@ VoxelRtPrograms::VoxelRtPrograms() {
     occupancy = build_program({"occupancy_volume.comp.glsl"}, defines);
     ambient_occlusion = build_program({"ambient_occlusion.comp.glsl"}, defines);
     trace = build_program({"full_screen.vert.glsl", "trace.frag.glsl"}, defines);
+    cull = build_program({"cull_voxels.comp.glsl"}, defines);
     chords = build_program({"chord_segments.comp.glsl"}, defines);
 }
 

@@ -15,6 +15,7 @@ struct VoxelRtPrograms {
     GlProgram occupancy;          // occupancy_volume.comp.glsl
     GlProgram ambient_occlusion;  // ambient_occlusion.comp.glsl
     GlProgram trace;              // full_screen.vert.glsl + trace.frag.glsl
+    GlProgram cull;               // cull_voxels.comp.glsl
     GlProgram chords;             // chord_segments.comp.glsl (occlusion without decoding)
 };
 

@@ -48,6 +48,7 @@ public:
     std::uint64_t fragment_count() const { return fragments_count_; }
     bool has_ambient_occlusion() const { return bool(ambient_occlusion_); }
     GLuint ambient_occlusion_texture() const { return ambient_occlusion_.get(); }
+    GLuint cells_buffer() const { return cells_.get(); }
 
     // Binds the cells, offsets and fragments buffers and the textures
     // (occupancy on unit 0, ambient occlusion on unit 1).
