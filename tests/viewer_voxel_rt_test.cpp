@@ -14,7 +14,9 @@
 #include <random>
 #include <unordered_set>
 
+#include "cli_runner.hpp"
 #include "gpu_scene.hpp"
+#include "png_file.hpp"
 #include "orbit_camera.hpp"
 #include "render_target.hpp"
 #include "renderer.hpp"
@@ -483,5 +485,27 @@ TEST(VoxelRtCulling, ImagesWithAndWithoutCullingAgree) {
                     100.0 * double(visible) / double(occupied), tracer.culling()->last_update_ms(), rate);
         EXPECT_LT(visible, occupied);
         EXPECT_GE(rate, 0.999);
+    }
+}
+
+TEST(VoxelRtCli, RenderDrawsWithEveryOptionAndRefusesBadOnes) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const std::string fft = compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft");
+    const char* cases[] = {"--engine voxel-rt --grid 32", "--engine voxel-rt --grid 32 --ao --shadows",
+                           "--engine voxel-rt --grid 32 --opacity 0.3", "--ao --style tubes --grid 32"};
+    for (int i = 0; i < 4; ++i) {
+        const std::string png = dir.file(std::to_string(i) + ".png");
+        const CommandResult r = run_cli("render " + fft + " -o " + png + " --size 120x90 --camera left --radius 0.4 " + cases[i]);
+        ASSERT_EQ(r.status, 0) << cases[i] << ": " << r.output;
+        const viewer::RgbaImage img = viewer::read_png(png);
+        std::size_t lit = 0;
+        for (std::size_t k = 0; k < img.rgba.size(); k += 4) lit += img.rgba[k] + img.rgba[k + 1] + img.rgba[k + 2] > 30;
+        EXPECT_GT(lit, 500u) << cases[i];
+    }
+    for (const char* bad : {"--engine nope", "--engine voxel-rt --grid 2", "--engine voxel-rt --opacity 0",
+                            "--engine voxel-rt --opacity 1.5", "--shadows", "--opacity 0.5"}) {
+        const CommandResult r = run_cli("render " + fft + " -o " + dir.file("x.png") + " --size 32x32 " + bad);
+        EXPECT_EQ(r.status, 2) << bad << ": " << r.output;
     }
 }

@@ -44,13 +44,12 @@ OcclusionVolume VoxelRayTracer::chord_occlusion(const GpuScene& scene, const Ren
     return chords_->volume();
 }
 
-void VoxelRayTracer::trace(const GpuScene& scene, const Camera& camera, const RenderOptions& o, RenderTarget& target) {
+void VoxelRayTracer::trace(const Camera& camera, const RenderOptions& o, RenderTarget& target) {
     const GlProgram& p = programs_.trace;
     const GLuint id = p.get();
     glUseProgram(id);
     set_shading_uniforms(p, camera, o);
     bind_segments(p, segments_->segments(), structure_->grid(), o.tube_radius_mm);
-    (void)scene;
     // Culling: opaque frames (nothing hides what lies behind a transparent
     // surface); --no-culling turns it off as it does the raster selection.
     const bool cull = o.frustum_culling && o.opacity >= 1.0f;
@@ -118,7 +117,7 @@ FrameStats VoxelRayTracer::render(const GpuScene& scene, const Camera& camera, c
     glDepthFunc(GL_LESS);
     if (o.time_stages) glFinish();
     const auto t1 = std::chrono::steady_clock::now();
-    trace(scene, camera, o, target);
+    trace(camera, o, target);
     if (o.time_stages) {
         glFinish();
         stats.draw_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();

@@ -49,7 +49,7 @@ public:
 
 private:
     void ensure_structure(const GpuScene& scene, const RenderOptions& options);
-    void trace(const GpuScene& scene, const Camera& camera, const RenderOptions& options, RenderTarget& target);
+    void trace(const Camera& camera, const RenderOptions& options, RenderTarget& target);
 
     const GpuPrograms& shared_;
     VoxelRtPrograms programs_;
