@@ -1,7 +1,7 @@
 // The capsules style against Intel Embree's round linear curves (a sphere
-// swept along each segment: the same capsules), traced per pixel on the CPU
-// through a real bundle. Embree is a test-only dependency; without it the
-// test skips.
+// swept along each segment: the same capsules; tests/embree_capsules.hpp),
+// traced per pixel on the CPU through a real bundle. Embree is a test-only
+// dependency; without it the test skips.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,7 +14,7 @@
 #include "viewer_test_util.hpp"
 
 #if FIBLET_HAS_EMBREE
-#include <embree3/rtcore.h>
+#include "embree_capsules.hpp"
 #endif
 
 using namespace fiblet;
@@ -23,64 +23,14 @@ using namespace fiblet::test;
 #if FIBLET_HAS_EMBREE
 namespace {
 
-// Every fiber of the file (CPU-decoded points) as one round linear curve of
-// constant radius; returns, per pixel of the camera's w × h image, the hit
-// distance along the pixel's unit ray (+inf: miss).
+// Per pixel of the camera's w × h image, Embree's hit distance along the
+// pixel's unit ray (+inf: miss).
 std::vector<float> embree_image(const FftFile& file, float radius, const Camera& cam, int w, int h) {
-    const CpuDecoded d = cpu_decode_blocks(file);
-    RTCDevice device = rtcNewDevice(nullptr);
-    RTCScene scene = rtcNewScene(device);
-    RTCGeometry curves = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
-    const std::size_t points = d.xyz.size() / 3;
-    auto* v = static_cast<float*>(
-        rtcSetNewGeometryBuffer(curves, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 16, points));
-    for (std::size_t i = 0; i < points; ++i) {
-        const Vec3f p = d.point(i);
-        v[4 * i] = p.x, v[4 * i + 1] = p.y, v[4 * i + 2] = p.z, v[4 * i + 3] = radius;
-    }
-    std::vector<unsigned> starts;  // segment i joins points i and i + 1 of one fiber
-    for (std::uint64_t f = 0; f < file.header().fibers; ++f) {
-        const std::uint64_t first = file.first_block(f), count = file.block_count(f);
-        for (std::size_t i = d.block_first[first]; i + 1 < d.block_first[first + count]; ++i) starts.push_back(unsigned(i));
-    }
-    auto* idx = static_cast<unsigned*>(
-        rtcSetNewGeometryBuffer(curves, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, 4, starts.size()));
-    std::copy(starts.begin(), starts.end(), idx);
-    rtcCommitGeometry(curves);
-    rtcAttachGeometry(scene, curves);
-    rtcReleaseGeometry(curves);
-    rtcCommitScene(scene);
-
-    // The pixel rays of view.hpp's camera (as the oracle of viewer_tubes_test).
-    auto unit = [](double x, double y, double z) {
-        const double n = std::sqrt(x * x + y * y + z * z);
-        return std::array<double, 3>{x / n, y / n, z / n};
-    };
-    const auto fwd = unit(cam.target.x - cam.position.x, cam.target.y - cam.position.y, cam.target.z - cam.position.z);
-    const auto right = unit(fwd[1] * cam.up.z - fwd[2] * cam.up.y, fwd[2] * cam.up.x - fwd[0] * cam.up.z,
-                            fwd[0] * cam.up.y - fwd[1] * cam.up.x);
-    const std::array<double, 3> up{right[1] * fwd[2] - right[2] * fwd[1], right[2] * fwd[0] - right[0] * fwd[2],
-                                   right[0] * fwd[1] - right[1] * fwd[0]};
-    const double t = std::tan(double(cam.fov_y_deg) * M_PI / 360.0);
+    const EmbreeCapsules oracle(file, radius);
     std::vector<float> out(std::size_t(w) * std::size_t(h), INFINITY);
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
     for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            const double nx = (x + 0.5) / w * 2 - 1, ny = 1 - (y + 0.5) / h * 2;
-            const auto dir = unit(fwd[0] + nx * t * cam.aspect * right[0] + ny * t * up[0],
-                                  fwd[1] + nx * t * cam.aspect * right[1] + ny * t * up[1],
-                                  fwd[2] + nx * t * cam.aspect * right[2] + ny * t * up[2]);
-            RTCRayHit rh{};
-            rh.ray.org_x = cam.position.x, rh.ray.org_y = cam.position.y, rh.ray.org_z = cam.position.z;
-            rh.ray.dir_x = float(dir[0]), rh.ray.dir_y = float(dir[1]), rh.ray.dir_z = float(dir[2]);
-            rh.ray.tnear = 0, rh.ray.tfar = INFINITY, rh.ray.mask = ~0u;
-            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            rtcIntersect1(scene, &context, &rh);
-            if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) out[std::size_t(y) * std::size_t(w) + std::size_t(x)] = rh.ray.tfar;
-        }
-    rtcReleaseScene(scene);
-    rtcReleaseDevice(device);
+        for (int x = 0; x < w; ++x)
+            out[std::size_t(y) * std::size_t(w) + std::size_t(x)] = oracle.nearest(cam.position, pixel_ray(cam, x, y, w, h)).t;
     return out;
 }
 

@@ -86,7 +86,12 @@ std::string transparency_json(const viewer::TransparencyBench& t, const viewer::
 void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::string& device, int width, int height,
                  const std::vector<viewer::BenchCase>& cases, double scan_ms, double sequential_ms,
                  viewer::DecoderKind decoder, viewer::DrawStyle style,
-                 const std::optional<viewer::TransparencyBench>& transparency, const viewer::RenderOptions& options) {
+                 const std::optional<viewer::TransparencyBench>& transparency, const viewer::RenderOptions& options,
+                 const viewer::Renderer& renderer) {
+    // The voxel ray tracer's one-off preprocessing (the warm-up frame's).
+    const viewer::voxel_rt::VoxelRayTracer* rt = a.view.engine == "voxel-rt" ? renderer.voxel_ray_tracer_if_made() : nullptr;
+    const viewer::voxel_rt::VoxelStructure* vs = rt ? rt->structure() : nullptr;
+    const viewer::voxel_rt::BuildTimes bt = vs ? vs->times() : viewer::voxel_rt::BuildTimes{};
     if (a.json) {
         std::string list = "[";
         for (std::size_t i = 0; i < cases.size(); ++i) {
@@ -109,6 +114,18 @@ void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::
                                .integer("blocks", scene.block_count())
                                .str("decoder", viewer::decoder_name(decoder))
                                .str("style", viewer::draw_style_name(style))
+                               .str("engine", a.view.engine)
+                               .raw("voxel_rt", vs ? Json{}
+                                                         .integer("grid", std::uint64_t(vs->grid().n))
+                                                         .num("decode_ms", rt->last_decode_ms())
+                                                         .num("count_ms", bt.count_ms)
+                                                         .num("scan_ms", bt.scan_ms)
+                                                         .num("fill_ms", bt.fill_ms)
+                                                         .num("occupancy_ms", bt.occupancy_ms)
+                                                         .num("ambient_occlusion_ms", bt.ambient_occlusion_ms)
+                                                         .integer("fragments", vs->fragment_count())
+                                                         .render()
+                                                   : "null")
                                .num("radius_mm", a.view.radius)
                                .num("decode_all_scan_ms", scan_ms)
                                .num("decode_all_sequential_ms", sequential_ms)
@@ -122,6 +139,15 @@ void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::
     fmt::print("device: {}; stage times by {}\n", device, viewer::timing_method_name(viewer::default_timing_method()));
     fmt::print("style: {}{}\n", viewer::draw_style_name(style),
                style == viewer::DrawStyle::tubes ? fmt::format(", radius {} mm", a.view.radius) : "");
+    if (vs)
+        fmt::print("engine: voxel-rt, {}³ grid, capsule radius {} mm{}{}{}: preprocessing once (first frame) {:.1f} ms: "
+                   "decode {:.1f}, voxelize (counts + occupancy) {:.1f}, prefix sum {:.1f}, fragment lists {:.1f}, "
+                   "occupancy pyramid {:.1f}, ambient occlusion {:.1f}; {} fragments ({:.1f} MiB)\n",
+                   vs->grid().n, a.view.radius, a.view.ao ? ", --ao" : "", a.view.shadows ? ", --shadows" : "",
+                   a.view.opacity < 1 ? fmt::format(", --opacity {}", a.view.opacity) : "",
+                   rt->last_decode_ms() + bt.total_ms(), rt->last_decode_ms(), bt.count_ms, bt.scan_ms, bt.fill_ms,
+                   bt.occupancy_ms, bt.ambient_occlusion_ms, vs->fragment_count(),
+                   double(vs->fragment_count()) * 4 / (1 << 20));
     fmt::print("decoding all {} blocks: scan {:.2f} ms, sequential {:.2f} ms; frames below use the {} decoder\n",
                scene.block_count(), scan_ms, sequential_ms, viewer::decoder_name(decoder));
     fmt::print("{:<9} {:<12} {:>10} {:>10} {:>11} {:>9} {:>10} {:>9} {:>10} {:>9}\n", "view", "culling+LoD",
@@ -188,7 +214,8 @@ void run(const RenderArgs& a) {
         if (options.transparent())
             transparency = viewer::run_transparency_bench(scene, renderer, target, camera_for(1), options, a.frames);
         print_bench(a, scene, context.description(), width, height, cases, scan_ms, sequential_ms,
-                    options.decoder.value_or(viewer::default_decoder()), options.style, transparency, options);
+                    options.decoder.value_or(viewer::default_decoder()), options.style, transparency, options,
+                    renderer);
     }
     if (a.output.empty()) return;
     // One image; a turntable (frame i turned 360 i / n degrees about the

@@ -86,13 +86,26 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
                                             " (tubes: ray-cast spline tubes; capsules: a ray-cast capsule per "
                                             "segment; docs/viewer.md)")
         ->capture_default_str();
-    cmd->add_option("--radius", a.radius, "Tube and capsule radius in mm (--style tubes, capsules)")->capture_default_str();
+    cmd->add_option("--radius", a.radius, "Tube and capsule radius in mm (--style tubes, capsules; --engine voxel-rt)")
+        ->capture_default_str();
+    cmd->add_option("--engine", a.engine,
+                    "What draws: " + viewer::render_engine_names() +
+                        " (raster: the --style techniques; voxel-rt: every segment a capsule of --radius, ray "
+                        "traced through a voxel grid; docs/viewer.md)")
+        ->capture_default_str();
+    cmd->add_option("--grid", a.grid, "Voxels per side of the voxel ray tracer's cubic grid, 4..512 (--engine voxel-rt)")
+        ->capture_default_str();
+    cmd->add_flag("--ao", a.ao,
+                  "Ambient occlusion from 12 cones through a voxel occupancy (--engine voxel-rt: of every segment; "
+                  "raster: of one chord per block, nothing decoded)");
+    cmd->add_flag("--shadows", a.shadows, "A shadow ray towards the light (--engine voxel-rt)");
     cmd->add_option("--fiber-radii", a.fiber_radii,
                     "Tube and capsule radius per streamline from a text file (mm, one per streamline, in file "
                     "order), instead of --radius")
         ->check(CLI::ExistingFile);
     cmd->add_option("--opacity", a.opacity,
-                    "Opacity of every streamline, in (0, 1]; below 1 they blend, ordered by --transparency")
+                    "Opacity of every streamline, in (0, 1]; below 1 they blend, ordered by --transparency "
+                    "(--engine voxel-rt: every capsule a ray enters composited in depth order)")
         ->capture_default_str();
     cmd->add_option("--transparency", a.transparency,
                     "How streamlines blend when --opacity < 1: sorted (~1 mm chunks sorted back to front on the "
@@ -184,6 +197,16 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
     o.style = *style;
     if (!(a.radius > 0 && a.radius <= 100)) throw Error(Errc::invalid_argument, "--radius must be in (0, 100] mm");
     o.tube_radius_mm = a.radius;
+    const auto engine = viewer::parse_render_engine(a.engine);
+    if (!engine)
+        throw Error(Errc::invalid_argument, "--engine: '" + a.engine + "' is not one of " + viewer::render_engine_names());
+    o.engine = *engine;
+    if (a.grid < 4 || a.grid > 512) throw Error(Errc::invalid_argument, "--grid must be in 4..512");
+    if (o.engine != viewer::RenderEngine::voxel_rt && a.shadows)
+        throw Error(Errc::invalid_argument, "--shadows needs --engine voxel-rt");
+    o.voxel_grid = a.grid;
+    o.ambient_occlusion = a.ao;
+    o.shadows = a.shadows;
     if (a.supersample < 1 || a.supersample > viewer::kMaxSupersample)
         throw Error(Errc::invalid_argument, "--supersample must be in 1.." + std::to_string(viewer::kMaxSupersample));
     o.color_by_direction = a.color == "direction";

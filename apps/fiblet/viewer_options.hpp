@@ -29,6 +29,10 @@ struct ViewerArgs {
     int odf_lmax = -1;
     float opacity = 1;
     std::string transparency;  // empty: sorted (lines) / unsorted (tubes, capsules)
+    // The voxel ray tracer (--engine voxel-rt).
+    std::string engine = "raster";
+    int grid = 128;
+    bool ao = false, shadows = false;
 };
 
 // Adds the input file and the camera, shading and selection options.

@@ -8,12 +8,15 @@
 
 #include "decoder_kind.hpp"
 #include "draw_style.hpp"
+#include "render_engine.hpp"
 #include "fiblet/view.hpp"
 #include "transparency/transparency_mode.hpp"
 
 namespace fiblet::viewer {
 
 struct RenderOptions {
+    RenderEngine engine = RenderEngine::raster;
+
     // Per-frame selection on the GPU (fiblet/view.hpp definitions).
     bool frustum_culling = true;
     bool level_of_detail = true;
@@ -43,6 +46,10 @@ struct RenderOptions {
     // ordered by `transparency` (transparency/); 1 draws opaque.
     float opacity = 1.0f;
     TransparencyMode transparency = TransparencyMode::sorted;
+    // Voxel ray tracer (engine voxel_rt; capsules of tube_radius_mm).
+    int voxel_grid = 128;            // voxels along each side of its cubic grid
+    bool ambient_occlusion = false;  // 12 cones through the occupancy pyramid
+    bool shadows = false;            // one shadow ray towards the headlight
     bool clear = true;  // clear the target first (false: draw over what it holds, depth included)
 
     bool time_stages = false;       // time cull / decode / draw (GpuTimer, default_timing_method)

@@ -98,14 +98,23 @@ DrawTechnique& Renderer::technique(DrawStyle style) {
     return *t;
 }
 
+voxel_rt::VoxelRayTracer& Renderer::voxel_ray_tracer() {
+    if (!voxel_ray_tracer_) voxel_ray_tracer_ = std::make_unique<voxel_rt::VoxelRayTracer>(programs_);
+    return *voxel_ray_tracer_;
+}
+
 FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const RenderOptions& options,
                             RenderTarget& target) {
+    if (options.engine == RenderEngine::voxel_rt) return voxel_ray_tracer().render(scene, camera, options, target);
     RenderOptions o = options;
     // A transparent frame blends every segment of what it selects: no coarse blocks.
     if (o.transparent()) o.level_of_detail = false;
     o.fiber_colors = options.fiber_colors && scene.has_fiber_colors();
     o.fiber_radii = options.fiber_radii && scene.has_fiber_radii();
     ensure_buffers(scene, o.record_decisions);
+    // --ao: occlusion from one chord per block, built once per scene and grid.
+    OcclusionVolume occlusion;
+    if (o.ambient_occlusion) occlusion = voxel_ray_tracer().chord_occlusion(scene, o);
     const Viewport viewport{target.width(), target.height()};
     const GLuint fb = target.framebuffer();
     glBindFramebuffer(GL_FRAMEBUFFER, fb);
@@ -137,7 +146,7 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const R
         stats.fine_segments = scene.segment_count();
     }
 
-    const FrameInputs in{scene, camera, o, select};
+    const FrameInputs in{scene, camera, o, select, o.ambient_occlusion ? &occlusion : nullptr};
     if (o.transparent()) blend_target_.begin(target, o.clear, o.background, o.opacity);
     if (o.transparent() && o.style == DrawStyle::lines && o.transparency != TransparencyMode::unsorted) {
         timer.begin(Stage::draw);

@@ -27,6 +27,7 @@
 #include "transparency/sorted_chunks.hpp"
 #include "transparency/transparent_lines.hpp"
 #include "transparency/voxlines.hpp"
+#include "voxel_rt/voxel_ray_tracer.hpp"
 
 namespace fiblet::viewer {
 
@@ -34,8 +35,14 @@ class Renderer {
 public:
     explicit Renderer(const GpuPrograms& programs);
 
+    // Draws with options.engine: the raster pipeline below, or the voxel
+    // ray tracer (voxel_rt/), which does its own selection and decoding.
     FrameStats render(const GpuScene& scene, const Camera& camera, const RenderOptions& options,
                       RenderTarget& target);
+
+    // The voxel ray tracer render() uses (made on first use; tests).
+    voxel_rt::VoxelRayTracer& voxel_ray_tracer();
+    const voxel_rt::VoxelRayTracer* voxel_ray_tracer_if_made() const { return voxel_ray_tracer_.get(); }
 
     // The selection pass alone (what render() runs first when culling, LoD
     // or a subset is on): fills the fine and coarse lists and returns their
@@ -73,6 +80,7 @@ private:
     void draw_ordered_lines(const FrameInputs& in, DecoderKind decoder, std::uint32_t blocks);
 
     const GpuPrograms& programs_;
+    std::unique_ptr<voxel_rt::VoxelRayTracer> voxel_ray_tracer_;  // made on first use
     std::unique_ptr<BlockDecoder> decoder_;
     std::map<DrawStyle, std::unique_ptr<DrawTechnique>> techniques_;
     GlBuffer fine_list_, coarse_list_, counters_, decisions_;

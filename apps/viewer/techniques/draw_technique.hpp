@@ -15,6 +15,8 @@
 
 namespace fiblet::viewer {
 
+struct OcclusionVolume;
+
 // Vertices of the box proxy of the ray-cast styles (shaders/box_proxy.glsl).
 inline constexpr unsigned kBoxProxyVertices = 36;
 
@@ -24,6 +26,7 @@ struct FrameInputs {
     const Camera& camera;
     const RenderOptions& options;
     bool use_list;  // batches are the fine list's blocks (else blocks first + i)
+    const OcclusionVolume* occlusion = nullptr;  // --ao: the chord-based volume (voxel_rt/chord_occlusion.hpp)
 };
 
 // A decoded batch: slot i of `points` (and of `tangents`, when the technique

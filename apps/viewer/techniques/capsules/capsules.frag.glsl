@@ -6,6 +6,7 @@
 // ray, for precision. Writes depth, shading and the fiber.
 #include "surface_shading.glsl"
 #include "slab_clip.glsl"
+#include "occlusion_lookup.glsl"
 
 layout(location = 0) flat in vec3 vEnd0;
 layout(location = 1) flat in vec3 vEnd1;
@@ -55,6 +56,7 @@ void main() {
     vec3 hit = o + best * dir;
     if (outsideSlab(hit)) discard;
     gl_FragDepth = windowDepth(hit);
-    outColor = vec4(shadeSurface(normalize(normal), ba, -dir, vFiber), 1.0);
+    vec3 n = normalize(normal);
+    outColor = vec4(shadeSurface(n, ba, -dir, vFiber) * (1.0 - rasterOcclusion(hit, n)), 1.0);
     outFiber = vFiber + 1u;
 }

@@ -3,6 +3,7 @@
 #include "gpu_bindings.hpp"
 #include "shader_program.hpp"
 #include "shading_uniforms.hpp"
+#include "voxel_rt/chord_occlusion.hpp"
 
 namespace fiblet::viewer {
 
@@ -11,6 +12,7 @@ CapsulesTechnique::CapsulesTechnique()
 
 void CapsulesTechnique::begin_frame(const FrameInputs& in) {
     set_shading_uniforms(draw_, in.camera, in.options);
+    set_occlusion_uniforms(draw_, in.occlusion);
     glProgramUniform1f(draw_.get(), uniform(draw_, "uRadius"), in.options.tube_radius_mm);
     glProgramUniform1i(draw_.get(), uniform(draw_, "uFiberRadii"), in.options.fiber_radii ? 1 : 0);
     coarse_lines_.begin_frame(in);

@@ -6,12 +6,13 @@ layout(location = 2) flat in uint vFiber;
 
 #include "line_color.glsl"
 #include "slab_clip.glsl"
+#include "occlusion_lookup.glsl"
 
 layout(location = 0) out vec4 outColor;
 layout(location = 1) out uint outFiber;
 
 void main() {
     if (outsideSlab(vWorld)) discard;
-    outColor = vec4(min(lineColor(vTangent, vWorld, vFiber), vec3(1.0)), 1.0);
+    outColor = vec4(min(lineColor(vTangent, vWorld, vFiber), vec3(1.0)) * (1.0 - rasterOcclusion(vWorld, vec3(0.0))), 1.0);
     outFiber = vFiber + 1u;
 }

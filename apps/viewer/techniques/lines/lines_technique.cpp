@@ -3,6 +3,7 @@
 #include "gpu_bindings.hpp"
 #include "shader_program.hpp"
 #include "shading_uniforms.hpp"
+#include "voxel_rt/chord_occlusion.hpp"
 
 namespace fiblet::viewer {
 
@@ -14,6 +15,8 @@ void LinesTechnique::begin_frame(const FrameInputs& in) {
     glLineWidth(in.options.line_width);
     set_shading_uniforms(fine_, in.camera, in.options);
     set_shading_uniforms(coarse_, in.camera, in.options);
+    set_occlusion_uniforms(fine_, in.occlusion);
+    set_occlusion_uniforms(coarse_, in.occlusion);
 }
 
 void LinesTechnique::draw_batch(const FrameInputs& in, const DecodedBatch& batch) {

@@ -14,6 +14,7 @@
 #include "tube_piece.glsl"
 #include "surface_shading.glsl"
 #include "slab_clip.glsl"
+#include "occlusion_lookup.glsl"
 
 layout(std430, binding = BINDING_TUBE_PIECES) readonly buffer Pieces { TubePiece pieces[]; };
 
@@ -172,6 +173,6 @@ void main() {
     vec3 normal = normalize(hit - centre);
     vec3 tangent = 2.0 * (1.0 - t) * (q.c1.xyz - q.c0.xyz) + 2.0 * t * (q.c2.xyz - q.c1.xyz);
     uint fiber = floatBitsToUint(q.center.w);
-    outColor = vec4(shadeSurface(normal, tangent, -dir, fiber), 1.0);
+    outColor = vec4(shadeSurface(normal, tangent, -dir, fiber) * (1.0 - rasterOcclusion(hit, normal)), 1.0);
     outFiber = fiber + 1u;
 }

@@ -3,6 +3,7 @@
 #include "gpu_bindings.hpp"
 #include "shader_program.hpp"
 #include "shading_uniforms.hpp"
+#include "voxel_rt/chord_occlusion.hpp"
 
 namespace fiblet::viewer {
 
@@ -17,6 +18,7 @@ TubesTechnique::TubesTechnique(float tangent_scale)
 
 void TubesTechnique::begin_frame(const FrameInputs& in) {
     set_shading_uniforms(draw_, in.camera, in.options);
+    set_occlusion_uniforms(draw_, in.occlusion);
     coarse_lines_.begin_frame(in);
 }
 

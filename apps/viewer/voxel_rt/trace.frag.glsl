@@ -1,0 +1,298 @@
+#version 450
+// The voxel ray tracer, one pixel per fragment: the pixel's ray walks the
+// grid voxel by voxel (DDA), testing the capsules of each non-empty voxel's
+// fragment list analytically and accepting only hits inside that voxel, so
+// that the first voxel with a hit holds the nearest one. Opaque: the
+// nearest hit, shaded with ambient occlusion (the per-voxel volume,
+// trilinear) and a shadow ray towards the light. Transparent (uOpacity <
+// 1): every capsule entered, voxel by voxel, the k nearest of a voxel
+// insertion-sorted by 32-bit keys (depth in the voxel | fragment) and
+// composited front to back, repeated from the last key when a voxel has
+// more than k.
+#include "scene_buffers.glsl"
+#include "voxel_segments.glsl"
+#include "surface_shading.glsl"
+
+layout(std430, binding = BINDING_VRT_CELLS) readonly buffer Cells { uint cells[]; };
+layout(std430, binding = BINDING_VRT_OFFSETS) readonly buffer Offsets { uint offsets[]; };
+layout(std430, binding = BINDING_VRT_FRAGMENTS) readonly buffer Fragments { uint fragments[]; };
+layout(std430, binding = BINDING_VRT_VISIBLE) readonly buffer Visible { uint visible[]; };  // voxel_culling.hpp
+layout(binding = 1) uniform sampler3D uAmbientOcclusion;
+
+uniform vec3 uCameraRight, uCameraUp, uCameraForward;
+uniform float uTanHalfFovY, uAspect;
+uniform vec2 uViewportSize;
+uniform bool uUseAmbientOcclusion, uUseShadows;
+uniform bool uWriteSegments;  // tests: segment + 1 in the fiber buffer instead of fiber + 1
+uniform float uOpacity;
+// Culling (opaque primary rays): skip invisible voxels, and invisible
+// blocks of 2^uSkipLevel voxels at once.
+uniform bool uCulling, uSkipBlocks;
+uniform uint uSkipLevel, uSkipN, uSkipOffset;
+
+layout(location = 0) out vec4 outColor;
+layout(location = 1) out uint outFiber;
+
+const int kSortedHits = 8;  // k
+
+// Entry distance of the unit ray (o, d) into capsule a–b of radius r (-1:
+// none), and the outward normal there. Solved from a point near the
+// capsule on the ray, for precision (as capsules.frag.glsl). Without
+// `startCap` the sphere at a is left out: it is the previous segment's
+// sphere at its end, and counting it once makes the hit segment well
+// defined at joints (Embree's round linear curves give it to the previous
+// segment too).
+float capsuleEntry(vec3 o, vec3 d, vec3 a, vec3 b, float r, bool startCap, out vec3 normal) {
+    float along = dot(0.5 * (a + b) - o, d);
+    vec3 oa = o + along * d - a, ba = b - a;
+    float baba = dot(ba, ba), bard = dot(ba, d), baoa = dot(ba, oa);
+    float best = 1e30;
+    normal = vec3(0.0);
+    float qa = baba - bard * bard;
+    if (qa > 1e-12 * baba) {
+        float qb = baba * dot(d, oa) - baoa * bard, qc = baba * dot(oa, oa) - baoa * baoa - r * r * baba;
+        float h = qb * qb - qa * qc;
+        if (h >= 0.0) {
+            float t = (-qb - sqrt(h)) / qa, y = baoa + t * bard;
+            if (y > 0.0 && y < baba) best = t, normal = oa + t * d - ba * (y / baba);
+        }
+    }
+    for (int end = startCap ? 0 : 1; end < 2; ++end) {
+        vec3 oc = oa - (end == 0 ? vec3(0.0) : ba);
+        float k = dot(d, oc), h = k * k - (dot(oc, oc) - r * r);
+        if (h < 0.0) continue;
+        float t = -k - sqrt(h);
+        if (t < best) best = t, normal = oc + t * d;
+    }
+    if (best >= 1e30) return -1.0;
+    normal = normalize(normal);
+    return along + best;
+}
+
+struct Walk {
+    ivec3 voxel, step;
+    vec3 tNext, tDelta;
+    float tEnter, tExit, tEnd;
+};
+
+// Starts the walk of the ray (o, d) from distance tMin; false when the ray
+// misses the grid.
+bool startWalk(vec3 o, vec3 d, float tMin, out Walk w) {
+    float n = float(uGridN);
+    vec3 g = toGrid(o), dg = d / uVoxelMm;
+    vec3 inv = vec3(dg.x != 0.0 ? 1.0 / dg.x : 1e30, dg.y != 0.0 ? 1.0 / dg.y : 1e30, dg.z != 0.0 ? 1.0 / dg.z : 1e30);
+    vec3 t0 = (vec3(0.0) - g) * inv, t1 = (vec3(n) - g) * inv;
+    vec3 tl = min(t0, t1), th = max(t0, t1);
+    float tNear = max(max(max(tl.x, tl.y), tl.z), tMin), tFar = min(min(th.x, th.y), th.z);
+    if (tFar <= tNear) return false;
+    w.voxel = clamp(ivec3(floor(g + tNear * dg)), ivec3(0), ivec3(int(uGridN) - 1));
+    w.step = ivec3(sign(dg));
+    w.tDelta = abs(inv);
+    w.tNext = vec3((vec3(w.voxel) + step(vec3(0.0), dg) - g) * inv);
+    if (dg.x == 0.0) w.tNext.x = 1e30;
+    if (dg.y == 0.0) w.tNext.y = 1e30;
+    if (dg.z == 0.0) w.tNext.z = 1e30;
+    w.tEnter = tNear;
+    w.tExit = min(min(min(w.tNext.x, w.tNext.y), w.tNext.z), tFar);
+    w.tEnd = tFar;
+    return true;
+}
+
+bool advance(inout Walk w) {
+    int axis = w.tNext.x <= w.tNext.y ? (w.tNext.x <= w.tNext.z ? 0 : 2) : (w.tNext.y <= w.tNext.z ? 1 : 2);
+    w.voxel[axis] += w.step[axis];
+    if (w.voxel[axis] < 0 || w.voxel[axis] >= int(uGridN)) return false;
+    w.tEnter = w.tNext[axis];
+    w.tNext[axis] += w.tDelta[axis];
+    w.tExit = min(min(min(w.tNext.x, w.tNext.y), w.tNext.z), w.tEnd);
+    return w.tEnter < w.tEnd;
+}
+
+struct Hit {
+    float t;
+    uint segment;
+    vec3 normal;
+};
+
+void segmentEnds(uint s, out vec3 a, out vec3 b) {
+    uint i = segmentFirstPoint(s);
+    a = vrtPoints[i].xyz, b = vrtPoints[i + 1u].xyz;
+}
+
+// Whether segment s starts its fiber (else the previous segment ends at its start).
+bool firstOfFiber(uint s) {
+    uint slot = segmentSlot(s);
+    return uAllSegmentsValid || (s == slot * uSegmentsPerSlot && (slot == 0u || blockFiber[slot - 1u] != blockFiber[slot]));
+}
+
+// capsuleEntry of segment s (transparent: every capsule whole, each entered once).
+float segmentEntry(vec3 o, vec3 d, uint s, out vec3 normal) {
+    vec3 a, b;
+    segmentEnds(s, a, b);
+    return capsuleEntry(o, d, a, b, uRadiusMm, uOpacity < 1.0 || firstOfFiber(s), normal);
+}
+
+// Distance at which the ray leaves the culling block holding the walk's voxel.
+float blockExit(vec3 o, vec3 d, Walk w) {
+    vec3 g = toGrid(o), dg = d / uVoxelMm;
+    float size = float(1u << uSkipLevel);
+    vec3 lo = vec3(w.voxel >> int(uSkipLevel)) * size, hi = lo + size;
+    vec3 bound = mix(lo, hi, step(vec3(0.0), dg));
+    vec3 t = vec3(dg.x != 0.0 ? (bound.x - g.x) / dg.x : 1e30, dg.y != 0.0 ? (bound.y - g.y) / dg.y : 1e30,
+                  dg.z != 0.0 ? (bound.z - g.z) / dg.z : 1e30);
+    return min(min(t.x, t.y), t.z);
+}
+
+// The nearest hit beyond tMin (anyHit: the first found, for shadows, which
+// ignore culling).
+bool traceNearest(vec3 o, vec3 d, float tMin, bool anyHit, out Hit hit) {
+    Walk w;
+    hit.t = 1e30, hit.segment = 0u, hit.normal = vec3(0.0);
+    if (!startWalk(o, d, tMin, w)) return false;
+    float eps = 1e-4 * uVoxelMm;
+    bool cull = uCulling && !anyHit;
+    for (int i = 0; i < 4 * int(uGridN); ++i) {
+        if (cull && uSkipBlocks) {
+            ivec3 b = w.voxel >> int(uSkipLevel);
+            if (visible[uSkipOffset + (uint(b.z) * uSkipN + uint(b.y)) * uSkipN + uint(b.x)] == 0u) {
+                // Past the block (a hair beyond, so that the walk restarts outside it).
+                if (!startWalk(o, d, max(blockExit(o, d, w), w.tEnter) + 1e-3 * uVoxelMm, w)) break;
+                continue;
+            }
+        }
+        uint cell = voxelIndex(w.voxel);
+        uint count = cull && visible[cell] == 0u ? 0u : cells[cell] & 0xffffu;
+        if (count != 0u) {
+            uint first = offsets[cell];
+            for (uint k = first; k < first + count; ++k) {
+                uint s = fragments[k];
+                vec3 normal;
+                float t = segmentEntry(o, d, s, normal);
+                if (t < max(w.tEnter, tMin) - eps || t > w.tExit + eps || t <= tMin) continue;
+                if (anyHit) return true;
+                // Ties: the lower segment, so that the image does not depend on list order.
+                if (t < hit.t || (t == hit.t && s < hit.segment)) hit.t = t, hit.segment = s, hit.normal = normal;
+            }
+            if (hit.t < 1e30) return true;
+        }
+        if (!advance(w)) break;
+    }
+    return false;
+}
+
+vec3 shadeHit(vec3 o, vec3 d, Hit h) {
+    vec3 a, b;
+    segmentEnds(h.segment, a, b);
+    uint fiber = blockFiber[segmentSlot(h.segment)];
+    if (!uUseAmbientOcclusion && !uUseShadows) return shadeSurface(h.normal, b - a, -d, fiber);
+    if (uShowNormals) return 0.5 * h.normal + 0.5;
+    vec3 p = o + h.t * d, base = baseColor(b - a, fiber);
+    if (!uLighting) return base;
+    float ao = 0.0;
+    if (uUseAmbientOcclusion)
+        ao = texture(uAmbientOcclusion, (toGrid(p) + 0.5 * h.normal) / float(uGridN)).r;
+    float lit = 1.0;
+    Hit blocker;
+    if (uUseShadows && dot(h.normal, uLightDirection) > 0.0 &&
+        traceNearest(p + 1e-3 * uVoxelMm * h.normal, uLightDirection, 1e-4 * uVoxelMm, true, blocker))
+        lit = 0.0;
+    float diffuse = max(dot(h.normal, uLightDirection), 0.0) * lit;
+    float specular = pow(max(dot(h.normal, normalize(uLightDirection - d)), 0.0), uShininess) * lit;
+    // Ambient occlusion darkens the whole surface (the headlight is near the eye).
+    return min((base * (uAmbient + uDiffuse * diffuse) + vec3(uSpecular * specular)) * (1.0 - ao), vec3(1.0));
+}
+
+vec3 slotPoint(uint slot, uint k) { return vrtPoints[slot * (uSegmentsPerSlot + 1u) + k].xyz; }
+
+// Whether the capsule of segment s entered at p is where the ray enters the
+// fiber's tube: p between the planes at the segment's joints normal to the
+// central-difference tangents there (the capsules of one fiber overlap at
+// joints; the planes split the tube into pieces that do not). A fiber's
+// ends keep their round caps.
+bool insideClipPlanes(uint s, vec3 p) {
+    if (uAllSegmentsValid) return true;
+    uint slot = segmentSlot(s), seg = s - slot * uSegmentsPerSlot, count = blockPointCount(slot);
+    vec3 a, b;
+    segmentEnds(s, a, b);
+    // The point before a.
+    if (seg > 0u) {
+        if (dot(p - a, b - slotPoint(slot, seg - 1u)) < 0.0) return false;
+    } else if (!firstOfFiber(s)) {
+        if (dot(p - a, b - slotPoint(slot - 1u, blockPointCount(slot - 1u) - 1u)) < 0.0) return false;
+    }
+    // The point after b: in this slot (the next block's first point at
+    // index count), or the next block's second.
+    if (seg + 2u < count || (seg + 2u == count && !isLastBlockOfFiber(slot))) {
+        if (dot(p - b, slotPoint(slot, seg + 2u) - a) > 0.0) return false;
+    } else if (seg + 1u == count && blockSegmentCount(slot + 1u) >= 1u) {
+        if (dot(p - b, slotPoint(slot + 1u, 1u) - a) > 0.0) return false;
+    }
+    return true;
+}
+
+uint keyOf(float t, Walk w, uint local) {
+    float f = clamp((t - w.tEnter) / max(w.tExit - w.tEnter, 1e-30), 0.0, 1.0);
+    return (uint(f * 65535.0) << 16) | local;
+}
+
+// Composites every capsule the ray enters; returns premultiplied colour and
+// coverage, and the nearest hit.
+vec4 traceTransparent(vec3 o, vec3 d, out Hit nearest) {
+    Walk w;
+    nearest.t = 1e30, nearest.segment = 0u, nearest.normal = vec3(0.0);
+    vec3 color = vec3(0.0);
+    float transmittance = 1.0;
+    if (!startWalk(o, d, 0.0, w)) return vec4(0.0);
+    for (int i = 0; i < 4 * int(uGridN) && transmittance > 1.0 / 1024.0; ++i) {
+        uint cell = voxelIndex(w.voxel);
+        uint count = min(cells[cell] & 0xffffu, 65535u), first = offsets[cell];
+        bool more = count != 0u, started = false;
+        uint lastKey = 0u;
+        while (more) {
+            uint keys[kSortedHits];
+            int n = 0;
+            for (uint k = 0u; k < count; ++k) {
+                vec3 normal;
+                float t = segmentEntry(o, d, fragments[first + k], normal);
+                // Each capsule is entered in one voxel: [tEnter, tExit).
+                if (t < w.tEnter || t >= w.tExit || t <= 0.0) continue;
+                if (!insideClipPlanes(fragments[first + k], o + t * d)) continue;
+                uint key = keyOf(t, w, k);
+                if (started && key <= lastKey) continue;
+                if (n == kSortedHits && key >= keys[n - 1]) continue;
+                int j = min(n, kSortedHits - 1);
+                while (j > 0 && keys[j - 1] > key) keys[j] = keys[j - 1], --j;
+                keys[j] = key;
+                n = min(n + 1, kSortedHits);
+            }
+            for (int j = 0; j < n; ++j) {
+                Hit h;
+                h.segment = fragments[first + (keys[j] & 0xffffu)];
+                h.t = segmentEntry(o, d, h.segment, h.normal);
+                if (h.t < nearest.t) nearest = h;
+                color += transmittance * uOpacity * shadeHit(o, d, h);
+                transmittance *= 1.0 - uOpacity;
+            }
+            more = n == kSortedHits;
+            if (more) lastKey = keys[n - 1], started = true;
+        }
+        if (!advance(w)) break;
+    }
+    return vec4(color, 1.0 - transmittance);
+}
+
+void main() {
+    vec2 ndc = gl_FragCoord.xy / uViewportSize * 2.0 - 1.0;
+    vec3 d = normalize(uCameraForward + ndc.x * uTanHalfFovY * uAspect * uCameraRight + ndc.y * uTanHalfFovY * uCameraUp);
+    vec3 o = uCameraPosition;
+    Hit h;
+    if (uOpacity < 1.0) {
+        outColor = traceTransparent(o, d, h);
+        if (h.t >= 1e30) discard;
+    } else {
+        if (!traceNearest(o, d, 0.0, false, h)) discard;
+        outColor = vec4(shadeHit(o, d, h), 1.0);
+    }
+    outFiber = uWriteSegments ? h.segment + 1u : blockFiber[segmentSlot(h.segment)] + 1u;
+    gl_FragDepth = windowDepth(o + h.t * d);
+}

@@ -1,0 +1,70 @@
+// The voxel ray tracing engine (Kraaijeveld et al., "Real-Time Rendering of
+// Dynamic Line Sets using Voxel Ray Tracing", CGF 2026) on the GPU
+// decoder's output: every segment is a capsule of RenderOptions::
+// tube_radius_mm. Unlike the per-batch techniques it needs all segments
+// resident and a voxelization before the first pixel; both are kept
+// between frames while the scene, grid, radius and ambient occlusion stay
+// the same (the lines are static here), so a frame is one full-screen trace.
+#pragma once
+
+#include <memory>
+
+#include "gpu_programs.hpp"
+#include "gpu_scene.hpp"
+#include "render_options.hpp"
+#include "render_target.hpp"
+#include "voxel_rt/chord_occlusion.hpp"
+#include "voxel_rt/resident_segments.hpp"
+#include "voxel_rt/voxel_culling.hpp"
+#include "voxel_rt/voxel_rt_programs.hpp"
+#include "voxel_rt/voxel_structure.hpp"
+
+namespace fiblet::viewer::voxel_rt {
+
+class VoxelRayTracer {
+public:
+    explicit VoxelRayTracer(const GpuPrograms& programs);
+    ~VoxelRayTracer();
+
+    // Draws the frame (clearing the target when options.clear). The first
+    // frame of a scene decodes and voxelizes it: its FrameStats::decode_ms
+    // holds that preprocessing, draw_ms the trace (with time_stages).
+    FrameStats render(const GpuScene& scene, const Camera& camera, const RenderOptions& options,
+                      RenderTarget& target);
+
+    // The chord-based ambient occlusion of the scene on options' grid, for
+    // the rasterized styles' --ao (built on first use, kept while the scene,
+    // grid and radius stay the same).
+    OcclusionVolume chord_occlusion(const GpuScene& scene, const RenderOptions& options);
+    const ChordOcclusion* chord_occlusion_structure() const { return chords_.get(); }
+
+    // Tests: the fiber buffer gets segment + 1 (segment s = block ×
+    // points_per_block + its index in the block) instead of fiber + 1.
+    void write_segment_ids(bool on) { write_segment_ids_ = on; }
+    // The structure the last frame traced (null before the first).
+    const VoxelStructure* structure() const { return structure_.get(); }
+    // The culling of the last opaque frame with culling on (null before).
+    const VoxelCulling* culling() const { return culling_.get(); }
+    double last_decode_ms() const { return segments_ ? segments_->decode_ms() : 0; }
+
+private:
+    void ensure_structure(const GpuScene& scene, const RenderOptions& options);
+    void trace(const Camera& camera, const RenderOptions& options, RenderTarget& target);
+
+    const GpuPrograms& shared_;
+    VoxelRtPrograms programs_;
+    std::unique_ptr<SceneSegments> segments_;
+    std::unique_ptr<VoxelStructure> structure_;
+    std::unique_ptr<VoxelCulling> culling_;  // of structure_
+    const GpuScene* built_scene_ = nullptr;
+    int built_grid_ = 0;
+    float built_radius_ = 0;
+    std::unique_ptr<ChordOcclusion> chords_;
+    const GpuScene* chords_scene_ = nullptr;
+    int chords_grid_ = 0;
+    float chords_radius_ = 0;
+    GlVertexArray empty_vertex_array_;
+    bool write_segment_ids_ = false;
+};
+
+}  // namespace fiblet::viewer::voxel_rt

@@ -1,0 +1,23 @@
+#include "voxel_rt/voxel_rt_bindings.hpp"
+
+#include <fmt/core.h>
+
+#include "gpu_bindings.hpp"
+
+namespace fiblet::viewer::voxel_rt {
+
+std::string voxel_rt_defines() {
+    std::string s = gpu_binding_defines();
+    auto def = [&](const char* name, unsigned v) { s += fmt::format("#define {} {}\n", name, v); };
+    def("BINDING_VRT_POINTS", binding::kPoints);
+    def("BINDING_VRT_CELLS", binding::kCells);
+    def("BINDING_VRT_OFFSETS", binding::kOffsets);
+    def("BINDING_VRT_FRAGMENTS", binding::kFragments);
+    def("BINDING_VRT_CURSOR", binding::kCursor);
+    def("BINDING_VRT_CHUNKS", binding::kChunks);
+    def("BINDING_VRT_SOLID", binding::kSolid);
+    def("BINDING_VRT_VISIBLE", binding::kVisible);
+    return s;
+}
+
+}  // namespace fiblet::viewer::voxel_rt

@@ -1,0 +1,25 @@
+// Binding points of the voxel ray tracer's own buffers: numbered after the
+// shared ones (gpu_bindings.hpp) with room for those to grow, given to its
+// shaders as #defines next to gpu_binding_defines().
+#pragma once
+
+#include <string>
+
+namespace fiblet::viewer::voxel_rt {
+
+namespace binding {
+inline constexpr unsigned kPoints = 20;     // resident decoded segments (BlockDecoder's slot layout)
+inline constexpr unsigned kCells = 21;      // per voxel: occupancy (high 16 bits, 1/128) | count (low 16)
+inline constexpr unsigned kOffsets = 22;    // per voxel: first entry of its fragment list (voxels + 1)
+inline constexpr unsigned kFragments = 23;  // fragment lists: segment indices
+inline constexpr unsigned kCursor = 24;     // per voxel: fill cursor of the second voxelization pass
+inline constexpr unsigned kChunks = 25;     // prefix sum: per chunk of voxels
+inline constexpr unsigned kSolid = 26;      // culling: per voxel, eroded occupancy full (1) or not (0)
+inline constexpr unsigned kVisible = 27;    // culling: visibility pyramid, every level (finest first)
+inline constexpr unsigned kHighest = kVisible;
+}  // namespace binding
+
+// gpu_binding_defines() and BINDING_VRT_* for this module's bindings.
+std::string voxel_rt_defines();
+
+}  // namespace fiblet::viewer::voxel_rt

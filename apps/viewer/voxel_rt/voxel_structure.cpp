@@ -1,0 +1,188 @@
+#include "voxel_rt/voxel_structure.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "fiblet/error.hpp"
+#include "shader_program.hpp"
+#include "voxel_rt/voxel_rt_bindings.hpp"
+
+namespace fiblet::viewer::voxel_rt {
+
+namespace {
+
+// Voxels per prefix-sum chunk (walked by one invocation).
+constexpr std::uint32_t kScanChunk = 256;
+
+// Wall-clock milliseconds of `work` with the GL queue drained before and
+// after (llvmpipe's timer queries do not measure compute).
+template <class Work>
+double timed(Work&& work) {
+    glFinish();
+    const auto t0 = std::chrono::steady_clock::now();
+    work();
+    glFinish();
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+int mip_levels(int n) {
+    int levels = 1;
+    while ((n >> levels) > 0) ++levels;
+    return levels;
+}
+
+GlTexture make_volume(int n, int levels) {
+    GLuint t = 0;
+    glCreateTextures(GL_TEXTURE_3D, 1, &t);
+    glTextureStorage3D(t, levels, GL_R16F, n, n, n);
+    glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, levels > 1 ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR);
+    glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
+        glTextureParameteri(t, wrap, GL_CLAMP_TO_BORDER);
+    const float border[4] = {0, 0, 0, 0};
+    glTextureParameterfv(t, GL_TEXTURE_BORDER_COLOR, border);
+    return GlTexture(t);
+}
+
+std::uint64_t voxel_count(const VoxelGrid& g) { return std::uint64_t(g.n) * std::uint64_t(g.n) * std::uint64_t(g.n); }
+
+}  // namespace
+
+void bind_segments(const GlProgram& p, const ResidentSegments& s, const VoxelGrid& g, float radius_mm) {
+    const GLuint id = p.get();
+    if (s.scene) s.scene->bind(p);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kPoints, s.points);
+    glProgramUniform1ui(id, uniform(p, "uGridN"), GLuint(g.n));
+    glProgramUniform3f(id, uniform(p, "uGridOrigin"), g.origin[0], g.origin[1], g.origin[2]);
+    glProgramUniform1f(id, uniform(p, "uVoxelMm"), g.voxel_mm);
+    glProgramUniform1ui(id, uniform(p, "uSegmentSlots"), s.slots);
+    glProgramUniform1ui(id, uniform(p, "uSegmentsPerSlot"), s.segments_per_slot);
+    glProgramUniform1i(id, uniform(p, "uAllSegmentsValid"), s.scene ? 0 : 1);
+    glProgramUniform1f(id, uniform(p, "uRadiusMm"), radius_mm);
+}
+
+VoxelStructure::VoxelStructure(const VoxelRtPrograms& p, const VoxelGrid& grid, const ResidentSegments& s,
+                               float radius_mm, bool ambient_occlusion)
+    : grid_(grid) {
+    const std::uint64_t voxels = voxel_count(grid_);
+    cells_ = make_buffer(GLsizeiptr(voxels * 4), nullptr, 0);
+    offsets_ = make_buffer(GLsizeiptr((voxels + 1) * 4), nullptr, 0);
+    cursor_ = make_buffer(GLsizeiptr(voxels * 4), nullptr, 0);
+    times_.count_ms = timed([&] { count_and_occupy(p, s, radius_mm); });
+    times_.scan_ms = timed([&] { prefix_sum(p); });
+    times_.fill_ms = timed([&] { fill_lists(p, s, radius_mm); });
+    times_.occupancy_ms = timed([&] { build_occupancy(p); });
+    if (ambient_occlusion) times_.ambient_occlusion_ms = timed([&] { build_ambient_occlusion(p); });
+    cursor_.reset();
+}
+
+void VoxelStructure::dispatch_segments(const GlProgram& p, const ResidentSegments& s) const {
+    const std::uint64_t groups = (std::uint64_t(s.slots) * s.segments_per_slot + 63) / 64;
+    if (groups == 0) return;
+    const std::uint64_t x = std::min<std::uint64_t>(groups, 65535);
+    glProgramUniform1ui(p.get(), uniform(p, "uSegmentBase"), 0);
+    glDispatchCompute(GLuint(x), GLuint((groups + x - 1) / x), 1);
+}
+
+void VoxelStructure::count_and_occupy(const VoxelRtPrograms& p, const ResidentSegments& s, float radius_mm) {
+    const GLuint zero = 0;
+    glClearNamedBufferData(cells_.get(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    glUseProgram(p.voxelize.get());
+    bind_segments(p.voxelize, s, grid_, radius_mm);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCells, cells_.get());
+    glProgramUniform1ui(p.voxelize.get(), uniform(p.voxelize, "uPass"), 0);
+    dispatch_segments(p.voxelize, s);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+}
+
+void VoxelStructure::prefix_sum(const VoxelRtPrograms& p) {
+    const auto voxels = std::uint32_t(voxel_count(grid_));
+    const std::uint32_t chunks = (voxels + kScanChunk - 1) / kScanChunk;
+    const GlBuffer chunk_sums = make_buffer(GLsizeiptr(chunks + 1) * 4, nullptr, 0);
+    const GLuint id = p.scan.get();
+    glUseProgram(id);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCells, cells_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kOffsets, offsets_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCursor, cursor_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kChunks, chunk_sums.get());
+    glProgramUniform1ui(id, uniform(p.scan, "uVoxels"), voxels);
+    glProgramUniform1ui(id, uniform(p.scan, "uChunk"), kScanChunk);
+    for (GLuint stage : {0u, 1u, 2u}) {
+        glProgramUniform1ui(id, uniform(p.scan, "uStage"), stage);
+        glDispatchCompute(stage == 1 ? 1 : (chunks + 63) / 64, 1, 1);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    }
+    std::uint32_t total = 0;
+    glGetNamedBufferSubData(offsets_.get(), GLintptr(voxels) * 4, 4, &total);
+    fragments_count_ = total;
+    const std::uint64_t bytes = std::max<std::uint64_t>(total, 1) * 4;
+    if (bytes > max_storage_buffer_bytes())
+        throw Error(Errc::unsupported, "voxel-rt: the fragment lists need " + std::to_string(bytes >> 20) +
+                                           " MiB, over the driver's largest storage buffer (" +
+                                           std::to_string(max_storage_buffer_bytes() >> 20) +
+                                           " MiB); use a smaller --grid or --radius");
+    fragments_ = make_buffer(GLsizeiptr(bytes), nullptr, 0);
+}
+
+void VoxelStructure::fill_lists(const VoxelRtPrograms& p, const ResidentSegments& s, float radius_mm) {
+    glUseProgram(p.voxelize.get());
+    bind_segments(p.voxelize, s, grid_, radius_mm);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCells, cells_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCursor, cursor_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFragments, fragments_.get());
+    glProgramUniform1ui(p.voxelize.get(), uniform(p.voxelize, "uPass"), 1);
+    dispatch_segments(p.voxelize, s);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+}
+
+void VoxelStructure::build_occupancy(const VoxelRtPrograms& p) {
+    occupancy_ = make_volume(grid_.n, mip_levels(grid_.n));
+    glUseProgram(p.occupancy.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCells, cells_.get());
+    glProgramUniform1ui(p.occupancy.get(), uniform(p.occupancy, "uGridN"), GLuint(grid_.n));
+    glBindImageTexture(0, occupancy_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R16F);
+    const GLuint groups = GLuint((grid_.n + 3) / 4);
+    glDispatchCompute(groups, groups, groups);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+    // The averaging mip pyramid the cones sample.
+    glGenerateTextureMipmap(occupancy_.get());
+}
+
+void VoxelStructure::build_ambient_occlusion(const VoxelRtPrograms& p) {
+    ambient_occlusion_ = make_volume(grid_.n, 1);
+    glUseProgram(p.ambient_occlusion.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCells, cells_.get());
+    glProgramUniform1ui(p.ambient_occlusion.get(), uniform(p.ambient_occlusion, "uGridN"), GLuint(grid_.n));
+    glBindTextureUnit(0, occupancy_.get());
+    glBindImageTexture(0, ambient_occlusion_.get(), 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R16F);
+    const GLuint groups = GLuint((grid_.n + 3) / 4);
+    glDispatchCompute(groups, groups, groups);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+}
+
+void VoxelStructure::bind() const {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCells, cells_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kOffsets, offsets_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFragments, fragments_.get());
+    glBindTextureUnit(0, occupancy_.get());
+    glBindTextureUnit(1, ambient_occlusion_ ? ambient_occlusion_.get() : occupancy_.get());
+}
+
+std::vector<std::uint32_t> VoxelStructure::read_cells() const {
+    std::vector<std::uint32_t> out(voxel_count(grid_));
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(cells_.get(), 0, GLsizeiptr(out.size() * 4), out.data());
+    return out;
+}
+
+std::vector<float> VoxelStructure::read_ambient_occlusion() const {
+    if (!ambient_occlusion_) return {};
+    std::vector<float> out(voxel_count(grid_));
+    glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glGetTextureImage(ambient_occlusion_.get(), 0, GL_RED, GL_FLOAT, GLsizei(out.size() * 4), out.data());
+    return out;
+}
+
+}  // namespace fiblet::viewer::voxel_rt

@@ -1,0 +1,77 @@
+// What the ray tracer traces: from resident segments, the voxels' packed
+// occupancy and counts (first voxelization pass), their fragment lists
+// (prefix sum, second pass), the occupancy mip pyramid and, on request, the
+// ambient occlusion volume. Built once per scene, grid and radius: the
+// frames only trace it.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "gl_objects.hpp"
+#include "gpu_scene.hpp"
+#include "voxel_rt/voxel_grid.hpp"
+#include "voxel_rt/voxel_rt_programs.hpp"
+
+namespace fiblet::viewer::voxel_rt {
+
+// Segments resident on the GPU: `slots` slots of segments_per_slot + 1
+// points (vec4, world mm) each, segment s joining points s + slot and
+// s + slot + 1 (slot = s / segments_per_slot). With a scene, slot b is
+// block b and holds blockSegmentCount(b) segments; without, every slot
+// holds segments_per_slot.
+struct ResidentSegments {
+    GLuint points = 0;
+    std::uint32_t slots = 0, segments_per_slot = 1;
+    const GpuScene* scene = nullptr;
+};
+
+struct BuildTimes {
+    double count_ms = 0, scan_ms = 0, fill_ms = 0, occupancy_ms = 0, ambient_occlusion_ms = 0;
+    double total_ms() const { return count_ms + scan_ms + fill_ms + occupancy_ms + ambient_occlusion_ms; }
+};
+
+// Sets the uniforms of voxel_segments.glsl (and the scene's) on `program`
+// and binds the segments.
+void bind_segments(const GlProgram& program, const ResidentSegments& segments, const VoxelGrid& grid,
+                   float radius_mm);
+
+class VoxelStructure {
+public:
+    // Throws fiblet::Error{unsupported} when the fragment lists exceed the
+    // driver's largest storage buffer.
+    VoxelStructure(const VoxelRtPrograms& programs, const VoxelGrid& grid, const ResidentSegments& segments,
+                   float radius_mm, bool ambient_occlusion);
+
+    const VoxelGrid& grid() const { return grid_; }
+    const BuildTimes& times() const { return times_; }
+    std::uint64_t fragment_count() const { return fragments_count_; }
+    bool has_ambient_occlusion() const { return bool(ambient_occlusion_); }
+    GLuint ambient_occlusion_texture() const { return ambient_occlusion_.get(); }
+    GLuint cells_buffer() const { return cells_.get(); }
+
+    // Binds the cells, offsets and fragments buffers and the textures
+    // (occupancy on unit 0, ambient occlusion on unit 1).
+    void bind() const;
+
+    // Per voxel (x fastest): packed cell (occupancy << 16 | count).
+    std::vector<std::uint32_t> read_cells() const;
+    // Per voxel: ambient occlusion in [0, 1] (empty without it).
+    std::vector<float> read_ambient_occlusion() const;
+
+private:
+    void count_and_occupy(const VoxelRtPrograms& p, const ResidentSegments& s, float radius_mm);
+    void prefix_sum(const VoxelRtPrograms& p);
+    void fill_lists(const VoxelRtPrograms& p, const ResidentSegments& s, float radius_mm);
+    void build_occupancy(const VoxelRtPrograms& p);
+    void build_ambient_occlusion(const VoxelRtPrograms& p);
+    void dispatch_segments(const GlProgram& program, const ResidentSegments& s) const;
+
+    VoxelGrid grid_;
+    BuildTimes times_;
+    GlBuffer cells_, offsets_, cursor_, fragments_;
+    GlTexture occupancy_, ambient_occlusion_;
+    std::uint64_t fragments_count_ = 0;
+};
+
+}  // namespace fiblet::viewer::voxel_rt

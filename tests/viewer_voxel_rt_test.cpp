@@ -1,0 +1,511 @@
+// The voxel ray tracer (apps/viewer/voxel_rt): its conservative capsule
+// voxelization (CPU against sampled capsule points, GPU against the CPU
+// exactly, and the non-conservative widening as a negative check), its
+// opaque images against Intel Embree's round linear curves (the same
+// capsules), and its ambient occlusion.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <numeric>
+#include <random>
+#include <unordered_set>
+
+#include "cli_runner.hpp"
+#include "gpu_scene.hpp"
+#include "png_file.hpp"
+#include "orbit_camera.hpp"
+#include "render_target.hpp"
+#include "renderer.hpp"
+#include "viewer_test_util.hpp"
+#include "voxel_rt/capsule_voxelization.hpp"
+#include "voxel_rt/voxel_structure.hpp"
+
+#if FIBLET_HAS_EMBREE
+#include "embree_capsules.hpp"
+#endif
+
+using namespace fiblet;
+using namespace fiblet::test;
+namespace vrt = fiblet::viewer::voxel_rt;
+
+namespace {
+
+struct Capsule {
+    std::array<float, 3> a, b;
+};
+
+constexpr int kGrid = 64;
+
+// Capsules in voxel units inside the grid: random ends up to 12 voxels
+// apart, in every direction.
+std::vector<Capsule> random_capsules(std::size_t count, float radius, std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> pos(radius + 0.01f, float(kGrid) - radius - 0.01f), off(-6.0f, 6.0f);
+    std::vector<Capsule> out;
+    while (out.size() < count) {
+        Capsule c;
+        for (int k = 0; k < 3; ++k) c.a[k] = pos(rng), c.b[k] = c.a[k] + off(rng);
+        bool inside = true;
+        for (int k = 0; k < 3; ++k) inside &= c.b[k] > radius && c.b[k] < float(kGrid) - radius;
+        if (inside) out.push_back(c);
+    }
+    return out;
+}
+
+// Points of the capsule: half inside, half on its surface.
+std::vector<std::array<float, 3>> sample_capsule(const Capsule& c, float r, std::mt19937& rng, int count) {
+    std::normal_distribution<float> g;
+    std::uniform_real_distribution<float> u(0, 1);
+    std::vector<std::array<float, 3>> out;
+    for (int i = 0; i < count; ++i) {
+        const float t = u(rng);
+        float v[3] = {g(rng), g(rng), g(rng)};
+        const float n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        const float len = (i % 2 ? std::cbrt(u(rng)) : 0.99999f) * r / std::max(n, 1e-6f);
+        std::array<float, 3> p;
+        for (int k = 0; k < 3; ++k) p[k] = c.a[k] + t * (c.b[k] - c.a[k]) + v[k] * len;
+        out.push_back(p);
+    }
+    return out;
+}
+
+// Sampled capsule points whose voxel the voxelization did not visit.
+std::size_t missed_voxels(const std::vector<Capsule>& capsules, float r, vrt::HalfExtentRule rule,
+                          std::size_t& capsules_missing) {
+    std::mt19937 rng(7);
+    std::size_t missed = 0;
+    capsules_missing = 0;
+    for (const Capsule& c : capsules) {
+        std::unordered_set<int> visited;
+        vrt::for_each_capsule_voxel(c.a, c.b, r, kGrid,
+                                    [&](int x, int y, int z) { visited.insert((z * kGrid + y) * kGrid + x); }, rule);
+        std::size_t here = 0;
+        for (const auto& p : sample_capsule(c, r, rng, 400)) {
+            const int x = int(std::floor(p[0])), y = int(std::floor(p[1])), z = int(std::floor(p[2]));
+            here += !visited.count((z * kGrid + y) * kGrid + x);
+        }
+        missed += here;
+        capsules_missing += here > 0;
+    }
+    return missed;
+}
+
+const float kRadii[] = {0.1f, 0.2f, 0.7f, 2.5f};  // voxels; 2500 capsules each
+
+}  // namespace
+
+TEST(VoxelRtVoxelization, EveryVoxelOfASampledCapsulePointIsVisited) {
+    std::size_t missed = 0, naive_missed = 0, naive_capsules = 0, total = 0;
+    for (float r : kRadii) {
+        const auto capsules = random_capsules(2500, r, std::uint32_t(r * 1000));
+        std::size_t bad = 0, naive_bad = 0;
+        missed += missed_voxels(capsules, r, vrt::HalfExtentRule::ellipse, bad);
+        naive_missed += missed_voxels(capsules, r, vrt::HalfExtentRule::radius_only, naive_bad);
+        naive_capsules += naive_bad;
+        total += capsules.size();
+    }
+    std::printf("%zu capsules: exact half-extent misses %zu sampled points; widening by r alone misses %zu "
+                "points of %zu capsules\n",
+                total, missed, naive_missed, naive_capsules);
+    EXPECT_EQ(missed, 0u);
+    // The negative check: widening the minor axes by r alone is not conservative.
+    EXPECT_GT(naive_capsules, 0u);
+}
+
+TEST(VoxelRtVoxelization, GpuCountsEqualTheCpuImplementation) {
+    FIBLET_REQUIRE_GL();
+    const vrt::VoxelRtPrograms programs;
+    vrt::VoxelGrid grid;
+    grid.n = kGrid, grid.voxel_mm = 1, grid.origin = {0, 0, 0};
+    std::size_t voxels_compared = 0, differing = 0;
+    std::uint64_t visits = 0;
+    for (float r : kRadii) {
+        const auto capsules = random_capsules(2500, r, std::uint32_t(r * 1000));
+        std::vector<float> points;  // one slot of two points per capsule
+        std::vector<std::uint32_t> cpu(std::size_t(kGrid) * kGrid * kGrid, 0);
+        for (const Capsule& c : capsules) {
+            points.insert(points.end(), {c.a[0], c.a[1], c.a[2], 1, c.b[0], c.b[1], c.b[2], 1});
+            vrt::for_each_capsule_voxel(c.a, c.b, r, kGrid, [&](int x, int y, int z) {
+                ++cpu[std::size_t((z * kGrid + y) * kGrid + x)];
+            });
+        }
+        const viewer::GlBuffer buffer = viewer::make_buffer(GLsizeiptr(points.size() * 4), points.data(), 0);
+        const vrt::ResidentSegments segments{buffer.get(), std::uint32_t(capsules.size()), 1, nullptr};
+        const vrt::VoxelStructure structure(programs, grid, segments, r, false);
+        const auto cells = structure.read_cells();
+        for (std::size_t v = 0; v < cpu.size(); ++v) {
+            differing += (cells[v] & 0xffffu) != cpu[v];
+            visits += cpu[v];
+        }
+        voxels_compared += cpu.size();
+        EXPECT_EQ(structure.fragment_count(), std::accumulate(cpu.begin(), cpu.end(), std::uint64_t(0)));
+    }
+    std::printf("GPU vs CPU voxelization: %zu voxels, %zu differ (%llu visits)\n", voxels_compared, differing,
+                static_cast<unsigned long long>(visits));
+    EXPECT_EQ(differing, 0u);
+}
+
+namespace {
+
+// A render of the voxel ray tracer (on a 64³ grid unless the options say
+// otherwise) with segment IDs in the fiber buffer.
+struct TracedImage {
+    std::vector<std::uint32_t> segments;  // segment + 1, 0 = background
+    std::vector<std::uint8_t> rgba;
+    std::vector<float> depth;  // window depth
+};
+TracedImage trace_image(const viewer::GpuScene& scene, const Camera& cam, int w, int h, viewer::RenderOptions o) {
+    if (o.voxel_grid == viewer::RenderOptions{}.voxel_grid) o.voxel_grid = 64;
+    viewer::Renderer renderer(*viewer_gl().programs);
+    renderer.voxel_ray_tracer().write_segment_ids(true);
+    viewer::RenderTarget target(w, h);
+    o.engine = viewer::RenderEngine::voxel_rt;
+    renderer.render(scene, cam, o, target);
+    return {target.read_fibers(), target.read_rgba(), target.read_depth()};
+}
+
+}  // namespace
+
+TEST(VoxelRtTrace, OpaqueImagesAgreeWithEmbree) {
+#if !FIBLET_HAS_EMBREE
+    GTEST_SKIP() << "built without Embree (libembree-dev, scripts/setup.sh)";
+#else
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const int w = 200, h = 200;
+    const float radius = 0.3f;
+    const EmbreeCapsules oracle(file, radius);
+    for (const char* view : {"left", "oblique"}) {
+        SCOPED_TRACE(view);
+        const Camera cam = viewer::camera_from_spec(view, scene, 1.0f, 35, 2.0f);
+        viewer::RenderOptions o;
+        o.tube_radius_mm = radius;
+        const TracedImage img = trace_image(scene, cam, w, h, o);
+        std::size_t agree = 0, hits = 0, both = 0, same = 0, joint = 0;
+        const double n = cam.near_mm, f = cam.far_mm, tt = std::tan(double(cam.fov_y_deg) * M_PI / 360.0);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const auto ref = oracle.nearest(cam.position, pixel_ray(cam, x, y, w, h));
+                const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+                const std::uint32_t got = img.segments[i];
+                const bool hit = std::isfinite(ref.t);
+                hits += hit;
+                agree += hit == (got != 0);
+                if (!hit || got == 0) continue;
+                ++both;
+                if (got - 1 == ref.segment) {
+                    ++same;
+                    continue;
+                }
+                // The sphere at a joint belongs to both segments: the same
+                // point (eye depth within 0.01 r) on the neighbour counts.
+                const double z_gpu = 2 * n * f / ((f + n) - (2.0 * img.depth[i] - 1.0) * (f - n));
+                const double nx = (x + 0.5) / w * 2 - 1, ny = 1 - (y + 0.5) / h * 2;
+                const double cosine = 1.0 / std::sqrt(1 + nx * nx * tt * tt * cam.aspect * cam.aspect + ny * ny * tt * tt);
+                joint += oracle.consecutive(got - 1, ref.segment) && std::fabs(ref.t * cosine - z_gpu) <= 0.01 * radius;
+            }
+        const double rate = double(agree) / double(w * h), strict = double(same) / double(both),
+                     same_rate = double(same + joint) / double(both);
+        std::printf("%s: voxel-rt vs Embree, %d pixels (%zu hit): hit/miss %.5f, same segment %.5f (%.5f counting "
+                    "the neighbour's hit on the sphere of their joint as the same; %zu such)\n",
+                    view, w * h, hits, rate, strict, same_rate, joint);
+        EXPECT_GT(hits, 2000u);
+        EXPECT_GE(rate, 0.999);
+        EXPECT_GE(same_rate, 0.995);
+    }
+#endif
+}
+
+TEST(VoxelRtTrace, TransparencyMatchesEmbreeCompositingEveryHit) {
+#if !FIBLET_HAS_EMBREE
+    GTEST_SKIP() << "built without Embree (libembree-dev, scripts/setup.sh)";
+#else
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const int w = 160, h = 160;
+    const float radius = 0.6f, alpha = 0.25f;
+    const EmbreeCapsules oracle(file, radius);
+    // A coarse grid, so that voxels hold more than k = 8 entries of a ray.
+    const int n = 12;
+    const vrt::VoxelGrid grid = vrt::grid_around(scene.bounds(), n, radius);
+    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 2.0f);
+    viewer::RenderOptions o;
+    o.tube_radius_mm = radius;
+    o.opacity = alpha;
+    o.lighting = false;  // colour = |direction|: the oracle composites the same colours
+    o.voxel_grid = n;
+    const TracedImage img = trace_image(scene, cam, w, h, o);
+    int worst = 0;
+    std::size_t within = 0, crowded = 0, crowded_within = 0, max_in_voxel = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const auto dir = pixel_ray(cam, x, y, w, h);
+            const auto hits = oracle.all(cam.position, dir);
+            double rgb[3] = {0, 0, 0}, transmittance = 1;
+            std::map<std::array<int, 3>, std::size_t> per_voxel;
+            for (const auto& hit : hits) {
+                const auto c = oracle.direction(hit.segment);
+                for (int k = 0; k < 3; ++k) rgb[k] += transmittance * alpha * std::fabs(c[k]);
+                transmittance *= 1 - alpha;
+                const auto g = grid.to_grid({cam.position.x + float(hit.t * dir[0]), cam.position.y + float(hit.t * dir[1]),
+                                             cam.position.z + float(hit.t * dir[2])});
+                max_in_voxel = std::max(max_in_voxel, ++per_voxel[{int(g[0]), int(g[1]), int(g[2])}]);
+            }
+            bool over_k = false;
+            for (const auto& [v, n] : per_voxel) over_k |= n > 8;
+            const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+            int diff = 0;
+            for (int k = 0; k < 3; ++k)
+                diff = std::max(diff, std::abs(int(img.rgba[4 * i + std::size_t(k)]) - int(std::lround(rgb[k] * 255))));
+            worst = std::max(worst, diff);
+            within += diff <= 2;
+            crowded += over_k;
+            crowded_within += over_k && diff <= 2;
+        }
+    const double rate = double(within) / double(w * h);
+    std::printf("transparency (alpha %.2f) vs Embree, every hit composited: %.5f of %d pixels within 2/255 (worst "
+                "%d/255); %zu pixels cross a voxel with more than k = 8 hits (at most %zu), %zu of them within 2/255\n",
+                alpha, rate, w * h, worst, crowded, max_in_voxel, crowded_within);
+    EXPECT_GT(crowded, 100u);
+    EXPECT_GE(double(crowded_within), 0.99 * double(crowded));
+    EXPECT_GE(rate, 0.999);
+#endif
+}
+
+namespace {
+
+// The ambient occlusion volume sampled trilinearly at a point (voxel
+// units), as the trace shader's texture lookup.
+float sample_volume(const std::vector<float>& v, int n, std::array<float, 3> p) {
+    float out = 0;
+    const float x = p[0] - 0.5f, y = p[1] - 0.5f, z = p[2] - 0.5f;
+    const int x0 = int(std::floor(x)), y0 = int(std::floor(y)), z0 = int(std::floor(z));
+    for (int dz = 0; dz < 2; ++dz)
+        for (int dy = 0; dy < 2; ++dy)
+            for (int dx = 0; dx < 2; ++dx) {
+                const int xi = std::clamp(x0 + dx, 0, n - 1), yi = std::clamp(y0 + dy, 0, n - 1),
+                          zi = std::clamp(z0 + dz, 0, n - 1);
+                const float wx = dx ? x - float(x0) : 1 - (x - float(x0)), wy = dy ? y - float(y0) : 1 - (y - float(y0)),
+                            wz = dz ? z - float(z0) : 1 - (z - float(z0));
+                out += wx * wy * wz * v[std::size_t((zi * n + yi) * n + xi)];
+            }
+    return out;
+}
+
+// The ambient occlusion volume of capsules of radius r (voxel units) in
+// the 64³ test grid.
+std::vector<float> ambient_occlusion_of(const std::vector<Capsule>& capsules, float r) {
+    const vrt::VoxelRtPrograms programs;
+    vrt::VoxelGrid grid;
+    grid.n = kGrid, grid.voxel_mm = 1, grid.origin = {0, 0, 0};
+    std::vector<float> points;
+    for (const Capsule& c : capsules) points.insert(points.end(), {c.a[0], c.a[1], c.a[2], 1, c.b[0], c.b[1], c.b[2], 1});
+    const viewer::GlBuffer buffer = viewer::make_buffer(GLsizeiptr(points.size() * 4), points.data(), 0);
+    const vrt::VoxelStructure structure(programs, grid, {buffer.get(), std::uint32_t(capsules.size()), 1, nullptr}, r,
+                                        true);
+    return structure.read_ambient_occlusion();
+}
+
+}  // namespace
+
+TEST(VoxelRtAmbientOcclusion, HalfSpaceSlabIsHalfOccludedAnIsolatedLineNot) {
+    FIBLET_REQUIRE_GL();
+    // A slab of touching lines along x filling z < 32 (surface at z = 32).
+    std::vector<Capsule> slab;
+    for (float z = 0.5f; z <= 31.5f; z += 0.5f)
+        for (float y = 0.5f; y <= 63.5f; y += 0.5f) slab.push_back({{0.5f, y, z}, {63.5f, y, z}});
+    const auto ao = ambient_occlusion_of(slab, 0.5f);
+    // On the surface, looked up half a voxel out along the normal (as the trace shader).
+    const float surface = sample_volume(ao, kGrid, {32, 32, 32.5f});
+    // One line of radius 0.2 voxel through the middle.
+    const auto line_ao = ambient_occlusion_of({{{4.5f, 30.3f, 31.7f}, {59.5f, 33.1f, 32.2f}}}, 0.2f);
+    const float line = sample_volume(line_ao, kGrid, {32, 31.6f + 0.7f, 31.95f});
+    std::printf("ambient occlusion: half-space slab surface %.4f, isolated line %.4f\n", surface, line);
+    EXPECT_NEAR(surface, 0.5f, 0.05f);
+    EXPECT_LT(line, 0.05f);
+}
+
+TEST(VoxelRtAmbientOcclusion, CorrelatesWithMonteCarloOcclusionRays) {
+#if !FIBLET_HAS_EMBREE
+    GTEST_SKIP() << "built without Embree (libembree-dev, scripts/setup.sh)";
+#else
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const float radius = 0.3f;
+    const EmbreeCapsules oracle(file, radius);
+    viewer::Renderer renderer(*viewer_gl().programs);
+    viewer::RenderOptions o;
+    o.engine = viewer::RenderEngine::voxel_rt;
+    o.voxel_grid = 64, o.tube_radius_mm = radius, o.ambient_occlusion = true;
+    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 2.0f);
+    viewer::RenderTarget target(8, 8);
+    renderer.render(scene, cam, o, target);
+    const vrt::VoxelStructure& structure = *renderer.voxel_ray_tracer().structure();
+    const auto ao = structure.read_ambient_occlusion();
+    const vrt::VoxelGrid& grid = structure.grid();
+    // Surface points: Embree's hits of a coarse image; per point, the cone
+    // estimate against the fraction of 256 uniform directions blocked
+    // between the cones' start and reach (1 and 16 voxels,
+    // cone_occlusion.glsl), both from the lookup point half a voxel out
+    // along the normal.
+    std::mt19937 rng(3);
+    std::normal_distribution<double> g;
+    const float reach = 16 * grid.voxel_mm;
+    std::vector<double> cones, rays;
+    const int w = 48, h = 48;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const auto dir = pixel_ray(cam, x, y, w, h);
+            const auto hit = oracle.nearest(cam.position, dir);
+            if (!std::isfinite(hit.t)) continue;
+            const Vec3f p{cam.position.x + float(hit.t * dir[0]), cam.position.y + float(hit.t * dir[1]),
+                          cam.position.z + float(hit.t * dir[2])};
+            const auto [a, b] = oracle.ends(hit.segment);
+            const float abx = b.x - a.x, aby = b.y - a.y, abz = b.z - a.z;
+            const float u = std::clamp(((p.x - a.x) * abx + (p.y - a.y) * aby + (p.z - a.z) * abz) /
+                                           std::max(abx * abx + aby * aby + abz * abz, 1e-12f), 0.0f, 1.0f);
+            float nx = p.x - (a.x + u * abx), ny = p.y - (a.y + u * aby), nz = p.z - (a.z + u * abz);
+            const float nn = std::sqrt(nx * nx + ny * ny + nz * nz);
+            nx /= nn, ny /= nn, nz /= nn;
+            auto gp = grid.to_grid({p.x, p.y, p.z});
+            cones.push_back(sample_volume(ao, grid.n, {gp[0] + 0.5f * nx, gp[1] + 0.5f * ny, gp[2] + 0.5f * nz}));
+            const float out = 0.5f * grid.voxel_mm;
+            const Vec3f start{p.x + out * nx, p.y + out * ny, p.z + out * nz};
+            int blocked = 0;
+            for (int k = 0; k < 256; ++k) {
+                double v[3] = {g(rng), g(rng), g(rng)};
+                const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+                blocked += oracle.occluded(start, {v[0] / n, v[1] / n, v[2] / n}, grid.voxel_mm, reach);
+            }
+            rays.push_back(blocked / 256.0);
+        }
+    const double n = double(cones.size());
+    double mc = 0, mr = 0;
+    for (std::size_t i = 0; i < cones.size(); ++i) mc += cones[i] / n, mr += rays[i] / n;
+    double scc = 0, srr = 0, scr = 0;
+    for (std::size_t i = 0; i < cones.size(); ++i)
+        scc += (cones[i] - mc) * (cones[i] - mc), srr += (rays[i] - mr) * (rays[i] - mr),
+            scr += (cones[i] - mc) * (rays[i] - mr);
+    const double correlation = scr / std::sqrt(scc * srr);
+    std::printf("ambient occlusion at %zu surface points: cones mean %.3f, Monte-Carlo rays mean %.3f, "
+                "correlation %.4f\n",
+                cones.size(), mc, mr, correlation);
+    EXPECT_GT(cones.size(), 200u);
+    EXPECT_GE(correlation, 0.9);
+#endif
+}
+
+TEST(VoxelRtAmbientOcclusion, OneChordPerBlockMatchesEverySegment) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("small-ifod1.tck"), "small.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    viewer::Renderer renderer(*viewer_gl().programs);
+    viewer::RenderOptions o;
+    o.engine = viewer::RenderEngine::voxel_rt;
+    o.ambient_occlusion = true;
+    // 64³ in CI; FIBLET_VOXEL_RT_GRID=128 for the figure.
+    o.voxel_grid = std::getenv("FIBLET_VOXEL_RT_GRID") ? std::atoi(std::getenv("FIBLET_VOXEL_RT_GRID")) : 64;
+    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 2.0f);
+    viewer::RenderTarget target(8, 8);
+    renderer.render(scene, cam, o, target);
+    auto& tracer = renderer.voxel_ray_tracer();
+    const auto full = tracer.structure()->read_ambient_occlusion();
+    const auto cells = tracer.structure()->read_cells();
+    tracer.chord_occlusion(scene, o);
+    const auto chords = tracer.chord_occlusion_structure()->structure().read_ambient_occlusion();
+    ASSERT_EQ(full.size(), chords.size());
+    // Over the voxels the fibers occupy (where surfaces are shaded).
+    std::vector<double> diff;
+    double mf = 0, mc = 0;
+    std::vector<std::size_t> used;
+    for (std::size_t v = 0; v < full.size(); ++v)
+        if (cells[v] & 0xffffu) used.push_back(v), mf += full[v], mc += chords[v];
+    const double n = double(used.size());
+    mf /= n, mc /= n;
+    double sff = 0, scc = 0, sfc = 0, mean_abs = 0;
+    for (std::size_t v : used) {
+        const double f = full[v] - mf, c = chords[v] - mc;
+        sff += f * f, scc += c * c, sfc += f * c;
+        diff.push_back(std::fabs(double(full[v]) - double(chords[v])));
+        mean_abs += diff.back() / n;
+    }
+    std::sort(diff.begin(), diff.end());
+    const double p99 = diff[std::size_t(0.99 * double(diff.size() - 1))];
+    const double correlation = sfc / std::sqrt(sff * scc);
+    std::printf("small-ifod1, %d³: chord vs full-segment ambient occlusion over %zu occupied voxels: |dAO| mean %.4f, "
+                "p99 %.4f, correlation %.4f (means %.3f / %.3f)\n",
+                o.voxel_grid, used.size(), mean_abs, p99, correlation, mf, mc);
+    EXPECT_LE(mean_abs, 0.02);
+    EXPECT_LE(p99, 0.08);
+    EXPECT_GE(correlation, 0.98);
+}
+
+TEST(VoxelRtCulling, ImagesWithAndWithoutCullingAgree) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("small-ifod1.tck"), "small.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const int w = 256, h = 192;
+    for (const char* view : {"oblique", "top"}) {
+        SCOPED_TRACE(view);
+        const Camera cam = viewer::camera_from_spec(view, scene, float(w) / float(h), 35, 1.0f);
+        viewer::Renderer renderer(*viewer_gl().programs);
+        renderer.voxel_ray_tracer().write_segment_ids(true);
+        viewer::RenderTarget target(w, h);
+        viewer::RenderOptions o;
+        o.engine = viewer::RenderEngine::voxel_rt;
+        o.voxel_grid = 64;
+        o.frustum_culling = false;
+        renderer.render(scene, cam, o, target);
+        const auto off = target.read_fibers();
+        o.frustum_culling = true;
+        renderer.render(scene, cam, o, target);
+        const auto on = target.read_fibers();
+        const auto& tracer = renderer.voxel_ray_tracer();
+        const std::uint64_t visible = tracer.culling()->visible_voxels();
+        std::uint64_t occupied = 0;
+        for (auto c : tracer.structure()->read_cells()) occupied += (c & 0xffffu) != 0;
+        std::size_t same = 0;
+        for (std::size_t i = 0; i < on.size(); ++i) same += on[i] == off[i];
+        const double rate = double(same) / double(on.size());
+        std::printf("%s: culling keeps %llu of %llu occupied voxels (%.1f %%; %.1f ms); images agree on %.5f of "
+                    "pixels (same segment)\n",
+                    view, static_cast<unsigned long long>(visible), static_cast<unsigned long long>(occupied),
+                    100.0 * double(visible) / double(occupied), tracer.culling()->last_update_ms(), rate);
+        EXPECT_LT(visible, occupied);
+        EXPECT_GE(rate, 0.999);
+    }
+}
+
+TEST(VoxelRtCli, RenderDrawsWithEveryOptionAndRefusesBadOnes) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const std::string fft = compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft");
+    const char* cases[] = {"--engine voxel-rt --grid 32", "--engine voxel-rt --grid 32 --ao --shadows",
+                           "--engine voxel-rt --grid 32 --opacity 0.3", "--ao --style tubes --grid 32"};
+    for (int i = 0; i < 4; ++i) {
+        const std::string png = dir.file(std::to_string(i) + ".png");
+        const CommandResult r = run_cli("render " + fft + " -o " + png + " --size 120x90 --camera left --radius 0.4 " + cases[i]);
+        ASSERT_EQ(r.status, 0) << cases[i] << ": " << r.output;
+        const viewer::RgbaImage img = viewer::read_png(png);
+        std::size_t lit = 0;
+        for (std::size_t k = 0; k < img.rgba.size(); k += 4) lit += img.rgba[k] + img.rgba[k + 1] + img.rgba[k + 2] > 30;
+        EXPECT_GT(lit, 500u) << cases[i];
+    }
+    for (const char* bad : {"--engine nope", "--engine voxel-rt --grid 2", "--engine voxel-rt --opacity 0",
+                            "--engine voxel-rt --opacity 1.5", "--shadows", "--opacity 0.5"}) {
+        const CommandResult r = run_cli("render " + fft + " -o " + dir.file("x.png") + " --size 32x32 " + bad);
+        EXPECT_EQ(r.status, 2) << bad << ": " << r.output;
+    }
+}
