@@ -113,6 +113,82 @@ TEST(Resample, CubicKeepsTheLengthOfASmoothCurveSampledNearTheStep) {
     }
 }
 
+// A walk that turns by up to 40° per vertex (as tractography's sharpest)
+// at irregular spacing, 0.2 to 0.9 mm.
+static std::vector<Vec3f> turning_walk(std::mt19937& rng, int segments) {
+    std::uniform_real_distribution<double> u(-1, 1), len(0.2, 0.9);
+    const double max_turn = 40 * M_PI / 180;
+    double d[3] = {1, 0, 0};
+    std::vector<Vec3f> line{{0, 0, 0}};
+    for (int i = 0; i < segments; ++i) {
+        // d += a random perpendicular nudge of at most tan(max_turn), renormalized.
+        double r[3] = {u(rng), u(rng), u(rng)};
+        const double along = r[0] * d[0] + r[1] * d[1] + r[2] * d[2];
+        for (int k = 0; k < 3; ++k) r[k] -= along * d[k];
+        const double rn = std::sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) + 1e-12;
+        const double nudge = std::tan(max_turn) * std::fabs(u(rng)) / rn;
+        for (int k = 0; k < 3; ++k) d[k] += nudge * r[k];
+        const double dn = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (double& v : d) v /= dn;
+        const double l = len(rng);
+        line.push_back({float(line.back().x + d[0] * l), float(line.back().y + d[1] * l), float(line.back().z + d[2] * l)});
+    }
+    return line;
+}
+
+TEST(Resample, LengthKeepingTensionMakesEveryFiberAsLongAsItsInput) {
+    // Where the Bessel cubic is not enough (walks turning by up to 40° at
+    // irregular spacing around the step; a helix sampled near the step), the fitted tension
+    // brings each resampled fiber to its input's length within the fit's
+    // tolerance (plus the rounding of the tension to its quantum), and
+    // resampling with the returned tension gives the same points as letting
+    // resample_keeping_end fit it.
+    std::mt19937 rng(12);
+    std::uniform_real_distribution<double> spacing(0.45, 0.55);
+    int changed = 0;
+    for (int trial = 0; trial < 40; ++trial) {
+        std::vector<Vec3f> line;
+        double step = 0.5;
+        if (trial % 2 == 0) {
+            line = turning_walk(rng, 120);
+            step = 0.4;
+        } else {
+            std::vector<double> spacings(200);
+            for (double& d : spacings) d = spacing(rng);
+            line = helix_points(spacings);
+        }
+        const double input = length_of(line);
+        std::vector<Vec3f> bessel, fitted, given;
+        resample_keeping_end(line, step, bessel, ResampleCurve::cubic);
+        resample_keeping_end(line, step, fitted, ResampleCurve::cubic_keeping_length);
+        const double tension = length_keeping_tension(line, step);
+        resample_cubic_keeping_end(line, step, tension, given);
+        EXPECT_EQ(fitted, given);
+        EXPECT_GE(tension, 0.0);
+        EXPECT_LE(tension, kMaxResampleTension);
+        EXPECT_EQ(std::fmod(tension, kTensionQuantum), 0.0) << "a tension 16 bits cannot hold";
+        const double bessel_change = std::fabs(length_of(bessel) - input);
+        const double fitted_change = std::fabs(length_of(fitted) - input);
+        EXPECT_LT(fitted_change, 2 * kLengthTolerance * step) << "trial " << trial << ", tension " << tension
+                                                              << ", Bessel's cubic was off by " << bessel_change;
+        changed += bessel_change > 4 * kLengthTolerance * step;
+        for (std::size_t i = 1; i + 1 < fitted.size(); ++i) EXPECT_NEAR(dist(fitted[i - 1], fitted[i]), step, 1e-5);
+        EXPECT_EQ(fitted.back(), line.back());
+    }
+    EXPECT_GT(changed, 20) << "inputs the Bessel cubic already keeps the length of test nothing";
+}
+
+TEST(Resample, LengthKeepingTensionOfAStraightOrShortFiber) {
+    // Nothing to fit: a straight fiber is its own curve at any tension.
+    const std::vector<Vec3f> straight{{0, 0, 0}, {3.3f, 0, 0}, {7, 0, 0}};
+    std::vector<Vec3f> out;
+    resample_keeping_end(straight, 1.0, out, ResampleCurve::cubic_keeping_length);
+    EXPECT_NEAR(length_of(out), 7.0, 1e-5);
+    EXPECT_EQ(length_keeping_tension({}, 1.0), 1.0);
+    const std::vector<Vec3f> one{{1, 2, 3}};
+    EXPECT_EQ(length_keeping_tension(one, 1.0), 1.0);
+}
+
 TEST(Resample, ShortAndDegenerateInputs) {
     std::vector<Vec3f> out;
     resample_fixed_step({}, 1.0, out);

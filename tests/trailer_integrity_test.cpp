@@ -229,9 +229,10 @@ TEST(TrailerIntegrity, TrailerValuesAreValidatedForEveryReader) {
                 }
         });
     };
-    EXPECT_EQ(FftFile(fx.fft).resampling()->curve, ResampleCurve::cubic);
+    EXPECT_EQ(FftFile(fx.fft).resampling()->curve, ResampleCurve::cubic_keeping_length);
+    EXPECT_EQ(FftFile(with_curve({1, 0}, "cubic.fft")).resampling()->curve, ResampleCurve::cubic);
     EXPECT_EQ(FftFile(with_curve({0, 0}, "polyline.fft")).resampling()->curve, ResampleCurve::polyline);
-    for (const auto& words : std::vector<std::vector<std::uint32_t>>{{2, 0}, {1, 1}, {1}, {1, 0, 0}}) {
+    for (const auto& words : std::vector<std::vector<std::uint32_t>>{{3, 0}, {1, 1}, {1}, {1, 0, 0}}) {
         SCOPED_TRACE(words.size());
         EXPECT_EQ(open_error(with_curve(words, "curve.fft")), Errc::fft_format);
     }

@@ -223,12 +223,13 @@ def cubic_offset_bound(f):
     can be from the chord point of the same parameter: on segment i,
     d_i (4/27) (|m_i - u_i| + |m_i+1 - u_i|), and each Bessel tangent m
     (a convex combination of the two unit chords at its point) is within
-    the turn angle there of either chord."""
+    the turn angle there of either chord; the fiber's fitted tension
+    (at most 4) scales m: |tension m - u| <= 4 |m - u| + 3."""
     d = np.linalg.norm(np.diff(f.astype(np.float64), axis=0), axis=1)
     u = np.diff(f.astype(np.float64), axis=0) / d[:, None]
     turn = np.arccos(np.clip((u[1:] * u[:-1]).sum(1), -1, 1))
     turn_at = np.concatenate([[turn[0]], turn, [turn[-1]]])  # per point: its turn (the ends: their neighbour's)
-    return float((d * 4 / 27 * (turn_at[:-1] + turn_at[1:])).max())
+    return float((d * 4 / 27 * (4 * (turn_at[:-1] + turn_at[1:]) + 6)).max())
 
 
 def test_resampled_point_data_follows_the_polyline(tmp_path, cli):

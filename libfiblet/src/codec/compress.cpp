@@ -280,6 +280,20 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
 
     // Pass 1b (resampling only): the counts and turning angles change.
     PointFieldResampler point_fields(report.resampled ? &fields : nullptr, fiber_points);
+    // Each fiber's fitted tension (formats/fft.md §5), in kTensionQuantum
+    // units: fitted once here, reused by pass 2 (2 bytes a fiber). The fit
+    // needs the decoder's stretch of each step: resampled input has its step
+    // scale tuned on the sample first (with the input's own turns; the cap
+    // is tuned again after this pass, at that scale).
+    std::vector<std::uint16_t> tensions(report.resampled ? scan.fibers : 0);
+    if (options.step_scale && !(*options.step_scale > 0.5 && *options.step_scale < 2))
+        throw Error(Errc::invalid_argument, "the step scale must be in (0.5, 2)");
+    std::optional<double> step_scale = options.step_scale;
+    if (report.resampled && !step_scale)
+        step_scale = detail::tune_parameters({sample.fibers(), {}, step}, turns, h, options.search, step, std::nullopt,
+                                             std::nullopt)
+                         .step_scale;
+    const double stretch = step_scale ? decoder_stretch(float(step * *step_scale / h.scaling), h.scaling, step) : 1.0;
     if (report.resampled) {
         reader.rewind();
         turns = detail::TurnStatistics(points_per_block, kSharpBlocks);
@@ -291,7 +305,9 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
                 throw Error(Errc::unsupported, tck_path + ": " + detail::streamline_label(f) + " (" +
                                                    std::to_string(fiber_length) + " mm) needs more than 65535 blocks at a " +
                                                    std::to_string(step) + " mm step");
-            const bool short_tail = resample_keeping_end(fiber, step, resampled);
+            const double tension = length_keeping_tension(fiber, step, stretch);
+            tensions[f] = std::uint16_t(std::lround(tension / kTensionQuantum));
+            const bool short_tail = resample_cubic_keeping_end(fiber, step, tension, resampled);
             fiber_points[f++] = std::uint32_t(resampled.size());
             // The turn towards a kept end is one step per fiber, often a
             // noisy short one: left out of the turn statistics, so the cap
@@ -308,14 +324,12 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     scan.min_dot = turns.min_dot();
     if (options.cap_ratio && !(*options.cap_ratio > 0 && *options.cap_ratio <= 2))
         throw Error(Errc::invalid_argument, "the cap ratio must be in (0, 2]");
-    if (options.step_scale && !(*options.step_scale > 0.5 && *options.step_scale < 2))
-        throw Error(Errc::invalid_argument, "the step scale must be in (0.5, 2)");
     std::optional<float> fixed_ratio;
     if (options.cap_ratio) fixed_ratio = float(*options.cap_ratio);
     else if (options.turn_percentile) fixed_ratio = compute_ratio(h.scaling, step, turns.dot_at_percentile(*options.turn_percentile));
     detail::TunedParameters tuned = detail::tune_parameters(
         {sample.fibers(), turns.sharpest_blocks(), report.resampled ? step : 0.0}, turns, h, options.search, step,
-        fixed_ratio, options.step_scale);
+        fixed_ratio, step_scale);
     h.ratio = tuned.ratio;
     report.step_scale = tuned.step_scale;
     h.step = float(step * report.step_scale / h.scaling);
@@ -382,8 +396,8 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             w.decoded.clear();
             w.decoded_exact.clear();
             if (report.resampled) {
-                const bool short_tail = resample_keeping_end(original, step, w.resampled, ResampleCurve::cubic,
-                                                             point_fields.active() ? &w.positions : nullptr);
+                const bool short_tail = resample_cubic_keeping_end(original, step, tensions[f] * kTensionQuantum, w.resampled,
+                                                                   point_fields.active() ? &w.positions : nullptr);
                 if (point_fields.active()) point_fields.resample(f, w.positions);
                 points = w.resampled;
                 end_fractions[f] = detail::encode_keeping_end(encoder, points, short_tail, step, f, w.blocks,
@@ -445,7 +459,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         }
         if (report.resampled) {
             TrailerChunk c{kResampledTag, std::vector<std::uint8_t>(16)};  // step, curve, 0
-            const auto curve = std::uint32_t(ResampleCurve::cubic);
+            const auto curve = std::uint32_t(detail::kWrittenCurve);
             std::memcpy(c.payload.data(), &step, 8);
             std::memcpy(c.payload.data() + 8, &curve, 4);
             chunks.push_back(std::move(c));

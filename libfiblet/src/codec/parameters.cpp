@@ -112,7 +112,7 @@ SampleError measure(const TuningSet& set, const FiberEncoder& encoder) {
     };
     for (const auto& fiber : set.fibers) {
         if (set.resample_step_mm > 0) {
-            resample_fixed_step(fiber, set.resample_step_mm, resampled);
+            resample_fixed_step(fiber, set.resample_step_mm, resampled, kWrittenCurve);
             encode(resampled, true);
         } else {
             encode(fiber, true);
@@ -122,9 +122,18 @@ SampleError measure(const TuningSet& set, const FiberEncoder& encoder) {
     return {n ? sum / double(n) : 0.0, max};
 }
 
-TunedParameters tune_parameters(const TuningSet& set, const TurnStatistics& turns, FftHeader h,
+TunedParameters tune_parameters(const TuningSet& given, const TurnStatistics& turns, FftHeader h,
                                 const SearchOptions& search, double sampling_step_mm,
                                 std::optional<float> fixed_ratio, std::optional<double> fixed_scale) {
+    // Fibers to resample are resampled once here, not at every measure().
+    TuningSet resampled_set;
+    if (given.resample_step_mm > 0) {
+        resampled_set.sharp_blocks = given.sharp_blocks;
+        resampled_set.fibers.resize(given.fibers.size());
+        for (std::size_t i = 0; i < given.fibers.size(); ++i)
+            resample_fixed_step(given.fibers[i], given.resample_step_mm, resampled_set.fibers[i], kWrittenCurve);
+    }
+    const TuningSet& set = given.resample_step_mm > 0 ? resampled_set : given;
     constexpr double kDefaultScale = 1.0005;
     TunedParameters best{fixed_ratio.value_or(compute_ratio(h.scaling, sampling_step_mm, turns.min_dot())),
                          fixed_scale.value_or(1.0), search};

@@ -13,8 +13,13 @@
 #include "fiblet/encode.hpp"
 #include "fiblet/fft_format.hpp"
 #include "fiblet/geometry.hpp"
+#include "fiblet/resample.hpp"
 
 namespace fiblet::detail {
+
+// The curve compress resamples variable-step input on (its RSMP chunk):
+// lengths kept fiber by fiber.
+inline constexpr ResampleCurve kWrittenCurve = ResampleCurve::cubic_keeping_length;
 
 // The turning angles between consecutive unit segment directions
 // (zero-length segments carry no direction and are skipped): a histogram

@@ -29,8 +29,9 @@ double segment_distance(V3 p, V3 a, V3 b) {
 // Pieces per input segment when tracing the cubic: about 16 per step, so the
 // pieces' own corner cutting (~(1/16)² of a step's) is far below the codec's
 // error; segments much shorter than the step stay straight.
-std::size_t pieces_for(double segment_length, double step) {
-    const double n = std::ceil(16.0 * segment_length / step);
+constexpr double kPiecesPerStep = 16;
+std::size_t pieces_for(double segment_length, double step, double per_step) {
+    const double n = std::ceil(per_step * segment_length / step);
     return std::size_t(std::clamp(n, 1.0, 256.0));
 }
 
@@ -117,7 +118,9 @@ void walk_polyline(std::span<const Vec3f> in, ChordWalk& walk) {
 // points, as short straight pieces; it passes through every input point. On
 // long segments the tangents lean towards the segment (curve_weight): a
 // Hermite segment whose end tangents are its own direction is the segment.
-void walk_cubic(std::span<const Vec3f> in, double step, ChordWalk& walk) {
+// `tension` scales every tangent: 0 gives the polyline itself, 1 the Bessel
+// cubic, more a rounder curve (directions, hence C¹ joints, are kept).
+void walk_cubic(std::span<const Vec3f> in, double step, double tension, double pieces_per_step, ChordWalk& walk) {
     thread_local std::vector<V3> p, m;
     thread_local std::vector<std::size_t> index;
     distinct_points(in, p, index);
@@ -133,8 +136,8 @@ void walk_cubic(std::span<const Vec3f> in, double step, ChordWalk& walk) {
         const double d = length(sub(p[i + 1], p[i]));
         const double w = curve_weight(d, step);
         const V3 u = mul(sub(p[i + 1], p[i]), 1.0 / d);
-        const V3 m0 = lerp(u, m[i], w), m1 = lerp(u, m[i + 1], w);
-        const std::size_t pieces = w > 0 ? pieces_for(d, step) : 1;
+        const V3 m0 = mul(lerp(u, m[i], w), tension), m1 = mul(lerp(u, m[i + 1], w), tension);
+        const std::size_t pieces = w > 0 ? pieces_for(d, step, pieces_per_step) : 1;
         V3 from = p[i];
         for (std::size_t k = 1; k <= pieces; ++k) {
             const double t = double(k) / double(pieces), t2 = t * t, t3 = t2 * t;
@@ -146,27 +149,101 @@ void walk_cubic(std::span<const Vec3f> in, double step, ChordWalk& walk) {
         }
     }
 }
-}  // namespace
 
-void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out, ResampleCurve curve,
-                         std::vector<PolylinePosition>* positions) {
+// The chord walk on the curve of the given tension (the polyline for
+// ResampleCurve::polyline), then the input's last point when the tail is kept.
+// Returns whether it was appended.
+bool resample_on(std::span<const Vec3f> in, double step, ResampleCurve curve, double tension, bool keep_end,
+                 double pieces_per_step,
+                 std::vector<Vec3f>& out, std::vector<PolylinePosition>* positions) {
     out.clear();
     if (positions) positions->clear();
-    if (in.empty()) return;
+    if (in.empty()) return false;
     ChordWalk walk(to_v3(in[0]), step, out, positions);
     if (curve == ResampleCurve::polyline) walk_polyline(in, walk);
-    else walk_cubic(in, step, walk);
-}
-
-bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out, ResampleCurve curve,
-                          std::vector<PolylinePosition>* positions) {
-    resample_fixed_step(in, step, out, curve, positions);
-    if (in.size() < 2) return false;
+    else walk_cubic(in, step, tension, pieces_per_step, walk);
+    if (!keep_end || in.size() < 2) return false;
     const V3 tail = sub(to_v3(in.back()), to_v3(out.back()));
     if (!(std::sqrt(dot(tail, tail)) > kKeptTailFraction * step)) return false;
     out.push_back(in.back());
     if (positions) positions->push_back({in.size() - 2, 1.0});
     return true;
+}
+
+double polyline_length_of(std::span<const Vec3f> p) {
+    double len = 0;
+    for (std::size_t i = 1; i < p.size(); ++i) len += length(sub(to_v3(p[i]), to_v3(p[i - 1])));
+    return len;
+}
+}  // namespace
+
+double length_keeping_tension(std::span<const Vec3f> in, double step, double stretch) {
+    constexpr double kMax = kMaxResampleTension;
+    const double target = polyline_length_of(in), tolerance = kLengthTolerance * step;
+    thread_local std::vector<Vec3f> walked;
+    // Length of the decoded fiber minus the input's, at tension t (the
+    // chords between anchors, two a block, are not stretched: 0.1 % of a
+    // step each, left out).
+    auto excess = [&](double t) {
+        resample_on(in, step, ResampleCurve::cubic, t, true, kPiecesPerStep, walked, nullptr);
+        return stretch * polyline_length_of(walked) - target;
+    };
+    double best_t = 1, best = excess(1);
+    if (!(std::fabs(best) > tolerance)) return best_t;
+    // Multiples of the quantum, so that a tension kept in 16 bits is the one
+    // fitted (the lengths move by nanometres).
+    auto quantized = [](double t) { return std::round(t / kTensionQuantum) * kTensionQuantum; };
+    auto consider = [&](double t, double e) {
+        if (std::fabs(e) < std::fabs(best)) best = e, best_t = t;
+    };
+    // Bracket the root: rounder curves are longer, so move away from the
+    // Bessel cubic towards the missing length (1.75, 2.5, 4 or 0.5, 0).
+    const bool too_short = best < 0;
+    double lo = 1, e_lo = best, hi = 1, e_hi = best;
+    const double up[] = {1.75, 2.5, kMax}, down[] = {0.5, 0};
+    bool bracketed = false;
+    for (const double t : too_short ? std::span<const double>(up) : std::span<const double>(down)) {
+        const double e = excess(t);
+        consider(t, e);
+        bracketed = (e < 0) != too_short || e == 0;
+        (bracketed == too_short ? hi : lo) = t, (bracketed == too_short ? e_hi : e_lo) = e;
+        if (bracketed) break;
+    }
+    if (!bracketed || !(std::fabs(best) > tolerance)) return quantized(best_t);
+    // Regula falsi, Illinois variant (halves the weight of an end kept twice).
+    int kept_side = 0;
+    for (int i = 0; i < kMaxTensionIterations && std::fabs(best) > tolerance; ++i) {
+        const double t = (lo * e_hi - hi * e_lo) / (e_hi - e_lo);
+        const double e = excess(t);
+        consider(t, e);
+        if ((e < 0) == (e_lo < 0)) {
+            lo = t, e_lo = e;
+            if (kept_side == 1) e_hi *= 0.5;
+            kept_side = 1;
+        } else {
+            hi = t, e_hi = e;
+            if (kept_side == -1) e_lo *= 0.5;
+            kept_side = -1;
+        }
+    }
+    return quantized(best_t);
+}
+
+bool resample_cubic_keeping_end(std::span<const Vec3f> in, double step, double tension, std::vector<Vec3f>& out,
+                                std::vector<PolylinePosition>* positions) {
+    return resample_on(in, step, ResampleCurve::cubic, tension, true, kPiecesPerStep, out, positions);
+}
+
+void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out, ResampleCurve curve,
+                         std::vector<PolylinePosition>* positions) {
+    const double tension = curve == ResampleCurve::cubic_keeping_length ? length_keeping_tension(in, step) : 1.0;
+    resample_on(in, step, curve, tension, false, kPiecesPerStep, out, positions);
+}
+
+bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out, ResampleCurve curve,
+                          std::vector<PolylinePosition>* positions) {
+    const double tension = curve == ResampleCurve::cubic_keeping_length ? length_keeping_tension(in, step) : 1.0;
+    return resample_on(in, step, curve, tension, true, kPiecesPerStep, out, positions);
 }
 
 void interpolate_point_values(std::span<const PolylinePosition> positions, const float* in_values,
