@@ -46,6 +46,7 @@ std::string decompress_one(const DecompressArgs& a, const std::string& input, co
     DecodeOptions options;
     options.decoder = parse_decoder(a.decoder);
     options.threads = a.threads;
+    options.overlap_sink = true;  // format and write one chunk while the next is decoded
     const std::string decoder = decoder_name(options.decoder);
     const std::string out_path = writable_path(output, ".tck", stdout_spool);
     const auto sink = open_streamline_sink(out_path, sink_header, a.force || stdout_spool);
