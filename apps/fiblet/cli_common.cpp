@@ -88,6 +88,13 @@ void write_decoded_fiber(StreamlineSink& sink, const float* xyz, std::uint64_t n
     sink.write(xyz, std::size_t(n));
 }
 
+void write_decoded_chunk(StreamlineSink& sink, const Streamlines& chunk, const std::string& input,
+                         std::uint64_t first) {
+    for (std::size_t i = 0; i < chunk.size(); ++i)
+        check_decoded_finite(&chunk.xyz[3 * chunk.offsets[i]], chunk.offsets[i + 1] - chunk.offsets[i], input, first + i);
+    sink.write_chunk(chunk.xyz.data(), chunk.offsets);
+}
+
 std::string human_bytes(std::uint64_t b) {
     if (b < 10000) return fmt::format("{} B", b);
     if (b < 1'000'000) return fmt::format("{:.1f} kB", b / 1e3);

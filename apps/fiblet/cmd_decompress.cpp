@@ -54,9 +54,7 @@ std::string decompress_one(const DecompressArgs& a, const std::string& input, co
     decode_file(
         file,
         [&](std::uint64_t first, const Streamlines& chunk) {
-            for (std::size_t i = 0; i < chunk.size(); ++i)
-                write_decoded_fiber(*sink, &chunk.xyz[3 * chunk.offsets[i]], chunk.offsets[i + 1] - chunk.offsets[i],
-                                    input, first + i);
+            write_decoded_chunk(*sink, chunk, input, first);
             progress.update("decompress", h.fibers ? double(first + chunk.size()) / double(h.fibers) : 1.0);
         },
         options);
