@@ -1,6 +1,7 @@
 // MRtrix3 .tck writer (Float32LE), through an AtomicOutputFile.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string_view>
 
@@ -140,9 +141,15 @@ void TckWriter::write_chunk(const float* xyz, std::span<const std::uint64_t> off
         m.check_open();
         const float* p = xyz + 3 * offsets[i];
         const std::uint64_t n = offsets[i + 1] - offsets[i];
-        bool finite = true;
-        for (std::uint64_t k = 0; k < 3 * n; ++k) finite &= std::isfinite(p[k]);
-        if (!finite)
+        // NaN and Inf have every exponent bit set: one mask and compare a
+        // value, which vectorizes (the sink thread's time is the writes').
+        std::uint32_t bad = 0;
+        for (std::uint64_t k = 0; k < 3 * n; ++k) {
+            std::uint32_t b;
+            std::memcpy(&b, p + k, 4);
+            bad |= std::uint32_t((b & 0x7f800000u) == 0x7f800000u);
+        }
+        if (bad)
             throw Error(Errc::invalid_input, m.out.path() + ": cannot write a non-finite coordinate (" +
                                                  detail::streamline_label(m.count + i) + "): a .tck cannot hold NaN or Inf");
         if (m.count + i >= kMaxCount)
