@@ -198,6 +198,10 @@ def main():
         md.append(f"\n(Google Benchmark: {ctx.get('num_cpus', '?')} CPUs at {ctx.get('mhz_per_cpu', '?')} MHz, "
                   f"load average {', '.join(f'{x:.1f}' for x in ctx.get('load_avg', []))}.)\n")
 
+    # The parallel-pipeline table (scripts/bench_pipeline.sh) keeps its place.
+    pipeline = os.path.join(os.path.dirname(os.path.abspath(a.md)), "results-pipeline.md")
+    if os.path.exists(pipeline):
+        md.append("\n" + open(pipeline).read())
     with open(a.md, "w") as f:
         f.write("\n".join(md))
 

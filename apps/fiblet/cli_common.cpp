@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -68,6 +69,14 @@ void Progress::done() {
 
 namespace {
 void check_decoded_finite(const float* xyz, std::uint64_t n, const std::string& input, std::uint64_t fiber) {
+    // Fast path (vectorizes): no value with every exponent bit set (NaN, Inf).
+    std::uint32_t bad = 0;
+    for (std::uint64_t i = 0; i < 3 * n; ++i) {
+        std::uint32_t b;
+        std::memcpy(&b, xyz + i, 4);
+        bad |= std::uint32_t((b & 0x7f800000u) == 0x7f800000u);
+    }
+    if (!bad) return;
     for (std::uint64_t i = 0; i < 3 * n; ++i)
         if (!std::isfinite(xyz[i]))
             throw Error(Errc::invalid_input, input + ": fiber " + std::to_string(fiber) +
@@ -86,6 +95,13 @@ void write_decoded_fiber(StreamlineSink& sink, const float* xyz, std::uint64_t n
                          std::uint64_t fiber) {
     check_decoded_finite(xyz, n, input, fiber);
     sink.write(xyz, std::size_t(n));
+}
+
+void write_decoded_chunk(StreamlineSink& sink, const Streamlines& chunk, const std::string& input,
+                         std::uint64_t first) {
+    for (std::size_t i = 0; i < chunk.size(); ++i)
+        check_decoded_finite(&chunk.xyz[3 * chunk.offsets[i]], chunk.offsets[i + 1] - chunk.offsets[i], input, first + i);
+    sink.write_chunk(chunk.xyz.data(), chunk.offsets);
 }
 
 std::string human_bytes(std::uint64_t b) {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/streamline_io.hpp"
@@ -64,6 +65,9 @@ void write_decoded_fiber(TckWriter& writer, const float* xyz, std::uint64_t n, c
                          std::uint64_t fiber);
 void write_decoded_fiber(StreamlineSink& sink, const float* xyz, std::uint64_t n, const std::string& input,
                          std::uint64_t fiber);
+// The same for every fiber of a decoded chunk whose first is fiber `first`,
+// written at once (StreamlineSink::write_chunk: a .tck without a copy).
+void write_decoded_chunk(StreamlineSink& sink, const Streamlines& chunk, const std::string& input, std::uint64_t first);
 
 // Minimal JSON object builder (values are numbers, strings, bools or nested
 // objects already rendered), keys in insertion order.

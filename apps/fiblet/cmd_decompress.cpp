@@ -46,6 +46,7 @@ std::string decompress_one(const DecompressArgs& a, const std::string& input, co
     DecodeOptions options;
     options.decoder = parse_decoder(a.decoder);
     options.threads = a.threads;
+    options.overlap_sink = true;  // format and write one chunk while the next is decoded
     const std::string decoder = decoder_name(options.decoder);
     const std::string out_path = writable_path(output, ".tck", stdout_spool);
     const auto sink = open_streamline_sink(out_path, sink_header, a.force || stdout_spool);
@@ -53,9 +54,7 @@ std::string decompress_one(const DecompressArgs& a, const std::string& input, co
     decode_file(
         file,
         [&](std::uint64_t first, const Streamlines& chunk) {
-            for (std::size_t i = 0; i < chunk.size(); ++i)
-                write_decoded_fiber(*sink, &chunk.xyz[3 * chunk.offsets[i]], chunk.offsets[i + 1] - chunk.offsets[i],
-                                    input, first + i);
+            write_decoded_chunk(*sink, chunk, input, first);
             progress.update("decompress", h.fibers ? double(first + chunk.size()) / double(h.fibers) : 1.0);
         },
         options);

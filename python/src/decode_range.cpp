@@ -1,13 +1,16 @@
 #include "decode_range.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
+#include <string_view>
 #include <exception>
 #include <string>
 #include <thread>
 
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
+#include "fiblet/parallel.hpp"
 
 namespace fiblet::python {
 namespace {
@@ -26,6 +29,15 @@ void decode_run(const Context& ctx, const std::uint8_t* blocks, std::size_t coun
     else decode_blocks_scalar(ctx, blocks, count, xyz);
 }
 
+// The output's pages: FIBLET_PY_BUFFER=populate|huge picks one for
+// measuring (scripts/bench_python.sh); the default is the faster on the
+// medium tractogram (bench/results.md).
+PageMode output_page_mode() {
+    const char* v = std::getenv("FIBLET_PY_BUFFER");
+    if (v && std::string_view(v) == "populate") return PageMode::populate;
+    return PageMode::huge;
+}
+
 }  // namespace
 
 bool fast_block_decoder_available() { return has_fast_decoder<DecodeContext>; }
@@ -36,41 +48,31 @@ DecodedRange decode_range(const FftFile& file, std::uint64_t begin, std::uint64_
     const DecodeContext ctx(file);
     const std::uint32_t bb = ctx.header.block_bytes();
     const std::uint64_t b0 = file.block_end(begin), nblocks = file.block_end(end) - b0;
-    PopulatedBuffer blocks(nblocks * bb);
-    file.read_blocks(b0, nblocks, blocks.as<std::uint8_t>());
-    const std::uint8_t* data = blocks.as<const std::uint8_t>();
+    PopulatedBuffer blocks(nblocks * bb, PageMode::huge);
+    std::uint8_t* data = blocks.as<std::uint8_t>();
 
-    // Contiguous runs of blocks, one per thread, each decoded at its own
-    // point offset (known once the runs' blocks are counted).
+    // Contiguous runs of blocks, up to 4 per thread, handed out one at a time
+    // by the library's pool (fiblet/parallel.hpp): each run is read and
+    // counted, then decoded at its own point offset, all in parallel.
     if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-    const std::uint64_t runs = std::max<std::uint64_t>(1, std::min<std::uint64_t>(threads, nblocks / 4096));
+    const std::uint64_t runs =
+        threads == 1 ? 1 : std::clamp<std::uint64_t>(nblocks / 1024, 1, std::uint64_t(4) * threads);
     std::vector<std::uint64_t> run_block(runs + 1), run_point(runs + 1, 0);
     for (std::uint64_t r = 0; r <= runs; ++r) run_block[r] = nblocks * r / runs;
-    for (std::uint64_t r = 0; r < runs; ++r)
-        run_point[r + 1] =
-            run_point[r] + count_block_points(ctx, data + run_block[r] * bb, run_block[r + 1] - run_block[r]);
+    parallel_for(runs, threads, [&](std::size_t r) {
+        const std::uint64_t n = run_block[r + 1] - run_block[r];
+        file.read_blocks(b0 + run_block[r], n, data + run_block[r] * bb);
+        run_point[r + 1] = count_block_points(ctx, data + run_block[r] * bb, n);
+    });
+    for (std::uint64_t r = 0; r < runs; ++r) run_point[r + 1] += run_point[r];
 
     DecodedRange out;
     out.points = run_point[runs];
-    out.xyz = PopulatedBuffer(out.points * 3 * sizeof(float));
+    out.xyz = PopulatedBuffer(out.points * 3 * sizeof(float), output_page_mode());
     float* xyz = out.xyz.as<float>();
-    auto work = [&](std::uint64_t r) {
+    parallel_for(runs, threads, [&](std::size_t r) {
         decode_run(ctx, data + run_block[r] * bb, run_block[r + 1] - run_block[r], xyz + 3 * run_point[r]);
-    };
-    std::vector<std::thread> pool;
-    std::vector<std::exception_ptr> failures(runs);
-    for (std::uint64_t r = 1; r < runs; ++r)
-        pool.emplace_back([&, r] {
-            try {
-                work(r);
-            } catch (...) {
-                failures[r] = std::current_exception();
-            }
-        });
-    work(0);
-    for (std::thread& t : pool) t.join();
-    for (const std::exception_ptr& f : failures)
-        if (f) std::rethrow_exception(f);
+    });
 
     // Per-fiber offsets from the blocks' point counts.
     out.offsets.reserve(end - begin + 1);

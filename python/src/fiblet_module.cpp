@@ -29,6 +29,7 @@
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/image_mask.hpp"
+#include "fiblet/parallel.hpp"
 #include "fiblet/select.hpp"
 #include "fiblet/streamline_io.hpp"
 #include "fiblet/tck.hpp"
@@ -167,12 +168,11 @@ std::vector<std::uint64_t> kept_by_points(FibersView s, const Regions& regions, 
             kept[f] = k;
         }
     };
+    // Parts of at least 256 fibers, up to 4 per thread, from the library's pool.
     if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-    const std::uint64_t n = s.size(), parts = std::max<std::uint64_t>(1, std::min<std::uint64_t>(threads, n / 256));
-    std::vector<std::thread> pool;
-    for (std::uint64_t t = 1; t < parts; ++t) pool.emplace_back(test, n * t / parts, n * (t + 1) / parts);
-    test(0, n / parts);
-    for (std::thread& t : pool) t.join();
+    const std::uint64_t n = s.size(),
+                        parts = std::clamp<std::uint64_t>(n / 256, 1, std::uint64_t(4) * threads);
+    parallel_for(parts, threads, [&](std::size_t t) { test(n * t / parts, n * (t + 1) / parts); });
     std::vector<std::uint64_t> keep;
     for (std::uint64_t f = 0; f < n; ++f)
         if (kept[f]) keep.push_back(f);

@@ -13,13 +13,24 @@
 
 namespace fiblet::python {
 
+// How the pages of a buffer come to be: faulted in up front by one thread
+// (populate), or on first touch by whichever threads write them, in 2 MB
+// transparent huge pages where the kernel allows (huge: 512x fewer faults,
+// taken by the decoding threads in parallel; scripts/bench_python.sh
+// measures both with FIBLET_PY_BUFFER=populate|huge).
+enum class PageMode { populate, huge };
+
 class PopulatedBuffer {
 public:
     PopulatedBuffer() = default;
-    explicit PopulatedBuffer(std::size_t bytes) : bytes_(bytes) {
+    explicit PopulatedBuffer(std::size_t bytes, PageMode mode = PageMode::populate) : bytes_(bytes) {
         if (bytes_ == 0) return;
-        void* p = ::mmap(nullptr, bytes_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+        const int populate = mode == PageMode::populate ? MAP_POPULATE : 0;
+        void* p = ::mmap(nullptr, bytes_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | populate, -1, 0);
         if (p == MAP_FAILED) throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+        if (mode == PageMode::huge) ::madvise(p, bytes_, MADV_HUGEPAGE);  // advice only: ignored where unsupported
+#endif
         data_ = p;
     }
     ~PopulatedBuffer() {

@@ -119,6 +119,11 @@ struct DecodeOptions {
     std::size_t chunk_blocks = 0;
     Decoder decoder;                      // automatic: the fastest on this CPU
     unsigned threads = 0;                 // 0 = all cores; order of the output never depends on it
+    // decode_file only: call the sink on a thread of its own, in order, while
+    // the next chunk is read and decoded (a pipeline: read -> decode -> sink,
+    // e.g. format and write a .tck). The sink must then not need the
+    // caller's thread; its exceptions still reach the caller.
+    bool overlap_sink = false;
 };
 
 // Decodes fibers [begin, end) of a file.

@@ -41,6 +41,9 @@ public:
     AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
 
     void write(const void* data, std::size_t size);               // appends
+    // Appends `count` pieces (data[i], sizes[i] bytes) in order, handed to
+    // the kernel as they are (writev), without copying them first.
+    void write_pieces(const void* const* data, const std::size_t* sizes, std::size_t count);
     void write_at(const void* data, std::size_t size, std::uint64_t offset);  // patches
     std::uint64_t size() const { return written_; }
     // Flushes and renames into place: over the destination if `overwrite`,

@@ -73,6 +73,13 @@ public:
     virtual ~StreamlineSink() = default;
     // One streamline of n points (3n floats), in order.
     virtual void write(const float* xyz, std::size_t n_points) = 0;
+    // Streamlines i = 0 .. offsets.size() - 2: points offsets[i] to
+    // offsets[i + 1] - 1 of xyz. The same as write() for each, which is what
+    // a sink does unless it can write them at once (a .tck: writev).
+    virtual void write_chunk(const float* xyz, std::span<const std::uint64_t> offsets) {
+        for (std::size_t i = 0; i + 1 < offsets.size(); ++i)
+            write(xyz + 3 * offsets[i], std::size_t(offsets[i + 1] - offsets[i]));
+    }
     // Completes the file (atomically); without it no output is left.
     virtual void finish() = 0;
 };

@@ -111,6 +111,10 @@ public:
     void write(std::span<const Vec3f> streamline);
     // Same, from a flat float array of 3*n values.
     void write(const float* xyz, std::size_t n_points);
+    // Streamlines i = 0 .. offsets.size() - 2 of a chunk: points offsets[i]
+    // to offsets[i + 1] - 1 of xyz (3 floats each), handed to the kernel
+    // where they lie, with their separators (no copy: writev).
+    void write_chunk(const float* xyz, std::span<const std::uint64_t> offsets);
     void finish();
 
     std::uint64_t count() const;

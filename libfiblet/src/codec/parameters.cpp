@@ -42,17 +42,32 @@ void TurnStatistics::add_fiber(std::span<const Vec3f> f) {
     if (fiber_max < 0) return;
     const double fiber_min = 1.0 - 2.0 * fiber_max;  // the dot of the sharpest turn
     min_dot_ = std::min(min_dot_, fiber_min);
-    if (kept_blocks_ == 0) return;
+    if (!wants(fiber_min)) return;
+    const std::size_t b0 = at / points_per_block_ * points_per_block_;
+    const std::size_t b1 = std::min(f.size(), b0 + points_per_block_);
+    keep(fiber_min, std::vector<Vec3f>(f.begin() + std::ptrdiff_t(b0), f.begin() + std::ptrdiff_t(b1)));
+}
+
+bool TurnStatistics::wants(double dot) const {
+    return kept_blocks_ > 0 && (sharpest_.size() < kept_blocks_ || dot < sharpest_.front().first);
+}
+
+void TurnStatistics::keep(double dot, std::vector<Vec3f> block) {
     auto by_dot = [](const auto& a, const auto& b) { return a.first < b.first; };
     if (sharpest_.size() == kept_blocks_) {
-        if (fiber_min >= sharpest_.front().first) return;
         std::pop_heap(sharpest_.begin(), sharpest_.end(), by_dot);
         sharpest_.pop_back();
     }
-    const std::size_t b0 = at / points_per_block_ * points_per_block_;
-    const std::size_t b1 = std::min(f.size(), b0 + points_per_block_);
-    sharpest_.emplace_back(fiber_min, std::vector<Vec3f>(f.begin() + std::ptrdiff_t(b0), f.begin() + std::ptrdiff_t(b1)));
+    sharpest_.emplace_back(dot, std::move(block));
     std::push_heap(sharpest_.begin(), sharpest_.end(), by_dot);
+}
+
+void TurnStatistics::merge(const TurnStatistics& other) {
+    for (std::size_t i = 0; i < bins_.size() && i < other.bins_.size(); ++i) bins_[i] += other.bins_[i];
+    count_ += other.count_;
+    min_dot_ = std::min(min_dot_, other.min_dot_);
+    for (const auto& [dot, block] : other.sharpest_)
+        if (wants(dot)) keep(dot, block);
 }
 
 double TurnStatistics::dot_at_percentile(double p) const {

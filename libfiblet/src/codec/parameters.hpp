@@ -30,6 +30,9 @@ class TurnStatistics {
 public:
     TurnStatistics(std::uint32_t points_per_block, std::size_t kept_blocks);
     void add_fiber(std::span<const Vec3f> fiber);
+    // Adds the turns another one counted (same block size; its kept blocks
+    // offered in its order): a scan split into parts merges them in order.
+    void merge(const TurnStatistics& other);
     std::uint64_t count() const { return count_; }
     // Smallest dot product of consecutive unit directions (1 when none).
     double min_dot() const { return min_dot_; }
@@ -46,6 +49,8 @@ private:
     std::uint32_t points_per_block_;
     std::size_t kept_blocks_;
     std::vector<std::pair<double, std::vector<Vec3f>>> sharpest_;  // (dot, block points), a max-heap on dot
+    bool wants(double dot) const;
+    void keep(double dot, std::vector<Vec3f> block);
 };
 
 // A deterministic sample of whole fibers for tuning: every k-th fiber, with

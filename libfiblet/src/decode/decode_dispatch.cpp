@@ -14,7 +14,7 @@
 
 #include "core/thread_count.hpp"
 #include "decode/decode_kernels.hpp"
-#include "decode/parallel_runs.hpp"
+#include "fiblet/parallel.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 
@@ -220,17 +220,19 @@ std::size_t decode_blocks(const DecodeContext& ctx, const std::uint8_t* blocks, 
     }
     // Contiguous runs of blocks; each run's output starts after the points
     // of the runs before it, so the order never depends on `threads`.
+    // Up to 4 runs per thread, handed out one at a time by the pool.
     const std::size_t bb = ctx.header.block_bytes();
-    std::vector<std::size_t> first(threads + 1), points(threads + 1, 0);
-    for (unsigned t = 0; t <= threads; ++t) first[t] = count * t / threads;
-    detail::parallel_runs(threads, [&](unsigned t) {
+    const auto runs = unsigned(std::clamp<std::size_t>(count / (kMinBlocksPerThread / 2), 1, 4 * threads));
+    std::vector<std::size_t> first(runs + 1), points(runs + 1, 0);
+    for (unsigned t = 0; t <= runs; ++t) first[t] = count * t / runs;
+    parallel_for(runs, threads, [&](std::size_t t) {
         points[t + 1] = count_block_points(ctx, blocks + first[t] * bb, first[t + 1] - first[t]);
     });
-    for (unsigned t = 0; t < threads; ++t) points[t + 1] += points[t];
-    detail::parallel_runs(threads, [&](unsigned t) {
+    for (unsigned t = 0; t < runs; ++t) points[t + 1] += points[t];
+    parallel_for(runs, threads, [&](std::size_t t) {
         detail::decode_resolved(ctx, blocks + first[t] * bb, first[t + 1] - first[t], xyz + 3 * points[t], d);
     });
-    return points[threads];
+    return points[runs];
 }
 
 }  // namespace fiblet

@@ -1,15 +1,19 @@
 // Whole fibers out of a file: chunks of whole fibers are read and decoded
-// by `threads` workers, each on a contiguous run of the chunk's blocks
-// (reading, counting and decoding all in parallel), into one output in
-// fiber order.
+// by `threads` threads of the library's pool, a contiguous run of the
+// chunk's blocks at a time (reading, counting and decoding all in
+// parallel), into one output in fiber order.
 #include <algorithm>
+#include <condition_variable>
+#include <exception>
+#include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "core/thread_count.hpp"
 #include "decode/decode_kernels.hpp"
-#include "decode/parallel_runs.hpp"
+#include "fiblet/parallel.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 
@@ -52,12 +56,14 @@ public:
         blocks_ = file_.block_end(f1) - b0;
         const std::size_t bb = ctx_.header.block_bytes();
         data_.resize(blocks_ * bb);
-        // Runs of at least a few thousand blocks (below that a thread costs more than it saves).
-        runs_ = unsigned(std::clamp<std::uint64_t>(blocks_ / 2048, 1, threads_));
+        // Runs of at least a thousand blocks (below that handing one out
+        // costs more than it saves), up to 4 per thread: taken one at a time
+        // from the pool, so a thread scheduled late does less of the chunk.
+        runs_ = threads_ == 1 ? 1u : unsigned(std::clamp<std::uint64_t>(blocks_ / 1024, 1, 4 * threads_));
         first_.assign(runs_ + 1, 0);
         points_.assign(runs_ + 1, 0);
         for (unsigned t = 0; t <= runs_; ++t) first_[t] = blocks_ * t / runs_;
-        detail::parallel_runs(runs_, [&](unsigned t) {
+        parallel_for(runs_, threads_, [&](std::size_t t) {
             const std::size_t n = first_[t + 1] - first_[t];
             file_.read_blocks(b0 + first_[t], n, data_.data() + first_[t] * bb);
             points_[t + 1] = count_block_points(ctx_, data_.data() + first_[t] * bb, n);
@@ -70,7 +76,7 @@ public:
     // writes offsets[0 .. f1 - f0] = base + points before each fiber.
     void decode(float* xyz, std::uint64_t* offsets, std::uint64_t base) {
         const std::size_t bb = ctx_.header.block_bytes();
-        detail::parallel_runs(runs_, [&](unsigned t) {
+        parallel_for(runs_, threads_, [&](std::size_t t) {
             detail::decode_resolved(ctx_, data_.data() + first_[t] * bb, first_[t + 1] - first_[t],
                                     xyz + 3 * points_[t], decoder_);
         });
@@ -142,25 +148,105 @@ std::uint64_t decode_fibers_into(const FftFile& file, std::uint64_t begin, std::
     return done;
 }
 
+namespace {
+
+// The sink stage of a pipelined decode_file: one thread that calls the sink
+// on each chunk posted, in order, while the caller decodes the next one.
+// One chunk in flight at a time (a bounded queue of one).
+class SinkStage {
+public:
+    explicit SinkStage(const std::function<void(std::uint64_t, const Streamlines&)>& sink)
+        : sink_(sink), thread_([this] { run(); }) {}
+    ~SinkStage() {
+        {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            stop_ = true;
+        }
+        cv_.notify_all();
+        thread_.join();
+    }
+    // Waits until the chunk posted last is done with (rethrows the sink's exception).
+    void wait_idle() {
+        std::unique_lock<std::mutex> lock(mutex_);
+        cv_.wait(lock, [&] { return !chunk_ || error_; });
+        if (error_) std::rethrow_exception(error_);
+    }
+    // Hands `chunk` to the sink; it stays untouched until wait_idle returns.
+    void post(std::uint64_t first, const Streamlines& chunk) {
+        wait_idle();
+        {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            first_ = first, chunk_ = &chunk;
+        }
+        cv_.notify_all();
+    }
+
+private:
+    void run() {
+        for (;;) {
+            std::unique_lock<std::mutex> lock(mutex_);
+            cv_.wait(lock, [&] { return chunk_ || stop_; });
+            if (!chunk_) return;
+            const Streamlines* chunk = chunk_;
+            const std::uint64_t first = first_;
+            lock.unlock();
+            std::exception_ptr error;
+            try {
+                sink_(first, *chunk);
+            } catch (...) {
+                error = std::current_exception();
+            }
+            lock.lock();
+            chunk_ = nullptr;
+            if (error && !error_) error_ = error;
+            lock.unlock();
+            cv_.notify_all();
+            if (error) return;
+        }
+    }
+
+    const std::function<void(std::uint64_t, const Streamlines&)>& sink_;
+    std::mutex mutex_;
+    std::condition_variable cv_;
+    const Streamlines* chunk_ = nullptr;
+    std::uint64_t first_ = 0;
+    bool stop_ = false;
+    std::exception_ptr error_;
+    std::thread thread_;  // last: starts once the rest is set up
+};
+
+}  // namespace
+
 void decode_file(const FftFile& file, const std::function<void(std::uint64_t, const Streamlines&)>& sink,
                  const DecodeOptions& options) {
     ChunkDecoder chunks(file, options);
     const std::uint64_t fibers = file.header().fibers;
-    Streamlines chunk;
+    // Two chunks: one decoded while the sink (on its own thread, with
+    // overlap_sink) has the other.
+    Streamlines chunk[2];
+    const int buffers = options.overlap_sink ? 2 : 1;
     // Room for a usual chunk up front: growing would copy it.
-    chunk.xyz.reserve(3 * std::min<std::uint64_t>(chunks.chunk_blocks(), file.header().blocks) *
-                      file.header().points_per_block);
+    for (int k = 0; k < buffers; ++k)
+        chunk[k].xyz.reserve(3 * std::min<std::uint64_t>(chunks.chunk_blocks(), file.header().blocks) *
+                             file.header().points_per_block);
+    std::optional<SinkStage> stage;
+    if (options.overlap_sink) stage.emplace(sink);
     std::uint64_t points = 0;
+    int k = 0;
     for (std::uint64_t f = 0; f < fibers;) {
         const std::uint64_t e = chunks.chunk_end(f, fibers);
         const std::uint64_t n = chunks.load(f, e);
         points += n;
-        chunk.xyz.resize(3 * n);
-        chunk.offsets.resize(e - f + 1);
-        chunks.decode(chunk.xyz.data(), chunk.offsets.data(), 0);
-        sink(f, chunk);
+        Streamlines& c = chunk[k];
+        c.xyz.resize(3 * n);
+        c.offsets.resize(e - f + 1);
+        chunks.decode(c.xyz.data(), c.offsets.data(), 0);
+        if (stage) stage->post(f, c);
+        else sink(f, c);
+        k = (k + 1) % buffers;
         f = e;
     }
+    if (stage) stage->wait_idle();
     // A whole-file reader reports the header's count: it must be what it wrote.
     if (points != file.header().points)
         throw Error(Errc::fft_format, file.path() + ": not a valid .fft file: the blocks hold " + std::to_string(points) +

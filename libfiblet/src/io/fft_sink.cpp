@@ -12,6 +12,7 @@
 #include "fiblet/error.hpp"
 #include "fiblet/fftz_format.hpp"
 #include "fiblet/output_file.hpp"
+#include "fiblet/parallel.hpp"
 
 namespace fiblet::detail {
 
@@ -150,28 +151,12 @@ private:
             at += n;
         }
         std::vector<std::vector<std::uint8_t>> done(jobs.size());
-        auto work = [&](std::size_t first) {
-            for (std::size_t j = first; j < jobs.size(); j += threads_) {
-                const auto fields = options_.transpose ? transpose_block_group(jobs[j], bits_, block_bytes_)
-                                                       : std::vector<std::uint8_t>(jobs[j].begin(), jobs[j].end());
-                done[j] = compress_frame(fields, options_.level);
-            }
-        };
-        const std::size_t n_threads = std::min<std::size_t>(threads_, jobs.size());
-        std::vector<std::exception_ptr> failures(n_threads);
-        auto guarded = [&](std::size_t t) {
-            try {
-                work(t);
-            } catch (...) {
-                failures[t] = std::current_exception();
-            }
-        };
-        std::vector<std::thread> pool;
-        for (std::size_t t = 1; t < n_threads; ++t) pool.emplace_back(guarded, t);
-        if (n_threads > 0) guarded(0);
-        for (auto& th : pool) th.join();
-        for (const auto& f : failures)
-            if (f) std::rethrow_exception(f);
+        // One frame at a time from the library's pool.
+        parallel_for(jobs.size(), threads_, [&](std::size_t j) {
+            const auto fields = options_.transpose ? transpose_block_group(jobs[j], bits_, block_bytes_)
+                                                   : std::vector<std::uint8_t>(jobs[j].begin(), jobs[j].end());
+            done[j] = compress_frame(fields, options_.level);
+        });
         for (std::size_t j = 0; j < jobs.size(); ++j) frame(done[j], jobs[j].size());
         pending_.erase(pending_.begin(), pending_.begin() + std::ptrdiff_t(at));
     }

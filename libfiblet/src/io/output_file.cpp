@@ -1,5 +1,7 @@
 #include "fiblet/output_file.hpp"
 
+#include <sys/uio.h>
+
 #include <fcntl.h>
 #include <pthread.h>
 #include <stdio.h>  // renameat2, RENAME_NOREPLACE
@@ -147,6 +149,31 @@ void AtomicOutputFile::write(const void* data, std::size_t size) {
         buffer_.append(static_cast<const char*>(data), size);
     }
     written_ += size;
+}
+
+void AtomicOutputFile::write_pieces(const void* const* data, const std::size_t* sizes, std::size_t count) {
+    flush_buffer();
+    constexpr std::size_t kMaxPieces = 1024;  // IOV_MAX on Linux
+    iovec iov[kMaxPieces];
+    for (std::size_t at = 0; at < count;) {
+        const std::size_t n = std::min(kMaxPieces, count - at);
+        for (std::size_t i = 0; i < n; ++i) iov[i] = {const_cast<void*>(data[at + i]), sizes[at + i]};
+        iovec* v = iov;
+        std::size_t left = n;
+        while (left > 0) {
+            const ssize_t w = ::writev(fd_, v, int(left));
+            if (w < 0) {
+                if (errno == EINTR) continue;
+                throw Error(Errc::io, path_ + ": write failed: " + errno_text());
+            }
+            written_ += std::uint64_t(w);
+            // Skip what was written (a short write may stop inside a piece).
+            std::size_t done = std::size_t(w);
+            while (left > 0 && done >= v->iov_len) done -= v->iov_len, ++v, --left;
+            if (left > 0) v->iov_base = static_cast<char*>(v->iov_base) + done, v->iov_len -= done;
+        }
+        at += n;
+    }
 }
 
 void AtomicOutputFile::write_at(const void* data, std::size_t size, std::uint64_t offset) {

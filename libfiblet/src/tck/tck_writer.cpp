@@ -1,6 +1,7 @@
 // MRtrix3 .tck writer (Float32LE), through an AtomicOutputFile.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string_view>
 
@@ -125,6 +126,39 @@ void TckWriter::write(const float* xyz, std::size_t n_points) {
     bool finite = true;
     for (std::size_t i = 0; i < 3 * n_points; ++i) finite &= std::isfinite(xyz[i]);
     impl_->append(xyz, n_points, finite);
+}
+
+void TckWriter::write_chunk(const float* xyz, std::span<const std::uint64_t> offsets) {
+    Impl& m = *impl_;
+    if (offsets.size() < 2) return;
+    const std::size_t fibers = offsets.size() - 1;
+    static const float sep[3] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN(),
+                                 std::numeric_limits<float>::quiet_NaN()};
+    std::vector<const void*> data;
+    std::vector<std::size_t> sizes;
+    data.reserve(2 * fibers), sizes.reserve(2 * fibers);
+    for (std::size_t i = 0; i < fibers; ++i) {
+        m.check_open();
+        const float* p = xyz + 3 * offsets[i];
+        const std::uint64_t n = offsets[i + 1] - offsets[i];
+        // NaN and Inf have every exponent bit set: one mask and compare a
+        // value, which vectorizes (the sink thread's time is the writes').
+        std::uint32_t bad = 0;
+        for (std::uint64_t k = 0; k < 3 * n; ++k) {
+            std::uint32_t b;
+            std::memcpy(&b, p + k, 4);
+            bad |= std::uint32_t((b & 0x7f800000u) == 0x7f800000u);
+        }
+        if (bad)
+            throw Error(Errc::invalid_input, m.out.path() + ": cannot write a non-finite coordinate (" +
+                                                 detail::streamline_label(m.count + i) + "): a .tck cannot hold NaN or Inf");
+        if (m.count + i >= kMaxCount)
+            throw Error(Errc::unsupported, m.out.path() + ": more than " + std::to_string(kMaxCount) + " streamlines");
+        if (n > 0) data.push_back(p), sizes.push_back(std::size_t(n) * sizeof(Vec3f));
+        data.push_back(sep), sizes.push_back(sizeof sep);
+    }
+    m.out.write_pieces(data.data(), sizes.data(), data.size());
+    m.count += fibers;
 }
 
 void TckWriter::finish() {

@@ -37,6 +37,9 @@ class TckSink final : public StreamlineSink {
 public:
     TckSink(const std::string& path, const SinkHeader& h, bool overwrite) : writer_(path, h.properties, overwrite) {}
     void write(const float* xyz, std::size_t n) override { writer_.write(xyz, n); }
+    void write_chunk(const float* xyz, std::span<const std::uint64_t> offsets) override {
+        writer_.write_chunk(xyz, offsets);
+    }
     void finish() override { writer_.finish(); }
 
 private:

@@ -1,0 +1,165 @@
+// The encode stage of compress_tck (compress_stages.hpp): a three-stage
+// pipeline over batches of whole fibers,
+//
+//   read_fiber_batch  the caller's thread parses the next batch of the
+//                     input (compress_read.cpp)
+//   encode_task       the worker pool encodes the current batch, a task (a
+//                     contiguous run of ~16 k points) at a time
+//   write_batch       the caller writes the previous batch's blocks,
+//                     checksum and index entries, in order
+//
+// so reading and writing overlap the encoding, and a thread the OS
+// schedules late only takes fewer tasks. Memory is bounded: two batches of
+// input (~3 MB each) and their blocks.
+#include <cmath>
+#include <cstring>
+#include <utility>
+
+#include "codec/compress_stages.hpp"
+#include "codec/fiber_end_encoder.hpp"
+#include "fiblet/parallel.hpp"
+
+namespace fiblet::detail {
+
+namespace {
+
+double length(Vec3f a, Vec3f b) {
+    const double dx = double(b.x) - a.x, dy = double(b.y) - a.y, dz = double(b.z) - a.z;
+    return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+// One task's outputs and scratch. Task t of every batch uses slot t of its
+// batch's set: statistics accumulate per slot in batch order and are merged
+// in slot order at the end, whichever thread ran the task.
+struct Slot {
+    std::vector<std::uint8_t> blocks;
+    std::vector<Vec3f> decoded, decoded_exact, resampled, scratch;
+    std::vector<PolylinePosition> positions;  // of the resampled points on the input
+    ErrorStats error;
+    GeometryError geometry;  // both ways against the input polylines
+    IndexBuilder index;      // bounds of this task's blocks (the BIDX chunk)
+};
+
+// Stage 2, one task: fibers [cuts[t], cuts[t + 1]) of the batch into the slot.
+void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t, Slot& w) {
+    w.blocks.clear();
+    w.index.clear();
+    for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1]; ++i) {
+        const std::vector<Vec3f>& original = b.fibers[i];
+        std::span<const Vec3f> points = original;
+        const auto f = std::uint32_t(b.first_fiber + i);
+        w.decoded.clear();
+        w.decoded_exact.clear();
+        if (in.step > 0) {
+            const bool fields = in.point_fields && in.point_fields->active();
+            const bool short_tail = resample_cubic_keeping_end(original, in.step, (*in.tensions)[f] * kTensionQuantum,
+                                                               w.resampled, fields ? &w.positions : nullptr);
+            if (fields) in.point_fields->resample(f, w.positions);
+            points = w.resampled;
+            (*in.end_fractions)[f] = encode_keeping_end(in.encoder, points, short_tail, in.step, f, w.blocks,
+                                                        w.decoded, &w.decoded_exact, w.scratch);
+        } else {
+            in.encoder.encode(points, f, w.blocks, &w.decoded, &w.decoded_exact);
+        }
+        if (in.block_index) w.index.add_fiber(w.decoded);
+        for (std::size_t k = 0; k < points.size(); ++k) {
+            // The header's error holds for fiblet's float decoders and an exact one alike.
+            const double e = length(points[k], w.decoded[k]);
+            w.error.add(w.decoded_exact.empty() ? e : std::max(e, length(points[k], w.decoded_exact[k])), f);
+        }
+        w.geometry.add_fiber(original, w.decoded, f);
+    }
+}
+
+// Stage 3: a batch's blocks, checksums and index entries, in task order.
+void write_batch(const FiberBatch& b, std::vector<Slot>& slots, FftSink& out, FftChecksumBuilder& checksum,
+                 IndexBuilder& index) {
+    for (std::size_t t = 0; t < b.tasks(); ++t) {
+        out.write_blocks(slots[t].blocks);
+        checksum.add_blocks(slots[t].blocks.data(), slots[t].blocks.size());
+        index.append(slots[t].index);
+    }
+}
+
+}  // namespace
+
+PointFieldResampler::PointFieldResampler(std::vector<StreamlineField>* fields,
+                                         const std::vector<std::uint32_t>& original_points) {
+    if (!fields) return;
+    for (StreamlineField& f : *fields)
+        if (f.scope() == FieldScope::point) point_fields_.push_back(&f);
+    if (point_fields_.empty()) return;
+    original_offsets_.resize(original_points.size() + 1);
+    for (std::size_t i = 0; i < original_points.size(); ++i)
+        original_offsets_[i + 1] = original_offsets_[i] + original_points[i];
+    for (StreamlineField* f : point_fields_) {
+        std::vector<float> v(std::size_t(f->values()));
+        for (std::uint64_t k = 0; k < v.size(); ++k) v[k] = narrow_to_float(field_value(f->type, &f->bytes[k * f->value_size()]));
+        input_.push_back(std::move(v));
+    }
+}
+
+void PointFieldResampler::set_resampled_points(const std::vector<std::uint32_t>& points) {
+    if (!active()) return;
+    offsets_.assign(points.size() + 1, 0);
+    for (std::size_t i = 0; i < points.size(); ++i) offsets_[i + 1] = offsets_[i] + points[i];
+    for (StreamlineField* f : point_fields_) output_.emplace_back(std::size_t(offsets_.back()) * f->components);
+}
+
+void PointFieldResampler::resample(std::uint32_t f, std::span<const PolylinePosition> positions) {
+    for (std::size_t i = 0; i < point_fields_.size(); ++i) {
+        const std::size_t c = point_fields_[i]->components;
+        interpolate_point_values(positions, &input_[i][original_offsets_[f] * c], c, &output_[i][offsets_[f] * c]);
+    }
+}
+
+void PointFieldResampler::finish() {
+    for (std::size_t i = 0; i < point_fields_.size(); ++i) {
+        StreamlineField& f = *point_fields_[i];
+        f.type = FieldType::float32;
+        f.bytes.resize(output_[i].size() * 4);
+        std::memcpy(f.bytes.data(), output_[i].data(), f.bytes.size());
+    }
+}
+
+EncodeStageResult encode_stage(StreamlineSource& reader, const EncodeStageInputs& in, FftSink& out,
+                               FftChecksumBuilder& checksum, IndexBuilder& index, const CompressOptions& options) {
+    reader.rewind();
+    // Two batches and two sets of slots: one being encoded, one being read
+    // (the batch) or written (its slots).
+    FiberBatch batch[2];
+    std::vector<Slot> slots[2];
+    const IndexBuilder empty_index = index;  // the file's layout, no blocks yet
+    auto add_slots = [&](int k) {
+        while (slots[k].size() < batch[k].tasks()) slots[k].emplace_back().index = empty_index;
+    };
+    auto progress = [&] {
+        if (options.progress && reader.data_bytes() > 0)
+            options.progress("encode", double(reader.bytes_consumed()) / double(reader.data_bytes()));
+    };
+
+    int cur = 0;
+    bool more = read_fiber_batch(reader, batch[cur], 0);
+    bool pending_write = false;  // slots[1 - cur] hold the previous batch's output
+    while (more) {
+        const FiberBatch& b = batch[cur];
+        add_slots(cur);
+        ParallelJob job(b.tasks(), in.threads, [&, cur](std::size_t t) { encode_task(in, batch[cur], t, slots[cur][t]); });
+        // While the pool encodes: write the previous batch, read the next.
+        if (pending_write) write_batch(batch[1 - cur], slots[1 - cur], out, checksum, index);
+        const auto next_first = std::uint32_t(b.first_fiber + b.count);
+        more = read_fiber_batch(reader, batch[1 - cur], next_first);
+        job.wait();
+        progress();
+        pending_write = true;
+        cur = 1 - cur;
+    }
+    if (pending_write) write_batch(batch[1 - cur], slots[1 - cur], out, checksum, index);
+
+    EncodeStageResult r;
+    for (int k = 0; k < 2; ++k)
+        for (const Slot& w : slots[k]) r.error.merge(w.error), r.geometry.merge(w.geometry);
+    return r;
+}
+
+}  // namespace fiblet::detail

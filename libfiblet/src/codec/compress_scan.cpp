@@ -1,0 +1,227 @@
+// The scan stage of compress_tck (compress_stages.hpp): pass 1 (counts,
+// bounds, spacing, turning angles) and, when resampling, pass 1b (the
+// resampled counts and turns). Both are pipelines over batches of whole
+// fibers: the caller's thread reads the next batch (read_fiber_batch) and
+// does the per-fiber bookkeeping that must follow the file's order while
+// the worker pool measures the current batch, a task at a time. Each task
+// index has its own partial statistics (one set per batch parity), merged in
+// index order at the end: the result does not depend on the thread count.
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "codec/compress_stages.hpp"
+#include "core/streamline_label.hpp"
+#include "fiblet/error.hpp"
+#include "fiblet/parallel.hpp"
+
+namespace fiblet::detail {
+
+namespace {
+
+double length(Vec3f a, Vec3f b) {
+    const double dx = double(b.x) - a.x, dy = double(b.y) - a.y, dz = double(b.z) - a.z;
+    return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+void report_progress(const CompressOptions& o, const char* phase, const StreamlineSource& r) {
+    if (o.progress && r.data_bytes() > 0) o.progress(phase, double(r.bytes_consumed()) / double(r.data_bytes()));
+}
+
+// Pass 1's partial statistics of one task index.
+struct ScanSlot {
+    double min[3] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                     std::numeric_limits<double>::infinity()};
+    double max[3] = {-min[0], -min[1], -min[2]};
+    double step_min = std::numeric_limits<double>::infinity(), step_max = 0, length_sum = 0;
+    std::uint64_t segments = 0;
+    LengthHistogram lengths;
+    std::optional<TurnStatistics> turns;
+};
+
+void scan_task(const FiberBatch& b, std::size_t t, ScanSlot& s) {
+    double length_sum = 0;  // this task's, added to the slot's once (the same sums whatever the threads)
+    for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1]; ++i) {
+        const std::vector<Vec3f>& fiber = b.fibers[i];
+        for (std::size_t k = 0; k < fiber.size(); ++k) {
+            const Vec3f p = fiber[k];
+            const double c[3] = {p.x, p.y, p.z};
+            for (int a = 0; a < 3; ++a) s.min[a] = std::min(s.min[a], c[a]), s.max[a] = std::max(s.max[a], c[a]);
+            if (k > 0) {
+                const double len = length(fiber[k - 1], p);
+                s.lengths.add(len);
+                length_sum += len;
+                s.step_min = std::min(s.step_min, len);
+                s.step_max = std::max(s.step_max, len);
+                ++s.segments;
+            }
+        }
+        s.turns->add_fiber(fiber);
+    }
+    s.length_sum += length_sum;
+}
+
+// Pass 1b's partial statistics of one task index.
+struct ResampleSlot {
+    std::vector<Vec3f> resampled;
+    std::optional<TurnStatistics> turns;
+    std::uint64_t off_step_segments = 0;
+    std::optional<std::uint64_t> too_long;  // the first fiber of this batch's task needing > 65535 blocks
+    double too_long_mm = 0;
+};
+
+}  // namespace
+
+void LengthHistogram::add(double len) {
+    const float f = float(len);
+    ++count_;
+    if (!(f >= kMin)) return ++below_, void();
+    const std::uint32_t i = std::min<std::uint32_t>((std::bit_cast<std::uint32_t>(f) - kMinBits) >> kShift, kBins - 1);
+    auto& block = blocks_[i >> kMantissaBits];
+    if (!block) block = std::make_unique<std::uint64_t[]>(kBlock);  // zeroed
+    ++block[i & (kBlock - 1)];
+}
+
+void LengthHistogram::merge(const LengthHistogram& o) {
+    count_ += o.count_, below_ += o.below_;
+    for (std::uint32_t e = 0; e < kExponents; ++e) {
+        if (!o.blocks_[e]) continue;
+        if (!blocks_[e]) blocks_[e] = std::make_unique<std::uint64_t[]>(kBlock);
+        for (std::uint32_t j = 0; j < kBlock; ++j) blocks_[e][j] += o.blocks_[e][j];
+    }
+}
+
+double LengthHistogram::median() const {
+    std::uint64_t seen = below_;
+    if (count_ == 0 || 2 * seen >= count_) return 0.0;
+    for (std::uint32_t e = 0; e < kExponents; ++e) {
+        if (!blocks_[e]) continue;
+        for (std::uint32_t j = 0; j < kBlock; ++j) {
+            seen += blocks_[e][j];
+            if (2 * seen >= count_) {
+                const std::uint32_t lo = kMinBits + ((e * kBlock + j) << kShift);
+                return 0.5 * (double(std::bit_cast<float>(lo)) + double(std::bit_cast<float>(lo + (1u << kShift))));
+            }
+        }
+    }
+    return 0.0;
+}
+
+ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_t points_per_block,
+                           std::size_t sharp_blocks, std::size_t tuning_points, unsigned threads,
+                           const CompressOptions& options) {
+    ScanStageResult r{.fiber_points = {},
+                      .turns = TurnStatistics(points_per_block, sharp_blocks),
+                      .sample = FiberSample(tuning_points),
+                      .lengths = {}};
+    FiberBatch batch[2];
+    std::vector<ScanSlot> slots[2];
+    auto add_slots = [&](int k) {
+        while (slots[k].size() < batch[k].tasks())
+            slots[k].emplace_back().turns.emplace(points_per_block, sharp_blocks);
+    };
+    int cur = 0;
+    bool more = read_fiber_batch(reader, batch[cur], 0);
+    while (more) {
+        const FiberBatch& b = batch[cur];
+        add_slots(cur);
+        ParallelJob job(b.tasks(), threads, [&, cur](std::size_t t) { scan_task(batch[cur], t, slots[cur][t]); });
+        // In file order, on the caller's thread while the pool measures.
+        for (std::size_t i = 0; i < b.count; ++i) {
+            const std::vector<Vec3f>& fiber = b.fibers[i];
+            if (fiber.size() > std::numeric_limits<std::uint32_t>::max())
+                throw Error(Errc::unsupported, reader.path() + ": a streamline with more than 2^32 points");
+            ++scan.fibers;
+            scan.points += fiber.size();
+            scan.empty_fibers += fiber.empty();
+            scan.single_point_fibers += fiber.size() == 1;
+            r.fiber_points.push_back(std::uint32_t(fiber.size()));
+            r.sample.offer(fiber);
+        }
+        more = read_fiber_batch(reader, batch[1 - cur], std::uint32_t(b.first_fiber + b.count));
+        job.wait();
+        report_progress(options, "scan", reader);
+        cur = 1 - cur;
+    }
+    // Merged in slot order: the same sums whatever the thread count.
+    scan.min = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                std::numeric_limits<double>::infinity()};
+    scan.max = {-scan.min[0], -scan.min[1], -scan.min[2]};
+    scan.step_min = std::numeric_limits<double>::infinity();
+    scan.step_max = 0;
+    double length_sum = 0;
+    for (int k = 0; k < 2; ++k)
+        for (const ScanSlot& s : slots[k]) {
+            for (int a = 0; a < 3; ++a) scan.min[a] = std::min(scan.min[a], s.min[a]), scan.max[a] = std::max(scan.max[a], s.max[a]);
+            scan.step_min = std::min(scan.step_min, s.step_min);
+            scan.step_max = std::max(scan.step_max, s.step_max);
+            scan.segments += s.segments;
+            length_sum += s.length_sum;
+            r.lengths.merge(s.lengths);
+            r.turns.merge(*s.turns);
+        }
+    r.length_sum = length_sum;
+    return r;
+}
+
+void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double tolerance,
+                         std::size_t max_fiber_points, TckScan& scan, std::vector<std::uint32_t>& fiber_points,
+                         std::vector<std::uint16_t>& tensions, TurnStatistics& turns, std::uint32_t points_per_block,
+                         std::size_t sharp_blocks, unsigned threads, const CompressOptions& options) {
+    const double step = resample.step_mm;
+    reader.rewind();
+    FiberBatch batch[2];
+    std::vector<ResampleSlot> slots[2];
+    auto add_slots = [&](int k) {
+        while (slots[k].size() < batch[k].tasks())
+            slots[k].emplace_back().turns.emplace(points_per_block, sharp_blocks);
+    };
+    auto task = [&](const FiberBatch& b, std::size_t t, ResampleSlot& s) {
+        s.too_long.reset();
+        for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1]; ++i) {
+            const std::vector<Vec3f>& fiber = b.fibers[i];
+            const std::uint64_t f = b.first_fiber + i;
+            double fiber_length = 0;
+            for (std::size_t k = 1; k < fiber.size(); ++k) fiber_length += length(fiber[k - 1], fiber[k]);
+            if (!(fiber_length / step < double(max_fiber_points))) {
+                s.too_long = f, s.too_long_mm = fiber_length;
+                return;  // reported in fiber order by the caller
+            }
+            const double tension = length_keeping_tension(fiber, step, resample.stretch);
+            tensions[f] = std::uint16_t(std::lround(tension / kTensionQuantum));
+            const bool short_tail = resample_cubic_keeping_end(fiber, step, tension, s.resampled);
+            fiber_points[f] = std::uint32_t(s.resampled.size());
+            // The turn towards a kept end is one step per fiber, often a
+            // noisy short one: left out of the turn statistics, so the cap
+            // (sized for the whole-step turns) stays as fine as before.
+            s.turns->add_fiber(std::span<const Vec3f>(s.resampled).first(s.resampled.size() - short_tail));
+            for (std::size_t k = 1; k < fiber.size(); ++k)
+                s.off_step_segments += std::fabs(length(fiber[k - 1], fiber[k]) - step) > tolerance * step;
+        }
+    };
+    int cur = 0;
+    bool more = read_fiber_batch(reader, batch[cur], 0);
+    while (more) {
+        const FiberBatch& b = batch[cur];
+        add_slots(cur);
+        ParallelJob job(b.tasks(), threads, [&, cur](std::size_t t) { task(batch[cur], t, slots[cur][t]); });
+        more = read_fiber_batch(reader, batch[1 - cur], std::uint32_t(b.first_fiber + b.count));
+        job.wait();
+        for (std::size_t t = 0; t < b.tasks(); ++t)
+            if (const ResampleSlot& s = slots[cur][t]; s.too_long)
+                throw Error(Errc::unsupported, reader.path() + ": " + streamline_label(*s.too_long) + " (" +
+                                                   std::to_string(s.too_long_mm) + " mm) needs more than 65535 blocks at a " +
+                                                   std::to_string(step) + " mm step");
+        report_progress(options, "resample-scan", reader);
+        cur = 1 - cur;
+    }
+    turns = TurnStatistics(points_per_block, sharp_blocks);
+    for (int k = 0; k < 2; ++k)
+        for (const ResampleSlot& s : slots[k]) {
+            turns.merge(*s.turns);
+            scan.off_step_segments += s.off_step_segments;
+        }
+}
+
+}  // namespace fiblet::detail

@@ -1,0 +1,147 @@
+// Internal: the stages of compress_tck (compress.cpp), one file each:
+//   read    (compress_read.cpp)   batches of whole fibers from the input,
+//                                 cut into tasks for the worker pool;
+//   scan    (compress_scan.cpp)   pass 1: counts, bounds, spacing, turns;
+//                                 pass 1b when resampling: the new counts;
+//   encode  (compress_encode.cpp) pass 2, a pipeline: read a batch of
+//                                 fibers -> encode it on the worker pool ->
+//                                 write its blocks, the next batch read while
+//                                 the pool encodes this one.
+#pragma once
+
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "codec/parameters.hpp"
+#include "fiblet/block_index.hpp"
+#include "fiblet/checksum.hpp"
+#include "fiblet/compress.hpp"
+#include "fiblet/encode.hpp"
+#include "fiblet/error_stats.hpp"
+#include "fiblet/fiber_ends.hpp"
+#include "fiblet/geometry_error.hpp"
+#include "fiblet/resample.hpp"
+#include "fiblet/streamline_io.hpp"
+#include "io/fft_sink.hpp"
+
+namespace fiblet::detail {
+
+// A batch: ~256 k points of whole fibers (at least one fiber), cut into tasks
+// of ~16 k points; neither depends on the thread count, so no output does.
+inline constexpr std::size_t kBatchPoints = std::size_t{1} << 18;
+inline constexpr std::size_t kTaskPoints = std::size_t{1} << 14;
+
+struct FiberBatch {
+    std::vector<std::vector<Vec3f>> fibers;  // kept between batches: their capacity is reused
+    std::size_t count = 0;                   // fibers in this batch
+    std::uint32_t first_fiber = 0;
+    std::vector<std::size_t> cuts;  // task t has fibers [cuts[t], cuts[t + 1])
+    std::size_t tasks() const { return cuts.empty() ? 0 : cuts.size() - 1; }
+};
+
+// The read stage: the next batch of fibers from `reader` (first_fiber: the
+// index of its first); false at the end of the input. More than 2^32 - 1
+// fibers in all: Error{unsupported} (fiber IDs are 32-bit).
+bool read_fiber_batch(StreamlineSource& reader, FiberBatch& b, std::uint32_t first_fiber);
+
+// Median of segment lengths from a histogram of their float32 bit patterns
+// (the top 13 mantissa bits: 1.2e-4 relative resolution between 1 um and
+// 2 m, no logarithm per segment), one block of bins per binary exponent,
+// allocated when a length first falls in it: constant, small memory.
+class LengthHistogram {
+public:
+    void add(double len);
+    void merge(const LengthHistogram& other);
+    double median() const;
+
+private:
+    static constexpr float kMin = 0x1p-20f;
+    static constexpr std::uint32_t kMinBits = std::bit_cast<std::uint32_t>(kMin), kShift = 10;
+    static constexpr std::uint32_t kMantissaBits = 23 - kShift, kBlock = 1u << kMantissaBits;
+    static constexpr std::uint32_t kExponents = 31, kBins = kExponents * kBlock;  // 2^-20 .. 2^11 mm
+    std::array<std::unique_ptr<std::uint64_t[]>, kExponents> blocks_;
+    std::uint64_t count_ = 0, below_ = 0;
+};
+
+// Pass 1: what the scan found besides `scan`'s fields.
+struct ScanStageResult {
+    std::vector<std::uint32_t> fiber_points;  // per fiber
+    TurnStatistics turns;                     // turning angles and the sharpest blocks
+    FiberSample sample;                       // fibers for tuning the encoder
+    LengthHistogram lengths;                  // segment lengths (their median)
+    double length_sum = 0;
+};
+
+// Pass 1 over `reader` (from where it stands: its start): fills scan's
+// counts, bounds and step extremes (not step_mean/median: from the result).
+ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_t points_per_block,
+                           std::size_t sharp_blocks, std::size_t tuning_points, unsigned threads,
+                           const CompressOptions& options);
+
+// How pass 1b resamples: the step (mm) and the decoder's stretch of it
+// that the length-keeping tension allows for (length_keeping_tension).
+struct ResampleStep {
+    double step_mm = 0, stretch = 1;
+};
+
+// Pass 1b (resampling): each fiber's length-keeping tension into `tensions`
+// (in kTensionQuantum units) and its resampled point count into
+// fiber_points, the turns of the resampled fibers into `turns` (replaced),
+// scan.off_step_segments. A fiber needing more than max_fiber_points:
+// Error{unsupported} (the first in file order).
+void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double tolerance,
+                         std::size_t max_fiber_points, TckScan& scan, std::vector<std::uint32_t>& fiber_points,
+                         std::vector<std::uint16_t>& tensions, TurnStatistics& turns, std::uint32_t points_per_block,
+                         std::size_t sharp_blocks, unsigned threads, const CompressOptions& options);
+
+// Per-point fields of resampled input, re-made at the resampled points
+// (float32, linear between the two input points of the piece each lies on:
+// interpolate_point_values);
+// the other fields are kept as read.
+class PointFieldResampler {
+public:
+    // `fields`: null when the input is not resampled; `original_points`:
+    // each fiber's input point count.
+    PointFieldResampler(std::vector<StreamlineField>* fields, const std::vector<std::uint32_t>& original_points);
+    bool active() const { return !point_fields_.empty(); }
+    // The resampled point counts are known: size the outputs.
+    void set_resampled_points(const std::vector<std::uint32_t>& points);
+    // Fiber f was resampled at `positions` (threads write disjoint fibers).
+    void resample(std::uint32_t f, std::span<const PolylinePosition> positions);
+    void finish();
+
+private:
+    std::vector<StreamlineField*> point_fields_;
+    std::vector<std::uint64_t> original_offsets_, offsets_;
+    std::vector<std::vector<float>> input_, output_;
+};
+
+// What the encode stage needs besides the input: the encoder, the
+// resampling step (0: none), the outputs it fills.
+struct EncodeStageInputs {
+    const FiberEncoder& encoder;
+    double step = 0;                     // resampling step (mm), 0 when not resampled
+    PointFieldResampler* point_fields = nullptr;
+    FiberEndFractions* end_fractions = nullptr;  // resampled: one per fiber
+    const std::vector<std::uint16_t>* tensions = nullptr;  // resampled: pass 1b's, one per fiber
+    bool block_index = true;
+    unsigned threads = 1;
+};
+
+struct EncodeStageResult {
+    ErrorStats error;
+    GeometryError geometry;
+};
+
+// Pass 2: reads `reader` from its start, encodes every fiber and writes the
+// blocks to `out` (and `checksum`, `index`) in fiber order. The output does
+// not depend on `threads`: batches and tasks are cut by point counts only,
+// and each task's statistics are merged in task order.
+EncodeStageResult encode_stage(StreamlineSource& reader, const EncodeStageInputs& in, FftSink& out,
+                               FftChecksumBuilder& checksum, IndexBuilder& index, const CompressOptions& options);
+
+}  // namespace fiblet::detail
