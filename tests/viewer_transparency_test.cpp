@@ -29,6 +29,7 @@ constexpr int kSize = 256;
 
 struct Segment {
     Vec3f p0, p1;
+    std::uint32_t fiber;  // index in the file
 };
 
 // Every segment of every fiber, as the CPU reference decoder gives the
@@ -39,7 +40,8 @@ std::vector<Segment> decoded_segments(const FftFile& file, const viewer::GpuScen
     std::size_t point = 0;
     for (std::uint64_t f = 0; f < scene.fiber_count(); ++f) {
         const std::uint32_t n = scene.fiber_points(f);
-        for (std::uint32_t k = 0; k + 1 < n; ++k) out.push_back({d.point(point + k), d.point(point + k + 1)});
+        for (std::uint32_t k = 0; k + 1 < n; ++k)
+            out.push_back({d.point(point + k), d.point(point + k + 1), std::uint32_t(f)});
         point += n;
     }
     return out;
@@ -65,16 +67,19 @@ bool exits_diamond(float ax, float ay, float bx, float by, float cx, float cy) {
 struct Fragment {
     double depth;
     float r, g, b;
+    double alpha;
 };
 
 // The exact composite (RGBA8, rows from the top as RenderTarget::read_rgba)
 // and the number of fragments of each pixel; colour by direction, no
-// lighting, black background.
+// lighting, black background. With `fiber_alpha` (one per fiber) a fragment
+// blends with opacity x its fiber's (the GPU's float product, fiber_colors.glsl).
 struct Reference {
     std::vector<std::uint8_t> rgba;
     std::vector<std::uint32_t> fragments;
 };
-Reference exact_reference(const std::vector<Segment>& segments, const Camera& cam, double opacity) {
+Reference exact_reference(const std::vector<Segment>& segments, const Camera& cam, double opacity,
+                          const std::vector<float>* fiber_alpha = nullptr) {
     const Mat4 vp = view_projection_matrix(cam);
     const Vec3f forward = [&] {
         const Vec3f d{cam.target.x - cam.position.x, cam.target.y - cam.position.y, cam.target.z - cam.position.z};
@@ -94,7 +99,8 @@ Reference exact_reference(const std::vector<Segment>& segments, const Camera& ca
         const Vec3f mid{(s.p0.x + s.p1.x) / 2, (s.p0.y + s.p1.y) / 2, (s.p0.z + s.p1.z) / 2};
         const double depth = double(mid.x - cam.position.x) * forward.x + double(mid.y - cam.position.y) * forward.y +
                              double(mid.z - cam.position.z) * forward.z;
-        const Fragment f{depth, std::fabs(dx / len), std::fabs(dy / len), std::fabs(dz / len)};
+        const double alpha = fiber_alpha ? double(float(opacity) * (*fiber_alpha)[s.fiber]) : opacity;
+        const Fragment f{depth, std::fabs(dx / len), std::fabs(dy / len), std::fabs(dz / len), alpha};
         const int x0 = std::max(0, int(std::floor(std::min(ax, bx) - 1))), x1 = std::min(kSize - 1, int(std::max(ax, bx) + 1));
         const int y0 = std::max(0, int(std::floor(std::min(ay, by) - 1))), y1 = std::min(kSize - 1, int(std::max(ay, by) + 1));
         for (int y = y0; y <= y1; ++y)
@@ -109,7 +115,7 @@ Reference exact_reference(const std::vector<Segment>& segments, const Camera& ca
         double c[3] = {0, 0, 0};
         for (const Fragment& f : frags) {
             const float rgb[3] = {f.r, f.g, f.b};
-            for (int k = 0; k < 3; ++k) c[k] = opacity * rgb[k] + (1 - opacity) * c[k];
+            for (int k = 0; k < 3; ++k) c[k] = f.alpha * rgb[k] + (1 - f.alpha) * c[k];
         }
         for (int k = 0; k < 3; ++k) ref.rgba[4 * i + std::size_t(k)] = std::uint8_t(std::lround(std::clamp(c[k], 0.0, 1.0) * 255));
         ref.fragments[i] = std::uint32_t(frags.size());
@@ -266,6 +272,23 @@ void print_table_header() {
                 "max", "vs unsorted");
 }
 
+// One row per mode (kModes' order) of the table; with `check`, the issue's
+// bounds for the ordered modes.
+void report_modes(const std::string& name, float alpha, const ImageError (&errors)[3], bool check) {
+    const ImageError& unsorted = errors[2];
+    for (int m = 0; m < 3; ++m) {
+        const ImageError& e = errors[m];
+        std::printf("%-22s %5.2f %-9s %11.3f %13.3f %8d %10.3f\n", name.c_str(), alpha,
+                    viewer::transparency_mode_name(kModes[m]), e.mean, 100 * e.share_over_8, e.max,
+                    unsorted.mean > 0 ? e.mean / unsorted.mean : 0.0);
+        if (!check || kModes[m] == viewer::TransparencyMode::unsorted) continue;
+        SCOPED_TRACE(name + " " + viewer::transparency_mode_name(kModes[m]) + " alpha " + std::to_string(alpha));
+        EXPECT_LE(e.mean, 1.0);
+        EXPECT_LE(e.share_over_8, 0.01);
+        EXPECT_LE(e.mean, 0.25 * unsorted.mean);
+    }
+}
+
 // Every mode against the exact reference at both opacities, printed; with
 // `check`, the bounds for the ordered modes.
 void compare_modes(const TempDir& dir, const BundleCase& bundle, bool check) {
@@ -279,19 +302,7 @@ void compare_modes(const TempDir& dir, const BundleCase& bundle, bool check) {
         const Reference ref = exact_reference(segments, cam, alpha);
         ImageError errors[3];
         for (int m = 0; m < 3; ++m) errors[m] = image_error(render(scene, cam, transparent_options(kModes[m], alpha)), ref);
-        const ImageError& unsorted = errors[2];
-        for (int m = 0; m < 3; ++m) {
-            const ImageError& e = errors[m];
-            std::printf("%-22s %5.2f %-9s %11.3f %13.3f %8d %10.3f\n", bundle.name, alpha,
-                        viewer::transparency_mode_name(kModes[m]), e.mean, 100 * e.share_over_8, e.max,
-                        unsorted.mean > 0 ? e.mean / unsorted.mean : 0.0);
-            if (!check || kModes[m] == viewer::TransparencyMode::unsorted) continue;
-            SCOPED_TRACE(std::string(bundle.name) + " " + viewer::transparency_mode_name(kModes[m]) + " alpha " +
-                         std::to_string(alpha));
-            EXPECT_LE(e.mean, 1.0);
-            EXPECT_LE(e.share_over_8, 0.01);
-            EXPECT_LE(e.mean, 0.25 * unsorted.mean);
-        }
+        report_modes(bundle.name, alpha, errors, check);
     }
 }
 
@@ -312,6 +323,108 @@ TEST(ViewerTransparency, DISABLED_WholeSmallIfod1Table) {
     const TempDir dir;
     print_table_header();
     compare_modes(dir, {"small-ifod1", read_tck_fibers(shared_data("small-ifod1.tck"))}, false);
+}
+
+// Per-fiber opacities (--fiber-opacity): random ones in [0, 1] on a shared
+// bundle, times a global opacity; the reference blends every fragment with
+// its fiber's product. The ordered modes meet the bounds.
+TEST(ViewerTransparency, PerFiberOpacityMatchesTheExactReference) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    write_tck(dir.file("b.tck"), read_tck_fibers(std::string(FIBLET_SHARED_DIR) + "/data/bundles/AF_L-step0.1.tck"));
+    const FftFile file(compress_into(dir, dir.file("b.tck"), "b.fft"));
+    viewer::GpuScene scene(file, *viewer_gl().programs);
+    ASSERT_GT(scene.fiber_count(), 10u);
+    std::mt19937 rng(1616);
+    std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+    std::vector<float> alpha(scene.fiber_count());
+    for (float& a : alpha) a = uniform(rng);
+    scene.set_fiber_opacities(alpha);
+    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 1);
+    const std::vector<Segment> segments = decoded_segments(file, scene);
+    print_table_header();
+    for (const float global : {0.2f, 1.0f}) {
+        const Reference ref = exact_reference(segments, cam, global, &alpha);
+        ImageError errors[3];
+        for (int m = 0; m < 3; ++m) {
+            auto o = transparent_options(kModes[m], global);
+            o.fiber_opacity = true;
+            errors[m] = image_error(render(scene, cam, o), ref);
+        }
+        report_modes("AF_L-step0.1 x U(0,1)", global, errors, true);
+    }
+}
+
+TEST(ViewerTransparency, AFiberOfOpacityZeroDisappears) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const auto fibers = read_tck_fibers(std::string(FIBLET_SHARED_DIR) + "/data/bundles/AF_L-step0.1.tck");
+    ASSERT_GT(fibers.size(), 10u);
+    write_tck(dir.file("b.tck"), fibers);
+    const FftFile file(compress_into(dir, dir.file("b.tck"), "b.fft"));
+    viewer::GpuScene scene(file, *viewer_gl().programs);
+    const std::uint64_t last = scene.fiber_count() - 1;
+    ASSERT_EQ(scene.fiber_id(last), last);
+    std::vector<float> alpha(scene.fiber_count(), 1.0f);
+    alpha[last] = 0;
+    scene.set_fiber_opacities(alpha);
+    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 1);
+    const std::vector<Segment> segments = decoded_segments(file, scene);
+    std::vector<Segment> others, gone;
+    for (const Segment& seg : segments) (seg.fiber == last ? gone : others).push_back(seg);
+    const Reference without = exact_reference(others, cam, 0.3), only = exact_reference(gone, cam, 0.3);
+    for (const auto mode : kModes) {
+        SCOPED_TRACE(viewer::transparency_mode_name(mode));
+        auto o = transparent_options(mode, 0.3f);
+        o.fiber_opacity = true;
+        const auto image = render(scene, cam, o);
+        // Every pixel the fiber alone covers stays background.
+        std::size_t its_own = 0, lit = 0;
+        for (std::size_t i = 0; i < only.fragments.size(); ++i)
+            if (only.fragments[i] > 0 && without.fragments[i] == 0) {
+                ++its_own;
+                lit += image[4 * i] || image[4 * i + 1] || image[4 * i + 2];
+            }
+        EXPECT_GT(its_own, 20u);
+        EXPECT_EQ(lit, 0u);
+        const ImageError e = image_error(image, without);
+        std::printf("last fiber at opacity 0, %-8s: %zu of its own pixels lit of %zu; against the reference without "
+                    "it mean %.3f/255, %.3f %% above 8/255\n",
+                    viewer::transparency_mode_name(mode), lit, its_own, e.mean, 100 * e.share_over_8);
+        if (mode == viewer::TransparencyMode::unsorted) continue;
+        EXPECT_LE(e.mean, 1.0);
+        EXPECT_LE(e.share_over_8, 0.01);
+        if (mode != viewer::TransparencyMode::sorted) continue;
+        // Sorted keys chunks by block and the scene's box: leaving the fiber
+        // out by ID blends the same fragments in the same order.
+        auto subset = transparent_options(mode, 0.3f);
+        subset.id_max = std::uint32_t(last - 1);
+        EXPECT_EQ(image, render(scene, cam, subset));
+    }
+}
+
+TEST(ViewerTransparency, FiberOpacitiesOfOneAreTheGlobalOpacity) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    auto fibers = read_tck_fibers(std::string(FIBLET_SHARED_DIR) + "/data/small-sdstream.tck");
+    fibers.resize(300);
+    write_tck(dir.file("s.tck"), fibers);
+    const FftFile file(compress_into(dir, dir.file("s.tck"), "s.fft"));
+    viewer::GpuScene scene(file, *viewer_gl().programs);
+    scene.set_fiber_opacities(std::vector<float>(scene.fiber_count(), 1.0f));
+    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 1);
+    for (const auto mode : kModes) {
+        auto o = transparent_options(mode, 0.2f);
+        o.lighting = true;
+        o.frustum_culling = mode != viewer::TransparencyMode::unsorted;  // as TwoRendersAreByteIdentical
+        auto per_fiber = o;
+        per_fiber.fiber_opacity = true;
+        EXPECT_EQ(render(scene, cam, per_fiber), render(scene, cam, o)) << viewer::transparency_mode_name(mode);
+    }
+    EXPECT_THROW(scene.set_fiber_opacities({0.5f}), Error);
+    std::vector<float> bad(scene.fiber_count(), 0.5f);
+    bad[7] = 1.5f;
+    EXPECT_THROW(scene.set_fiber_opacities(bad), Error);
 }
 
 TEST(ViewerTransparency, FiberOrderDoesNotChangeASortedImage) {
@@ -374,6 +487,31 @@ TEST(ViewerTransparency, CliOptions) {
                              "--opacity 0.3 --transparency unsorted --style tubes"}) {
         const CommandResult r = run_cli("render " + fft + " -o " + dir.file("y.png") + " -f --size 64x48 " + good);
         EXPECT_EQ(r.status, 0) << good << ": " << r.output;
+    }
+    // --fiber-opacity: one value in [0, 1] per streamline, a file or dps/NAME.
+    const FftFile file(fft);
+    std::string alpha, over;
+    for (std::uint64_t f = 0; f < file.header().fibers; ++f) {
+        alpha += f % 3 ? "0.5\n" : "0\n";
+        over += f == 3 ? "1.5\n" : "1\n";
+    }
+    write_file(dir.file("alpha.txt"), alpha);
+    write_file(dir.file("over.txt"), over);
+    write_file(dir.file("short.txt"), "0.5\n");
+    const std::string common = "render " + fft + " -o " + dir.file("z.png") + " -f --size 64x48 ";
+    for (const std::string& good : {"--fiber-opacity " + dir.file("alpha.txt"),
+                                   "--fiber-opacity " + dir.file("alpha.txt") + " --opacity 0.5 --style capsules"}) {
+        const CommandResult r = run_cli(common + good);
+        EXPECT_EQ(r.status, 0) << good << ": " << r.output;
+    }
+    for (const auto& [bad, status] : std::vector<std::pair<std::string, int>>{
+             {"--fiber-opacity " + dir.file("over.txt"), 4},
+             {"--fiber-opacity " + dir.file("short.txt"), 4},
+             {"--fiber-opacity dps/weight", 2},
+             {"--fiber-opacity " + dir.file("missing.txt"), 2},
+             {"--fiber-opacity " + dir.file("alpha.txt") + " --engine voxel-rt", 2}}) {
+        const CommandResult r = run_cli(common + bad);
+        EXPECT_EQ(r.status, status) << bad << ": " << r.output;
     }
     const CommandResult bench =
         run_cli("render " + fft + " --bench --frames 1 --size 64x48 --json --opacity 0.2 --transparency sorted");

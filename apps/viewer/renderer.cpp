@@ -107,6 +107,7 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const R
                             RenderTarget& target) {
     if (options.engine == RenderEngine::voxel_rt) return voxel_ray_tracer().render(scene, camera, options, target);
     RenderOptions o = options;
+    o.fiber_opacity = options.fiber_opacity && scene.has_fiber_opacities();
     // A transparent frame blends every segment of what it selects: no coarse blocks.
     if (o.transparent()) o.level_of_detail = false;
     o.fiber_colors = options.fiber_colors && scene.has_fiber_colors();
@@ -147,7 +148,7 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const R
     }
 
     const FrameInputs in{scene, camera, o, select, o.ambient_occlusion ? &occlusion : nullptr};
-    if (o.transparent()) blend_target_.begin(target, o.clear, o.background, o.opacity);
+    if (o.transparent()) blend_target_.begin(target, o.clear, o.background);
     if (o.transparent() && o.style == DrawStyle::lines && o.transparency != TransparencyMode::unsorted) {
         timer.begin(Stage::draw);
         draw_ordered_lines(in, decoder, std::uint32_t(stats.fine_blocks));

@@ -22,6 +22,7 @@
 #include "png_file.hpp"
 #include "render_target.hpp"
 #include "renderer.hpp"
+#include "fiber_opacity.hpp"
 #include "fiber_radii.hpp"
 #include "supersampling.hpp"
 #include "scene_file.hpp"
@@ -185,6 +186,7 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
     GpuScene scene(file, programs);
     load_fiber_colors(options.fiber_colors, file, scene);
     if (!options.fiber_radii_path.empty()) load_fiber_radii(options.fiber_radii_path, scene);
+    if (!options.fiber_opacity_source.empty()) load_fiber_opacities(options.fiber_opacity_source, file, scene);
     Renderer renderer(programs);
     int fb_width = 0, fb_height = 0;
     glfwGetFramebufferSize(w, &fb_width, &fb_height);
