@@ -427,6 +427,190 @@ TEST(ViewerTransparency, FiberOpacitiesOfOneAreTheGlobalOpacity) {
     EXPECT_THROW(scene.set_fiber_opacities(bad), Error);
 }
 
+namespace {
+
+// The unit ray through the centre of pixel (x, y) (rows from the top) of
+// view.hpp's camera (as tests/embree_capsules.hpp's pixel_ray).
+std::array<double, 3> pixel_ray(const Camera& cam, int x, int y, int w, int h) {
+    auto unit = [](double a, double b, double c) {
+        const double n = std::sqrt(a * a + b * b + c * c);
+        return std::array<double, 3>{a / n, b / n, c / n};
+    };
+    const auto fwd = unit(cam.target.x - cam.position.x, cam.target.y - cam.position.y, cam.target.z - cam.position.z);
+    const auto right = unit(fwd[1] * cam.up.z - fwd[2] * cam.up.y, fwd[2] * cam.up.x - fwd[0] * cam.up.z,
+                            fwd[0] * cam.up.y - fwd[1] * cam.up.x);
+    const std::array<double, 3> up{right[1] * fwd[2] - right[2] * fwd[1], right[2] * fwd[0] - right[0] * fwd[2],
+                                   right[0] * fwd[1] - right[1] * fwd[0]};
+    const double t = std::tan(double(cam.fov_y_deg) * M_PI / 360.0);
+    const double nx = (x + 0.5) / w * 2 - 1, ny = 1 - (y + 0.5) / h * 2;
+    return unit(fwd[0] + nx * t * cam.aspect * right[0] + ny * t * up[0],
+                fwd[1] + nx * t * cam.aspect * right[1] + ny * t * up[1],
+                fwd[2] + nx * t * cam.aspect * right[2] + ny * t * up[2]);
+}
+
+// Entry distance of the unit ray (o, d) into the capsule of segment a-b and
+// radius r (the union of the cylinder between the end planes and the two
+// end spheres, as capsules.frag.glsl), or infinity; double precision.
+double capsule_entry(const std::array<double, 3>& o, const std::array<double, 3>& d, Vec3f pa, Vec3f pb, double r) {
+    using V = std::array<double, 3>;
+    auto dot3 = [](const V& u, const V& v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; };
+    const V a{pa.x, pa.y, pa.z}, b{pb.x, pb.y, pb.z};
+    const V ba{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, oa{o[0] - a[0], o[1] - a[1], o[2] - a[2]};
+    double best = INFINITY;
+    const double baba = dot3(ba, ba), bard = dot3(ba, d), baoa = dot3(ba, oa);
+    const double qa = baba - bard * bard;
+    if (qa > 1e-12 * baba) {
+        const double qb = baba * dot3(d, oa) - baoa * bard, qc = baba * dot3(oa, oa) - baoa * baoa - r * r * baba;
+        const double h = qb * qb - qa * qc;
+        if (h >= 0) {
+            const double t = (-qb - std::sqrt(h)) / qa, y = baoa + t * bard;
+            if (y > 0 && y < baba && t > 0) best = t;
+        }
+    }
+    for (const V& c : {a, b}) {
+        const V oc{o[0] - c[0], o[1] - c[1], o[2] - c[2]};
+        const double bb = dot3(d, oc), h = bb * bb - (dot3(oc, oc) - r * r);
+        if (h >= 0 && -bb - std::sqrt(h) > 0) best = std::min(best, -bb - std::sqrt(h));
+    }
+    return best;
+}
+
+// The exact composite of what the capsules style blends: every capsule's
+// entry on each pixel's ray (one per capsule, as its box's front faces give
+// one fragment), sorted back to front; colour by direction, no lighting.
+Reference capsule_reference(const std::vector<Segment>& segments, const Camera& cam, double radius, double opacity) {
+    const Mat4 vp = view_projection_matrix(cam);
+    const Vec3f eye = cam.position;
+    const std::array<double, 3> o{eye.x, eye.y, eye.z};
+    std::vector<std::vector<Fragment>> pixels(std::size_t(kSize) * kSize);
+    for (const Segment& s : segments) {
+        const float dx = s.p1.x - s.p0.x, dy = s.p1.y - s.p0.y, dz = s.p1.z - s.p0.z;
+        const float len = std::sqrt(dx * dx + dy * dy + dz * dz);
+        if (!(len > 0)) continue;
+        // The pixels of the capsule's box on screen (rows from the top), a pixel more.
+        float lo_x = INFINITY, hi_x = -INFINITY, lo_y = INFINITY, hi_y = -INFINITY;
+        bool behind = false;
+        for (int corner = 0; corner < 8; ++corner) {
+            const float r = float(radius);
+            const Vec3f p{(corner & 1 ? std::max(s.p0.x, s.p1.x) + r : std::min(s.p0.x, s.p1.x) - r),
+                          (corner & 2 ? std::max(s.p0.y, s.p1.y) + r : std::min(s.p0.y, s.p1.y) - r),
+                          (corner & 4 ? std::max(s.p0.z, s.p1.z) + r : std::min(s.p0.z, s.p1.z) - r)};
+            const auto c = clip_of(vp, p);
+            if (c[3] <= 0) behind = true;
+            const float x = (c[0] / c[3] * 0.5f + 0.5f) * float(kSize), y = (0.5f - c[1] / c[3] * 0.5f) * float(kSize);
+            lo_x = std::min(lo_x, x), hi_x = std::max(hi_x, x), lo_y = std::min(lo_y, y), hi_y = std::max(hi_y, y);
+        }
+        if (behind) continue;
+        const Fragment f{0, std::fabs(dx / len), std::fabs(dy / len), std::fabs(dz / len), opacity};
+        for (int y = std::max(0, int(lo_y) - 1); y <= std::min(kSize - 1, int(hi_y) + 1); ++y)
+            for (int x = std::max(0, int(lo_x) - 1); x <= std::min(kSize - 1, int(hi_x) + 1); ++x) {
+                const double t = capsule_entry(o, pixel_ray(cam, x, y, kSize, kSize), s.p0, s.p1, radius);
+                if (!std::isfinite(t)) continue;
+                Fragment g = f;
+                g.depth = t;
+                pixels[std::size_t(y) * kSize + std::size_t(x)].push_back(g);
+            }
+    }
+    Reference ref{std::vector<std::uint8_t>(pixels.size() * 4, 255), std::vector<std::uint32_t>(pixels.size())};
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+        auto& frags = pixels[i];
+        std::stable_sort(frags.begin(), frags.end(), [](const Fragment& a, const Fragment& b) { return a.depth > b.depth; });
+        double c[3] = {0, 0, 0};
+        for (const Fragment& f : frags) {
+            const float rgb[3] = {f.r, f.g, f.b};
+            for (int k = 0; k < 3; ++k) c[k] = f.alpha * rgb[k] + (1 - f.alpha) * c[k];
+        }
+        for (int k = 0; k < 3; ++k) ref.rgba[4 * i + std::size_t(k)] = std::uint8_t(std::lround(std::clamp(c[k], 0.0, 1.0) * 255));
+        ref.fragments[i] = std::uint32_t(frags.size());
+    }
+    return ref;
+}
+
+}  // namespace
+
+// Sorted chunks through the ray-cast styles: three layers 10 mm apart
+// written nearest first, drawn sorted, against the same layers written
+// farthest first and blended unsorted in file order (the right order:
+// tubes of a layer do not overlap, and a fiber's overlapping pieces have
+// one colour).
+TEST(ViewerTransparency, SortedTubesAndCapsulesBlendBackToFront) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    auto fibers = separated_layers();
+    write_tck(dir.file("near.tck"), fibers);
+    std::reverse(fibers.begin(), fibers.end());
+    write_tck(dir.file("far.tck"), fibers);
+    const FftFile near_first(compress_into(dir, dir.file("near.tck"), "near.fft"));
+    const FftFile far_first(compress_into(dir, dir.file("far.tck"), "far.fft"));
+    const viewer::GpuScene near_scene(near_first, *viewer_gl().programs), far_scene(far_first, *viewer_gl().programs);
+    const Camera cam = frontal_camera();
+    for (const auto style : {viewer::DrawStyle::tubes, viewer::DrawStyle::capsules}) {
+        SCOPED_TRACE(viewer::draw_style_name(style));
+        auto o = transparent_options(viewer::TransparencyMode::sorted, 0.3f);
+        o.style = style;
+        o.tube_radius_mm = 0.3f;
+        auto right = o;
+        right.transparency = viewer::TransparencyMode::unsorted;
+        right.frustum_culling = false;  // file order
+        const auto expected = render(far_scene, cam, right);
+        const auto sorted = render(near_scene, cam, o);
+        auto wrong = right;
+        const auto unsorted = render(near_scene, cam, wrong);
+        int sorted_max = 0, unsorted_max = 0;
+        std::size_t lit = 0;
+        for (std::size_t i = 0; i < expected.size(); ++i) {
+            sorted_max = std::max(sorted_max, std::abs(int(sorted[i]) - int(expected[i])));
+            unsorted_max = std::max(unsorted_max, std::abs(int(unsorted[i]) - int(expected[i])));
+            lit += i % 4 == 0 && (expected[i] || expected[i + 1] || expected[i + 2]);
+        }
+        std::printf("separated layers, %-8s: sorted (nearest first) vs back to front: max %d/255; unsorted %d/255; "
+                    "%zu pixels lit\n",
+                    viewer::draw_style_name(style), sorted_max, unsorted_max, lit);
+        EXPECT_GT(lit, 5000u);
+        EXPECT_LE(sorted_max, 2);
+        EXPECT_GT(unsorted_max, 8);
+        EXPECT_EQ(sorted, render(near_scene, cam, o)) << "two sorted renders differ";
+    }
+}
+
+// Sorted capsules on a real bundle against the exact composite of every
+// capsule entry (capsule_reference).
+TEST(ViewerTransparency, SortedCapsulesMatchTheExactReference) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    write_tck(dir.file("b.tck"), read_tck_fibers(std::string(FIBLET_SHARED_DIR) + "/data/bundles/AF_L-step0.1.tck"));
+    const FftFile file(compress_into(dir, dir.file("b.tck"), "b.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 1);
+    const std::vector<Segment> segments = decoded_segments(file, scene);
+    constexpr float kRadius = 0.3f;
+    print_table_header();
+    for (const float alpha : {0.05f, 0.2f}) {
+        const Reference ref = capsule_reference(segments, cam, kRadius, alpha);
+        ImageError errors[3];
+        for (int m = 0; m < 3; ++m) {
+            if (kModes[m] == viewer::TransparencyMode::voxlines) continue;  // lines only
+            auto o = transparent_options(kModes[m], alpha);
+            o.style = viewer::DrawStyle::capsules;
+            o.tube_radius_mm = kRadius;
+            errors[m] = image_error(render(scene, cam, o), ref);
+        }
+        const ImageError &sorted = errors[0], &unsorted = errors[2];
+        for (const int m : {0, 2})
+            std::printf("%-22s %5.2f %-9s %11.3f %13.3f %8d %10.3f\n", "AF_L capsules r 0.3", alpha,
+                        viewer::transparency_mode_name(kModes[m]), errors[m].mean, 100 * errors[m].share_over_8,
+                        errors[m].max, unsorted.mean > 0 ? errors[m].mean / unsorted.mean : 0.0);
+        // Measured (llvmpipe): 0.28 / 0.017 % at alpha 0.05 (the line
+        // bounds), 1.22 / 1.7 % at 0.2: tubes 0.6 mm wide touch, and 1 mm
+        // chunks do not order their interleaved entries; asserted with margin.
+        SCOPED_TRACE("alpha " + std::to_string(alpha));
+        EXPECT_GT(sorted.covered, 5000u);
+        EXPECT_LE(sorted.mean, alpha < 0.1f ? 1.0 : 1.5);
+        EXPECT_LE(sorted.share_over_8, alpha < 0.1f ? 0.01 : 0.025);
+        EXPECT_LE(sorted.mean, 0.15 * unsorted.mean);
+    }
+}
+
 TEST(ViewerTransparency, FiberOrderDoesNotChangeASortedImage) {
     FIBLET_REQUIRE_GL();
     const TempDir dir;
@@ -477,14 +661,16 @@ TEST(ViewerTransparency, CliOptions) {
     const TempDir dir;
     const std::string fft = compress_into(dir, shared_data("bundles/AF_L.tck"), "af.fft");
     for (const char* bad : {"--opacity 0", "--opacity 1.5", "--opacity 0.5 --transparency depth",
-                            "--opacity 0.5 --transparency sorted --style tubes",
+                            "--opacity 0.5 --transparency voxlines --style tubes",
                             "--opacity 0.5 --transparency voxlines --style capsules"}) {
         const CommandResult r = run_cli("render " + fft + " -o " + dir.file("x.png") + " --size 32x32 " + bad);
         EXPECT_EQ(r.status, 2) << bad << ": " << r.output;
         EXPECT_FALSE(std::filesystem::exists(dir.file("x.png"))) << bad;
     }
     for (const char* good : {"--opacity 0.3", "--opacity 0.3 --transparency voxlines",
-                             "--opacity 0.3 --transparency unsorted --style tubes"}) {
+                             "--opacity 0.3 --transparency unsorted --style tubes",
+                             "--opacity 0.3 --transparency sorted --style tubes",
+                             "--opacity 0.3 --style capsules"}) {
         const CommandResult r = run_cli("render " + fft + " -o " + dir.file("y.png") + " -f --size 64x48 " + good);
         EXPECT_EQ(r.status, 0) << good << ": " << r.output;
     }

@@ -41,23 +41,24 @@ std::uint32_t fiber_id(std::uint64_t id) {
     return std::uint32_t(id);
 }
 
-// --opacity and --transparency: the lines' default order is sorted; the
-// ray-cast styles blend unsorted only.
+// --opacity and --transparency: the default order is sorted; voxlines
+// draw lines only.
 void set_transparency(const ViewerArgs& a, viewer::RenderOptions& o) {
     if (!(a.opacity > 0 && a.opacity <= 1)) throw Error(Errc::invalid_argument, "--opacity must be in (0, 1]");
     o.opacity = a.opacity;
     const bool lines = o.style == viewer::DrawStyle::lines;
     if (a.transparency.empty()) {
-        o.transparency = lines ? viewer::TransparencyMode::sorted : viewer::TransparencyMode::unsorted;
+        o.transparency = viewer::TransparencyMode::sorted;
         return;
     }
     const auto mode = viewer::parse_transparency_mode(a.transparency);
     if (!mode)
         throw Error(Errc::invalid_argument, "--transparency: '" + a.transparency + "' is not one of " +
                                                 viewer::transparency_mode_names());
-    if (!lines && *mode != viewer::TransparencyMode::unsorted)
-        throw Error(Errc::invalid_argument, "--transparency " + a.transparency + " draws lines; --style " +
-                                                std::string(viewer::draw_style_name(o.style)) + " blends unsorted only");
+    if (!lines && *mode == viewer::TransparencyMode::voxlines)
+        throw Error(Errc::invalid_argument, "--transparency voxlines draws lines; --style " +
+                                                std::string(viewer::draw_style_name(o.style)) +
+                                                " blends sorted or unsorted");
     o.transparency = *mode;
 }
 
@@ -119,8 +120,8 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
         ->check(fiber_values_check());
     cmd->add_option("--transparency", a.transparency,
                     "How streamlines blend when --opacity < 1 or with --fiber-opacity: sorted (~1 mm chunks sorted back to front on the "
-                    "GPU; the default), voxlines (10 mm voxels back to front, precomputed axis orders inside), "
-                    "unsorted (plain blending); tubes and capsules blend unsorted");
+                    "GPU; the default; lines, tubes, capsules), voxlines (10 mm voxels back to front, precomputed "
+                    "axis orders inside; lines), unsorted (plain blending)");
     cmd->add_option("--supersample", a.supersample,
                     "Anti-aliasing of the PNG (render) or screenshots (view): draw N times larger per axis and "
                     "average, 1..8")
