@@ -240,7 +240,9 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
             const int px = int(s.pick->first * fb_width / std::max(win_width, 1));
             const int py = int(s.pick->second * fb_height / std::max(win_height, 1));
             s.pick.reset();
-            if (const auto f = pick_fiber(target, scene, px, py))
+            // A transparent frame is drawn again opaque to pick from: draw it again after.
+            if (s.render.transparent()) s.dirty = true;
+            if (const auto f = pick_fiber_in_frame(renderer, scene, camera, s.render, target, px, py))
                 fmt::print("fiber ID {} (index {}): {} points, {:.2f} mm\n", f->id, f->index, f->points, f->length_mm);
             else
                 fmt::print("no fiber at ({}, {})\n", px, py);
