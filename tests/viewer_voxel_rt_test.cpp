@@ -504,7 +504,8 @@ TEST(VoxelRtCli, RenderDrawsWithEveryOptionAndRefusesBadOnes) {
         EXPECT_GT(lit, 500u) << cases[i];
     }
     for (const char* bad : {"--engine nope", "--engine voxel-rt --grid 2", "--engine voxel-rt --opacity 0",
-                            "--engine voxel-rt --opacity 1.5", "--shadows", "--opacity 0.5 --style tubes --transparency sorted"}) {
+                            "--engine voxel-rt --opacity 1.5", "--shadows",
+                            "--opacity 0.5 --style tubes --transparency voxlines"}) {  // --opacity: both engines
         const CommandResult r = run_cli("render " + fft + " -o " + dir.file("x.png") + " --size 32x32 " + bad);
         EXPECT_EQ(r.status, 2) << bad << ": " << r.output;
     }

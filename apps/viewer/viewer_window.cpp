@@ -22,6 +22,7 @@
 #include "png_file.hpp"
 #include "render_target.hpp"
 #include "renderer.hpp"
+#include "fiber_opacity.hpp"
 #include "fiber_radii.hpp"
 #include "supersampling.hpp"
 #include "scene_file.hpp"
@@ -185,6 +186,7 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
     GpuScene scene(file, programs);
     load_fiber_colors(options.fiber_colors, file, scene);
     if (!options.fiber_radii_path.empty()) load_fiber_radii(options.fiber_radii_path, scene);
+    if (!options.fiber_opacity_source.empty()) load_fiber_opacities(options.fiber_opacity_source, file, scene);
     Renderer renderer(programs);
     int fb_width = 0, fb_height = 0;
     glfwGetFramebufferSize(w, &fb_width, &fb_height);
@@ -232,18 +234,7 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
                            s.render.level_of_detail ? "on" : "off")
                    .c_str());
 
-        if (s.pick) {
-            int win_width = 1, win_height = 1;
-            glfwGetWindowSize(w, &win_width, &win_height);
-            const int px = int(s.pick->first * fb_width / std::max(win_width, 1));
-            const int py = int(s.pick->second * fb_height / std::max(win_height, 1));
-            s.pick.reset();
-            if (const auto f = pick_fiber(target, scene, px, py))
-                fmt::print("fiber ID {} (index {}): {} points, {:.2f} mm\n", f->id, f->index, f->points, f->length_mm);
-            else
-                fmt::print("no fiber at ({}, {})\n", px, py);
-            std::fflush(stdout);
-        }
+        // Screenshots first: picking a transparent frame draws over the target.
         if (s.screenshot) {
             s.screenshot = false;
             const std::string name = next_screenshot_name(options.screenshot_prefix);
@@ -256,6 +247,20 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
             else
                 write_png(name, {target.width(), target.height(), target.read_rgba()}, false);
             fmt::print("screenshot: {}\n", name);
+            std::fflush(stdout);
+        }
+        if (s.pick) {
+            int win_width = 1, win_height = 1;
+            glfwGetWindowSize(w, &win_width, &win_height);
+            const int px = int(s.pick->first * fb_width / std::max(win_width, 1));
+            const int py = int(s.pick->second * fb_height / std::max(win_height, 1));
+            s.pick.reset();
+            // A transparent frame is drawn again opaque to pick from: draw it again after.
+            if (s.render.transparent()) s.dirty = true;
+            if (const auto f = pick_fiber_in_frame(renderer, scene, camera, s.render, target, px, py))
+                fmt::print("fiber ID {} (index {}): {} points, {:.2f} mm\n", f->id, f->index, f->points, f->length_mm);
+            else
+                fmt::print("no fiber at ({}, {})\n", px, py);
             std::fflush(stdout);
         }
     }
