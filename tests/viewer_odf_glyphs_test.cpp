@@ -768,6 +768,58 @@ TEST(OdfGlyphs, GlyphsAndFibersOccludeEachOther) {
 }
 
 // The same SH image as MRtrix .mif (mrconvert) gives the same glyphs.
+// The renderer widens the camera's near and far planes to the overlays'
+// boxes: a glyph and a slice through it, drawn with planes that cut
+// through both (0.02 mm apart around the centre), look as with planes around
+// them; clip_planes_covering leaves planes that already hold them alone.
+TEST(OdfGlyphs, ClipPlanesCoverTheOverlays) {
+    FIBLET_REQUIRE_PHANTOM_FOD();
+    FIBLET_REQUIRE_GL();
+    static const std::vector<float> crossing = crossing_voxel(phantom_fod());
+    viewer::GlyphSet set;
+    set.lmax = 8;
+    set.coefficients_per_glyph = viewer::sh_coefficient_count(8);
+    const double bound = viewer::sh_amplitude_bound(crossing.data(), 8);
+    for (int i = 0; i < set.coefficients_per_glyph; ++i) set.coefficients.push_back(float(crossing[std::size_t(i)] / bound));
+    set.centers.push_back({0, 0, 0, 1});
+    set.extents.push_back(viewer::glyph_box_extents(set.coefficients, 8, viewer::fibonacci_half_sphere(512)));
+    viewer::SliceImage slice;
+    slice.width = slice.height = 2;
+    slice.values = {0, 1, 2, 3};
+    slice.min = 0, slice.max = 3;
+    slice.corners = {{{-1.5f, -1.5f, 0.2f}, {1.5f, -1.5f, 0.2f}, {-1.5f, 1.5f, 0.2f}, {1.5f, 1.5f, 0.2f}}};
+    const std::vector<std::shared_ptr<viewer::Overlay>> overlays{std::make_shared<viewer::ImageSliceOverlay>(slice),
+                                                                 std::make_shared<viewer::OdfGlyphsOverlay>(set)};
+    Camera wide;
+    wide.position = {2.2f, -2.9f, 1.7f};
+    wide.target = {0, 0, 0};
+    wide.up = {0, 0, 1};
+    wide.fov_y_deg = 40;
+    wide.aspect = 1;
+    wide.near_mm = 0.5f, wide.far_mm = 10;
+    const float distance = std::sqrt(2.2f * 2.2f + 2.9f * 2.9f + 1.7f * 1.7f);
+    Camera narrow = wide;
+    narrow.near_mm = distance - 0.01f, narrow.far_mm = distance + 0.01f;
+    const Camera covering = viewer::clip_planes_covering(narrow, overlays);
+    const Camera unchanged = viewer::clip_planes_covering(wide, overlays);
+    EXPECT_EQ(unchanged.near_mm, wide.near_mm);
+    EXPECT_EQ(unchanged.far_mm, wide.far_mm);
+    EXPECT_LT(covering.near_mm, distance - 1.4f);  // the slice's corner nearest the camera
+    EXPECT_GT(covering.far_mm, distance + 1.4f);
+    const int w = 128, h = 128;
+    const OverlayFrame a = render_overlays(overlays, wide, w, h), b = render_overlays(overlays, narrow, w, h);
+    int drawn = 0, differ = 0;
+    for (std::size_t i = 0; i < a.depth.size(); ++i) {
+        drawn += a.depth[i] < 1.0f;
+        differ += (a.depth[i] < 1.0f) != (b.depth[i] < 1.0f);
+        for (int c = 0; c < 3; ++c) differ += std::abs(int(a.rgba[4 * i + std::size_t(c)]) - int(b.rgba[4 * i + std::size_t(c)])) > 1;
+    }
+    std::printf("planes %.3f..%.3f mm widened to %.3f..%.3f: %d pixels drawn, %d differ from planes 0.5..10\n", narrow.near_mm,
+                narrow.far_mm, covering.near_mm, covering.far_mm, drawn, differ);
+    EXPECT_GT(drawn, 2000);
+    EXPECT_EQ(differ, 0);
+}
+
 TEST(OdfGlyphs, MifAndNiftiGiveTheSameGlyphs) {
     FIBLET_REQUIRE_PHANTOM_FOD();
     if (std::system("command -v mrconvert >/dev/null 2>&1") != 0) GTEST_SKIP() << "no mrconvert (Debian mrtrix3)";
