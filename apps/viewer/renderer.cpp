@@ -103,9 +103,11 @@ voxel_rt::VoxelRayTracer& Renderer::voxel_ray_tracer() {
     return *voxel_ray_tracer_;
 }
 
-FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const RenderOptions& options,
+FrameStats Renderer::render(const GpuScene& scene, const Camera& requested, const RenderOptions& options,
                             RenderTarget& target) {
-    if (options.engine == RenderEngine::voxel_rt) return voxel_ray_tracer().render(scene, camera, options, target);
+    if (options.engine == RenderEngine::voxel_rt) return voxel_ray_tracer().render(scene, requested, options, target);
+    // Near and far planes widened to hold the overlays (overlay.hpp).
+    const Camera camera = clip_planes_covering(requested, overlays_);
     RenderOptions o = options;
     o.fiber_opacity = options.fiber_opacity && scene.has_fiber_opacities();
     // A transparent frame blends every segment of what it selects: no coarse blocks.
