@@ -509,3 +509,69 @@ TEST(VoxelRtCli, RenderDrawsWithEveryOptionAndRefusesBadOnes) {
         EXPECT_EQ(r.status, 2) << bad << ": " << r.output;
     }
 }
+
+TEST(VoxelRtMemory, SegmentsSplitOverSeveralBuffersRenderTheSameImage) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("small-ifod1.tck"), "small.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const std::uint64_t slot_bytes = std::uint64_t(scene.header().points_per_block + 1) * 16;
+    const std::uint64_t total = slot_bytes * scene.block_count();
+    struct Frame {
+        std::vector<std::uint32_t> fibers;
+        std::vector<std::uint8_t> rgba;
+        std::size_t parts;
+        double decode_ms, draw_ms;
+    };
+    // The trace's time: the best of two frames after the one that builds.
+    auto draw = [&](std::uint64_t part_bytes, const viewer::RenderOptions& o, int w, int h) {
+        const Camera cam = viewer::camera_from_spec("oblique", scene, float(w) / float(h), 35, 1.0f);
+        viewer::Renderer renderer(*viewer_gl().programs);
+        renderer.voxel_ray_tracer().write_segment_ids(true);
+        renderer.voxel_ray_tracer().set_segment_part_bytes(part_bytes);
+        viewer::RenderTarget target(w, h);
+        renderer.render(scene, cam, o, target);
+        double best = 1e30;
+        for (int k = 0; k < 2; ++k) best = std::min(best, renderer.render(scene, cam, o, target).draw_ms);
+        return Frame{target.read_fibers(), target.read_rgba(), renderer.voxel_ray_tracer().segment_parts(),
+                     renderer.voxel_ray_tracer().last_decode_ms(), best};
+    };
+    // Five parts (the last one partly filled).
+    const std::uint64_t part_bytes = total / 5 + slot_bytes;
+    for (const float opacity : {1.0f, 0.3f}) {
+        SCOPED_TRACE(opacity);
+        viewer::RenderOptions o;
+        o.engine = viewer::RenderEngine::voxel_rt;
+        o.voxel_grid = 64;
+        o.ambient_occlusion = opacity >= 1, o.shadows = opacity >= 1;
+        o.opacity = opacity;
+        o.time_stages = true;
+        // Transparent frames on llvmpipe take seconds: a smaller image.
+        const int w = opacity < 1 ? 96 : 256, h = opacity < 1 ? 72 : 192;
+        const Frame one = draw(0, o, w, h), split = draw(part_bytes, o, w, h);
+        ASSERT_EQ(one.parts, 1u);
+        ASSERT_EQ(split.parts, 5u);
+        std::size_t same = 0, hit = 0;
+        for (std::size_t i = 0; i < one.fibers.size(); ++i) {
+            bool eq = one.fibers[i] == split.fibers[i];
+            for (int k = 0; k < 4; ++k) eq &= one.rgba[4 * i + std::size_t(k)] == split.rgba[4 * i + std::size_t(k)];
+            same += eq;
+            hit += one.fibers[i] != 0;
+        }
+        const double rate = double(same) / double(one.fibers.size());
+        std::printf("opacity %.1f: %.2f MiB of segments in one buffer vs %zu buffers of %.2f MiB: %.5f of %zu pixels "
+                    "identical (%zu hit); decode %.1f / %.1f ms, trace %.1f / %.1f ms\n",
+                    double(opacity), double(total) / 1048576.0, split.parts, double(part_bytes) / 1048576.0, rate,
+                    one.fibers.size(), hit, one.decode_ms, split.decode_ms, one.draw_ms, split.draw_ms);
+        EXPECT_GT(hit, std::size_t(w * h / 5));
+        EXPECT_GE(rate, 0.999);
+    }
+    // More parts than binding points: refused, not drawn in part.
+    viewer::Renderer renderer(*viewer_gl().programs);
+    renderer.voxel_ray_tracer().set_segment_part_bytes(total / 9);
+    viewer::RenderTarget target(8, 8);
+    viewer::RenderOptions o;
+    o.engine = viewer::RenderEngine::voxel_rt;
+    o.voxel_grid = 16;
+    EXPECT_THROW(renderer.render(scene, viewer::camera_from_spec("oblique", scene, 1.0f, 35, 1.0f), o, target), Error);
+}

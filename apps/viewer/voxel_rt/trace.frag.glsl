@@ -116,7 +116,7 @@ struct Hit {
 
 void segmentEnds(uint s, out vec3 a, out vec3 b) {
     uint i = segmentFirstPoint(s);
-    a = vrtPoints[i].xyz, b = vrtPoints[i + 1u].xyz;
+    a = vrtPoint(i), b = vrtPoint(i + 1u);
 }
 
 // Whether segment s starts its fiber (else the previous segment ends at its start).
@@ -202,7 +202,7 @@ vec3 shadeHit(vec3 o, vec3 d, Hit h) {
     return min((base * (uAmbient + uDiffuse * diffuse) + vec3(uSpecular * specular)) * (1.0 - ao), vec3(1.0));
 }
 
-vec3 slotPoint(uint slot, uint k) { return vrtPoints[slot * (uSegmentsPerSlot + 1u) + k].xyz; }
+vec3 slotPoint(uint slot, uint k) { return vrtPoint(slot * (uSegmentsPerSlot + 1u) + k); }
 
 // Whether the capsule of segment s entered at p is where the ray enters the
 // fiber's tube: p between the planes at the segment's joints normal to the

@@ -20,7 +20,7 @@ VoxelRayTracer::~VoxelRayTracer() = default;
 void VoxelRayTracer::ensure_structure(const GpuScene& scene, const RenderOptions& o) {
     if (built_scene_ != &scene || !segments_) {
         structure_.reset();
-        segments_ = std::make_unique<SceneSegments>(scene, shared_);
+        segments_ = std::make_unique<SceneSegments>(scene, shared_, part_bytes_);
         built_scene_ = &scene;
     }
     const bool ao = o.ambient_occlusion;

@@ -46,6 +46,12 @@ public:
     // The culling of the last opaque frame with culling on (null before).
     const VoxelCulling* culling() const { return culling_.get(); }
     double last_decode_ms() const { return segments_ ? segments_->decode_ms() : 0; }
+    // The most bytes of one storage buffer of resident segments (0: the
+    // driver's largest; tests set a few MB to force the split over several
+    // buffers). Takes effect with the next scene built.
+    void set_segment_part_bytes(std::uint64_t bytes) { part_bytes_ = bytes, segments_.reset(); }
+    // Storage buffers the resident segments of the last frame occupy.
+    std::size_t segment_parts() const { return segments_ ? segments_->part_count() : 0; }
 
 private:
     void ensure_structure(const GpuScene& scene, const RenderOptions& options);
@@ -65,6 +71,7 @@ private:
     float chords_radius_ = 0;
     GlVertexArray empty_vertex_array_;
     bool write_segment_ids_ = false;
+    std::uint64_t part_bytes_ = 0;
 };
 
 }  // namespace fiblet::viewer::voxel_rt

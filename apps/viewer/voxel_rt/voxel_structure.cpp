@@ -54,6 +54,14 @@ void bind_segments(const GlProgram& p, const ResidentSegments& s, const VoxelGri
     const GLuint id = p.get();
     if (s.scene) s.scene->bind(p);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kPoints, s.points);
+    // Unused parts' bindings hold part 0 (a binding must hold a buffer).
+    for (unsigned part = 1; part < binding::kPointParts; ++part)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kMorePoints + part - 1,
+                         part <= s.more_parts.size() ? s.more_parts[part - 1] : s.points);
+    const bool split = !s.more_parts.empty();
+    glProgramUniform1ui(id, uniform(p, "uPointParts"), GLuint(1 + s.more_parts.size()));
+    glProgramUniform1ui(id, uniform(p, "uPointsPerPart"),
+                        split ? GLuint(s.slots_per_part * (s.segments_per_slot + 1)) : 0xffffffffu);
     glProgramUniform1ui(id, uniform(p, "uGridN"), GLuint(g.n));
     glProgramUniform3f(id, uniform(p, "uGridOrigin"), g.origin[0], g.origin[1], g.origin[2]);
     glProgramUniform1f(id, uniform(p, "uVoxelMm"), g.voxel_mm);

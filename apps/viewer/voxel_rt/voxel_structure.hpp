@@ -20,10 +20,15 @@ namespace fiblet::viewer::voxel_rt {
 // s + slot + 1 (slot = s / segments_per_slot). With a scene, slot b is
 // block b and holds blockSegmentCount(b) segments; without, every slot
 // holds segments_per_slot.
+// The points may be split over several storage buffers (parts, at most
+// binding::kPointParts): then `points` is part 0, more_parts the others, and
+// every part but the last holds slots_per_part whole slots.
 struct ResidentSegments {
     GLuint points = 0;
     std::uint32_t slots = 0, segments_per_slot = 1;
     const GpuScene* scene = nullptr;
+    std::vector<GLuint> more_parts;
+    std::uint32_t slots_per_part = 0;  // with more_parts
 };
 
 struct BuildTimes {

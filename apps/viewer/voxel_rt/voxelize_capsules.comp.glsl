@@ -58,15 +58,15 @@ void main() {
     if (seg >= segments) return;
     uint i = segmentFirstPoint(s);
     gSegment = s;
-    gA = toGrid(vrtPoints[i].xyz), gB = toGrid(vrtPoints[i + 1u].xyz);
+    gA = toGrid(vrtPoint(i)), gB = toGrid(vrtPoint(i + 1u));
     gRadius = uRadiusMm / uVoxelMm;
     gEffective = max(gRadius, 0.5);
     // Clip planes normal to the central-difference tangents at the joints
     // inside the slot.
     gClipA = vec3(0.0), gClipB = vec3(0.0);
     if (uPass == 0u && !uAllSegmentsValid) {
-        if (seg > 0u) gClipA = toGrid(vrtPoints[i + 1u].xyz) - toGrid(vrtPoints[i - 1u].xyz);
-        if (seg + 1u < segments) gClipB = toGrid(vrtPoints[i + 2u].xyz) - gA;
+        if (seg > 0u) gClipA = toGrid(vrtPoint(i + 1u)) - toGrid(vrtPoint(i - 1u));
+        if (seg + 1u < segments) gClipB = toGrid(vrtPoint(i + 2u)) - gA;
     }
     forEachCapsuleVoxel(gA, gB, gRadius);
 }
