@@ -129,7 +129,7 @@ bool firstOfFiber(uint s) {
 float segmentEntry(vec3 o, vec3 d, uint s, out vec3 normal) {
     vec3 a, b;
     segmentEnds(s, a, b);
-    return capsuleEntry(o, d, a, b, uRadiusMm, uOpacity < 1.0 || firstOfFiber(s), normal);
+    return capsuleEntry(o, d, a, b, segmentRadiusMm(s), uOpacity < 1.0 || firstOfFiber(s), normal);
 }
 
 // Distance at which the ray leaves the culling block holding the walk's voxel.

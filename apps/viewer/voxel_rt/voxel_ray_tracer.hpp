@@ -56,6 +56,7 @@ public:
 private:
     void ensure_structure(const GpuScene& scene, const RenderOptions& options);
     void trace(const Camera& camera, const RenderOptions& options, RenderTarget& target);
+    ResidentSegments segments_for(const GpuScene& scene, const RenderOptions& options) const;
 
     const GpuPrograms& shared_;
     VoxelRtPrograms programs_;
@@ -65,6 +66,7 @@ private:
     const GpuScene* built_scene_ = nullptr;
     int built_grid_ = 0;
     float built_radius_ = 0;
+    bool built_fiber_radii_ = false;
     std::unique_ptr<ChordOcclusion> chords_;
     const GpuScene* chords_scene_ = nullptr;
     int chords_grid_ = 0;

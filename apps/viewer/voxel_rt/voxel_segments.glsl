@@ -25,6 +25,7 @@ uniform uint uPointParts;       // storage buffers holding points (1 to 8)
 // slot); otherwise the scene's blocks say how many segments each holds.
 uniform bool uAllSegmentsValid;
 uniform float uRadiusMm;
+#include "fiber_radii.glsl"  // uFiberRadii: the scene's per-fiber radii instead of uRadiusMm
 
 // Point i of the slot layout (world mm).
 vec3 vrtPoint(uint i) {
@@ -44,5 +45,9 @@ vec3 vrtPoint(uint i) {
 
 uint segmentSlot(uint s) { return s / uSegmentsPerSlot; }
 uint segmentFirstPoint(uint s) { return s + segmentSlot(s); }
+// The capsule radius of segment s (mm): its fiber's with per-fiber radii.
+float segmentRadiusMm(uint s) {
+    return uFiberRadii && !uAllSegmentsValid ? fiberRadii[blockFiber[segmentSlot(s)]] : uRadiusMm;
+}
 vec3 toGrid(vec3 world) { return (world - uGridOrigin) / uVoxelMm; }
 uint voxelIndex(ivec3 v) { return (uint(v.z) * uGridN + uint(v.y)) * uGridN + uint(v.x); }

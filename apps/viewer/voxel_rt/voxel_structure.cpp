@@ -69,6 +69,7 @@ void bind_segments(const GlProgram& p, const ResidentSegments& s, const VoxelGri
     glProgramUniform1ui(id, uniform(p, "uSegmentsPerSlot"), s.segments_per_slot);
     glProgramUniform1i(id, uniform(p, "uAllSegmentsValid"), s.scene ? 0 : 1);
     glProgramUniform1f(id, uniform(p, "uRadiusMm"), radius_mm);
+    glProgramUniform1i(id, uniform(p, "uFiberRadii"), s.fiber_radii && s.scene && s.scene->has_fiber_radii() ? 1 : 0);
 }
 
 VoxelStructure::VoxelStructure(const VoxelRtPrograms& p, const VoxelGrid& grid, const ResidentSegments& s,

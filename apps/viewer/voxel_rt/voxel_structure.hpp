@@ -29,6 +29,9 @@ struct ResidentSegments {
     const GpuScene* scene = nullptr;
     std::vector<GLuint> more_parts;
     std::uint32_t slots_per_part = 0;  // with more_parts
+    // Capsules of the scene's per-fiber radii instead of radius_mm (with a
+    // scene that has them).
+    bool fiber_radii = false;
 };
 
 struct BuildTimes {

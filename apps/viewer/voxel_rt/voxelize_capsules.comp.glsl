@@ -59,7 +59,7 @@ void main() {
     uint i = segmentFirstPoint(s);
     gSegment = s;
     gA = toGrid(vrtPoint(i)), gB = toGrid(vrtPoint(i + 1u));
-    gRadius = uRadiusMm / uVoxelMm;
+    gRadius = segmentRadiusMm(s) / uVoxelMm;
     gEffective = max(gRadius, 0.5);
     // Clip planes normal to the central-difference tangents at the joints
     // inside the slot.
