@@ -574,7 +574,8 @@ TEST(VoxelRtMemory, SegmentsSplitOverSeveralBuffersRenderTheSameImage) {
     struct Frame {
         std::vector<std::uint32_t> fibers;
         std::vector<std::uint8_t> rgba;
-        std::size_t parts;
+        std::size_t parts, fragment_parts;
+        std::uint64_t fragments;
         double decode_ms, draw_ms;
     };
     // The trace's time: the best of two frames after the one that builds.
@@ -587,8 +588,9 @@ TEST(VoxelRtMemory, SegmentsSplitOverSeveralBuffersRenderTheSameImage) {
         renderer.render(scene, cam, o, target);
         double best = 1e30;
         for (int k = 0; k < 2; ++k) best = std::min(best, renderer.render(scene, cam, o, target).draw_ms);
-        return Frame{target.read_fibers(), target.read_rgba(), renderer.voxel_ray_tracer().segment_parts(),
-                     renderer.voxel_ray_tracer().last_decode_ms(), best};
+        const auto& tracer = renderer.voxel_ray_tracer();
+        return Frame{target.read_fibers(), target.read_rgba(), tracer.segment_parts(), tracer.fragment_parts(),
+                     tracer.structure()->fragment_count(), tracer.last_decode_ms(), best};
     };
     // Five parts (the last one partly filled).
     const std::uint64_t part_bytes = total / 5 + slot_bytes;
@@ -604,7 +606,9 @@ TEST(VoxelRtMemory, SegmentsSplitOverSeveralBuffersRenderTheSameImage) {
         const int w = opacity < 1 ? 96 : 256, h = opacity < 1 ? 72 : 192;
         const Frame one = draw(0, o, w, h), split = draw(part_bytes, o, w, h);
         ASSERT_EQ(one.parts, 1u);
+        ASSERT_EQ(one.fragment_parts, 1u);
         ASSERT_EQ(split.parts, 5u);
+        ASSERT_GE(split.fragment_parts, 2u);
         std::size_t same = 0, hit = 0;
         for (std::size_t i = 0; i < one.fibers.size(); ++i) {
             bool eq = one.fibers[i] == split.fibers[i];
@@ -613,10 +617,12 @@ TEST(VoxelRtMemory, SegmentsSplitOverSeveralBuffersRenderTheSameImage) {
             hit += one.fibers[i] != 0;
         }
         const double rate = double(same) / double(one.fibers.size());
-        std::printf("opacity %.1f: %.2f MiB of segments in one buffer vs %zu buffers of %.2f MiB: %.5f of %zu pixels "
-                    "identical (%zu hit); decode %.1f / %.1f ms, trace %.1f / %.1f ms\n",
-                    double(opacity), double(total) / 1048576.0, split.parts, double(part_bytes) / 1048576.0, rate,
-                    one.fibers.size(), hit, one.decode_ms, split.decode_ms, one.draw_ms, split.draw_ms);
+        std::printf("opacity %.1f: %.2f MiB of segments and %.2f MiB of fragment lists in one buffer each vs %zu and "
+                    "%zu buffers of %.2f MiB: %.5f of %zu pixels identical (%zu hit); decode %.1f / %.1f ms, trace "
+                    "%.1f / %.1f ms\n",
+                    double(opacity), double(total) / 1048576.0, double(one.fragments) * 4 / 1048576.0, split.parts,
+                    split.fragment_parts, double(part_bytes) / 1048576.0, rate, one.fibers.size(), hit, one.decode_ms,
+                    split.decode_ms, one.draw_ms, split.draw_ms);
         EXPECT_GT(hit, std::size_t(w * h / 5));
         EXPECT_GE(rate, 0.999);
     }

@@ -33,7 +33,8 @@ void VoxelRayTracer::ensure_structure(const GpuScene& scene, const RenderOptions
     // The grid's margin: the largest capsule radius.
     const VoxelGrid grid =
         grid_around(scene.bounds(), o.voxel_grid, fiber_radii ? scene.max_fiber_radius() : o.tube_radius_mm);
-    structure_ = std::make_unique<VoxelStructure>(programs_, grid, segments_for(scene, o), o.tube_radius_mm, ao);
+    structure_ = std::make_unique<VoxelStructure>(programs_, grid, segments_for(scene, o), o.tube_radius_mm, ao,
+                                                  part_bytes_);
     built_grid_ = o.voxel_grid, built_radius_ = o.tube_radius_mm, built_fiber_radii_ = fiber_radii;
 }
 
@@ -72,7 +73,7 @@ void VoxelRayTracer::trace(const Camera& camera, const RenderOptions& o, RenderT
         glProgramUniform1i(id, uniform(p, "uSkipBlocks"), 0);
         // A binding must hold a buffer: the cells stand in for the pyramid.
     }
-    structure_->bind();
+    structure_->bind(&p);
     if (!cull) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kVisible, structure_->cells_buffer());
     const CameraBasis b = camera_basis(camera);
     glProgramUniform3f(id, uniform(p, "uCameraRight"), b.right.x, b.right.y, b.right.z);

@@ -46,12 +46,14 @@ public:
     // The culling of the last opaque frame with culling on (null before).
     const VoxelCulling* culling() const { return culling_.get(); }
     double last_decode_ms() const { return segments_ ? segments_->decode_ms() : 0; }
-    // The most bytes of one storage buffer of resident segments (0: the
-    // driver's largest; tests set a few MB to force the split over several
-    // buffers). Takes effect with the next scene built.
+    // The most bytes of one buffer of resident segments and of one buffer of
+    // fragment lists (0: the driver's largest storage buffer and buffer
+    // texture; tests set a few MB to force the split over several buffers).
+    // Takes effect with the next scene built.
     void set_segment_part_bytes(std::uint64_t bytes) { part_bytes_ = bytes, segments_.reset(); }
     // Storage buffers the resident segments of the last frame occupy.
     std::size_t segment_parts() const { return segments_ ? segments_->part_count() : 0; }
+    std::size_t fragment_parts() const { return structure_ ? structure_->fragment_parts() : 0; }
 
 private:
     void ensure_structure(const GpuScene& scene, const RenderOptions& options);
