@@ -18,8 +18,9 @@ inline constexpr unsigned kSolid = 26;      // culling: per voxel, eroded occupa
 inline constexpr unsigned kVisible = 27;    // culling: visibility pyramid, every level (finest first)
 // The resident segments split over several storage buffers (one buffer is
 // limited to GL_MAX_SHADER_STORAGE_BLOCK_SIZE: llvmpipe 128 MiB): part 0 at
-// kPoints, parts 1.. at kMorePoints + part - 1. Eight parts: the trace's
-// fragment shader then uses the 16 storage blocks llvmpipe offers a stage.
+// kPoints, parts 1.. at kMorePoints + part - 1. Eight parts: with them the
+// trace's fragment shader uses 15 of the 16 storage blocks llvmpipe (and
+// NVIDIA) offer a stage.
 inline constexpr unsigned kPointParts = 8;
 inline constexpr unsigned kMorePoints = 28;
 inline constexpr unsigned kHighest = kMorePoints + kPointParts - 2;
