@@ -108,7 +108,7 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
     cmd->add_flag("--shadows", a.shadows, "A shadow ray towards the light (--engine voxel-rt)");
     cmd->add_option("--fiber-radii", a.fiber_radii,
                     "Tube and capsule radius per streamline from a text file (mm, one per streamline, in file "
-                    "order), instead of --radius")
+                    "order), instead of --radius (also --engine voxel-rt)")
         ->check(CLI::ExistingFile);
     cmd->add_option("--opacity", a.opacity,
                     "Opacity of every streamline, in (0, 1]; below 1 they blend, ordered by --transparency "

@@ -35,7 +35,7 @@ const char* window_controls_help() {
            "  click: print the fiber under the cursor (ID, points, length)\n"
            "  R: reset view    S: screenshot (PNG)    C: culling on/off    L: level of detail on/off\n"
            "  D: colour by direction / fixed    I: lighting on/off    +/-: line width    T: lines / tubes / capsules\n"
-           "  H: help    Q, Esc: quit\n";
+           "  E: engine raster / voxel-rt    H: help    Q, Esc: quit\n";
 }
 
 namespace {
@@ -94,6 +94,10 @@ void on_key(GLFWwindow* w, int key, int, int action, int) {
             s.render.style = s.render.style == DrawStyle::lines   ? DrawStyle::tubes
                              : s.render.style == DrawStyle::tubes ? DrawStyle::capsules
                                                                   : DrawStyle::lines;
+            break;
+        case GLFW_KEY_E:
+            s.render.engine =
+                s.render.engine == RenderEngine::raster ? RenderEngine::voxel_rt : RenderEngine::raster;
             break;
         case GLFW_KEY_H: fmt::print("{}", window_controls_help()); break;
         default: return;
@@ -218,7 +222,18 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
         target.resize(fb_width, fb_height);
         const Camera camera = s.orbit.camera(float(fb_width) / float(fb_height));
         const auto t0 = std::chrono::steady_clock::now();
-        const FrameStats st = renderer.render(scene, camera, s.render, target);
+        FrameStats st;
+        try {
+            st = renderer.render(scene, camera, s.render, target);
+        } catch (const Error& e) {
+            // E on a scene the voxel ray tracer refuses (its buffers): say
+            // why and keep drawing with the rasterizer.
+            if (s.render.engine != RenderEngine::voxel_rt || e.code() != Errc::unsupported) throw;
+            fmt::print(stderr, "{}; back to --engine raster\n", e.what());
+            s.render.engine = RenderEngine::raster;
+            s.dirty = true;
+            continue;
+        }
         const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
         glNamedFramebufferReadBuffer(target.framebuffer(), GL_COLOR_ATTACHMENT0);
@@ -230,7 +245,9 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
             w, fmt::format("{} | {:.1f} ms (GPU cull {:.1f} decode {:.1f} draw {:.1f}) | {} blocks ({} coarse), {} "
                            "segments | {} | culling {} LoD {}",
                            title, frame_ms, st.cull_ms, st.decode_ms, st.draw_ms, st.drawn_blocks(), st.coarse_blocks,
-                           st.drawn_segments(), draw_style_name(s.render.style), s.render.frustum_culling ? "on" : "off",
+                           st.drawn_segments(),
+                           s.render.engine == RenderEngine::voxel_rt ? "voxel-rt" : draw_style_name(s.render.style),
+                           s.render.frustum_culling ? "on" : "off",
                            s.render.level_of_detail ? "on" : "off")
                    .c_str());
 
