@@ -8,7 +8,9 @@
 #if defined(__GNUC__) && defined(__x86_64__)
 #include <immintrin.h>
 #endif
+#ifdef __SSE2__
 #include <emmintrin.h>
+#endif
 
 namespace fiblet {
 
@@ -25,6 +27,16 @@ double distance(Vec3f a, Vec3f b) {
 // loop. The polyline's length comes with them (the same double arithmetic
 // and order as polyline_length).
 constexpr std::size_t kLanes = 8;
+
+// v[i] = sqrt(v[i]), two at a time where SSE2 is there (sqrtpd rounds
+// correctly, as std::sqrt does).
+void sqrt_all(double* v, std::size_t n) {
+    std::size_t i = 0;
+#ifdef __SSE2__
+    for (; i + 2 <= n; i += 2) _mm_storeu_pd(v + i, _mm_sqrt_pd(_mm_loadu_pd(v + i)));
+#endif
+    for (; i < n; ++i) v[i] = std::sqrt(v[i]);
+}
 
 struct Segments {
     std::vector<double> ax, ay, az, ux, uy, uz, inv_uu, len;
@@ -52,10 +64,8 @@ void segments_of(std::span<const Vec3f> line, Segments& out) {
     // The segments' lengths: square roots two at a time (correctly rounded,
     // as std::sqrt), summed in order.
     if (line.size() > 1) {
-        std::size_t s = 0;
-        for (; s + 2 <= n; s += 2) _mm_storeu_pd(&out.len[s], _mm_sqrt_pd(_mm_loadu_pd(&out.len[s])));
-        for (; s < n; ++s) out.len[s] = std::sqrt(out.len[s]);
-        for (s = 0; s < n; ++s) length += out.len[s];
+        sqrt_all(out.len.data(), n);
+        for (std::size_t s = 0; s < n; ++s) length += out.len[s];
     }
     out.length = length;
 }
@@ -161,9 +171,7 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
     }
     // Square roots two at a time (correctly rounded, as std::sqrt), then
     // the statistics in order.
-    std::size_t k = 0;
-    for (; k + 2 <= nearest.size(); k += 2) _mm_storeu_pd(&nearest[k], _mm_sqrt_pd(_mm_loadu_pd(&nearest[k])));
-    for (; k < nearest.size(); ++k) nearest[k] = std::sqrt(nearest[k]);
+    sqrt_all(nearest.data(), nearest.size());
     out.add_all(nearest.data(), nearest.size(), fiber);
     return g.length;
 }
