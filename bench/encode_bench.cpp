@@ -4,6 +4,8 @@
 //
 //   build/bench/fiblet_bench --benchmark_filter=Encode
 //
+// BM_EncodeMetrics: the symmetric error report alone (GeometryError).
+//
 // Input: FIBLET_BENCH_TCK (default ../shared/data/small-ifod1.tck).
 #include <benchmark/benchmark.h>
 
@@ -15,6 +17,7 @@
 
 #include "fiblet/compress.hpp"
 #include "fiblet/encode.hpp"
+#include "fiblet/geometry_error.hpp"
 #include "fiblet/tck.hpp"
 
 namespace {
@@ -71,6 +74,24 @@ BENCHMARK(BM_EncodeSearch)
     ->Args({16, 0})
     ->Args({16, 1})
     ->Unit(benchmark::kMillisecond);
+
+// The symmetric error report compress computes on every point (both ways
+// against the polylines, endpoints, lengths), on the default effort's decoded
+// fibers, one thread: the share of the pipeline that is not the code search.
+void BM_EncodeMetrics(benchmark::State& state) {
+    const Input& in = input(8, 1);
+    const fiblet::FiberEncoder encoder(in.report.header, in.report.search);
+    std::vector<std::vector<fiblet::Vec3f>> decoded(in.fibers.size());
+    std::vector<std::uint8_t> blocks;
+    for (std::size_t i = 0; i < in.fibers.size(); ++i) encoder.encode(in.fibers[i], std::uint32_t(i), blocks, &decoded[i]);
+    for (auto _ : state) {
+        fiblet::GeometryError g;
+        for (std::size_t i = 0; i < in.fibers.size(); ++i) g.add_fiber(in.fibers[i], decoded[i], i);
+        benchmark::DoNotOptimize(g.hausdorff_mm());
+    }
+    state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(in.points));
+}
+BENCHMARK(BM_EncodeMetrics)->Unit(benchmark::kMillisecond);
 
 // The whole pipeline (.tck on disk -> .fft on disk), one thread.
 void BM_EncodePipeline(benchmark::State& state) {

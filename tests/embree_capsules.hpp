@@ -42,7 +42,8 @@ public:
         unsigned segment;  // block × points_per_block + index in the block (the viewer's numbering)
     };
 
-    EmbreeCapsules(const FftFile& file, float radius) {
+    // fiber_radii: per fiber (file order), instead of radius (--fiber-radii).
+    EmbreeCapsules(const FftFile& file, float radius, const std::vector<float>& fiber_radii = {}) {
         d_ = cpu_decode_blocks(file);
         const CpuDecoded& d = d_;
         device_ = rtcNewDevice(nullptr);
@@ -60,6 +61,9 @@ public:
         const std::uint32_t ppb = file.header().points_per_block;
         for (std::uint64_t f = 0; f < file.header().fibers; ++f) {
             const std::uint64_t first = file.first_block(f), count = file.block_count(f);
+            if (!fiber_radii.empty())
+                for (std::size_t i = d.block_first[first]; i < d.block_first[first + count]; ++i)
+                    v[4 * i + 3] = fiber_radii[f];
             for (std::uint64_t b = first; b < first + count; ++b)
                 for (std::size_t i = d.block_first[b]; i < d.block_first[b + 1]; ++i) {
                     if (i + 1 >= d.block_first[first + count]) break;

@@ -272,7 +272,7 @@ TEST(EncodeStress, StepJitterOf15Percent) {
     const double coord = max_abs(fibers);
     for (std::size_t i = 0; i < fibers.size(); ++i) {
         std::vector<Vec3f> resampled;
-        resample_keeping_end(fibers[i], r.step_mm, resampled);
+        resample_keeping_end(fibers[i], *file.resampling(), resampled);
         ASSERT_EQ(resampled.size(), s.offsets[i + 1] - s.offsets[i]);
         const auto bound = test::error_bounds(resampled, r.header.points_per_block, bound_params(r.header, r.search, coord));
         for (std::size_t k = 0; k < resampled.size(); ++k) {

@@ -40,7 +40,7 @@ struct ExactMeasurement {
 inline const std::vector<Vec3f>& target_points(const std::vector<Vec3f>& input, const Resampling& resampling,
                                                std::vector<Vec3f>& scratch) {
     if (!(resampling.step_mm > 0)) return input;
-    resample_fixed_step(input, resampling.step_mm, scratch, resampling.curve);
+    resample_fixed_step(input, resampling, scratch);
     return scratch;
 }
 
@@ -64,6 +64,8 @@ inline ExactMeasurement measure_exact(const std::string& fft_path, const std::st
     if (rsmp.size() >= 8) std::memcpy(&resampling.step_mm, rsmp.data(), 8);
     if (rsmp.size() == 16) std::memcpy(&resampling.curve, rsmp.data() + 8, 4);
     m.resampled = resampling.step_mm > 0;
+    // Curve 2's tension allows for the decoder's step over the resampling step.
+    if (m.resampled) resampling.stretch = decoder_stretch(dec.header.step, dec.header.scaling, resampling.step_mm);
 
     FftFile file(fft_path);
     DecodeOptions options;

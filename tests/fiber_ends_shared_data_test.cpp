@@ -75,7 +75,7 @@ TEST(FiberEndsSharedData, EndpointsAndLengthsMatchTheInput) {
             len_max = std::max(len_max, std::fabs(length_of(p, n) - li));
             len_change_sum += length_of(p, n) - li, len_abs_sum += std::fabs(length_of(p, n) - li), ++measured;
             input_len_sum += li;
-            if (r.resampled) resample_keeping_end(f, r.step_mm, target);
+            if (r.resampled) resample_keeping_end(f, *file.resampling(), target);
             else target = f;
             const double lt = length_of(&target[0].x, target.size());
             target_len_max = std::max(target_len_max, std::fabs(length_of(p, n) - lt) - 1e-3 * lt);
@@ -114,7 +114,7 @@ double mean_target_length(const std::string& tck, const std::string& fft) {
     double sum = 0;
     std::size_t n = 0;
     while (in.next(f)) {
-        if (resampling) resample_keeping_end(f, resampling->step_mm, target, resampling->curve);
+        if (resampling) resample_keeping_end(f, *resampling, target);
         else target = f;
         if (!target.empty()) sum += length_of(&target[0].x, target.size());
         ++n;

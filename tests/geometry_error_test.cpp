@@ -150,5 +150,25 @@ TEST(GeometryError, MergeEqualsOneAccumulator) {
     EXPECT_NEAR(a.length_change_mm().mean(), all.length_change_mm().mean(), 1e-15);
 }
 
+
+// Fixed-step pairs (as many decoded points as input points: the path that
+// evaluates a window ahead of the hint), from 1 to 400 points, with repeated
+// points (zero-length segments) and decoded points about 1 to 30 µm off (codec errors; the window is a
+// heuristic: decoded points half a step off can miss the nearest segment).
+TEST(GeometryError, MatchesBruteForceOnFixedStepPairs) {
+    std::mt19937 rng(17);
+    std::vector<std::pair<Line, Line>> pairs;
+    for (int k = 0; k < 40; ++k) {
+        const int n = k < 8 ? k + 1 : 30 + 9 * k;
+        Line in = curve(n, 0.1, k % 5 == 0 ? 2.0 : 0, rng, 0);
+        if (n > 6) in[n / 2] = in[n / 2 - 1];  // a zero-length segment
+        std::normal_distribution<double> e(0, k % 3 == 0 ? 0.01 : 0.002);
+        Line dec = in;
+        for (Vec3f& p : dec) p = {float(p.x + e(rng)), float(p.y + e(rng)), float(p.z + e(rng))};
+        pairs.emplace_back(in, dec);
+    }
+    expect_matches_brute(pairs);
+}
+
 }  // namespace
 }  // namespace fiblet

@@ -52,6 +52,39 @@ TEST(ViewerPicking, KnownFibersSeenFromAbove) {
     EXPECT_FALSE(viewer::pick_fiber(target, scene, 199, 159, 2).has_value());
 }
 
+// A transparent frame leaves no fiber indices: pick_fiber_in_frame draws it
+// opaque to pick from (issue 16).
+TEST(ViewerPicking, PicksUnderATransparentFrame) {
+    FIBLET_REQUIRE_GL();
+    std::vector<std::vector<Vec3f>> fibers;
+    for (int k = 0; k < 4; ++k) {
+        std::vector<Vec3f> f;
+        for (int i = 0; i < 200; ++i) f.push_back({-10 + 0.1f * float(i), -12 + 8 * float(k), 0.5f * float(k)});
+        fibers.push_back(f);
+    }
+    const TempDir dir;
+    write_tck(dir.file("lines.tck"), fibers);
+    const FftFile file(compress_into(dir, dir.file("lines.tck"), "lines.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    viewer::Renderer renderer(*viewer_gl().programs);
+    viewer::RenderTarget target(200, 160);
+    const Camera cam = viewer::camera_from_spec("top", scene, 200.0f / 160.0f, 35, 1);
+    for (const auto style : {viewer::DrawStyle::lines, viewer::DrawStyle::capsules}) {
+        viewer::RenderOptions o;
+        o.style = style;
+        o.opacity = 0.3f;
+        const Mat4 vp = view_projection_matrix(cam);
+        for (std::size_t k = 0; k < fibers.size(); ++k) {
+            renderer.render(scene, cam, o, target);
+            const Projected p = to_window(clip_of(vp, fibers[k][100]), 200, 160);
+            EXPECT_FALSE(viewer::pick_fiber(target, scene, int(p.x), int(p.y), 2).has_value()) << "no indices";
+            const auto picked = viewer::pick_fiber_in_frame(renderer, scene, cam, o, target, int(p.x), int(p.y), 2);
+            ASSERT_TRUE(picked.has_value()) << viewer::draw_style_name(style) << " fiber " << k;
+            EXPECT_EQ(picked->index, k);
+        }
+    }
+}
+
 TEST(ViewerPicking, PickedFiberPassesThroughThePixel) {
     FIBLET_REQUIRE_GL();
     const FftFile file(shared_data("reference/small-sdstream.fft"));

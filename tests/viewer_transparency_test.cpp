@@ -29,6 +29,7 @@ constexpr int kSize = 256;
 
 struct Segment {
     Vec3f p0, p1;
+    std::uint32_t fiber;  // index in the file
 };
 
 // Every segment of every fiber, as the CPU reference decoder gives the
@@ -39,7 +40,8 @@ std::vector<Segment> decoded_segments(const FftFile& file, const viewer::GpuScen
     std::size_t point = 0;
     for (std::uint64_t f = 0; f < scene.fiber_count(); ++f) {
         const std::uint32_t n = scene.fiber_points(f);
-        for (std::uint32_t k = 0; k + 1 < n; ++k) out.push_back({d.point(point + k), d.point(point + k + 1)});
+        for (std::uint32_t k = 0; k + 1 < n; ++k)
+            out.push_back({d.point(point + k), d.point(point + k + 1), std::uint32_t(f)});
         point += n;
     }
     return out;
@@ -65,16 +67,19 @@ bool exits_diamond(float ax, float ay, float bx, float by, float cx, float cy) {
 struct Fragment {
     double depth;
     float r, g, b;
+    double alpha;
 };
 
 // The exact composite (RGBA8, rows from the top as RenderTarget::read_rgba)
 // and the number of fragments of each pixel; colour by direction, no
-// lighting, black background.
+// lighting, black background. With `fiber_alpha` (one per fiber) a fragment
+// blends with opacity x its fiber's (the GPU's float product, fiber_colors.glsl).
 struct Reference {
     std::vector<std::uint8_t> rgba;
     std::vector<std::uint32_t> fragments;
 };
-Reference exact_reference(const std::vector<Segment>& segments, const Camera& cam, double opacity) {
+Reference exact_reference(const std::vector<Segment>& segments, const Camera& cam, double opacity,
+                          const std::vector<float>* fiber_alpha = nullptr) {
     const Mat4 vp = view_projection_matrix(cam);
     const Vec3f forward = [&] {
         const Vec3f d{cam.target.x - cam.position.x, cam.target.y - cam.position.y, cam.target.z - cam.position.z};
@@ -94,7 +99,8 @@ Reference exact_reference(const std::vector<Segment>& segments, const Camera& ca
         const Vec3f mid{(s.p0.x + s.p1.x) / 2, (s.p0.y + s.p1.y) / 2, (s.p0.z + s.p1.z) / 2};
         const double depth = double(mid.x - cam.position.x) * forward.x + double(mid.y - cam.position.y) * forward.y +
                              double(mid.z - cam.position.z) * forward.z;
-        const Fragment f{depth, std::fabs(dx / len), std::fabs(dy / len), std::fabs(dz / len)};
+        const double alpha = fiber_alpha ? double(float(opacity) * (*fiber_alpha)[s.fiber]) : opacity;
+        const Fragment f{depth, std::fabs(dx / len), std::fabs(dy / len), std::fabs(dz / len), alpha};
         const int x0 = std::max(0, int(std::floor(std::min(ax, bx) - 1))), x1 = std::min(kSize - 1, int(std::max(ax, bx) + 1));
         const int y0 = std::max(0, int(std::floor(std::min(ay, by) - 1))), y1 = std::min(kSize - 1, int(std::max(ay, by) + 1));
         for (int y = y0; y <= y1; ++y)
@@ -109,7 +115,7 @@ Reference exact_reference(const std::vector<Segment>& segments, const Camera& ca
         double c[3] = {0, 0, 0};
         for (const Fragment& f : frags) {
             const float rgb[3] = {f.r, f.g, f.b};
-            for (int k = 0; k < 3; ++k) c[k] = opacity * rgb[k] + (1 - opacity) * c[k];
+            for (int k = 0; k < 3; ++k) c[k] = f.alpha * rgb[k] + (1 - f.alpha) * c[k];
         }
         for (int k = 0; k < 3; ++k) ref.rgba[4 * i + std::size_t(k)] = std::uint8_t(std::lround(std::clamp(c[k], 0.0, 1.0) * 255));
         ref.fragments[i] = std::uint32_t(frags.size());
@@ -266,6 +272,23 @@ void print_table_header() {
                 "max", "vs unsorted");
 }
 
+// One row per mode (kModes' order) of the table; with `check`, the issue's
+// bounds for the ordered modes.
+void report_modes(const std::string& name, float alpha, const ImageError (&errors)[3], bool check) {
+    const ImageError& unsorted = errors[2];
+    for (int m = 0; m < 3; ++m) {
+        const ImageError& e = errors[m];
+        std::printf("%-22s %5.2f %-9s %11.3f %13.3f %8d %10.3f\n", name.c_str(), alpha,
+                    viewer::transparency_mode_name(kModes[m]), e.mean, 100 * e.share_over_8, e.max,
+                    unsorted.mean > 0 ? e.mean / unsorted.mean : 0.0);
+        if (!check || kModes[m] == viewer::TransparencyMode::unsorted) continue;
+        SCOPED_TRACE(name + " " + viewer::transparency_mode_name(kModes[m]) + " alpha " + std::to_string(alpha));
+        EXPECT_LE(e.mean, 1.0);
+        EXPECT_LE(e.share_over_8, 0.01);
+        EXPECT_LE(e.mean, 0.25 * unsorted.mean);
+    }
+}
+
 // Every mode against the exact reference at both opacities, printed; with
 // `check`, the bounds for the ordered modes.
 void compare_modes(const TempDir& dir, const BundleCase& bundle, bool check) {
@@ -279,19 +302,7 @@ void compare_modes(const TempDir& dir, const BundleCase& bundle, bool check) {
         const Reference ref = exact_reference(segments, cam, alpha);
         ImageError errors[3];
         for (int m = 0; m < 3; ++m) errors[m] = image_error(render(scene, cam, transparent_options(kModes[m], alpha)), ref);
-        const ImageError& unsorted = errors[2];
-        for (int m = 0; m < 3; ++m) {
-            const ImageError& e = errors[m];
-            std::printf("%-22s %5.2f %-9s %11.3f %13.3f %8d %10.3f\n", bundle.name, alpha,
-                        viewer::transparency_mode_name(kModes[m]), e.mean, 100 * e.share_over_8, e.max,
-                        unsorted.mean > 0 ? e.mean / unsorted.mean : 0.0);
-            if (!check || kModes[m] == viewer::TransparencyMode::unsorted) continue;
-            SCOPED_TRACE(std::string(bundle.name) + " " + viewer::transparency_mode_name(kModes[m]) + " alpha " +
-                         std::to_string(alpha));
-            EXPECT_LE(e.mean, 1.0);
-            EXPECT_LE(e.share_over_8, 0.01);
-            EXPECT_LE(e.mean, 0.25 * unsorted.mean);
-        }
+        report_modes(bundle.name, alpha, errors, check);
     }
 }
 
@@ -312,6 +323,292 @@ TEST(ViewerTransparency, DISABLED_WholeSmallIfod1Table) {
     const TempDir dir;
     print_table_header();
     compare_modes(dir, {"small-ifod1", read_tck_fibers(shared_data("small-ifod1.tck"))}, false);
+}
+
+// Per-fiber opacities (--fiber-opacity): random ones in [0, 1] on a shared
+// bundle, times a global opacity; the reference blends every fragment with
+// its fiber's product. The ordered modes meet the bounds.
+TEST(ViewerTransparency, PerFiberOpacityMatchesTheExactReference) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    write_tck(dir.file("b.tck"), read_tck_fibers(std::string(FIBLET_SHARED_DIR) + "/data/bundles/AF_L-step0.1.tck"));
+    const FftFile file(compress_into(dir, dir.file("b.tck"), "b.fft"));
+    viewer::GpuScene scene(file, *viewer_gl().programs);
+    ASSERT_GT(scene.fiber_count(), 10u);
+    std::mt19937 rng(1616);
+    std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+    std::vector<float> alpha(scene.fiber_count());
+    for (float& a : alpha) a = uniform(rng);
+    scene.set_fiber_opacities(alpha);
+    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 1);
+    const std::vector<Segment> segments = decoded_segments(file, scene);
+    print_table_header();
+    for (const float global : {0.2f, 1.0f}) {
+        const Reference ref = exact_reference(segments, cam, global, &alpha);
+        ImageError errors[3];
+        for (int m = 0; m < 3; ++m) {
+            auto o = transparent_options(kModes[m], global);
+            o.fiber_opacity = true;
+            errors[m] = image_error(render(scene, cam, o), ref);
+        }
+        report_modes("AF_L-step0.1 x U(0,1)", global, errors, true);
+    }
+}
+
+TEST(ViewerTransparency, AFiberOfOpacityZeroDisappears) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const auto fibers = read_tck_fibers(std::string(FIBLET_SHARED_DIR) + "/data/bundles/AF_L-step0.1.tck");
+    ASSERT_GT(fibers.size(), 10u);
+    write_tck(dir.file("b.tck"), fibers);
+    const FftFile file(compress_into(dir, dir.file("b.tck"), "b.fft"));
+    viewer::GpuScene scene(file, *viewer_gl().programs);
+    const std::uint64_t last = scene.fiber_count() - 1;
+    ASSERT_EQ(scene.fiber_id(last), last);
+    std::vector<float> alpha(scene.fiber_count(), 1.0f);
+    alpha[last] = 0;
+    scene.set_fiber_opacities(alpha);
+    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 1);
+    const std::vector<Segment> segments = decoded_segments(file, scene);
+    std::vector<Segment> others, gone;
+    for (const Segment& seg : segments) (seg.fiber == last ? gone : others).push_back(seg);
+    const Reference without = exact_reference(others, cam, 0.3), only = exact_reference(gone, cam, 0.3);
+    for (const auto mode : kModes) {
+        SCOPED_TRACE(viewer::transparency_mode_name(mode));
+        auto o = transparent_options(mode, 0.3f);
+        o.fiber_opacity = true;
+        const auto image = render(scene, cam, o);
+        // Every pixel the fiber alone covers stays background.
+        std::size_t its_own = 0, lit = 0;
+        for (std::size_t i = 0; i < only.fragments.size(); ++i)
+            if (only.fragments[i] > 0 && without.fragments[i] == 0) {
+                ++its_own;
+                lit += image[4 * i] || image[4 * i + 1] || image[4 * i + 2];
+            }
+        EXPECT_GT(its_own, 20u);
+        EXPECT_EQ(lit, 0u);
+        const ImageError e = image_error(image, without);
+        std::printf("last fiber at opacity 0, %-8s: %zu of its own pixels lit of %zu; against the reference without "
+                    "it mean %.3f/255, %.3f %% above 8/255\n",
+                    viewer::transparency_mode_name(mode), lit, its_own, e.mean, 100 * e.share_over_8);
+        if (mode == viewer::TransparencyMode::unsorted) continue;
+        EXPECT_LE(e.mean, 1.0);
+        EXPECT_LE(e.share_over_8, 0.01);
+        if (mode != viewer::TransparencyMode::sorted) continue;
+        // Sorted keys chunks by block and the scene's box: leaving the fiber
+        // out by ID blends the same fragments in the same order.
+        auto subset = transparent_options(mode, 0.3f);
+        subset.id_max = std::uint32_t(last - 1);
+        EXPECT_EQ(image, render(scene, cam, subset));
+    }
+}
+
+TEST(ViewerTransparency, FiberOpacitiesOfOneAreTheGlobalOpacity) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    auto fibers = read_tck_fibers(std::string(FIBLET_SHARED_DIR) + "/data/small-sdstream.tck");
+    fibers.resize(300);
+    write_tck(dir.file("s.tck"), fibers);
+    const FftFile file(compress_into(dir, dir.file("s.tck"), "s.fft"));
+    viewer::GpuScene scene(file, *viewer_gl().programs);
+    scene.set_fiber_opacities(std::vector<float>(scene.fiber_count(), 1.0f));
+    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 1);
+    for (const auto mode : kModes) {
+        auto o = transparent_options(mode, 0.2f);
+        o.lighting = true;
+        o.frustum_culling = mode != viewer::TransparencyMode::unsorted;  // as TwoRendersAreByteIdentical
+        auto per_fiber = o;
+        per_fiber.fiber_opacity = true;
+        EXPECT_EQ(render(scene, cam, per_fiber), render(scene, cam, o)) << viewer::transparency_mode_name(mode);
+    }
+    EXPECT_THROW(scene.set_fiber_opacities({0.5f}), Error);
+    std::vector<float> bad(scene.fiber_count(), 0.5f);
+    bad[7] = 1.5f;
+    EXPECT_THROW(scene.set_fiber_opacities(bad), Error);
+}
+
+namespace {
+
+// The unit ray through the centre of pixel (x, y) (rows from the top) of
+// view.hpp's camera (as tests/embree_capsules.hpp's pixel_ray).
+std::array<double, 3> pixel_ray(const Camera& cam, int x, int y, int w, int h) {
+    auto unit = [](double a, double b, double c) {
+        const double n = std::sqrt(a * a + b * b + c * c);
+        return std::array<double, 3>{a / n, b / n, c / n};
+    };
+    const auto fwd = unit(cam.target.x - cam.position.x, cam.target.y - cam.position.y, cam.target.z - cam.position.z);
+    const auto right = unit(fwd[1] * cam.up.z - fwd[2] * cam.up.y, fwd[2] * cam.up.x - fwd[0] * cam.up.z,
+                            fwd[0] * cam.up.y - fwd[1] * cam.up.x);
+    const std::array<double, 3> up{right[1] * fwd[2] - right[2] * fwd[1], right[2] * fwd[0] - right[0] * fwd[2],
+                                   right[0] * fwd[1] - right[1] * fwd[0]};
+    const double t = std::tan(double(cam.fov_y_deg) * M_PI / 360.0);
+    const double nx = (x + 0.5) / w * 2 - 1, ny = 1 - (y + 0.5) / h * 2;
+    return unit(fwd[0] + nx * t * cam.aspect * right[0] + ny * t * up[0],
+                fwd[1] + nx * t * cam.aspect * right[1] + ny * t * up[1],
+                fwd[2] + nx * t * cam.aspect * right[2] + ny * t * up[2]);
+}
+
+// Entry distance of the unit ray (o, d) into the capsule of segment a-b and
+// radius r (the union of the cylinder between the end planes and the two
+// end spheres, as capsules.frag.glsl), or infinity; double precision.
+double capsule_entry(const std::array<double, 3>& o, const std::array<double, 3>& d, Vec3f pa, Vec3f pb, double r) {
+    using V = std::array<double, 3>;
+    auto dot3 = [](const V& u, const V& v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; };
+    const V a{pa.x, pa.y, pa.z}, b{pb.x, pb.y, pb.z};
+    const V ba{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, oa{o[0] - a[0], o[1] - a[1], o[2] - a[2]};
+    double best = INFINITY;
+    const double baba = dot3(ba, ba), bard = dot3(ba, d), baoa = dot3(ba, oa);
+    const double qa = baba - bard * bard;
+    if (qa > 1e-12 * baba) {
+        const double qb = baba * dot3(d, oa) - baoa * bard, qc = baba * dot3(oa, oa) - baoa * baoa - r * r * baba;
+        const double h = qb * qb - qa * qc;
+        if (h >= 0) {
+            const double t = (-qb - std::sqrt(h)) / qa, y = baoa + t * bard;
+            if (y > 0 && y < baba && t > 0) best = t;
+        }
+    }
+    for (const V& c : {a, b}) {
+        const V oc{o[0] - c[0], o[1] - c[1], o[2] - c[2]};
+        const double bb = dot3(d, oc), h = bb * bb - (dot3(oc, oc) - r * r);
+        if (h >= 0 && -bb - std::sqrt(h) > 0) best = std::min(best, -bb - std::sqrt(h));
+    }
+    return best;
+}
+
+// The exact composite of what the capsules style blends: every capsule's
+// entry on each pixel's ray (one per capsule, as its box's front faces give
+// one fragment), sorted back to front; colour by direction, no lighting.
+Reference capsule_reference(const std::vector<Segment>& segments, const Camera& cam, double radius, double opacity) {
+    const Mat4 vp = view_projection_matrix(cam);
+    const Vec3f eye = cam.position;
+    const std::array<double, 3> o{eye.x, eye.y, eye.z};
+    std::vector<std::vector<Fragment>> pixels(std::size_t(kSize) * kSize);
+    for (const Segment& s : segments) {
+        const float dx = s.p1.x - s.p0.x, dy = s.p1.y - s.p0.y, dz = s.p1.z - s.p0.z;
+        const float len = std::sqrt(dx * dx + dy * dy + dz * dz);
+        if (!(len > 0)) continue;
+        // The pixels of the capsule's box on screen (rows from the top), a pixel more.
+        float lo_x = INFINITY, hi_x = -INFINITY, lo_y = INFINITY, hi_y = -INFINITY;
+        bool behind = false;
+        for (int corner = 0; corner < 8; ++corner) {
+            const float r = float(radius);
+            const Vec3f p{(corner & 1 ? std::max(s.p0.x, s.p1.x) + r : std::min(s.p0.x, s.p1.x) - r),
+                          (corner & 2 ? std::max(s.p0.y, s.p1.y) + r : std::min(s.p0.y, s.p1.y) - r),
+                          (corner & 4 ? std::max(s.p0.z, s.p1.z) + r : std::min(s.p0.z, s.p1.z) - r)};
+            const auto c = clip_of(vp, p);
+            if (c[3] <= 0) behind = true;
+            const float x = (c[0] / c[3] * 0.5f + 0.5f) * float(kSize), y = (0.5f - c[1] / c[3] * 0.5f) * float(kSize);
+            lo_x = std::min(lo_x, x), hi_x = std::max(hi_x, x), lo_y = std::min(lo_y, y), hi_y = std::max(hi_y, y);
+        }
+        if (behind) continue;
+        const Fragment f{0, std::fabs(dx / len), std::fabs(dy / len), std::fabs(dz / len), opacity};
+        for (int y = std::max(0, int(lo_y) - 1); y <= std::min(kSize - 1, int(hi_y) + 1); ++y)
+            for (int x = std::max(0, int(lo_x) - 1); x <= std::min(kSize - 1, int(hi_x) + 1); ++x) {
+                const double t = capsule_entry(o, pixel_ray(cam, x, y, kSize, kSize), s.p0, s.p1, radius);
+                if (!std::isfinite(t)) continue;
+                Fragment g = f;
+                g.depth = t;
+                pixels[std::size_t(y) * kSize + std::size_t(x)].push_back(g);
+            }
+    }
+    Reference ref{std::vector<std::uint8_t>(pixels.size() * 4, 255), std::vector<std::uint32_t>(pixels.size())};
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+        auto& frags = pixels[i];
+        std::stable_sort(frags.begin(), frags.end(), [](const Fragment& a, const Fragment& b) { return a.depth > b.depth; });
+        double c[3] = {0, 0, 0};
+        for (const Fragment& f : frags) {
+            const float rgb[3] = {f.r, f.g, f.b};
+            for (int k = 0; k < 3; ++k) c[k] = f.alpha * rgb[k] + (1 - f.alpha) * c[k];
+        }
+        for (int k = 0; k < 3; ++k) ref.rgba[4 * i + std::size_t(k)] = std::uint8_t(std::lround(std::clamp(c[k], 0.0, 1.0) * 255));
+        ref.fragments[i] = std::uint32_t(frags.size());
+    }
+    return ref;
+}
+
+}  // namespace
+
+// Sorted chunks through the ray-cast styles: three layers 10 mm apart
+// written nearest first, drawn sorted, against the same layers written
+// farthest first and blended unsorted in file order (the right order:
+// tubes of a layer do not overlap, and a fiber's overlapping pieces have
+// one colour).
+TEST(ViewerTransparency, SortedTubesAndCapsulesBlendBackToFront) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    auto fibers = separated_layers();
+    write_tck(dir.file("near.tck"), fibers);
+    std::reverse(fibers.begin(), fibers.end());
+    write_tck(dir.file("far.tck"), fibers);
+    const FftFile near_first(compress_into(dir, dir.file("near.tck"), "near.fft"));
+    const FftFile far_first(compress_into(dir, dir.file("far.tck"), "far.fft"));
+    const viewer::GpuScene near_scene(near_first, *viewer_gl().programs), far_scene(far_first, *viewer_gl().programs);
+    const Camera cam = frontal_camera();
+    for (const auto style : {viewer::DrawStyle::tubes, viewer::DrawStyle::capsules}) {
+        SCOPED_TRACE(viewer::draw_style_name(style));
+        auto o = transparent_options(viewer::TransparencyMode::sorted, 0.3f);
+        o.style = style;
+        o.tube_radius_mm = 0.3f;
+        auto right = o;
+        right.transparency = viewer::TransparencyMode::unsorted;
+        right.frustum_culling = false;  // file order
+        const auto expected = render(far_scene, cam, right);
+        const auto sorted = render(near_scene, cam, o);
+        auto wrong = right;
+        const auto unsorted = render(near_scene, cam, wrong);
+        int sorted_max = 0, unsorted_max = 0;
+        std::size_t lit = 0;
+        for (std::size_t i = 0; i < expected.size(); ++i) {
+            sorted_max = std::max(sorted_max, std::abs(int(sorted[i]) - int(expected[i])));
+            unsorted_max = std::max(unsorted_max, std::abs(int(unsorted[i]) - int(expected[i])));
+            lit += i % 4 == 0 && (expected[i] || expected[i + 1] || expected[i + 2]);
+        }
+        std::printf("separated layers, %-8s: sorted (nearest first) vs back to front: max %d/255; unsorted %d/255; "
+                    "%zu pixels lit\n",
+                    viewer::draw_style_name(style), sorted_max, unsorted_max, lit);
+        EXPECT_GT(lit, 5000u);
+        EXPECT_LE(sorted_max, 2);
+        EXPECT_GT(unsorted_max, 8);
+        EXPECT_EQ(sorted, render(near_scene, cam, o)) << "two sorted renders differ";
+    }
+}
+
+// Sorted capsules on a real bundle against the exact composite of every
+// capsule entry (capsule_reference).
+TEST(ViewerTransparency, SortedCapsulesMatchTheExactReference) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    write_tck(dir.file("b.tck"), read_tck_fibers(std::string(FIBLET_SHARED_DIR) + "/data/bundles/AF_L-step0.1.tck"));
+    const FftFile file(compress_into(dir, dir.file("b.tck"), "b.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 1);
+    const std::vector<Segment> segments = decoded_segments(file, scene);
+    constexpr float kRadius = 0.3f;
+    print_table_header();
+    for (const float alpha : {0.05f, 0.2f}) {
+        const Reference ref = capsule_reference(segments, cam, kRadius, alpha);
+        ImageError errors[3];
+        for (int m = 0; m < 3; ++m) {
+            if (kModes[m] == viewer::TransparencyMode::voxlines) continue;  // lines only
+            auto o = transparent_options(kModes[m], alpha);
+            o.style = viewer::DrawStyle::capsules;
+            o.tube_radius_mm = kRadius;
+            errors[m] = image_error(render(scene, cam, o), ref);
+        }
+        const ImageError &sorted = errors[0], &unsorted = errors[2];
+        for (const int m : {0, 2})
+            std::printf("%-22s %5.2f %-9s %11.3f %13.3f %8d %10.3f\n", "AF_L capsules r 0.3", alpha,
+                        viewer::transparency_mode_name(kModes[m]), errors[m].mean, 100 * errors[m].share_over_8,
+                        errors[m].max, unsorted.mean > 0 ? errors[m].mean / unsorted.mean : 0.0);
+        // Measured (llvmpipe): 0.28 / 0.017 % at alpha 0.05 (the line
+        // bounds), 1.22 / 1.7 % at 0.2: tubes 0.6 mm wide touch, and 1 mm
+        // chunks do not order their interleaved entries; asserted with margin.
+        SCOPED_TRACE("alpha " + std::to_string(alpha));
+        EXPECT_GT(sorted.covered, 5000u);
+        EXPECT_LE(sorted.mean, alpha < 0.1f ? 1.0 : 1.5);
+        EXPECT_LE(sorted.share_over_8, alpha < 0.1f ? 0.01 : 0.025);
+        EXPECT_LE(sorted.mean, 0.15 * unsorted.mean);
+    }
 }
 
 TEST(ViewerTransparency, FiberOrderDoesNotChangeASortedImage) {
@@ -364,16 +661,43 @@ TEST(ViewerTransparency, CliOptions) {
     const TempDir dir;
     const std::string fft = compress_into(dir, shared_data("bundles/AF_L.tck"), "af.fft");
     for (const char* bad : {"--opacity 0", "--opacity 1.5", "--opacity 0.5 --transparency depth",
-                            "--opacity 0.5 --transparency sorted --style tubes",
+                            "--opacity 0.5 --transparency voxlines --style tubes",
                             "--opacity 0.5 --transparency voxlines --style capsules"}) {
         const CommandResult r = run_cli("render " + fft + " -o " + dir.file("x.png") + " --size 32x32 " + bad);
         EXPECT_EQ(r.status, 2) << bad << ": " << r.output;
         EXPECT_FALSE(std::filesystem::exists(dir.file("x.png"))) << bad;
     }
     for (const char* good : {"--opacity 0.3", "--opacity 0.3 --transparency voxlines",
-                             "--opacity 0.3 --transparency unsorted --style tubes"}) {
+                             "--opacity 0.3 --transparency unsorted --style tubes",
+                             "--opacity 0.3 --transparency sorted --style tubes",
+                             "--opacity 0.3 --style capsules"}) {
         const CommandResult r = run_cli("render " + fft + " -o " + dir.file("y.png") + " -f --size 64x48 " + good);
         EXPECT_EQ(r.status, 0) << good << ": " << r.output;
+    }
+    // --fiber-opacity: one value in [0, 1] per streamline, a file or dps/NAME.
+    const FftFile file(fft);
+    std::string alpha, over;
+    for (std::uint64_t f = 0; f < file.header().fibers; ++f) {
+        alpha += f % 3 ? "0.5\n" : "0\n";
+        over += f == 3 ? "1.5\n" : "1\n";
+    }
+    write_file(dir.file("alpha.txt"), alpha);
+    write_file(dir.file("over.txt"), over);
+    write_file(dir.file("short.txt"), "0.5\n");
+    const std::string common = "render " + fft + " -o " + dir.file("z.png") + " -f --size 64x48 ";
+    for (const std::string& good : {"--fiber-opacity " + dir.file("alpha.txt"),
+                                   "--fiber-opacity " + dir.file("alpha.txt") + " --opacity 0.5 --style capsules"}) {
+        const CommandResult r = run_cli(common + good);
+        EXPECT_EQ(r.status, 0) << good << ": " << r.output;
+    }
+    for (const auto& [bad, status] : std::vector<std::pair<std::string, int>>{
+             {"--fiber-opacity " + dir.file("over.txt"), 4},
+             {"--fiber-opacity " + dir.file("short.txt"), 4},
+             {"--fiber-opacity dps/weight", 2},
+             {"--fiber-opacity " + dir.file("missing.txt"), 2},
+             {"--fiber-opacity " + dir.file("alpha.txt") + " --engine voxel-rt", 2}}) {
+        const CommandResult r = run_cli(common + bad);
+        EXPECT_EQ(r.status, status) << bad << ": " << r.output;
     }
     const CommandResult bench =
         run_cli("render " + fft + " --bench --frames 1 --size 64x48 --json --opacity 0.2 --transparency sorted");

@@ -170,6 +170,53 @@ TracedImage trace_image(const viewer::GpuScene& scene, const Camera& cam, int w,
 
 }  // namespace
 
+#if FIBLET_HAS_EMBREE
+namespace {
+
+// An opaque w × h voxel-rt image against the oracle's nearest hits: hit/miss
+// agreement and the same hit segment. `joint_mm`: how close (eye depth) a
+// hit on the neighbouring segment must be to count as the shared joint's.
+void expect_opaque_agreement(const viewer::GpuScene& scene, const EmbreeCapsules& oracle, const char* view,
+                             const viewer::RenderOptions& o, double joint_mm) {
+    const int w = 200, h = 200;
+    const Camera cam = viewer::camera_from_spec(view, scene, 1.0f, 35, 2.0f);
+    const TracedImage img = trace_image(scene, cam, w, h, o);
+    std::size_t agree = 0, hits = 0, both = 0, same = 0, joint = 0;
+    const double n = cam.near_mm, f = cam.far_mm, tt = std::tan(double(cam.fov_y_deg) * M_PI / 360.0);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const auto ref = oracle.nearest(cam.position, pixel_ray(cam, x, y, w, h));
+            const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+            const std::uint32_t got = img.segments[i];
+            const bool hit = std::isfinite(ref.t);
+            hits += hit;
+            agree += hit == (got != 0);
+            if (!hit || got == 0) continue;
+            ++both;
+            if (got - 1 == ref.segment) {
+                ++same;
+                continue;
+            }
+            // The sphere at a joint belongs to both segments: the same
+            // point (eye depth within joint_mm) on the neighbour counts.
+            const double z_gpu = 2 * n * f / ((f + n) - (2.0 * img.depth[i] - 1.0) * (f - n));
+            const double nx = (x + 0.5) / w * 2 - 1, ny = 1 - (y + 0.5) / h * 2;
+            const double cosine = 1.0 / std::sqrt(1 + nx * nx * tt * tt * cam.aspect * cam.aspect + ny * ny * tt * tt);
+            joint += oracle.consecutive(got - 1, ref.segment) && std::fabs(ref.t * cosine - z_gpu) <= joint_mm;
+        }
+    const double rate = double(agree) / double(w * h), strict = double(same) / double(both),
+                 same_rate = double(same + joint) / double(both);
+    std::printf("%s%s: voxel-rt vs Embree, %d pixels (%zu hit): hit/miss %.5f, same segment %.5f (%.5f counting "
+                "the neighbour's hit on the sphere of their joint as the same; %zu such)\n",
+                view, o.fiber_radii ? " (per-fiber radii)" : "", w * h, hits, rate, strict, same_rate, joint);
+    EXPECT_GT(hits, 2000u);
+    EXPECT_GE(rate, 0.999);
+    EXPECT_GE(same_rate, 0.995);
+}
+
+}  // namespace
+#endif
+
 TEST(VoxelRtTrace, OpaqueImagesAgreeWithEmbree) {
 #if !FIBLET_HAS_EMBREE
     GTEST_SKIP() << "built without Embree (libembree-dev, scripts/setup.sh)";
@@ -178,47 +225,47 @@ TEST(VoxelRtTrace, OpaqueImagesAgreeWithEmbree) {
     const TempDir dir;
     const FftFile file(compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft"));
     const viewer::GpuScene scene(file, *viewer_gl().programs);
-    const int w = 200, h = 200;
     const float radius = 0.3f;
     const EmbreeCapsules oracle(file, radius);
     for (const char* view : {"left", "oblique"}) {
         SCOPED_TRACE(view);
-        const Camera cam = viewer::camera_from_spec(view, scene, 1.0f, 35, 2.0f);
         viewer::RenderOptions o;
         o.tube_radius_mm = radius;
-        const TracedImage img = trace_image(scene, cam, w, h, o);
-        std::size_t agree = 0, hits = 0, both = 0, same = 0, joint = 0;
-        const double n = cam.near_mm, f = cam.far_mm, tt = std::tan(double(cam.fov_y_deg) * M_PI / 360.0);
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) {
-                const auto ref = oracle.nearest(cam.position, pixel_ray(cam, x, y, w, h));
-                const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
-                const std::uint32_t got = img.segments[i];
-                const bool hit = std::isfinite(ref.t);
-                hits += hit;
-                agree += hit == (got != 0);
-                if (!hit || got == 0) continue;
-                ++both;
-                if (got - 1 == ref.segment) {
-                    ++same;
-                    continue;
-                }
-                // The sphere at a joint belongs to both segments: the same
-                // point (eye depth within 0.01 r) on the neighbour counts.
-                const double z_gpu = 2 * n * f / ((f + n) - (2.0 * img.depth[i] - 1.0) * (f - n));
-                const double nx = (x + 0.5) / w * 2 - 1, ny = 1 - (y + 0.5) / h * 2;
-                const double cosine = 1.0 / std::sqrt(1 + nx * nx * tt * tt * cam.aspect * cam.aspect + ny * ny * tt * tt);
-                joint += oracle.consecutive(got - 1, ref.segment) && std::fabs(ref.t * cosine - z_gpu) <= 0.01 * radius;
-            }
-        const double rate = double(agree) / double(w * h), strict = double(same) / double(both),
-                     same_rate = double(same + joint) / double(both);
-        std::printf("%s: voxel-rt vs Embree, %d pixels (%zu hit): hit/miss %.5f, same segment %.5f (%.5f counting "
-                    "the neighbour's hit on the sphere of their joint as the same; %zu such)\n",
-                    view, w * h, hits, rate, strict, same_rate, joint);
-        EXPECT_GT(hits, 2000u);
-        EXPECT_GE(rate, 0.999);
-        EXPECT_GE(same_rate, 0.995);
+        expect_opaque_agreement(scene, oracle, view, o, 0.01 * radius);
     }
+#endif
+}
+
+TEST(VoxelRtTrace, PerFiberRadiiAgreeWithEmbree) {
+#if !FIBLET_HAS_EMBREE
+    GTEST_SKIP() << "built without Embree (libembree-dev, scripts/setup.sh)";
+#else
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft"));
+    viewer::GpuScene scene(file, *viewer_gl().programs);
+    // 0.1 to 0.6 mm, neighbours in file order differing.
+    std::vector<float> radii(file.header().fibers);
+    for (std::size_t f = 0; f < radii.size(); ++f) radii[f] = 0.1f + 0.125f * float((f * 7) % 5);
+    scene.set_fiber_radii(radii);
+    const EmbreeCapsules oracle(file, 0.0f, radii);
+    viewer::RenderOptions o;
+    o.tube_radius_mm = 0.3f;  // ignored: --fiber-radii
+    o.fiber_radii = true;
+    for (const char* view : {"left", "oblique"}) {
+        SCOPED_TRACE(view);
+        expect_opaque_agreement(scene, oracle, view, o, 0.01 * 0.1);
+    }
+    // The radii reach the image: the default radius alone draws another one.
+    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 2.0f);
+    o.fiber_radii = false;
+    const auto uniform = trace_image(scene, cam, 120, 120, o).segments;
+    o.fiber_radii = true;
+    const auto per_fiber = trace_image(scene, cam, 120, 120, o).segments;
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < uniform.size(); ++i) differ += (uniform[i] != 0) != (per_fiber[i] != 0);
+    std::printf("per-fiber radii vs --radius 0.3 alone: %zu of %zu pixels differ in hit/miss\n", differ, uniform.size());
+    EXPECT_GT(differ, 200u);
 #endif
 }
 
@@ -492,9 +539,16 @@ TEST(VoxelRtCli, RenderDrawsWithEveryOptionAndRefusesBadOnes) {
     FIBLET_REQUIRE_GL();
     const TempDir dir;
     const std::string fft = compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft");
+    {
+        const FftFile file(fft);
+        std::FILE* f = std::fopen(dir.file("radii.txt").c_str(), "w");
+        for (std::uint64_t k = 0; k < file.header().fibers; ++k) std::fprintf(f, "%g\n", 0.2 + 0.1 * double(k % 3));
+        std::fclose(f);
+    }
+    const std::string radii = "--engine voxel-rt --grid 32 --ao --fiber-radii " + dir.file("radii.txt");
     const char* cases[] = {"--engine voxel-rt --grid 32", "--engine voxel-rt --grid 32 --ao --shadows",
-                           "--engine voxel-rt --grid 32 --opacity 0.3", "--ao --style tubes --grid 32"};
-    for (int i = 0; i < 4; ++i) {
+                           "--engine voxel-rt --grid 32 --opacity 0.3", "--ao --style tubes --grid 32", radii.c_str()};
+    for (int i = 0; i < 5; ++i) {
         const std::string png = dir.file(std::to_string(i) + ".png");
         const CommandResult r = run_cli("render " + fft + " -o " + png + " --size 120x90 --camera left --radius 0.4 " + cases[i]);
         ASSERT_EQ(r.status, 0) << cases[i] << ": " << r.output;
@@ -504,8 +558,81 @@ TEST(VoxelRtCli, RenderDrawsWithEveryOptionAndRefusesBadOnes) {
         EXPECT_GT(lit, 500u) << cases[i];
     }
     for (const char* bad : {"--engine nope", "--engine voxel-rt --grid 2", "--engine voxel-rt --opacity 0",
-                            "--engine voxel-rt --opacity 1.5", "--shadows", "--opacity 0.5 --style tubes --transparency sorted"}) {
+                            "--engine voxel-rt --opacity 1.5", "--shadows",
+                            "--opacity 0.5 --style tubes --transparency voxlines"}) {  // --opacity: both engines
         const CommandResult r = run_cli("render " + fft + " -o " + dir.file("x.png") + " --size 32x32 " + bad);
         EXPECT_EQ(r.status, 2) << bad << ": " << r.output;
     }
+}
+
+TEST(VoxelRtMemory, SegmentsSplitOverSeveralBuffersRenderTheSameImage) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("small-ifod1.tck"), "small.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const std::uint64_t slot_bytes = std::uint64_t(scene.header().points_per_block + 1) * 16;
+    const std::uint64_t total = slot_bytes * scene.block_count();
+    struct Frame {
+        std::vector<std::uint32_t> fibers;
+        std::vector<std::uint8_t> rgba;
+        std::size_t parts, fragment_parts;
+        std::uint64_t fragments;
+        double decode_ms, draw_ms;
+    };
+    // The trace's time: the best of two frames after the one that builds.
+    auto draw = [&](std::uint64_t part_bytes, const viewer::RenderOptions& o, int w, int h) {
+        const Camera cam = viewer::camera_from_spec("oblique", scene, float(w) / float(h), 35, 1.0f);
+        viewer::Renderer renderer(*viewer_gl().programs);
+        renderer.voxel_ray_tracer().write_segment_ids(true);
+        renderer.voxel_ray_tracer().set_segment_part_bytes(part_bytes);
+        viewer::RenderTarget target(w, h);
+        renderer.render(scene, cam, o, target);
+        double best = 1e30;
+        for (int k = 0; k < 2; ++k) best = std::min(best, renderer.render(scene, cam, o, target).draw_ms);
+        const auto& tracer = renderer.voxel_ray_tracer();
+        return Frame{target.read_fibers(), target.read_rgba(), tracer.segment_parts(), tracer.fragment_parts(),
+                     tracer.structure()->fragment_count(), tracer.last_decode_ms(), best};
+    };
+    // Five parts (the last one partly filled).
+    const std::uint64_t part_bytes = total / 5 + slot_bytes;
+    for (const float opacity : {1.0f, 0.3f}) {
+        SCOPED_TRACE(opacity);
+        viewer::RenderOptions o;
+        o.engine = viewer::RenderEngine::voxel_rt;
+        o.voxel_grid = 64;
+        o.ambient_occlusion = opacity >= 1, o.shadows = opacity >= 1;
+        o.opacity = opacity;
+        o.time_stages = true;
+        // Transparent frames on llvmpipe take seconds: a smaller image.
+        const int w = opacity < 1 ? 96 : 256, h = opacity < 1 ? 72 : 192;
+        const Frame one = draw(0, o, w, h), split = draw(part_bytes, o, w, h);
+        ASSERT_EQ(one.parts, 1u);
+        ASSERT_EQ(one.fragment_parts, 1u);
+        ASSERT_EQ(split.parts, 5u);
+        ASSERT_GE(split.fragment_parts, 2u);
+        std::size_t same = 0, hit = 0;
+        for (std::size_t i = 0; i < one.fibers.size(); ++i) {
+            bool eq = one.fibers[i] == split.fibers[i];
+            for (int k = 0; k < 4; ++k) eq &= one.rgba[4 * i + std::size_t(k)] == split.rgba[4 * i + std::size_t(k)];
+            same += eq;
+            hit += one.fibers[i] != 0;
+        }
+        const double rate = double(same) / double(one.fibers.size());
+        std::printf("opacity %.1f: %.2f MiB of segments and %.2f MiB of fragment lists in one buffer each vs %zu and "
+                    "%zu buffers of %.2f MiB: %.5f of %zu pixels identical (%zu hit); decode %.1f / %.1f ms, trace "
+                    "%.1f / %.1f ms\n",
+                    double(opacity), double(total) / 1048576.0, double(one.fragments) * 4 / 1048576.0, split.parts,
+                    split.fragment_parts, double(part_bytes) / 1048576.0, rate, one.fibers.size(), hit, one.decode_ms,
+                    split.decode_ms, one.draw_ms, split.draw_ms);
+        EXPECT_GT(hit, std::size_t(w * h / 5));
+        EXPECT_GE(rate, 0.999);
+    }
+    // More parts than binding points: refused, not drawn in part.
+    viewer::Renderer renderer(*viewer_gl().programs);
+    renderer.voxel_ray_tracer().set_segment_part_bytes(total / 9);
+    viewer::RenderTarget target(8, 8);
+    viewer::RenderOptions o;
+    o.engine = viewer::RenderEngine::voxel_rt;
+    o.voxel_grid = 16;
+    EXPECT_THROW(renderer.render(scene, viewer::camera_from_spec("oblique", scene, 1.0f, 35, 1.0f), o, target), Error);
 }

@@ -21,6 +21,7 @@
 #include "render_target.hpp"
 #include "renderer.hpp"
 #include "scene_file.hpp"
+#include "fiber_opacity.hpp"
 #include "fiber_radii.hpp"
 #include "supersampling.hpp"
 #include "viewer_options.hpp"
@@ -198,6 +199,7 @@ void run(const RenderArgs& a) {
     viewer::GpuScene scene(file, programs);
     viewer::load_fiber_colors(fiber_color_source(a.view), file, scene);
     if (!a.view.fiber_radii.empty()) viewer::load_fiber_radii(a.view.fiber_radii, scene);
+    if (!a.view.fiber_opacity.empty()) viewer::load_fiber_opacities(a.view.fiber_opacity, file, scene);
     viewer::RenderTarget target(width, height);
     viewer::Renderer renderer(programs);
     renderer.set_overlays(viewer::make_overlays(overlay_sources, options));

@@ -14,6 +14,7 @@ void run(const ViewerArgs& a) {
     o.screenshot_supersample = a.supersample;
     o.fiber_colors = fiber_color_source(a);
     o.fiber_radii_path = a.fiber_radii;
+    o.fiber_opacity_source = a.fiber_opacity;
     o.overlays = overlay_sources_from(a);
     viewer::run_viewer_window(a.input, o);
 }

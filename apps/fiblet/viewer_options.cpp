@@ -25,29 +25,40 @@ std::array<float, 3> parse_color(std::string text, const char* option) {
     return {float((v >> 16) & 255) / 255.0f, float((v >> 8) & 255) / 255.0f, float(v & 255) / 255.0f};
 }
 
+// A per-streamline value source (--fiber-values, --fiber-opacity): an
+// existing file or dps/NAME (fiber_colors.hpp).
+CLI::Validator fiber_values_check() {
+    return CLI::ExistingFile | CLI::Validator(
+                                   [](const std::string& v) {
+                                       return viewer::is_data_field_name(v) ? std::string() : "not dps/NAME";
+                                   },
+                                   "dps/NAME");
+}
+
 std::uint32_t fiber_id(std::uint64_t id) {
     if (id > std::numeric_limits<std::uint32_t>::max())
         throw Error(Errc::invalid_argument, "--fibers: " + std::to_string(id) + " is not a fiber ID (at most 2^32-1)");
     return std::uint32_t(id);
 }
 
-// --opacity and --transparency: the lines' default order is sorted; the
-// ray-cast styles blend unsorted only.
+// --opacity and --transparency: the default order is sorted; voxlines
+// draw lines only.
 void set_transparency(const ViewerArgs& a, viewer::RenderOptions& o) {
     if (!(a.opacity > 0 && a.opacity <= 1)) throw Error(Errc::invalid_argument, "--opacity must be in (0, 1]");
     o.opacity = a.opacity;
     const bool lines = o.style == viewer::DrawStyle::lines;
     if (a.transparency.empty()) {
-        o.transparency = lines ? viewer::TransparencyMode::sorted : viewer::TransparencyMode::unsorted;
+        o.transparency = viewer::TransparencyMode::sorted;
         return;
     }
     const auto mode = viewer::parse_transparency_mode(a.transparency);
     if (!mode)
         throw Error(Errc::invalid_argument, "--transparency: '" + a.transparency + "' is not one of " +
                                                 viewer::transparency_mode_names());
-    if (!lines && *mode != viewer::TransparencyMode::unsorted)
-        throw Error(Errc::invalid_argument, "--transparency " + a.transparency + " draws lines; --style " +
-                                                std::string(viewer::draw_style_name(o.style)) + " blends unsorted only");
+    if (!lines && *mode == viewer::TransparencyMode::voxlines)
+        throw Error(Errc::invalid_argument, "--transparency voxlines draws lines; --style " +
+                                                std::string(viewer::draw_style_name(o.style)) +
+                                                " blends sorted or unsorted");
     o.transparency = *mode;
 }
 
@@ -71,11 +82,7 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
                     "Colour each streamline by a value, through viridis: a text file (one number per streamline, as "
                     "MRtrix3's per-streamline files) or dps/NAME, the per-streamline data the .fft carries (a .trk's "
                     "properties, a TRX's dps/)")
-        ->check(CLI::ExistingFile | CLI::Validator(
-                                        [](const std::string& v) {
-                                            return viewer::is_data_field_name(v) ? std::string() : "not dps/NAME";
-                                        },
-                                        "dps/NAME"));
+        ->check(fiber_values_check());
     cmd->add_option("--value-range", a.value_range, "MIN:MAX of --fiber-values mapped to the colour map (default: "
                                                     "the values' range)");
     cmd->add_option("--background", a.background, "Background colour: RRGGBB, black, white, gray")
@@ -101,16 +108,20 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
     cmd->add_flag("--shadows", a.shadows, "A shadow ray towards the light (--engine voxel-rt)");
     cmd->add_option("--fiber-radii", a.fiber_radii,
                     "Tube and capsule radius per streamline from a text file (mm, one per streamline, in file "
-                    "order), instead of --radius")
+                    "order), instead of --radius (also --engine voxel-rt)")
         ->check(CLI::ExistingFile);
     cmd->add_option("--opacity", a.opacity,
                     "Opacity of every streamline, in (0, 1]; below 1 they blend, ordered by --transparency "
                     "(--engine voxel-rt: every capsule a ray enters composited in depth order)")
         ->capture_default_str();
+    cmd->add_option("--fiber-opacity", a.fiber_opacity,
+                    "Opacity per streamline, in [0, 1], times --opacity (below 1 they blend): a text file (one "
+                    "number per streamline, in file order) or dps/NAME, as --fiber-values (raster engine)")
+        ->check(fiber_values_check());
     cmd->add_option("--transparency", a.transparency,
-                    "How streamlines blend when --opacity < 1: sorted (~1 mm chunks sorted back to front on the "
-                    "GPU; the default), voxlines (10 mm voxels back to front, precomputed axis orders inside), "
-                    "unsorted (plain blending); tubes and capsules blend unsorted");
+                    "How streamlines blend when --opacity < 1 or with --fiber-opacity: sorted (~1 mm chunks sorted back to front on the "
+                    "GPU; the default; lines, tubes, capsules), voxlines (10 mm voxels back to front, precomputed "
+                    "axis orders inside; lines), unsorted (plain blending)");
     cmd->add_option("--supersample", a.supersample,
                     "Anti-aliasing of the PNG (render) or screenshots (view): draw N times larger per axis and "
                     "average, 1..8")
@@ -228,6 +239,9 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
     set_transparency(a, o);
     o.fiber_colors = !fiber_color_source(a).empty();
     o.fiber_radii = !a.fiber_radii.empty();
+    o.fiber_opacity = !a.fiber_opacity.empty();
+    if (o.fiber_opacity && o.engine != viewer::RenderEngine::raster)
+        throw Error(Errc::invalid_argument, "--fiber-opacity needs --engine raster");
     return o;
 }
 

@@ -28,6 +28,7 @@ struct ViewerArgs {
     float odf_scale = 1, slab = 0;
     int odf_lmax = -1;
     float opacity = 1;
+    std::string fiber_opacity;  // per-streamline opacities: a file or dps/NAME (fiber_opacity.hpp)
     std::string transparency;  // empty: sorted (lines) / unsorted (tubes, capsules)
     // The voxel ray tracer (--engine voxel-rt).
     std::string engine = "raster";

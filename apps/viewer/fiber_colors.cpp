@@ -121,15 +121,16 @@ std::vector<float> fiber_values_from_data(const FftFile& file, const std::string
 
 bool is_data_field_name(const std::string& values) { return values.rfind("dps/", 0) == 0 && values.size() > 4; }
 
+std::vector<float> read_fiber_value_source(const std::string& source, const FftFile& file) {
+    const bool from_data = is_data_field_name(source) && !std::filesystem::exists(source);
+    return from_data ? fiber_values_from_data(file, source) : read_fiber_values(source, file.header().fibers);
+}
+
 void load_fiber_colors(const FiberColorSource& source, const FftFile& file, GpuScene& scene) {
     if (!source.colors_path.empty()) {
         scene.set_fiber_colors(read_fiber_colors(source.colors_path, scene.fiber_count()));
     } else if (!source.values_path.empty()) {
-        const bool from_data = is_data_field_name(source.values_path) && !std::filesystem::exists(source.values_path);
-        const std::vector<float> values = from_data
-                                              ? fiber_values_from_data(file, source.values_path)
-                                              : read_fiber_values(source.values_path, scene.fiber_count());
-        scene.set_fiber_colors(colors_from_values(values, source.value_range));
+        scene.set_fiber_colors(colors_from_values(read_fiber_value_source(source.values_path, file), source.value_range));
     }
 }
 

@@ -33,6 +33,10 @@ std::vector<float> fiber_values_from_data(const FftFile& file, const std::string
 // Whether a values source is such a name ("dps/" and more); a file of that
 // name, when one exists, is read instead.
 bool is_data_field_name(const std::string& values);
+// One finite number per streamline of `file` from `source`: a text file
+// (read_fiber_values) or "dps/NAME" (fiber_values_from_data) as above. What
+// --fiber-values and --fiber-opacity read.
+std::vector<float> read_fiber_value_source(const std::string& source, const FftFile& file);
 
 // Values mapped through viridis over [low, high] (default: the values'
 // range), clamped.

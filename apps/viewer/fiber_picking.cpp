@@ -4,6 +4,8 @@
 #include <limits>
 #include <vector>
 
+#include "renderer.hpp"
+
 namespace fiblet::viewer {
 
 std::optional<PickedFiber> pick_fiber(const RenderTarget& target, const GpuScene& scene, int x, int y,
@@ -25,6 +27,19 @@ std::optional<PickedFiber> pick_fiber(const RenderTarget& target, const GpuScene
                               px, py};
         }
     return out;
+}
+
+std::optional<PickedFiber> pick_fiber_in_frame(Renderer& renderer, const GpuScene& scene, const Camera& camera,
+                                               const RenderOptions& options, RenderTarget& target, int x, int y,
+                                               int radius_px) {
+    if (options.transparent() && options.engine == RenderEngine::raster) {
+        RenderOptions opaque = options;
+        opaque.opacity = 1;
+        opaque.fiber_opacity = false;
+        opaque.clear = true;
+        renderer.render(scene, camera, opaque, target);
+    }
+    return pick_fiber(target, scene, x, y, radius_px);
 }
 
 }  // namespace fiblet::viewer

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "gpu_scene.hpp"
+#include "render_options.hpp"
 #include "render_target.hpp"
 
 namespace fiblet::viewer {
@@ -23,5 +24,15 @@ struct PickedFiber {
 // `radius_px` pixels, as drawn by the last frame into `target`.
 std::optional<PickedFiber> pick_fiber(const RenderTarget& target, const GpuScene& scene, int x, int y,
                                       int radius_px = 3);
+
+class Renderer;
+// pick_fiber for a frame drawn with `options`: a transparent frame leaves no
+// fiber indices (its fibers blend without depth), so the frame is drawn
+// again opaque into `target` (opacity 1, no per-fiber opacity) and the
+// fiber picked is the nearest one drawn there, whatever its opacity; the
+// caller redraws the transparent frame. An opaque frame is read as drawn.
+std::optional<PickedFiber> pick_fiber_in_frame(Renderer& renderer, const GpuScene& scene, const Camera& camera,
+                                               const RenderOptions& options, RenderTarget& target, int x, int y,
+                                               int radius_px = 3);
 
 }  // namespace fiblet::viewer

@@ -25,12 +25,13 @@ inline constexpr unsigned kFiberRadii = 13;   // per fiber: tube radius (mm), wh
 inline constexpr unsigned kGlyphCoefficients = 14;  // overlays/odf_glyphs: SH coefficients, glyph units
 inline constexpr unsigned kGlyphCenters = 15;       // overlays/odf_glyphs: centre, radius (mm) and box (glyph_boxes.glsl)
 inline constexpr unsigned kStorageCount = 16;
-// Transparent frames (transparency/) reuse the binding points of buffers they
-// never bind (no level of detail, no tangents, no tubes, no decisions), so
-// that the viewer asks the driver for no more bindings.
+// Transparent frames (transparency/) reuse the binding points of buffers
+// that no pass using them binds (no level of detail, no decisions; tube
+// pieces and tangents only in the draw passes, after the sort), so that the
+// viewer asks the driver for no more bindings.
 inline constexpr unsigned kChunkKeys = kCoarseList;      // per chunk: its depth bucket
 inline constexpr unsigned kChunkHistogram = kCounters;   // chunks per (bucket, lane), then their offsets
-inline constexpr unsigned kSortedChunks = kDecisions;    // per sorted slot: chunk index in its block
+inline constexpr unsigned kSortedChunks = kDecisions;    // per sorted slot: block x chunks per block + chunk
 inline constexpr unsigned kSortedBlocks = kTubePieces;   // per sorted slot: its block
 inline constexpr unsigned kVoxlineSegments = kTangents;  // voxlines: both ends of every segment
 inline constexpr unsigned kVoxlineOrders = kTubePieces;  // voxlines: the three axis orders of every voxel

@@ -135,16 +135,33 @@ double GpuScene::fiber_length_mm(std::uint64_t index) const {
     return steps * double(header_.step) * double(header_.scaling);
 }
 
+void GpuScene::upload_fiber_colors() {
+    if (fiber_rgba_.empty()) fiber_rgba_.assign(fiber_count() * 4, 1.0f);
+    check_fits(fiber_rgba_.size() * 4, "fiber colours");
+    fiber_colors_ = make_buffer(GLsizeiptr(fiber_rgba_.size() * 4), fiber_rgba_.data(), 0);
+}
+
 void GpuScene::set_fiber_colors(const std::vector<std::array<float, 3>>& rgb) {
     if (rgb.size() != fiber_count())
         throw Error(Errc::invalid_argument, fmt::format("{} fiber colours for {} fibers", rgb.size(), fiber_count()));
     if (rgb.empty()) return;
-    check_fits(rgb.size() * 16, "fiber colours");
-    std::vector<float> rgba;
-    rgba.reserve(rgb.size() * 4);
-    for (const auto& c : rgb) rgba.insert(rgba.end(), {c[0], c[1], c[2], 1.0f});
-    fiber_colors_ = make_buffer(GLsizeiptr(rgba.size() * 4), rgba.data(), 0);
+    if (fiber_rgba_.empty()) fiber_rgba_.assign(fiber_count() * 4, 1.0f);
+    for (std::size_t f = 0; f < rgb.size(); ++f)
+        for (std::size_t k = 0; k < 3; ++k) fiber_rgba_[4 * f + k] = rgb[f][k];
+    upload_fiber_colors();
     has_fiber_colors_ = true;
+}
+
+void GpuScene::set_fiber_opacities(const std::vector<float>& alpha) {
+    if (alpha.size() != fiber_count())
+        throw Error(Errc::invalid_argument, fmt::format("{} fiber opacities for {} fibers", alpha.size(), fiber_count()));
+    for (const float a : alpha)
+        if (!(a >= 0 && a <= 1)) throw Error(Errc::invalid_argument, fmt::format("fiber opacity {} is not in [0, 1]", a));
+    if (alpha.empty()) return;
+    if (fiber_rgba_.empty()) fiber_rgba_.assign(fiber_count() * 4, 1.0f);
+    for (std::size_t f = 0; f < alpha.size(); ++f) fiber_rgba_[4 * f + 3] = alpha[f];
+    upload_fiber_colors();
+    has_fiber_opacities_ = true;
 }
 
 void GpuScene::set_fiber_radii(const std::vector<float>& mm) {

@@ -60,6 +60,13 @@ public:
     // on a count that is not fiber_count().
     void set_fiber_colors(const std::vector<std::array<float, 3>>& rgb);
     bool has_fiber_colors() const { return has_fiber_colors_; }
+    // Per-fiber opacities in [0, 1] (one per fiber) for
+    // RenderOptions::fiber_opacity: kept in the colours buffer's alpha
+    // (fiber_colors.glsl), so they need no binding of their own. Throws
+    // fiblet::Error{invalid_argument} on a count that is not fiber_count()
+    // or a value outside [0, 1].
+    void set_fiber_opacities(const std::vector<float>& alpha);
+    bool has_fiber_opacities() const { return has_fiber_opacities_; }
     // Per-fiber tube radii in mm (> 0, one per fiber) for
     // RenderOptions::fiber_radii; throws fiblet::Error{invalid_argument}.
     void set_fiber_radii(const std::vector<float>& mm);
@@ -79,8 +86,10 @@ private:
     std::vector<Vec3f> sample_points_;
     GlBuffer blocks_, block_fiber_, fiber_points_buffer_, fiber_ends_, fiber_end_fraction_, local_frames_;
     std::vector<float> end_fraction_;  // per fiber, kept part of the last step (ENDS chunk; 1 without)
-    GlBuffer fiber_colors_;            // one vec4 when there are none (a binding must hold a buffer)
-    bool has_fiber_colors_ = false;
+    void upload_fiber_colors();
+    GlBuffer fiber_colors_;            // one vec4 when there are neither colours nor opacities (a binding must hold a buffer)
+    std::vector<float> fiber_rgba_;    // per fiber: colour (white without) and opacity (1 without)
+    bool has_fiber_colors_ = false, has_fiber_opacities_ = false;
     GlBuffer fiber_radii_;             // one float when there are none
     std::vector<float> fiber_radii_mm_;
     float min_radius_ = 0, max_radius_ = 0;

@@ -73,6 +73,7 @@ TransparencyBench run_transparency_bench(const GpuScene& scene, Renderer& render
                                          const Camera& camera, const RenderOptions& transparent, int frames) {
     RenderOptions opaque = transparent;
     opaque.opacity = 1;
+    opaque.fiber_opacity = false;
     TransparencyBench b;
     b.opaque_ms = median_frame_ms(scene, renderer, target, camera, opaque, frames);
     b.transparent_ms = median_frame_ms(scene, renderer, target, camera, transparent, frames);

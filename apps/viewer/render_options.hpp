@@ -43,8 +43,10 @@ struct RenderOptions {
     std::array<float, 4> slab_plane{0, 0, 1, 0};
     float slab_half_width_mm = 0;
     // Transparency: every fragment blends with this opacity (0 < opacity <= 1),
-    // ordered by `transparency` (transparency/); 1 draws opaque.
+    // times its fiber's own with fiber_opacity, ordered by `transparency`
+    // (transparency/); 1 without fiber_opacity draws opaque.
     float opacity = 1.0f;
+    bool fiber_opacity = false;  // the scene's per-fiber opacities (GpuScene::set_fiber_opacities), when it has them
     TransparencyMode transparency = TransparencyMode::sorted;
     // Voxel ray tracer (engine voxel_rt; capsules of tube_radius_mm).
     int voxel_grid = 128;            // voxels along each side of its cubic grid
@@ -55,7 +57,7 @@ struct RenderOptions {
     bool time_stages = false;       // time cull / decode / draw (GpuTimer, default_timing_method)
     bool record_decisions = false;  // keep each block's culling decision (Renderer::read_decisions)
 
-    bool transparent() const { return opacity < 1.0f; }
+    bool transparent() const { return opacity < 1.0f || fiber_opacity; }
     bool subset_active() const {
         return id_min > 0 || id_max < std::numeric_limits<std::uint32_t>::max() || min_length_mm > 0 ||
                max_length_mm < std::numeric_limits<double>::infinity();

@@ -103,10 +103,13 @@ voxel_rt::VoxelRayTracer& Renderer::voxel_ray_tracer() {
     return *voxel_ray_tracer_;
 }
 
-FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const RenderOptions& options,
+FrameStats Renderer::render(const GpuScene& scene, const Camera& requested, const RenderOptions& options,
                             RenderTarget& target) {
-    if (options.engine == RenderEngine::voxel_rt) return voxel_ray_tracer().render(scene, camera, options, target);
+    if (options.engine == RenderEngine::voxel_rt) return voxel_ray_tracer().render(scene, requested, options, target);
+    // Near and far planes widened to hold the overlays (overlay.hpp).
+    const Camera camera = clip_planes_covering(requested, overlays_);
     RenderOptions o = options;
+    o.fiber_opacity = options.fiber_opacity && scene.has_fiber_opacities();
     // A transparent frame blends every segment of what it selects: no coarse blocks.
     if (o.transparent()) o.level_of_detail = false;
     o.fiber_colors = options.fiber_colors && scene.has_fiber_colors();
@@ -147,10 +150,11 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& camera, const R
     }
 
     const FrameInputs in{scene, camera, o, select, o.ambient_occlusion ? &occlusion : nullptr};
-    if (o.transparent()) blend_target_.begin(target, o.clear, o.background, o.opacity);
-    if (o.transparent() && o.style == DrawStyle::lines && o.transparency != TransparencyMode::unsorted) {
+    if (o.transparent()) blend_target_.begin(target, o.clear, o.background);
+    if (o.transparent() && o.transparency != TransparencyMode::unsorted &&
+        (o.style == DrawStyle::lines || block_technique(o).draws_chunks())) {
         timer.begin(Stage::draw);
-        draw_ordered_lines(in, decoder, std::uint32_t(stats.fine_blocks));
+        draw_ordered(in, decoder, std::uint32_t(stats.fine_blocks));
         timer.end();
     } else {
         DrawTechnique& draw = block_technique(o);
@@ -205,8 +209,8 @@ void Renderer::draw_blocks(const FrameInputs& in, DrawTechnique& draw, DecoderKi
     }
 }
 
-void Renderer::draw_ordered_lines(const FrameInputs& in, DecoderKind decoder, std::uint32_t blocks) {
-    if (in.options.transparency == TransparencyMode::voxlines) {
+void Renderer::draw_ordered(const FrameInputs& in, DecoderKind decoder, std::uint32_t blocks) {
+    if (in.options.transparency == TransparencyMode::voxlines && in.options.style == DrawStyle::lines) {
         // Voxlines keep their own copy of every segment, built once per scene.
         if (!voxlines_ || &voxlines_->scene() != &in.scene)
             voxlines_ = std::make_unique<Voxlines>(in.scene, programs_, decoder);
@@ -214,9 +218,9 @@ void Renderer::draw_ordered_lines(const FrameInputs& in, DecoderKind decoder, st
         return;
     }
     if (!sorted_chunks_) sorted_chunks_ = std::make_unique<SortedChunks>();
-    auto& lines = static_cast<TransparentLines&>(block_technique(in.options));
-    lines.begin_frame(in);
-    sorted_chunks_->draw(in, *decoder_, decoder, fine_list_.get(), blocks, lines);
+    DrawTechnique& draw = block_technique(in.options);
+    draw.begin_frame(in);
+    sorted_chunks_->draw(in, *decoder_, decoder, fine_list_.get(), blocks, draw);
 }
 
 std::uint64_t Renderer::transparency_bytes() const {

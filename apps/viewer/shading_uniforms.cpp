@@ -33,6 +33,8 @@ void set_shading_uniforms(const GlProgram& p, const Camera& camera, const Render
     const auto& s = o.slab_plane;
     glProgramUniform4f(id, uniform(p, "uSlabPlane"), s[0], s[1], s[2], s[3]);
     glProgramUniform1f(id, uniform(p, "uSlabHalfWidth"), o.slab_half_width_mm);
+    glProgramUniform1f(id, uniform(p, "uGlobalOpacity"), o.opacity);
+    glProgramUniform1i(id, uniform(p, "uFiberOpacity"), o.fiber_opacity ? 1 : 0);
 }
 
 }  // namespace fiblet::viewer

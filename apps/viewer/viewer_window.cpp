@@ -22,6 +22,7 @@
 #include "png_file.hpp"
 #include "render_target.hpp"
 #include "renderer.hpp"
+#include "fiber_opacity.hpp"
 #include "fiber_radii.hpp"
 #include "supersampling.hpp"
 #include "scene_file.hpp"
@@ -34,7 +35,7 @@ const char* window_controls_help() {
            "  click: print the fiber under the cursor (ID, points, length)\n"
            "  R: reset view    S: screenshot (PNG)    C: culling on/off    L: level of detail on/off\n"
            "  D: colour by direction / fixed    I: lighting on/off    +/-: line width    T: lines / tubes / capsules\n"
-           "  H: help    Q, Esc: quit\n";
+           "  E: engine raster / voxel-rt    H: help    Q, Esc: quit\n";
 }
 
 namespace {
@@ -93,6 +94,10 @@ void on_key(GLFWwindow* w, int key, int, int action, int) {
             s.render.style = s.render.style == DrawStyle::lines   ? DrawStyle::tubes
                              : s.render.style == DrawStyle::tubes ? DrawStyle::capsules
                                                                   : DrawStyle::lines;
+            break;
+        case GLFW_KEY_E:
+            s.render.engine =
+                s.render.engine == RenderEngine::raster ? RenderEngine::voxel_rt : RenderEngine::raster;
             break;
         case GLFW_KEY_H: fmt::print("{}", window_controls_help()); break;
         default: return;
@@ -185,6 +190,7 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
     GpuScene scene(file, programs);
     load_fiber_colors(options.fiber_colors, file, scene);
     if (!options.fiber_radii_path.empty()) load_fiber_radii(options.fiber_radii_path, scene);
+    if (!options.fiber_opacity_source.empty()) load_fiber_opacities(options.fiber_opacity_source, file, scene);
     Renderer renderer(programs);
     int fb_width = 0, fb_height = 0;
     glfwGetFramebufferSize(w, &fb_width, &fb_height);
@@ -216,7 +222,18 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
         target.resize(fb_width, fb_height);
         const Camera camera = s.orbit.camera(float(fb_width) / float(fb_height));
         const auto t0 = std::chrono::steady_clock::now();
-        const FrameStats st = renderer.render(scene, camera, s.render, target);
+        FrameStats st;
+        try {
+            st = renderer.render(scene, camera, s.render, target);
+        } catch (const Error& e) {
+            // E on a scene the voxel ray tracer refuses (its buffers): say
+            // why and keep drawing with the rasterizer.
+            if (s.render.engine != RenderEngine::voxel_rt || e.code() != Errc::unsupported) throw;
+            fmt::print(stderr, "{}; back to --engine raster\n", e.what());
+            s.render.engine = RenderEngine::raster;
+            s.dirty = true;
+            continue;
+        }
         const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
         glNamedFramebufferReadBuffer(target.framebuffer(), GL_COLOR_ATTACHMENT0);
@@ -228,22 +245,13 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
             w, fmt::format("{} | {:.1f} ms (GPU cull {:.1f} decode {:.1f} draw {:.1f}) | {} blocks ({} coarse), {} "
                            "segments | {} | culling {} LoD {}",
                            title, frame_ms, st.cull_ms, st.decode_ms, st.draw_ms, st.drawn_blocks(), st.coarse_blocks,
-                           st.drawn_segments(), draw_style_name(s.render.style), s.render.frustum_culling ? "on" : "off",
+                           st.drawn_segments(),
+                           s.render.engine == RenderEngine::voxel_rt ? "voxel-rt" : draw_style_name(s.render.style),
+                           s.render.frustum_culling ? "on" : "off",
                            s.render.level_of_detail ? "on" : "off")
                    .c_str());
 
-        if (s.pick) {
-            int win_width = 1, win_height = 1;
-            glfwGetWindowSize(w, &win_width, &win_height);
-            const int px = int(s.pick->first * fb_width / std::max(win_width, 1));
-            const int py = int(s.pick->second * fb_height / std::max(win_height, 1));
-            s.pick.reset();
-            if (const auto f = pick_fiber(target, scene, px, py))
-                fmt::print("fiber ID {} (index {}): {} points, {:.2f} mm\n", f->id, f->index, f->points, f->length_mm);
-            else
-                fmt::print("no fiber at ({}, {})\n", px, py);
-            std::fflush(stdout);
-        }
+        // Screenshots first: picking a transparent frame draws over the target.
         if (s.screenshot) {
             s.screenshot = false;
             const std::string name = next_screenshot_name(options.screenshot_prefix);
@@ -256,6 +264,20 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
             else
                 write_png(name, {target.width(), target.height(), target.read_rgba()}, false);
             fmt::print("screenshot: {}\n", name);
+            std::fflush(stdout);
+        }
+        if (s.pick) {
+            int win_width = 1, win_height = 1;
+            glfwGetWindowSize(w, &win_width, &win_height);
+            const int px = int(s.pick->first * fb_width / std::max(win_width, 1));
+            const int py = int(s.pick->second * fb_height / std::max(win_height, 1));
+            s.pick.reset();
+            // A transparent frame is drawn again opaque to pick from: draw it again after.
+            if (s.render.transparent()) s.dirty = true;
+            if (const auto f = pick_fiber_in_frame(renderer, scene, camera, s.render, target, px, py))
+                fmt::print("fiber ID {} (index {}): {} points, {:.2f} mm\n", f->id, f->index, f->points, f->length_mm);
+            else
+                fmt::print("no fiber at ({}, {})\n", px, py);
             std::fflush(stdout);
         }
     }

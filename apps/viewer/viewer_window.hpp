@@ -16,10 +16,11 @@ struct WindowOptions {
     float fov_y_deg = 35, zoom = 1;
     RenderOptions render;
     std::string screenshot_prefix = "fiblet-screenshot";  // + "-NNN.png" in the working directory
-    int screenshot_supersample = 1;
+    int screenshot_supersample = 1;  // screenshots drawn again, supersampled (supersampling.hpp)
     FiberColorSource fiber_colors;  // render.fiber_colors turns them on
     OverlaySources overlays;        // glyphs and slices over the fibers
-    std::string fiber_radii_path;   // fiber_radii.hpp; render.fiber_radii turns them on  // screenshots drawn again, supersampled (supersampling.hpp)
+    std::string fiber_radii_path;   // fiber_radii.hpp; render.fiber_radii turns them on
+    std::string fiber_opacity_source;  // fiber_opacity.hpp; render.fiber_opacity turns them on
 };
 
 // The key and mouse bindings, for --help and the H key.

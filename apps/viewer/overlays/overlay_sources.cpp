@@ -1,9 +1,12 @@
 #include "overlays/overlay_sources.hpp"
 
+#include <algorithm>
+
 #include "fiblet/error.hpp"
 #include "overlays/image_slice/image_slice_overlay.hpp"
 #include "overlays/odf_glyphs/glyph_set.hpp"
 #include "overlays/odf_glyphs/odf_glyphs_overlay.hpp"
+#include "vec_ops.hpp"
 
 namespace fiblet::viewer {
 
@@ -31,6 +34,32 @@ std::vector<std::shared_ptr<Overlay>> make_overlays(const OverlaySources& s, Ren
         options.slab_half_width_mm = 0.5f * s.slab_mm;
     }
     return overlays;
+}
+
+Camera clip_planes_covering(const Camera& camera, const std::vector<std::shared_ptr<Overlay>>& overlays) {
+    const Vec3f forward = normalized(sub(camera.target, camera.position));
+    float lo = camera.near_mm, hi = camera.far_mm;
+    bool widened = false;
+    for (const auto& overlay : overlays) {
+        const auto box = overlay ? overlay->bounds() : std::nullopt;
+        if (!box) continue;
+        float nearest = 0, farthest = 0;
+        for (int c = 0; c < 8; ++c) {
+            const Vec3f corner{(*box)[c & 1].x, (*box)[(c >> 1) & 1].y, (*box)[(c >> 2) & 1].z};
+            const float depth = dot(sub(corner, camera.position), forward);
+            nearest = c == 0 ? depth : std::min(nearest, depth);
+            farthest = c == 0 ? depth : std::max(farthest, depth);
+        }
+        if (!(farthest > 0)) continue;  // behind the camera
+        // 0.1 % beyond the box, as set_clip_planes leaves 1 % around the fibers.
+        if (farthest * 1.001f > hi) hi = farthest * 1.001f, widened = true;
+        if (nearest * 0.999f < lo) lo = nearest * 0.999f, widened = true;
+    }
+    if (!widened) return camera;
+    Camera c = camera;
+    c.far_mm = hi;
+    c.near_mm = std::min(camera.near_mm, std::max(lo, 1e-4f * hi));
+    return c;
 }
 
 }  // namespace fiblet::viewer

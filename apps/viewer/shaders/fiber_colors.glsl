@@ -1,13 +1,20 @@
 // The base colour of a fiber's surface or line: its own colour when the
 // scene has per-fiber colours and they are on, else |tangent| as RGB (the
-// MRtrix3 / TrackVis convention) or the fixed colour.
+// MRtrix3 / TrackVis convention) or the fixed colour. The buffer's alpha is
+// the fiber's own opacity (GpuScene::set_fiber_opacities; 1 without).
 layout(std430, binding = BINDING_FIBER_COLORS) readonly buffer FiberColors { vec4 fiberColors[]; };
 
 uniform bool uColorByDirection;
 uniform bool uFiberColors;
 uniform vec3 uFixedColor;
+uniform float uGlobalOpacity = 1.0;  // RenderOptions::opacity
+uniform bool uFiberOpacity = false;  // RenderOptions::fiber_opacity
 
 vec3 baseColor(vec3 tangent, uint fiber) {
     if (uFiberColors) return fiberColors[fiber].rgb;
     return uColorByDirection && dot(tangent, tangent) > 0.0 ? abs(normalize(tangent)) : uFixedColor;
 }
+
+// What a fragment of the fiber blends with (blend_target.hpp): the global
+// opacity, times the fiber's own when they are on; 1 in opaque frames.
+float fiberAlpha(uint fiber) { return uFiberOpacity ? uGlobalOpacity * fiberColors[fiber].a : uGlobalOpacity; }

@@ -55,6 +55,16 @@ public:
     // binding::kCoarseList): blocks the level of detail reduced to one
     // segment each, from their first point to the next block's first point.
     virtual void draw_coarse(const FrameInputs&, std::uint32_t count) = 0;
+
+    // Sorted transparency (transparency/sorted_chunks.hpp): whether the
+    // technique draws chunks, and draws them: slot i of the decoded batch
+    // holds the block of sorted entry fineList[batch.first + i] (the fine
+    // list, bound at binding::kFineList, holds block * chunks_per_block +
+    // chunk), and only that chunk's segments, [chunk, chunk + 1) *
+    // chunk_segments of the block, are drawn, slot after slot.
+    virtual bool draws_chunks() const { return false; }
+    virtual void draw_chunks(const FrameInputs&, const DecodedBatch&, std::uint32_t /*chunk_segments*/,
+                             std::uint32_t /*chunks_per_block*/) {}
 };
 
 }  // namespace fiblet::viewer

@@ -15,7 +15,7 @@ void BlendTarget::ensure_size(int width, int height) {
     width_ = width, height_ = height;
 }
 
-void BlendTarget::begin(RenderTarget& target, bool clear, const std::array<float, 3>& background, float opacity) {
+void BlendTarget::begin(RenderTarget& target, bool clear, const std::array<float, 3>& background) {
     ensure_size(target.width(), target.height());
     if (clear) {
         const float rgba[4] = {background[0], background[1], background[2], 1.0f};
@@ -29,8 +29,7 @@ void BlendTarget::begin(RenderTarget& target, bool clear, const std::array<float
     glDisable(GL_DEPTH_TEST);
     glDepthMask(GL_FALSE);
     glEnable(GL_BLEND);
-    glBlendColor(0, 0, 0, opacity);
-    glBlendFunc(GL_CONSTANT_ALPHA, GL_ONE_MINUS_CONSTANT_ALPHA);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
 }
 
 void BlendTarget::resolve(RenderTarget& target) {

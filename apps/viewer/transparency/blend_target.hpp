@@ -17,9 +17,10 @@ class BlendTarget {
 public:
     // Binds the float image (the target's size) for drawing, filled with the
     // background (`clear`) or with the target's colours, and sets blending
-    // with a constant opacity: dst = opacity src + (1 - opacity) dst, in the
-    // order the fragments are drawn. No depth test.
-    void begin(RenderTarget& target, bool clear, const std::array<float, 3>& background, float opacity);
+    // with each fragment's alpha (its fiber's opacity, fiber_colors.glsl):
+    // dst = alpha src + (1 - alpha) dst, in the order the fragments are
+    // drawn; the image's alpha stays 1. No depth test.
+    void begin(RenderTarget& target, bool clear, const std::array<float, 3>& background);
     // Writes the blended image into the target's colours (its fiber indices
     // are left as cleared) and restores opaque drawing.
     void resolve(RenderTarget& target);

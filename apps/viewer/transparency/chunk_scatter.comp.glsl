@@ -2,7 +2,8 @@
 // Sorted transparency, step 4: each lane walks its chunks in order again and
 // puts each at the next place of its (bucket, lane): back to front, and in
 // block order within a bucket (stable, deterministic). A sorted place gets
-// the chunk's block and its index in the block.
+// the chunk's block (what the decoder reads) and its entry, block x chunks
+// per block + its index in the block (what the techniques draw from).
 layout(local_size_x = 64) in;
 
 layout(std430, binding = BINDING_CHUNK_KEYS) readonly buffer ChunkKeys { uint chunkKeys[]; };
@@ -27,6 +28,6 @@ void main() {
         uint place = histogram[cell];
         histogram[cell] = place + 1u;
         sortedBlocks[place] = i / uChunksPerBlock;
-        sortedChunks[place] = i % uChunksPerBlock;
+        sortedChunks[place] = i;
     }
 }

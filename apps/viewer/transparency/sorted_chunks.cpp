@@ -43,14 +43,14 @@ void SortedChunks::ensure_buffers(std::uint32_t scene_chunks) {
 }
 
 void SortedChunks::draw(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind, GLuint fine_list,
-                        std::uint32_t blocks, TransparentLines& lines) {
+                        std::uint32_t blocks, DrawTechnique& technique) {
     if (blocks == 0) return;
     chunks_per_block_ = (in.scene.header().points_per_block + kChunkSegments - 1) / kChunkSegments;
     const std::uint32_t scene_chunks = in.scene.block_count() * chunks_per_block_;
     ensure_buffers(scene_chunks);
     key_chunks(in, decoder, kind, fine_list, blocks);
     sort_chunks(scene_chunks);
-    draw_sorted(in, decoder, kind, blocks * chunks_per_block_, lines);
+    draw_sorted(in, decoder, kind, blocks * chunks_per_block_, technique);
 }
 
 void SortedChunks::key_chunks(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind,
@@ -116,16 +116,18 @@ void SortedChunks::sort_chunks(std::uint32_t chunks) {
 }
 
 void SortedChunks::draw_sorted(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind,
-                               std::uint32_t chunks, TransparentLines& lines) {
+                               std::uint32_t chunks, DrawTechnique& technique) {
     // Each sorted place decodes its chunk's whole block into its own slot
-    // (a block is decoded once per chunk: the price of keeping nothing).
+    // (a block is decoded once per chunk: the price of keeping nothing); the
+    // technique then reads the places' entries as its list.
     for (std::uint32_t first = 0; first < chunks; first += decoder.capacity()) {
         const std::uint32_t count = std::min(decoder.capacity(), chunks - first);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, sorted_blocks_.get());
-        decoder.decode(in.scene, kind, true, first, count);
+        decoder.decode(in.scene, kind, true, first, count, technique.needs_tangents());
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kSortedChunks, sorted_chunks_.get());
-        lines.draw_chunks(in, decoder.points_buffer(), first, count, kChunkSegments);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, sorted_chunks_.get());
+        technique.draw_chunks(in, {decoder.points_buffer(), decoder.tangents_buffer(), first, count}, kChunkSegments,
+                              chunks_per_block_);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     }
 }

@@ -5,15 +5,16 @@
 // bucket (chunk_keys.comp.glsl); a stable counting sort (chunk_count,
 // chunk_scan, chunk_scatter) orders the chunks, by block index within a
 // bucket (not by the fine list's order, which the culling's atomics vary); a second pass decodes the
-// sorted chunks' blocks a batch at a time and draws each chunk
-// (TransparentLines::draw_chunks). GL blends in the order the primitives
-// are drawn, and the sort has no atomics, so a frame is deterministic.
+// sorted chunks' blocks a batch at a time and draws each chunk through the
+// frame's technique (DrawTechnique::draw_chunks: transparent lines, tubes,
+// capsules). GL blends in the order the primitives are drawn, and the sort
+// has no atomics, so a frame is deterministic.
 #pragma once
 
 #include <cstdint>
 
 #include "block_decoder.hpp"
-#include "transparency/transparent_lines.hpp"
+#include "techniques/draw_technique.hpp"
 
 namespace fiblet::viewer {
 
@@ -28,7 +29,7 @@ public:
     // Draws `blocks` blocks: the fine list's first ones (bound by the caller
     // to `fine_list`) when in.use_list, else blocks 0..blocks-1.
     void draw(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind, GLuint fine_list,
-              std::uint32_t blocks, TransparentLines& lines);
+              std::uint32_t blocks, DrawTechnique& technique);
 
     std::uint64_t gpu_bytes() const { return std::uint64_t(capacity_) * 12 + std::uint64_t(kBuckets) * kLanes * 4; }
 
@@ -38,7 +39,7 @@ private:
                     std::uint32_t blocks);
     void sort_chunks(std::uint32_t scene_chunks);
     void draw_sorted(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind, std::uint32_t chunks,
-                     TransparentLines& lines);
+                     DrawTechnique& technique);
 
     std::uint32_t chunks_per_block_ = 0;
     GlProgram keys_, count_, scan_, scatter_;

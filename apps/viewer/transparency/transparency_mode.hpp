@@ -8,8 +8,8 @@
 namespace fiblet::viewer {
 
 enum class TransparencyMode {
-    sorted,    // ~1 mm chunks of the decoded blocks sorted back to front on the GPU (sorted_chunks.hpp)
-    voxlines,  // the Voxlines paper: 10 mm voxels back to front, precomputed axis orders inside (voxlines.hpp)
+    sorted,    // ~1 mm chunks of the decoded blocks sorted back to front on the GPU (sorted_chunks.hpp), any style
+    voxlines,  // the Voxlines paper: 10 mm voxels back to front, precomputed axis orders inside (voxlines.hpp); lines only, other styles draw sorted
     unsorted,  // plain blending in the order the blocks are drawn
 };
 

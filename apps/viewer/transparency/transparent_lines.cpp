@@ -31,21 +31,21 @@ void TransparentLines::draw_batch(const FrameInputs& in, const DecodedBatch& bat
     glProgramUniform1i(id, uniform(program_, "uUseList"), in.use_list ? 1 : 0);
     glProgramUniform1ui(id, uniform(program_, "uFirst"), batch.first);
     glProgramUniform1ui(id, uniform(program_, "uSlotSegments"), segments);
-    glProgramUniform1i(id, uniform(program_, "uChunks"), 0);
+    glProgramUniform1ui(id, uniform(program_, "uChunksPerBlock"), 0);
     glDrawArrays(GL_TRIANGLES, 0, GLsizei(kVerticesPerSegment * segments * batch.count));
 }
 
-void TransparentLines::draw_chunks(const FrameInputs& in, GLuint points, std::uint32_t first, std::uint32_t count,
-                                   std::uint32_t chunk_segments) {
+void TransparentLines::draw_chunks(const FrameInputs& in, const DecodedBatch& batch, std::uint32_t chunk_segments,
+                                   std::uint32_t chunks_per_block) {
     const GLuint id = program_.get();
     glUseProgram(id);
     in.scene.bind(program_);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kPoints, points);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kPoints, batch.points);
     glProgramUniform1i(id, uniform(program_, "uUseList"), 1);
-    glProgramUniform1ui(id, uniform(program_, "uFirst"), first);
+    glProgramUniform1ui(id, uniform(program_, "uFirst"), batch.first);
     glProgramUniform1ui(id, uniform(program_, "uSlotSegments"), chunk_segments);
-    glProgramUniform1i(id, uniform(program_, "uChunks"), 1);
-    glDrawArrays(GL_TRIANGLES, 0, GLsizei(kVerticesPerSegment * chunk_segments * count));
+    glProgramUniform1ui(id, uniform(program_, "uChunksPerBlock"), chunks_per_block);
+    glDrawArrays(GL_TRIANGLES, 0, GLsizei(kVerticesPerSegment * chunk_segments * batch.count));
 }
 
 }  // namespace fiblet::viewer

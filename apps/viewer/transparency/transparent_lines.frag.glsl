@@ -1,6 +1,6 @@
 #version 450
 // Transparent lines: the pixels of the diamond-exit rule, illuminated as
-// opaque lines are; the opacity is the blend constant (blend_target.hpp).
+// opaque lines are; alpha is the fiber's opacity (fiberAlpha, blend_target.hpp).
 layout(location = 0) flat in vec3 vTangent;
 layout(location = 1) flat in vec3 vWorld;
 layout(location = 2) flat in uint vFiber;
@@ -14,5 +14,5 @@ layout(location = 0) out vec4 outColor;
 
 void main() {
     if (!exitsDiamond(vWindowEnds.xy, vWindowEnds.zw, gl_FragCoord.xy) || outsideSlab(vWorld)) discard;
-    outColor = vec4(lineColor(vTangent, vWorld, vFiber), 1.0);
+    outColor = vec4(lineColor(vTangent, vWorld, vFiber), fiberAlpha(vFiber));
 }

@@ -2,8 +2,7 @@
 // fragment shader keeps the pixels of the diamond-exit rule
 // (diamond_exit.glsl), so that a fiber blends once per pixel it crosses, the
 // same on every driver. As a technique it draws whole decoded blocks in the
-// renderer's order (unsorted blending); sorted_chunks.hpp draws its sorted
-// chunks through draw_chunks.
+// renderer's order (unsorted blending), or sorted chunks (draw_chunks).
 #pragma once
 
 #include "techniques/draw_technique.hpp"
@@ -18,12 +17,9 @@ public:
     // Transparent frames have no level of detail: nothing is coarse.
     void draw_coarse(const FrameInputs&, std::uint32_t) override {}
 
-    // Slots 0..count-1 of `points` hold the blocks sortedBlocks[first + i]
-    // (bound at binding::kFineList); slot i draws their chunk
-    // sortedChunks[first + i] (bound at binding::kSortedChunks) of
-    // `chunk_segments` segments.
-    void draw_chunks(const FrameInputs& in, GLuint points, std::uint32_t first, std::uint32_t count,
-                     std::uint32_t chunk_segments);
+    bool draws_chunks() const override { return true; }
+    void draw_chunks(const FrameInputs& in, const DecodedBatch& batch, std::uint32_t chunk_segments,
+                     std::uint32_t chunks_per_block) override;
 
     // The program (voxlines.hpp draws with the same uniforms and fragment shader).
     static void set_uniforms(const GlProgram& program, const FrameInputs& in);

@@ -15,7 +15,23 @@
 
 layout(std430, binding = BINDING_VRT_CELLS) readonly buffer Cells { uint cells[]; };
 layout(std430, binding = BINDING_VRT_OFFSETS) readonly buffer Offsets { uint offsets[]; };
-layout(std430, binding = BINDING_VRT_FRAGMENTS) readonly buffer Fragments { uint fragments[]; };
+// The fragment lists: up to 4 buffer textures of uFragmentsPerPart entries.
+layout(binding = VRT_FRAGMENT_UNIT) uniform usamplerBuffer uFragments0;
+layout(binding = VRT_FRAGMENT_UNIT + 1) uniform usamplerBuffer uFragments1;
+layout(binding = VRT_FRAGMENT_UNIT + 2) uniform usamplerBuffer uFragments2;
+layout(binding = VRT_FRAGMENT_UNIT + 3) uniform usamplerBuffer uFragments3;
+uniform uint uFragmentsPerPart;
+
+uint fragmentAt(uint i) {
+    uint part = i / uFragmentsPerPart;
+    int j = int(i - part * uFragmentsPerPart);
+    switch (part) {
+        case 0u: return texelFetch(uFragments0, j).r;
+        case 1u: return texelFetch(uFragments1, j).r;
+        case 2u: return texelFetch(uFragments2, j).r;
+        default: return texelFetch(uFragments3, j).r;
+    }
+}
 layout(std430, binding = BINDING_VRT_VISIBLE) readonly buffer Visible { uint visible[]; };  // voxel_culling.hpp
 layout(binding = 1) uniform sampler3D uAmbientOcclusion;
 
@@ -116,7 +132,7 @@ struct Hit {
 
 void segmentEnds(uint s, out vec3 a, out vec3 b) {
     uint i = segmentFirstPoint(s);
-    a = vrtPoints[i].xyz, b = vrtPoints[i + 1u].xyz;
+    a = vrtPoint(i), b = vrtPoint(i + 1u);
 }
 
 // Whether segment s starts its fiber (else the previous segment ends at its start).
@@ -129,7 +145,7 @@ bool firstOfFiber(uint s) {
 float segmentEntry(vec3 o, vec3 d, uint s, out vec3 normal) {
     vec3 a, b;
     segmentEnds(s, a, b);
-    return capsuleEntry(o, d, a, b, uRadiusMm, uOpacity < 1.0 || firstOfFiber(s), normal);
+    return capsuleEntry(o, d, a, b, segmentRadiusMm(s), uOpacity < 1.0 || firstOfFiber(s), normal);
 }
 
 // Distance at which the ray leaves the culling block holding the walk's voxel.
@@ -165,7 +181,7 @@ bool traceNearest(vec3 o, vec3 d, float tMin, bool anyHit, out Hit hit) {
         if (count != 0u) {
             uint first = offsets[cell];
             for (uint k = first; k < first + count; ++k) {
-                uint s = fragments[k];
+                uint s = fragmentAt(k);
                 vec3 normal;
                 float t = segmentEntry(o, d, s, normal);
                 if (t < max(w.tEnter, tMin) - eps || t > w.tExit + eps || t <= tMin) continue;
@@ -202,7 +218,7 @@ vec3 shadeHit(vec3 o, vec3 d, Hit h) {
     return min((base * (uAmbient + uDiffuse * diffuse) + vec3(uSpecular * specular)) * (1.0 - ao), vec3(1.0));
 }
 
-vec3 slotPoint(uint slot, uint k) { return vrtPoints[slot * (uSegmentsPerSlot + 1u) + k].xyz; }
+vec3 slotPoint(uint slot, uint k) { return vrtPoint(slot * (uSegmentsPerSlot + 1u) + k); }
 
 // Whether the capsule of segment s entered at p is where the ray enters the
 // fiber's tube: p between the planes at the segment's joints normal to the
@@ -253,10 +269,10 @@ vec4 traceTransparent(vec3 o, vec3 d, out Hit nearest) {
             int n = 0;
             for (uint k = 0u; k < count; ++k) {
                 vec3 normal;
-                float t = segmentEntry(o, d, fragments[first + k], normal);
+                float t = segmentEntry(o, d, fragmentAt(first + k), normal);
                 // Each capsule is entered in one voxel: [tEnter, tExit).
                 if (t < w.tEnter || t >= w.tExit || t <= 0.0) continue;
-                if (!insideClipPlanes(fragments[first + k], o + t * d)) continue;
+                if (!insideClipPlanes(fragmentAt(first + k), o + t * d)) continue;
                 uint key = keyOf(t, w, k);
                 if (started && key <= lastKey) continue;
                 if (n == kSortedHits && key >= keys[n - 1]) continue;
@@ -267,7 +283,7 @@ vec4 traceTransparent(vec3 o, vec3 d, out Hit nearest) {
             }
             for (int j = 0; j < n; ++j) {
                 Hit h;
-                h.segment = fragments[first + (keys[j] & 0xffffu)];
+                h.segment = fragmentAt(first + (keys[j] & 0xffffu));
                 h.t = segmentEntry(o, d, h.segment, h.normal);
                 if (h.t < nearest.t) nearest = h;
                 color += transmittance * uOpacity * shadeHit(o, d, h);

@@ -20,18 +20,28 @@ VoxelRayTracer::~VoxelRayTracer() = default;
 void VoxelRayTracer::ensure_structure(const GpuScene& scene, const RenderOptions& o) {
     if (built_scene_ != &scene || !segments_) {
         structure_.reset();
-        segments_ = std::make_unique<SceneSegments>(scene, shared_);
+        segments_ = std::make_unique<SceneSegments>(scene, shared_, part_bytes_);
         built_scene_ = &scene;
     }
     const bool ao = o.ambient_occlusion;
+    const bool fiber_radii = o.fiber_radii && scene.has_fiber_radii();
     if (structure_ && built_grid_ == o.voxel_grid && built_radius_ == o.tube_radius_mm &&
-        (!ao || structure_->has_ambient_occlusion()))
+        built_fiber_radii_ == fiber_radii && (!ao || structure_->has_ambient_occlusion()))
         return;
     culling_.reset();
     structure_.reset();  // its memory first
-    const VoxelGrid grid = grid_around(scene.bounds(), o.voxel_grid, o.tube_radius_mm);
-    structure_ = std::make_unique<VoxelStructure>(programs_, grid, segments_->segments(), o.tube_radius_mm, ao);
-    built_grid_ = o.voxel_grid, built_radius_ = o.tube_radius_mm;
+    // The grid's margin: the largest capsule radius.
+    const VoxelGrid grid =
+        grid_around(scene.bounds(), o.voxel_grid, fiber_radii ? scene.max_fiber_radius() : o.tube_radius_mm);
+    structure_ = std::make_unique<VoxelStructure>(programs_, grid, segments_for(scene, o), o.tube_radius_mm, ao,
+                                                  part_bytes_);
+    built_grid_ = o.voxel_grid, built_radius_ = o.tube_radius_mm, built_fiber_radii_ = fiber_radii;
+}
+
+ResidentSegments VoxelRayTracer::segments_for(const GpuScene& scene, const RenderOptions& o) const {
+    ResidentSegments s = segments_->segments();
+    s.fiber_radii = o.fiber_radii && scene.has_fiber_radii();
+    return s;
 }
 
 OcclusionVolume VoxelRayTracer::chord_occlusion(const GpuScene& scene, const RenderOptions& o) {
@@ -49,7 +59,7 @@ void VoxelRayTracer::trace(const Camera& camera, const RenderOptions& o, RenderT
     const GLuint id = p.get();
     glUseProgram(id);
     set_shading_uniforms(p, camera, o);
-    bind_segments(p, segments_->segments(), structure_->grid(), o.tube_radius_mm);
+    bind_segments(p, segments_for(*built_scene_, o), structure_->grid(), o.tube_radius_mm);
     // Culling: opaque frames (nothing hides what lies behind a transparent
     // surface); --no-culling turns it off as it does the raster selection.
     const bool cull = o.frustum_culling && o.opacity >= 1.0f;
@@ -63,7 +73,7 @@ void VoxelRayTracer::trace(const Camera& camera, const RenderOptions& o, RenderT
         glProgramUniform1i(id, uniform(p, "uSkipBlocks"), 0);
         // A binding must hold a buffer: the cells stand in for the pyramid.
     }
-    structure_->bind();
+    structure_->bind(&p);
     if (!cull) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kVisible, structure_->cells_buffer());
     const CameraBasis b = camera_basis(camera);
     glProgramUniform3f(id, uniform(p, "uCameraRight"), b.right.x, b.right.y, b.right.z);

@@ -46,10 +46,19 @@ public:
     // The culling of the last opaque frame with culling on (null before).
     const VoxelCulling* culling() const { return culling_.get(); }
     double last_decode_ms() const { return segments_ ? segments_->decode_ms() : 0; }
+    // The most bytes of one buffer of resident segments and of one buffer of
+    // fragment lists (0: the driver's largest storage buffer and buffer
+    // texture; tests set a few MB to force the split over several buffers).
+    // Takes effect with the next scene built.
+    void set_segment_part_bytes(std::uint64_t bytes) { part_bytes_ = bytes, segments_.reset(); }
+    // Storage buffers the resident segments of the last frame occupy.
+    std::size_t segment_parts() const { return segments_ ? segments_->part_count() : 0; }
+    std::size_t fragment_parts() const { return structure_ ? structure_->fragment_parts() : 0; }
 
 private:
     void ensure_structure(const GpuScene& scene, const RenderOptions& options);
     void trace(const Camera& camera, const RenderOptions& options, RenderTarget& target);
+    ResidentSegments segments_for(const GpuScene& scene, const RenderOptions& options) const;
 
     const GpuPrograms& shared_;
     VoxelRtPrograms programs_;
@@ -59,12 +68,14 @@ private:
     const GpuScene* built_scene_ = nullptr;
     int built_grid_ = 0;
     float built_radius_ = 0;
+    bool built_fiber_radii_ = false;
     std::unique_ptr<ChordOcclusion> chords_;
     const GpuScene* chords_scene_ = nullptr;
     int chords_grid_ = 0;
     float chords_radius_ = 0;
     GlVertexArray empty_vertex_array_;
     bool write_segment_ids_ = false;
+    std::uint64_t part_bytes_ = 0;
 };
 
 }  // namespace fiblet::viewer::voxel_rt

@@ -17,6 +17,9 @@ std::string voxel_rt_defines() {
     def("BINDING_VRT_CHUNKS", binding::kChunks);
     def("BINDING_VRT_SOLID", binding::kSolid);
     def("BINDING_VRT_VISIBLE", binding::kVisible);
+    def("VRT_FRAGMENT_UNIT", binding::kFragmentUnit);
+    for (unsigned part = 1; part < binding::kPointParts; ++part)
+        s += fmt::format("#define BINDING_VRT_POINTS{} {}\n", part, binding::kMorePoints + part - 1);
     return s;
 }
 

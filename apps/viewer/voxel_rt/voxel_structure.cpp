@@ -54,6 +54,14 @@ void bind_segments(const GlProgram& p, const ResidentSegments& s, const VoxelGri
     const GLuint id = p.get();
     if (s.scene) s.scene->bind(p);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kPoints, s.points);
+    // Unused parts' bindings hold part 0 (a binding must hold a buffer).
+    for (unsigned part = 1; part < binding::kPointParts; ++part)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kMorePoints + part - 1,
+                         part <= s.more_parts.size() ? s.more_parts[part - 1] : s.points);
+    const bool split = !s.more_parts.empty();
+    glProgramUniform1ui(id, uniform(p, "uPointParts"), GLuint(1 + s.more_parts.size()));
+    glProgramUniform1ui(id, uniform(p, "uPointsPerPart"),
+                        split ? GLuint(s.slots_per_part * (s.segments_per_slot + 1)) : 0xffffffffu);
     glProgramUniform1ui(id, uniform(p, "uGridN"), GLuint(g.n));
     glProgramUniform3f(id, uniform(p, "uGridOrigin"), g.origin[0], g.origin[1], g.origin[2]);
     glProgramUniform1f(id, uniform(p, "uVoxelMm"), g.voxel_mm);
@@ -61,11 +69,12 @@ void bind_segments(const GlProgram& p, const ResidentSegments& s, const VoxelGri
     glProgramUniform1ui(id, uniform(p, "uSegmentsPerSlot"), s.segments_per_slot);
     glProgramUniform1i(id, uniform(p, "uAllSegmentsValid"), s.scene ? 0 : 1);
     glProgramUniform1f(id, uniform(p, "uRadiusMm"), radius_mm);
+    glProgramUniform1i(id, uniform(p, "uFiberRadii"), s.fiber_radii && s.scene && s.scene->has_fiber_radii() ? 1 : 0);
 }
 
 VoxelStructure::VoxelStructure(const VoxelRtPrograms& p, const VoxelGrid& grid, const ResidentSegments& s,
-                               float radius_mm, bool ambient_occlusion)
-    : grid_(grid) {
+                               float radius_mm, bool ambient_occlusion, std::uint64_t part_bytes)
+    : grid_(grid), part_bytes_(part_bytes) {
     const std::uint64_t voxels = voxel_count(grid_);
     cells_ = make_buffer(GLsizeiptr(voxels * 4), nullptr, 0);
     offsets_ = make_buffer(GLsizeiptr((voxels + 1) * 4), nullptr, 0);
@@ -117,13 +126,29 @@ void VoxelStructure::prefix_sum(const VoxelRtPrograms& p) {
     std::uint32_t total = 0;
     glGetNamedBufferSubData(offsets_.get(), GLintptr(voxels) * 4, 4, &total);
     fragments_count_ = total;
-    const std::uint64_t bytes = std::max<std::uint64_t>(total, 1) * 4;
-    if (bytes > max_storage_buffer_bytes())
-        throw Error(Errc::unsupported, "voxel-rt: the fragment lists need " + std::to_string(bytes >> 20) +
-                                           " MiB, over the driver's largest storage buffer (" +
-                                           std::to_string(max_storage_buffer_bytes() >> 20) +
-                                           " MiB); use a smaller --grid or --radius");
-    fragments_ = make_buffer(GLsizeiptr(bytes), nullptr, 0);
+    // Parts of whole entries, each a buffer texture's worth at most.
+    GLint texels = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &texels);
+    std::uint64_t per_part = std::uint64_t(texels);
+    if (part_bytes_) per_part = std::min(per_part, part_bytes_ / 4);
+    per_part = std::max<std::uint64_t>(per_part, 1);
+    const std::uint64_t entries = std::max<std::uint64_t>(total, 1);
+    const std::uint64_t parts = (entries + per_part - 1) / per_part;
+    if (parts > binding::kFragmentParts)
+        throw Error(Errc::unsupported, "voxel-rt: the fragment lists need " + std::to_string((entries * 4) >> 20) +
+                                           " MiB, over " + std::to_string(binding::kFragmentParts) +
+                                           " of the driver's largest buffer textures (" +
+                                           std::to_string((per_part * 4) >> 20) +
+                                           " MiB each); use a smaller --grid or --radius");
+    fragments_per_part_ = std::uint32_t(std::min(per_part, entries));
+    for (std::uint64_t part = 0; part < parts; ++part) {
+        const std::uint64_t count = std::min<std::uint64_t>(fragments_per_part_, entries - part * fragments_per_part_);
+        fragment_parts_.push_back(make_buffer(GLsizeiptr(count * 4), nullptr, 0));
+        GLuint t = 0;
+        glCreateTextures(GL_TEXTURE_BUFFER, 1, &t);
+        glTextureBuffer(t, GL_R32UI, fragment_parts_.back().get());
+        fragment_textures_.emplace_back(t);
+    }
 }
 
 void VoxelStructure::fill_lists(const VoxelRtPrograms& p, const ResidentSegments& s, float radius_mm) {
@@ -131,7 +156,10 @@ void VoxelStructure::fill_lists(const VoxelRtPrograms& p, const ResidentSegments
     bind_segments(p.voxelize, s, grid_, radius_mm);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCells, cells_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCursor, cursor_.get());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFragments, fragments_.get());
+    for (unsigned part = 0; part < binding::kFragmentParts; ++part)
+        glBindImageTexture(part, fragment_textures_[part < fragment_textures_.size() ? part : 0].get(), 0, GL_FALSE, 0,
+                           GL_WRITE_ONLY, GL_R32UI);
+    glProgramUniform1ui(p.voxelize.get(), uniform(p.voxelize, "uFragmentsPerPart"), fragments_per_part_);
     glProgramUniform1ui(p.voxelize.get(), uniform(p.voxelize, "uPass"), 1);
     dispatch_segments(p.voxelize, s);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -162,10 +190,13 @@ void VoxelStructure::build_ambient_occlusion(const VoxelRtPrograms& p) {
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
 }
 
-void VoxelStructure::bind() const {
+void VoxelStructure::bind(const GlProgram* trace) const {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCells, cells_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kOffsets, offsets_.get());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFragments, fragments_.get());
+    for (unsigned part = 0; part < binding::kFragmentParts; ++part)
+        glBindTextureUnit(binding::kFragmentUnit + part,
+                          fragment_textures_[part < fragment_textures_.size() ? part : 0].get());
+    if (trace) glProgramUniform1ui(trace->get(), uniform(*trace, "uFragmentsPerPart"), fragments_per_part_);
     glBindTextureUnit(0, occupancy_.get());
     glBindTextureUnit(1, ambient_occlusion_ ? ambient_occlusion_.get() : occupancy_.get());
 }

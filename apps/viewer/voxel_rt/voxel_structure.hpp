@@ -20,10 +20,18 @@ namespace fiblet::viewer::voxel_rt {
 // s + slot + 1 (slot = s / segments_per_slot). With a scene, slot b is
 // block b and holds blockSegmentCount(b) segments; without, every slot
 // holds segments_per_slot.
+// The points may be split over several storage buffers (parts, at most
+// binding::kPointParts): then `points` is part 0, more_parts the others, and
+// every part but the last holds slots_per_part whole slots.
 struct ResidentSegments {
     GLuint points = 0;
     std::uint32_t slots = 0, segments_per_slot = 1;
     const GpuScene* scene = nullptr;
+    std::vector<GLuint> more_parts;
+    std::uint32_t slots_per_part = 0;  // with more_parts
+    // Capsules of the scene's per-fiber radii instead of radius_mm (with a
+    // scene that has them).
+    bool fiber_radii = false;
 };
 
 struct BuildTimes {
@@ -38,10 +46,12 @@ void bind_segments(const GlProgram& program, const ResidentSegments& segments, c
 
 class VoxelStructure {
 public:
-    // Throws fiblet::Error{unsupported} when the fragment lists exceed the
-    // driver's largest storage buffer.
+    // The fragment lists lie in up to binding::kFragmentParts buffers of at
+    // most part_bytes (0: GL_MAX_TEXTURE_BUFFER_SIZE texels; tests set a few
+    // MB to force the split). Throws fiblet::Error{unsupported} when they
+    // need more.
     VoxelStructure(const VoxelRtPrograms& programs, const VoxelGrid& grid, const ResidentSegments& segments,
-                   float radius_mm, bool ambient_occlusion);
+                   float radius_mm, bool ambient_occlusion, std::uint64_t part_bytes = 0);
 
     const VoxelGrid& grid() const { return grid_; }
     const BuildTimes& times() const { return times_; }
@@ -50,9 +60,11 @@ public:
     GLuint ambient_occlusion_texture() const { return ambient_occlusion_.get(); }
     GLuint cells_buffer() const { return cells_.get(); }
 
-    // Binds the cells, offsets and fragments buffers and the textures
-    // (occupancy on unit 0, ambient occlusion on unit 1).
-    void bind() const;
+    // Binds the cells and offsets buffers and the textures (occupancy on
+    // unit 0, ambient occlusion on unit 1, the fragment lists' parts from
+    // binding::kFragmentUnit), and sets `trace`'s uFragmentsPerPart.
+    void bind(const GlProgram* trace = nullptr) const;
+    std::size_t fragment_parts() const { return fragment_textures_.size(); }
 
     // Per voxel (x fastest): packed cell (occupancy << 16 | count).
     std::vector<std::uint32_t> read_cells() const;
@@ -69,7 +81,11 @@ private:
 
     VoxelGrid grid_;
     BuildTimes times_;
-    GlBuffer cells_, offsets_, cursor_, fragments_;
+    GlBuffer cells_, offsets_, cursor_;
+    std::vector<GlBuffer> fragment_parts_;
+    std::vector<GlTexture> fragment_textures_;  // R32UI buffer textures of fragment_parts_
+    std::uint32_t fragments_per_part_ = 1;
+    std::uint64_t part_bytes_ = 0;
     GlTexture occupancy_, ambient_occlusion_;
     std::uint64_t fragments_count_ = 0;
 };

@@ -12,7 +12,24 @@ layout(local_size_x = 64) in;
 
 layout(std430, binding = BINDING_VRT_CELLS) buffer Cells { uint cells[]; };
 layout(std430, binding = BINDING_VRT_CURSOR) buffer Cursor { uint cursor[]; };
-layout(std430, binding = BINDING_VRT_FRAGMENTS) writeonly buffer Fragments { uint fragments[]; };
+// The fragment lists in up to 4 parts of uFragmentsPerPart entries
+// (voxel_rt_bindings.hpp).
+layout(r32ui, binding = 0) uniform writeonly uimageBuffer uFragments0;
+layout(r32ui, binding = 1) uniform writeonly uimageBuffer uFragments1;
+layout(r32ui, binding = 2) uniform writeonly uimageBuffer uFragments2;
+layout(r32ui, binding = 3) uniform writeonly uimageBuffer uFragments3;
+uniform uint uFragmentsPerPart;
+
+void writeFragment(uint i, uint segment) {
+    uint part = i / uFragmentsPerPart;
+    int j = int(i - part * uFragmentsPerPart);
+    switch (part) {
+        case 0u: imageStore(uFragments0, j, uvec4(segment)); break;
+        case 1u: imageStore(uFragments1, j, uvec4(segment)); break;
+        case 2u: imageStore(uFragments2, j, uvec4(segment)); break;
+        default: imageStore(uFragments3, j, uvec4(segment)); break;
+    }
+}
 
 uniform uint uPass;
 uniform uint uSegmentBase;  // first segment of this dispatch
@@ -46,7 +63,7 @@ void visitVoxel(ivec3 v) {
         uint occ = uint(occupancy(v) * 128.0 + 0.5);
         atomicAdd(cells[cell], (occ << 16) | 1u);
     } else {
-        fragments[atomicAdd(cursor[cell], 1u)] = gSegment;
+        writeFragment(atomicAdd(cursor[cell], 1u), gSegment);
     }
 }
 
@@ -58,15 +75,15 @@ void main() {
     if (seg >= segments) return;
     uint i = segmentFirstPoint(s);
     gSegment = s;
-    gA = toGrid(vrtPoints[i].xyz), gB = toGrid(vrtPoints[i + 1u].xyz);
-    gRadius = uRadiusMm / uVoxelMm;
+    gA = toGrid(vrtPoint(i)), gB = toGrid(vrtPoint(i + 1u));
+    gRadius = segmentRadiusMm(s) / uVoxelMm;
     gEffective = max(gRadius, 0.5);
     // Clip planes normal to the central-difference tangents at the joints
     // inside the slot.
     gClipA = vec3(0.0), gClipB = vec3(0.0);
     if (uPass == 0u && !uAllSegmentsValid) {
-        if (seg > 0u) gClipA = toGrid(vrtPoints[i + 1u].xyz) - toGrid(vrtPoints[i - 1u].xyz);
-        if (seg + 1u < segments) gClipB = toGrid(vrtPoints[i + 2u].xyz) - gA;
+        if (seg > 0u) gClipA = toGrid(vrtPoint(i + 1u)) - toGrid(vrtPoint(i - 1u));
+        if (seg + 1u < segments) gClipB = toGrid(vrtPoint(i + 2u)) - gA;
     }
     forEachCapsuleVoxel(gA, gB, gRadius);
 }

@@ -64,10 +64,12 @@ struct PolylinePosition {
     double t;
 };
 
-// How a file's variable-step input was resampled (its RSMP chunk).
+// How a file's variable-step input was resampled (its RSMP chunk, and the
+// decoder's stretch of the step from its header: decoder_stretch).
 struct Resampling {
     double step_mm = 0;
     ResampleCurve curve = ResampleCurve::cubic;
+    double stretch = 1;  // what the length-keeping tension allowed for (cubic_keeping_length)
 };
 
 // Walks along the curve from the first point and emits points on it whose
@@ -98,6 +100,12 @@ bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Ve
 // already known (length_keeping_tension's).
 bool resample_cubic_keeping_end(std::span<const Vec3f> in, double step, double tension, std::vector<Vec3f>& out,
                                 std::vector<PolylinePosition>* positions = nullptr);
+
+// The same, resampled as a file says (curve, step and, for the
+// length-keeping tension, the decoder's stretch): the points compress aimed
+// at, so that a comparison with the source measures what the codec did.
+void resample_fixed_step(std::span<const Vec3f> in, const Resampling& how, std::vector<Vec3f>& out);
+bool resample_keeping_end(std::span<const Vec3f> in, const Resampling& how, std::vector<Vec3f>& out);
 
 // Per-point values (`components` floats per input point) at resampled points:
 // linear interpolation between the two input points of the segment each

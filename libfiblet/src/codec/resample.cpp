@@ -246,6 +246,18 @@ bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Ve
     return resample_on(in, step, curve, tension, true, kPiecesPerStep, out, positions);
 }
 
+void resample_fixed_step(std::span<const Vec3f> in, const Resampling& how, std::vector<Vec3f>& out) {
+    const double tension =
+        how.curve == ResampleCurve::cubic_keeping_length ? length_keeping_tension(in, how.step_mm, how.stretch) : 1.0;
+    resample_on(in, how.step_mm, how.curve, tension, false, kPiecesPerStep, out, nullptr);
+}
+
+bool resample_keeping_end(std::span<const Vec3f> in, const Resampling& how, std::vector<Vec3f>& out) {
+    const double tension =
+        how.curve == ResampleCurve::cubic_keeping_length ? length_keeping_tension(in, how.step_mm, how.stretch) : 1.0;
+    return resample_on(in, how.step_mm, how.curve, tension, true, kPiecesPerStep, out, nullptr);
+}
+
 void interpolate_point_values(std::span<const PolylinePosition> positions, const float* in_values,
                               std::size_t components, float* out_values) {
     for (std::size_t k = 0; k < positions.size(); ++k) {

@@ -157,6 +157,7 @@ Resampling parse_resampling(const TrailerChunk& c, const FftHeader& h, const std
             bad_chunk(name, c.tag, "unknown resampling curve " + std::to_string(curve) + "/" + std::to_string(reserved));
         r.curve = ResampleCurve(curve);
     }
+    r.stretch = decoder_stretch(h.step, h.scaling, r.step_mm);
     return r;
 }
 

@@ -25,7 +25,6 @@ Comparison compare_to_reference(const FftFile& fft, const std::string& tck_path,
     const Resampling resampling = fft.resampling().value_or(Resampling{});  // validated at open: step finite, > 0
     c.resampled = fft.resampling().has_value();
     const bool keeps_ends = fft.end_fractions() != nullptr;
-    const double stretch = decoder_stretch(h.step, h.scaling, resampling.step_mm);  // of the fitted tensions
     const auto source = open_streamline_source(tck_path, {.allow_count_mismatch = allow_count_mismatch});
     StreamlineSource& ref = *source;  // a .tck, .trk or TRX
     std::vector<Vec3f> original, resampled;
@@ -40,11 +39,8 @@ Comparison compare_to_reference(const FftFile& fft, const std::string& tck_path,
             if (c.resampled) {
                 // Files with an ENDS chunk keep each fiber's end point; older
                 // ones dropped the tail shorter than a step.
-                if (resampling.curve == ResampleCurve::cubic_keeping_length)
-                    resample_cubic_keeping_end(original, resampling.step_mm,
-                                               length_keeping_tension(original, resampling.step_mm, stretch), resampled);
-                else if (keeps_ends) resample_keeping_end(original, resampling.step_mm, resampled, resampling.curve);
-                else resample_fixed_step(original, resampling.step_mm, resampled, resampling.curve);
+                if (keeps_ends) resample_keeping_end(original, resampling, resampled);
+                else resample_fixed_step(original, resampling, resampled);
                 target = resampled;
             }
             const std::uint64_t n = chunk.offsets[i + 1] - chunk.offsets[i];

@@ -6,25 +6,33 @@
 namespace fiblet {
 
 namespace {
-constexpr double kBinMm = 1e-5;          // 0.01 µm
-constexpr double kBinsPerMm = 1e5;
-constexpr std::size_t kBins = 200000;    // up to 2 mm
-constexpr std::size_t kPageBins = 2048;  // 20.48 µm per page
-constexpr std::size_t kPages = (kBins + 1 + kPageBins - 1) / kPageBins;
+constexpr double kBinMm = 1e-5;  // 0.01 µm
 }  // namespace
 
-ErrorStats::ErrorStats() : pages_(kPages) {}
+ErrorStats::ErrorStats() : pages_((kBins + 1 + kPageBins - 1) / kPageBins) {}
 
-void ErrorStats::add(double e, std::uint64_t fiber) {
-    ++count_;
-    sum_ += e;
-    sum_sq_ += e * e;
-    if (count_ == 1 || e > max_) max_ = e, worst_fiber_ = fiber;
-    const double bin = e * kBinsPerMm;  // a multiply: add() runs several times per point in compress
-    const std::size_t i = bin < double(kBins) ? std::size_t(bin) : kBins;
-    std::vector<std::uint64_t>& page = pages_[i / kPageBins];
+void ErrorStats::select_page(std::size_t p) {
+    std::vector<std::uint64_t>& page = pages_[p];
     if (page.empty()) page.resize(kPageBins, 0);
-    ++page[i % kPageBins];
+    page_ = page.data(), page_index_ = p;
+}
+
+void ErrorStats::add_all(const double* errors, std::size_t n, std::uint64_t fiber) {
+    std::uint64_t count = count_;
+    double sum = sum_, sum_sq = sum_sq_, max = max_;
+    std::uint64_t worst = worst_fiber_;
+    for (std::size_t k = 0; k < n; ++k) {
+        const double e = errors[k];
+        ++count;
+        sum += e;
+        sum_sq += e * e;
+        if (count == 1 || e > max) max = e, worst = fiber;
+        const double bin = e * kBinsPerMm;
+        const std::size_t i = bin < double(kBins) ? std::size_t(bin) : kBins;
+        if (i / kPageBins != page_index_) [[unlikely]] select_page(i / kPageBins);
+        ++page_[i % kPageBins];
+    }
+    count_ = count, sum_ = sum, sum_sq_ = sum_sq, max_ = max, worst_fiber_ = worst;
 }
 
 void ErrorStats::merge(const ErrorStats& o) {
@@ -34,7 +42,7 @@ void ErrorStats::merge(const ErrorStats& o) {
     count_ += o.count_;
     sum_ += o.sum_;
     sum_sq_ += o.sum_sq_;
-    for (std::size_t p = 0; p < kPages; ++p) {
+    for (std::size_t p = 0; p < pages_.size(); ++p) {
         if (o.pages_[p].empty()) continue;
         if (pages_[p].empty()) pages_[p].resize(kPageBins, 0);
         for (std::size_t i = 0; i < kPageBins; ++i) pages_[p][i] += o.pages_[p][i];

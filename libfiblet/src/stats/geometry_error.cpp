@@ -5,6 +5,13 @@
 #include <limits>
 #include <vector>
 
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#endif
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
+
 namespace fiblet {
 
 namespace {
@@ -14,30 +21,91 @@ double distance(Vec3f a, Vec3f b) {
     return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
 
-// A segment of the polyline measured against: its start, direction and the
-// inverse squared length, computed once per fiber (no division per query).
-struct Segment {
-    double ax, ay, az, ux, uy, uz, inv_uu;
+// The segments of the polyline measured against, as columns (start,
+// direction, inverse squared length), computed once per fiber: the window
+// of segments a point is measured against is evaluated as one vectorizable
+// loop. The polyline's length comes with them (the same double arithmetic
+// and order as polyline_length).
+constexpr std::size_t kLanes = 8;
+
+// v[i] = sqrt(v[i]), two at a time where SSE2 is there (sqrtpd rounds
+// correctly, as std::sqrt does).
+void sqrt_all(double* v, std::size_t n) {
+    std::size_t i = 0;
+#ifdef __SSE2__
+    for (; i + 2 <= n; i += 2) _mm_storeu_pd(v + i, _mm_sqrt_pd(_mm_loadu_pd(v + i)));
+#endif
+    for (; i < n; ++i) v[i] = std::sqrt(v[i]);
+}
+
+struct Segments {
+    std::vector<double> ax, ay, az, ux, uy, uz, inv_uu, len;
+    double length = 0;
 };
 
-void segments_of(std::span<const Vec3f> line, std::vector<Segment>& out) {
-    out.clear();
+void segments_of(std::span<const Vec3f> line, Segments& out) {
     const std::size_t n = line.size() > 1 ? line.size() - 1 : 1;  // a single point: one degenerate segment
+    // kLanes padding segments far away (their squared distance is +inf,
+    // never a nearest one), so a window of up to kLanes segments is always
+    // evaluated whole.
+    for (auto* v : {&out.ax, &out.ay, &out.az}) v->assign(n + kLanes, 1e300);
+    for (auto* v : {&out.ux, &out.uy, &out.uz, &out.inv_uu}) v->assign(n + kLanes, 0.0);
+    out.len.resize(n);
+    double length = 0;
     for (std::size_t s = 0; s < n; ++s) {
         const Vec3f a = line[s], b = line[std::min(s + 1, line.size() - 1)];
         const double ux = double(b.x) - a.x, uy = double(b.y) - a.y, uz = double(b.z) - a.z;
         const double uu = ux * ux + uy * uy + uz * uz;
-        out.push_back({a.x, a.y, a.z, ux, uy, uz, uu > 0 ? 1.0 / uu : 0.0});
+        out.ax[s] = a.x, out.ay[s] = a.y, out.az[s] = a.z;
+        out.ux[s] = ux, out.uy[s] = uy, out.uz[s] = uz;
+        out.inv_uu[s] = uu > 0 ? 1.0 / uu : 0.0;
+        out.len[s] = uu;
     }
+    // The segments' lengths: square roots two at a time (correctly rounded,
+    // as std::sqrt), summed in order.
+    if (line.size() > 1) {
+        sqrt_all(out.len.data(), n);
+        for (std::size_t s = 0; s < n; ++s) length += out.len[s];
+    }
+    out.length = length;
 }
 
-// Squared distance from p to a segment (its start when it has no length).
-double distance2(const Segment& g, double px, double py, double pz) {
-    const double wx = px - g.ax, wy = py - g.ay, wz = pz - g.az;
-    double t = (wx * g.ux + wy * g.uy + wz * g.uz) * g.inv_uu;
-    t = t < 0 ? 0 : (t > 1 ? 1 : t);
-    const double dx = wx - t * g.ux, dy = wy - t * g.uy, dz = wz - t * g.uz;
-    return dx * dx + dy * dy + dz * dz;
+#if defined(__GNUC__) && defined(__x86_64__)
+#define FIBLET_GEOMETRY_AVX2 1
+#endif
+
+// Squared distances of p to the kLanes segments from `base` into d: the
+// same double operations, in the same order, as the scalar dist2 below
+// (max(0, t) and min(1, t) return t for a NaN and keep -0, as the
+// ternaries do; no fused multiply-add: -ffp-contract=off).
+#ifdef FIBLET_GEOMETRY_AVX2
+__attribute__((target("avx2"))) inline void window_avx2(const Segments& g, double px, double py, double pz,
+                                                        std::size_t base, double* d) {
+    const __m256d x = _mm256_set1_pd(px), y = _mm256_set1_pd(py), z = _mm256_set1_pd(pz);
+    const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
+    for (std::size_t h = 0; h < kLanes; h += 4) {
+        const std::size_t s = base + h;
+        const __m256d ux = _mm256_loadu_pd(&g.ux[s]), uy = _mm256_loadu_pd(&g.uy[s]), uz = _mm256_loadu_pd(&g.uz[s]);
+        const __m256d wx = _mm256_sub_pd(x, _mm256_loadu_pd(&g.ax[s])), wy = _mm256_sub_pd(y, _mm256_loadu_pd(&g.ay[s])),
+                      wz = _mm256_sub_pd(z, _mm256_loadu_pd(&g.az[s]));
+        __m256d t = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(wx, ux), _mm256_mul_pd(wy, uy)), _mm256_mul_pd(wz, uz));
+        t = _mm256_mul_pd(t, _mm256_loadu_pd(&g.inv_uu[s]));
+        t = _mm256_min_pd(one, _mm256_max_pd(zero, t));  // (0 > t ? 0 : t), then (1 < t ? 1 : t)
+        const __m256d dx = _mm256_sub_pd(wx, _mm256_mul_pd(t, ux)), dy = _mm256_sub_pd(wy, _mm256_mul_pd(t, uy)),
+                      dz = _mm256_sub_pd(wz, _mm256_mul_pd(t, uz));
+        _mm256_storeu_pd(d + h, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)),
+                                              _mm256_mul_pd(dz, dz)));
+    }
+}
+#endif
+
+bool have_avx2() {
+#ifdef FIBLET_GEOMETRY_AVX2
+    static const bool yes = __builtin_cpu_supports("avx2");
+    return yes;
+#else
+    return false;
+#endif
 }
 
 // Every point of `from` against the polyline `to`, in order along both, so
@@ -45,21 +113,67 @@ double distance2(const Segment& g, double px, double py, double pz) {
 // reach of the last nearest one are searched (squared distances, one square
 // root per point; this runs on every point `compress` writes): two segments
 // back, and ahead the segments one step of `from` can cross plus two.
-void points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to, ErrorStats& out, std::uint64_t fiber) {
-    if (from.empty() || to.empty()) return;
-    thread_local std::vector<Segment> segments;
-    segments_of(to, segments);
+// Returns the length of `to`.
+//
+// Fixed-step files (as many points as the polyline): point k's window is
+// [hint - 2, hint + 4) and the hint stays at k - 1 or k, so the kLanes
+// segments from k - 4 are evaluated first, independently of the hint (the
+// points' evaluations overlap instead of waiting on each other's nearest
+// segment); the nearest one is then chosen from the same window as always,
+// or evaluated directly where the window leaves those kLanes. The result is
+// the same, bit for bit.
+double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to, ErrorStats& out, std::uint64_t fiber) {
+    if (to.empty()) return 0;
+    thread_local Segments g;
+    segments_of(to, g);
+    if (from.empty()) return g.length;
+    const std::size_t n = g.ax.size() - kLanes;
     const std::size_t ahead = 2 + (to.size() + from.size() - 1) / from.size();
+    thread_local std::vector<double> d2;
+    d2.resize(ahead + 3);
+    const double *ax = g.ax.data(), *ay = g.ay.data(), *az = g.az.data(), *ux = g.ux.data(), *uy = g.uy.data(),
+                 *uz = g.uz.data(), *inv = g.inv_uu.data();
+    double* d = d2.data();
+    // Squared distance of p to segment s (its start when it has no length).
+    auto dist2 = [&](double px, double py, double pz, std::size_t s) {
+        const double wx = px - ax[s], wy = py - ay[s], wz = pz - az[s];
+        double t = (wx * ux[s] + wy * uy[s] + wz * uz[s]) * inv[s];
+        t = t < 0 ? 0 : (t > 1 ? 1 : t);
+        const double dx = wx - t * ux[s], dy = wy - t * uy[s], dz = wz - t * uz[s];
+        return dx * dx + dy * dy + dz * dz;
+    };
     std::size_t hint = 0;
-    for (const Vec3f& p : from) {
-        const std::size_t lo = hint > 2 ? hint - 2 : 0, hi = std::min(segments.size(), hint + ahead + 1);
+    const bool paired = from.size() == to.size() && have_avx2();
+    alignas(32) double lanes[kLanes];
+    thread_local std::vector<double> nearest;  // squared distances, then distances
+    nearest.resize(from.size());
+    for (std::size_t k = 0; k < from.size(); ++k) {
+        const Vec3f& p = from[k];
+        const std::size_t lo = hint > 2 ? hint - 2 : 0, hi = std::min(n, hint + ahead + 1), w = hi - lo;
+        const double px = p.x, py = p.y, pz = p.z;
         double best = std::numeric_limits<double>::infinity();
-        for (std::size_t s = lo; s < hi; ++s) {
-            const double d2 = distance2(segments[s], p.x, p.y, p.z);
-            if (d2 < best) best = d2, hint = s;
+#ifdef FIBLET_GEOMETRY_AVX2
+        if (paired) {
+            const std::size_t base = k >= 4 ? k - 4 : 0;
+            window_avx2(g, px, py, pz, base, lanes);
+            if (lo >= base && hi <= base + kLanes) {
+                for (std::size_t s = lo; s < hi; ++s)
+                    if (lanes[s - base] < best) best = lanes[s - base], hint = s;
+                nearest[k] = best;
+                continue;
+            }
         }
-        out.add(std::sqrt(best), fiber);
+#endif
+        for (std::size_t j = 0; j < w; ++j) d[j] = dist2(px, py, pz, lo + j);
+        for (std::size_t j = 0; j < w; ++j)
+            if (d[j] < best) best = d[j], hint = lo + j;
+        nearest[k] = best;
     }
+    // Square roots two at a time (correctly rounded, as std::sqrt), then
+    // the statistics in order.
+    sqrt_all(nearest.data(), nearest.size());
+    out.add_all(nearest.data(), nearest.size(), fiber);
+    return g.length;
 }
 
 }  // namespace
@@ -84,12 +198,11 @@ double polyline_length(std::span<const Vec3f> line) {
 }
 
 void GeometryError::add_fiber(std::span<const Vec3f> input, std::span<const Vec3f> decoded, std::uint64_t fiber) {
-    points_to_polyline(decoded, input, decoded_to_input_, fiber);
-    points_to_polyline(input, decoded, input_to_decoded_, fiber);
+    const double li = points_to_polyline(decoded, input, decoded_to_input_, fiber);
+    const double ld = points_to_polyline(input, decoded, input_to_decoded_, fiber);
     if (input.empty() || decoded.empty()) return;
     endpoint_.add(distance(input.front(), decoded.front()), fiber);
     endpoint_.add(distance(input.back(), decoded.back()), fiber);
-    const double li = polyline_length(input), ld = polyline_length(decoded);
     length_mm_.add(std::fabs(ld - li), fiber);
     signed_length_sum_ += ld - li;
     if (li > 0) length_pct_.add(100.0 * std::fabs(ld - li) / li, fiber);

@@ -61,4 +61,14 @@ void ImageSliceOverlay::draw(const Camera& camera, const RenderOptions&) {
     glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
 }
 
+std::optional<std::array<Vec3f, 2>> ImageSliceOverlay::bounds() const {
+    std::array<Vec3f, 2> b;
+    for (int c = 0; c < 4; ++c) {
+        const auto& p = geometry_.corners[std::size_t(c)];
+        b[0] = c == 0 ? Vec3f{p[0], p[1], p[2]} : Vec3f{std::min(b[0].x, p[0]), std::min(b[0].y, p[1]), std::min(b[0].z, p[2])};
+        b[1] = c == 0 ? Vec3f{p[0], p[1], p[2]} : Vec3f{std::max(b[1].x, p[0]), std::max(b[1].y, p[1]), std::max(b[1].z, p[2])};
+    }
+    return b;
+}
+
 }  // namespace fiblet::viewer

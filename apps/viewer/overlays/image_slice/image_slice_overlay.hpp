@@ -27,6 +27,7 @@ class ImageSliceOverlay final : public Overlay {
 public:
     explicit ImageSliceOverlay(const SliceImage& slice);
     void draw(const Camera& camera, const RenderOptions& options) override;
+    std::optional<std::array<Vec3f, 2>> bounds() const override;
 
 private:
     GlProgram program_;

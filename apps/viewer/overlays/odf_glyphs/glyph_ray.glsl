@@ -5,15 +5,22 @@ uniform int uLmax;
 // glyph_inverse_vandermonde(uLmax), row-major (uLmax + 1)².
 uniform float uInverseVandermonde[(kMaxLmax + 1) * (kMaxLmax + 1)];
 
-float homogenized(uint base, vec3 x) {
-    float r = length(x);
-    return r == 0.0 ? 0.0 : pow(r, float(uLmax)) * shValue(base, uLmax, x / r);
-}
-
 float powi(float x, int n) {
     float r = 1.0;
     for (int i = 0; i < n; ++i) r *= x;
     return r;
+}
+
+// glyph_normal of glyph_ray.hpp: −∇F at x ≠ 0 in closed form, normalized
+// (the zero vector at x = 0).
+vec3 glyphNormal(uint base, int k, vec3 x) {
+    float r = length(x);
+    if (!(r > 0.0)) return vec3(0.0);
+    vec3 u = x / r, g;
+    float f = shValueAndGradient(base, k, u, g);
+    vec3 n = (float(k + 1) * r * r - float(k) * f * f) * u - f * g;
+    float len = length(n);
+    return len > 0.0 ? n / len : n;
 }
 
 // First hit of o + t d (unit d, glyph units, coefficients from `base`)
@@ -62,17 +69,6 @@ bool traceGlyph(uint base, vec3 o, vec3 d, float tMin, float tolerance, out floa
     if (!firstRoot(poly, degree, lo, hi, tolerance, s)) return false;
     t = t0 + s;
 
-    float X = rho, Y = s, g = 0.0, gx = 0.0, gy = 0.0;
-    for (int j = 0; j <= k; ++j) {
-        float xp = powi(X, k - j), yp = powi(Y, j);
-        g += a[j] * xp * yp;
-        if (k - j > 0) gx += a[j] * float(k - j) * powi(X, k - j - 1) * yp;
-        if (j > 0) gy += a[j] * float(j) * xp * powi(Y, j - 1);
-    }
-    vec3 x = X * e1 + Y * e2;
-    float h = 1e-3;
-    float gz = (homogenized(base, x + h * e3) - homogenized(base, x - h * e3)) / (2.0 * h);
-    vec3 n = 2.0 * g * (gx * e1 + gy * e2 + gz * e3) - float(2 * k + 2) * powi(X * X + Y * Y, k) * x;
-    normal = -normalize(n);
+    normal = glyphNormal(base, k, rho * e1 + s * e2);
     return true;
 }

@@ -86,6 +86,30 @@ T homogenized(const Coefficients& b, int k, const Vec3<T>& x) {
     return std::pow(r, T(k)) * sh_value<T>(b, k, x[0] / r, x[1] / r, x[2] / r);
 }
 
+// The outward unit normal at x ≠ 0 (glyph units) of the level set of
+// F(x) = f_h(x)² − ‖x‖^{2k+2} through x, in closed form. With x = r u,
+// f_h = r^k f(u) is homogeneous of degree k (Euler: its radial derivative is
+// k f_h / r) and across u it changes as r^{k−1} ∇_S f(u), so
+//   ∇f_h = r^{k−1} (k f u + ∇_S f),
+//   ∇F = 2 f_h ∇f_h − (2k+2) r^{2k} x = 2 r^{2k−1} ((k f² − (k+1) r²) u + f ∇_S f),
+// and −∇F (outward: F grows inwards) lies along ((k+1) r² − k f²) u − f ∇_S f.
+// On the surface (r = |f|) that is r² u − f ∇_S f ∝ x − (f/r) ∇_S f, the
+// paper's formula; off it (the root finder's tolerance) still exactly −∇F.
+// One SH evaluation with its gradient (sh_value_and_gradient).
+template <class T, class Coefficients>
+Vec3<T> glyph_normal(const Coefficients& b, int k, const Vec3<T>& x) {
+    const T r = std::sqrt(dot3(x, x));
+    if (!(r > 0)) return {0, 0, 0};
+    const Vec3<T> u{x[0] / r, x[1] / r, x[2] / r};
+    T g[3];
+    const T f = sh_value_and_gradient<T>(b, k, u[0], u[1], u[2], g);
+    const T radial = T(k + 1) * r * r - T(k) * f * f;
+    Vec3<T> n{radial * u[0] - f * g[0], radial * u[1] - f * g[1], radial * u[2] - f * g[2]};
+    const T len = std::sqrt(dot3(n, n));
+    if (len > 0) n = {n[0] / len, n[1] / len, n[2] / len};
+    return n;
+}
+
 // The first hit of the ray o + t d (unit d, glyph units) with t in
 // [t_min, ∞), or nothing. `tolerance`: the root finder's step tolerance.
 template <class T, class Coefficients>
@@ -116,30 +140,8 @@ std::optional<GlyphHit<T>> trace_glyph(const Coefficients& b, int k, const std::
     if (!s) return std::nullopt;
     GlyphHit<T> hit;
     hit.t = p.t0 + *s;
-    // ∇F = 2 f_h ∇f_h − (2k+2) ‖x‖^{2k} x. In the plane ∇f_h is the
-    // derivative of Σ a_j X^{k−j} Y^j; across it, a central difference.
     const T X = p.rho, Y = *s;
-    T g = 0, gx = 0, gy = 0;
-    for (int j = 0; j <= k; ++j) {
-        const T xp = std::pow(X, T(k - j)), yp = std::pow(Y, T(j));
-        g += a[j] * xp * yp;
-        if (k - j > 0) gx += a[j] * T(k - j) * std::pow(X, T(k - j - 1)) * yp;
-        if (j > 0) gy += a[j] * T(j) * xp * std::pow(Y, T(j - 1));
-    }
-    const Vec3<T> x{X * p.e1[0] + Y * p.e2[0], X * p.e1[1] + Y * p.e2[1], X * p.e1[2] + Y * p.e2[2]};
-    const T h = T(1e-3);
-    const Vec3<T> xp{x[0] + h * p.e3[0], x[1] + h * p.e3[1], x[2] + h * p.e3[2]};
-    const Vec3<T> xm{x[0] - h * p.e3[0], x[1] - h * p.e3[1], x[2] - h * p.e3[2]};
-    const T gz = (homogenized<T>(b, k, xp) - homogenized<T>(b, k, xm)) / (2 * h);
-    const T r2k = std::pow(X * X + Y * Y, T(k));
-    const T k2 = T(2 * k + 2);
-    Vec3<T> n;
-    for (int i = 0; i < 3; ++i)
-        n[i] = 2 * g * (gx * p.e1[i] + gy * p.e2[i] + gz * p.e3[i]) - k2 * r2k * x[i];
-    const T len = std::sqrt(dot3(n, n));
-    if (len > 0) n = {n[0] / len, n[1] / len, n[2] / len};
-    // F grows inwards; the outward normal is −∇F.
-    hit.normal = {-n[0], -n[1], -n[2]};
+    hit.normal = glyph_normal<T>(b, k, Vec3<T>{X * p.e1[0] + Y * p.e2[0], X * p.e1[1] + Y * p.e2[1], X * p.e1[2] + Y * p.e2[2]});
     return hit;
 }
 

@@ -1,10 +1,12 @@
 #include "overlays/odf_glyphs/odf_glyphs_overlay.hpp"
 
+#include <algorithm>
 #include <vector>
 
 #include "gpu_bindings.hpp"
 #include "overlays/odf_glyphs/glyph_ray.hpp"
 #include "shader_program.hpp"
+#include "vec_ops.hpp"
 #include "shading_uniforms.hpp"
 #include "techniques/draw_technique.hpp"
 
@@ -24,6 +26,13 @@ OdfGlyphsOverlay::OdfGlyphsOverlay(const GlyphSet& g)
     for (std::size_t i = 0; i < g.centers.size(); ++i) {
         const auto e = g.extents.empty() ? std::array<float, 3>{1, 1, 1} : g.extents[i];
         boxes.insert(boxes.end(), {g.centers[i][0], g.centers[i][1], g.centers[i][2], g.centers[i][3], e[0], e[1], e[2], 0.0f});
+        const Vec3f c{g.centers[i][0], g.centers[i][1], g.centers[i][2]};
+        const Vec3f half{g.centers[i][3] * e[0], g.centers[i][3] * e[1], g.centers[i][3] * e[2]};
+        const Vec3f lo = sub(c, half), hi = add(c, half);
+        if (!bounds_) bounds_ = std::array<Vec3f, 2>{lo, hi};
+        auto& b = *bounds_;
+        b[0] = {std::min(b[0].x, lo.x), std::min(b[0].y, lo.y), std::min(b[0].z, lo.z)};
+        b[1] = {std::max(b[1].x, hi.x), std::max(b[1].y, hi.y), std::max(b[1].z, hi.z)};
     }
     centers_ = boxes.empty() ? make_buffer(sizeof none, none, 0)
                              : make_buffer(GLsizeiptr(boxes.size() * sizeof(float)), boxes.data(), 0);

@@ -15,9 +15,11 @@ class OdfGlyphsOverlay final : public Overlay {
 public:
     explicit OdfGlyphsOverlay(const GlyphSet& glyphs);
     void draw(const Camera& camera, const RenderOptions& options) override;
+    std::optional<std::array<Vec3f, 2>> bounds() const override { return bounds_; }
     std::size_t glyph_count() const { return glyphs_; }
 
 private:
+    std::optional<std::array<Vec3f, 2>> bounds_;  // the glyphs' boxes; nothing without glyphs
     GlProgram program_;
     GlBuffer coefficients_, centers_;
     std::size_t glyphs_ = 0;

@@ -1,7 +1,9 @@
 #version 450
 // One capsule per decoded segment (as fine_lines.vert.glsl numbers them):
 // the oriented box around it (box_proxy.glsl); segments a block does not
-// have are sent outside the clip volume.
+// have are sent outside the clip volume. A slot draws uSlotSegments
+// segments: its whole block, or with uChunksPerBlock > 0 (sorted
+// transparency) one chunk, the list holding block x uChunksPerBlock + chunk.
 #include "scene_buffers.glsl"
 #include "box_proxy.glsl"
 #include "fiber_radii.glsl"
@@ -12,6 +14,8 @@ layout(std430, binding = BINDING_POINTS) readonly buffer Points { vec4 points[];
 uniform mat4 uViewProjection;
 uniform bool uUseList;
 uniform uint uFirst;
+uniform uint uSlotSegments;    // uPointsPerBlock, or a chunk's segments
+uniform uint uChunksPerBlock;  // 0: slots are whole blocks
 
 layout(location = 0) flat out vec3 vEnd0;
 layout(location = 1) flat out vec3 vEnd1;
@@ -22,8 +26,13 @@ layout(location = 4) flat out float vRadius;
 void main() {
     uint v = uint(gl_VertexID);
     uint capsule = v / kBoxVertices;
-    uint slot = capsule / uPointsPerBlock, segment = capsule % uPointsPerBlock;
-    uint block = uUseList ? fineList[uFirst + slot] : uFirst + slot;
+    uint slot = capsule / uSlotSegments, segment = capsule % uSlotSegments;
+    uint entry = uUseList ? fineList[uFirst + slot] : uFirst + slot;
+    uint block = entry;
+    if (uChunksPerBlock > 0u) {
+        block = entry / uChunksPerBlock;
+        segment += (entry % uChunksPerBlock) * uSlotSegments;
+    }
     if (segment >= blockSegmentCount(block)) {
         vEnd0 = vEnd1 = vWorld = vec3(0.0);
         vFiber = 0u;

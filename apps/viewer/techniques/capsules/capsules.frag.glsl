@@ -57,6 +57,6 @@ void main() {
     if (outsideSlab(hit)) discard;
     gl_FragDepth = windowDepth(hit);
     vec3 n = normalize(normal);
-    outColor = vec4(shadeSurface(n, ba, -dir, vFiber) * (1.0 - rasterOcclusion(hit, n)), 1.0);
+    outColor = vec4(shadeSurface(n, ba, -dir, vFiber) * (1.0 - rasterOcclusion(hit, n)), fiberAlpha(vFiber));
     outFiber = vFiber + 1u;
 }

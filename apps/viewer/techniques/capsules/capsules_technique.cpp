@@ -19,14 +19,27 @@ void CapsulesTechnique::begin_frame(const FrameInputs& in) {
 }
 
 void CapsulesTechnique::draw_batch(const FrameInputs& in, const DecodedBatch& batch) {
-    glUseProgram(draw_.get());
+    draw_slots(in, batch, in.use_list, in.scene.header().points_per_block, 0);
+}
+
+void CapsulesTechnique::draw_chunks(const FrameInputs& in, const DecodedBatch& batch, std::uint32_t chunk_segments,
+                                    std::uint32_t chunks_per_block) {
+    draw_slots(in, batch, true, chunk_segments, chunks_per_block);
+}
+
+void CapsulesTechnique::draw_slots(const FrameInputs& in, const DecodedBatch& batch, bool use_list,
+                                   std::uint32_t slot_segments, std::uint32_t chunks_per_block) {
+    const GLuint id = draw_.get();
+    glUseProgram(id);
     in.scene.bind(draw_);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kPoints, batch.points);
-    glProgramUniform1i(draw_.get(), uniform(draw_, "uUseList"), in.use_list ? 1 : 0);
-    glProgramUniform1ui(draw_.get(), uniform(draw_, "uFirst"), batch.first);
+    glProgramUniform1i(id, uniform(draw_, "uUseList"), use_list ? 1 : 0);
+    glProgramUniform1ui(id, uniform(draw_, "uFirst"), batch.first);
+    glProgramUniform1ui(id, uniform(draw_, "uSlotSegments"), slot_segments);
+    glProgramUniform1ui(id, uniform(draw_, "uChunksPerBlock"), chunks_per_block);
     glEnable(GL_CULL_FACE);
     glCullFace(GL_BACK);
-    glDrawArrays(GL_TRIANGLES, 0, GLsizei(kBoxProxyVertices * in.scene.header().points_per_block * batch.count));
+    glDrawArrays(GL_TRIANGLES, 0, GLsizei(kBoxProxyVertices * slot_segments * batch.count));
     glDisable(GL_CULL_FACE);
 }
 

@@ -19,8 +19,13 @@ public:
     void begin_frame(const FrameInputs& in) override;
     void draw_batch(const FrameInputs& in, const DecodedBatch& batch) override;
     void draw_coarse(const FrameInputs& in, std::uint32_t count) override;
+    bool draws_chunks() const override { return true; }
+    void draw_chunks(const FrameInputs& in, const DecodedBatch& batch, std::uint32_t chunk_segments,
+                     std::uint32_t chunks_per_block) override;
 
 private:
+    void draw_slots(const FrameInputs& in, const DecodedBatch& batch, bool use_list, std::uint32_t slot_segments,
+                    std::uint32_t chunks_per_block);
     GlProgram draw_;
     LinesTechnique coarse_lines_;
 };

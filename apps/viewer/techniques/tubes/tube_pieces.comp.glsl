@@ -2,7 +2,10 @@
 // Tube pieces of a decoded batch, one invocation per Hermite segment: nodes
 // every uNodeSpacing points of a slot (and its last point), tangents from
 // the decoder's unit tangents (tube_spline.hpp), two quadratic Bézier
-// pieces per segment, each with its oriented bounding box.
+// pieces per segment, each with its oriented bounding box. With
+// uChunksPerBlock > 0 (sorted transparency) the list holds block x
+// uChunksPerBlock + chunk and a slot keeps only the segments whose first
+// node lies in its chunk (points [chunk, chunk + 1) x uChunkSegments).
 layout(local_size_x = 64) in;
 
 #include "scene_buffers.glsl"
@@ -20,6 +23,8 @@ uniform uint uCount;            // slots in the batch
 uniform uint uNodeSpacing;      // points between nodes
 uniform uint uSegmentsPerSlot;  // tube_segments_per_slot
 uniform float uTangentScale;    // c of tube_spline.hpp (1/4)
+uniform uint uChunksPerBlock;   // 0: slots are whole blocks
+uniform uint uChunkSegments;
 
 // The node's unit direction: the mean of the tangents arriving at and
 // leaving point k. A block's first point and the point joining the next
@@ -85,10 +90,12 @@ void main() {
     uint id = gl_GlobalInvocationID.x;
     uint slot = id / uSegmentsPerSlot, segment = id % uSegmentsPerSlot;
     if (slot >= uCount) return;
-    uint block = uUseList ? fineList[uFirst + slot] : uFirst + slot;
+    uint entry = uUseList ? fineList[uFirst + slot] : uFirst + slot;
+    uint block = uChunksPerBlock > 0u ? entry / uChunksPerBlock : entry;
     uint last = blockSegmentCount(block);  // the slot's points are 0..last
     uint k0 = segment * uNodeSpacing;
-    if (k0 >= last) {
+    bool otherChunk = uChunksPerBlock > 0u && k0 / uChunkSegments != entry % uChunksPerBlock;
+    if (k0 >= last || otherChunk) {
         pieces[2u * id].c0.w = -1.0;
         pieces[2u * id + 1u].c0.w = -1.0;
         return;

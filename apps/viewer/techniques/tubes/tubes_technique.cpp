@@ -1,5 +1,7 @@
 #include "techniques/tubes/tubes_technique.hpp"
 
+#include <algorithm>
+
 #include "gpu_bindings.hpp"
 #include "shader_program.hpp"
 #include "shading_uniforms.hpp"
@@ -23,6 +25,11 @@ void TubesTechnique::begin_frame(const FrameInputs& in) {
 }
 
 std::uint32_t TubesTechnique::build_pieces(const FrameInputs& in, const DecodedBatch& batch) {
+    return build_pieces(in, batch, in.use_list, 0, 0);
+}
+
+std::uint32_t TubesTechnique::build_pieces(const FrameInputs& in, const DecodedBatch& batch, bool use_list,
+                                           std::uint32_t chunk_segments, std::uint32_t chunks_per_block) {
     const FftHeader& h = in.scene.header();
     const std::uint32_t s = tube_node_spacing(tube_radius_for_spacing(in.scene, in.options), h.step * h.scaling);
     const std::uint32_t segments_per_slot = tube_segments_per_slot(h.points_per_block, s);
@@ -37,7 +44,9 @@ std::uint32_t TubesTechnique::build_pieces(const FrameInputs& in, const DecodedB
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kPoints, batch.points);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kTangents, batch.tangents);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kTubePieces, pieces_.get());
-    glProgramUniform1i(id, uniform(build_, "uUseList"), in.use_list ? 1 : 0);
+    glProgramUniform1i(id, uniform(build_, "uUseList"), use_list ? 1 : 0);
+    glProgramUniform1ui(id, uniform(build_, "uChunksPerBlock"), chunks_per_block);
+    glProgramUniform1ui(id, uniform(build_, "uChunkSegments"), std::max(chunk_segments, 1u));
     glProgramUniform1ui(id, uniform(build_, "uFirst"), batch.first);
     glProgramUniform1ui(id, uniform(build_, "uCount"), batch.count);
     glProgramUniform1ui(id, uniform(build_, "uNodeSpacing"), s);
@@ -52,7 +61,18 @@ std::uint32_t TubesTechnique::build_pieces(const FrameInputs& in, const DecodedB
 
 void TubesTechnique::draw_batch(const FrameInputs& in, const DecodedBatch& batch) {
     if (batch.count == 0) return;
-    const std::uint32_t pieces = build_pieces(in, batch);
+    draw_pieces(build_pieces(in, batch));
+}
+
+void TubesTechnique::draw_chunks(const FrameInputs& in, const DecodedBatch& batch, std::uint32_t chunk_segments,
+                                 std::uint32_t chunks_per_block) {
+    // Every slot builds its block's segments, those of other chunks empty
+    // (drawn as nothing): the pieces keep the order of the slots.
+    if (batch.count == 0) return;
+    draw_pieces(build_pieces(in, batch, true, chunk_segments, chunks_per_block));
+}
+
+void TubesTechnique::draw_pieces(std::uint32_t pieces) {
     glUseProgram(draw_.get());
     glEnable(GL_CULL_FACE);
     glCullFace(GL_BACK);

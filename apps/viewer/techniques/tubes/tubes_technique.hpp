@@ -24,6 +24,9 @@ public:
     void begin_frame(const FrameInputs& in) override;
     void draw_batch(const FrameInputs& in, const DecodedBatch& batch) override;
     void draw_coarse(const FrameInputs& in, std::uint32_t count) override;
+    bool draws_chunks() const override { return true; }
+    void draw_chunks(const FrameInputs& in, const DecodedBatch& batch, std::uint32_t chunk_segments,
+                     std::uint32_t chunks_per_block) override;
 
     // The pieces of a batch (first step of draw_batch), left in
     // pieces_buffer() and bound at binding::kTubePieces; returns how many
@@ -32,6 +35,9 @@ public:
     GLuint pieces_buffer() const { return pieces_.get(); }
 
 private:
+    std::uint32_t build_pieces(const FrameInputs& in, const DecodedBatch& batch, bool use_list,
+                               std::uint32_t chunk_segments, std::uint32_t chunks_per_block);
+    void draw_pieces(std::uint32_t pieces);
     float tangent_scale_;
     GlProgram build_, draw_;
     GlBuffer pieces_;
