@@ -30,7 +30,7 @@ std::vector<float> embree_image(const FftFile& file, float radius, const Camera&
     std::vector<float> out(std::size_t(w) * std::size_t(h), INFINITY);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
-            out[std::size_t(y) * std::size_t(w) + std::size_t(x)] = oracle.nearest(cam.position, pixel_ray(cam, x, y, w, h)).t;
+            out[std::size_t(y) * std::size_t(w) + std::size_t(x)] = oracle.nearest(cam.position, camera_pixel_ray(cam, x, y, w, h)).t;
     return out;
 }
 

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -28,6 +29,25 @@ struct ViewerGl {
     std::unique_ptr<viewer::GpuPrograms> programs;
     std::string error;
 };
+
+// The unit ray through the centre of pixel (x, y) (rows from the top) of
+// view.hpp's camera: what the CPU references trace.
+inline std::array<double, 3> camera_pixel_ray(const Camera& cam, int x, int y, int w, int h) {
+    auto unit = [](double a, double b, double c) {
+        const double n = std::sqrt(a * a + b * b + c * c);
+        return std::array<double, 3>{a / n, b / n, c / n};
+    };
+    const auto fwd = unit(cam.target.x - cam.position.x, cam.target.y - cam.position.y, cam.target.z - cam.position.z);
+    const auto right = unit(fwd[1] * cam.up.z - fwd[2] * cam.up.y, fwd[2] * cam.up.x - fwd[0] * cam.up.z,
+                            fwd[0] * cam.up.y - fwd[1] * cam.up.x);
+    const std::array<double, 3> up{right[1] * fwd[2] - right[2] * fwd[1], right[2] * fwd[0] - right[0] * fwd[2],
+                                   right[0] * fwd[1] - right[1] * fwd[0]};
+    const double t = std::tan(double(cam.fov_y_deg) * M_PI / 360.0);
+    const double nx = (x + 0.5) / w * 2 - 1, ny = 1 - (y + 0.5) / h * 2;
+    return unit(fwd[0] + nx * t * cam.aspect * right[0] + ny * t * up[0],
+                fwd[1] + nx * t * cam.aspect * right[1] + ny * t * up[1],
+                fwd[2] + nx * t * cam.aspect * right[2] + ny * t * up[2]);
+}
 
 // Made on first use, kept for the whole test program.
 inline ViewerGl& viewer_gl() {

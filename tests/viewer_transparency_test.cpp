@@ -429,25 +429,6 @@ TEST(ViewerTransparency, FiberOpacitiesOfOneAreTheGlobalOpacity) {
 
 namespace {
 
-// The unit ray through the centre of pixel (x, y) (rows from the top) of
-// view.hpp's camera (as tests/embree_capsules.hpp's pixel_ray).
-std::array<double, 3> pixel_ray(const Camera& cam, int x, int y, int w, int h) {
-    auto unit = [](double a, double b, double c) {
-        const double n = std::sqrt(a * a + b * b + c * c);
-        return std::array<double, 3>{a / n, b / n, c / n};
-    };
-    const auto fwd = unit(cam.target.x - cam.position.x, cam.target.y - cam.position.y, cam.target.z - cam.position.z);
-    const auto right = unit(fwd[1] * cam.up.z - fwd[2] * cam.up.y, fwd[2] * cam.up.x - fwd[0] * cam.up.z,
-                            fwd[0] * cam.up.y - fwd[1] * cam.up.x);
-    const std::array<double, 3> up{right[1] * fwd[2] - right[2] * fwd[1], right[2] * fwd[0] - right[0] * fwd[2],
-                                   right[0] * fwd[1] - right[1] * fwd[0]};
-    const double t = std::tan(double(cam.fov_y_deg) * M_PI / 360.0);
-    const double nx = (x + 0.5) / w * 2 - 1, ny = 1 - (y + 0.5) / h * 2;
-    return unit(fwd[0] + nx * t * cam.aspect * right[0] + ny * t * up[0],
-                fwd[1] + nx * t * cam.aspect * right[1] + ny * t * up[1],
-                fwd[2] + nx * t * cam.aspect * right[2] + ny * t * up[2]);
-}
-
 // Entry distance of the unit ray (o, d) into the capsule of segment a-b and
 // radius r (the union of the cylinder between the end planes and the two
 // end spheres, as capsules.frag.glsl), or infinity; double precision.
@@ -504,7 +485,7 @@ Reference capsule_reference(const std::vector<Segment>& segments, const Camera& 
         const Fragment f{0, std::fabs(dx / len), std::fabs(dy / len), std::fabs(dz / len), opacity};
         for (int y = std::max(0, int(lo_y) - 1); y <= std::min(kSize - 1, int(hi_y) + 1); ++y)
             for (int x = std::max(0, int(lo_x) - 1); x <= std::min(kSize - 1, int(hi_x) + 1); ++x) {
-                const double t = capsule_entry(o, pixel_ray(cam, x, y, kSize, kSize), s.p0, s.p1, radius);
+                const double t = capsule_entry(o, camera_pixel_ray(cam, x, y, kSize, kSize), s.p0, s.p1, radius);
                 if (!std::isfinite(t)) continue;
                 Fragment g = f;
                 g.depth = t;

@@ -185,7 +185,7 @@ void expect_opaque_agreement(const viewer::GpuScene& scene, const EmbreeCapsules
     const double n = cam.near_mm, f = cam.far_mm, tt = std::tan(double(cam.fov_y_deg) * M_PI / 360.0);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
-            const auto ref = oracle.nearest(cam.position, pixel_ray(cam, x, y, w, h));
+            const auto ref = oracle.nearest(cam.position, camera_pixel_ray(cam, x, y, w, h));
             const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
             const std::uint32_t got = img.segments[i];
             const bool hit = std::isfinite(ref.t);
@@ -294,7 +294,7 @@ TEST(VoxelRtTrace, TransparencyMatchesEmbreeCompositingEveryHit) {
     std::size_t within = 0, crowded = 0, crowded_within = 0, max_in_voxel = 0;
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
-            const auto dir = pixel_ray(cam, x, y, w, h);
+            const auto dir = camera_pixel_ray(cam, x, y, w, h);
             const auto hits = oracle.all(cam.position, dir);
             double rgb[3] = {0, 0, 0}, transmittance = 1;
             std::map<std::array<int, 3>, std::size_t> per_voxel;
@@ -412,7 +412,7 @@ TEST(VoxelRtAmbientOcclusion, CorrelatesWithMonteCarloOcclusionRays) {
     const int w = 48, h = 48;
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
-            const auto dir = pixel_ray(cam, x, y, w, h);
+            const auto dir = camera_pixel_ray(cam, x, y, w, h);
             const auto hit = oracle.nearest(cam.position, dir);
             if (!std::isfinite(hit.t)) continue;
             const Vec3f p{cam.position.x + float(hit.t * dir[0]), cam.position.y + float(hit.t * dir[1]),

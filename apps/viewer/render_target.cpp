@@ -83,4 +83,17 @@ std::vector<float> RenderTarget::read_depth() const {
     return out;
 }
 
+void RenderTarget::begin_frame(bool clear, const std::array<float, 3>& background) const {
+    const GLuint fb = framebuffer();
+    glBindFramebuffer(GL_FRAMEBUFFER, fb);
+    glViewport(0, 0, width_, height_);
+    if (!clear) return;
+    const float color[4] = {background[0], background[1], background[2], 1.0f};
+    const GLuint no_fiber[4] = {0, 0, 0, 0};
+    const float far_depth = 1.0f;
+    glClearNamedFramebufferfv(fb, GL_COLOR, 0, color);
+    glClearNamedFramebufferuiv(fb, GL_COLOR, 1, no_fiber);
+    glClearNamedFramebufferfv(fb, GL_DEPTH, 0, &far_depth);
+}
+
 }  // namespace fiblet::viewer

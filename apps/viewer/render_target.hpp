@@ -3,6 +3,7 @@
 // window shows it by a blit; headless rendering reads it back.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -17,6 +18,9 @@ public:
     int width() const { return width_; }
     int height() const { return height_; }
     GLuint framebuffer() const { return framebuffer_.get(); }
+    // Binds it for drawing over its whole size; with `clear`, fills it with
+    // the background, no fiber and the far depth first.
+    void begin_frame(bool clear, const std::array<float, 3>& background) const;
 
     // Colour as RGBA8, rows from the top of the image.
     std::vector<std::uint8_t> read_rgba() const;

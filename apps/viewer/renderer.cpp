@@ -119,17 +119,7 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& requested, cons
     OcclusionVolume occlusion;
     if (o.ambient_occlusion) occlusion = voxel_ray_tracer().chord_occlusion(scene, o);
     const Viewport viewport{target.width(), target.height()};
-    const GLuint fb = target.framebuffer();
-    glBindFramebuffer(GL_FRAMEBUFFER, fb);
-    glViewport(0, 0, viewport.width, viewport.height);
-    if (o.clear) {
-        const float background[4] = {o.background[0], o.background[1], o.background[2], 1.0f};
-        const GLuint no_fiber[4] = {0, 0, 0, 0};
-        const float far_depth = 1.0f;
-        glClearNamedFramebufferfv(fb, GL_COLOR, 0, background);
-        glClearNamedFramebufferuiv(fb, GL_COLOR, 1, no_fiber);
-        glClearNamedFramebufferfv(fb, GL_DEPTH, 0, &far_depth);
-    }
+    target.begin_frame(o.clear, o.background);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glBindVertexArray(empty_vertex_array_.get());

@@ -100,9 +100,7 @@ void VoxelRayTracer::trace(const Camera& camera, const RenderOptions& o, RenderT
 
 FrameStats VoxelRayTracer::render(const GpuScene& scene, const Camera& camera, const RenderOptions& o,
                                   RenderTarget& target) {
-    const GLuint fb = target.framebuffer();
-    glBindFramebuffer(GL_FRAMEBUFFER, fb);
-    glViewport(0, 0, target.width(), target.height());
+    target.begin_frame(false, o.background);  // the structure's passes may draw to it
     FrameStats stats;
     const auto t0 = std::chrono::steady_clock::now();
     const void* before = structure_.get();
@@ -111,16 +109,7 @@ FrameStats VoxelRayTracer::render(const GpuScene& scene, const Camera& camera, c
         glFinish();
         stats.decode_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     }
-    glBindFramebuffer(GL_FRAMEBUFFER, fb);
-    glViewport(0, 0, target.width(), target.height());
-    if (o.clear) {
-        const float background[4] = {o.background[0], o.background[1], o.background[2], 1.0f};
-        const GLuint no_fiber[4] = {0, 0, 0, 0};
-        const float far_depth = 1.0f;
-        glClearNamedFramebufferfv(fb, GL_COLOR, 0, background);
-        glClearNamedFramebufferuiv(fb, GL_COLOR, 1, no_fiber);
-        glClearNamedFramebufferfv(fb, GL_DEPTH, 0, &far_depth);
-    }
+    target.begin_frame(o.clear, o.background);
     // The trace writes the depth of its nearest hit: test it like the
     // rasterized styles, so that it composes with what the target holds.
     glEnable(GL_DEPTH_TEST);
