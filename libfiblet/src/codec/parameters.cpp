@@ -109,7 +109,7 @@ void FiberSample::offer(std::span<const Vec3f> fiber) {
 
 SampleError measure(const TuningSet& set, const FiberEncoder& encoder) {
     std::vector<std::uint8_t> blocks;
-    std::vector<Vec3f> decoded, resampled;
+    std::vector<Vec3f> decoded;
     double sum = 0, max = 0;
     std::size_t n = 0;
     auto encode = [&](std::span<const Vec3f> points, bool in_mean) {
@@ -125,14 +125,7 @@ SampleError measure(const TuningSet& set, const FiberEncoder& encoder) {
         }
         if (in_mean) n += points.size();
     };
-    for (const auto& fiber : set.fibers) {
-        if (set.resample_step_mm > 0) {
-            resample_fixed_step(fiber, set.resample_step_mm, resampled, kWrittenCurve);
-            encode(resampled, true);
-        } else {
-            encode(fiber, true);
-        }
-    }
+    for (const auto& fiber : set.fibers) encode(fiber, true);
     for (const auto& block : set.sharp_blocks) encode(block, false);
     return {n ? sum / double(n) : 0.0, max};
 }

@@ -85,6 +85,9 @@ struct SampleError {
     // a well-sized cap gives on tractography data.
     double objective() const { return mean_mm + max_mm / 3.0; }
 };
+// The error of encoding the set's fibers and sharp blocks as they are
+// (tune_parameters resamples a set with a resample step once, before it
+// measures; the step is not read here).
 SampleError measure(const TuningSet& set, const FiberEncoder& encoder);
 
 // Blocks whose max error exceeds this multiple of the mean error are

@@ -234,28 +234,33 @@ bool resample_cubic_keeping_end(std::span<const Vec3f> in, double step, double t
     return resample_on(in, step, ResampleCurve::cubic, tension, true, kPiecesPerStep, out, positions);
 }
 
+namespace {
+// The tension `how` resamples on: fitted for the length-keeping curve, else
+// Bessel's (1; the polyline walk ignores it).
+double tension_for(std::span<const Vec3f> in, const Resampling& how) {
+    return how.curve == ResampleCurve::cubic_keeping_length ? length_keeping_tension(in, how.step_mm, how.stretch)
+                                                            : 1.0;
+}
+}  // namespace
+
 void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out, ResampleCurve curve,
                          std::vector<PolylinePosition>* positions) {
-    const double tension = curve == ResampleCurve::cubic_keeping_length ? length_keeping_tension(in, step) : 1.0;
-    resample_on(in, step, curve, tension, false, kPiecesPerStep, out, positions);
+    const Resampling how{.step_mm = step, .curve = curve};
+    resample_on(in, step, curve, tension_for(in, how), false, kPiecesPerStep, out, positions);
 }
 
 bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out, ResampleCurve curve,
                           std::vector<PolylinePosition>* positions) {
-    const double tension = curve == ResampleCurve::cubic_keeping_length ? length_keeping_tension(in, step) : 1.0;
-    return resample_on(in, step, curve, tension, true, kPiecesPerStep, out, positions);
+    const Resampling how{.step_mm = step, .curve = curve};
+    return resample_on(in, step, curve, tension_for(in, how), true, kPiecesPerStep, out, positions);
 }
 
 void resample_fixed_step(std::span<const Vec3f> in, const Resampling& how, std::vector<Vec3f>& out) {
-    const double tension =
-        how.curve == ResampleCurve::cubic_keeping_length ? length_keeping_tension(in, how.step_mm, how.stretch) : 1.0;
-    resample_on(in, how.step_mm, how.curve, tension, false, kPiecesPerStep, out, nullptr);
+    resample_on(in, how.step_mm, how.curve, tension_for(in, how), false, kPiecesPerStep, out, nullptr);
 }
 
 bool resample_keeping_end(std::span<const Vec3f> in, const Resampling& how, std::vector<Vec3f>& out) {
-    const double tension =
-        how.curve == ResampleCurve::cubic_keeping_length ? length_keeping_tension(in, how.step_mm, how.stretch) : 1.0;
-    return resample_on(in, how.step_mm, how.curve, tension, true, kPiecesPerStep, out, nullptr);
+    return resample_on(in, how.step_mm, how.curve, tension_for(in, how), true, kPiecesPerStep, out, nullptr);
 }
 
 void interpolate_point_values(std::span<const PolylinePosition> positions, const float* in_values,
