@@ -3,6 +3,7 @@
 // exactly, and the non-conservative widening as a negative check), its
 // opaque images against Intel Embree's round linear curves (the same
 // capsules), and its ambient occlusion.
+#include <fmt/core.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -327,6 +328,96 @@ TEST(VoxelRtTrace, TransparencyMatchesEmbreeCompositingEveryHit) {
 #endif
 }
 
+// Per-fiber opacities (--fiber-opacity) times --opacity: each capsule
+// entered composites with its fiber's product (the GPU's float product,
+// fiber_colors.glsl), against Embree's every hit; a fiber of opacity 0 is
+// not drawn at all: no pixel names one of its segments, and where only such
+// fibers lie the pixel stays background (but where the two ray tracers
+// disagree on a silhouette, as the image bound allows).
+TEST(VoxelRtTrace, PerFiberOpacityMatchesEmbreeCompositingEveryHit) {
+#if !FIBLET_HAS_EMBREE
+    GTEST_SKIP() << "built without Embree (libembree-dev, scripts/setup.sh)";
+#else
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft"));
+    viewer::GpuScene scene(file, *viewer_gl().programs);
+    const int w = 160, h = 160;
+    const float radius = 0.6f, global = 0.5f;
+    // U(0, 1), every fourth fiber 0.
+    std::mt19937 rng(1818);
+    std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+    std::vector<float> alpha(scene.fiber_count());
+    for (std::size_t f = 0; f < alpha.size(); ++f) alpha[f] = f % 4 == 0 ? 0.0f : uniform(rng);
+    scene.set_fiber_opacities(alpha);
+    std::vector<std::uint64_t> fiber_of_block(file.header().blocks);
+    for (std::uint64_t f = 0; f < file.header().fibers; ++f)
+        for (std::uint64_t b = file.first_block(f); b < file.first_block(f) + file.block_count(f); ++b)
+            fiber_of_block[b] = f;
+    const std::uint32_t ppb = file.header().points_per_block;
+    const EmbreeCapsules oracle(file, radius);
+    // The coarse grid of the global-opacity test: voxels with more than k hits.
+    const int n = 12;
+    const vrt::VoxelGrid grid = vrt::grid_around(scene.bounds(), n, radius);
+    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 2.0f);
+    viewer::RenderOptions o;
+    o.tube_radius_mm = radius;
+    o.opacity = global;
+    o.fiber_opacity = true;
+    o.lighting = false;
+    o.voxel_grid = n;
+    const TracedImage img = trace_image(scene, cam, w, h, o);
+    int worst = 0;
+    std::size_t within = 0, crowded = 0, crowded_within = 0, invisible_only = 0, invisible_lit = 0, names_invisible = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const auto dir = camera_pixel_ray(cam, x, y, w, h);
+            const auto hits = oracle.all(cam.position, dir);
+            double rgb[3] = {0, 0, 0}, transmittance = 1;
+            std::map<std::array<int, 3>, std::size_t> per_voxel;
+            bool any_visible = false;
+            for (const auto& hit : hits) {
+                const double a = double(global * alpha[fiber_of_block[hit.segment / ppb]]);
+                any_visible |= a > 0;
+                const auto c = oracle.direction(hit.segment);
+                for (int k = 0; k < 3; ++k) rgb[k] += transmittance * a * std::fabs(c[k]);
+                transmittance *= 1 - a;
+                const auto g = grid.to_grid({cam.position.x + float(hit.t * dir[0]), cam.position.y + float(hit.t * dir[1]),
+                                             cam.position.z + float(hit.t * dir[2])});
+                ++per_voxel[{int(g[0]), int(g[1]), int(g[2])}];
+            }
+            bool over_k = false;
+            for (const auto& [v, count] : per_voxel) over_k |= count > 8;
+            const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+            int diff = 0;
+            for (int k = 0; k < 3; ++k)
+                diff = std::max(diff, std::abs(int(img.rgba[4 * i + std::size_t(k)]) - int(std::lround(rgb[k] * 255))));
+            worst = std::max(worst, diff);
+            within += diff <= 2;
+            crowded += over_k;
+            crowded_within += over_k && diff <= 2;
+            if (!hits.empty() && !any_visible) {
+                ++invisible_only;
+                invisible_lit += std::max({img.rgba[4 * i], img.rgba[4 * i + 1], img.rgba[4 * i + 2]}) > 2;
+            }
+            names_invisible += img.segments[i] != 0 && alpha[fiber_of_block[(img.segments[i] - 1) / ppb]] == 0;
+        }
+    const double rate = double(within) / double(w * h);
+    std::printf("per-fiber opacity (%.2f x U(0,1), every 4th fiber 0) vs Embree, every hit composited: %.5f of %d "
+                "pixels within 2/255 (worst %d/255); %zu pixels cross a voxel with more than k = 8 hits, %zu of them "
+                "within 2/255; %zu pixels only on fibers of opacity 0, %zu of them lit over 2/255; %zu pixels name a "
+                "segment of opacity 0\n",
+                double(global), rate, w * h, worst, crowded, crowded_within, invisible_only, invisible_lit,
+                names_invisible);
+    EXPECT_GT(crowded, 100u);
+    EXPECT_GE(double(crowded_within), 0.99 * double(crowded));
+    EXPECT_GE(rate, 0.999);
+    EXPECT_GT(invisible_only, 20u);
+    EXPECT_LE(double(invisible_lit), 0.001 * double(w * h));
+    EXPECT_EQ(names_invisible, 0u);
+#endif
+}
+
 namespace {
 
 // The ambient occlusion volume sampled trilinearly at a point (voxel
@@ -533,6 +624,111 @@ TEST(VoxelRtCulling, ImagesWithAndWithoutCullingAgree) {
         EXPECT_LT(visible, occupied);
         EXPECT_GE(rate, 0.999);
     }
+}
+
+// The occupancy pyramid of empty-space skipping against the cells read
+// back: a cell of level l >= 1 is marked exactly when a voxel under it has a
+// fragment list; the pyramid stops at an odd side (12 -> 6 -> 3).
+TEST(VoxelRtSkipping, OccupancyPyramidMarksExactlyTheCellsHoldingSomething) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("small-ifod1.tck"), "small.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    for (const int n : {64, 12}) {
+        SCOPED_TRACE(n);
+        viewer::Renderer renderer(*viewer_gl().programs);
+        viewer::RenderTarget target(8, 8);
+        viewer::RenderOptions o;
+        o.engine = viewer::RenderEngine::voxel_rt;
+        o.voxel_grid = n;
+        renderer.render(scene, viewer::camera_from_spec("oblique", scene, 1.0f, 35, 1.0f), o, target);
+        const vrt::VoxelStructure& s = *renderer.voxel_ray_tracer().structure();
+        const std::vector<std::uint32_t> offset = s.pyramid().level_offset;
+        ASSERT_EQ(offset.size(), n == 64 ? 7u : 3u);
+        std::vector<std::uint8_t> level(std::size_t(n) * std::size_t(n) * std::size_t(n));
+        const auto cells = s.read_cells();
+        for (std::size_t i = 0; i < level.size(); ++i) level[i] = (cells[i] & 0xffffu) != 0;
+        const std::vector<std::uint8_t> gpu = s.read_occupied_pyramid();
+        ASSERT_EQ(gpu.size(), s.pyramid().cells - offset[1]);
+        std::string report;
+        for (std::size_t l = 1; l < offset.size(); ++l) {
+            const int side = n >> l, child = 2 * side;
+            std::vector<std::uint8_t> next(std::size_t(side) * std::size_t(side) * std::size_t(side));
+            for (int z = 0; z < child; ++z)
+                for (int y = 0; y < child; ++y)
+                    for (int x = 0; x < child; ++x)
+                        next[std::size_t(((z / 2) * side + y / 2) * side + x / 2)] |=
+                            level[std::size_t((z * child + y) * child + x)];
+            std::size_t wrong = 0, empty = 0;
+            for (std::size_t i = 0; i < next.size(); ++i) {
+                wrong += gpu[offset[l] - offset[1] + i] != next[i];
+                empty += !next[i];
+            }
+            EXPECT_EQ(wrong, 0u) << "level " << l;
+            report += fmt::format(" level {} ({}³) {:.1f} %", l, side, 100.0 * double(empty) / double(next.size()));
+            level = std::move(next);
+        }
+        std::printf("%d³ grid, empty cells:%s\n", n, report.c_str());
+    }
+}
+
+// Hierarchical empty-space skipping only leaves out empty cells: the images
+// with it and without it (the DDA voxel by voxel) are the same, for opaque
+// primary rays through the culling's visibility pyramid, for shadow rays and
+// primary rays without culling through the occupancy pyramid, and for
+// transparent rays.
+TEST(VoxelRtSkipping, ImagesWithAndWithoutEmptySpaceSkippingAreTheSame) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress_into(dir, shared_data("small-ifod1.tck"), "small.fft"));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    struct Case {
+        const char* name;
+        float opacity;
+        bool culling, shading;
+        int w, h;
+    };
+    // Transparent frames on llvmpipe take seconds: a smaller image.
+    const Case cases[] = {{"opaque, culling", 1.0f, true, false, 256, 192},
+                          {"opaque, no culling, --ao --shadows", 1.0f, false, true, 256, 192},
+                          {"opacity 0.3", 0.3f, false, false, 96, 72}};
+    for (const Case& c : cases)
+        for (const char* view : {"oblique", "top"}) {
+            SCOPED_TRACE(std::string(c.name) + ", " + view);
+            const Camera cam = viewer::camera_from_spec(view, scene, float(c.w) / float(c.h), 35, 1.0f);
+            viewer::Renderer renderer(*viewer_gl().programs);
+            renderer.voxel_ray_tracer().write_segment_ids(true);
+            viewer::RenderTarget target(c.w, c.h);
+            viewer::RenderOptions o;
+            o.engine = viewer::RenderEngine::voxel_rt;
+            o.voxel_grid = 64;
+            o.opacity = c.opacity;
+            o.frustum_culling = c.culling;
+            o.ambient_occlusion = o.shadows = c.shading;
+            o.time_stages = true;
+            renderer.render(scene, cam, o, target);  // builds the structure
+            o.empty_space_skipping = false;
+            const double off_ms = renderer.render(scene, cam, o, target).draw_ms;
+            const auto off_fibers = target.read_fibers();
+            const auto off_rgba = target.read_rgba();
+            o.empty_space_skipping = true;
+            const double on_ms = renderer.render(scene, cam, o, target).draw_ms;
+            const auto on_fibers = target.read_fibers();
+            const auto on_rgba = target.read_rgba();
+            std::size_t same = 0, hit = 0;
+            for (std::size_t i = 0; i < on_fibers.size(); ++i) {
+                bool eq = on_fibers[i] == off_fibers[i];
+                for (std::size_t k = 0; k < 4; ++k) eq &= on_rgba[4 * i + k] == off_rgba[4 * i + k];
+                same += eq;
+                hit += off_fibers[i] != 0;
+            }
+            const double rate = double(same) / double(on_fibers.size());
+            std::printf("%s, %s: with and without empty-space skipping %.5f of %zu pixels identical (%zu hit); trace "
+                        "%.1f ms vs %.1f ms without\n",
+                        c.name, view, rate, on_fibers.size(), hit, on_ms, off_ms);
+            EXPECT_GT(hit, std::size_t(c.w * c.h / 10));
+            EXPECT_GE(rate, 0.999);
+        }
 }
 
 TEST(VoxelRtCli, RenderDrawsWithEveryOptionAndRefusesBadOnes) {

@@ -106,6 +106,9 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
                   "Ambient occlusion from 12 cones through a voxel occupancy (--engine voxel-rt: of every segment; "
                   "raster: of one chord per block, nothing decoded)");
     cmd->add_flag("--shadows", a.shadows, "A shadow ray towards the light (--engine voxel-rt)");
+    cmd->add_flag("--no-empty-space-skipping", a.no_empty_space_skipping,
+                  "Rays walk the grid voxel by voxel instead of skipping the empty cells of its mip pyramid, for "
+                  "comparison: the same image, slower (--engine voxel-rt)");
     cmd->add_option("--fiber-radii", a.fiber_radii,
                     "Tube and capsule radius per streamline from a text file (mm, one per streamline, in file "
                     "order), instead of --radius (also --engine voxel-rt)")
@@ -116,7 +119,7 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
         ->capture_default_str();
     cmd->add_option("--fiber-opacity", a.fiber_opacity,
                     "Opacity per streamline, in [0, 1], times --opacity (below 1 they blend): a text file (one "
-                    "number per streamline, in file order) or dps/NAME, as --fiber-values (raster engine)")
+                    "number per streamline, in file order) or dps/NAME, as --fiber-values (also --engine voxel-rt)")
         ->check(fiber_values_check());
     cmd->add_option("--transparency", a.transparency,
                     "How streamlines blend when --opacity < 1 or with --fiber-opacity: sorted (~1 mm chunks sorted back to front on the "
@@ -218,6 +221,7 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
     o.voxel_grid = a.grid;
     o.ambient_occlusion = a.ao;
     o.shadows = a.shadows;
+    o.empty_space_skipping = !a.no_empty_space_skipping;
     if (a.supersample < 1 || a.supersample > viewer::kMaxSupersample)
         throw Error(Errc::invalid_argument, "--supersample must be in 1.." + std::to_string(viewer::kMaxSupersample));
     o.color_by_direction = a.color == "direction";
@@ -240,8 +244,6 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
     o.fiber_colors = !fiber_color_source(a).empty();
     o.fiber_radii = !a.fiber_radii.empty();
     o.fiber_opacity = !a.fiber_opacity.empty();
-    if (o.fiber_opacity && o.engine != viewer::RenderEngine::raster)
-        throw Error(Errc::invalid_argument, "--fiber-opacity needs --engine raster");
     return o;
 }
 

@@ -33,7 +33,7 @@ struct ViewerArgs {
     // The voxel ray tracer (--engine voxel-rt).
     std::string engine = "raster";
     int grid = 128;
-    bool ao = false, shadows = false;
+    bool ao = false, shadows = false, no_empty_space_skipping = false;
 };
 
 // Adds the input file and the camera, shading and selection options.

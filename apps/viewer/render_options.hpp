@@ -52,6 +52,7 @@ struct RenderOptions {
     int voxel_grid = 128;            // voxels along each side of its cubic grid
     bool ambient_occlusion = false;  // 12 cones through the occupancy pyramid
     bool shadows = false;            // one shadow ray towards the headlight
+    bool empty_space_skipping = true;  // rays skip empty cells of the occupancy / culling pyramid (false: voxel by voxel)
     bool clear = true;  // clear the target first (false: draw over what it holds, depth included)
 
     bool time_stages = false;       // time cull / decode / draw (GpuTimer, default_timing_method)

@@ -4,11 +4,12 @@
 // fragment list analytically and accepting only hits inside that voxel, so
 // that the first voxel with a hit holds the nearest one. Opaque: the
 // nearest hit, shaded with ambient occlusion (the per-voxel volume,
-// trilinear) and a shadow ray towards the light. Transparent (uOpacity <
-// 1): every capsule entered, voxel by voxel, the k nearest of a voxel
-// insertion-sorted by 32-bit keys (depth in the voxel | fragment) and
-// composited front to back, repeated from the last key when a voxel has
-// more than k.
+// trilinear) and a shadow ray towards the light. Transparent
+// (uTransparent): every capsule entered, voxel by voxel, the k nearest of a
+// voxel insertion-sorted by 32-bit keys (depth in the voxel | fragment) and
+// composited front to back with its fiber's alpha (fiberAlpha: --opacity,
+// times the fiber's own with --fiber-opacity), repeated from the last key
+// when a voxel has more than k.
 #include "scene_buffers.glsl"
 #include "voxel_segments.glsl"
 #include "surface_shading.glsl"
@@ -40,11 +41,10 @@ uniform float uTanHalfFovY, uAspect;
 uniform vec2 uViewportSize;
 uniform bool uUseAmbientOcclusion, uUseShadows;
 uniform bool uWriteSegments;  // tests: segment + 1 in the fiber buffer instead of fiber + 1
-uniform float uOpacity;
-// Culling (opaque primary rays): skip invisible voxels, and invisible
-// blocks of 2^uSkipLevel voxels at once.
-uniform bool uCulling, uSkipBlocks;
-uniform uint uSkipLevel, uSkipN, uSkipOffset;
+uniform bool uTransparent;  // RenderOptions::transparent(): alphas from fiberAlpha (fiber_colors.glsl)
+// Culling (opaque primary rays): skip invisible voxels.
+uniform bool uCulling;
+uniform bool uEmptySpaceSkipping;  // RenderOptions::empty_space_skipping (empty_space_skipping.glsl)
 
 layout(location = 0) out vec4 outColor;
 layout(location = 1) out uint outFiber;
@@ -124,6 +124,8 @@ bool advance(inout Walk w) {
     return w.tEnter < w.tEnd;
 }
 
+#include "empty_space_skipping.glsl"
+
 struct Hit {
     float t;
     uint segment;
@@ -145,18 +147,7 @@ bool firstOfFiber(uint s) {
 float segmentEntry(vec3 o, vec3 d, uint s, out vec3 normal) {
     vec3 a, b;
     segmentEnds(s, a, b);
-    return capsuleEntry(o, d, a, b, segmentRadiusMm(s), uOpacity < 1.0 || firstOfFiber(s), normal);
-}
-
-// Distance at which the ray leaves the culling block holding the walk's voxel.
-float blockExit(vec3 o, vec3 d, Walk w) {
-    vec3 g = toGrid(o), dg = d / uVoxelMm;
-    float size = float(1u << uSkipLevel);
-    vec3 lo = vec3(w.voxel >> int(uSkipLevel)) * size, hi = lo + size;
-    vec3 bound = mix(lo, hi, step(vec3(0.0), dg));
-    vec3 t = vec3(dg.x != 0.0 ? (bound.x - g.x) / dg.x : 1e30, dg.y != 0.0 ? (bound.y - g.y) / dg.y : 1e30,
-                  dg.z != 0.0 ? (bound.z - g.z) / dg.z : 1e30);
-    return min(min(t.x, t.y), t.z);
+    return capsuleEntry(o, d, a, b, segmentRadiusMm(s), uTransparent || firstOfFiber(s), normal);
 }
 
 // The nearest hit beyond tMin (anyHit: the first found, for shadows, which
@@ -168,14 +159,7 @@ bool traceNearest(vec3 o, vec3 d, float tMin, bool anyHit, out Hit hit) {
     float eps = 1e-4 * uVoxelMm;
     bool cull = uCulling && !anyHit;
     for (int i = 0; i < 4 * int(uGridN); ++i) {
-        if (cull && uSkipBlocks) {
-            ivec3 b = w.voxel >> int(uSkipLevel);
-            if (visible[uSkipOffset + (uint(b.z) * uSkipN + uint(b.y)) * uSkipN + uint(b.x)] == 0u) {
-                // Past the block (a hair beyond, so that the walk restarts outside it).
-                if (!startWalk(o, d, max(blockExit(o, d, w), w.tEnter) + 1e-3 * uVoxelMm, w)) break;
-                continue;
-            }
-        }
+        if (uEmptySpaceSkipping && !skipEmptySpace(o, d, cull, w)) break;
         uint cell = voxelIndex(w.voxel);
         uint count = cull && visible[cell] == 0u ? 0u : cells[cell] & 0xffffu;
         if (count != 0u) {
@@ -260,6 +244,7 @@ vec4 traceTransparent(vec3 o, vec3 d, out Hit nearest) {
     float transmittance = 1.0;
     if (!startWalk(o, d, 0.0, w)) return vec4(0.0);
     for (int i = 0; i < 4 * int(uGridN) && transmittance > 1.0 / 1024.0; ++i) {
+        if (uEmptySpaceSkipping && !skipEmptySpace(o, d, false, w)) break;
         uint cell = voxelIndex(w.voxel);
         uint count = min(cells[cell] & 0xffffu, 65535u), first = offsets[cell];
         bool more = count != 0u, started = false;
@@ -285,9 +270,11 @@ vec4 traceTransparent(vec3 o, vec3 d, out Hit nearest) {
                 Hit h;
                 h.segment = fragmentAt(first + (keys[j] & 0xffffu));
                 h.t = segmentEntry(o, d, h.segment, h.normal);
+                float alpha = fiberAlpha(blockFiber[segmentSlot(h.segment)]);
+                if (alpha <= 0.0) continue;  // an invisible fiber: not the pixel's fiber or depth either
                 if (h.t < nearest.t) nearest = h;
-                color += transmittance * uOpacity * shadeHit(o, d, h);
-                transmittance *= 1.0 - uOpacity;
+                color += transmittance * alpha * shadeHit(o, d, h);
+                transmittance *= 1.0 - alpha;
             }
             more = n == kSortedHits;
             if (more) lastKey = keys[n - 1], started = true;
@@ -302,7 +289,7 @@ void main() {
     vec3 d = normalize(uCameraForward + ndc.x * uTanHalfFovY * uAspect * uCameraRight + ndc.y * uTanHalfFovY * uCameraUp);
     vec3 o = uCameraPosition;
     Hit h;
-    if (uOpacity < 1.0) {
+    if (uTransparent) {
         outColor = traceTransparent(o, d, h);
         if (h.t >= 1e30) discard;
     } else {

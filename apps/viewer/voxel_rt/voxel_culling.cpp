@@ -19,16 +19,10 @@ void dispatch_cube(int n) {
 }  // namespace
 
 VoxelCulling::VoxelCulling(const VoxelRtPrograms& programs, const VoxelStructure& structure)
-    : n_(structure.grid().n) {
-    std::uint64_t total = 0;
-    for (int n = n_; n >= 1; n /= 2) {
-        level_offset_.push_back(std::uint32_t(total));
-        total += std::uint64_t(n) * std::uint64_t(n) * std::uint64_t(n);
-        if (n % 2) break;  // the pyramid stops at an odd size
-    }
+    : n_(structure.grid().n), pyramid_(pyramid_layout(n_)) {
     const std::uint64_t voxels = std::uint64_t(n_) * std::uint64_t(n_) * std::uint64_t(n_);
     solid_ = make_buffer(GLsizeiptr(voxels * 4), nullptr, 0);
-    visible_ = make_buffer(GLsizeiptr(total * 4), nullptr, 0);
+    visible_ = make_buffer(GLsizeiptr(pyramid_.cells * 4), nullptr, 0);
     const GlProgram& p = programs.cull;
     glUseProgram(p.get());
     structure.bind();
@@ -57,11 +51,12 @@ void VoxelCulling::update(const VoxelRtPrograms& programs, const VoxelStructure&
     glProgramUniform1ui(id, uniform(p, "uStage"), 1);
     dispatch_cube(n_);
     glProgramUniform1ui(id, uniform(p, "uStage"), 2);
-    for (std::size_t level = 1; level < level_offset_.size(); ++level) {
+    const std::vector<std::uint32_t>& offset = pyramid_.level_offset;
+    for (std::size_t level = 1; level < offset.size(); ++level) {
         const int n = n_ >> level;
         glProgramUniform1ui(id, uniform(p, "uLevelN"), GLuint(n));
-        glProgramUniform1ui(id, uniform(p, "uLevelOffset"), level_offset_[level]);
-        glProgramUniform1ui(id, uniform(p, "uChildOffset"), level_offset_[level - 1]);
+        glProgramUniform1ui(id, uniform(p, "uLevelOffset"), offset[level]);
+        glProgramUniform1ui(id, uniform(p, "uChildOffset"), offset[level - 1]);
         dispatch_cube(n);
     }
     glFinish();
@@ -71,12 +66,7 @@ void VoxelCulling::update(const VoxelRtPrograms& programs, const VoxelStructure&
 
 void VoxelCulling::bind(const GlProgram& p) const {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kVisible, visible_.get());
-    const bool skip = int(level_offset_.size()) > kSkipLevel;
     glProgramUniform1i(p.get(), uniform(p, "uCulling"), 1);
-    glProgramUniform1i(p.get(), uniform(p, "uSkipBlocks"), skip ? 1 : 0);
-    glProgramUniform1ui(p.get(), uniform(p, "uSkipLevel"), GLuint(kSkipLevel));
-    glProgramUniform1ui(p.get(), uniform(p, "uSkipN"), GLuint(n_ >> kSkipLevel));
-    glProgramUniform1ui(p.get(), uniform(p, "uSkipOffset"), skip ? level_offset_[kSkipLevel] : 0);
 }
 
 std::uint64_t VoxelCulling::visible_voxels() const {

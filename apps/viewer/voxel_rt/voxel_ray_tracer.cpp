@@ -62,7 +62,8 @@ void VoxelRayTracer::trace(const Camera& camera, const RenderOptions& o, RenderT
     bind_segments(p, segments_for(*built_scene_, o), structure_->grid(), o.tube_radius_mm);
     // Culling: opaque frames (nothing hides what lies behind a transparent
     // surface); --no-culling turns it off as it does the raster selection.
-    const bool cull = o.frustum_culling && o.opacity >= 1.0f;
+    const bool transparent = o.transparent();
+    const bool cull = o.frustum_culling && !transparent;
     if (cull) {
         if (!culling_) culling_ = std::make_unique<VoxelCulling>(programs_, *structure_);
         culling_->update(programs_, *structure_, camera);
@@ -70,7 +71,6 @@ void VoxelRayTracer::trace(const Camera& camera, const RenderOptions& o, RenderT
         culling_->bind(p);
     } else {
         glProgramUniform1i(id, uniform(p, "uCulling"), 0);
-        glProgramUniform1i(id, uniform(p, "uSkipBlocks"), 0);
         // A binding must hold a buffer: the cells stand in for the pyramid.
     }
     structure_->bind(&p);
@@ -85,8 +85,8 @@ void VoxelRayTracer::trace(const Camera& camera, const RenderOptions& o, RenderT
     glProgramUniform1i(id, uniform(p, "uUseAmbientOcclusion"), o.ambient_occlusion ? 1 : 0);
     glProgramUniform1i(id, uniform(p, "uUseShadows"), o.shadows ? 1 : 0);
     glProgramUniform1i(id, uniform(p, "uWriteSegments"), write_segment_ids_ ? 1 : 0);
-    glProgramUniform1f(id, uniform(p, "uOpacity"), o.opacity);
-    const bool transparent = o.opacity < 1.0f;
+    glProgramUniform1i(id, uniform(p, "uTransparent"), transparent ? 1 : 0);
+    glProgramUniform1i(id, uniform(p, "uEmptySpaceSkipping"), o.empty_space_skipping ? 1 : 0);
     if (transparent) {
         // Premultiplied colour over the background; the fiber buffer is an
         // integer attachment, which blending leaves alone.
@@ -98,8 +98,10 @@ void VoxelRayTracer::trace(const Camera& camera, const RenderOptions& o, RenderT
     if (transparent) glDisablei(GL_BLEND, 0);
 }
 
-FrameStats VoxelRayTracer::render(const GpuScene& scene, const Camera& camera, const RenderOptions& o,
+FrameStats VoxelRayTracer::render(const GpuScene& scene, const Camera& camera, const RenderOptions& options,
                                   RenderTarget& target) {
+    RenderOptions o = options;
+    o.fiber_opacity = options.fiber_opacity && scene.has_fiber_opacities();
     target.begin_frame(false, o.background);  // the structure's passes may draw to it
     FrameStats stats;
     const auto t0 = std::chrono::steady_clock::now();

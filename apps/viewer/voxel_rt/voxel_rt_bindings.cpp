@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include "gpu_bindings.hpp"
+#include "voxel_rt/voxel_pyramid.hpp"
 
 namespace fiblet::viewer::voxel_rt {
 
@@ -18,6 +19,8 @@ std::string voxel_rt_defines() {
     def("BINDING_VRT_SOLID", binding::kSolid);
     def("BINDING_VRT_VISIBLE", binding::kVisible);
     def("VRT_FRAGMENT_UNIT", binding::kFragmentUnit);
+    def("VRT_OCCUPIED_UNIT", binding::kOccupiedUnit);
+    def("VRT_PYRAMID_LEVELS", unsigned(kMaxPyramidLevels));
     for (unsigned part = 1; part < binding::kPointParts; ++part)
         s += fmt::format("#define BINDING_VRT_POINTS{} {}\n", part, binding::kMorePoints + part - 1);
     return s;

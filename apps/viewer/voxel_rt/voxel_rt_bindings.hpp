@@ -31,6 +31,10 @@ inline constexpr unsigned kHighest = kMorePoints + kPointParts - 2;
 // second voxelization pass writes them as image buffers on image units 0...
 inline constexpr unsigned kFragmentParts = 4;
 inline constexpr unsigned kFragmentUnit = 2;
+// The occupancy pyramid of empty-space skipping (levels 1.., R8UI): a buffer
+// texture on this unit for the trace, an image buffer on image unit 0 while
+// it is built.
+inline constexpr unsigned kOccupiedUnit = kFragmentUnit + kFragmentParts;
 }  // namespace binding
 
 // gpu_binding_defines() and BINDING_VRT_* for this module's bindings.

@@ -22,6 +22,7 @@ VoxelRtPrograms::VoxelRtPrograms() {
     ambient_occlusion = build_program({"ambient_occlusion.comp.glsl"}, defines);
     trace = build_program({"full_screen.vert.glsl", "trace.frag.glsl"}, defines);
     cull = build_program({"cull_voxels.comp.glsl"}, defines);
+    occupied_pyramid = build_program({"occupied_pyramid.comp.glsl"}, defines);
     chords = build_program({"chord_segments.comp.glsl"}, defines);
 }
 

@@ -16,6 +16,7 @@ struct VoxelRtPrograms {
     GlProgram ambient_occlusion;  // ambient_occlusion.comp.glsl
     GlProgram trace;              // full_screen.vert.glsl + trace.frag.glsl
     GlProgram cull;               // cull_voxels.comp.glsl
+    GlProgram occupied_pyramid;   // occupied_pyramid.comp.glsl (empty-space skipping)
     GlProgram chords;             // chord_segments.comp.glsl (occlusion without decoding)
 };
 

@@ -82,7 +82,10 @@ VoxelStructure::VoxelStructure(const VoxelRtPrograms& p, const VoxelGrid& grid, 
     times_.count_ms = timed([&] { count_and_occupy(p, s, radius_mm); });
     times_.scan_ms = timed([&] { prefix_sum(p); });
     times_.fill_ms = timed([&] { fill_lists(p, s, radius_mm); });
-    times_.occupancy_ms = timed([&] { build_occupancy(p); });
+    times_.occupancy_ms = timed([&] {
+        build_occupancy(p);
+        build_occupied_pyramid(p);
+    });
     if (ambient_occlusion) times_.ambient_occlusion_ms = timed([&] { build_ambient_occlusion(p); });
     cursor_.reset();
 }
@@ -178,6 +181,31 @@ void VoxelStructure::build_occupancy(const VoxelRtPrograms& p) {
     glGenerateTextureMipmap(occupancy_.get());
 }
 
+void VoxelStructure::build_occupied_pyramid(const VoxelRtPrograms& p) {
+    pyramid_ = pyramid_layout(grid_.n);
+    const std::vector<std::uint32_t>& offset = pyramid_.level_offset;
+    const std::uint64_t stored = offset.size() > 1 ? pyramid_.cells - offset[1] : 1;
+    occupied_ = make_buffer(GLsizeiptr(stored), nullptr, 0);
+    GLuint t = 0;
+    glCreateTextures(GL_TEXTURE_BUFFER, 1, &t);
+    glTextureBuffer(t, GL_R8UI, occupied_.get());
+    occupied_texture_ = GlTexture(t);
+    const GLuint id = p.occupied_pyramid.get();
+    glUseProgram(id);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCells, cells_.get());
+    glBindImageTexture(0, occupied_texture_.get(), 0, GL_FALSE, 0, GL_READ_WRITE, GL_R8UI);
+    glProgramUniform1ui(id, uniform(p.occupied_pyramid, "uGridN"), GLuint(grid_.n));
+    for (std::size_t level = 1; level < offset.size(); ++level) {
+        glProgramUniform1ui(id, uniform(p.occupied_pyramid, "uLevel"), GLuint(level));
+        glProgramUniform1ui(id, uniform(p.occupied_pyramid, "uLevelOffset"), offset[level] - offset[1]);
+        glProgramUniform1ui(id, uniform(p.occupied_pyramid, "uChildOffset"),
+                            level > 1 ? offset[level - 1] - offset[1] : 0);
+        const GLuint groups = GLuint(((grid_.n >> level) + 3) / 4);
+        glDispatchCompute(groups, groups, groups);
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+    }
+}
+
 void VoxelStructure::build_ambient_occlusion(const VoxelRtPrograms& p) {
     ambient_occlusion_ = make_volume(grid_.n, 1);
     glUseProgram(p.ambient_occlusion.get());
@@ -199,12 +227,26 @@ void VoxelStructure::bind(const GlProgram* trace) const {
     if (trace) glProgramUniform1ui(trace->get(), uniform(*trace, "uFragmentsPerPart"), fragments_per_part_);
     glBindTextureUnit(0, occupancy_.get());
     glBindTextureUnit(1, ambient_occlusion_ ? ambient_occlusion_.get() : occupancy_.get());
+    glBindTextureUnit(binding::kOccupiedUnit, occupied_texture_.get());
+    if (!trace) return;
+    const GLuint id = trace->get();
+    glProgramUniform1i(id, uniform(*trace, "uPyramidLevels"), GLint(pyramid_.level_offset.size()));
+    glProgramUniform1uiv(id, uniform(*trace, "uPyramidOffset"), GLsizei(pyramid_.level_offset.size()),
+                         pyramid_.level_offset.data());
 }
 
 std::vector<std::uint32_t> VoxelStructure::read_cells() const {
     std::vector<std::uint32_t> out(voxel_count(grid_));
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     glGetNamedBufferSubData(cells_.get(), 0, GLsizeiptr(out.size() * 4), out.data());
+    return out;
+}
+
+std::vector<std::uint8_t> VoxelStructure::read_occupied_pyramid() const {
+    const std::vector<std::uint32_t>& offset = pyramid_.level_offset;
+    std::vector<std::uint8_t> out(offset.size() > 1 ? pyramid_.cells - offset[1] : 0);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    if (!out.empty()) glGetNamedBufferSubData(occupied_.get(), 0, GLsizeiptr(out.size()), out.data());
     return out;
 }
 

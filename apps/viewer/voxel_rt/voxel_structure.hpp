@@ -1,6 +1,7 @@
 // What the ray tracer traces: from resident segments, the voxels' packed
 // occupancy and counts (first voxelization pass), their fragment lists
-// (prefix sum, second pass), the occupancy mip pyramid and, on request, the
+// (prefix sum, second pass), the occupancy mip pyramids (averaged for the
+// cones, "anything here" for empty-space skipping) and, on request, the
 // ambient occlusion volume. Built once per scene, grid and radius: the
 // frames only trace it.
 #pragma once
@@ -11,6 +12,7 @@
 #include "gl_objects.hpp"
 #include "gpu_scene.hpp"
 #include "voxel_rt/voxel_grid.hpp"
+#include "voxel_rt/voxel_pyramid.hpp"
 #include "voxel_rt/voxel_rt_programs.hpp"
 
 namespace fiblet::viewer::voxel_rt {
@@ -59,15 +61,22 @@ public:
     bool has_ambient_occlusion() const { return bool(ambient_occlusion_); }
     GLuint ambient_occlusion_texture() const { return ambient_occlusion_.get(); }
     GLuint cells_buffer() const { return cells_.get(); }
+    // The layout of the grid's pyramids (the occupancy one here, the culling's).
+    const PyramidLayout& pyramid() const { return pyramid_; }
 
     // Binds the cells and offsets buffers and the textures (occupancy on
     // unit 0, ambient occlusion on unit 1, the fragment lists' parts from
-    // binding::kFragmentUnit), and sets `trace`'s uFragmentsPerPart.
+    // binding::kFragmentUnit, the occupancy pyramid on
+    // binding::kOccupiedUnit), and sets `trace`'s uFragmentsPerPart and
+    // pyramid layout.
     void bind(const GlProgram* trace = nullptr) const;
     std::size_t fragment_parts() const { return fragment_textures_.size(); }
 
     // Per voxel (x fastest): packed cell (occupancy << 16 | count).
     std::vector<std::uint32_t> read_cells() const;
+    // The occupancy pyramid's levels 1.. (pyramid() layout, less level 1's
+    // offset): 1 where a cell holds anything.
+    std::vector<std::uint8_t> read_occupied_pyramid() const;
     // Per voxel: ambient occlusion in [0, 1] (empty without it).
     std::vector<float> read_ambient_occlusion() const;
 
@@ -76,6 +85,7 @@ private:
     void prefix_sum(const VoxelRtPrograms& p);
     void fill_lists(const VoxelRtPrograms& p, const ResidentSegments& s, float radius_mm);
     void build_occupancy(const VoxelRtPrograms& p);
+    void build_occupied_pyramid(const VoxelRtPrograms& p);
     void build_ambient_occlusion(const VoxelRtPrograms& p);
     void dispatch_segments(const GlProgram& program, const ResidentSegments& s) const;
 
@@ -87,6 +97,9 @@ private:
     std::uint32_t fragments_per_part_ = 1;
     std::uint64_t part_bytes_ = 0;
     GlTexture occupancy_, ambient_occlusion_;
+    PyramidLayout pyramid_;
+    GlBuffer occupied_;             // levels 1.. of the occupancy pyramid, one byte a cell
+    GlTexture occupied_texture_;    // R8UI buffer texture of occupied_
     std::uint64_t fragments_count_ = 0;
 };
 
