@@ -61,7 +61,7 @@ const int kCylinder = 0, kStartSphere = 1, kEndSphere = 2;
 // outward normal. Solved from the ray's point nearest the capsule's middle,
 // placed with one rounding (fma): neighbouring capsules then see the same
 // ray to ~1e-7 of their size, which the tests at their joint need
-// (onSegmentPart); o + along·d rounded in world coordinates moved the ray
+// (segmentPartOwner); o + along·d rounded in world coordinates moved the ray
 // by ~1e-5 mm per capsule.
 float capsuleEntry(vec3 d, vec3 ra, vec3 rb, float r, out int part, out vec3 fromA, out vec3 normal) {
     float along = dot(0.5 * (ra + rb), d);
@@ -83,7 +83,7 @@ float capsuleEntry(vec3 d, vec3 ra, vec3 rb, float r, out int part, out vec3 fro
     // A cylinder entry between the end planes is the capsule's entry: the
     // spheres' roots there differ from it by less than float precision near
     // the end planes, where deciding by distance would split a joint's
-    // surface inconsistently with onSegmentPart's planes.
+    // surface inconsistently with segmentPartOwner's planes.
     bool onCylinder = best < 1e30;
     for (int end = 0; end < 2 && !onCylinder; ++end) {
         vec3 oc = oa - (end == 0 ? vec3(0.0) : ba);
@@ -169,37 +169,59 @@ void segmentNeighbours(uint s, out bool hasPrev, out vec3 prev, out bool hasNext
 
 vec3 unitOrZero(vec3 v) { float n = length(v); return n > 0.0 ? v / n : vec3(0.0); }
 
-// Whether the entry point p (relative to a) of segment s's capsule, on the
-// given part, lies on the segment's share of its fiber's tube surface: the
-// capsules of a fiber overlap at joints, and this partition (that of
-// Embree's round linear curves) gives every point of the tube's surface to
-// one segment. The cylinder ends at the planes through the joints normal
-// to the tangent there, the sum of the two unit directions (where two
-// equal-radius cylinders cross: the part beyond is inside the neighbour);
-// the sphere at a joint is the earlier segment's, before the plane where
-// the later one's cylinder starts; a fiber's end spheres are its first and
-// last segments'. (rp, rn: the neighbouring points, camera-relative.)
-bool onSegmentPart(int part, vec3 p, vec3 ra, vec3 rb, bool hasPrev, vec3 rp, bool hasNext, vec3 rn) {
-    if (part == kStartSphere) return !hasPrev;
+// Which segment's share of its fiber's tube surface the entry point p
+// (relative to a) of segment s's capsule, on the given part, lies on: -1
+// the previous segment's, 0 its own, 1 the next one's. The capsules of a
+// fiber overlap at joints; this partition (that of Embree's round linear
+// curves) gives every point of the tube's surface to one segment. The
+// cylinder ends at the planes through the joints normal to the tangent
+// there, the sum of the two unit directions (where two equal-radius
+// cylinders cross: the part beyond is inside the neighbour); the sphere at
+// a joint is the earlier segment's, before the plane where the later one's
+// cylinder starts; a fiber's end spheres are its first and last segments'.
+// (rp, rn: the neighbouring points, camera-relative.)
+int segmentPartOwner(int part, vec3 p, vec3 ra, vec3 rb, bool hasPrev, vec3 rp, bool hasNext, vec3 rn) {
+    if (part == kStartSphere) return hasPrev ? -1 : 0;
     vec3 ba = rb - ra, u = unitOrZero(ba), pb = p - ba;
-    if (part == kEndSphere) return !hasNext || dot(pb, rn - rb) <= 0.0;
-    if (hasPrev && dot(p, unitOrZero(ra - rp) + u) < 0.0) return false;
-    return !hasNext || dot(pb, u + unitOrZero(rn - rb)) <= 0.0;
+    if (part == kEndSphere) return !hasNext || dot(pb, rn - rb) <= 0.0 ? 0 : 1;
+    if (hasPrev && dot(p, unitOrZero(ra - rp) + u) < 0.0) return -1;
+    return !hasNext || dot(pb, u + unitOrZero(rn - rb)) <= 0.0 ? 0 : 1;
 }
 
-// The entry of the ray (o, d) into segment s's part of its fiber's tube
-// (capsuleEntry, onSegmentPart) if it lies in [tMin, tMax]; -1 otherwise.
-float segmentEntry(vec3 o, vec3 d, uint s, float tMin, float tMax, out vec3 normal) {
+// The entry of the ray (o, d) into segment s's capsule (capsuleEntry).
+float segmentCapsuleEntry(vec3 o, vec3 d, uint s, out vec3 ra, out vec3 rb, out int part, out vec3 p, out vec3 normal) {
     vec3 a, b;
     segmentEnds(s, a, b);
-    vec3 ra = a - o, rb = b - o, p;
-    int part;
-    float t = capsuleEntry(d, ra, rb, segmentRadiusMm(s), part, p, normal);
-    if (t < tMin || t > tMax) return -1.0;
+    ra = a - o, rb = b - o;
+    return capsuleEntry(d, ra, rb, segmentRadiusMm(s), part, p, normal);
+}
+
+// segmentPartOwner of segment s's capsule entry.
+int entryOwner(vec3 o, uint s, int part, vec3 p, vec3 ra, vec3 rb) {
+    if (part == kStartSphere) return firstOfFiber(s) ? 0 : -1;
     bool hasPrev, hasNext;
     vec3 prev, next;
     segmentNeighbours(s, hasPrev, prev, hasNext, next);
-    return onSegmentPart(part, p, ra, rb, hasPrev, prev - o, hasNext, next - o) ? t : -1.0;
+    return segmentPartOwner(part, p, ra, rb, hasPrev, prev - o, hasNext, next - o);
+}
+
+// The previous (-1) or next (1) segment of s in its fiber.
+uint neighbourSegment(uint s, int side) {
+    uint slot = segmentSlot(s), seg = s - slot * uSegmentsPerSlot;
+    if (side < 0) return seg > 0u ? s - 1u : (slot - 1u) * uSegmentsPerSlot + blockSegmentCount(slot - 1u) - 1u;
+    return seg + 1u < blockSegmentCount(slot) ? s + 1u : (slot + 1u) * uSegmentsPerSlot;
+}
+
+// The entry of the ray (o, d) into segment s's part of its fiber's tube
+// (capsuleEntry, segmentPartOwner) if it lies in [tMin, tMax]; -1
+// otherwise. The range first: the neighbours are read only for entries
+// that matter.
+float segmentEntry(vec3 o, vec3 d, uint s, float tMin, float tMax, out vec3 normal) {
+    vec3 ra, rb, p;
+    int part;
+    float t = segmentCapsuleEntry(o, d, s, ra, rb, part, p, normal);
+    if (t < tMin || t > tMax) return -1.0;
+    return entryOwner(o, s, part, p, ra, rb) == 0 ? t : -1.0;
 }
 
 // Distance at which the ray leaves the culling block holding the walk's voxel.
@@ -234,16 +256,27 @@ bool traceNearest(vec3 o, vec3 d, float tMin, bool anyHit, out Hit hit) {
         uint count = cull && visible[cell] == 0u ? 0u : cells[cell] & 0xffffu;
         if (count != 0u) {
             uint first = offsets[cell];
+            int part;
+            vec3 ra, rb, p;
             for (uint k = first; k < first + count; ++k) {
                 uint s = fragmentAt(k);
-                vec3 normal;
-                float t = segmentEntry(o, d, s, max(max(w.tEnter, tMin) - eps, tMin), w.tExit + eps, normal);
-                if (t <= tMin) continue;
+                vec3 normal, kra, krb, kp;
+                int kpart;
+                float t = segmentCapsuleEntry(o, d, s, kra, krb, kpart, kp, normal);
+                if (t < max(w.tEnter, tMin) - eps || t > w.tExit + eps || t <= tMin) continue;
                 if (anyHit) return true;
                 // Ties: the lower segment, so that the image does not depend on list order.
-                if (t < hit.t || (t == hit.t && s < hit.segment)) hit.t = t, hit.segment = s, hit.normal = normal;
+                if (t < hit.t || (t == hit.t && s < hit.segment))
+                    hit.t = t, hit.segment = s, hit.normal = normal, part = kpart, ra = kra, rb = krb, p = kp;
             }
-            if (hit.t < 1e30) return true;
+            if (hit.t < 1e30) {
+                // The nearest capsule entry is where the ray enters the tube;
+                // the segment owning that point of its surface is this one or
+                // a neighbour (whose entry is the same point).
+                int owner = entryOwner(o, hit.segment, part, p, ra, rb);
+                if (owner != 0) hit.segment = neighbourSegment(hit.segment, owner);
+                return true;
+            }
         }
         if (!advance(w)) break;
     }
@@ -309,7 +342,9 @@ vec4 traceTransparent(vec3 o, vec3 d, out Hit nearest) {
             for (int j = 0; j < n; ++j) {
                 Hit h;
                 h.segment = fragmentAt(first + (keys[j] & 0xffffu));
-                h.t = segmentEntry(o, d, h.segment, w.tEnter, w.tExit, h.normal);
+                vec3 ra, rb, p;
+                int part;
+                h.t = segmentCapsuleEntry(o, d, h.segment, ra, rb, part, p, h.normal);  // accepted above
                 if (h.t < nearest.t) nearest = h;
                 color += transmittance * uOpacity * shadeHit(o, d, h);
                 transmittance *= 1.0 - uOpacity;
