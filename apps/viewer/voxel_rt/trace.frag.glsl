@@ -5,7 +5,8 @@
 // that the first voxel with a hit holds the nearest one. Opaque: the
 // nearest hit, shaded with ambient occlusion (the per-voxel volume,
 // trilinear) and a shadow ray towards the light. Transparent (uOpacity <
-// 1): every capsule entered, voxel by voxel, the k nearest of a voxel
+// 1): every entry into a fiber's tube (a capsule entry on its segment's
+// part of the tube, segmentPartOwner), voxel by voxel, the k nearest of a voxel
 // insertion-sorted by 32-bit keys (depth in the voxel | fragment) and
 // composited front to back, repeated from the last key when a voxel has
 // more than k.
