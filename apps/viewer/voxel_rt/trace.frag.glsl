@@ -5,11 +5,12 @@
 // that the first voxel with a hit holds the nearest one. Opaque: the
 // nearest hit, shaded with ambient occlusion (the per-voxel volume,
 // trilinear) and a shadow ray towards the light. Transparent
-// (uTransparent): every capsule entered, voxel by voxel, the k nearest of a
-// voxel insertion-sorted by 32-bit keys (depth in the voxel | fragment) and
-// composited front to back with its fiber's alpha (fiberAlpha: --opacity,
-// times the fiber's own with --fiber-opacity), repeated from the last key
-// when a voxel has more than k.
+// (uTransparent): every entry into a fiber's tube (a capsule entry on its
+// segment's part of the tube, segmentPartOwner), voxel by voxel, the k
+// nearest of a voxel insertion-sorted by 32-bit keys (depth in the voxel |
+// fragment) and composited front to back with its fiber's alpha
+// (fiberAlpha: --opacity, times the fiber's own with --fiber-opacity),
+// repeated from the last key when a voxel has more than k.
 #include "scene_buffers.glsl"
 #include "voxel_segments.glsl"
 #include "surface_shading.glsl"
@@ -51,18 +52,25 @@ layout(location = 1) out uint outFiber;
 
 const int kSortedHits = 8;  // k
 
-// Entry distance of the unit ray (o, d) into capsule a–b of radius r (-1:
-// none), and the outward normal there. Solved from a point near the
-// capsule on the ray, for precision (as capsules.frag.glsl). Without
-// `startCap` the sphere at a is left out: it is the previous segment's
-// sphere at its end, and counting it once makes the hit segment well
-// defined at joints (Embree's round linear curves give it to the previous
-// segment too).
-float capsuleEntry(vec3 o, vec3 d, vec3 a, vec3 b, float r, bool startCap, out vec3 normal) {
-    float along = dot(0.5 * (a + b) - o, d);
-    vec3 oa = o + along * d - a, ba = b - a;
+// The capsule parts an entry point can lie on.
+const int kCylinder = 0, kStartSphere = 1, kEndSphere = 2;
+
+// Entry distance of the unit ray t·d into the capsule of radius r around
+// ra–rb (-1: none), given in camera-relative coordinates (point − eye, one
+// rounding per point, so that capsules sharing a point share it exactly);
+// the part of the capsule it lies on, the point relative to ra, and the
+// outward normal. Solved from the ray's point nearest the capsule's middle,
+// placed with one rounding (fma): neighbouring capsules then see the same
+// ray to ~1e-7 of their size, which the tests at their joint need
+// (segmentPartOwner); o + along·d rounded in world coordinates moved the ray
+// by ~1e-5 mm per capsule.
+float capsuleEntry(vec3 d, vec3 ra, vec3 rb, float r, out int part, out vec3 fromA, out vec3 normal) {
+    float along = dot(0.5 * (ra + rb), d);
+    precise vec3 oa = fma(vec3(along), d, -ra);
+    vec3 ba = rb - ra;
     float baba = dot(ba, ba), bard = dot(ba, d), baoa = dot(ba, oa);
     float best = 1e30;
+    part = kCylinder;
     normal = vec3(0.0);
     float qa = baba - bard * bard;
     if (qa > 1e-12 * baba) {
@@ -73,14 +81,20 @@ float capsuleEntry(vec3 o, vec3 d, vec3 a, vec3 b, float r, bool startCap, out v
             if (y > 0.0 && y < baba) best = t, normal = oa + t * d - ba * (y / baba);
         }
     }
-    for (int end = startCap ? 0 : 1; end < 2; ++end) {
+    // A cylinder entry between the end planes is the capsule's entry: the
+    // spheres' roots there differ from it by less than float precision near
+    // the end planes, where deciding by distance would split a joint's
+    // surface inconsistently with segmentPartOwner's planes.
+    bool onCylinder = best < 1e30;
+    for (int end = 0; end < 2 && !onCylinder; ++end) {
         vec3 oc = oa - (end == 0 ? vec3(0.0) : ba);
         float k = dot(d, oc), h = k * k - (dot(oc, oc) - r * r);
         if (h < 0.0) continue;
         float t = -k - sqrt(h);
-        if (t < best) best = t, normal = oc + t * d;
+        if (t < best) best = t, normal = oc + t * d, part = end == 0 ? kStartSphere : kEndSphere;
     }
     if (best >= 1e30) return -1.0;
+    fromA = oa + best * d;
     normal = normalize(normal);
     return along + best;
 }
@@ -143,11 +157,74 @@ bool firstOfFiber(uint s) {
     return uAllSegmentsValid || (s == slot * uSegmentsPerSlot && (slot == 0u || blockFiber[slot - 1u] != blockFiber[slot]));
 }
 
-// capsuleEntry of segment s (transparent: every capsule whole, each entered once).
-float segmentEntry(vec3 o, vec3 d, uint s, out vec3 normal) {
+// The points before and after segment s in its fiber (has*: whether there is one).
+vec3 slotPoint(uint slot, uint k) { return vrtPoint(slot * (uSegmentsPerSlot + 1u) + k); }
+void segmentNeighbours(uint s, out bool hasPrev, out vec3 prev, out bool hasNext, out vec3 next) {
+    hasPrev = false, hasNext = false, prev = vec3(0.0), next = vec3(0.0);
+    if (uAllSegmentsValid) return;
+    uint slot = segmentSlot(s), seg = s - slot * uSegmentsPerSlot, count = blockPointCount(slot);
+    if (seg > 0u) hasPrev = true, prev = slotPoint(slot, seg - 1u);
+    else if (!firstOfFiber(s)) hasPrev = true, prev = slotPoint(slot - 1u, blockPointCount(slot - 1u) - 1u);
+    // In this slot (the next block's first point at index count), or the next block's second.
+    if (seg + 2u < count || (seg + 2u == count && !isLastBlockOfFiber(slot))) hasNext = true, next = slotPoint(slot, seg + 2u);
+    else if (seg + 1u == count && blockSegmentCount(slot + 1u) >= 1u) hasNext = true, next = slotPoint(slot + 1u, 1u);
+}
+
+vec3 unitOrZero(vec3 v) { float n = length(v); return n > 0.0 ? v / n : vec3(0.0); }
+
+// Which segment's share of its fiber's tube surface the entry point p
+// (relative to a) of segment s's capsule, on the given part, lies on: -1
+// the previous segment's, 0 its own, 1 the next one's. The capsules of a
+// fiber overlap at joints; this partition (that of Embree's round linear
+// curves) gives every point of the tube's surface to one segment. The
+// cylinder ends at the planes through the joints normal to the tangent
+// there, the sum of the two unit directions (where two equal-radius
+// cylinders cross: the part beyond is inside the neighbour); the sphere at
+// a joint is the earlier segment's, before the plane where the later one's
+// cylinder starts; a fiber's end spheres are its first and last segments'.
+// (rp, rn: the neighbouring points, camera-relative.)
+int segmentPartOwner(int part, vec3 p, vec3 ra, vec3 rb, bool hasPrev, vec3 rp, bool hasNext, vec3 rn) {
+    if (part == kStartSphere) return hasPrev ? -1 : 0;
+    vec3 ba = rb - ra, u = unitOrZero(ba), pb = p - ba;
+    if (part == kEndSphere) return !hasNext || dot(pb, rn - rb) <= 0.0 ? 0 : 1;
+    if (hasPrev && dot(p, unitOrZero(ra - rp) + u) < 0.0) return -1;
+    return !hasNext || dot(pb, u + unitOrZero(rn - rb)) <= 0.0 ? 0 : 1;
+}
+
+// The entry of the ray (o, d) into segment s's capsule (capsuleEntry).
+float segmentCapsuleEntry(vec3 o, vec3 d, uint s, out vec3 ra, out vec3 rb, out int part, out vec3 p, out vec3 normal) {
     vec3 a, b;
     segmentEnds(s, a, b);
-    return capsuleEntry(o, d, a, b, segmentRadiusMm(s), uTransparent || firstOfFiber(s), normal);
+    ra = a - o, rb = b - o;
+    return capsuleEntry(d, ra, rb, segmentRadiusMm(s), part, p, normal);
+}
+
+// segmentPartOwner of segment s's capsule entry.
+int entryOwner(vec3 o, uint s, int part, vec3 p, vec3 ra, vec3 rb) {
+    if (part == kStartSphere) return firstOfFiber(s) ? 0 : -1;
+    bool hasPrev, hasNext;
+    vec3 prev, next;
+    segmentNeighbours(s, hasPrev, prev, hasNext, next);
+    return segmentPartOwner(part, p, ra, rb, hasPrev, prev - o, hasNext, next - o);
+}
+
+// The previous (-1) or next (1) segment of s in its fiber.
+uint neighbourSegment(uint s, int side) {
+    uint slot = segmentSlot(s), seg = s - slot * uSegmentsPerSlot;
+    if (side < 0) return seg > 0u ? s - 1u : (slot - 1u) * uSegmentsPerSlot + blockSegmentCount(slot - 1u) - 1u;
+    return seg + 1u < blockSegmentCount(slot) ? s + 1u : (slot + 1u) * uSegmentsPerSlot;
+}
+
+// The entry of the ray (o, d) into segment s's part of its fiber's tube
+// (capsuleEntry, segmentPartOwner) if it lies in [tMin, tMax]; -1
+// otherwise. The range first: the neighbours are read only for entries
+// that matter.
+float segmentEntry(vec3 o, vec3 d, uint s, float tMin, float tMax, out vec3 normal) {
+    vec3 ra, rb, p;
+    int part;
+    float t = segmentCapsuleEntry(o, d, s, ra, rb, part, p, normal);
+    if (t < tMin || t > tMax) return -1.0;
+    return entryOwner(o, s, part, p, ra, rb) == 0 ? t : -1.0;
 }
 
 // The nearest hit beyond tMin (anyHit: the first found, for shadows, which
@@ -164,16 +241,27 @@ bool traceNearest(vec3 o, vec3 d, float tMin, bool anyHit, out Hit hit) {
         uint count = cull && visible[cell] == 0u ? 0u : cells[cell] & 0xffffu;
         if (count != 0u) {
             uint first = offsets[cell];
+            int part;
+            vec3 ra, rb, p;
             for (uint k = first; k < first + count; ++k) {
                 uint s = fragmentAt(k);
-                vec3 normal;
-                float t = segmentEntry(o, d, s, normal);
+                vec3 normal, kra, krb, kp;
+                int kpart;
+                float t = segmentCapsuleEntry(o, d, s, kra, krb, kpart, kp, normal);
                 if (t < max(w.tEnter, tMin) - eps || t > w.tExit + eps || t <= tMin) continue;
                 if (anyHit) return true;
                 // Ties: the lower segment, so that the image does not depend on list order.
-                if (t < hit.t || (t == hit.t && s < hit.segment)) hit.t = t, hit.segment = s, hit.normal = normal;
+                if (t < hit.t || (t == hit.t && s < hit.segment))
+                    hit.t = t, hit.segment = s, hit.normal = normal, part = kpart, ra = kra, rb = krb, p = kp;
             }
-            if (hit.t < 1e30) return true;
+            if (hit.t < 1e30) {
+                // The nearest capsule entry is where the ray enters the tube;
+                // the segment owning that point of its surface is this one or
+                // a neighbour (whose entry is the same point).
+                int owner = entryOwner(o, hit.segment, part, p, ra, rb);
+                if (owner != 0) hit.segment = neighbourSegment(hit.segment, owner);
+                return true;
+            }
         }
         if (!advance(w)) break;
     }
@@ -202,34 +290,6 @@ vec3 shadeHit(vec3 o, vec3 d, Hit h) {
     return min((base * (uAmbient + uDiffuse * diffuse) + vec3(uSpecular * specular)) * (1.0 - ao), vec3(1.0));
 }
 
-vec3 slotPoint(uint slot, uint k) { return vrtPoint(slot * (uSegmentsPerSlot + 1u) + k); }
-
-// Whether the capsule of segment s entered at p is where the ray enters the
-// fiber's tube: p between the planes at the segment's joints normal to the
-// central-difference tangents there (the capsules of one fiber overlap at
-// joints; the planes split the tube into pieces that do not). A fiber's
-// ends keep their round caps.
-bool insideClipPlanes(uint s, vec3 p) {
-    if (uAllSegmentsValid) return true;
-    uint slot = segmentSlot(s), seg = s - slot * uSegmentsPerSlot, count = blockPointCount(slot);
-    vec3 a, b;
-    segmentEnds(s, a, b);
-    // The point before a.
-    if (seg > 0u) {
-        if (dot(p - a, b - slotPoint(slot, seg - 1u)) < 0.0) return false;
-    } else if (!firstOfFiber(s)) {
-        if (dot(p - a, b - slotPoint(slot - 1u, blockPointCount(slot - 1u) - 1u)) < 0.0) return false;
-    }
-    // The point after b: in this slot (the next block's first point at
-    // index count), or the next block's second.
-    if (seg + 2u < count || (seg + 2u == count && !isLastBlockOfFiber(slot))) {
-        if (dot(p - b, slotPoint(slot, seg + 2u) - a) > 0.0) return false;
-    } else if (seg + 1u == count && blockSegmentCount(slot + 1u) >= 1u) {
-        if (dot(p - b, slotPoint(slot + 1u, 1u) - a) > 0.0) return false;
-    }
-    return true;
-}
-
 uint keyOf(float t, Walk w, uint local) {
     float f = clamp((t - w.tEnter) / max(w.tExit - w.tEnter, 1e-30), 0.0, 1.0);
     return (uint(f * 65535.0) << 16) | local;
@@ -254,10 +314,9 @@ vec4 traceTransparent(vec3 o, vec3 d, out Hit nearest) {
             int n = 0;
             for (uint k = 0u; k < count; ++k) {
                 vec3 normal;
-                float t = segmentEntry(o, d, fragmentAt(first + k), normal);
+                float t = segmentEntry(o, d, fragmentAt(first + k), w.tEnter, w.tExit, normal);
                 // Each capsule is entered in one voxel: [tEnter, tExit).
-                if (t < w.tEnter || t >= w.tExit || t <= 0.0) continue;
-                if (!insideClipPlanes(fragmentAt(first + k), o + t * d)) continue;
+                if (t >= w.tExit || t <= 0.0) continue;
                 uint key = keyOf(t, w, k);
                 if (started && key <= lastKey) continue;
                 if (n == kSortedHits && key >= keys[n - 1]) continue;
@@ -269,7 +328,9 @@ vec4 traceTransparent(vec3 o, vec3 d, out Hit nearest) {
             for (int j = 0; j < n; ++j) {
                 Hit h;
                 h.segment = fragmentAt(first + (keys[j] & 0xffffu));
-                h.t = segmentEntry(o, d, h.segment, h.normal);
+                vec3 ra, rb, p;
+                int part;
+                h.t = segmentCapsuleEntry(o, d, h.segment, ra, rb, part, p, h.normal);  // accepted above
                 float alpha = fiberAlpha(blockFiber[segmentSlot(h.segment)]);
                 if (alpha <= 0.0) continue;  // an invisible fiber: not the pixel's fiber or depth either
                 if (h.t < nearest.t) nearest = h;
