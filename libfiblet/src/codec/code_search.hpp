@@ -191,9 +191,13 @@ public:
     LookaheadSearch(const Codebook& cb, float step, std::size_t depth)
         : cb_(cb), step_(step), step2_(step * step), two_step_(2.0f * step), depth_(std::min(depth, kMaxLookahead)) {}
 
-    // A block: codes[k] for targets[k] from the second anchor `p` and first frame `f`.
-    void start(Frame f, Vec3f p, std::span<const Vec3f> targets, Code* codes, Vec3f* decoded) {
-        f_ = f, p_ = p, targets_ = targets, codes_ = codes, decoded_ = decoded, k_ = 0;
+    // A block: codes[k] for targets[k] from the second anchor `p` and first
+    // frame `f`. `alt_targets`, when not empty, are the second decoder's
+    // (robust search, as in search_codes): aims at the middle of the two
+    // targets, a step's error is the larger of its two squared errors.
+    void start(Frame f, Vec3f p, std::span<const Vec3f> targets, Code* codes, Vec3f* decoded,
+               std::span<const Vec3f> alt_targets = {}) {
+        f_ = f, p_ = p, targets_ = targets, alt_ = alt_targets, codes_ = codes, decoded_ = decoded, k_ = 0;
         chain_ = &chains_[0], trial_ = &chains_[1];
         chain_->reset();
     }
@@ -209,8 +213,9 @@ public:
         decoded_[k] = p_;
         chain_->shift();
     }
-    void run(Frame f, Vec3f p, std::span<const Vec3f> targets, Code* codes, Vec3f* decoded) {
-        start(f, p, targets, codes, decoded);
+    void run(Frame f, Vec3f p, std::span<const Vec3f> targets, Code* codes, Vec3f* decoded,
+             std::span<const Vec3f> alt_targets = {}) {
+        start(f, p, targets, codes, decoded, alt_targets);
         while (!done()) step();
     }
 
@@ -219,7 +224,7 @@ private:
     // before the step (local), the code taken, its squared error, and the
     // state after it.
     struct Step {
-        Vec3f local;
+        Vec3f local, alt_local;  // alt_local: robust search only
         unsigned code;
         float error2;
         Frame f;
@@ -261,11 +266,20 @@ private:
     float error2(Vec3f local, unsigned code) const {
         return std::max(0.0f, dot(local, local) + step2_ - two_step_ * dot(cb_.direction(code), local));
     }
+    float error2(const Step& s, unsigned code) const {
+        const float e = error2(s.local, code);
+        return alt_.empty() ? e : std::max(e, error2(s.alt_local, code));
+    }
     // The greedy step for point j from state (f, p), without its state after.
     void aim(Step& s, std::size_t j, const Frame& f, Vec3f p) const {
         s.local = apply_transposed(f, targets_[j] - p);
-        s.code = cb_.nearest(s.local);
-        s.error2 = error2(s.local, s.code);
+        if (alt_.empty()) {
+            s.code = cb_.nearest(s.local);
+        } else {
+            s.alt_local = apply_transposed(f, alt_[j] - p);
+            s.code = cb_.nearest(apply_transposed(f, midpoint(targets_[j], alt_[j]) - p));
+        }
+        s.error2 = error2(s, s.code);
     }
 
     // Greedy steps until the chain covers points k .. end - 1.
@@ -283,7 +297,8 @@ private:
 
     // Replaces the aimed code's path by a rival's where one is cheaper.
     void choose(std::size_t k, std::size_t end) {
-        const Vec3f local = (*chain_)[0].local;  // copies: chain_ changes hands below
+        Step first;  // the aim's locals and code: copies, chain_ changes hands below
+        first.local = (*chain_)[0].local, first.alt_local = (*chain_)[0].alt_local;
         const unsigned aimed = (*chain_)[0].code;
         // The rivals' own errors; tried cheapest first, each found by a
         // branch-free scan (sorting them all costs more: most points try
@@ -297,7 +312,7 @@ private:
             for (int l = std::max(l0 - 1, 0); l <= std::min(l0 + 1, L - 1); ++l) {
                 const auto code = unsigned(h * L + l);
                 if (code == aimed) continue;
-                rival_error2[n] = error2(local, code), rival_code[n] = code, ++n;
+                rival_error2[n] = error2(first, code), rival_code[n] = code, ++n;
             }
         for (unsigned i = n; i < 8; ++i) rival_error2[i] = INFINITY, rival_code[i] = 0;
         float best = chain_->sum();
@@ -310,7 +325,7 @@ private:
             // The rival's path into trial_, abandoned once it costs `best`.
             Chain& t = *trial_;
             t.reset();
-            t[0].local = local;
+            t[0].local = first.local, t[0].alt_local = first.alt_local;
             t[0].error2 = e0;
             take(t[0], rival_code[r], f_, p_);
             t.n = 1;
@@ -332,7 +347,7 @@ private:
     const std::size_t depth_;
     Frame f_;  // the decoder's state before point k_
     Vec3f p_;
-    std::span<const Vec3f> targets_;
+    std::span<const Vec3f> targets_, alt_;
     Code* codes_ = nullptr;
     Vec3f* decoded_ = nullptr;
     std::size_t k_ = 0;

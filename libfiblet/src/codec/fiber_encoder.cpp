@@ -353,8 +353,12 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
             retry_codes8.resize(m);
             for (unsigned width : {1u, robust_beam}) {
                 if (width > 1 && best <= 1.21f * float_only) break;
-                search_codes(cb, SearchParams{width, 1}, frames[b], points[i0 + 1], h.step, t, retry_codes8.data(),
-                             retry_points.data(), std::span<const Vec3f>(alt));
+                if (width == 1 && search_.lookahead > 0)  // as the first search: greedy aiming with lookahead
+                    LookaheadSearch<Codebook8>(cb, h.step, search_.lookahead)
+                        .run(frames[b], points[i0 + 1], t, retry_codes8.data(), retry_points.data(), std::span<const Vec3f>(alt));
+                else
+                    search_codes(cb, SearchParams{width, 1}, frames[b], points[i0 + 1], h.step, t, retry_codes8.data(),
+                                 retry_points.data(), std::span<const Vec3f>(alt));
                 const float worst = worst_error2(retry_points.data(), t.data(), alt.data(), m);
                 if (!(worst < best)) continue;
                 best = worst;
