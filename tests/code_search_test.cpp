@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "codec/code_search.hpp"
 #include "codec/nearest_code_lut.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/encode.hpp"
@@ -182,4 +183,96 @@ TEST(CodeSearch, SixteenBitSearchDecodesToWhatTheEncoderPredicted) {
             EXPECT_EQ(BlockView16{blocks.data()}.fiber_id(), 7u);
         }
     }
+}
+
+namespace {
+
+// The lookahead rule written plainly (no branch and bound, no kept
+// continuation): every code of the 3x3 around the aimed one is followed by
+// `depth` greedy steps to the block's end at most, each scored by the sum of
+// its squared errors; the aimed code stands unless a code tried after it,
+// cheapest own error first, has a smaller sum.
+std::vector<std::uint8_t> brute_force_lookahead(const detail::Codebook8& cb, Frame f, Vec3f p, float step,
+                                                const std::vector<Vec3f>& t, std::size_t depth) {
+    using namespace detail;
+    auto error2 = [&](Vec3f local, unsigned c) {
+        return std::max(0.0f, dot(local, local) + step * step - 2.0f * step * dot(cb.direction(c), local));
+    };
+    std::vector<std::uint8_t> codes;
+    for (std::size_t k = 0; k < t.size(); ++k) {
+        const Vec3f local = apply_transposed(f, t[k] - p);
+        const unsigned aimed = cb.nearest(local);
+        auto path_error2 = [&](unsigned c) {
+            float e = error2(local, c);
+            Frame g = compose(f, cb.frame(c));
+            Vec3f q = p + step * g.c[0];
+            for (std::size_t j = k + 1; j < std::min(t.size(), k + 1 + depth); ++j) {
+                const Vec3f l = apply_transposed(g, t[j] - q);
+                const unsigned a = cb.nearest(l);
+                e += error2(l, a);
+                g = compose(g, cb.frame(a));
+                q = q + step * g.c[0];
+            }
+            return e;
+        };
+        std::vector<std::pair<float, unsigned>> rivals;  // (own error, code), in grid order
+        const int h0 = int(aimed) / 16, l0 = int(aimed) % 16;
+        for (int h = std::max(h0 - 1, 0); h <= std::min(h0 + 1, 15); ++h)
+            for (int l = std::max(l0 - 1, 0); l <= std::min(l0 + 1, 15); ++l)
+                if (unsigned(h * 16 + l) != aimed) rivals.emplace_back(error2(local, unsigned(h * 16 + l)), unsigned(h * 16 + l));
+        std::stable_sort(rivals.begin(), rivals.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+        unsigned code = aimed;
+        if (k + 1 < t.size()) {
+            float best = path_error2(aimed);
+            for (const auto& [own, c] : rivals)
+                if (const float e = path_error2(c); e < best) best = e, code = c;
+        }
+        codes.push_back(std::uint8_t(code));
+        f = compose(f, cb.frame(code));
+        p = p + step * f.c[0];
+    }
+    return codes;
+}
+
+}  // namespace
+
+TEST(CodeSearch, LookaheadChoosesWhatThePlainRuleChooses) {
+    using namespace detail;
+    const FftHeader h = header(0.0968f);
+    const DirectionTable table(h.ratio);
+    const detail::NearestCodeLut lut(table);
+    const detail::Codebook8 cb{table, lut};
+    std::size_t points = 0, differ_from_greedy = 0;
+    for (std::size_t depth : {1u, 2u, 4u}) {
+        detail::LookaheadSearch<detail::Codebook8> search(cb, h.step, depth);
+        for (const auto& f : walks(20, 58, 4 + unsigned(depth))) {
+            std::vector<Vec3f> t(f.size());
+            for (std::size_t k = 0; k < f.size(); ++k) t[k] = {f[k].x / h.scaling + 0.5f, f[k].y / h.scaling + 0.5f, f[k].z / h.scaling + 0.5f};
+            const Frame f0 = frame_from_axis(detail::normalize(t[1] - t[0]));
+            const std::vector<Vec3f> targets(t.begin() + 2, t.end());
+            std::vector<std::uint8_t> codes(targets.size()), greedy(targets.size());
+            std::vector<Vec3f> decoded(targets.size());
+            search.run(f0, t[1], targets, codes.data(), decoded.data());
+            EXPECT_EQ(codes, brute_force_lookahead(cb, f0, t[1], h.step, targets, depth)) << "depth " << depth;
+            detail::search_codes(cb, {1, 1}, f0, t[1], h.step, targets, greedy.data(), decoded.data());
+            for (std::size_t k = 0; k < codes.size(); ++k) differ_from_greedy += codes[k] != greedy[k];
+            points += codes.size();
+        }
+    }
+    EXPECT_GT(differ_from_greedy, points / 50);  // the lookahead does change codes
+}
+
+TEST(CodeSearch, LookaheadLowersTheSquaredErrorOfGreedyAiming) {
+    const auto fibers = walks(40, 300, 6);
+    const FftHeader h = header(0.0968f);
+    double greedy = 0, lookahead = 0;
+    SearchOptions with_lookahead{1, 1, 0, 1, 0};
+    with_lookahead.lookahead = 2;
+    for (const auto& f : fibers) {
+        block_max_errors(FiberEncoder(h, {1, 1, 0, 1, 0}), f, &greedy);
+        block_max_errors(FiberEncoder(h, with_lookahead), f, &lookahead);
+    }
+    EXPECT_LT(lookahead, 0.9 * greedy);
+    with_lookahead.lookahead = detail::kMaxLookahead + 1;
+    EXPECT_THROW(FiberEncoder(h, with_lookahead), Error);
 }

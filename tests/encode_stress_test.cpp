@@ -5,6 +5,7 @@
 // input polyline and the encoding's parameters.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -27,10 +28,11 @@ namespace {
 using Fiber = std::vector<Vec3f>;
 
 // The searches every case runs: greedy, greedy + retry (every block is
-// retried), beams of two radii.
+// retried), the default's lookahead + retry, beams of two radii.
 std::vector<std::pair<const char*, SearchOptions>> searches() {
     return {{"greedy", {1, 1, 0, 1, 0}},
             {"greedy+retry", {1, 1, 8, 1, 1e-9}},
+            {"lookahead2+retry", {1, 1, 8, 1, 1e-9, 2}},
             {"beam4", {4, 1, 0, 1, 0}},
             {"beam8r2+retry", {8, 2, 16, 3, 1e-9}}};
 }
@@ -85,7 +87,10 @@ test::BoundParams bound_params(const FftHeader& h, const SearchOptions& s, doubl
     const double chooser = h.ratio < 1.0f ? a.covering + 2 * std::sqrt(2.0) * std::tan(p.cap_angle) /
                                                              detail::NearestCodeLut::kGrid
                                           : a.covering + a.reach1;
-    const unsigned r = std::max(s.beam_width > 1 ? s.radius : 0u, s.retry_beam_width > 1 ? s.retry_radius : 0u);
+    // The lookahead (greedy aiming, beam 1) may take any code of the aimed one's 3x3.
+    const unsigned lookahead_radius = s.beam_width <= 1 && s.lookahead > 0 ? 1u : 0u;
+    const unsigned r = std::max({s.beam_width > 1 ? s.radius : 0u, s.retry_beam_width > 1 ? s.retry_radius : 0u,
+                                 lookahead_radius});
     p.aim_angle = chooser + (r == 1 ? a.reach1 : r == 2 ? a.reach2 : r == 3 ? a.reach3 : 0.0) + 1e-5;
     const double ulp = std::ldexp(1.0, -24);
     // A full quantum, not half: where a block's first segment runs along the

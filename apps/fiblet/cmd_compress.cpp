@@ -23,7 +23,7 @@ struct CompressArgs {
     unsigned bits = 8;
     std::uint32_t block_points = 0;
     int effort = kDefaultEffort;
-    std::optional<unsigned> beam, radius, retry_beam;
+    std::optional<unsigned> beam, radius, retry_beam, lookahead;
     std::optional<double> cap_ratio, step_scale;
     std::optional<double> turn_percentile;
     std::optional<std::size_t> tuning_points;
@@ -93,6 +93,7 @@ void run(const CompressArgs& a) {
         if (a.beam) o.search.beam_width = *a.beam;
         if (a.radius) o.search.radius = *a.radius;
         if (a.retry_beam) o.search.retry_beam_width = *a.retry_beam;
+        if (a.lookahead) o.search.lookahead = *a.lookahead;
         o.cap_ratio = a.cap_ratio;
         o.step_scale = a.step_scale;
         o.turn_percentile = a.turn_percentile;
@@ -168,6 +169,9 @@ void add_compress(CLI::App& app) {
     cmd->add_option("--retry-beam", args->retry_beam, "Beam width for re-searching the worst blocks (0 = none)")
         ->check(CLI::Range(0u, 64u));
     cmd->add_option("--beam", args->beam, "Code search: sequences kept per step (1 = greedy)")->check(CLI::Range(1u, 64u));
+    cmd->add_option("--lookahead", args->lookahead,
+                    "Code search (beam 1): judge each code by the errors of the next N points too (0 = greedy)")
+        ->check(CLI::Range(0u, 6u));
     cmd->add_option("--search-radius", args->radius, "Code search: candidate codes within this many levels")
         ->check(CLI::Range(1u, 3u));
     cmd->add_option("--cap-ratio", args->cap_ratio, "Cap ratio of the direction code (default: from the data)");

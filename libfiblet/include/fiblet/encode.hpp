@@ -25,6 +25,10 @@ struct SearchOptions {
     unsigned retry_beam_width = 0;  // 0: no retry; else 2..64
     unsigned retry_radius = 1;      // 1..3
     double retry_error_mm = 0;      // retry blocks whose max error exceeds this (> 0)
+    // Greedy aiming (beam 1, 8-bit codes) judges each code and its 3x3
+    // neighbours by their error plus the errors greedy aiming makes at
+    // the next `lookahead` points from where they lead; 0: plain greedy aiming.
+    unsigned lookahead = 0;  // 0..6
 };
 
 // The search of each effort level (0..kMaxEffort), from fast to thorough;

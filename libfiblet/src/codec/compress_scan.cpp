@@ -40,24 +40,37 @@ struct ScanSlot {
     std::optional<TurnStatistics> turns;
 };
 
+// The bounds of a fiber's points into min / max. Float comparisons (exact:
+// the double bounds of floats are floats), four coordinates apart so that
+// the loop vectorizes; NaN coordinates are left out, as the double
+// comparisons of std::min / std::max with a finite start left them out.
+void add_bounds(std::span<const Vec3f> fiber, double* min, double* max) {
+    constexpr float inf = std::numeric_limits<float>::infinity();
+    float lo[3] = {inf, inf, inf}, hi[3] = {-inf, -inf, -inf};
+    for (const Vec3f& p : fiber) {
+        lo[0] = p.x < lo[0] ? p.x : lo[0], lo[1] = p.y < lo[1] ? p.y : lo[1], lo[2] = p.z < lo[2] ? p.z : lo[2];
+        hi[0] = p.x > hi[0] ? p.x : hi[0], hi[1] = p.y > hi[1] ? p.y : hi[1], hi[2] = p.z > hi[2] ? p.z : hi[2];
+    }
+    for (int a = 0; a < 3; ++a) min[a] = std::min(min[a], double(lo[a])), max[a] = std::max(max[a], double(hi[a]));
+}
+
 void scan_task(const FiberBatch& b, std::size_t t, ScanSlot& s) {
     double length_sum = 0;  // this task's, added to the slot's once (the same sums whatever the threads)
+    thread_local std::vector<double> lengths;  // of a fiber's segments, shared with the turn statistics
     for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1]; ++i) {
         const std::vector<Vec3f>& fiber = b.fibers[i];
-        for (std::size_t k = 0; k < fiber.size(); ++k) {
-            const Vec3f p = fiber[k];
-            const double c[3] = {p.x, p.y, p.z};
-            for (int a = 0; a < 3; ++a) s.min[a] = std::min(s.min[a], c[a]), s.max[a] = std::max(s.max[a], c[a]);
-            if (k > 0) {
-                const double len = length(fiber[k - 1], p);
-                s.lengths.add(len);
-                length_sum += len;
-                s.step_min = std::min(s.step_min, len);
-                s.step_max = std::max(s.step_max, len);
-                ++s.segments;
-            }
+        add_bounds(fiber, s.min, s.max);
+        lengths.resize(fiber.empty() ? 0 : fiber.size() - 1);
+        for (std::size_t k = 1; k < fiber.size(); ++k) {
+            const double len = length(fiber[k - 1], fiber[k]);
+            lengths[k - 1] = len;
+            s.lengths.add(len);
+            length_sum += len;
+            s.step_min = std::min(s.step_min, len);
+            s.step_max = std::max(s.step_max, len);
         }
-        s.turns->add_fiber(fiber);
+        s.segments += lengths.size();
+        s.turns->add_fiber(fiber, lengths);
     }
     s.length_sum += length_sum;
 }

@@ -146,7 +146,7 @@ SearchOptions search_for_effort(int effort) {
     // beam), so every level searches the 3x3 neighbourhood.
     switch (effort) {
         case 0: return {1, 1, 0, 1, 0};    // greedy aiming
-        case 1: return {1, 1, 8, 1, 0};    // + a beam of 8 for the worst blocks
+        case 1: return {1, 1, 8, 1, 0, 2};  // greedy judged over the next two points + a beam of 8 for the worst blocks
         case 2: return {2, 1, 8, 1, 0};
         case 3: return {8, 1, 32, 1, 0};
         case 4: return {16, 1, 64, 1, 0};
@@ -158,6 +158,8 @@ FiberEncoder::FiberEncoder(const FftHeader& header, SearchOptions search) : head
     if (search_.beam_width < 1 || search_.beam_width > 64)
         throw Error(Errc::invalid_argument, "beam width must be in [1, 64]");
     if (search_.radius < 1 || search_.radius > 3) throw Error(Errc::invalid_argument, "search radius must be in [1, 3]");
+    if (search_.lookahead > kMaxLookahead)
+        throw Error(Errc::invalid_argument, "lookahead must be in [0, " + std::to_string(kMaxLookahead) + "]");
     if (search_.retry_beam_width > 64 || search_.retry_radius < 1 || search_.retry_radius > 3 ||
         !(search_.retry_error_mm >= 0))
         throw Error(Errc::invalid_argument, "retry beam width must be in [0, 64], its radius in [1, 3]");
@@ -252,7 +254,30 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
     };
     const SearchParams params{search_.beam_width, search_.radius};
     std::uint32_t b = 0;
-    if (params.beam <= 1 && !wide) {
+    if (params.beam <= 1 && !wide && search_.lookahead > 0) {
+        // Lookahead: four blocks at a time, in lockstep, so that their
+        // independent dependency chains overlap in the CPU (the blocks'
+        // searches do not interact: the same codes as one at a time).
+        const Codebook8 cb{*tables_->table8, *tables_->lut8};
+        constexpr int kLanes = 4;
+        const std::size_t depth = search_.lookahead;
+        LookaheadSearch<Codebook8> lanes[kLanes]{{cb, h.step, depth}, {cb, h.step, depth}, {cb, h.step, depth}, {cb, h.step, depth}};
+        auto start = [&](LookaheadSearch<Codebook8>& lane, std::uint32_t blk) {
+            const std::size_t i0 = std::size_t(blk) * ppb;
+            lane.start(frames[blk], points[i0 + 1], std::span<const Vec3f>(&targets[i0 + 2], block_points(blk) - 2),
+                       codes8_of(blk), &points[i0 + 2]);
+        };
+        for (; b + kLanes <= n_blocks && block_points(b + kLanes - 1) == ppb; b += kLanes) {
+            for (int i = 0; i < kLanes; ++i) start(lanes[i], b + i);
+            while (!lanes[0].done())
+                for (auto& lane : lanes) lane.step();
+        }
+        for (; b < n_blocks; ++b)
+            if (block_points(b) > 2) {
+                start(lanes[0], b);
+                while (!lanes[0].done()) lanes[0].step();
+            }
+    } else if (params.beam <= 1 && !wide) {
         // Greedy: four full blocks at a time (16-bit codes gain nothing: their
         // nearest-code search is branchy and dominates).
         constexpr int kLanes = 4;
@@ -328,8 +353,12 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
             retry_codes8.resize(m);
             for (unsigned width : {1u, robust_beam}) {
                 if (width > 1 && best <= 1.21f * float_only) break;
-                search_codes(cb, SearchParams{width, 1}, frames[b], points[i0 + 1], h.step, t, retry_codes8.data(),
-                             retry_points.data(), std::span<const Vec3f>(alt));
+                if (width == 1 && search_.lookahead > 0)  // as the first search: greedy aiming with lookahead
+                    LookaheadSearch<Codebook8>(cb, h.step, search_.lookahead)
+                        .run(frames[b], points[i0 + 1], t, retry_codes8.data(), retry_points.data(), std::span<const Vec3f>(alt));
+                else
+                    search_codes(cb, SearchParams{width, 1}, frames[b], points[i0 + 1], h.step, t, retry_codes8.data(),
+                                 retry_points.data(), std::span<const Vec3f>(alt));
                 const float worst = worst_error2(retry_points.data(), t.data(), alt.data(), m);
                 if (!(worst < best)) continue;
                 best = worst;

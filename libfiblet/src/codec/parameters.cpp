@@ -16,7 +16,14 @@ constexpr std::size_t kTurnBins = 1u << 15;
 TurnStatistics::TurnStatistics(std::uint32_t points_per_block, std::size_t kept_blocks)
     : bins_(kTurnBins + 1, 0), points_per_block_(std::max<std::uint32_t>(points_per_block, 1)), kept_blocks_(kept_blocks) {}
 
-void TurnStatistics::add_fiber(std::span<const Vec3f> f) {
+void TurnStatistics::add_fiber(std::span<const Vec3f> f) { add_turns(f, [](double n2, std::size_t) { return std::sqrt(n2); }); }
+
+void TurnStatistics::add_fiber(std::span<const Vec3f> f, std::span<const double> segment_lengths) {
+    add_turns(f, [&](double, std::size_t i) { return segment_lengths[i - 1]; });
+}
+
+template <class SegmentLength>
+void TurnStatistics::add_turns(std::span<const Vec3f> f, SegmentLength segment_length) {
     // Double: a float's square overflows beyond 1e19 mm and vanishes below
     // 1e-19 mm, and every float tractogram, whatever its units, must see
     // its turns (a cap sized for no turn at all wrecks the encoding).
@@ -28,7 +35,7 @@ void TurnStatistics::add_fiber(std::span<const Vec3f> f) {
         double dx = double(f[i].x) - f[i - 1].x, dy = double(f[i].y) - f[i - 1].y, dz = double(f[i].z) - f[i - 1].z;
         const double n2 = dx * dx + dy * dy + dz * dz;
         if (!(n2 > 0)) continue;
-        const double inv = 1.0 / std::sqrt(n2);
+        const double inv = 1.0 / segment_length(n2, i);
         dx *= inv, dy *= inv, dz *= inv;
         if (have) {
             const double ex = dx - px, ey = dy - py, ez = dz - pz;

@@ -30,6 +30,10 @@ class TurnStatistics {
 public:
     TurnStatistics(std::uint32_t points_per_block, std::size_t kept_blocks);
     void add_fiber(std::span<const Vec3f> fiber);
+    // The same, given the fiber's segment lengths (segment_lengths[i - 1] =
+    // |f[i] - f[i - 1]| in double, as add_fiber computes them): the scan
+    // measures them anyway, and this saves a square root per segment.
+    void add_fiber(std::span<const Vec3f> fiber, std::span<const double> segment_lengths);
     // Adds the turns another one counted (same block size; its kept blocks
     // offered in its order): a scan split into parts merges them in order.
     void merge(const TurnStatistics& other);
@@ -50,6 +54,8 @@ private:
     std::size_t kept_blocks_;
     std::vector<std::pair<double, std::vector<Vec3f>>> sharpest_;  // (dot, block points), a max-heap on dot
     bool wants(double dot) const;
+    template <class SegmentLength>
+    void add_turns(std::span<const Vec3f> fiber, SegmentLength segment_length);
     void keep(double dot, std::vector<Vec3f> block);
 };
 
