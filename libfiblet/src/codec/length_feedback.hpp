@@ -25,9 +25,10 @@
 namespace fiblet::detail {
 
 // How many of a block's last points have their targets moved (linearly
-// more towards the block's end), and the shares of the error tried.
+// more towards the block's end), and the shares of the error tried (of at
+// most the point error the block may have).
 inline constexpr std::uint32_t kLengthFeedbackPoints = 12;
-inline constexpr float kLengthFeedbackShares[] = {1.0f, 0.5f};
+inline constexpr float kLengthFeedbackShares[] = {1.0f, 0.5f, 0.25f};
 
 inline float segment_length(Vec3f a, Vec3f b) {
     const Vec3f d = b - a;
@@ -70,6 +71,8 @@ void feed_back_length(std::span<const Vec3f> targets, std::span<Vec3f> points, s
         const std::size_t m = n - 2, first = b0 + 2, moved_points = std::min<std::size_t>(kLengthFeedbackPoints, m);
         const float allowed2 = std::max(fiber_max2, max_error2(&points[first], first, m));
         double best = std::fabs(lag);
+        // A move farther than the error the block may have cannot be followed.
+        const float reach = std::sqrt(allowed2), move = std::clamp(float(lag), -reach, reach);
         for (const float share : kLengthFeedbackShares) {
             // Too long: the last points move on towards the next anchor (a
             // shorter bridge); too short: they fall back.
@@ -80,7 +83,7 @@ void feed_back_length(std::span<const Vec3f> targets, std::span<Vec3f> points, s
                 const float len = std::sqrt(dot(along, along));
                 if (!(len > 0)) continue;
                 const float w = float(moved_points - j) / float(moved_points);
-                moved[k - first] = moved[k - first] + (share * w * float(lag) / len) * along;
+                moved[k - first] = moved[k - first] + (share * w * move / len) * along;
             }
             candidate.resize(m);
             search(b, std::span<const Vec3f>(moved), candidate.data());
