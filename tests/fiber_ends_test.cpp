@@ -9,6 +9,7 @@
 #include <random>
 #include <vector>
 
+#include "codec/fiber_end_encoder.hpp"
 #include "fiblet/block_index.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/decode.hpp"
@@ -306,6 +307,60 @@ TEST(FiberEnds, ChunkOfTheWrongSizeIsRejected) {
     EXPECT_EQ(quantize_end_fraction(-1.0), 0);
     const Vec3f p = place_end_point({0, 0, 0}, {2, 0, 0}, quantize_end_fraction(0.25));
     EXPECT_NEAR(p.x, 0.5, 1e-4);
+}
+
+// The end fraction that keeps a fiber's length (fiber_end_encoder.hpp)
+// against a brute-force scan of [0, 1]: of the fractions whose end point
+// stays within the allowance (the fiber's largest other point error, or
+// the closest the segment comes to the end if that is farther), the one
+// whose decoded length comes closest to the target.
+TEST(FiberEnds, LengthKeepingFractionIsTheClosestAllowedByBruteForce) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1, 1);
+    auto d = [](Vec3f a, Vec3f b) {
+        const double x = double(a.x) - b.x, y = double(a.y) - b.y, z = double(a.z) - b.z;
+        return std::sqrt(x * x + y * y + z * z);
+    };
+    for (int trial = 0; trial < 300; ++trial) {
+        SCOPED_TRACE(trial);
+        // Targets 1 mm apart along x, the last a remainder; decoded within 0.05 mm.
+        const std::size_t n = 3 + std::size_t(trial % 5);
+        std::vector<Vec3f> targets(n), decoded(n);
+        for (std::size_t k = 0; k < n; ++k) targets[k] = {float(k), 0, 0};
+        targets[n - 1].x = float(n - 2) + float(0.2 + 0.7 * (u(rng) + 1) / 2);
+        for (std::size_t k = 0; k + 1 < n; ++k)
+            decoded[k] = {targets[k].x + float(0.05 * u(rng)), float(0.05 * u(rng)), float(0.05 * u(rng))};
+        decoded[n - 1] = {decoded[n - 2].x + 1.0f, decoded[n - 2].y + float(0.05 * u(rng)), decoded[n - 2].z};
+        double before = 0, other = 0;
+        for (std::size_t k = 1; k + 1 < n; ++k) before += d(decoded[k - 1], decoded[k]);
+        for (std::size_t k = 0; k + 1 < n; ++k) other = std::max(other, d(decoded[k], targets[k]));
+        const double target = before + d(decoded[n - 2], targets[n - 1]) + 0.3 * u(rng);
+        const Vec3f a = decoded[n - 2], b = decoded[n - 1];
+        // The end placed at fraction f, its distance to the true end (in double).
+        const Vec3f e = targets[n - 1];
+        auto end_miss = [&](double f) {
+            const double x = a.x + f * (double(b.x) - a.x) - e.x, y = a.y + f * (double(b.y) - a.y) - e.y,
+                         z = a.z + f * (double(b.z) - a.z) - e.z;
+            return std::sqrt(x * x + y * y + z * z);
+        };
+        constexpr int kSteps = 200000;
+        double closest = 1e9;
+        for (int i = 0; i <= kSteps; ++i) closest = std::min(closest, end_miss(double(i) / kSteps));
+        const double allowed = std::max(other, closest);
+        double best_f = -1, best = 1e9;
+        for (int i = 0; i <= kSteps; ++i) {
+            const double f = double(i) / kSteps;
+            if (end_miss(f) > allowed) continue;
+            const double miss = std::fabs(before + f * d(a, b) - target);
+            if (miss < best) best = miss, best_f = f;
+        }
+        ASSERT_GE(best_f, 0);
+        const double f = detail::length_keeping_fraction(decoded, targets, target);
+        // Within the allowance (to float rounding) and at least as close to
+        // the length as the scan (whose grid may miss the interval's edge).
+        EXPECT_LE(end_miss(f), allowed + 1e-6);
+        EXPECT_LE(std::fabs(before + f * d(a, b) - target), best + 1e-5);
+    }
 }
 
 }  // namespace

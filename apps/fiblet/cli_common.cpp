@@ -194,4 +194,10 @@ void add_threads_option(CLI::App* cmd, unsigned& threads, const std::string& wha
     });
 }
 
+void set_decoded_step_size(TckHeader& header, const FftFile& file) {
+    const FftHeader& h = file.header();
+    if (file.resampling() && !header.get("step_size")) return;
+    header.set("step_size", fmt::format("{:.9g}", double(h.step) * double(h.scaling)));
+}
+
 }  // namespace fiblet::cli

@@ -90,6 +90,13 @@ std::string json_quote(const std::string& s);
 // flag that add_ignore_trailer_flag() declares) the trailer is left unread,
 // and a warning says what that gives up.
 FftFile open_fft_input(const std::string& path, bool ignore_trailer);
+
+// Sets the `step_size` a decoded .tck declares: the decoder's step, except
+// for resampled input that declared none (raw bundles): its fibers end on a
+// fraction of a step (ENDS chunk), and MRtrix takes (points - 1) x step_size
+// as a streamline's length where a file declares one (`tckedit -minlength`),
+// so the decoded file, like its source, declares none.
+void set_decoded_step_size(TckHeader& header, const FftFile& file);
 void add_ignore_trailer_flag(CLI::App* cmd, bool& flag);
 
 // --output-dir DIR: created (with its parents) when missing; a file there is a usage error.

@@ -34,7 +34,7 @@ std::string decompress_one(const DecompressArgs& a, const std::string& input, co
     auto props = file.properties();
     TckHeader header;
     header.properties = props;
-    header.set("step_size", fmt::format("{:.9g}", double(h.step) * double(h.scaling)));
+    set_decoded_step_size(header, file);
     SinkHeader sink_header{header.properties, space_from_properties(props, input), file.streamline_fields(),
                            h.fibers, h.points};
     const TractogramFormat out_format = format_from_extension(output);  // .trk, .trx; else a .tck

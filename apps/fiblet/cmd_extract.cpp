@@ -138,7 +138,7 @@ void run(const ExtractArgs& a) {
     if (ext == ".tck") {
         TckHeader header;
         header.properties = file.properties();
-        header.set("step_size", fmt::format("{:.9g}", double(h.step) * double(h.scaling)));
+        set_decoded_step_size(header, file);
         TckWriter writer(a.output, header.properties, a.force);
         Progress progress(a.quiet || a.json);
         stats = select(file, index, query, [&](const SelectedChunk& chunk) {

@@ -57,6 +57,11 @@ public:
     // code tables, so trying several steps costs no table builds.
     FiberEncoder with_step(float step) const;
     FiberEncoder with_search(const SearchOptions& search) const;
+    // The same encoder keeping each fiber's length across its blocks
+    // (codec/length_feedback.hpp): the decoded length is steered towards
+    // the targets' polyline length times `stretch` (the decoder's step over
+    // the targets' spacing, for resampled input); 0 turns it off (default).
+    FiberEncoder with_length_feedback(float stretch) const;
 
     // Appends block_count(fiber.size()) blocks to `out`. When `decoded` is
     // given, the points fiblet's (float32) decoders will produce (world mm)
@@ -71,6 +76,7 @@ private:
     struct Tables;
     FftHeader header_;
     SearchOptions search_;
+    float length_stretch_ = 0;
     std::shared_ptr<const Tables> tables_;
 };
 

@@ -182,7 +182,9 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     h.ratio = tuned.ratio;
     report.step_scale = tuned.step_scale;
     h.step = float(step * report.step_scale / h.scaling);
-    const FiberEncoder encoder = tuned.encoder ? std::move(*tuned.encoder) : FiberEncoder(h, tuned.search);
+    // Resampled fibers keep their length across blocks (length_feedback.hpp).
+    const FiberEncoder encoder = (tuned.encoder ? std::move(*tuned.encoder) : FiberEncoder(h, tuned.search))
+                                     .with_length_feedback(report.resampled ? float(decoder_stretch(h.step, h.scaling, step)) : 0.0f);
     report.search = encoder.search();
     std::vector<FiberLutEntry> lut(scan.fibers);
     const std::uint64_t per_buffer = fft_max_blocks_per_buffer(h.block_bytes());

@@ -82,7 +82,7 @@ void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t
             if (fields) in.point_fields->resample(f, w.positions);
             points = w.resampled;
             (*in.end_fractions)[f] = encode_keeping_end(in.encoder, points, short_tail, in.step, f, w.blocks,
-                                                        w.decoded, &w.decoded_exact, w.scratch);
+                                                        w.decoded, &w.decoded_exact, w.scratch, polyline_length(original));
         } else {
             in.encoder.encode(points, f, w.blocks, &w.decoded, &w.decoded_exact);
         }

@@ -5,6 +5,7 @@
 #include "codec/anchor_conditioning.hpp"
 #include "codec/code_search.hpp"
 #include "codec/exact_model.hpp"
+#include "codec/length_feedback.hpp"
 #include "codec/nearest_code_lut.hpp"
 #include "core/block_geometry.hpp"
 #include "core/vec_math.hpp"
@@ -183,6 +184,12 @@ FiberEncoder FiberEncoder::with_step(float step) const {
 FiberEncoder FiberEncoder::with_search(const SearchOptions& search) const {
     FiberEncoder e = *this;
     e.search_ = search;
+    return e;
+}
+
+FiberEncoder FiberEncoder::with_length_feedback(float stretch) const {
+    FiberEncoder e = *this;
+    e.length_stretch_ = stretch;
     return e;
 }
 
@@ -366,6 +373,27 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
                 std::copy(retry_codes8.begin(), retry_codes8.end(), codes8_of(b));
             }
         }
+    }
+
+    // Length feedback across the blocks (length_feedback.hpp), with the
+    // retry's beam; robust blocks keep the codes that suit both decoders.
+    if (length_stretch_ > 0) {
+        const SearchParams feedback_params{std::max({8u, search_.beam_width, search_.retry_beam_width}), 1};
+        retry_codes8.resize(ppb);
+        retry_codes16.resize(ppb);
+        feed_back_length(
+            std::span<const Vec3f>(targets), std::span<Vec3f>(points), ppb, length_stretch_,
+            [&](std::uint32_t blk) { return wide || !(starts[blk].divergence > kRobustDivergence); },
+            [&](std::uint32_t blk, std::span<const Vec3f> t, Vec3f* dec) {
+                const std::size_t i0 = std::size_t(blk) * ppb;
+                if (wide) search_codes(Codebook16{*tables_->table16}, feedback_params, frames[blk], points[i0 + 1], h.step, t, retry_codes16.data(), dec);
+                else search_codes(Codebook8{*tables_->table8, *tables_->lut8}, feedback_params, frames[blk], points[i0 + 1], h.step, t, retry_codes8.data(), dec);
+            },
+            [&](std::uint32_t blk) {
+                const std::size_t i0 = std::size_t(blk) * ppb, m = block_points(blk) - 2;
+                if (wide) std::copy_n(retry_codes16.begin(), m, codes16.begin() + std::ptrdiff_t(i0));
+                else std::copy_n(retry_codes8.begin(), m, codes8_of(blk));
+            });
     }
 
     if (wide)

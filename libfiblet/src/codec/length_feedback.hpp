@@ -1,0 +1,101 @@
+// Internal: keeping a fiber's length across its blocks (error feedback).
+//
+// Inside a block every decoded segment is one step long; what the codes
+// change is where the block's last point lands along the track, and so the
+// length of the bridge segment to the next block's first anchor, which lies
+// on the target. Each block's lag is within the point error, but the lags
+// of a fiber's blocks add up in its length. The feedback carries the
+// fiber's length error so far (decoded minus target, the target segments
+// stretched by the decoder's step scale) into the next block: the targets
+// of the block's last points are moved along the track by the error the
+// bridge would leave, the block is searched again, and the new codes are
+// kept when they leave a smaller length error without a larger point error
+// than the fiber already has. The fiber's last block is left to the end
+// fraction (fiber_end_encoder.hpp), which places the end point.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/vec_math.hpp"
+
+namespace fiblet::detail {
+
+// How many of a block's last points have their targets moved (linearly
+// more towards the block's end), and the shares of the error tried (of at
+// most the point error the block may have).
+inline constexpr std::uint32_t kLengthFeedbackPoints = 12;
+inline constexpr float kLengthFeedbackShares[] = {1.0f, 0.5f, 0.25f};
+
+inline float segment_length(Vec3f a, Vec3f b) {
+    const Vec3f d = b - a;
+    return std::sqrt(dot(d, d));
+}
+
+// `targets` and `points` (decoded) of one fiber, normalized coordinates;
+// blocks of `ppb` points. Callbacks:
+//   adjustable(b)          whether block b's codes may be searched again
+//   search(b, t, decoded)  searches block b's codes for targets t (its
+//                          points 2..n-1) into a candidate, decoded into `decoded`
+//   keep(b)                the candidate becomes block b's codes
+template <class Adjustable, class Search, class Keep>
+void feed_back_length(std::span<const Vec3f> targets, std::span<Vec3f> points, std::uint32_t ppb, float stretch,
+                      Adjustable&& adjustable, Search&& search, Keep&& keep) {
+    const std::size_t n_points = points.size();
+    if (n_points <= ppb) return;  // one block: the end fraction does it all
+    thread_local std::vector<Vec3f> moved, candidate;
+    auto error_of = [&](std::size_t k) { return segment_length(points[k - 1], points[k]) - stretch * segment_length(targets[k - 1], targets[k]); };
+    auto max_error2 = [&](const Vec3f* decoded, std::size_t first, std::size_t m) {
+        float worst = 0;
+        for (std::size_t k = 0; k < m; ++k) {
+            const Vec3f d = decoded[k] - targets[first + k];
+            worst = std::max(worst, dot(d, d));
+        }
+        return worst;
+    };
+    // The point error the fiber has anyway: a block may go up to it.
+    const float fiber_max2 = max_error2(points.data(), 0, n_points);
+    double error = 0;  // decoded minus target length, up to the current point
+    for (std::size_t b0 = 0; b0 < n_points; b0 += ppb) {
+        const std::size_t n = std::min<std::size_t>(ppb, n_points - b0), last = b0 + n - 1;
+        for (std::size_t k = std::max<std::size_t>(b0, 1); k <= last; ++k) error += error_of(k);  // bridge, anchors, codes
+        if (n <= 2 || last + 1 >= n_points) continue;  // no codes, or the fiber's last block
+        const auto b = std::uint32_t(b0 / ppb);
+        // The error once the bridge to the next block is walked: the codes
+        // change only this bridge (every segment inside the block is a step).
+        const double lag = error + error_of(last + 1);
+        if (!adjustable(b) || !(std::fabs(lag) > 0)) continue;
+        const std::size_t m = n - 2, first = b0 + 2, moved_points = std::min<std::size_t>(kLengthFeedbackPoints, m);
+        const float allowed2 = std::max(fiber_max2, max_error2(&points[first], first, m));
+        double best = std::fabs(lag);
+        // A move farther than the error the block may have cannot be followed.
+        const float reach = std::sqrt(allowed2), move = std::clamp(float(lag), -reach, reach);
+        for (const float share : kLengthFeedbackShares) {
+            // Too long: the last points move on towards the next anchor (a
+            // shorter bridge); too short: they fall back.
+            moved.assign(targets.begin() + std::ptrdiff_t(first), targets.begin() + std::ptrdiff_t(last + 1));
+            for (std::size_t j = 0; j < moved_points; ++j) {
+                const std::size_t k = last - j;
+                const Vec3f along = targets[k + 1] - targets[k - 1];
+                const float len = std::sqrt(dot(along, along));
+                if (!(len > 0)) continue;
+                const float w = float(moved_points - j) / float(moved_points);
+                moved[k - first] = moved[k - first] + (share * w * move / len) * along;
+            }
+            candidate.resize(m);
+            search(b, std::span<const Vec3f>(moved), candidate.data());
+            if (max_error2(candidate.data(), first, m) > allowed2) continue;
+            const double now = std::fabs(error + segment_length(candidate[m - 1], points[last + 1]) -
+                                         stretch * segment_length(targets[last], targets[last + 1]));
+            if (!(now < best)) continue;
+            best = now;
+            std::copy(candidate.begin(), candidate.end(), points.begin() + std::ptrdiff_t(first));
+            keep(b);
+        }
+    }
+}
+
+}  // namespace fiblet::detail
