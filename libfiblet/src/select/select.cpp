@@ -446,9 +446,9 @@ private:
         std::vector<std::size_t> tested, first_point;
         while (candidates.next(batch_blocks(h_), blocks, fibers)) {
             reader_.read(blocks);
-            // Decoded: the blocks whose view sphere (from the header) meets a
-            // region they are tested against; the index's boxes bound groups
-            // of blocks, the sphere each block.
+            // Decoded: the blocks whose bound from headers (block_bound)
+            // meets a region they are tested against; the index's boxes
+            // bound groups of blocks, block_bound each block.
             tested.clear();
             for (std::size_t i = 0; i < blocks.size(); ++i) {
                 const std::uint64_t f = fibers[i], b = blocks[i];
