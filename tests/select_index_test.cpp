@@ -99,23 +99,88 @@ TEST_F(SelectIndex, ComputedIndexOfOfficialEncoderFilesHoldsEveryPoint) {
     }
 }
 
-TEST_F(SelectIndex, StoredBoxesAreWithinACellOfTheExactBoxes) {
+// The groups of the stored index: kDefaultIndexGroupBlocks blocks at a time
+// from each fiber's first block, as the format says.
+std::vector<std::pair<std::uint64_t, std::uint64_t>> index_groups(const FftFile& file, std::uint32_t g) {
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> groups;  // first block, end
+    for (std::uint64_t f = 0; f < file.header().fibers; ++f)
+        for (std::uint64_t b = file.first_block(f), e = b + file.block_count(f); b < e; b += g)
+            groups.emplace_back(b, std::min<std::uint64_t>(b + g, e));
+    return groups;
+}
+
+TEST_F(SelectIndex, StoredBoxesBoundGroupsWithinACellOfTheirExactBoxes) {
     const FftFile file(fiblet_file());
     const BlockIndex stored = BlockIndex::load(file), exact = BlockIndex::compute(file);
-    // 28 bits give 645 levels per axis, shared between the position (range
-    // 87 mm / cell) and the extent (6 mm / cell + 2): here 80 x 8 levels of
-    // a 1.10 mm cell, and a side moves by less than one cell.
+    const auto groups = index_groups(file, kDefaultIndexGroupBlocks);
+    EXPECT_EQ(stored.groups(), groups.size());
+    EXPECT_EQ(exact.groups(), exact.blocks());
+    // The grid for groups of 8 blocks (8 x 6 mm of fiber, 87 mm of range)
+    // has a cell of about 3 mm: every side of a group's box lies within a
+    // cell of the union of its blocks' exact boxes, and the same box is
+    // given for each of its blocks.
     double grow = 0;
-    for (std::uint64_t b = 0; b < stored.blocks(); ++b) {
-        const Aabb s = stored.block_box(b), e = exact.block_box(b);
-        for (float d : {e.min.x - s.min.x, e.min.y - s.min.y, e.min.z - s.min.z, s.max.x - e.max.x, s.max.y - e.max.y,
-                        s.max.z - e.max.z}) {
+    float cell = 0;
+    for (const auto& [b0, b1] : groups) {
+        Aabb u = exact.block_box(b0);
+        for (std::uint64_t b = b0 + 1; b < b1; ++b) {
+            const Aabb e = exact.block_box(b);
+            u.min = {std::min(u.min.x, e.min.x), std::min(u.min.y, e.min.y), std::min(u.min.z, e.min.z)};
+            u.max = {std::max(u.max.x, e.max.x), std::max(u.max.y, e.max.y), std::max(u.max.z, e.max.z)};
+        }
+        const Aabb s = stored.block_box(b0);
+        for (std::uint64_t b = b0 + 1; b < b1; ++b) {
+            const Aabb o = stored.block_box(b);
+            ASSERT_TRUE(o.min.x == s.min.x && o.max.z == s.max.z) << "block " << b;
+        }
+        for (float d : {u.min.x - s.min.x, u.min.y - s.min.y, u.min.z - s.min.z, s.max.x - u.max.x, s.max.y - u.max.y,
+                        s.max.z - u.max.z}) {
             ASSERT_GE(d, 0.0f);
-            ASSERT_LT(d, 1.15f) << "block " << b;
-            grow += d;
+            ASSERT_LT(d, 3.5f) << "group at block " << b0;
+            grow += d, cell = std::max(cell, d);
         }
     }
-    EXPECT_LT(grow / double(6 * stored.blocks()), 0.6);  // about half a cell on average
+    EXPECT_LT(grow / double(6 * groups.size()), 0.6 * cell);  // about half a cell on average
+}
+
+TEST_F(SelectIndex, EveryPointLiesInItsBlocksViewSphere) {
+    // Selections narrow an index group down to its blocks with this sphere
+    // (from the block's header): it must hold every decoded point.
+    for (const std::string& path : {fiblet_file(), dwi_file(), shared_data("reference/small-ifod1.fft")}) {
+        const FftFile file(path);
+        const DecodedFile d = decode_everything(file);
+        for (std::size_t b = 0; b < d.blocks.size(); ++b) {
+            const Sphere& s = d.blocks[b].sphere;
+            for (std::uint32_t k = 0; k < d.blocks[b].points; ++k) {
+                const Vec3f p = point_at(d, d.blocks[b].first_point + k);
+                const double dx = p.x - s.center.x, dy = p.y - s.center.y, dz = p.z - s.center.z;
+                ASSERT_LE(std::sqrt(dx * dx + dy * dy + dz * dz), double(s.radius)) << path << " block " << b;
+            }
+        }
+    }
+}
+
+TEST_F(SelectIndex, StoredJoinBoundsTheJumpBetweenBlocksOfAFiber) {
+    // Selections bound a block by the segment to the next block's first
+    // point (docs/select.md): the stored bound must hold every jump, and be
+    // about one step (not a loose number that would make it useless).
+    for (const std::string& path : {fiblet_file(), dwi_file()}) {
+        const FftFile file(path);
+        const BlockIndex index = BlockIndex::load(file);
+        const DecodedFile d = decode_everything(file);
+        double largest = 0;
+        for (std::size_t b = 0; b + 1 < d.blocks.size(); ++b) {
+            if (d.blocks[b].last_of_fiber) continue;
+            const Vec3f e = point_at(d, d.blocks[b].first_point + d.blocks[b].points - 1);
+            const Vec3f s = point_at(d, d.blocks[b + 1].first_point);
+            const double dx = double(s.x) - e.x, dy = double(s.y) - e.y, dz = double(s.z) - e.z;
+            largest = std::max(largest, std::sqrt(dx * dx + dy * dy + dz * dz));
+        }
+        EXPECT_GE(double(index.max_join()), largest) << path;
+        EXPECT_LT(double(index.max_join()), largest * 1.001 + 1e-6) << path;
+        const FftHeader& h = file.header();
+        EXPECT_LT(double(index.max_join()), 3.0 * double(h.step) * double(h.scaling)) << path;
+    }
 }
 
 TEST_F(SelectIndex, ChunkHasTheDocumentedSize) {
@@ -128,14 +193,13 @@ TEST_F(SelectIndex, ChunkHasTheDocumentedSize) {
         ASSERT_NE(c, nullptr);
         const FftHeader& h = file.header();
         const std::uint64_t count_bytes = h.points_per_block > 255 ? 2 : 1;
-        EXPECT_EQ(c->payload.size(), 56 + count_bytes * h.fibers + (std::uint64_t{h.blocks} * 28 + 7) / 8) << path;
+        const std::uint64_t groups = index_groups(file, kDefaultIndexGroupBlocks).size();
+        EXPECT_EQ(c->payload.size(), 72 + count_bytes * h.fibers + (groups * 28 + 7) / 8) << path;
         const BlockIndex index = BlockIndex::load(file);
         EXPECT_EQ(index.source(), BlockIndex::Source::chunk);
+        EXPECT_EQ(index.groups(), groups);
         expect_boxes_hold_points(file, index, decode_everything(file));
     }
-    // 3.5 bytes per 76-byte block plus one byte per fiber: under 5 % of the file.
-    const FftFile file(fiblet_file());
-    EXPECT_LT(double(file.find_chunk(kBlockIndexTag)->payload.size() + 16), 0.05 * double(file.file_size()));
 }
 
 TEST_F(SelectIndex, CandidatesNeverMissABlockWithAPointInTheRegion) {
@@ -143,8 +207,11 @@ TEST_F(SelectIndex, CandidatesNeverMissABlockWithAPointInTheRegion) {
         const FftFile file(path);
         const DecodedFile d = decode_everything(file);
         const BlockIndex index = BlockIndex::load(file);
+        // Boxes bound groups of blocks (stored chunk) or single blocks (computed).
+        const auto groups = index_groups(file, index.groups() == index.blocks() ? 1 : kDefaultIndexGroupBlocks);
+        ASSERT_EQ(groups.size(), index.groups());
         QueryGenerator gen(d, 5);
-        std::size_t candidates = 0, hits = 0;
+        std::size_t candidates = 0, hits = 0, candidate_groups = 0, hit_groups = 0;
         for (int i = 0; i < 40; ++i) {
             const Region r = gen.region();
             std::vector<std::uint64_t> bits;
@@ -159,11 +226,20 @@ TEST_F(SelectIndex, CandidatesNeverMissABlockWithAPointInTheRegion) {
                     ASSERT_TRUE(bit(bits, b)) << path << ": region " << i << " misses block " << b;
                 }
             }
+            for (const auto& [b0, b1] : groups) {
+                bool hit = false;
+                for (std::uint64_t b = b0; b < b1; ++b) {
+                    ASSERT_EQ(bit(bits, b), bit(bits, b0)) << "a group's blocks are candidates together";
+                    hit = hit || any_inside(d, d.blocks[b].first_point, d.blocks[b].points, r);
+                }
+                candidate_groups += bit(bits, b0), hit_groups += hit;
+            }
         }
         // Pruning works: small regions leave most blocks out, and the
-        // candidates are not many more than the blocks really hit.
+        // candidate boxes are not many more than the boxes really hit.
         EXPECT_LT(candidates, 40 * d.blocks.size() / 4);
-        EXPECT_LT(candidates, 3 * hits);
+        EXPECT_LT(candidate_groups, 3 * hit_groups);
+        EXPECT_GE(candidates, hits);
     }
 }
 
@@ -223,12 +299,83 @@ TEST_F(SelectIndex, MalformedChunksAreRejected) {
     EXPECT_TRUE(rejected(p, "bits.fft"));
     p = payload, std::memset(&p[36], 0, 4);  // cell 0
     EXPECT_TRUE(rejected(p, "cell.fft"));
-    p = payload, p[56] = std::uint8_t(p[56] == 1 ? 2 : 1);  // first fiber's point count no longer adds up
+    p = payload, p[72] = std::uint8_t(p[72] == 1 ? 2 : 1);  // first fiber's point count no longer adds up
     EXPECT_TRUE(rejected(p, "points.fft"));
-    p = payload, p[56] = 64;
+    p = payload, p[72] = 64;
     EXPECT_TRUE(rejected(p, "toomany.fft"));
     p = payload, std::memset(&p[40], 0xff, 4);  // levels overflow the code
     EXPECT_TRUE(rejected(p, "levels.fft"));
+    const float nan = std::nanf(""), negative = -1;
+    p = payload, std::memcpy(&p[64], &nan, 4);  // join distance
+    EXPECT_TRUE(rejected(p, "join-nan.fft"));
+    p = payload, std::memcpy(&p[64], &negative, 4);
+    EXPECT_TRUE(rejected(p, "join-negative.fft"));
+    p = payload, std::memset(&p[52], 0, 4);  // 0 blocks per group
+    EXPECT_TRUE(rejected(p, "group0.fft"));
+    p = payload, p[56] ^= 1;  // group count: the payload size no longer matches
+    EXPECT_TRUE(rejected(p, "groups.fft"));
+    // Groups of 7 blocks with the same number of groups: well-formed on its
+    // own, but the fibers' blocks make another number of groups.
+    p = payload, p[52] = 7;
+    EXPECT_TRUE(rejected(p, "group7.fft"));
+    // Version 1's size rule (56-byte header, a box per block) applied to a
+    // version-2 payload.
+    p = payload, p[0] = 1;
+    EXPECT_TRUE(rejected(p, "v1.fft"));
+}
+
+TEST_F(SelectIndex, VersionOneChunksOfOneBoxPerBlockAreStillRead) {
+    // Version 1 (fiblet before groups): the 56-byte header and a box per
+    // block. Made from a version-2 chunk of one-block groups, which has the
+    // same grid and codes.
+    const FftFile file(fiblet_file());
+    const DecodedFile d = decode_everything(file);
+    IndexBuilder builder(file.header(), kDefaultIndexBitsPerBlock, 1);
+    for (std::size_t b = 0; b < d.blocks.size(); ++b)
+        builder.add_block(&d.points.xyz[3 * d.blocks[b].first_point], d.blocks[b].points, d.blocks[b].last_of_fiber);
+    std::vector<std::uint8_t> v1 = builder.finish()->payload;
+    ASSERT_EQ(v1[52], 1);  // one block per group
+    v1.erase(v1.begin() + 52, v1.begin() + 72);  // group size and count, join, reserved
+    v1.insert(v1.begin() + 52, 4, 0);             // reserved
+    v1[0] = 1;
+    const FftFile old(with_index_payload(file, v1, dir_->file("v1.fft")));
+    const BlockIndex index = BlockIndex::load(old);
+    EXPECT_EQ(index.source(), BlockIndex::Source::chunk);
+    EXPECT_EQ(index.groups(), index.blocks());
+    expect_boxes_hold_points(old, index, d);
+    // Its boxes are the per-block boxes of version 1: within a 1.1 mm cell.
+    const BlockIndex exact = BlockIndex::compute(file);
+    for (std::uint64_t b = 0; b < index.blocks(); b += 7)
+        ASSERT_LT(exact.block_box(b).min.x - index.block_box(b).min.x, 1.15f) << "block " << b;
+    // Selections through it are the decode-everything reference's.
+    QueryGenerator gen(d, 3);
+    for (int i = 0; i < 10; ++i) {
+        Query q;
+        q.include.push_back(gen.region());
+        if (i % 2) q.roi_mode = RoiMode::blocks;
+        std::vector<SelectedRun> runs;
+        const Streamlines got = select_streamlines(old, index, q, &runs);
+        expect_same_selection(reference_select(old, d, q), got, runs, "query " + std::to_string(i));
+    }
+}
+
+TEST_F(SelectIndex, VerifyCatchesAJoinBoundBelowARealJump) {
+    // A writer that understated maxJoin: the file opens (well-formed), but a
+    // selection could lose blocks; verify decodes them and says so.
+    const FftFile good(fiblet_file());
+    EXPECT_NO_THROW(verify_fft_file(good.path()));
+    std::vector<std::uint8_t> p = good.find_chunk(kBlockIndexTag)->payload;
+    const float small = 0.25f * BlockIndex::load(good).max_join();
+    std::memcpy(&p[64], &small, 4);
+    const std::string bad = with_index_payload(good, p, dir_->file("join.fft"));
+    EXPECT_NO_THROW(FftFile{bad});
+    try {
+        verify_fft_file(bad);
+        ADD_FAILURE() << "verify passed a join bound below a real jump";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), Errc::fft_format);
+        EXPECT_NE(std::string(e.what()).find("BIDX"), std::string::npos) << e.what();
+    }
 }
 
 TEST_F(SelectIndex, BlocksOffTheGridAreNeverCulled) {
@@ -243,7 +390,7 @@ TEST_F(SelectIndex, BlocksOffTheGridAreNeverCulled) {
         if (b == 0) pts[0] += 1000;
         builder.add_block(pts.data(), d.blocks[b].points, d.blocks[b].last_of_fiber);
     }
-    EXPECT_EQ(builder.unbounded_blocks(), 1u);
+    EXPECT_EQ(builder.unbounded_blocks(), 1u);  // block 0's group
     const auto chunk = builder.finish();
     ASSERT_TRUE(chunk);
     const FftFile patched(with_index_payload(file, chunk->payload, dir_->file("unbounded.fft")));
@@ -251,8 +398,10 @@ TEST_F(SelectIndex, BlocksOffTheGridAreNeverCulled) {
     EXPECT_GT(index.block_box(0).max.x, 1e20f);
     std::vector<std::uint64_t> bits;
     index.blocks_near_sphere({-5000, 0, 0}, 1, bits);
-    EXPECT_TRUE(bit(bits, 0));
-    for (std::size_t b = 1; b < d.blocks.size(); ++b) EXPECT_FALSE(bit(bits, b));
+    // Block 0 and the other blocks of its group, none else.
+    const std::uint64_t group_end =
+        std::min<std::uint64_t>(kDefaultIndexGroupBlocks, patched.block_count(0));
+    for (std::size_t b = 0; b < d.blocks.size(); ++b) EXPECT_EQ(bit(bits, b), b < group_end) << "block " << b;
 }
 
 TEST_F(SelectIndex, BuilderRefusesLayoutsItCannotDescribe) {

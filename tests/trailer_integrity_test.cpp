@@ -291,7 +291,7 @@ TEST(TrailerIntegrity, VerifyCrossChecksWhatReadersRelyOn) {
     const std::string shrunk = fx.rewritten("shrunk.fft", {}, [&](std::vector<TrailerChunk>& chunks) {
         for (TrailerChunk& c : chunks)
             if (c.tag == kBlockIndexTag) {
-                const std::size_t codes = 56 + h.fibers;  // one byte of last-block points per fiber
+                const std::size_t codes = 72 + h.fibers;  // one byte of last-block points per fiber
                 for (std::size_t i = codes; i < c.payload.size(); ++i) c.payload[i] = 0;
             }
     });

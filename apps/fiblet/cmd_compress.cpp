@@ -181,7 +181,7 @@ void add_compress(CLI::App& app) {
     cmd->add_option("--tuning-points", args->tuning_points, "Points in the sample the cap and step are tuned on");
     cmd->add_option("--step-scale", args->step_scale, "Decoder step / sampling step (default: tuned on a sample)");
     cmd->add_flag("--no-index", args->no_index,
-                  "Leave out the block index (BIDX chunk, ~5 % of the file; extract and render compute it on load)");
+                  "Leave out the block index (BIDX chunk, under 1 % of the file; extract and render compute it on load)");
     cmd->add_flag("-z,--zstd", args->zstd,
                   "Write the seekable zstd container (.fftz, formats/fftz.md): smaller, still random access");
     cmd->add_option("--zstd-level", args->zstd_level, "zstd level (default 17)")->check(CLI::Range(1, 22));

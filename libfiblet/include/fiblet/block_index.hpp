@@ -3,11 +3,13 @@
 // without reading (let alone decoding) the others.
 //
 // On disk it is the optional "BIDX" trailer chunk (formats/fft-index.md):
-// one quantized box per block in 28 bits plus one byte per fiber (two when
-// blocks hold more than 255 points), about 3.6 bytes per 76-byte block. Files without it (e.g. from the official
-// encoder) get the same index computed on load by decoding every block once.
-// The hierarchy is never stored: it is rebuilt in memory on load (storing
-// block ids would cost more than the boxes).
+// one quantized box per group of up to 8 consecutive blocks of a fiber in 28
+// bits, plus one byte per fiber (two when blocks hold more than 255
+// points): under 1 % of a file. A selection narrows a group down to its
+// blocks with each block's own view sphere (from its header, no decoding).
+// Files without it (e.g. from the official encoder) get an index of exact
+// per-block boxes computed on load by decoding every block once. The
+// hierarchy is never stored: it is rebuilt in memory on load.
 #pragma once
 
 #include <array>
@@ -24,16 +26,19 @@
 namespace fiblet {
 
 inline constexpr std::array<char, 4> kBlockIndexTag = {'B', 'I', 'D', 'X'};
-inline constexpr unsigned kDefaultIndexBitsPerBlock = 28;
+inline constexpr unsigned kDefaultIndexBitsPerBlock = 28;  // bits per box code
+inline constexpr std::uint32_t kDefaultIndexGroupBlocks = 8;
 
 // Accumulates the bounds of blocks as they are written (compress, extract)
-// and serializes them as a BIDX chunk. Blocks come in file order, a fiber at
-// a time; builders filled in parallel on consecutive fibers are joined in
-// order with append(). Memory: 4 bytes per block.
+// and serializes them as a BIDX chunk: one box per group of group_blocks
+// consecutive blocks of a fiber. Blocks come in file order, a fiber at a
+// time; builders filled in parallel on consecutive fibers are joined in
+// order with append(). Memory: 4 bytes per group.
 class IndexBuilder {
 public:
     IndexBuilder() = default;  // unusable until assigned from a header-built one
-    explicit IndexBuilder(const FftHeader& header, unsigned bits_per_block = kDefaultIndexBitsPerBlock);
+    explicit IndexBuilder(const FftHeader& header, unsigned bits_per_box = kDefaultIndexBitsPerBlock,
+                          std::uint32_t group_blocks = kDefaultIndexGroupBlocks);
 
     // The decoded points (world mm) of one whole fiber laid out as the
     // encoder does: blocks of points_per_block points, the last one the rest.
@@ -44,9 +49,10 @@ public:
     void append(const IndexBuilder& later);
     void clear();
 
-    std::uint64_t blocks() const { return codes_.size(); }
+    std::uint64_t blocks() const { return blocks_; }
     std::uint64_t fibers() const { return last_points_.size(); }
-    // Blocks too large for the grid, stored as "unbounded" (never culled).
+    std::uint64_t groups() const { return codes_.size(); }
+    // Groups too large for the grid, stored as "unbounded" (never culled).
     std::uint64_t unbounded_blocks() const { return unbounded_; }
 
     // The BIDX chunk, or nullopt when the layout cannot be described: a
@@ -61,21 +67,29 @@ private:
         std::uint32_t min_levels = 1, extent_levels = 1;
     };
     void add_box(const Aabb& box, std::uint32_t n, bool last_of_fiber, float sphere_radius);
+    void close_group();
 
     FftHeader header_;
     unsigned bits_ = kDefaultIndexBitsPerBlock;
+    std::uint32_t group_blocks_ = kDefaultIndexGroupBlocks;
     Grid grid_;
-    std::vector<std::uint32_t> codes_;
+    std::vector<std::uint32_t> codes_;  // per closed group
+    Aabb group_box_{};                  // the open group's bounds
+    std::uint32_t group_fill_ = 0;      // blocks in the open group
+    std::uint64_t blocks_ = 0;
     std::vector<std::uint16_t> last_points_;
     std::uint32_t open_fiber_blocks_ = 0;  // blocks of the fiber being added
     bool layout_ok_ = true;
     std::uint64_t unbounded_ = 0;
     float max_sphere_radius_ = 0;
+    double max_join_ = 0;     // largest |last point of a block - first point of the next| in a fiber
+    Vec3f last_point_{};      // of the last block added
 };
 
-// The index of one file, in memory: per-block boxes, per-fiber point
-// counts, and a bounding volume hierarchy (8-wide, over blocks sorted along
-// a Morton curve) to find the blocks that meet a region.
+// The index of one file, in memory: boxes of groups of consecutive blocks
+// (a stored chunk's groups, or one exact box per block when computed),
+// per-fiber point counts, and a bounding volume hierarchy (8-wide, over the
+// groups sorted along a Morton curve) to find the blocks that meet a region.
 class BlockIndex {
 public:
     enum class Source { chunk, decoded };
@@ -87,14 +101,21 @@ public:
     static BlockIndex compute(const FftFile& file);
 
     Source source() const { return source_; }
-    std::uint64_t blocks() const { return rank_.size(); }
+    std::uint64_t blocks() const { return blocks_; }
+    // Boxes: groups of consecutive blocks of a fiber (one block each when
+    // computed).
+    std::uint64_t groups() const { return order_.size(); }
     std::uint64_t fibers() const { return fiber_points_.size(); }
     std::uint64_t fiber_points(std::uint64_t fiber) const { return fiber_points_[fiber]; }
-    // Bounds of every point a block decodes to (conservative; escaped blocks
-    // have an unbounded box).
-    Aabb block_box(std::uint64_t block) const { return sorted_boxes_[rank_[block]]; }
+    // Bounds of every point a block decodes to: its group's box
+    // (conservative; escaped groups have an unbounded box).
+    Aabb block_box(std::uint64_t block) const;
     // Every block's view sphere (view.hpp) has a radius at most this.
     float max_sphere_radius() const { return max_sphere_radius_; }
+    // A block's last point lies at most this far (mm) from the next block's
+    // first point of its fiber; negative when unknown (version-1 chunks,
+    // computed indexes, whose boxes bound single blocks).
+    float max_join() const { return max_join_; }
 
     // Blocks whose box may meet a sphere / a box / the frustum grown by
     // `margin`: a bitmap of blocks() bits, ORed into `bits` (resized as
@@ -111,18 +132,21 @@ public:
 
 private:
     BlockIndex() = default;
-    void set_blocks(std::vector<Aabb> boxes);  // sorts and builds the hierarchy
+    void set_blocks(std::vector<Aabb> boxes);  // one group per block; sorts and builds the hierarchy
     template <class BoxOf>
-    void build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of);  // (Morton key << 32 | block)
+    void build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of);  // (Morton key << 32 | group)
     template <class Classify>
     void collect(const Classify& classify, std::vector<std::uint64_t>& bits, std::vector<std::uint64_t>* inside) const;
 
     Source source_ = Source::decoded;
     std::vector<std::uint64_t> fiber_points_;
     float max_sphere_radius_ = 0;
-    std::vector<Aabb> sorted_boxes_;             // in Morton order
-    std::vector<std::uint32_t> order_;           // Morton position -> block
-    std::vector<std::uint32_t> rank_;            // block -> Morton position
+    float max_join_ = -1;
+    std::uint64_t blocks_ = 0;
+    std::vector<std::uint32_t> group_first_;     // group -> its first block; one more: blocks_
+    std::vector<Aabb> sorted_boxes_;             // groups in Morton order
+    std::vector<std::uint32_t> order_;           // Morton position -> group
+    std::vector<std::uint32_t> rank_;            // group -> Morton position
     std::vector<std::vector<Aabb>> levels_;      // levels_[k][j]: node j of level k (k = 0: leaves)
 };
 

@@ -20,7 +20,7 @@ namespace {
 // checksum can (a file may have none, or a writer may have been wrong): the
 // header's point count, the BIDX chunk's per-fiber counts and boxes, and
 // that every decoded point is finite. The chunk is read as parsed (2 bytes a
-// fiber, 4 a block), not as a BlockIndex, so verify's memory stays near the
+// fiber, 4 a group of blocks), not as a BlockIndex, so verify's memory stays near the
 // open file's 12 bytes a fiber.
 class BlockCrossCheck {
 public:
@@ -40,15 +40,21 @@ public:
         const float* p = xyz_.data();
         for (std::uint64_t b = 0; b < count; ++b) {
             const std::uint32_t n = block_flags(h, blocks + b * h.block_bytes()).point_count;
+            next_block();
             check_points(first + b, p, n);
-            count_points(n);
+            check_join(first + b, p, n);
+            fiber_points_ += n, points_ += n;
             p += 3 * n;
         }
     }
 
     std::uint64_t finish() {
         const FftHeader& h = file_.header();
+        if (started_) end_fiber(), ++fiber_, fiber_points_ = 0;
         for (; fiber_ < h.fibers; ++fiber_, fiber_points_ = 0) check_fiber();  // the fibers after the last block
+        if (index_ && group_base_ != index_->groups)
+            fail("the BIDX chunk stores " + std::to_string(index_->groups) + " groups, the fibers have " +
+                 std::to_string(group_base_));
         if (points_ != h.points)
             fail("the blocks hold " + std::to_string(points_) + " points, the header says " + std::to_string(h.points));
         return points_;
@@ -60,7 +66,11 @@ private:
     }
 
     void check_points(std::uint64_t block, const float* p, std::uint32_t n) const {
-        const Aabb box = boxes_ ? boxes_->box(index_->codes[block]) : Aabb{};
+        // The block's box is its group's: G blocks at a time from its fiber's first.
+        const std::uint64_t group = index_ ? group_base_ + (block_in_fiber_ - 1) / index_->group_blocks : 0;
+        if (index_ && group >= index_->groups)
+            fail("the fibers have more groups than the BIDX chunk stores (" + std::to_string(index_->groups) + ")");
+        const Aabb box = boxes_ ? boxes_->box(index_->codes[group]) : Aabb{};
         for (std::uint32_t i = 0; i < n; ++i, p += 3) {
             if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])))
                 fail("block " + std::to_string(block) + " decodes to a non-finite point");
@@ -71,12 +81,32 @@ private:
         }
     }
 
+    // The jump from the previous block of the fiber to this one is within
+    // the chunk's bound (selections rely on it to bound blocks by headers).
+    void check_join(std::uint64_t block, const float* p, std::uint32_t n) {
+        if (index_ && index_->max_join >= 0 && block_in_fiber_ > 1) {
+            const double dx = double(p[0]) - last_[0], dy = double(p[1]) - last_[1], dz = double(p[2]) - last_[2];
+            if (std::sqrt(dx * dx + dy * dy + dz * dz) > double(index_->max_join))
+                fail("block " + std::to_string(block) +
+                     " starts farther from the previous block's end than the BIDX chunk says (a selection would lose it)");
+        }
+        std::copy(p + 3 * (n - 1), p + 3 * n, last_);
+    }
+
     // Fibers in order: the LUT gives their block counts, the index their
-    // point counts (every block but a fiber's last is full).
-    void count_points(std::uint32_t n) {
-        while (block_in_fiber_ >= file_.block_count(fiber_)) check_fiber(), ++fiber_, block_in_fiber_ = 0, fiber_points_ = 0;
-        fiber_points_ += n, points_ += n;
+    // point counts (every block but a fiber's last is full) and groups.
+    void next_block() {
+        if (started_) {
+            while (block_in_fiber_ >= file_.block_count(fiber_)) end_fiber(), ++fiber_, block_in_fiber_ = 0, fiber_points_ = 0;
+        } else {
+            started_ = true;
+            while (file_.block_count(fiber_) == 0) check_fiber(), ++fiber_;
+        }
         ++block_in_fiber_;
+    }
+    void end_fiber() {
+        check_fiber();
+        if (index_) group_base_ += detail::index_groups_of_fiber(file_.block_count(fiber_), index_->group_blocks);
     }
     void check_fiber() const {
         if (!index_) return;
@@ -92,7 +122,9 @@ private:
     std::optional<detail::IndexChunk> index_;
     std::optional<detail::IndexBoxDecoder> boxes_;
     std::vector<float> xyz_;
-    std::uint64_t fiber_ = 0, block_in_fiber_ = 0, fiber_points_ = 0, points_ = 0;
+    std::uint64_t fiber_ = 0, block_in_fiber_ = 0, fiber_points_ = 0, points_ = 0, group_base_ = 0;
+    bool started_ = false;
+    float last_[3] = {};  // the previous block's last point
 };
 
 }  // namespace

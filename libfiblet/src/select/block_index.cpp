@@ -62,41 +62,59 @@ BlockIndex BlockIndex::load(const FftFile& file) {
     if (!chunk) return compute(file);
     const FftHeader& h = file.header();
     const detail::IndexChunk c = detail::parse_index_chunk(chunk->payload, h, file.path());
+    auto bad = [&](const std::string& what) {
+        throw Error(Errc::fft_format, file.path() + ": malformed BIDX (block index) chunk: " + what);
+    };
     BlockIndex index;
     index.source_ = Source::chunk;
+    index.blocks_ = h.blocks;
     index.max_sphere_radius_ = c.max_sphere_radius;
-    // Fiber point counts: full blocks but the last (checked against the header's total).
+    index.max_join_ = c.max_join;
+    // Fiber point counts: full blocks but the last (checked against the
+    // header's total); groups: G blocks at a time from each fiber's first.
     index.fiber_points_.resize(h.fibers);
+    index.group_first_.clear();
+    index.group_first_.reserve(c.groups + 1);
     std::uint64_t total = 0;
     for (std::uint64_t f = 0; f < h.fibers; ++f) {
         const std::uint32_t nb = file.block_count(f);
         const std::uint16_t last = c.last_block_points[f];
-        if ((nb == 0) != (last == 0))
-            throw Error(Errc::fft_format, file.path() + ": malformed BIDX (block index) chunk: fiber " +
-                                              std::to_string(f) + " point count disagrees with its blocks");
+        if ((nb == 0) != (last == 0)) bad("fiber " + std::to_string(f) + " point count disagrees with its blocks");
         index.fiber_points_[f] = nb == 0 ? 0 : std::uint64_t(nb - 1) * h.points_per_block + last;
         total += index.fiber_points_[f];
+        if (index.group_first_.size() + detail::index_groups_of_fiber(nb, c.group_blocks) > c.groups)
+            bad("its fibers have more groups of " + std::to_string(c.group_blocks) + " blocks than it stores");
+        for (std::uint32_t k = 0; k < nb; k += c.group_blocks)
+            index.group_first_.push_back(std::uint32_t(file.first_block(f) + k));
     }
+    if (index.group_first_.size() != c.groups)
+        bad("it stores " + std::to_string(c.groups) + " groups, its fibers have " +
+            std::to_string(index.group_first_.size()));
+    index.group_first_.push_back(std::uint32_t(h.blocks));
     if (total != h.points)
-        throw Error(Errc::fft_format, file.path() + ": malformed BIDX (block index) chunk: its fibers hold " +
-                                          std::to_string(total) + " points, the header says " +
-                                          std::to_string(h.points));
+        bad("its fibers hold " + std::to_string(total) + " points, the header says " + std::to_string(h.points));
     // Morton keys straight from the codes' cells, then boxes decoded in that order.
     const detail::IndexBoxDecoder decoder(c.grid);
     unsigned shift = 0;
     while ((decoder.max_centre2() >> shift) >= 1024) ++shift;
-    std::vector<std::uint64_t> keyed(c.blocks);
-    for (std::uint64_t b = 0; b < c.blocks; ++b) {
+    std::vector<std::uint64_t> keyed(c.groups);
+    for (std::uint64_t g = 0; g < c.groups; ++g) {
         std::uint64_t key = std::uint64_t{1} << 30;
-        if (!decoder.unbounded(c.codes[b])) {
+        if (!decoder.unbounded(c.codes[g])) {
             std::uint32_t m[3];
-            decoder.centre2(c.codes[b], m);
+            decoder.centre2(c.codes[g], m);
             key = spread_bits(m[0] >> shift) | spread_bits(m[1] >> shift) << 1 | spread_bits(m[2] >> shift) << 2;
         }
-        keyed[b] = key << 32 | b;
+        keyed[g] = key << 32 | g;
     }
-    index.build(keyed, [&](std::uint32_t b) { return decoder.box(c.codes[b]); });
+    index.build(keyed, [&](std::uint32_t g) { return decoder.box(c.codes[g]); });
     return index;
+}
+
+Aabb BlockIndex::block_box(std::uint64_t block) const {
+    const auto g = std::size_t(std::upper_bound(group_first_.begin(), group_first_.end() - 1, std::uint32_t(block)) -
+                               group_first_.begin()) - 1;
+    return sorted_boxes_[rank_[g]];
 }
 
 BlockIndex BlockIndex::compute(const FftFile& file) {
@@ -135,12 +153,15 @@ BlockIndex BlockIndex::compute(const FftFile& file) {
         for (std::uint64_t b = file.first_block(f), e = b + file.block_count(f); b < e; ++b) points += counts[b];
         index.fiber_points_[f] = points;
     }
+    index.blocks_ = h.blocks;
     index.set_blocks(std::move(boxes));
     return index;
 }
 
 void BlockIndex::set_blocks(std::vector<Aabb> boxes) {
     const std::size_t n = boxes.size();
+    group_first_.resize(n + 1);
+    for (std::size_t b = 0; b <= n; ++b) group_first_[b] = std::uint32_t(b);
     // Morton order of the box centres over the bounds of the bounded ones;
     // unbounded boxes go last, so that they spoil one path of the tree only.
     Aabb all = empty_box();
@@ -175,10 +196,10 @@ void BlockIndex::build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of) {
     sorted_boxes_.clear(), sorted_boxes_.reserve(n);
     rank_.resize(n);
     for (std::size_t pos = 0; pos < n; ++pos) {
-        const auto block = std::uint32_t(keyed[pos]);
-        order_.push_back(block);
-        rank_[block] = std::uint32_t(pos);
-        sorted_boxes_.push_back(box_of(block));
+        const auto group = std::uint32_t(keyed[pos]);
+        order_.push_back(group);
+        rank_[group] = std::uint32_t(pos);
+        sorted_boxes_.push_back(box_of(group));
     }
     // Levels of the tree: each node bounds kFanout consecutive children.
     levels_.clear();
@@ -196,14 +217,19 @@ template <class Classify>
 void BlockIndex::collect(const Classify& classify, std::vector<std::uint64_t>& bits,
                          std::vector<std::uint64_t>* inside) const {
     const std::size_t n = sorted_boxes_.size();
-    bits.resize((n + 63) / 64, 0);
-    if (inside) inside->resize((n + 63) / 64, 0);
+    bits.resize((blocks_ + 63) / 64, 0);
+    if (inside) inside->resize((blocks_ + 63) / 64, 0);
     if (n == 0) return;
+    // The blocks of the group at Morton position `pos`.
+    auto mark = [&](std::vector<std::uint64_t>& to, std::size_t pos) {
+        const std::uint32_t g = order_[pos];
+        for (std::uint32_t b = group_first_[g]; b < group_first_[g + 1]; ++b) set_bit(to, b);
+    };
     // Positions covered by node j of level k: [j * span, (j + 1) * span), span = 8^(k+1).
     auto mark_all = [&](std::size_t first, std::size_t last) {
         for (std::size_t pos = first; pos < std::min(last, n); ++pos) {
-            set_bit(bits, order_[pos]);
-            if (inside) set_bit(*inside, order_[pos]);
+            mark(bits, pos);
+            if (inside) mark(*inside, pos);
         }
     };
     auto visit = [&](auto& self, std::size_t k, std::size_t j, std::size_t span) -> void {
@@ -213,8 +239,8 @@ void BlockIndex::collect(const Classify& classify, std::vector<std::uint64_t>& b
         if (k == 0) {
             for (std::size_t pos = j * kFanout; pos < std::min(n, (j + 1) * kFanout); ++pos) {
                 const Overlap b = classify(sorted_boxes_[pos]);
-                if (b != Overlap::outside) set_bit(bits, order_[pos]);
-                if (b == Overlap::inside && inside) set_bit(*inside, order_[pos]);
+                if (b != Overlap::outside) mark(bits, pos);
+                if (b == Overlap::inside && inside) mark(*inside, pos);
             }
             return;
         }

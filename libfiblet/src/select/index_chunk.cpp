@@ -30,16 +30,17 @@ std::uint32_t max_axis_levels(unsigned bits) {
 
 }  // namespace
 
-IndexGrid IndexGrid::for_header(const FftHeader& h, unsigned bits) {
+IndexGrid IndexGrid::for_header(const FftHeader& h, unsigned bits, std::uint32_t group_blocks) {
     IndexGrid g;
     g.bits = bits;
     const float lo = float(-kCubeMargin);
     g.origin = h.to_world(lo, lo, lo);
     const double range = double(h.scaling) * (1 + 2 * kCubeMargin);
-    // Blocks span at most (n-1) steps plus the quantization of their second
-    // anchor; one more step of room keeps every block fiblet writes on the
-    // grid (larger ones are stored as unbounded, never wrongly culled).
-    const double extent = double(h.points_per_block) * double(h.step) * double(h.scaling);
+    // A group of G blocks spans at most G*n-1 steps plus the quantization of
+    // its first block's second anchor; one more step of room keeps every
+    // group fiblet writes on the grid (larger ones are stored as unbounded,
+    // never wrongly culled).
+    const double extent = double(group_blocks) * double(h.points_per_block) * double(h.step) * double(h.scaling);
     const std::uint32_t v = max_axis_levels(bits);
     double best = std::numeric_limits<double>::infinity();
     // A box of extent x spans i..j with j - i < x / cell + 2 + 2 * slack
@@ -99,6 +100,9 @@ std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c, const FftHe
     put(40, c.grid.min_levels);
     put(44, c.grid.extent_levels);
     put(48, c.max_sphere_radius);
+    put(52, c.group_blocks);
+    put(56, c.groups);
+    put(64, c.max_join);
     const unsigned count_bytes = index_count_bytes(h);
     out.resize(kIndexChunkHeaderBytes + count_bytes * c.last_block_points.size());
     for (std::size_t f = 0; f < c.last_block_points.size(); ++f) {
@@ -122,11 +126,13 @@ IndexChunk parse_index_chunk(const std::vector<std::uint8_t>& p, const FftHeader
     auto bad = [&](const std::string& what) -> IndexChunk {
         throw Error(Errc::fft_format, file + ": malformed BIDX (block index) chunk: " + what);
     };
-    if (p.size() < kIndexChunkHeaderBytes) return bad("truncated header");
+    if (p.size() < 4) return bad("truncated header");
     IndexChunk c;
     const std::uint8_t* b = p.data();
-    if (get_le<std::uint32_t>(b) != kIndexChunkVersion)
-        return bad("unsupported version " + std::to_string(get_le<std::uint32_t>(b)));
+    const std::uint32_t version = get_le<std::uint32_t>(b);
+    if (version != 1 && version != kIndexChunkVersion) return bad("unsupported version " + std::to_string(version));
+    const std::size_t header_bytes = version == 1 ? kIndexChunkV1HeaderBytes : kIndexChunkHeaderBytes;
+    if (p.size() < header_bytes) return bad("truncated header");
     c.grid.bits = get_le<std::uint32_t>(b + 4);
     c.fibers = get_le<std::uint64_t>(b + 8);
     c.blocks = get_le<std::uint64_t>(b + 16);
@@ -135,24 +141,33 @@ IndexChunk parse_index_chunk(const std::vector<std::uint8_t>& p, const FftHeader
     c.grid.min_levels = get_le<std::uint32_t>(b + 40);
     c.grid.extent_levels = get_le<std::uint32_t>(b + 44);
     c.max_sphere_radius = get_le<float>(b + 48);
+    // Version 1: one box per block.
+    c.group_blocks = version == 1 ? 1 : get_le<std::uint32_t>(b + 52);
+    c.groups = version == 1 ? c.blocks : get_le<std::uint64_t>(b + 56);
+    c.max_join = version == 1 ? -1.0f : get_le<float>(b + 64);
 
     const unsigned bits = c.grid.bits;
     if (bits < 8 || bits > 32) return bad("bits per block " + std::to_string(bits) + " outside [8, 32]");
     if (c.fibers != h.fibers || c.blocks != h.blocks) return bad("its fiber or block count differs from the header's");
+    // Every group holds 1..G blocks: at least ceil(blocks / G) of them, at most one a block.
+    if (c.group_blocks == 0) return bad("0 blocks per group");
+    if (c.groups > c.blocks || c.groups < (c.blocks + c.group_blocks - 1) / c.group_blocks)
+        return bad("its group count does not fit its block count");
     if (!(std::isfinite(c.grid.origin.x) && std::isfinite(c.grid.origin.y) && std::isfinite(c.grid.origin.z)))
         return bad("grid origin is not finite");
     if (!(std::isfinite(c.grid.cell) && c.grid.cell > 0)) return bad("grid cell is not a positive number");
     if (!(std::isfinite(c.max_sphere_radius) && c.max_sphere_radius >= 0)) return bad("invalid sphere radius");
+    if (version != 1 && !(std::isfinite(c.max_join) && c.max_join >= 0)) return bad("invalid block join distance");
     const std::uint64_t levels = std::uint64_t(c.grid.min_levels) * c.grid.extent_levels;
     if (c.grid.min_levels == 0 || c.grid.extent_levels == 0 || levels > 0xffffffffull ||
         levels * levels * levels > std::uint64_t(c.grid.unbounded_code()))
         return bad("grid levels do not fit the code width");
-    const std::uint64_t code_bytes = (c.blocks * bits + 7) / 8;
+    const std::uint64_t code_bytes = (c.groups * bits + 7) / 8;
     const unsigned count_bytes = index_count_bytes(h);
-    if (p.size() != kIndexChunkHeaderBytes + count_bytes * c.fibers + code_bytes)
+    if (p.size() != header_bytes + count_bytes * c.fibers + code_bytes)
         return bad("payload size does not match its counts");
 
-    const std::uint8_t* last = b + kIndexChunkHeaderBytes;
+    const std::uint8_t* last = b + header_bytes;
     c.last_block_points.resize(c.fibers);
     for (std::uint64_t f = 0; f < c.fibers; ++f) {
         const std::uint16_t n = count_bytes == 1 ? last[f] : std::uint16_t(last[2 * f] | last[2 * f + 1] << 8);
@@ -160,16 +175,16 @@ IndexChunk parse_index_chunk(const std::vector<std::uint8_t>& p, const FftHeader
         c.last_block_points[f] = n;
     }
 
-    c.codes.resize(c.blocks);
+    c.codes.resize(c.groups);
     const std::uint8_t* s = last + count_bytes * c.fibers;
     const std::uint64_t max_code = levels * levels * levels;
     const std::uint32_t mask = c.grid.unbounded_code();
-    for (std::uint64_t k = 0; k < c.blocks; ++k) {
+    for (std::uint64_t k = 0; k < c.groups; ++k) {
         const std::uint64_t bit = k * bits, byte = bit / 8;
         std::uint64_t word = 0;
         std::memcpy(&word, s + byte, std::min<std::uint64_t>(8, code_bytes - byte));
         const auto code = std::uint32_t((word >> (bit % 8)) & mask);
-        if (code != mask && code >= max_code) return bad("block code out of range");
+        if (code != mask && code >= max_code) return bad("box code out of range");
         c.codes[k] = code;
     }
     return c;

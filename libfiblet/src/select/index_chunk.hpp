@@ -11,8 +11,10 @@
 
 namespace fiblet::detail {
 
-inline constexpr std::uint32_t kIndexChunkVersion = 1;
-inline constexpr std::size_t kIndexChunkHeaderBytes = 56;
+// Version 2 bounds groups of consecutive blocks of a fiber (64-byte
+// header); version 1, one box per block (56-byte header), is still read.
+inline constexpr std::uint32_t kIndexChunkVersion = 2;
+inline constexpr std::size_t kIndexChunkHeaderBytes = 72, kIndexChunkV1HeaderBytes = 56;
 
 // Boxes are stored on a cubic grid: on each axis a box is [origin + i*cell,
 // origin + (i+e)*cell] with i < min_levels and e < extent_levels, the axis
@@ -29,9 +31,9 @@ struct IndexGrid {
     std::uint32_t unbounded_code() const { return bits >= 32 ? 0xffffffffu : (1u << bits) - 1; }
 
     // The grid for a file: covers the normalized cube (with a margin) and
-    // makes the cells as small as `bits` allow for blocks up to
-    // points_per_block steps across.
-    static IndexGrid for_header(const FftHeader& h, unsigned bits);
+    // makes the cells as small as `bits` allow for groups of `group_blocks`
+    // blocks, up to group_blocks * points_per_block steps across.
+    static IndexGrid for_header(const FftHeader& h, unsigned bits, std::uint32_t group_blocks);
     // Conservative code of a box (the decoded box contains it, with a small
     // slack for float rounding), or unbounded_code().
     std::uint32_t encode(const Aabb& box) const;
@@ -76,17 +78,28 @@ private:
 // Bytes per fiber of the last-block point counts.
 inline unsigned index_count_bytes(const FftHeader& h) { return h.points_per_block <= 255 ? 1 : 2; }
 
+// Groups of a fiber of `blocks` blocks: runs of group_blocks from its first
+// block, the last one the rest.
+inline std::uint64_t index_groups_of_fiber(std::uint64_t blocks, std::uint32_t group_blocks) {
+    return (blocks + group_blocks - 1) / group_blocks;
+}
+
 struct IndexChunk {
     IndexGrid grid;
-    std::uint64_t fibers = 0, blocks = 0;
+    std::uint32_t group_blocks = 1;  // 1 in version 1
+    std::uint64_t fibers = 0, blocks = 0, groups = 0;
     float max_sphere_radius = 0;
+    // Largest distance from a block's last point to the next block's first
+    // (same fiber), mm; negative: unknown (version 1).
+    float max_join = -1;
     std::vector<std::uint16_t> last_block_points;  // per fiber (stored in 1 byte, or 2 beyond 255 points a block)
-    std::vector<std::uint32_t> codes;             // per block
+    std::vector<std::uint32_t> codes;             // per group
 };
 
 std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c, const FftHeader& h);
 // Parses and validates a chunk against its file's header (counts, levels,
-// sizes, point totals). Throws Error{fft_format} naming `file`.
+// sizes). Throws Error{fft_format} naming `file`. What needs the fiber LUT
+// (the group count, point totals) is checked by its users.
 IndexChunk parse_index_chunk(const std::vector<std::uint8_t>& payload, const FftHeader& h, const std::string& file);
 
 }  // namespace fiblet::detail

@@ -8,6 +8,7 @@
 //      of detail) or points, decoded and handed out as runs.
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 
@@ -149,6 +150,67 @@ bool any_point_in(const std::vector<Region>& regions, const float* p, std::uint3
     return false;
 }
 
+Vec3f first_point(const FftHeader& h, const std::uint8_t* block);
+
+// Where a block's points lie, from block headers alone (no decoding): a
+// capsule, the points within `radius` of the segment a-b. The block's view
+// sphere (view.hpp: a = b = its first point, radius at least the length P
+// of its path) holds them. When the next block of the fiber is at hand and
+// the index bounds the jump from a block's last point to the next block's
+// first (`join`), every point p of the block also has |p - a| + |p - b| <=
+// P + join with a, b the two first points: an ellipsoid, which lies in the
+// capsule of radius sqrt((P + join)^2 - |ab|^2) / 2 around a-b. Blocks of
+// smooth fibers are nearly straight, so that capsule is thin.
+struct BlockBound {
+    Vec3f a, b;
+    float radius;
+};
+
+BlockBound block_bound(const FftHeader& h, const std::uint8_t* block, const std::uint8_t* next, float join) {
+    const Sphere s = block_bounding_sphere(h, block);
+    BlockBound bound{s.center, s.center, s.radius};
+    if (!next || join < 0) return bound;
+    const Vec3f b = first_point(h, next);
+    const double dx = double(b.x) - s.center.x, dy = double(b.y) - s.center.y, dz = double(b.z) - s.center.z;
+    const double reach = double(s.radius) + double(join), d2 = dx * dx + dy * dy + dz * dz;
+    if (d2 >= reach * reach) return bound;  // not a path the index describes: keep the sphere
+    const double r = 0.5 * std::sqrt(reach * reach - d2) * (1 + 1e-5) + 1e-5 * reach;
+    if (r < double(s.radius)) bound = {s.center, b, float(r)};
+    return bound;
+}
+
+// Whether a block within `c` may have a point in region `r`: false only
+// when none can, so that the block need not be decoded to be tested. The
+// slack dwarfs float rounding of the points and of Region::contains.
+bool bound_may_meet(const Region& r, const BlockBound& c) {
+    const double R = double(c.radius);
+    const double slack = 1e-3 + 1e-5 * (std::abs(double(c.a.x)) + std::abs(double(c.a.y)) + std::abs(double(c.a.z)) + R);
+    const double reach = R + slack;
+    if (r.shape == Region::Shape::sphere) {
+        // Distance from the centre to the segment a-b.
+        const double ux = double(c.b.x) - c.a.x, uy = double(c.b.y) - c.a.y, uz = double(c.b.z) - c.a.z;
+        const double wx = double(r.center.x) - c.a.x, wy = double(r.center.y) - c.a.y, wz = double(r.center.z) - c.a.z;
+        const double uu = ux * ux + uy * uy + uz * uz;
+        const double t = uu > 0 ? std::clamp((wx * ux + wy * uy + wz * uz) / uu, 0.0, 1.0) : 0.0;
+        const double ex = wx - t * ux, ey = wy - t * uy, ez = wz - t * uz, far = reach + r.radius;
+        return ex * ex + ey * ey + ez * ez <= far * far;
+    }
+    // Boxes and masks: the capsule's bounding box.
+    const auto e = float(reach);
+    const Aabb b{{std::min(c.a.x, c.b.x) - e, std::min(c.a.y, c.b.y) - e, std::min(c.a.z, c.b.z) - e},
+                 {std::max(c.a.x, c.b.x) + e, std::max(c.a.y, c.b.y) + e, std::max(c.a.z, c.b.z) + e}};
+    if (r.shape == Region::Shape::box)
+        return !(b.max.x < r.box.min.x || b.min.x > r.box.max.x || b.max.y < r.box.min.y || b.min.y > r.box.max.y ||
+                 b.max.z < r.box.min.z || b.min.z > r.box.max.z);
+    return r.mask->classify(b) != ImageMask::Overlap::outside;
+}
+
+bool bound_may_meet(const std::vector<Region>& regions, const BlockBound& c) {
+    for (const Region& r : regions)
+        if (bound_may_meet(r, c)) return true;
+    return false;
+}
+
 Vec3f first_point(const FftHeader& h, const std::uint8_t* block) {
     const auto a = block_anchors_normalized(h, block);
     return h.to_world(a[0], a[1], a[2]);
@@ -281,7 +343,9 @@ public:
           // A stored index describes the blocks as written: trusted to say a
           // block lies wholly inside a region only when the checksums tie it
           // to the blocks read (a damaged block read unverified may be elsewhere).
-          trust_inside_(index.source() == BlockIndex::Source::decoded || file.verifies_checksums()) {
+          trust_inside_(index.source() == BlockIndex::Source::decoded || file.verifies_checksums()),
+          // Boxes of groups of blocks: narrowed down to single blocks from their headers.
+          coarse_index_(index.groups() < index.blocks()) {
         if (index.blocks() != h_.blocks || index.fibers() != h_.fibers)
             throw Error(Errc::invalid_argument, file.path() + ": the block index belongs to another file");
         detail::check_query(q);
@@ -379,21 +443,42 @@ private:
         std::vector<std::uint32_t> blocks;
         std::vector<std::uint64_t> fibers;
         const std::uint32_t bb = h_.block_bytes();
+        std::vector<std::size_t> tested, first_point;
         while (candidates.next(batch_blocks(h_), blocks, fibers)) {
             reader_.read(blocks);
-            // One decode call for the whole batch (SIMD decoders fill their lanes).
-            std::vector<std::size_t> first_point(blocks.size() + 1, 0), all(blocks.size());
-            for (std::size_t i = 0; i < blocks.size(); ++i) all[i] = i;
-            const std::uint8_t* bytes = contiguous(blocks, all, [&](std::size_t i) { return reader_.block(i); });
-            decode_into(ctx_, bytes, blocks.size(), scratch_, 0);
-            for (std::size_t i = 0; i < blocks.size(); ++i)
-                first_point[i + 1] = first_point[i] + block_flags(h_, bytes + i * bb).point_count;
-            stats_.blocks_decoded += blocks.size();
+            // Decoded: the blocks whose bound from headers (block_bound)
+            // meets a region they are tested against; the index's boxes
+            // bound groups of blocks, block_bound each block.
+            tested.clear();
             for (std::size_t i = 0; i < blocks.size(); ++i) {
                 const std::uint64_t f = fibers[i], b = blocks[i];
                 if (excluded[f]) continue;
-                const float* p = &scratch_[3 * first_point[i]];
-                const auto n = std::uint32_t(first_point[i + 1] - first_point[i]);
+                if (!coarse_index_) {  // the index's boxes bound single blocks already
+                    tested.push_back(i);
+                    continue;
+                }
+                const bool has_next = i + 1 < blocks.size() && blocks[i + 1] == b + 1 && fibers[i + 1] == f;
+                const BlockBound c =
+                    block_bound(h_, reader_.block(i), has_next ? reader_.block(i + 1) : nullptr, index_.max_join());
+                bool test = !q_.exclude.empty() && has_bit(exc, b) && bound_may_meet(q_.exclude, c);
+                for (std::size_t k = 0; k < k_inc && !test; ++k)
+                    test = !(met[f] >> k & 1) && has_bit(inc[k], b) && bound_may_meet(q_.include[k], c);
+                if (test) tested.push_back(i);
+            }
+            if (tested.empty()) continue;
+            // One decode call for the whole batch (SIMD decoders fill their lanes).
+            const std::uint8_t* bytes = contiguous(blocks, tested, [&](std::size_t i) { return reader_.block(i); });
+            decode_into(ctx_, bytes, tested.size(), scratch_, 0);
+            first_point.assign(tested.size() + 1, 0);
+            for (std::size_t t = 0; t < tested.size(); ++t)
+                first_point[t + 1] = first_point[t] + block_flags(h_, bytes + t * bb).point_count;
+            stats_.blocks_decoded += tested.size();
+            for (std::size_t t = 0; t < tested.size(); ++t) {
+                const std::size_t i = tested[t];
+                const std::uint64_t f = fibers[i], b = blocks[i];
+                if (excluded[f]) continue;
+                const float* p = &scratch_[3 * first_point[t]];
+                const auto n = std::uint32_t(first_point[t + 1] - first_point[t]);
                 for (std::size_t k = 0; k < k_inc; ++k)
                     if (!(met[f] >> k & 1) && has_bit(inc[k], b) && any_point_in(q_.include[k], p, n))
                         met[f] |= std::uint64_t{1} << k;
@@ -464,17 +549,34 @@ private:
             }
             reader_.read(need);
 
-            // Header tests: the block's sphere against the frustum and the level of detail.
+            // Header tests: the block's sphere against the frustum, the level
+            // of detail and, where its points would be tested, the include
+            // regions (the index bounds groups of blocks, the sphere each block).
             kind.assign(blocks.size(), fine);
-            if (q_.view)
+            const bool include_tests = coarse_index_ && blocks_mode && !q_.include.empty();
+            if (q_.view || include_tests)
                 for (std::size_t i = 0; i < blocks.size(); ++i) {
                     // Scattered headers: fetch a few blocks ahead.
                     if (i + 8 < blocks.size()) __builtin_prefetch(reader_.block(at_need[i + 8]));
-                    const Sphere s = block_bounding_sphere(h_, reader_.block(at_need[i]));
-                    if (cull && !sphere_intersects_frustum(frustum, s.center, s.radius))
+                    const bool bound_test = include_tests && include_test(i);
+                    if (!q_.view && !bound_test) continue;
+                    const std::uint8_t* block = reader_.block(at_need[i]);
+                    const Sphere s = block_bounding_sphere(h_, block);
+                    if (cull && !sphere_intersects_frustum(frustum, s.center, s.radius)) {
                         kind[i] = dropped;
-                    else if (lod && lod->coarse(s.center, s.radius))
-                        kind[i] = coarse;
+                        continue;
+                    }
+                    if (bound_test) {
+                        const std::size_t k = at_need[i] + 1;
+                        const bool has_next = k < need.size() && need[k] == blocks[i] + 1 &&
+                                              std::uint64_t(blocks[i]) + 1 < file_.block_end(fibers[i] + 1);
+                        if (!bound_may_meet(q_.include, block_bound(h_, block, has_next ? reader_.block(k) : nullptr,
+                                                                    index_.max_join()))) {
+                            kind[i] = dropped;
+                            continue;
+                        }
+                    }
+                    if (lod && lod->coarse(s.center, s.radius)) kind[i] = coarse;
                 }
 
             for (std::size_t i = 0, j; i < blocks.size(); i = j) {
@@ -554,6 +656,7 @@ private:
     DecodeContext ctx_;
     detail::BlockBatchReader reader_;
     const bool trust_inside_;
+    const bool coarse_index_;
     std::vector<std::uint8_t> keep_;
     std::vector<float> scratch_;  // decoded points that are tested, not output
     std::vector<std::uint8_t> staging_;
