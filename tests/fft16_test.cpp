@@ -1,6 +1,8 @@
-// The 16-bit variant (formats/fft16.md) through the whole pipeline: its
-// header and block layout, decoding with FftFile/decode_fibers, and the
-// error the encoder records against an independent measurement.
+// The 16-bit variants (formats/fft16.md) through the whole pipeline: their
+// header and block layouts (packed version 17 in a .fft, version 16 in a
+// .fftz), decoding with FftFile/decode_fibers and with the float64
+// reference decoder, the error the encoder records against an independent
+// measurement, and the reader's strictness on malformed packed files.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,6 +14,8 @@
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/tck.hpp"
+#include "cli_runner.hpp"
+#include "exact_error.hpp"
 #include "test_util.hpp"
 
 using namespace fiblet;
@@ -36,22 +40,32 @@ void write_helices(const std::string& path, int count) {
 
 }  // namespace
 
-TEST(Fft16, CompressesToVersion16BlocksAndDecodesBelowAMicrometre) {
+// Bytes of a packed block of n points (formats/fft16.md), from the spec.
+std::uint64_t packed_bytes(std::uint64_t n) { return 18 + (n > 2 ? (15 * (n - 2) + 7) / 8 : 0); }
+
+TEST(Fft16, CompressesToPackedVersion17AndDecodesBelowAMicrometre) {
     test::TempDir dir;
     write_helices(dir.file("h.tck"), 12);
     CompressOptions o;
     o.direction_bits = 16;
     const CompressReport r = compress_tck(dir.file("h.tck"), dir.file("h.fft"), o);
-    EXPECT_EQ(r.header.version, kFft16Version);
-    EXPECT_EQ(r.header.points_per_block, kDefaultPointsPerBlock16);
-    EXPECT_EQ(r.header.block_bytes(), 24u + 2 * (126 - 2));
-    EXPECT_EQ(r.header.block_bytes() % 4, 0u);
+    EXPECT_EQ(r.header.version, kFft16PackedVersion);
+    EXPECT_EQ(r.header.points_per_block, 254u);
+    EXPECT_EQ(r.header.code_levels(), 181u);
 
     const FftFile file(dir.file("h.fft"));
     EXPECT_EQ(file.header().direction_bits(), 16u);
     EXPECT_EQ(file.header().blocks, r.header.blocks);
     // The first byte is the version: a version-2 reader stops there.
-    EXPECT_EQ(test::read_file(dir.file("h.fft"))[0], char(16));
+    EXPECT_EQ(test::read_file(dir.file("h.fft"))[0], char(17));
+    // No padding: every fiber's blocks hold 254 points but its last, packed back to back.
+    std::uint64_t blocks_bytes = 0;
+    for (int i = 0; i < 12; ++i) {
+        std::uint64_t n = 200 + 37 * i;
+        for (; n > 254; n -= 254) blocks_bytes += packed_bytes(254);
+        blocks_bytes += packed_bytes(n);
+    }
+    EXPECT_EQ(file.header().file_bytes(), file.header().blocks_offset() + blocks_bytes);
 
     const Comparison c = compare_to_reference(file, dir.file("h.tck"));
     EXPECT_EQ(c.points, r.header.points);
@@ -59,11 +73,34 @@ TEST(Fft16, CompressesToVersion16BlocksAndDecodesBelowAMicrometre) {
     EXPECT_NEAR(c.error.mean_mm(), r.error.mean_mm(), 1e-9);
     EXPECT_LT(c.error.max_mm(), 1e-3);
 
+    // The float64 reference decoder, written from the spec, agrees.
+    const test::ExactMeasurement m = test::measure_exact(dir.file("h.fft"), dir.file("h.tck"));
+    EXPECT_EQ(m.exact.points, r.header.points);
+    EXPECT_LT(m.exact.max_mm, 1e-3);
+    EXPECT_LT(m.exact.max_mm, 1.05 * r.error.max_mm());
+
     // Same data in 8 bits: 16-bit codes are far more precise.
     o.direction_bits = 8;
     const CompressReport r8 = compress_tck(dir.file("h.tck"), dir.file("h8.fft"), o);
     EXPECT_EQ(r8.header.version, kFftVersion);
     EXPECT_LT(10 * r.error.mean_mm(), r8.error.mean_mm());
+}
+
+TEST(Fft16, ZstdContainersHoldVersion16) {
+    test::TempDir dir;
+    write_helices(dir.file("h.tck"), 4);
+    CompressOptions o;
+    o.direction_bits = 16;
+    o.zstd = ZstdOptions{};
+    const CompressReport r = compress_tck(dir.file("h.tck"), dir.file("h.fftz"), o);
+    EXPECT_EQ(r.header.version, kFft16Version);
+    EXPECT_EQ(r.header.points_per_block, kDefaultPointsPerBlock16);
+    EXPECT_EQ(r.header.block_bytes(), 24u + 2 * (126 - 2));
+    const FftFile file(dir.file("h.fftz"));
+    EXPECT_EQ(file.header().code_levels(), 256u);
+    const Comparison c = compare_to_reference(file, dir.file("h.tck"));
+    EXPECT_NEAR(c.error.max_mm(), r.error.max_mm(), 1e-9);
+    EXPECT_LT(c.error.max_mm(), 1e-3);
 }
 
 TEST(Fft16, BlockFieldsHoldTheFiberLayout) {
@@ -92,27 +129,76 @@ TEST(Fft16, BlockFieldsHoldTheFiberLayout) {
     EXPECT_EQ(s.point_count(), 237u + 274u);
 }
 
-TEST(Fft16, RejectsBadCountsAndUnknownVersions) {
+TEST(Fft16, RejectsMalformedPackedFiles) {
     test::TempDir dir;
-    write_helices(dir.file("h.tck"), 2);
+    write_helices(dir.file("h.tck"), 2);  // 200 and 237 points: one block each
     CompressOptions o;
     o.direction_bits = 16;
     compress_tck(dir.file("h.tck"), dir.file("h.fft"), o);
-    std::string bytes = test::read_file(dir.file("h.fft"));
+    const std::string bytes = test::read_file(dir.file("h.fft"));
     const FftFile good(dir.file("h.fft"));
-    const std::size_t first_block = good.header().blocks_offset();
+    const std::size_t first_block = good.header().blocks_offset(), lut = good.header().lut_offset();
+    auto variant = [&](const std::string& name, auto change) {
+        std::string b = bytes;
+        change(b);
+        test::write_file(dir.file(name), b);
+        return dir.file(name);
+    };
+    auto errc_of = [](auto&& action) {  // the error's code, -1 for none
+        try {
+            action();
+        } catch (const Error& e) {
+            return int(e.code());
+        }
+        return -1;
+    };
+    const int fft_format = int(fft_format), checksum = int(checksum);
 
     std::string bad_version = bytes;
     bad_version[0] = 3;
     test::write_file(dir.file("v3.fft"), bad_version);
     EXPECT_THROW(FftFile{dir.file("v3.fft")}, Error);
 
-    std::string bad_count = bytes;  // a block claiming more points than a block holds
-    bad_count[first_block + kBlock16FlagsOffset] = char(0xff);
-    bad_count[first_block + kBlock16FlagsOffset + 1] = char(0x3f);
-    test::write_file(dir.file("count.fft"), bad_count);
-    const FftFile f(dir.file("count.fft"));
-    EXPECT_THROW(decode_fibers(f, 0, f.header().fibers), Error);
+    // A code past the 181 x 181 levels (0x7fff): the block is malformed,
+    // with or without checksums (structure is checked first).
+    const std::string code = variant("code.fft", [&](std::string& b) {
+        b[first_block + 18] = char(0xff), b[first_block + 19] = char(b[first_block + 19] | 0x7f);
+    });
+    for (const bool verify : {false, true}) {
+        const FftFile f(code, {.verify_checksums = verify});
+        EXPECT_EQ(errc_of([&] { decode_fibers(f, 0, f.header().fibers); }), fft_format);
+    }
+    // The CLI says so and exits with 4.
+    const test::CommandResult cli = test::run_cli("decompress -q -f " + code + " -o " + dir.file("code.tck"));
+    EXPECT_EQ(cli.status, 4) << cli.output;
+    EXPECT_NE(cli.output.find("past the 181 x 181 levels"), std::string::npos) << cli.output;
+    // A well-formed change (an anchor byte) is caught by the checksums of the blocks' content.
+    const std::string anchor = variant("anchor.fft", [&](std::string& b) { b[first_block + 4] ^= 1; });
+    const FftFile checked(anchor);
+    EXPECT_EQ(errc_of([&] { decode_fibers(checked, 0, checked.header().fibers); }), checksum);
+
+    // Non-zero bits after the last code: 198 codes fill 2970 bits, the
+    // block's last byte (371 after the anchors) has 6 unused bits.
+    const std::string pad = variant("pad.fft", [&](std::string& b) {
+        b[first_block + 18 + 371] = char(b[first_block + 18 + 371] | 0x80);
+    });
+    const FftFile p(pad, {.verify_checksums = false});
+    EXPECT_EQ(errc_of([&] { decode_fibers(p, 0, 1); }), fft_format);
+
+    // The LUT's point count must fit the fiber's block count, and sum to the header's.
+    const auto set_points = [&](std::uint32_t points) {
+        return [&, points](std::string& b) { std::memcpy(&b[lut + 4], &points, 4); };
+    };
+    EXPECT_EQ(errc_of([&] { FftFile{variant("blocks.fft", set_points(300)), {.verify_checksums = false}}; }),
+              fft_format);
+    EXPECT_EQ(errc_of([&] { FftFile{variant("sum.fft", set_points(201)), {.verify_checksums = false}}; }),
+              fft_format);
+    // Blocks cut short: the packed size exceeds the file.
+    EXPECT_EQ(errc_of([&] {
+                  FftFile{variant("short.fft", [&](std::string& b) { b.resize(first_block + 100); }),
+                          {.verify_checksums = false, .ignore_trailer = true}};
+              }),
+              fft_format);
 
     std::string big_block = bytes;  // points per block above the 14-bit count
     const std::uint32_t too_many = kMaxPointsPerBlock16 + 1;

@@ -18,6 +18,7 @@
 #include "codec/compress_stages.hpp"
 #include "codec/fiber_end_encoder.hpp"
 #include "fiblet/parallel.hpp"
+#include "format/packed_blocks16.hpp"
 
 namespace fiblet::detail {
 
@@ -32,7 +33,8 @@ double length(Vec3f a, Vec3f b) {
 // batch's set: statistics accumulate per slot in batch order and are merged
 // in slot order at the end, whichever thread ran the task.
 struct Slot {
-    std::vector<std::uint8_t> blocks;
+    std::vector<std::uint8_t> blocks;  // in the in-memory layout (checksums and index are of these)
+    std::vector<std::uint8_t> packed;  // version 17: the blocks as stored
     std::vector<Vec3f> decoded, decoded_exact, resampled, scratch;
     std::vector<PolylinePosition> positions;  // of the resampled points on the input
     ErrorStats error;
@@ -69,13 +71,16 @@ void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t
         }
         w.geometry.add_fiber(original, w.decoded, f);
     }
+    const FftHeader& h = in.encoder.header();
+    w.packed.clear();
+    if (h.packed()) pack_blocks16(h, w.blocks, w.packed);
 }
 
 // Stage 3: a batch's blocks, checksums and index entries, in task order.
 void write_batch(const FiberBatch& b, std::vector<Slot>& slots, FftSink& out, FftChecksumBuilder& checksum,
                  IndexBuilder& index) {
     for (std::size_t t = 0; t < b.tasks(); ++t) {
-        out.write_blocks(slots[t].blocks);
+        out.write_blocks(slots[t].packed.empty() ? slots[t].blocks : slots[t].packed);
         checksum.add_blocks(slots[t].blocks.data(), slots[t].blocks.size());
         index.append(slots[t].index);
     }

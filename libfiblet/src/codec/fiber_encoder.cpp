@@ -163,7 +163,7 @@ FiberEncoder::FiberEncoder(const FftHeader& header, SearchOptions search) : head
         throw Error(Errc::invalid_argument, "retry beam width must be in [0, 64], its radius in [1, 3]");
     auto t = std::make_shared<Tables>();
     if (header_.direction_bits() == 16) {
-        t->table16.emplace(header_.ratio);
+        t->table16.emplace(header_.ratio, header_.code_levels());
     } else {
         t->table8.emplace(header_.ratio);
         t->lut8.emplace(*t->table8);

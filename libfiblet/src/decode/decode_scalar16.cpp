@@ -14,7 +14,7 @@ using namespace detail;
 
 std::shared_ptr<const DirectionTable16> make_direction_table16(const FftHeader& header) {
     if (header.direction_bits() != 16) return nullptr;
-    return std::make_shared<const DirectionTable16>(header.ratio);
+    return std::make_shared<const DirectionTable16>(header.ratio, header.code_levels());
 }
 
 std::size_t decode_blocks_scalar16(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count,
