@@ -52,6 +52,7 @@ inline V3 code_direction(unsigned code, double ratio, unsigned levels = 16) {
     const double q1 = double(code / levels) / half - 1, q2 = double(code % levels) / half - 1;
     const double y = (q1 + q2) / 2, z = (q1 - q2) / 2;
     const V3 d = unit({1 - std::fabs(y) - std::fabs(z), y, z});
+    if (y == 0 && z == 0) return {1, 0, 0};  // fft16.md: an odd level count's straight-ahead code
     const double xc = 1 - ratio + ratio * d.x;
     const double lateral = std::sqrt((1 - xc * xc) / (1 - d.x * d.x));
     return unit({xc, d.y * lateral, d.z * lateral});
@@ -130,14 +131,14 @@ struct Decoded {
 // least significant bit first); returns its size in bytes.
 inline std::size_t decode_packed_block(const unsigned char* blk, unsigned count, const std::vector<Frame3>& table,
                                        double step, std::vector<V3>& out) {
-    double a[6];
-    for (int i = 0; i < 6; ++i)
-        a[i] = double(blk[3 * i] | blk[3 * i + 1] << 8 | blk[3 * i + 2] << 16) / 16777215.0;
-    const V3 a0{a[0], a[1], a[2]}, a1{a[3], a[4], a[5]};
+    double q[6];
+    for (int i = 0; i < 6; ++i) q[i] = double(blk[3 * i] | blk[3 * i + 1] << 8 | blk[3 * i + 2] << 16);
+    const V3 a0{q[0] / 16777215.0, q[1] / 16777215.0, q[2] / 16777215.0};
+    const V3 a1{q[3] / 16777215.0, q[4] / 16777215.0, q[5] / 16777215.0};
     out.push_back(a0);
     if (count < 2) return 18;
     out.push_back(a1);
-    const V3 d = a1 - a0;
+    const V3 d{q[3] - q[0], q[4] - q[1], q[5] - q[2]};  // the first axis: of the integer difference
     Frame3 f = frame_of(dot(d, d) > 0 ? unit(d) : V3{1, 0, 0});
     V3 p = a1;
     for (unsigned k = 0; k + 2 < count; ++k) {

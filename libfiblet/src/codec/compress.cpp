@@ -71,8 +71,9 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         throw Error(Errc::invalid_argument, "direction bits must be 8 or 16");
     const bool wide = options.direction_bits == 16;
     // 16 bits: packed blocks (version 17) in a .fft; fixed-size blocks
-    // (version 16) in a .fftz, whose block groups are transposed whole.
-    const bool packed = wide && !options.zstd;
+    // (version 16) in a .fftz, whose block groups are transposed whole, or
+    // when asked for.
+    const bool packed = wide && !options.zstd && !options.fixed_blocks16;
     const std::uint32_t points_per_block =
         options.points_per_block ? options.points_per_block
                                  : (packed ? kDefaultPointsPerBlock16Packed

@@ -10,6 +10,7 @@
 #include "core/vec_math.hpp"
 #include "fiblet/encode.hpp"
 #include "fiblet/error.hpp"
+#include "format/packed_blocks16.hpp"
 
 namespace fiblet {
 using namespace detail;
@@ -238,7 +239,9 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
             write_block_head(h, &out[base + std::size_t(b) * bb], p0, p1, fiber_id, b, n_blocks, n, block_reach(n));
         points[i0] = head.a0;
         if (n >= 2) points[i0 + 1] = head.a1;
-        frames[b] = wide ? frame_from_axis(anchor_axis(head.a0, head.a1)) : head.frame;
+        const BlockView16 written{&out[base + std::size_t(b) * bb]};
+        if (wide) frames[b] = frame_from_axis(h.packed() ? packed16_anchor_axis(written) : anchor_axis(head.a0, head.a1));
+        else frames[b] = head.frame;
         if (!wide) starts[b] = head;
     }
 

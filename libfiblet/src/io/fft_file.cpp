@@ -347,6 +347,7 @@ void FftFile::read_block_bytes(std::uint64_t first, std::uint64_t count, std::ui
                            std::to_string(f) + "): " + problem);
         p += packed16_block_bytes(place.points);
     }
+    if (raw.capacity() > (std::size_t{16} << 20)) std::vector<std::uint8_t>().swap(raw);  // a whole-file read: let it go
 }
 
 void FftFile::check_block_structure(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const {
