@@ -19,8 +19,8 @@ namespace fiblet::detail {
 // integers, normalized. The integers are exact in a float, so a float
 // decoder and an exact one agree up to the rounding of the normalization
 // (version 16 normalizes the difference of the float anchors, whose rounding
-// turns the axis by up to ~3e-5 rad at a 0.1 mm step: 0.8 um at the end of
-// a 254-point block).
+// can turn the axis by about 3e-5 rad at a 0.1 mm step: about 0.8 um at
+// the end of a 254-point block).
 inline Vec3f packed16_anchor_axis(const BlockView16& b) {
     auto diff = [&](int i) { return float(std::int32_t(b.anchor_word(3 + i)) - std::int32_t(b.anchor_word(i))); };
     const Vec3f d{diff(0), diff(1), diff(2)};
