@@ -5,6 +5,7 @@
 // measurement, and the reader's strictness on malformed packed files.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -69,8 +70,6 @@ TEST(Fft16, CompressesToPackedVersion17AndDecodesBelowAMicrometre) {
 
     const Comparison c = compare_to_reference(file, dir.file("h.tck"));
     EXPECT_EQ(c.points, r.header.points);
-    EXPECT_NEAR(c.error.max_mm(), r.error.max_mm(), 1e-9);  // the encoder's closed loop is the decoder
-    EXPECT_NEAR(c.error.mean_mm(), r.error.mean_mm(), 1e-9);
     EXPECT_LT(c.error.max_mm(), 1e-3);
 
     // The float64 reference decoder, written from the spec, agrees.
@@ -78,8 +77,11 @@ TEST(Fft16, CompressesToPackedVersion17AndDecodesBelowAMicrometre) {
     EXPECT_EQ(m.exact.points, r.header.points);
     EXPECT_TRUE(std::isfinite(m.exact.mean_mm()));  // every point decodes (the straight-ahead code too)
     EXPECT_LT(m.exact.max_mm, 1e-3);
-    // The float decoder's rounding moves points by a few nm (2.9 nm measured here).
-    EXPECT_LT(m.exact.max_mm, r.error.max_mm() + 1e-5);
+    // The recorded max error is the worse of the two decoders' (the encoder
+    // walks both), up to the encoder's float world coordinates (0.48 nm
+    // measured; the two decoders differ by 2.9 nm here).
+    EXPECT_NEAR(r.error.max_mm(), std::max(c.error.max_mm(), m.exact.max_mm), 1e-6);
+    EXPECT_LE(c.error.mean_mm(), r.error.mean_mm() + 1e-9);
 
     // Same data in 8 bits: the 181-level codes are 12 times finer per axis
     // (9.3 times smaller a mean error measured on these helices).
@@ -102,7 +104,10 @@ TEST(Fft16, ZstdContainersHoldVersion16) {
     const FftFile file(dir.file("h.fftz"));
     EXPECT_EQ(file.header().code_levels(), 256u);
     const Comparison c = compare_to_reference(file, dir.file("h.tck"));
-    EXPECT_NEAR(c.error.max_mm(), r.error.max_mm(), 1e-9);
+    // Recorded: the worse of the float decoder and an exact one, which
+    // differ by the float walk's rounding (nanometres here).
+    EXPECT_LE(c.error.max_mm(), r.error.max_mm() + 1e-9);
+    EXPECT_NEAR(c.error.max_mm(), r.error.max_mm(), 1e-5);
     EXPECT_LT(c.error.max_mm(), 1e-3);
 }
 
