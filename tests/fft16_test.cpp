@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "fiblet/checksum.hpp"
 #include "fiblet/compare.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/decode.hpp"
@@ -217,4 +218,45 @@ TEST(Fft16, RejectsMalformedPackedFiles) {
     CompressOptions wrong;
     wrong.direction_bits = 12;
     EXPECT_THROW(compress_tck(dir.file("h.tck"), dir.file("x.fft"), wrong), Error);
+}
+
+// Version 17's checksum groups hash the blocks as stored, packed
+// (formats/fft-checksum.md), so a reader verifies what it reads without
+// expanding a group's other blocks; every flipped byte of the blocks is
+// still caught, as a checksum or a format error.
+TEST(Fft16, ChecksumGroupsHashThePackedBytes) {
+    test::TempDir dir;
+    write_helices(dir.file("h.tck"), 3);  // 200, 237, 274 points: 4 blocks
+    CompressOptions o;
+    o.direction_bits = 16;
+    compress_tck(dir.file("h.tck"), dir.file("h.fft"), o);
+    const std::string bytes = test::read_file(dir.file("h.fft"));
+    const FftFile good(dir.file("h.fft"));
+    const std::size_t first_block = good.header().blocks_offset(), end = good.header().file_bytes();
+    // From the spec: the CSUM payload's first group hash (offset 32) is of
+    // bytes [blocksOffset, end of the blocks) when there is one group.
+    const std::string csum = test::exact::trailer_chunk(bytes, "CSUM");
+    ASSERT_EQ(csum.size(), 40u);
+    std::uint64_t group0 = 0;
+    std::memcpy(&group0, csum.data() + 32, 8);
+    EXPECT_EQ(group0, xxh64(bytes.data() + first_block, end - first_block));
+
+    // Every fifth byte, and the last (anchors, codes, the padding bits).
+    for (std::size_t at = first_block; at < end; at = at + 5 < end || at + 1 == end ? at + 5 : end - 1) {
+        std::string b = bytes;
+        b[at] = char(b[at] ^ 0x10);
+        test::write_file(dir.file("flip.fft"), b);
+        int code = -1;
+        try {
+            const FftFile f(dir.file("flip.fft"));
+            decode_fibers(f, 0, f.header().fibers);
+        } catch (const Error& e) {
+            code = int(e.code());
+        }
+        EXPECT_TRUE(code == int(Errc::checksum) || code == int(Errc::fft_format)) << "byte " << at << ": " << code;
+        if (at == first_block + 100) {  // a code byte: verify says so, with the checksum exit status
+            const test::CommandResult r = test::run_cli("verify " + dir.file("flip.fft"));
+            EXPECT_EQ(r.status, 7) << r.output;
+        }
+    }
 }

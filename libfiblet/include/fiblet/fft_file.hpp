@@ -130,7 +130,10 @@ private:
     void read_lut(std::uint64_t& lut_hash);
     void read_packed_lut_entry(std::uint64_t fiber, std::uint64_t buffer_base, std::uint64_t next_block);
     std::uint64_t fiber_of_block(std::uint64_t block) const;
-    void read_block_bytes(std::uint64_t first, std::uint64_t count, std::uint8_t* out) const;
+    // Where block `block` (up to blocks) starts, in bytes after the first block, as stored.
+    std::uint64_t stored_offset(std::uint64_t block) const;
+    void expand_packed_blocks(std::uint64_t first, std::uint64_t count, const std::uint8_t* packed,
+                              std::uint8_t* out) const;
     void open_trailer(std::span<const std::uint8_t> head, std::uint64_t lut_hash);
     void verify_open_checksums(std::span<const std::uint8_t> head, std::uint64_t lut_hash) const;
     void check_block_structure(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const;

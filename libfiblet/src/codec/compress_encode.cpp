@@ -33,8 +33,9 @@ double length(Vec3f a, Vec3f b) {
 // batch's set: statistics accumulate per slot in batch order and are merged
 // in slot order at the end, whichever thread ran the task.
 struct Slot {
-    std::vector<std::uint8_t> blocks;  // in the in-memory layout (checksums and index are of these)
-    std::vector<std::uint8_t> packed;  // version 17: the blocks as stored
+    std::vector<std::uint8_t> blocks;  // in the in-memory layout (the index is of these)
+    std::vector<std::uint8_t> packed;  // version 17: the blocks as stored (and checksummed)
+    std::vector<std::uint32_t> packed_sizes;  // of each packed block
     std::vector<Vec3f> decoded, decoded_exact, resampled, scratch;
     std::vector<PolylinePosition> positions;  // of the resampled points on the input
     ErrorStats error;
@@ -73,15 +74,22 @@ void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t
     }
     const FftHeader& h = in.encoder.header();
     w.packed.clear();
-    if (h.packed()) pack_blocks16(h, w.blocks, w.packed);
+    w.packed_sizes.clear();
+    if (h.packed()) pack_blocks16(h, w.blocks, w.packed, &w.packed_sizes);
 }
 
 // Stage 3: a batch's blocks, checksums and index entries, in task order.
 void write_batch(const FiberBatch& b, std::vector<Slot>& slots, FftSink& out, FftChecksumBuilder& checksum,
                  IndexBuilder& index) {
     for (std::size_t t = 0; t < b.tasks(); ++t) {
-        out.write_blocks(slots[t].packed.empty() ? slots[t].blocks : slots[t].packed);
-        checksum.add_blocks(slots[t].blocks.data(), slots[t].blocks.size());
+        const Slot& s = slots[t];
+        out.write_blocks(s.packed.empty() ? s.blocks : s.packed);
+        if (s.packed.empty()) {
+            checksum.add_blocks(s.blocks.data(), s.blocks.size());
+        } else {  // checksums cover the bytes as stored
+            const std::uint8_t* p = s.packed.data();
+            for (const std::uint32_t n : s.packed_sizes) checksum.add_block(p, n), p += n;
+        }
         index.append(slots[t].index);
     }
 }

@@ -12,13 +12,15 @@ std::uint16_t get_u16(const std::uint8_t* p) { return std::uint16_t(p[0] | p[1] 
 
 }  // namespace
 
-void pack_blocks16(const FftHeader& h, std::span<const std::uint8_t> blocks, std::vector<std::uint8_t>& out) {
+void pack_blocks16(const FftHeader& h, std::span<const std::uint8_t> blocks, std::vector<std::uint8_t>& out,
+                   std::vector<std::uint32_t>* sizes) {
     const std::size_t bb = h.block_bytes();
     for (std::size_t at = 0; at + bb <= blocks.size(); at += bb) {
         const std::uint8_t* b = blocks.data() + at;
         const std::uint32_t n = get_u16(b + kBlock16FlagsOffset) & kFlag16CountMask;
         const std::size_t start = out.size();
         out.resize(start + packed16_block_bytes(n));
+        if (sizes) sizes->push_back(packed16_block_bytes(n));
         std::uint8_t* p = out.data() + start;
         std::memcpy(p, b, kPacked16AnchorBytes);
         p += kPacked16AnchorBytes;

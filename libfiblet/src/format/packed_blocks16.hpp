@@ -28,8 +28,11 @@ inline Vec3f packed16_anchor_axis(const BlockView16& b) {
     return n2 > 0.0f ? (1.0f / std::sqrt(n2)) * d : Vec3f{1.0f, 0.0f, 0.0f};
 }
 
-// Appends the packed form of in-memory blocks (h.block_bytes() each) to `out`.
-void pack_blocks16(const FftHeader& h, std::span<const std::uint8_t> blocks, std::vector<std::uint8_t>& out);
+// Appends the packed form of in-memory blocks (h.block_bytes() each) to `out`,
+// and each packed block's size to `sizes` when given (the checksum groups
+// count blocks: fft-checksum.md).
+void pack_blocks16(const FftHeader& h, std::span<const std::uint8_t> blocks, std::vector<std::uint8_t>& out,
+                   std::vector<std::uint32_t>* sizes = nullptr);
 
 // Where a packed block sits in its fiber: the fields the packed layout
 // leaves out (they follow from the fiber LUT).

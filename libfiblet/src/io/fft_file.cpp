@@ -306,9 +306,23 @@ void FftFile::read_blocks(std::uint64_t first, std::uint64_t count, std::uint8_t
     if (first > header_.blocks || count > header_.blocks - first)
         throw Error(Errc::invalid_argument, path_ + ": block range past the end");
     if (count == 0) return;
-    read_block_bytes(first, count, out);
+    if (!header_.packed()) {
+        read_at(out, count * header_.block_bytes(), header_.blocks_offset() + first * header_.block_bytes());
+        check_block_structure(first, count, out);
+        if (verifies_checksums()) verify_block_groups(first, count, out);
+        return;
+    }
+    // Version 17: read packed, expand (which checks the codes), check, and
+    // verify the groups over the packed bytes (fft-checksum.md), so the
+    // blocks of a group outside the range are hashed, not expanded.
+    thread_local std::vector<std::uint8_t> stored;
+    const std::uint64_t begin = stored_offset(first);
+    stored.resize(stored_offset(first + count) - begin);
+    read_at(stored.data(), stored.size(), header_.blocks_offset() + begin);
+    expand_packed_blocks(first, count, stored.data(), out);
     check_block_structure(first, count, out);
-    if (verifies_checksums()) verify_block_groups(first, count, out);
+    if (verifies_checksums()) verify_block_groups(first, count, stored.data());
+    if (stored.capacity() > (std::size_t{16} << 20)) std::vector<std::uint8_t>().swap(stored);  // a whole-file read: let it go
 }
 
 std::uint64_t FftFile::fiber_of_block(std::uint64_t block) const {
@@ -320,21 +334,20 @@ std::uint64_t FftFile::fiber_of_block(std::uint64_t block) const {
            1;
 }
 
-// Blocks [first, first + count) in the in-memory layout: read as they are,
-// or (version 17) read packed and expanded.
-void FftFile::read_block_bytes(std::uint64_t first, std::uint64_t count, std::uint8_t* out) const {
+std::uint64_t FftFile::stored_offset(std::uint64_t block) const {
+    if (!header_.packed()) return block * header_.block_bytes();
+    if (block == header_.blocks) return packed_bytes_;
+    const std::uint64_t f = fiber_of_block(block);
+    return fiber_offset_[f] + (block - fiber_first_block_[f]) * packed16_block_bytes(header_.points_per_block);
+}
+
+// Packed blocks [first, first + count) at `packed` into the in-memory layout.
+void FftFile::expand_packed_blocks(std::uint64_t first, std::uint64_t count, const std::uint8_t* packed,
+                                   std::uint8_t* out) const {
     const std::uint64_t bb = header_.block_bytes();
-    if (!header_.packed()) return read_at(out, count * bb, header_.blocks_offset() + first * bb);
-    const std::uint32_t ppb = header_.points_per_block, full = packed16_block_bytes(ppb);
+    const std::uint32_t ppb = header_.points_per_block;
     std::uint64_t f = fiber_of_block(first), k = first - fiber_first_block_[f];
-    const std::uint64_t begin = fiber_offset_[f] + k * full;
-    const std::uint64_t last = first + count - 1, lf = fiber_of_block(last), lk = last - fiber_first_block_[lf];
-    const std::uint32_t last_points = lk + 1 < lut_[lf].block_count() ? ppb : fiber_points_[lf] - std::uint32_t(lk) * ppb;
-    const std::uint64_t end = fiber_offset_[lf] + lk * full + packed16_block_bytes(last_points);
-    thread_local std::vector<std::uint8_t> raw;
-    raw.resize(end - begin);
-    read_at(raw.data(), raw.size(), header_.blocks_offset() + begin);
-    const std::uint8_t* p = raw.data();
+    const std::uint8_t* p = packed;
     for (std::uint64_t b = 0; b < count; ++b, ++k) {
         while (k >= lut_[f].block_count()) ++f, k = 0;
         const std::uint32_t blocks_in_fiber = lut_[f].block_count();
@@ -347,7 +360,6 @@ void FftFile::read_block_bytes(std::uint64_t first, std::uint64_t count, std::ui
                            std::to_string(f) + "): " + problem);
         p += packed16_block_bytes(place.points);
     }
-    if (raw.capacity() > (std::size_t{16} << 20)) std::vector<std::uint8_t>().swap(raw);  // a whole-file read: let it go
 }
 
 void FftFile::check_block_structure(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const {
@@ -376,14 +388,16 @@ void FftFile::check_block_structure(std::uint64_t first, std::uint64_t count, co
     }
 }
 
+// `blocks`: blocks [first, first + count) as stored (packed for version 17).
 void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const {
     const FftChecksums& c = *checksums_;
-    const std::uint64_t bb = header_.block_bytes(), g_blocks = c.group_blocks, end = first + count;
+    const std::uint64_t g_blocks = c.group_blocks, end = first + count, base = stored_offset(first);
     std::vector<std::uint8_t> edge;  // the part of a group outside [first, end)
     Xxh64Stream hash;
     auto hash_from_file = [&](std::uint64_t b0, std::uint64_t b1) {
-        edge.resize((b1 - b0) * bb);
-        read_block_bytes(b0, b1 - b0, edge.data());
+        const std::uint64_t at = stored_offset(b0);
+        edge.resize(stored_offset(b1) - at);
+        read_at(edge.data(), edge.size(), header_.blocks_offset() + at);
         hash.update(edge.data(), edge.size());
     };
     for (std::uint64_t g = first / g_blocks; g <= (end - 1) / g_blocks; ++g) {
@@ -394,7 +408,8 @@ void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, cons
         hash.reset();
         if (g0 < first) hash_from_file(g0, first);
         const std::uint64_t in0 = std::max(g0, first), in1 = std::min(g1, end);
-        hash.update(blocks + (in0 - first) * bb, (in1 - in0) * bb);
+        const std::uint64_t at0 = stored_offset(in0);
+        hash.update(blocks + (at0 - base), stored_offset(in1) - at0);
         if (g1 > end) hash_from_file(end, g1);
         if (hash.digest() != c.group_hashes[g])
             throw Error(Errc::checksum, path_ + ": checksum mismatch in blocks " + std::to_string(g0) + ".." +

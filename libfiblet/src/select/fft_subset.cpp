@@ -101,6 +101,7 @@ SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedR
     const std::uint32_t bb = h.block_bytes();
     IndexBuilder index(h);
     std::vector<std::uint8_t> raw, packed;
+    std::vector<std::uint32_t> packed_sizes;
     std::vector<float> xyz;
     for (std::size_t i = 0; i < runs.size(); ++i) {
         const SelectedRun& r = runs[i];
@@ -118,14 +119,17 @@ SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedR
             p += 3 * n;
             h.points += n;
         }
-        if (h.packed()) {
+        if (h.packed()) {  // checksums cover the bytes as stored
             packed.clear();
-            detail::pack_blocks16(h, raw, packed);
+            packed_sizes.clear();
+            detail::pack_blocks16(h, raw, packed, &packed_sizes);
             out.write(packed.data(), packed.size());
+            const std::uint8_t* b = packed.data();
+            for (const std::uint32_t n : packed_sizes) checksum.add_block(b, n), b += n;
         } else {
             out.write(raw.data(), raw.size());
+            checksum.add_blocks(raw.data(), raw.size());
         }
-        checksum.add_blocks(raw.data(), raw.size());  // checksums cover the in-memory blocks
     }
     const auto head = serialize_fft_header(h);
     {
