@@ -218,16 +218,23 @@ int main(int argc, char** argv) {
             options.zstd = ZstdOptions{.level = 3, .group_blocks = 4, .transpose = transpose};
             if (compress_seed(e.path(), fftz, options)) ++n_fft;
         }
-        // The 16-bit variant (formats/fft16.md), with its default and a short block.
-        for (std::uint32_t ppb : {0u, 7u}) {
-            const fs::path fft = fft_dir / (stem + "-16bit-ppb" + std::to_string(ppb) + ".fft");
+        // The 16-bit variants (formats/fft16.md: packed version 17, with its
+        // default and a short block; fixed-size version 16).
+        for (std::uint32_t ppb : {0u, 7u, 1u}) {
+            const bool fixed = ppb == 1;
+            const fs::path fft = fft_dir / (stem + (fixed ? "-16bit-v16" : "-16bit-ppb" + std::to_string(ppb)) + ".fft");
             CompressOptions options;
             options.direction_bits = 16;
-            options.points_per_block = ppb;
+            options.points_per_block = fixed ? 0 : ppb;
+            options.fixed_blocks16 = fixed;
             if (!compress_seed(e.path(), fft, options)) continue;
             ++n_fft;
-            if (const std::string b = blocks_seed(fft); !b.empty())
+            if (const std::string b = blocks_seed(fft); !b.empty() && !fixed)
                 write_file(blocks_dir / (stem + "-16bit-ppb" + std::to_string(ppb) + ".blocks"), b);
+            if (ppb == 0) {  // packed blocks end where the LUT says: cut there, as without a trailer
+                const FftFile f(fft.string());
+                write_file(fft_dir / (stem + "-16bit-no-trailer.fft"), read_file(fft).substr(0, f.header().file_bytes()));
+            }
         }
     }
     fs::copy(tck_dir, compress_dir, fs::copy_options::overwrite_existing | fs::copy_options::recursive);

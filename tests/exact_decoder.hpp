@@ -1,5 +1,6 @@
 // A float64 reference decoder of version-2 .fft files, written from
-// formats/fft.md alone: it shares no code with the library's decoders (nor
+// formats/fft.md alone, and of version-17 files (packed 16-bit blocks),
+// written from formats/fft16.md: it shares no code with the library's decoders (nor
 // its frame or direction-table code), so that a test comparing the two
 // checks the format, not one implementation against itself. Every formula
 // is evaluated in double, so its output is the "exact" decode any
@@ -44,11 +45,14 @@ inline Frame3 frame_of(V3 axis) {
 inline V3 apply(const Frame3& f, V3 v) { return v.x * f.c[0] + v.y * f.c[1] + v.z * f.c[2]; }
 inline Frame3 compose(const Frame3& f, const Frame3& l) { return {{apply(f, l.c[0]), apply(f, l.c[1]), apply(f, l.c[2])}}; }
 
-// §4 "One byte per direction", decoding side: the code's direction in the cap.
-inline V3 code_direction(unsigned code, double ratio) {
-    const double q1 = double(code >> 4) / 7.5 - 1, q2 = double(code & 15) / 7.5 - 1;
+// §4 "One byte per direction", decoding side: the code's direction in the
+// cap; fft16.md: the same with `levels` levels per diagonal axis.
+inline V3 code_direction(unsigned code, double ratio, unsigned levels = 16) {
+    const double half = (levels - 1) / 2.0;
+    const double q1 = double(code / levels) / half - 1, q2 = double(code % levels) / half - 1;
     const double y = (q1 + q2) / 2, z = (q1 - q2) / 2;
     const V3 d = unit({1 - std::fabs(y) - std::fabs(z), y, z});
+    if (y == 0 && z == 0) return {1, 0, 0};  // fft16.md: an odd level count's straight-ahead code
     const double xc = 1 - ratio + ratio * d.x;
     const double lateral = std::sqrt((1 - xc * xc) / (1 - d.x * d.x));
     return unit({xc, d.y * lateral, d.z * lateral});
@@ -74,7 +78,7 @@ T le(const std::string& b, std::size_t at) {
 inline Header read_header(const std::string& b) {
     Header h;
     h.version = le<std::uint8_t>(b, 0);
-    if (h.version != 2) throw std::runtime_error("exact decoder: version " + std::to_string(h.version));
+    if (h.version != 2 && h.version != 17) throw std::runtime_error("exact decoder: version " + std::to_string(h.version));
     h.fibers = le<std::uint64_t>(b, 1), h.points = le<std::uint64_t>(b, 9);
     h.blocks = le<std::uint32_t>(b, 17), h.points_per_block = le<std::uint32_t>(b, 21);
     h.scaling = le<float>(b, 25);
@@ -122,10 +126,65 @@ struct Decoded {
     std::vector<std::vector<V3>> fibers;  // millimetres
 };
 
+// fft16.md, version 17: one packed block of `count` points at `blk` (18
+// anchor bytes, unorm24 least significant byte first, then 15-bit codes,
+// least significant bit first); returns its size in bytes.
+inline std::size_t decode_packed_block(const unsigned char* blk, unsigned count, const std::vector<Frame3>& table,
+                                       double step, std::vector<V3>& out) {
+    double q[6];
+    for (int i = 0; i < 6; ++i) q[i] = double(blk[3 * i] | blk[3 * i + 1] << 8 | blk[3 * i + 2] << 16);
+    const V3 a0{q[0] / 16777215.0, q[1] / 16777215.0, q[2] / 16777215.0};
+    const V3 a1{q[3] / 16777215.0, q[4] / 16777215.0, q[5] / 16777215.0};
+    out.push_back(a0);
+    if (count < 2) return 18;
+    out.push_back(a1);
+    const V3 d{q[3] - q[0], q[4] - q[1], q[5] - q[2]};  // the first axis: of the integer difference
+    Frame3 f = frame_of(dot(d, d) > 0 ? unit(d) : V3{1, 0, 0});
+    V3 p = a1;
+    for (unsigned k = 0; k + 2 < count; ++k) {
+        unsigned code = 0;
+        for (unsigned bit = 0; bit < 15; ++bit) {
+            const unsigned at = 15 * k + bit;
+            code |= unsigned(blk[18 + at / 8] >> (at % 8) & 1) << bit;
+        }
+        f = compose(f, table.at(code));
+        p = p + step * f.c[0];
+        out.push_back(p);
+    }
+    return 18 + (15 * (count - 2) + 7) / 8;  // count >= 2 here
+}
+
 // The whole file: fibers in LUT order, points mapped back to millimetres (§2).
 inline Decoded decode(const std::string& bytes) {
     Decoded d;
     Header& h = d.header = read_header(bytes);
+    if (h.version == 17) {
+        // fft16.md: 181 levels; the LUT's second word is the fiber's point
+        // count; packed blocks follow each other, fiber after fiber.
+        std::vector<Frame3> table(181 * 181);
+        for (unsigned c = 0; c < table.size(); ++c) table[c] = frame_of(code_direction(c, h.ratio, 181));
+        const std::size_t lut = 58 + 8 * h.buffer_ends.size();
+        std::size_t at = lut + 8 * h.fibers;
+        std::vector<V3> normalized;
+        for (std::uint64_t i = 0; i < h.fibers; ++i) {
+            const auto x = le<std::uint32_t>(bytes, lut + 8 * i), points = le<std::uint32_t>(bytes, lut + 8 * i + 4);
+            const unsigned count = x & 0xffff;
+            normalized.clear();
+            for (unsigned b = 0; b < count; ++b) {
+                const unsigned n = b + 1 < count ? h.points_per_block : points - b * h.points_per_block;
+                if (at + 18 + (n > 2 ? (15 * (n - 2) + 7) / 8 : 0) > bytes.size())
+                    throw std::runtime_error("exact decoder: block past the end");
+                at += decode_packed_block(reinterpret_cast<const unsigned char*>(bytes.data()) + at, n, table,
+                                          double(h.step), normalized);
+            }
+            auto& fiber = d.fibers.emplace_back();
+            for (const V3& p : normalized)
+                fiber.push_back({(p.x - 0.5) * double(h.scaling) - double(h.offset[0]),
+                                 (p.y - 0.5) * double(h.scaling) - double(h.offset[1]),
+                                 (p.z - 0.5) * double(h.scaling) - double(h.offset[2])});
+        }
+        return d;
+    }
     std::array<Frame3, 256> table;
     for (unsigned c = 0; c < 256; ++c) table[c] = frame_of(code_direction(c, h.ratio));
     const std::size_t lut = 58 + 8 * h.buffer_ends.size(), blocks = lut + 8 * h.fibers;

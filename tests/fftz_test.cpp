@@ -47,11 +47,12 @@ struct Files {
 };
 
 // The same tractogram as a plain .fft and as a .fftz (small groups, so
-// that a range spans several frames).
+// that a range spans several frames); 16 bits: version 16 in both.
 void make(Files& f, unsigned bits, bool transpose, std::uint32_t group = 7) {
     write_walks(f.dir.file("w.tck"), 60, 1);
     CompressOptions o;
     o.direction_bits = bits;
+    o.fixed_blocks16 = true;
     o.search = search_for_effort(0);
     o.step_scale = 1.0;
     o.cap_ratio = 0.1;

@@ -75,7 +75,7 @@ protected:
                 s->name = "official small-sdstream";
                 fft = shared_data("reference/small-sdstream.fft");
                 break;
-            case 3:  // 16-bit directions, default 126 points a block
+            case 3:  // 16-bit directions (packed version 17), default 254 points a block
                 s->name = "fiblet 16-bit dwi-small64d";
                 fft = dir_->file("dwi16.fft");
                 o.direction_bits = 16;

@@ -160,9 +160,9 @@ void add_compress(CLI::App& app) {
     cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs); created if missing");
     cmd->add_option("--step", args->step, "Fixed step in mm (default: measured; variable spacing is resampled)");
     add_threads_option(cmd, args->threads, "Encoding");
-    cmd->add_option("--bits", args->bits, "Bits per direction: 8 (.fft version 2) or 16 (formats/fft16.md)")
+    cmd->add_option("--bits", args->bits, "Bits per direction: 8 (.fft version 2) or 16 (formats/fft16.md: 15-bit codes in packed blocks; with --zstd, version 16)")
         ->check(CLI::IsMember({8u, 16u}));
-    cmd->add_option("--block-points", args->block_points, "Points per block (default 60 for 8 bits, 126 for 16)");
+    cmd->add_option("--block-points", args->block_points, "Points per block (default 60 for 8 bits; 254 for 16, 126 for 16 with --zstd)");
     cmd->add_option("-e,--effort", args->effort,
                     "Code search effort 0..4 (default 1): slower searches give smaller errors, same decoder")
         ->check(CLI::Range(0, kMaxEffort));

@@ -113,6 +113,7 @@ void info_fft(const InfoArgs& a) {
         j.str("file", a.input).str("format", f.is_zstd_container() ? "fftz" : "fft").integer("version", h.version);
         j.integer("fibers", h.fibers).integer("points", h.points).integer("blocks", h.blocks);
         j.integer("points_per_block", h.points_per_block).integer("block_bytes", h.block_bytes());
+        if (h.packed()) j.integer("packed_block_bytes", h.packed_block_bytes);
         j.num("scaling_mm", h.scaling);
         j.raw("offset_mm", fmt::format("[{:.9g}, {:.9g}, {:.9g}]", h.offset[0], h.offset[1], h.offset[2]));
         j.num("cap_ratio", h.ratio).num("step", h.step).num("step_mm", double(h.step) * h.scaling);
@@ -129,7 +130,11 @@ void info_fft(const InfoArgs& a) {
                                      : std::string(),
                human_bytes(f.file_size()));
     fmt::print("  fibers                 {}\n  points                 {}\n", h.fibers, h.points);
-    fmt::print("  blocks                 {} x {} B ({} points each)\n", h.blocks, h.block_bytes(), h.points_per_block);
+    if (h.packed())
+        fmt::print("  blocks                 {} packed, {} ({} points each, 15-bit codes)\n", h.blocks,
+                   human_bytes(h.packed_block_bytes), h.points_per_block);
+    else
+        fmt::print("  blocks                 {} x {} B ({} points each)\n", h.blocks, h.block_bytes(), h.points_per_block);
     fmt::print("  step                   {:.6g} mm ({:.6g} normalized)\n", double(h.step) * h.scaling, h.step);
     fmt::print("  cap ratio              {:.6g}\n", h.ratio);
     fmt::print("  scaling, offset (mm)   {:.6g}, ({:.6g}, {:.6g}, {:.6g})\n", h.scaling, h.offset[0], h.offset[1],

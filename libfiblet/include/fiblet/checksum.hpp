@@ -52,7 +52,7 @@ struct FftChecksums {
     std::uint64_t header_hash = 0;   // bytes [0, lut offset): fixed header and buffer table
     std::uint64_t lut_hash = 0;      // the fiber LUT
     std::uint64_t trailer_hash = 0;  // the trailer chunks stored before the CSUM chunk
-    std::vector<std::uint64_t> group_hashes;  // blocks [g * group_blocks, (g + 1) * group_blocks)
+    std::vector<std::uint64_t> group_hashes;  // blocks [g * group_blocks, (g + 1) * group_blocks), as stored
 
     std::uint64_t group_count(std::uint64_t blocks) const { return (blocks + group_blocks - 1) / group_blocks; }
 
@@ -72,6 +72,10 @@ public:
     explicit FftChecksumBuilder(std::uint32_t block_bytes, std::uint32_t group_blocks = kDefaultChecksumGroupBlocks);
     void add_lut(const void* data, std::size_t bytes);
     void add_blocks(const void* data, std::size_t bytes);
+    // One whole block of `bytes` bytes, as stored: version 17's packed blocks
+    // differ in size (their groups still count blocks). A writer uses either
+    // add_blocks or add_block for a file, not both.
+    void add_block(const void* data, std::size_t bytes);
     TrailerChunk finish(std::span<const std::uint8_t> header, const std::vector<TrailerChunk>& chunks_before);
 
 private:
@@ -79,6 +83,7 @@ private:
     FftChecksums sums_;
     Xxh64Stream lut_, group_;
     std::uint64_t group_bytes_ = 0;  // bytes of the current group so far
+    std::uint32_t group_block_count_ = 0;  // add_block: blocks of the current group so far
 };
 
 class FftFile;

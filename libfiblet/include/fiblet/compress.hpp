@@ -35,9 +35,10 @@ struct ZstdOptions {
 
 struct CompressOptions {
     std::optional<double> step_mm;            // overrides the measured step
-    std::uint32_t points_per_block = 0;       // 0: 60 for 8-bit codes, 126 for 16-bit codes
+    std::uint32_t points_per_block = 0;       // 0: 60 for 8-bit codes; 16-bit: 254 (.fft), 126 (.fftz)
     // Encoder choices; the decoder is the same whatever they are (docs/encode.md).
-    unsigned direction_bits = 8;              // 8: version-2 .fft; 16: the 16-bit variant (formats/fft16.md)
+    unsigned direction_bits = 8;              // 8: version-2 .fft; 16: version 17 (.fft) or 16 (.fftz) (formats/fft16.md)
+    bool fixed_blocks16 = false;              // 16-bit codes in version 16's fixed-size blocks in a .fft too
     SearchOptions search = search_for_effort(kDefaultEffort);  // code search (see search_for_effort)
     std::optional<double> cap_ratio;          // cap ratio; default: tuned on a sample
     std::optional<double> turn_percentile;    // or: a cap that holds this percentile of the turning angles

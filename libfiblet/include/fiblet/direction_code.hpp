@@ -58,24 +58,32 @@ private:
     std::array<Frame, 256> frames_;
 };
 
-// The 16-bit direction code of the .fft16 layout (formats/fft16.md): the
-// same cap mapping and half-octahedron, quantized with 256 levels on each
-// diagonal axis (high byte: y+z, low byte: y-z).
-std::uint16_t quantize_half_octahedron16(Vec3f dir);
-Vec3f dequantize_half_octahedron16(std::uint16_t code);
+// The wide direction codes of the 16-bit layouts (formats/fft16.md): the
+// same cap mapping and half-octahedron, quantized with `levels` levels on
+// each diagonal axis; the code is level(y+z) * levels + level(y-z).
+// Version 16 has 256 levels (the high byte holds y+z), version 17 has 181
+// (15-bit codes; an odd count has a straight-ahead code).
+inline constexpr unsigned kCodeLevels16 = 256;
+inline constexpr unsigned kCodeLevels15 = 181;
+std::uint16_t quantize_half_octahedron16(Vec3f dir, unsigned levels = kCodeLevels16);
+Vec3f dequantize_half_octahedron16(std::uint16_t code, unsigned levels = kCodeLevels16);
 
-// The 65536 local frames of a 16-bit file (2.4 MB, built once per file).
+// The levels^2 local frames of a 16-bit file (built once per file), in a
+// table of 65536 (2.4 MB).
 class DirectionTable16 {
 public:
-    explicit DirectionTable16(float ratio);
+    explicit DirectionTable16(float ratio, unsigned levels = kCodeLevels16);
     float ratio() const { return ratio_; }
+    unsigned levels() const { return levels_; }
+    std::uint32_t code_count() const { return levels_ * levels_; }
     const Frame& frame(std::uint16_t code) const { return frames_[code]; }
     const Vec3f& direction(std::uint16_t code) const { return frames_[code].c[0]; }
-    // As DirectionTable::nearest_code, with 16-bit codes.
+    // As DirectionTable::nearest_code, with wide codes.
     std::uint16_t nearest_code(Vec3f local_dir) const;
 
 private:
     float ratio_;
+    unsigned levels_;
     std::vector<Frame> frames_;
 };
 

@@ -65,7 +65,7 @@ public:
 
     // Appends block_count(fiber.size()) blocks to `out`. When `decoded` is
     // given, the points fiblet's (float32) decoders will produce (world mm)
-    // are appended to it; `decoded_exact` (8-bit files) gets the points an
+    // are appended to it; `decoded_exact` gets the points an
     // exact (float64) decoder of the format produces, rounded to float.
     // Where a block's first frame is ill-conditioned the two differ by more
     // than float rounding; the encoder chooses codes that suit both there.

@@ -128,6 +128,12 @@ public:
 private:
     struct Mapping;
     void read_lut(std::uint64_t& lut_hash);
+    void read_packed_lut_entry(std::uint64_t fiber, std::uint64_t buffer_base, std::uint64_t next_block);
+    std::uint64_t fiber_of_block(std::uint64_t block) const;
+    // Where block `block` (up to blocks) starts, in bytes after the first block, as stored.
+    std::uint64_t stored_offset(std::uint64_t block) const;
+    void expand_packed_blocks(std::uint64_t first, std::uint64_t count, const std::uint8_t* packed,
+                              std::uint8_t* out) const;
     void open_trailer(std::span<const std::uint8_t> head, std::uint64_t lut_hash);
     void verify_open_checksums(std::span<const std::uint8_t> head, std::uint64_t lut_hash) const;
     void check_block_structure(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const;
@@ -143,6 +149,11 @@ private:
     FftHeader header_;
     std::vector<FiberLutEntry> lut_;
     std::vector<std::uint32_t> fiber_first_block_;  // block counts are 32-bit, so are first blocks
+    // Version 17 (packed blocks): each fiber's points and where its blocks
+    // start (bytes after the first block); sums over the LUT as it is read.
+    std::vector<std::uint32_t> fiber_points_;
+    std::vector<std::uint64_t> fiber_offset_;
+    std::uint64_t packed_points_ = 0, packed_bytes_ = 0;
     std::vector<TrailerChunk> trailer_;
     std::vector<std::pair<std::string, std::string>> properties_;
     std::optional<Resampling> resampling_;

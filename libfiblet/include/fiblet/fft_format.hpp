@@ -10,9 +10,13 @@
 //            of the fiber inside its buffer)
 //   blocks   nbBlocks x blockSize bytes (76 for 60 points)
 //
-// The 16-bit variant (formats/fft16.md) has the same header and LUT with
-// version = 16, so readers of version 2 reject it cleanly; its blocks hold
-// unorm24 anchors and 16-bit direction codes.
+// The 16-bit variants (formats/fft16.md) have the same header with version
+// = 16 or 17, so readers of version 2 reject them cleanly; their blocks hold
+// unorm24 anchors and wide direction codes. Version 16 stores fixed-size
+// blocks; version 17 stores packed blocks (15-bit codes, no padding, no
+// per-block id or flags) that FftFile expands, on reading, to the in-memory
+// block layout of version 16 (BlockView16), so every consumer of blocks
+// sees one 16-bit layout.
 #pragma once
 
 #include <array>
@@ -28,7 +32,8 @@
 namespace fiblet {
 
 inline constexpr std::uint8_t kFftVersion = 2;
-inline constexpr std::uint8_t kFft16Version = 16;  // 16-bit directions (formats/fft16.md)
+inline constexpr std::uint8_t kFft16Version = 16;        // 16-bit directions, fixed-size blocks (formats/fft16.md)
+inline constexpr std::uint8_t kFft16PackedVersion = 17;  // 15-bit directions, packed blocks (formats/fft16.md)
 inline constexpr std::uint32_t kDefaultPointsPerBlock = 60;
 inline constexpr std::uint32_t kMaxPointsPerBlock = 63;  // 6-bit count in the flags byte
 inline constexpr std::size_t kFftFixedHeaderBytes = 1 + 8 + 8 + 4 + 4 + 4 * 8 + 1;  // up to the SSBO table
@@ -66,6 +71,18 @@ constexpr std::uint32_t fft16_block_bytes(std::uint32_t points_per_block) {
     return (24 + 2 * (points_per_block - 2) + 3) / 4 * 4;
 }
 
+// Packed blocks of version 17 on disk (formats/fft16.md): the 18 anchor
+// bytes, then n - 2 codes of 15 bits (levels 181 x 181) as one bit stream,
+// least significant bit first, zero bits up to the next byte. Every block of
+// a fiber holds pointsPerBlock points but its last; blocks follow each other
+// with no gap, so a block's offset follows from the fiber LUT.
+inline constexpr std::uint32_t kDefaultPointsPerBlock16Packed = 254;
+inline constexpr std::size_t kPacked16AnchorBytes = 18;
+inline constexpr unsigned kPacked16CodeBits = 15;
+constexpr std::uint32_t packed16_block_bytes(std::uint32_t points) {
+    return std::uint32_t(kPacked16AnchorBytes) + (points > 2 ? (kPacked16CodeBits * (points - 2) + 7) / 8 : 0);
+}
+
 // Largest number of blocks one GPU buffer holds (2^31 bytes / block size).
 constexpr std::uint64_t fft_max_blocks_per_buffer(std::uint32_t block_bytes) {
     return (std::uint64_t{1} << 31) / block_bytes;
@@ -84,20 +101,30 @@ struct FftHeader {
     float max_error_mm = 0;
     float mean_error_mm = 0;
     std::vector<std::uint64_t> buffer_ends;  // cumulative block count at the end of each buffer
+    // Version 17: bytes of the packed blocks on disk, known from the fiber
+    // LUT (FftFile sets it after reading the LUT, the encoder after encoding).
+    std::uint64_t packed_block_bytes = 0;
 
-    // 8 for version 2, 16 for the 16-bit variant.
-    unsigned direction_bits() const { return version == kFft16Version ? 16 : 8; }
+    // 8 for version 2, 16 for the 16-bit variants.
+    unsigned direction_bits() const { return version == kFft16Version || packed() ? 16 : 8; }
+    // Version 17: packed blocks on disk, expanded on reading.
+    bool packed() const { return version == kFft16PackedVersion; }
+    // Levels per diagonal axis of the direction code.
+    unsigned code_levels() const { return packed() ? 181 : version == kFft16Version ? 256 : 16; }
     std::uint32_t max_points_per_block() const {
-        return version == kFft16Version ? kMaxPointsPerBlock16 : kMaxPointsPerBlock;
+        return direction_bits() == 16 ? kMaxPointsPerBlock16 : kMaxPointsPerBlock;
     }
+    // Bytes of a block in memory (for version 17: expanded, as version 16).
     std::uint32_t block_bytes() const {
-        return version == kFft16Version ? fft16_block_bytes(points_per_block) : fft_block_bytes(points_per_block);
+        return direction_bits() == 16 ? fft16_block_bytes(points_per_block) : fft_block_bytes(points_per_block);
     }
     float step_mm() const { return step * scaling; }
     // Bytes before the fiber LUT / before the first block.
     std::uint64_t lut_offset() const { return kFftFixedHeaderBytes + 8 * buffer_ends.size(); }
     std::uint64_t blocks_offset() const { return lut_offset() + 8 * fibers; }
-    std::uint64_t file_bytes() const { return blocks_offset() + std::uint64_t{blocks} * block_bytes(); }
+    std::uint64_t file_bytes() const {
+        return blocks_offset() + (packed() ? packed_block_bytes : std::uint64_t{blocks} * block_bytes());
+    }
 
     // Normalized <-> world coordinates.
     Vec3f to_world(float nx, float ny, float nz) const {

@@ -42,20 +42,20 @@ struct SearchParams {
 // The 8-bit codes of version-2 files, with the fast nearest-code lookup.
 struct Codebook8 {
     using Code = std::uint8_t;
-    static constexpr int kLevels = 16;
     const DirectionTable& table;
     const NearestCodeLut& lut;
+    static constexpr int levels() { return 16; }
 
     Code nearest(Vec3f local) const { return lut.usable() ? lut(local) : table.nearest_code(local); }
     const Frame& frame(unsigned c) const { return table.frame(Code(c)); }
     const Vec3f& direction(unsigned c) const { return table.direction(Code(c)); }
 };
 
-// The 16-bit codes of .fft16 files.
+// The wide codes of 16-bit files (256 or 181 levels).
 struct Codebook16 {
     using Code = std::uint16_t;
-    static constexpr int kLevels = 256;
     const DirectionTable16& table;
+    int levels() const { return int(table.levels()); }
 
     Code nearest(Vec3f local) const { return table.nearest_code(local); }
     const Frame& frame(unsigned c) const { return table.frame(Code(c)); }
@@ -125,10 +125,11 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
             const Vec3f alt_local = robust ? apply_transposed(st.f, alt_targets[k] - st.p) : local;
             const float alt_base = st.cost + dot(alt_local, alt_local) + step2;
             const unsigned aimed = cb.nearest(robust ? midpoint(local, alt_local) : local);
-            const int h0 = int(aimed) / Codebook::kLevels, l0 = int(aimed) % Codebook::kLevels;
-            for (int h = std::max(h0 - r, 0); h <= std::min(h0 + r, Codebook::kLevels - 1); ++h)
-                for (int l = std::max(l0 - r, 0); l <= std::min(l0 + r, Codebook::kLevels - 1); ++l) {
-                    const auto code = std::uint32_t(h * Codebook::kLevels + l);
+            const int levels = cb.levels();
+            const int h0 = int(aimed) / levels, l0 = int(aimed) % levels;
+            for (int h = std::max(h0 - r, 0); h <= std::min(h0 + r, levels - 1); ++h)
+                for (int l = std::max(l0 - r, 0); l <= std::min(l0 + r, levels - 1); ++l) {
+                    const auto code = std::uint32_t(h * levels + l);
                     float cost = base - two_step * dot(cb.direction(code), local);
                     if (robust) cost = std::max(cost, alt_base - two_step * dot(cb.direction(code), alt_local));
                     if (kept == width && !(cost < cand[width - 1].cost)) continue;

@@ -70,8 +70,14 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     if (options.direction_bits != 8 && options.direction_bits != 16)
         throw Error(Errc::invalid_argument, "direction bits must be 8 or 16");
     const bool wide = options.direction_bits == 16;
+    // 16 bits: packed blocks (version 17) in a .fft; fixed-size blocks
+    // (version 16) in a .fftz, whose block groups are transposed whole, or
+    // when asked for.
+    const bool packed = wide && !options.zstd && !options.fixed_blocks16;
     const std::uint32_t points_per_block =
-        options.points_per_block ? options.points_per_block : (wide ? kDefaultPointsPerBlock16 : kDefaultPointsPerBlock);
+        options.points_per_block ? options.points_per_block
+                                 : (packed ? kDefaultPointsPerBlock16Packed
+                                           : wide ? kDefaultPointsPerBlock16 : kDefaultPointsPerBlock);
     const std::uint32_t max_points_per_block = wide ? kMaxPointsPerBlock16 : kMaxPointsPerBlock;
     if (points_per_block < 2 || points_per_block > max_points_per_block)
         throw Error(Errc::invalid_argument, "points per block must be in [2, " + std::to_string(max_points_per_block) + "]");
@@ -129,7 +135,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     // Normalization into the unit cube; the step is what the decoder will
     // use (float, normalized), and resampling uses exactly that length.
     FftHeader& h = report.header;
-    h.version = wide ? kFft16Version : kFftVersion;
+    h.version = packed ? kFft16PackedVersion : wide ? kFft16Version : kFftVersion;
     h.points_per_block = points_per_block;
     h.fibers = scan.fibers;
     double extent = 0;
@@ -196,7 +202,11 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         if (in_buffer + nb > per_buffer) h.buffer_ends.push_back(blocks), in_buffer = 0;
         if (h.buffer_ends.size() > 254)
             throw Error(Errc::unsupported, tck_path + ": more than 255 GPU buffers of blocks");
-        lut[f] = {std::uint32_t(h.buffer_ends.size()) << 16 | nb, std::uint32_t(in_buffer)};
+        // Version 17 stores the fiber's point count where version 16 has its first block.
+        lut[f] = {std::uint32_t(h.buffer_ends.size()) << 16 | nb, packed ? fiber_points[f] : std::uint32_t(in_buffer)};
+        if (packed && nb > 0)
+            h.packed_block_bytes += (nb - 1) * std::uint64_t{packed16_block_bytes(points_per_block)} +
+                                    packed16_block_bytes(fiber_points[f] - (nb - 1) * points_per_block);
         blocks += nb, in_buffer += nb;
         h.points += fiber_points[f];
     }

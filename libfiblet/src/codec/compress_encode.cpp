@@ -21,6 +21,7 @@
 #include "codec/compress_stages.hpp"
 #include "codec/fiber_end_encoder.hpp"
 #include "fiblet/parallel.hpp"
+#include "format/packed_blocks16.hpp"
 
 namespace fiblet::detail {
 
@@ -56,7 +57,9 @@ void add_point_errors(std::span<const Vec3f> targets, std::span<const Vec3f> dec
 // batch's set: statistics accumulate per slot in batch order and are merged
 // in slot order at the end, whichever thread ran the task.
 struct Slot {
-    std::vector<std::uint8_t> blocks;
+    std::vector<std::uint8_t> blocks;  // in the in-memory layout (the index is of these)
+    std::vector<std::uint8_t> packed;  // version 17: the blocks as stored (and checksummed)
+    std::vector<std::uint32_t> packed_sizes;  // of each packed block
     std::vector<Vec3f> decoded, decoded_exact, resampled, scratch;
     std::vector<PolylinePosition> positions;  // of the resampled points on the input
     std::vector<double> point_errors;         // scratch of add_point_errors
@@ -90,14 +93,24 @@ void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t
         add_point_errors(points, w.decoded, w.decoded_exact, f, w.point_errors, w.error);
         w.geometry.add_fiber(original, w.decoded, f);
     }
+    const FftHeader& h = in.encoder.header();
+    w.packed.clear();
+    w.packed_sizes.clear();
+    if (h.packed()) pack_blocks16(h, w.blocks, w.packed, &w.packed_sizes);
 }
 
 // Stage 3: a batch's blocks, checksums and index entries, in task order.
 void write_batch(const FiberBatch& b, std::vector<Slot>& slots, FftSink& out, FftChecksumBuilder& checksum,
                  IndexBuilder& index) {
     for (std::size_t t = 0; t < b.tasks(); ++t) {
-        out.write_blocks(slots[t].blocks);
-        checksum.add_blocks(slots[t].blocks.data(), slots[t].blocks.size());
+        const Slot& s = slots[t];
+        out.write_blocks(s.packed.empty() ? s.blocks : s.packed);
+        if (s.packed.empty()) {
+            checksum.add_blocks(s.blocks.data(), s.blocks.size());
+        } else {  // checksums cover the bytes as stored
+            const std::uint8_t* p = s.packed.data();
+            for (const std::uint32_t n : s.packed_sizes) checksum.add_block(p, n), p += n;
+        }
         index.append(slots[t].index);
     }
 }

@@ -41,27 +41,26 @@ Vec3f map_cap_to_half_sphere(Vec3f v, float ratio) {
 
 namespace {
 
-// Half-octahedron quantizer with `Levels` levels per diagonal axis: the
-// code is level(y+z) * Levels + level(y-z), i.e. the high nibble/byte holds
-// y+z. 8-bit codes use 16 levels, 16-bit codes 256.
-template <int Levels>
-unsigned quantize_levels(Vec3f d) {
-    constexpr float half = 0.5f * float(Levels - 1);
+// Half-octahedron quantizer with `levels` levels per diagonal axis: the
+// code is level(y+z) * levels + level(y-z), i.e. the high nibble/byte holds
+// y+z. 8-bit codes use 16 levels, 16-bit codes 256 (version 16) or 181
+// (version 17).
+unsigned quantize_levels(Vec3f d, int levels) {
+    const float half = 0.5f * float(levels - 1);
     const float ax = d.x > 0.0f ? d.x : 0.0f;  // below the rim: project onto x = 0
     const float l1 = ax + std::fabs(d.y) + std::fabs(d.z);
     const float vy = l1 > 0.0f ? d.y / l1 : 0.0f;
     const float vz = l1 > 0.0f ? d.z / l1 : 0.0f;
-    auto level = [](float u) {
-        return static_cast<unsigned>(std::clamp(std::floor(0.5f + half * (1.0f + u)), 0.0f, float(Levels - 1)));
+    auto level = [&](float u) {
+        return static_cast<unsigned>(std::clamp(std::floor(0.5f + half * (1.0f + u)), 0.0f, float(levels - 1)));
     };
-    return level(vy + vz) * Levels + level(vy - vz);
+    return level(vy + vz) * unsigned(levels) + level(vy - vz);
 }
 
-template <int Levels>
-Vec3f dequantize_levels(unsigned code) {
-    constexpr float half = 0.5f * float(Levels - 1);
-    const float q1 = float(code / Levels) / half - 1.0f;
-    const float q2 = float(code % Levels) / half - 1.0f;
+Vec3f dequantize_levels(unsigned code, int levels) {
+    const float half = 0.5f * float(levels - 1);
+    const float q1 = float(code / unsigned(levels)) / half - 1.0f;
+    const float q2 = float(code % unsigned(levels)) / half - 1.0f;
     const float y = 0.5f * (q1 + q2), z = 0.5f * (q1 - q2);
     return normalize(Vec3f{1.0f - std::fabs(y) - std::fabs(z), y, z});
 }
@@ -69,21 +68,21 @@ Vec3f dequantize_levels(unsigned code) {
 // The code whose cap direction is closest in angle to `local`: the formula
 // code of the direction mapped back to the half sphere, refined over its
 // 3x3 neighbourhood (the cap mapping bends the cells a little).
-template <int Levels, class Table>
-unsigned nearest_levels(const Table& t, Vec3f local) {
+template <class Table>
+unsigned nearest_levels(const Table& t, Vec3f local, int levels) {
     const float ratio = t.ratio();
-    if (!(dot(local, local) > 0.0f)) return quantize_levels<Levels>(map_cap_to_half_sphere({1, 0, 0}, ratio));
+    if (!(dot(local, local) > 0.0f)) return quantize_levels(map_cap_to_half_sphere({1, 0, 0}, ratio), levels);
     const Vec3f unit = normalize(local);
     // Outside the cap the code can only lie on the rim: aim along (0, y, z).
     const Vec3f on_half_sphere =
         unit.x >= 1.0f - ratio ? map_cap_to_half_sphere(unit, ratio) : Vec3f{0.0f, unit.y, unit.z};
-    const unsigned guess = quantize_levels<Levels>(on_half_sphere);
-    const int h0 = int(guess / Levels), l0 = int(guess % Levels);
+    const unsigned guess = quantize_levels(on_half_sphere, levels);
+    const int h0 = int(guess) / levels, l0 = int(guess) % levels;
     unsigned best = guess;
     float best_dot = dot(t.direction(guess), local);
-    for (int h = std::max(h0 - 1, 0); h <= std::min(h0 + 1, Levels - 1); ++h)
-        for (int l = std::max(l0 - 1, 0); l <= std::min(l0 + 1, Levels - 1); ++l) {
-            const auto code = unsigned(h * Levels + l);
+    for (int h = std::max(h0 - 1, 0); h <= std::min(h0 + 1, levels - 1); ++h)
+        for (int l = std::max(l0 - 1, 0); l <= std::min(l0 + 1, levels - 1); ++l) {
+            const auto code = unsigned(h * levels + l);
             const float d = dot(t.direction(code), local);
             if (d > best_dot) best_dot = d, best = code;
         }
@@ -92,10 +91,12 @@ unsigned nearest_levels(const Table& t, Vec3f local) {
 
 }  // namespace
 
-std::uint8_t quantize_half_octahedron(Vec3f d) { return static_cast<std::uint8_t>(quantize_levels<16>(d)); }
-Vec3f dequantize_half_octahedron(std::uint8_t code) { return dequantize_levels<16>(code); }
-std::uint16_t quantize_half_octahedron16(Vec3f d) { return static_cast<std::uint16_t>(quantize_levels<256>(d)); }
-Vec3f dequantize_half_octahedron16(std::uint16_t code) { return dequantize_levels<256>(code); }
+std::uint8_t quantize_half_octahedron(Vec3f d) { return static_cast<std::uint8_t>(quantize_levels(d, 16)); }
+Vec3f dequantize_half_octahedron(std::uint8_t code) { return dequantize_levels(code, 16); }
+std::uint16_t quantize_half_octahedron16(Vec3f d, unsigned levels) {
+    return static_cast<std::uint16_t>(quantize_levels(d, int(levels)));
+}
+Vec3f dequantize_half_octahedron16(std::uint16_t code, unsigned levels) { return dequantize_levels(code, int(levels)); }
 
 // A code's frame, computed in double and rounded once: the float formulas
 // lose digits where the cap is narrow (1 - x^2 cancels for x near 1: at a
@@ -112,15 +113,18 @@ DirectionTable::DirectionTable(float ratio) : ratio_(ratio) {
 }
 
 std::uint8_t DirectionTable::nearest_code(Vec3f local) const {
-    return static_cast<std::uint8_t>(nearest_levels<16>(*this, local));
+    return static_cast<std::uint8_t>(nearest_levels(*this, local, 16));
 }
 
-DirectionTable16::DirectionTable16(float ratio) : ratio_(ratio), frames_(65536) {
-    for (unsigned k = 0; k < 65536; ++k) frames_[k] = rounded_code_frame(k, 256, ratio);
+DirectionTable16::DirectionTable16(float ratio, unsigned levels) : ratio_(ratio), levels_(levels), frames_(65536) {
+    for (unsigned k = 0; k < levels * levels; ++k) frames_[k] = rounded_code_frame(k, levels, ratio);
+    // Every u16 has a frame, so no block bytes index past the table: codes
+    // past levels^2 (FftFile rejects them) repeat the central code's frame.
+    for (unsigned k = levels * levels; k < 65536; ++k) frames_[k] = frames_[levels / 2 * (levels + 1)];
 }
 
 std::uint16_t DirectionTable16::nearest_code(Vec3f local) const {
-    return static_cast<std::uint16_t>(nearest_levels<256>(*this, local));
+    return static_cast<std::uint16_t>(nearest_levels(*this, local, int(levels_)));
 }
 
 }  // namespace fiblet

@@ -8,6 +8,9 @@
 // is normalize(F0 x C), so where the first segment runs nearly along the
 // helper vector C, the anchors' float rounding (1e-5 rad of axis for a
 // 0.1 mm step) turns the block about its axis by that divided by |F0 x C|.
+// 16-bit files start both decoders from the same axis (fft16.md), but over
+// a 254-point block the float walk's rounding drifts from the exact walk by
+// up to ~0.1 um, so the encoder measures there too (only (a) below).
 // The encoder uses this model to (a) measure every point's error under the
 // exact decode as well, so the header's max error holds for both, and (b)
 // in ill-conditioned blocks, aim the codes at the middle of the two
@@ -17,6 +20,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 #include "fiblet/direction_code.hpp"
 #include "fiblet/geometry.hpp"
@@ -65,9 +69,26 @@ private:
     std::array<FrameD, 256> frames_;
 };
 
+// The levels^2 local frames of 16-bit codes (fft16.md), in double.
+class ExactDirectionTable16 {
+public:
+    ExactDirectionTable16(float ratio, unsigned levels);
+    const FrameD& frame(std::uint16_t code) const { return frames_[code < frames_.size() ? code : frames_.size() / 2]; }
+
+private:
+    std::vector<FrameD> frames_;
+};
+
+// The first frame of a 16-bit block from its anchors' unorm24 integers: the
+// axis of their exact difference (fft16.md, version 17; version 16's float
+// anchors differ from it only by the float decoder's rounding).
+FrameD exact_block_frame24(const std::array<std::uint32_t, 3>& q0, const std::array<std::uint32_t, 3>& q1);
+
 // Decodes the direction codes of one block exactly from its second anchor
 // and first frame (normalized coordinates): writes `count` points.
 void exact_walk(const ExactDirectionTable& table, FrameD f, Vec3d p, double step, const std::uint8_t* codes,
+                std::size_t count, Vec3d* out);
+void exact_walk(const ExactDirectionTable16& table, FrameD f, Vec3d p, double step, const std::uint16_t* codes,
                 std::size_t count, Vec3d* out);
 
 // The unorm16 value of an anchor coordinate, exactly.

@@ -11,6 +11,7 @@
 #include "core/vec_math.hpp"
 #include "fiblet/encode.hpp"
 #include "fiblet/error.hpp"
+#include "format/packed_blocks16.hpp"
 
 namespace fiblet {
 using namespace detail;
@@ -129,6 +130,7 @@ struct FiberEncoder::Tables {
     std::optional<NearestCodeLut> lut8;
     std::optional<DirectionTable16> table16;
     std::optional<ExactDirectionTable> exact8;  // the exact decoder's frames (exact_model.hpp)
+    std::optional<ExactDirectionTable16> exact16;
 };
 
 float compute_ratio(double scaling_mm, double step_mm, double min_dot) {
@@ -166,7 +168,8 @@ FiberEncoder::FiberEncoder(const FftHeader& header, SearchOptions search) : head
         throw Error(Errc::invalid_argument, "retry beam width must be in [0, 64], its radius in [1, 3]");
     auto t = std::make_shared<Tables>();
     if (header_.direction_bits() == 16) {
-        t->table16.emplace(header_.ratio);
+        t->table16.emplace(header_.ratio, header_.code_levels());
+        t->exact16.emplace(header_.ratio, header_.code_levels());
     } else {
         t->table8.emplace(header_.ratio);
         t->lut8.emplace(*t->table8);
@@ -247,7 +250,9 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
             write_block_head(h, &out[base + std::size_t(b) * bb], p0, p1, fiber_id, b, n_blocks, n, block_reach(n));
         points[i0] = head.a0;
         if (n >= 2) points[i0 + 1] = head.a1;
-        frames[b] = wide ? frame_from_axis(anchor_axis(head.a0, head.a1)) : head.frame;
+        const BlockView16 written{&out[base + std::size_t(b) * bb]};
+        if (wide) frames[b] = frame_from_axis(h.packed() ? packed16_anchor_axis(written) : anchor_axis(head.a0, head.a1));
+        else frames[b] = head.frame;
         if (!wide) starts[b] = head;
     }
 
@@ -404,6 +409,34 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
         decoded->reserve(decoded->size() + n_points);
         for (std::size_t k = 0; k < n_points; ++k) decoded->push_back(h.to_world(points[k].x, points[k].y, points[k].z));
     }
+    auto world = [&](Vec3d p) {
+        return Vec3f{float((p.x - 0.5) * double(h.scaling) - double(h.offset[0])),
+                     float((p.y - 0.5) * double(h.scaling) - double(h.offset[1])),
+                     float((p.z - 0.5) * double(h.scaling) - double(h.offset[2]))};
+    };
+    if (decoded_exact && wide) {
+        // The exact decode of every block: no bound on the walks' divergence
+        // is tight enough at 254 points to skip blocks (walk_divergence
+        // gives ~3 um where they differ by ~0.1 um).
+        thread_local std::vector<Vec3d> walked;
+        walked.resize(ppb);
+        decoded_exact->reserve(decoded_exact->size() + n_points);
+        for (b = 0; b < n_blocks; ++b) {
+            const BlockView16 blk{&out[base + std::size_t(b) * bb]};
+            const std::array<std::uint32_t, 3> q0{blk.anchor_word(0), blk.anchor_word(1), blk.anchor_word(2)};
+            const std::array<std::uint32_t, 3> q1{blk.anchor_word(3), blk.anchor_word(4), blk.anchor_word(5)};
+            auto anchor = [](const std::array<std::uint32_t, 3>& q) {
+                return Vec3d{double(q[0]) / kUnorm24Max, double(q[1]) / kUnorm24Max, double(q[2]) / kUnorm24Max};
+            };
+            const std::size_t i0 = std::size_t(b) * ppb, n = block_points(b), m = n > 2 ? n - 2 : 0;
+            decoded_exact->push_back(world(anchor(q0)));
+            if (n < 2) continue;
+            decoded_exact->push_back(world(anchor(q1)));
+            exact_walk(*tables_->exact16, exact_block_frame24(q0, q1), anchor(q1), double(h.step), codes16.data() + i0, m,
+                       walked.data());
+            for (std::size_t k = 0; k < m; ++k) decoded_exact->push_back(world(walked[k]));
+        }
+    }
     if (decoded_exact && !wide) {
         // The exact decode, block by block; a block whose float errors plus
         // the bound on the two decoders' divergence stay below the fiber's
@@ -411,11 +444,6 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
         // points (most blocks), which keeps the cost of this pass small.
         thread_local std::vector<Vec3d> walked;
         walked.resize(ppb);
-        auto world = [&](Vec3d p) {
-            return Vec3f{float((p.x - 0.5) * double(h.scaling) - double(h.offset[0])),
-                         float((p.y - 0.5) * double(h.scaling) - double(h.offset[1])),
-                         float((p.z - 0.5) * double(h.scaling) - double(h.offset[2]))};
-        };
         const double out_slack = 4 * 0x1p-24 * (1 + std::max({std::fabs(h.offset[0]), std::fabs(h.offset[1]), std::fabs(h.offset[2])}) / h.scaling);
         auto block_error = [&](std::uint32_t blk) {
             const std::size_t i0 = std::size_t(blk) * ppb;

@@ -8,13 +8,14 @@
 #include "core/block_geometry.hpp"
 #include "core/vec_math.hpp"
 #include "fiblet/error.hpp"
+#include "format/packed_blocks16.hpp"
 
 namespace fiblet {
 using namespace detail;
 
 std::shared_ptr<const DirectionTable16> make_direction_table16(const FftHeader& header) {
     if (header.direction_bits() != 16) return nullptr;
-    return std::make_shared<const DirectionTable16>(header.ratio);
+    return std::make_shared<const DirectionTable16>(header.ratio, header.code_levels());
 }
 
 std::size_t decode_blocks_scalar16(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count,
@@ -36,7 +37,7 @@ std::size_t decode_blocks_scalar16(const DecodeContext& ctx, const std::uint8_t*
         emit(a0);
         if (n < 2) continue;
         emit(a1);
-        Frame frame = frame_from_axis(anchor_axis(a0, a1));
+        Frame frame = frame_from_axis(h.packed() ? packed16_anchor_axis(block) : anchor_axis(a0, a1));
         Vec3f p = a1;
         for (std::uint32_t k = 2; k < n; ++k) {
             frame = compose(frame, table.frame(block.code(k - 2)));

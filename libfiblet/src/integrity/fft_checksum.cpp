@@ -68,12 +68,21 @@ void FftChecksumBuilder::add_blocks(const void* data, std::size_t bytes) {
     }
 }
 
-TrailerChunk FftChecksumBuilder::finish(std::span<const std::uint8_t> header,
-                                        const std::vector<TrailerChunk>& chunks_before) {
-    if (group_bytes_ > 0) {  // the last, shorter group
+void FftChecksumBuilder::add_block(const void* data, std::size_t bytes) {
+    group_.update(data, bytes);
+    if (++group_block_count_ == sums_.group_blocks) {
         sums_.group_hashes.push_back(group_.digest());
         group_.reset();
-        group_bytes_ = 0;
+        group_block_count_ = 0;
+    }
+}
+
+TrailerChunk FftChecksumBuilder::finish(std::span<const std::uint8_t> header,
+                                        const std::vector<TrailerChunk>& chunks_before) {
+    if (group_bytes_ > 0 || group_block_count_ > 0) {  // the last, shorter group
+        sums_.group_hashes.push_back(group_.digest());
+        group_.reset();
+        group_bytes_ = 0, group_block_count_ = 0;
     }
     sums_.header_hash = xxh64(header.data(), header.size());
     sums_.lut_hash = lut_.digest();

@@ -154,6 +154,7 @@ VerifyReport verify_fft_file(const std::string& path, const std::function<void(d
     }
     r.points = cross.finish();
     if (r.has_checksum) r.groups = file.checksums()->group_count(h.blocks);
+    if (h.packed()) r.bytes_read = h.packed_block_bytes;  // read packed, counted expanded above
     r.bytes_read += h.blocks_offset();
     return r;
 }

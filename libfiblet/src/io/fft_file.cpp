@@ -14,6 +14,7 @@
 
 #include "core/bytes.hpp"
 #include "fiblet/error.hpp"
+#include "format/packed_blocks16.hpp"
 #include "io/fft_trailer.hpp"
 #include "fiblet/tractogram_format.hpp"
 #include "io/fftz_reader.hpp"
@@ -45,12 +46,12 @@ FftHeader parse_fft_header(std::span<const std::uint8_t> b, std::uint64_t file_s
     FftHeader h;
     const std::uint8_t* p = b.data();
     h.version = p[0];
-    if (h.version != kFftVersion && h.version != kFft16Version) {
+    if (h.version != kFftVersion && h.version != kFft16Version && h.version != kFft16PackedVersion) {
         const TractogramFormat other = detect_tractogram_format(name);  // a .trk, .tck... given for a .fft
         if (other != TractogramFormat::unknown && other != TractogramFormat::fft && other != TractogramFormat::fftz)
             throw Error(Errc::unsupported, name + ": " + tractogram_format_description(other) +
                                                ", not a .fft file (compress it into one first)");
-        bad(name, "unsupported version " + std::to_string(h.version) + " (fiblet reads versions 2 and 16)");
+        bad(name, "unsupported version " + std::to_string(h.version) + " (fiblet reads versions 2, 16 and 17)");
     }
     h.fibers = get_le<std::uint64_t>(p + 1);
     h.points = get_le<std::uint64_t>(p + 9);
@@ -79,7 +80,9 @@ FftHeader parse_fft_header(std::span<const std::uint8_t> b, std::uint64_t file_s
     for (unsigned i = 0; i < buffers; ++i) h.buffer_ends.push_back(get_le<std::uint64_t>(p + kFftFixedHeaderBytes + 8 * i));
     if (h.fibers > (file_size - std::min(file_size, fixed)) / 8)
         bad(name, "fiber count " + std::to_string(h.fibers) + " exceeds the file size");
-    if (std::uint64_t{h.blocks} * h.block_bytes() > file_size - std::min(file_size, fixed + 8 * h.fibers))
+    // Packed blocks (version 17) hold at least their anchors; their exact size follows from the LUT.
+    const std::uint64_t least_block_bytes = h.packed() ? kPacked16AnchorBytes : h.block_bytes();
+    if (std::uint64_t{h.blocks} * least_block_bytes > file_size - std::min(file_size, fixed + 8 * h.fibers))
         bad(name, "block count " + std::to_string(h.blocks) + " exceeds the file size (truncated blocks?)");
     if (h.blocks > 0 && buffers == 0) bad(name, "blocks but no buffer table");
     std::uint64_t prev = 0;
@@ -146,6 +149,7 @@ void FftFile::read_lut(std::uint64_t& lut_hash) {
     if (fftz_) fftz_->check_lut_content();
     lut_.resize(header_.fibers);
     fiber_first_block_.resize(header_.fibers);
+    if (header_.packed()) fiber_points_.resize(header_.fibers), fiber_offset_.resize(header_.fibers);
     std::vector<std::uint8_t> raw;
     Xxh64Stream hash;
     std::uint64_t next = 0;  // fibers are stored in order, their blocks contiguous
@@ -163,6 +167,7 @@ void FftFile::read_lut(std::uint64_t& lut_hash) {
                                " past the buffer table");
             const std::uint64_t base =
                 buffer == 0 || buffer > header_.buffer_ends.size() ? 0 : header_.buffer_ends[buffer - 1];
+            if (header_.packed()) read_packed_lut_entry(i, base, next);
             const std::uint64_t first = base + lut_[i].y;
             if (lut_[i].block_count() > 0 && first != next)
                 bad(path_, "fiber " + std::to_string(i) + " LUT entry points to block " + std::to_string(first) +
@@ -176,7 +181,36 @@ void FftFile::read_lut(std::uint64_t& lut_hash) {
     if (next != header_.blocks)
         bad(path_, "the fiber LUT covers " + std::to_string(next) + " blocks, the header says " +
                        std::to_string(header_.blocks));
+    if (header_.packed()) {
+        if (packed_points_ != header_.points)
+            bad(path_, "the fiber LUT counts " + std::to_string(packed_points_) + " points, the header says " +
+                           std::to_string(header_.points));
+        header_.packed_block_bytes = packed_bytes_;
+        if (header_.file_bytes() > logical_size_)
+            bad(path_, "the packed blocks need " + std::to_string(packed_bytes_) +
+                           " bytes, more than the file holds (truncated blocks?)");
+    }
     lut_hash = hash.digest();
+}
+
+// Version 17: the LUT's second word is the fiber's point count. It fixes
+// the block count and where the fiber's packed blocks start; in memory the
+// entry becomes the version-16 one (first block inside its buffer).
+void FftFile::read_packed_lut_entry(std::uint64_t i, std::uint64_t base, std::uint64_t next) {
+    const std::uint32_t points = lut_[i].y, ppb = header_.points_per_block;
+    const std::uint64_t blocks = (std::uint64_t{points} + ppb - 1) / ppb;
+    if (blocks != lut_[i].block_count())
+        bad(path_, "fiber " + std::to_string(i) + " LUT entry: " + std::to_string(points) + " points in " +
+                       std::to_string(lut_[i].block_count()) + " blocks of " + std::to_string(ppb));
+    if (blocks > 0 && next < base)
+        bad(path_, "fiber " + std::to_string(i) + " LUT entry starts before its buffer");
+    fiber_points_[i] = points;
+    fiber_offset_[i] = packed_bytes_;
+    packed_points_ += points;
+    if (blocks > 0)
+        packed_bytes_ += (blocks - 1) * packed16_block_bytes(ppb) +
+                         packed16_block_bytes(points - std::uint32_t(blocks - 1) * ppb);
+    lut_[i].y = std::uint32_t(blocks > 0 ? next - base : 0);
 }
 
 void FftFile::read_at(std::uint8_t* out, std::uint64_t size, std::uint64_t offset) const {
@@ -250,6 +284,10 @@ FftFile& FftFile::operator=(FftFile&& o) noexcept {
         header_ = std::move(o.header_);
         lut_ = std::move(o.lut_);
         fiber_first_block_ = std::move(o.fiber_first_block_);
+        fiber_points_ = std::move(o.fiber_points_);
+        fiber_offset_ = std::move(o.fiber_offset_);
+        packed_points_ = o.packed_points_;
+        packed_bytes_ = o.packed_bytes_;
         trailer_ = std::move(o.trailer_);
         properties_ = std::move(o.properties_);
         resampling_ = o.resampling_;
@@ -268,20 +306,65 @@ void FftFile::read_blocks(std::uint64_t first, std::uint64_t count, std::uint8_t
     if (first > header_.blocks || count > header_.blocks - first)
         throw Error(Errc::invalid_argument, path_ + ": block range past the end");
     if (count == 0) return;
-    const std::uint64_t bb = header_.block_bytes();
-    read_at(out, count * bb, header_.blocks_offset() + first * bb);
+    if (!header_.packed()) {
+        read_at(out, count * header_.block_bytes(), header_.blocks_offset() + first * header_.block_bytes());
+        check_block_structure(first, count, out);
+        if (verifies_checksums()) verify_block_groups(first, count, out);
+        return;
+    }
+    // Version 17: read packed, expand (which checks the codes), check, and
+    // verify the groups over the packed bytes (fft-checksum.md), so the
+    // blocks of a group outside the range are hashed, not expanded.
+    thread_local std::vector<std::uint8_t> stored;
+    const std::uint64_t begin = stored_offset(first);
+    stored.resize(stored_offset(first + count) - begin);
+    read_at(stored.data(), stored.size(), header_.blocks_offset() + begin);
+    expand_packed_blocks(first, count, stored.data(), out);
     check_block_structure(first, count, out);
-    if (verifies_checksums()) verify_block_groups(first, count, out);
+    if (verifies_checksums()) verify_block_groups(first, count, stored.data());
+    if (stored.capacity() > (std::size_t{16} << 20)) std::vector<std::uint8_t>().swap(stored);  // a whole-file read: let it go
+}
+
+std::uint64_t FftFile::fiber_of_block(std::uint64_t block) const {
+    // The last fiber starting at or before it (an empty fiber shares its
+    // successor's first block, so it is skipped).
+    return std::uint64_t(std::upper_bound(fiber_first_block_.begin(), fiber_first_block_.end(),
+                                          std::uint32_t(block)) -
+                         fiber_first_block_.begin()) -
+           1;
+}
+
+std::uint64_t FftFile::stored_offset(std::uint64_t block) const {
+    if (!header_.packed()) return block * header_.block_bytes();
+    if (block == header_.blocks) return packed_bytes_;
+    const std::uint64_t f = fiber_of_block(block);
+    return fiber_offset_[f] + (block - fiber_first_block_[f]) * packed16_block_bytes(header_.points_per_block);
+}
+
+// Packed blocks [first, first + count) at `packed` into the in-memory layout.
+void FftFile::expand_packed_blocks(std::uint64_t first, std::uint64_t count, const std::uint8_t* packed,
+                                   std::uint8_t* out) const {
+    const std::uint64_t bb = header_.block_bytes();
+    const std::uint32_t ppb = header_.points_per_block;
+    std::uint64_t f = fiber_of_block(first), k = first - fiber_first_block_[f];
+    const std::uint8_t* p = packed;
+    for (std::uint64_t b = 0; b < count; ++b, ++k) {
+        while (k >= lut_[f].block_count()) ++f, k = 0;
+        const std::uint32_t blocks_in_fiber = lut_[f].block_count();
+        const detail::PackedBlockPlace place{
+            k + 1 < blocks_in_fiber ? ppb : fiber_points_[f] - std::uint32_t(k) * ppb, std::uint32_t(f), k == 0,
+            k + 1 == blocks_in_fiber};
+        const std::string problem = detail::expand_block16(header_, p, place, out + b * bb);
+        if (!problem.empty())
+            bad(path_, "block " + std::to_string(first + b) + " (block " + std::to_string(k) + " of fiber " +
+                           std::to_string(f) + "): " + problem);
+        p += packed16_block_bytes(place.points);
+    }
 }
 
 void FftFile::check_block_structure(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const {
     const std::uint32_t bb = header_.block_bytes();
-    // The fiber holding block `first`: the last one starting at or before it
-    // (an empty fiber shares its successor's first block, so it is skipped).
-    std::uint64_t f = std::uint64_t(std::upper_bound(fiber_first_block_.begin(), fiber_first_block_.end(),
-                                                     std::uint32_t(first)) -
-                                    fiber_first_block_.begin()) -
-                      1;
+    std::uint64_t f = fiber_of_block(first);  // the fiber holding block `first`
     std::uint64_t k = first - fiber_first_block_[f];
     for (std::uint64_t b = 0; b < count; ++b, ++k) {
         while (k >= lut_[f].block_count()) ++f, k = 0;
@@ -305,14 +388,16 @@ void FftFile::check_block_structure(std::uint64_t first, std::uint64_t count, co
     }
 }
 
+// `blocks`: blocks [first, first + count) as stored (packed for version 17).
 void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const {
     const FftChecksums& c = *checksums_;
-    const std::uint64_t bb = header_.block_bytes(), g_blocks = c.group_blocks, end = first + count;
+    const std::uint64_t g_blocks = c.group_blocks, end = first + count, base = stored_offset(first);
     std::vector<std::uint8_t> edge;  // the part of a group outside [first, end)
     Xxh64Stream hash;
     auto hash_from_file = [&](std::uint64_t b0, std::uint64_t b1) {
-        edge.resize((b1 - b0) * bb);
-        read_at(edge.data(), edge.size(), header_.blocks_offset() + b0 * bb);
+        const std::uint64_t at = stored_offset(b0);
+        edge.resize(stored_offset(b1) - at);
+        read_at(edge.data(), edge.size(), header_.blocks_offset() + at);
         hash.update(edge.data(), edge.size());
     };
     for (std::uint64_t g = first / g_blocks; g <= (end - 1) / g_blocks; ++g) {
@@ -323,7 +408,8 @@ void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, cons
         hash.reset();
         if (g0 < first) hash_from_file(g0, first);
         const std::uint64_t in0 = std::max(g0, first), in1 = std::min(g1, end);
-        hash.update(blocks + (in0 - first) * bb, (in1 - in0) * bb);
+        const std::uint64_t at0 = stored_offset(in0);
+        hash.update(blocks + (at0 - base), stored_offset(in1) - at0);
         if (g1 > end) hash_from_file(end, g1);
         if (hash.digest() != c.group_hashes[g])
             throw Error(Errc::checksum, path_ + ": checksum mismatch in blocks " + std::to_string(g0) + ".." +
@@ -336,7 +422,8 @@ void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, cons
 std::span<const std::uint8_t> FftFile::mapped_blocks(std::uint64_t first, std::uint64_t count) const {
     if (first > header_.blocks || count > header_.blocks - first)
         throw Error(Errc::invalid_argument, path_ + ": block range past the end");
-    if (count == 0 || fd_ < 0 || !mapping_ || fftz_) return {};  // a container has no blocks to map
+    // A container has no blocks to map, nor has a packed file (they are expanded on reading).
+    if (count == 0 || fd_ < 0 || !mapping_ || fftz_ || header_.packed()) return {};
     const std::uint64_t bb = header_.block_bytes();
     Mapping& m = *mapping_;
     std::call_once(m.once, [&] {

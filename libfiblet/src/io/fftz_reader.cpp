@@ -90,6 +90,8 @@ void FftzReader::check_layout(const FftHeader& h) {
     auto bad = [&](const std::string& what) {
         throw Error(Errc::fft_format, name_ + ": not a valid .fftz file: " + what);
     };
+    // Block groups are whole fixed-size blocks: 16-bit containers hold version 16.
+    if (h.packed()) bad("holds a version-17 .fft (packed blocks); 16-bit containers hold version 16");
     block_bytes_ = h.block_bytes();
     direction_bits_ = h.direction_bits();
     groups_ = (std::uint64_t(h.blocks) + descriptor_.group_blocks - 1) / descriptor_.group_blocks;

@@ -8,6 +8,7 @@
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/output_file.hpp"
+#include "format/packed_blocks16.hpp"
 #include "select/block_decoder.hpp"
 
 namespace fiblet {
@@ -31,6 +32,13 @@ void place_block(const FftHeader& h, std::uint8_t* b, std::uint32_t id, std::uin
     b[kBlockFlagsOffset] = std::uint8_t((not_first ? kFlagNotFirst : 0) | (not_last ? kFlagNotLast : 0) |
                                         (b[kBlockFlagsOffset] & kFlagCountMask));
     b[kBlockIndexOffset] = std::uint8_t(k);  // modulo 256, as the format stores it
+}
+
+// Version 17's LUT holds point counts: a run's blocks are full but its last,
+// which is read for its count.
+std::uint32_t run_points(const FftFile& source, const SelectedRun& r) {
+    const auto last = source.read_blocks(r.first_block + r.block_count - 1, 1);
+    return (r.block_count - 1) * source.header().points_per_block + BlockView16{last.data()}.point_count();
 }
 
 // The kept fibers' last-step fractions: a run that stops before its fiber's
@@ -72,7 +80,8 @@ SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedR
             throw Error(Errc::invalid_argument, "run " + std::to_string(i) + " is not a block range of its fiber");
         if (in_buffer + r.block_count > per_buffer) h.buffer_ends.push_back(blocks), in_buffer = 0;
         if (h.buffer_ends.size() > 254) throw Error(Errc::unsupported, path + ": more than 255 GPU buffers of blocks");
-        lut[i] = {std::uint32_t(h.buffer_ends.size()) << 16 | r.block_count, std::uint32_t(in_buffer)};
+        lut[i] = {std::uint32_t(h.buffer_ends.size()) << 16 | r.block_count,
+                  h.packed() ? run_points(source, r) : std::uint32_t(in_buffer)};
         blocks += r.block_count, in_buffer += r.block_count;
     }
     if (blocks > std::numeric_limits<std::uint32_t>::max())
@@ -91,7 +100,8 @@ SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedR
     const DecodeContext ctx(source);
     const std::uint32_t bb = h.block_bytes();
     IndexBuilder index(h);
-    std::vector<std::uint8_t> raw;
+    std::vector<std::uint8_t> raw, packed;
+    std::vector<std::uint32_t> packed_sizes;
     std::vector<float> xyz;
     for (std::size_t i = 0; i < runs.size(); ++i) {
         const SelectedRun& r = runs[i];
@@ -109,8 +119,17 @@ SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedR
             p += 3 * n;
             h.points += n;
         }
-        out.write(raw.data(), raw.size());
-        checksum.add_blocks(raw.data(), raw.size());
+        if (h.packed()) {  // checksums cover the bytes as stored
+            packed.clear();
+            packed_sizes.clear();
+            detail::pack_blocks16(h, raw, packed, &packed_sizes);
+            out.write(packed.data(), packed.size());
+            const std::uint8_t* b = packed.data();
+            for (const std::uint32_t n : packed_sizes) checksum.add_block(b, n), b += n;
+        } else {
+            out.write(raw.data(), raw.size());
+            checksum.add_blocks(raw.data(), raw.size());
+        }
     }
     const auto head = serialize_fft_header(h);
     {
