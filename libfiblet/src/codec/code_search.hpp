@@ -307,7 +307,7 @@ private:
         float rival_error2[8];
         unsigned rival_code[8];
         unsigned n = 0;
-        constexpr int L = Codebook::kLevels;
+        const int L = cb_.levels();
         const int h0 = int(aimed) / L, l0 = int(aimed) % L;
         for (int h = std::max(h0 - 1, 0); h <= std::min(h0 + 1, L - 1); ++h)
             for (int l = std::max(l0 - 1, 0); l <= std::min(l0 + 1, L - 1); ++l) {

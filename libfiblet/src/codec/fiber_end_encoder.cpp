@@ -74,7 +74,7 @@ std::uint16_t encode_keeping_end(const FiberEncoder& encoder, std::span<const Ve
     }
     encoder.encode(coded, fiber_id, blocks, &decoded, decoded_exact);
     Vec3f& last = decoded[first + n - 1];
-    const Vec3f prev = decoded[first + n - 2], end = points[n - 1];
+    const Vec3f prev = decoded[first + n - 2];
     const double f = length_keeping_fraction(std::span<const Vec3f>(decoded).subspan(first, n), points, target_length_mm);
     const std::uint16_t q = quantize_end_fraction(f);
     const Vec3f placed = place_end_point(prev, last, q);
