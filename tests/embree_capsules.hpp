@@ -66,6 +66,7 @@ public:
                     fiber_.push_back(unsigned(f));
                     segment_.push_back(unsigned(b * ppb + (i - d.block_first[b])));
                     start_of_segment_[segment_.back()] = unsigned(i);
+                    fiber_of_segment_[segment_.back()] = unsigned(f);
                 }
         }
         device_ = rtcNewDevice(nullptr);
@@ -87,6 +88,9 @@ public:
         if (a == start_of_segment_.end() || b == start_of_segment_.end()) return false;
         return a->second + 1 == b->second || b->second + 1 == a->second;
     }
+
+    // The fiber (file order) of a segment.
+    unsigned fiber(unsigned segment) const { return fiber_of_segment_.at(segment); }
 
     // The end points of a segment (CPU-decoded).
     std::array<Vec3f, 2> ends(unsigned segment) const {
@@ -253,6 +257,7 @@ private:
     RTCScene tube_ = nullptr, capsules_ = nullptr;
     std::vector<unsigned> start_, fiber_, segment_;  // per Embree primitive
     std::unordered_map<unsigned, unsigned> start_of_segment_;  // its first point, CPU-decoded numbering
+    std::unordered_map<unsigned, unsigned> fiber_of_segment_;
 };
 
 }  // namespace fiblet::test

@@ -238,6 +238,48 @@ void expect_opaque_agreement(const viewer::GpuScene& scene, const EmbreeCapsules
     EXPECT_GE(strict, 0.995);
 }
 
+// Whether the oracle's entries along a pixel's ray (the fibers entered, in
+// order) change when the ray's direction turns by kRayTurn towards either
+// side of two axes across it: the ray passes within ~kRayTurn · t of a
+// tube's silhouette (or of where two stretches of one tube meet), closer
+// than the renderer's ray can be placed. The shader's direction is float
+// arithmetic on float camera vectors (normalize(forward + ndc.x · ...)):
+// emulated on the CPU for the 160² rays of the transparency tests, it lies
+// up to 1.7e-7 rad from the test's double one (≈ 2e-5 mm at the scene's
+// ~110 mm), so which of the two rays enters a tube it grazes closer than
+// that is a tie neither side decides (CST_R, 160², r 0.6 mm: one ray dips
+// 2.9e-6 mm into a cylinder it grazes, the shader's passes 4.0e-6 mm
+// outside; 11/255 at α 0.25). kRayTurn is ~6× the measured offset, the
+// same 1e-6 of the distance that the oracle takes as float noise
+// (inside_fiber); the pixels it leaves out are counted and printed.
+constexpr double kRayTurn = 1e-6;
+bool entries_change_when_the_ray_turns(const EmbreeCapsules& oracle, const Vec3f& org, const std::array<double, 3>& dir,
+                                       const std::vector<EmbreeCapsules::Hit>& hits) {
+    auto fibers = [&](const std::vector<EmbreeCapsules::Hit>& entries) {
+        std::vector<unsigned> out;
+        for (const auto& e : entries) out.push_back(oracle.fiber(e.segment));
+        return out;
+    };
+    const std::vector<unsigned> here = fibers(hits);
+    // Two unit vectors across the ray.
+    const std::array<double, 3> helper = std::fabs(dir[0]) < 0.9 ? std::array<double, 3>{1, 0, 0} : std::array<double, 3>{0, 1, 0};
+    auto cross = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
+        return std::array<double, 3>{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+    };
+    auto unit = [](std::array<double, 3> v) {
+        const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        return std::array<double, 3>{v[0] / n, v[1] / n, v[2] / n};
+    };
+    const auto e1 = unit(cross(dir, helper)), e2 = cross(dir, e1);
+    for (const auto& e : {e1, e2})
+        for (double side : {-1.0, 1.0}) {
+            const auto turned = unit({dir[0] + side * kRayTurn * e[0], dir[1] + side * kRayTurn * e[1],
+                                      dir[2] + side * kRayTurn * e[2]});
+            if (fibers(oracle.all(org, turned)) != here) return true;
+        }
+    return false;
+}
+
 }  // namespace
 #endif
 
@@ -314,8 +356,8 @@ TEST(VoxelRtTrace, TransparencyMatchesEmbreeCompositingEveryHit) {
     o.lighting = false;  // colour = |direction|: the oracle composites the same colours
     o.voxel_grid = n;
     const TracedImage img = trace_image(scene, cam, w, h, o);
-    int worst = 0;
-    std::size_t within = 0, crowded = 0, crowded_within = 0, max_in_voxel = 0;
+    int worst = 0, grazing_worst = 0;
+    std::size_t within = 0, crowded = 0, crowded_within = 0, max_in_voxel = 0, grazing = 0;
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             const auto dir = camera_pixel_ray(cam, x, y, w, h);
@@ -336,18 +378,25 @@ TEST(VoxelRtTrace, TransparencyMatchesEmbreeCompositingEveryHit) {
             int diff = 0;
             for (int k = 0; k < 3; ++k)
                 diff = std::max(diff, std::abs(int(img.rgba[4 * i + std::size_t(k)]) - int(std::lround(rgb[k] * 255))));
+            if (entries_change_when_the_ray_turns(oracle, cam.position, dir, hits)) {
+                ++grazing, grazing_worst = std::max(grazing_worst, diff);
+                continue;
+            }
             worst = std::max(worst, diff);
             within += diff <= 2;
             crowded += over_k;
             crowded_within += over_k && diff <= 2;
         }
-    const double rate = double(within) / double(w * h);
+    const double rate = double(within) / double(w * h - int(grazing));
     std::printf("transparency (alpha %.2f) vs Embree, every hit composited: %.5f of %d pixels within 2/255 (worst "
-                "%d/255); %zu pixels cross a voxel with more than k = 8 hits (at most %zu), %zu of them within 2/255\n",
-                alpha, rate, w * h, worst, crowded, max_in_voxel, crowded_within);
+                "%d/255); %zu pixels cross a voxel with more than k = 8 hits (at most %zu), %zu of them within 2/255; "
+                "%zu pixels left out, their rays within %g · t of a silhouette (worst %d/255)\n",
+                alpha, rate, w * h - int(grazing), worst, crowded, max_in_voxel, crowded_within, grazing, kRayTurn,
+                grazing_worst);
     EXPECT_GT(crowded, 100u);
     EXPECT_EQ(crowded_within, crowded);
     EXPECT_LE(worst, 2);
+    EXPECT_LE(grazing, std::size_t(w * h) / 1000);  // grazing rays stay rare: kRayTurn not too large
 #endif
 }
 
@@ -390,8 +439,9 @@ TEST(VoxelRtTrace, PerFiberOpacityMatchesEmbreeCompositingEveryHit) {
     o.lighting = false;
     o.voxel_grid = n;
     const TracedImage img = trace_image(scene, cam, w, h, o);
-    int worst = 0;
-    std::size_t within = 0, crowded = 0, crowded_within = 0, invisible_only = 0, invisible_lit = 0, names_invisible = 0;
+    int worst = 0, grazing_worst = 0;
+    std::size_t within = 0, crowded = 0, crowded_within = 0, invisible_only = 0, invisible_lit = 0, names_invisible = 0,
+                grazing = 0;
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             const auto dir = camera_pixel_ray(cam, x, y, w, h);
@@ -415,26 +465,31 @@ TEST(VoxelRtTrace, PerFiberOpacityMatchesEmbreeCompositingEveryHit) {
             int diff = 0;
             for (int k = 0; k < 3; ++k)
                 diff = std::max(diff, std::abs(int(img.rgba[4 * i + std::size_t(k)]) - int(std::lround(rgb[k] * 255))));
-            worst = std::max(worst, diff);
-            within += diff <= 2;
-            crowded += over_k;
-            crowded_within += over_k && diff <= 2;
+            if (entries_change_when_the_ray_turns(oracle, cam.position, dir, hits)) {
+                ++grazing, grazing_worst = std::max(grazing_worst, diff);
+            } else {
+                worst = std::max(worst, diff);
+                within += diff <= 2;
+                crowded += over_k;
+                crowded_within += over_k && diff <= 2;
+            }
             if (!hits.empty() && !any_visible) {
                 ++invisible_only;
                 invisible_lit += std::max({img.rgba[4 * i], img.rgba[4 * i + 1], img.rgba[4 * i + 2]}) > 2;
             }
             names_invisible += img.segments[i] != 0 && alpha[fiber_of_block[(img.segments[i] - 1) / ppb]] == 0;
         }
-    const double rate = double(within) / double(w * h);
+    const double rate = double(within) / double(w * h - int(grazing));
     std::printf("per-fiber opacity (%.2f x U(0,1), every 4th fiber 0) vs Embree, every hit composited: %.5f of %d "
                 "pixels within 2/255 (worst %d/255); %zu pixels cross a voxel with more than k = 8 hits, %zu of them "
-                "within 2/255; %zu pixels only on fibers of opacity 0, %zu of them lit over 2/255; %zu pixels name a "
-                "segment of opacity 0\n",
-                double(global), rate, w * h, worst, crowded, crowded_within, invisible_only, invisible_lit,
-                names_invisible);
+                "within 2/255; %zu pixels left out, their rays within %g · t of a silhouette (worst %d/255); %zu pixels "
+                "only on fibers of opacity 0, %zu of them lit over 2/255; %zu pixels name a segment of opacity 0\n",
+                double(global), rate, w * h - int(grazing), worst, crowded, crowded_within, grazing, kRayTurn,
+                grazing_worst, invisible_only, invisible_lit, names_invisible);
     EXPECT_GT(crowded, 100u);
     EXPECT_EQ(crowded_within, crowded);
     EXPECT_LE(worst, 2);
+    EXPECT_LE(grazing, std::size_t(w * h) / 1000);  // grazing rays stay rare: kRayTurn not too large
     EXPECT_GT(invisible_only, 20u);
     EXPECT_EQ(invisible_lit, 0u);
     EXPECT_EQ(names_invisible, 0u);
