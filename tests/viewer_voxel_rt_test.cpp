@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <map>
 #include <numeric>
 #include <random>
@@ -280,6 +281,62 @@ bool entries_change_when_the_ray_turns(const EmbreeCapsules& oracle, const Vec3f
     return false;
 }
 
+// The oracle's every entry along each pixel's ray composited front to back
+// (colour |direction|, each entry with alpha_of(segment)) against the traced
+// image: per pixel the largest channel difference /255, pixels crossing a
+// voxel with more than k = 8 entries, and grazing rays
+// (entries_change_when_the_ray_turns) counted apart.
+struct CompositingAgreement {
+    int worst = 0, grazing_worst = 0;
+    std::size_t pixels = 0, within = 0, crowded = 0, crowded_within = 0, max_in_voxel = 0, grazing = 0;
+    std::size_t invisible_only = 0, invisible_lit = 0;  // rays entering only alpha-0 fibers; of those, lit over 2/255
+    double rate() const { return double(within) / double(pixels - grazing); }
+};
+
+CompositingAgreement compare_with_oracle_compositing(const TracedImage& img, const Camera& cam, int w, int h,
+                                                     const vrt::VoxelGrid& grid, const EmbreeCapsules& oracle,
+                                                     const std::function<double(unsigned)>& alpha_of) {
+    CompositingAgreement r;
+    r.pixels = std::size_t(w) * std::size_t(h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const auto dir = camera_pixel_ray(cam, x, y, w, h);
+            const auto hits = oracle.all(cam.position, dir);
+            double rgb[3] = {0, 0, 0}, transmittance = 1;
+            std::map<std::array<int, 3>, std::size_t> per_voxel;
+            bool any_visible = false;
+            for (const auto& hit : hits) {
+                const double a = alpha_of(hit.segment);
+                any_visible |= a > 0;
+                const auto c = oracle.direction(hit.segment);
+                for (int k = 0; k < 3; ++k) rgb[k] += transmittance * a * std::fabs(c[k]);
+                transmittance *= 1 - a;
+                const auto g = grid.to_grid({cam.position.x + float(hit.t * dir[0]), cam.position.y + float(hit.t * dir[1]),
+                                             cam.position.z + float(hit.t * dir[2])});
+                r.max_in_voxel = std::max(r.max_in_voxel, ++per_voxel[{int(g[0]), int(g[1]), int(g[2])}]);
+            }
+            bool over_k = false;
+            for (const auto& [v, count] : per_voxel) over_k |= count > 8;
+            const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+            int diff = 0;
+            for (int k = 0; k < 3; ++k)
+                diff = std::max(diff, std::abs(int(img.rgba[4 * i + std::size_t(k)]) - int(std::lround(rgb[k] * 255))));
+            if (entries_change_when_the_ray_turns(oracle, cam.position, dir, hits)) {
+                ++r.grazing, r.grazing_worst = std::max(r.grazing_worst, diff);
+            } else {
+                r.worst = std::max(r.worst, diff);
+                r.within += diff <= 2;
+                r.crowded += over_k;
+                r.crowded_within += over_k && diff <= 2;
+            }
+            if (!hits.empty() && !any_visible) {
+                ++r.invisible_only;
+                r.invisible_lit += std::max({img.rgba[4 * i], img.rgba[4 * i + 1], img.rgba[4 * i + 2]}) > 2;
+            }
+        }
+    return r;
+}
+
 }  // namespace
 #endif
 
@@ -356,47 +413,17 @@ TEST(VoxelRtTrace, TransparencyMatchesEmbreeCompositingEveryHit) {
     o.lighting = false;  // colour = |direction|: the oracle composites the same colours
     o.voxel_grid = n;
     const TracedImage img = trace_image(scene, cam, w, h, o);
-    int worst = 0, grazing_worst = 0;
-    std::size_t within = 0, crowded = 0, crowded_within = 0, max_in_voxel = 0, grazing = 0;
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            const auto dir = camera_pixel_ray(cam, x, y, w, h);
-            const auto hits = oracle.all(cam.position, dir);
-            double rgb[3] = {0, 0, 0}, transmittance = 1;
-            std::map<std::array<int, 3>, std::size_t> per_voxel;
-            for (const auto& hit : hits) {
-                const auto c = oracle.direction(hit.segment);
-                for (int k = 0; k < 3; ++k) rgb[k] += transmittance * alpha * std::fabs(c[k]);
-                transmittance *= 1 - alpha;
-                const auto g = grid.to_grid({cam.position.x + float(hit.t * dir[0]), cam.position.y + float(hit.t * dir[1]),
-                                             cam.position.z + float(hit.t * dir[2])});
-                max_in_voxel = std::max(max_in_voxel, ++per_voxel[{int(g[0]), int(g[1]), int(g[2])}]);
-            }
-            bool over_k = false;
-            for (const auto& [v, n] : per_voxel) over_k |= n > 8;
-            const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
-            int diff = 0;
-            for (int k = 0; k < 3; ++k)
-                diff = std::max(diff, std::abs(int(img.rgba[4 * i + std::size_t(k)]) - int(std::lround(rgb[k] * 255))));
-            if (entries_change_when_the_ray_turns(oracle, cam.position, dir, hits)) {
-                ++grazing, grazing_worst = std::max(grazing_worst, diff);
-                continue;
-            }
-            worst = std::max(worst, diff);
-            within += diff <= 2;
-            crowded += over_k;
-            crowded_within += over_k && diff <= 2;
-        }
-    const double rate = double(within) / double(w * h - int(grazing));
-    std::printf("transparency (alpha %.2f) vs Embree, every hit composited: %.5f of %d pixels within 2/255 (worst "
+    const CompositingAgreement r =
+        compare_with_oracle_compositing(img, cam, w, h, grid, oracle, [&](unsigned) { return double(alpha); });
+    std::printf("transparency (alpha %.2f) vs Embree, every hit composited: %.5f of %zu pixels within 2/255 (worst "
                 "%d/255); %zu pixels cross a voxel with more than k = 8 hits (at most %zu), %zu of them within 2/255; "
                 "%zu pixels left out, their rays within %g · t of a silhouette (worst %d/255)\n",
-                alpha, rate, w * h - int(grazing), worst, crowded, max_in_voxel, crowded_within, grazing, kRayTurn,
-                grazing_worst);
-    EXPECT_GT(crowded, 100u);
-    EXPECT_EQ(crowded_within, crowded);
-    EXPECT_LE(worst, 2);
-    EXPECT_LE(grazing, std::size_t(w * h) / 1000);  // grazing rays stay rare: kRayTurn not too large
+                alpha, r.rate(), r.pixels - r.grazing, r.worst, r.crowded, r.max_in_voxel, r.crowded_within, r.grazing,
+                kRayTurn, r.grazing_worst);
+    EXPECT_GT(r.crowded, 100u);
+    EXPECT_EQ(r.crowded_within, r.crowded);
+    EXPECT_LE(r.worst, 2);
+    EXPECT_LE(r.grazing, r.pixels / 1000);  // grazing rays stay rare: kRayTurn not too large
 #endif
 }
 
@@ -439,59 +466,22 @@ TEST(VoxelRtTrace, PerFiberOpacityMatchesEmbreeCompositingEveryHit) {
     o.lighting = false;
     o.voxel_grid = n;
     const TracedImage img = trace_image(scene, cam, w, h, o);
-    int worst = 0, grazing_worst = 0;
-    std::size_t within = 0, crowded = 0, crowded_within = 0, invisible_only = 0, invisible_lit = 0, names_invisible = 0,
-                grazing = 0;
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            const auto dir = camera_pixel_ray(cam, x, y, w, h);
-            const auto hits = oracle.all(cam.position, dir);
-            double rgb[3] = {0, 0, 0}, transmittance = 1;
-            std::map<std::array<int, 3>, std::size_t> per_voxel;
-            bool any_visible = false;
-            for (const auto& hit : hits) {
-                const double a = double(global * alpha[fiber_of_block[hit.segment / ppb]]);
-                any_visible |= a > 0;
-                const auto c = oracle.direction(hit.segment);
-                for (int k = 0; k < 3; ++k) rgb[k] += transmittance * a * std::fabs(c[k]);
-                transmittance *= 1 - a;
-                const auto g = grid.to_grid({cam.position.x + float(hit.t * dir[0]), cam.position.y + float(hit.t * dir[1]),
-                                             cam.position.z + float(hit.t * dir[2])});
-                ++per_voxel[{int(g[0]), int(g[1]), int(g[2])}];
-            }
-            bool over_k = false;
-            for (const auto& [v, count] : per_voxel) over_k |= count > 8;
-            const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
-            int diff = 0;
-            for (int k = 0; k < 3; ++k)
-                diff = std::max(diff, std::abs(int(img.rgba[4 * i + std::size_t(k)]) - int(std::lround(rgb[k] * 255))));
-            if (entries_change_when_the_ray_turns(oracle, cam.position, dir, hits)) {
-                ++grazing, grazing_worst = std::max(grazing_worst, diff);
-            } else {
-                worst = std::max(worst, diff);
-                within += diff <= 2;
-                crowded += over_k;
-                crowded_within += over_k && diff <= 2;
-            }
-            if (!hits.empty() && !any_visible) {
-                ++invisible_only;
-                invisible_lit += std::max({img.rgba[4 * i], img.rgba[4 * i + 1], img.rgba[4 * i + 2]}) > 2;
-            }
-            names_invisible += img.segments[i] != 0 && alpha[fiber_of_block[(img.segments[i] - 1) / ppb]] == 0;
-        }
-    const double rate = double(within) / double(w * h - int(grazing));
-    std::printf("per-fiber opacity (%.2f x U(0,1), every 4th fiber 0) vs Embree, every hit composited: %.5f of %d "
+    const CompositingAgreement r = compare_with_oracle_compositing(
+        img, cam, w, h, grid, oracle, [&](unsigned segment) { return double(global * alpha[fiber_of_block[segment / ppb]]); });
+    std::size_t names_invisible = 0;
+    for (const std::uint32_t s : img.segments) names_invisible += s != 0 && alpha[fiber_of_block[(s - 1) / ppb]] == 0;
+    std::printf("per-fiber opacity (%.2f x U(0,1), every 4th fiber 0) vs Embree, every hit composited: %.5f of %zu "
                 "pixels within 2/255 (worst %d/255); %zu pixels cross a voxel with more than k = 8 hits, %zu of them "
                 "within 2/255; %zu pixels left out, their rays within %g · t of a silhouette (worst %d/255); %zu pixels "
                 "only on fibers of opacity 0, %zu of them lit over 2/255; %zu pixels name a segment of opacity 0\n",
-                double(global), rate, w * h - int(grazing), worst, crowded, crowded_within, grazing, kRayTurn,
-                grazing_worst, invisible_only, invisible_lit, names_invisible);
-    EXPECT_GT(crowded, 100u);
-    EXPECT_EQ(crowded_within, crowded);
-    EXPECT_LE(worst, 2);
-    EXPECT_LE(grazing, std::size_t(w * h) / 1000);  // grazing rays stay rare: kRayTurn not too large
-    EXPECT_GT(invisible_only, 20u);
-    EXPECT_EQ(invisible_lit, 0u);
+                double(global), r.rate(), r.pixels - r.grazing, r.worst, r.crowded, r.crowded_within, r.grazing, kRayTurn,
+                r.grazing_worst, r.invisible_only, r.invisible_lit, names_invisible);
+    EXPECT_GT(r.crowded, 100u);
+    EXPECT_EQ(r.crowded_within, r.crowded);
+    EXPECT_LE(r.worst, 2);
+    EXPECT_LE(r.grazing, r.pixels / 1000);  // grazing rays stay rare: kRayTurn not too large
+    EXPECT_GT(r.invisible_only, 20u);
+    EXPECT_EQ(r.invisible_lit, 0u);
     EXPECT_EQ(names_invisible, 0u);
 #endif
 }
