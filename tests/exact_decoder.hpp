@@ -126,6 +126,17 @@ struct Decoded {
     std::vector<std::vector<V3>> fibers;  // millimetres
 };
 
+// §2: normalized points back to millimetres (scaling, offset of the header).
+inline std::vector<V3> to_millimetres(const std::vector<V3>& normalized, const Header& h) {
+    std::vector<V3> out;
+    out.reserve(normalized.size());
+    for (const V3& p : normalized)
+        out.push_back({(p.x - 0.5) * double(h.scaling) - double(h.offset[0]),
+                       (p.y - 0.5) * double(h.scaling) - double(h.offset[1]),
+                       (p.z - 0.5) * double(h.scaling) - double(h.offset[2])});
+    return out;
+}
+
 // fft16.md, version 17: one packed block of `count` points at `blk` (18
 // anchor bytes, unorm24 least significant byte first, then 15-bit codes,
 // least significant bit first); returns its size in bytes.
@@ -177,11 +188,7 @@ inline Decoded decode(const std::string& bytes) {
                 at += decode_packed_block(reinterpret_cast<const unsigned char*>(bytes.data()) + at, n, table,
                                           double(h.step), normalized);
             }
-            auto& fiber = d.fibers.emplace_back();
-            for (const V3& p : normalized)
-                fiber.push_back({(p.x - 0.5) * double(h.scaling) - double(h.offset[0]),
-                                 (p.y - 0.5) * double(h.scaling) - double(h.offset[1]),
-                                 (p.z - 0.5) * double(h.scaling) - double(h.offset[2])});
+            d.fibers.push_back(to_millimetres(normalized, h));
         }
         return d;
     }
@@ -199,11 +206,7 @@ inline Decoded decode(const std::string& bytes) {
             if (at + h.block_bytes() > bytes.size()) throw std::runtime_error("exact decoder: block past the end");
             decode_block(reinterpret_cast<const unsigned char*>(bytes.data()) + at, table, double(h.step), normalized);
         }
-        auto& fiber = d.fibers.emplace_back();
-        for (const V3& p : normalized)
-            fiber.push_back({(p.x - 0.5) * double(h.scaling) - double(h.offset[0]),
-                             (p.y - 0.5) * double(h.scaling) - double(h.offset[1]),
-                             (p.z - 0.5) * double(h.scaling) - double(h.offset[2])});
+        d.fibers.push_back(to_millimetres(normalized, h));
     }
     return d;
 }
