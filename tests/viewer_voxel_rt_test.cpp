@@ -449,11 +449,6 @@ TEST(VoxelRtTrace, PerFiberOpacityMatchesEmbreeCompositingEveryHit) {
     std::vector<float> alpha(scene.fiber_count());
     for (std::size_t f = 0; f < alpha.size(); ++f) alpha[f] = f % 4 == 0 ? 0.0f : uniform(rng);
     scene.set_fiber_opacities(alpha);
-    std::vector<std::uint64_t> fiber_of_block(file.header().blocks);
-    for (std::uint64_t f = 0; f < file.header().fibers; ++f)
-        for (std::uint64_t b = file.first_block(f); b < file.first_block(f) + file.block_count(f); ++b)
-            fiber_of_block[b] = f;
-    const std::uint32_t ppb = file.header().points_per_block;
     const EmbreeCapsules oracle(file, radius);
     // The coarse grid of the global-opacity test: voxels with more than k hits.
     const int n = 12;
@@ -467,9 +462,9 @@ TEST(VoxelRtTrace, PerFiberOpacityMatchesEmbreeCompositingEveryHit) {
     o.voxel_grid = n;
     const TracedImage img = trace_image(scene, cam, w, h, o);
     const CompositingAgreement r = compare_with_oracle_compositing(
-        img, cam, w, h, grid, oracle, [&](unsigned segment) { return double(global * alpha[fiber_of_block[segment / ppb]]); });
+        img, cam, w, h, grid, oracle, [&](unsigned segment) { return double(global * alpha[oracle.fiber(segment)]); });
     std::size_t names_invisible = 0;
-    for (const std::uint32_t s : img.segments) names_invisible += s != 0 && alpha[fiber_of_block[(s - 1) / ppb]] == 0;
+    for (const std::uint32_t s : img.segments) names_invisible += s != 0 && alpha[oracle.fiber(s - 1)] == 0;
     std::printf("per-fiber opacity (%.2f x U(0,1), every 4th fiber 0) vs Embree, every hit composited: %.5f of %zu "
                 "pixels within 2/255 (worst %d/255); %zu pixels cross a voxel with more than k = 8 hits, %zu of them "
                 "within 2/255; %zu pixels left out, their rays within %g · t of a silhouette (worst %d/255); %zu pixels "
