@@ -30,11 +30,6 @@ namespace fiblet::detail {
 inline constexpr std::uint32_t kLengthFeedbackPoints = 12;
 inline constexpr float kLengthFeedbackShares[] = {1.0f, 0.5f, 0.25f};
 
-inline float segment_length(Vec3f a, Vec3f b) {
-    const Vec3f d = b - a;
-    return std::sqrt(dot(d, d));
-}
-
 // `targets` and `points` (decoded) of one fiber, normalized coordinates;
 // blocks of `ppb` points. Callbacks:
 //   adjustable(b)          whether block b's codes may be searched again
@@ -47,7 +42,7 @@ void feed_back_length(std::span<const Vec3f> targets, std::span<Vec3f> points, s
     const std::size_t n_points = points.size();
     if (n_points <= ppb) return;  // one block: the end fraction does it all
     thread_local std::vector<Vec3f> moved, candidate;
-    auto error_of = [&](std::size_t k) { return segment_length(points[k - 1], points[k]) - stretch * segment_length(targets[k - 1], targets[k]); };
+    auto error_of = [&](std::size_t k) { return norm(points[k] - points[k - 1]) - stretch * norm(targets[k] - targets[k - 1]); };
     auto max_error2 = [&](const Vec3f* decoded, std::size_t first, std::size_t m) {
         float worst = 0;
         for (std::size_t k = 0; k < m; ++k) {
@@ -88,8 +83,8 @@ void feed_back_length(std::span<const Vec3f> targets, std::span<Vec3f> points, s
             candidate.resize(m);
             search(b, std::span<const Vec3f>(moved), candidate.data());
             if (max_error2(candidate.data(), first, m) > allowed2) continue;
-            const double now = std::fabs(error + segment_length(candidate[m - 1], points[last + 1]) -
-                                         stretch * segment_length(targets[last], targets[last + 1]));
+            const double now = std::fabs(error + norm(points[last + 1] - candidate[m - 1]) -
+                                         stretch * norm(targets[last + 1] - targets[last]));
             if (!(now < best)) continue;
             best = now;
             std::copy(candidate.begin(), candidate.end(), points.begin() + std::ptrdiff_t(first));
