@@ -392,27 +392,45 @@ TEST(VoxelRtTrace, PerFiberRadiiAgreeWithEmbree) {
 #endif
 }
 
+#if FIBLET_HAS_EMBREE
+namespace {
+// The scene of the transparency tests: CST_R-step0.1 as 0.6 mm capsules on
+// a coarse 12³ grid, so that voxels hold more than k = 8 entries of a ray,
+// seen obliquely, unlit (colour = |direction|: the oracle composites the
+// same colours), with the oracle of the same capsules.
+struct CoarseGridCapsules {
+    static constexpr int kGrid = 12;
+    static constexpr float kRadius = 0.6f;
+    TempDir dir;
+    FftFile file{compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft")};
+    viewer::GpuScene scene{file, *viewer_gl().programs};
+    EmbreeCapsules oracle{file, kRadius};
+    vrt::VoxelGrid grid = vrt::grid_around(scene.bounds(), kGrid, kRadius);
+    Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 2.0f);
+    viewer::RenderOptions options(float opacity) const {
+        viewer::RenderOptions o;
+        o.tube_radius_mm = kRadius;
+        o.opacity = opacity;
+        o.lighting = false;
+        o.voxel_grid = kGrid;
+        return o;
+    }
+};
+}  // namespace
+#endif
+
 TEST(VoxelRtTrace, TransparencyMatchesEmbreeCompositingEveryHit) {
 #if !FIBLET_HAS_EMBREE
     GTEST_SKIP() << "built without Embree (libembree-dev, scripts/setup.sh)";
 #else
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CoarseGridCapsules c;
     const int w = 160, h = 160;
-    const float radius = 0.6f, alpha = 0.25f;
-    const EmbreeCapsules oracle(file, radius);
-    // A coarse grid, so that voxels hold more than k = 8 entries of a ray.
-    const int n = 12;
-    const vrt::VoxelGrid grid = vrt::grid_around(scene.bounds(), n, radius);
-    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 2.0f);
-    viewer::RenderOptions o;
-    o.tube_radius_mm = radius;
-    o.opacity = alpha;
-    o.lighting = false;  // colour = |direction|: the oracle composites the same colours
-    o.voxel_grid = n;
-    const TracedImage img = trace_image(scene, cam, w, h, o);
+    const float alpha = 0.25f;
+    const EmbreeCapsules& oracle = c.oracle;
+    const vrt::VoxelGrid& grid = c.grid;
+    const Camera& cam = c.cam;
+    const TracedImage img = trace_image(c.scene, cam, w, h, c.options(alpha));
     const CompositingAgreement r =
         compare_with_oracle_compositing(img, cam, w, h, grid, oracle, [&](unsigned) { return double(alpha); });
     std::printf("transparency (alpha %.2f) vs Embree, every hit composited: %.5f of %zu pixels within 2/255 (worst "
@@ -438,29 +456,21 @@ TEST(VoxelRtTrace, PerFiberOpacityMatchesEmbreeCompositingEveryHit) {
     GTEST_SKIP() << "built without Embree (libembree-dev, scripts/setup.sh)";
 #else
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft"));
-    viewer::GpuScene scene(file, *viewer_gl().programs);
+    CoarseGridCapsules c;
     const int w = 160, h = 160;
-    const float radius = 0.6f, global = 0.5f;
+    const float global = 0.5f;
     // U(0, 1), every fourth fiber 0.
     std::mt19937 rng(1818);
     std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
-    std::vector<float> alpha(scene.fiber_count());
+    std::vector<float> alpha(c.scene.fiber_count());
     for (std::size_t f = 0; f < alpha.size(); ++f) alpha[f] = f % 4 == 0 ? 0.0f : uniform(rng);
-    scene.set_fiber_opacities(alpha);
-    const EmbreeCapsules oracle(file, radius);
-    // The coarse grid of the global-opacity test: voxels with more than k hits.
-    const int n = 12;
-    const vrt::VoxelGrid grid = vrt::grid_around(scene.bounds(), n, radius);
-    const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 2.0f);
-    viewer::RenderOptions o;
-    o.tube_radius_mm = radius;
-    o.opacity = global;
+    c.scene.set_fiber_opacities(alpha);
+    const EmbreeCapsules& oracle = c.oracle;
+    const vrt::VoxelGrid& grid = c.grid;
+    const Camera& cam = c.cam;
+    viewer::RenderOptions o = c.options(global);
     o.fiber_opacity = true;
-    o.lighting = false;
-    o.voxel_grid = n;
-    const TracedImage img = trace_image(scene, cam, w, h, o);
+    const TracedImage img = trace_image(c.scene, cam, w, h, o);
     const CompositingAgreement r = compare_with_oracle_compositing(
         img, cam, w, h, grid, oracle, [&](unsigned segment) { return double(global * alpha[oracle.fiber(segment)]); });
     std::size_t names_invisible = 0;
