@@ -42,9 +42,9 @@ TEST(ViewerCapsules, AgreeWithEmbreeOnARealBundle) {
     GTEST_SKIP() << "built without Embree (libembree-dev, scripts/setup.sh)";
 #else
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(shared_data("bundles/CST_R-step0.1.tck"));
+    const FftFile& file = compressed.file;
+    const viewer::GpuScene& scene = compressed.scene;
     const int w = 200, h = 200;
     const float radius = 0.3f;
     for (const char* view : {"left", "oblique"}) {

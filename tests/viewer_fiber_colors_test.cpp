@@ -65,9 +65,8 @@ TEST(ViewerFiberColors, ValuesMapThroughViridisOverTheirRange) {
 
 TEST(ViewerFiberColors, EveryPixelShowsItsFibersColour) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("bundles/AF_L-step0.1.tck"), "af.fft"));
-    viewer::GpuScene scene(file, *viewer_gl().programs);
+    CompressedScene compressed(shared_data("bundles/AF_L-step0.1.tck"));
+    viewer::GpuScene& scene = compressed.scene;
     // A distinct colour per fiber.
     std::vector<viewer::Rgb> colors;
     for (std::uint64_t f = 0; f < scene.fiber_count(); ++f)
@@ -126,7 +125,7 @@ TEST(ViewerFiberColors, CommandLineChecksTheFiles) {
     const CommandResult zero = run_cli(common + " -f --style tubes --fiber-radii " + dir.file("v.txt"));  // 0, 1, ...
     EXPECT_EQ(zero.status, 4) << zero.output;
     EXPECT_NE(zero.output.find("not positive"), std::string::npos) << zero.output;
-    for (const std::string bad : {" --fiber-values " + dir.file("v.txt") + " --fiber-colors " + dir.file("v.txt"),
+    for (const std::string& bad : {" --fiber-values " + dir.file("v.txt") + " --fiber-colors " + dir.file("v.txt"),
                                   std::string(" --value-range 0:10"),
                                   " --fiber-values " + dir.file("v.txt") + " --value-range 5:1"}) {
         const CommandResult r = run_cli(common + " -f" + bad);

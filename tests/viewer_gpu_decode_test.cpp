@@ -118,9 +118,9 @@ TEST(ViewerGpuDecode, EveryBlockBoundaryCase) {
 // step arriving at each point (F0), the first point taking its first step's.
 TEST(ViewerGpuDecode, TangentsAreTheUnitStepDirections) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("bundles/AF_L-step0.1.tck"), "af.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(shared_data("bundles/AF_L-step0.1.tck"));
+    const FftFile& file = compressed.file;
+    const viewer::GpuScene& scene = compressed.scene;
     const CpuDecoded cpu = cpu_decode_blocks(file);
     for (const auto kind : {viewer::DecoderKind::sequential, viewer::DecoderKind::scan}) {
         SCOPED_TRACE(viewer::decoder_name(kind));

@@ -659,9 +659,8 @@ TEST(OdfCli, RenderDrawsGlyphsOverASliceAndChecksItsOptions) {
 TEST(ViewerSlab, OnlyFibersWithinTheSlabAreDrawn) {
     FIBLET_REQUIRE_GL();
     if (!shared_data_available()) GTEST_SKIP() << "no shared data";
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("bundles/CST_R.tck"), "cst.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(shared_data("bundles/CST_R.tck"));
+    const viewer::GpuScene& scene = compressed.scene;
     const Vec3f c = scene.bounds().center();
     Camera cam;
     cam.position = {c.x + 30, c.y - 60, c.z + 20};
@@ -730,8 +729,7 @@ TEST(OdfGlyphs, GlyphsAndFibersOccludeEachOther) {
             }
             fibers.push_back(along_x), fibers.push_back(along_y);
         }
-        write_tck(dir.file("grid.tck"), fibers);
-        const FftFile file(compress_into(dir, dir.file("grid.tck"), "grid.fft"));
+        const FftFile file(compress_fibers(dir, fibers, "grid"));
         const viewer::GpuScene scene(file, *viewer_gl().programs);
         viewer::Renderer renderer(*viewer_gl().programs);
         renderer.set_overlays({glyph});

@@ -25,10 +25,9 @@ TEST(ViewerPicking, KnownFibersSeenFromAbove) {
         for (int i = 0; i < points; ++i) f.push_back({-15 + 0.1f * float(i), -20 + 8 * float(k), 0.3f * float(k)});
         fibers.push_back(f);
     }
-    const TempDir dir;
-    write_tck(dir.file("lines.tck"), fibers);
-    const FftFile file(compress_into(dir, dir.file("lines.tck"), "lines.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(fibers);
+    const FftFile& file = compressed.file;
+    const viewer::GpuScene& scene = compressed.scene;
     viewer::Renderer renderer(*viewer_gl().programs);
     viewer::RenderTarget target(200, 160);
     const Camera cam = viewer::camera_from_spec("top", scene, 200.0f / 160.0f, 35, 1);
@@ -62,10 +61,8 @@ TEST(ViewerPicking, PicksUnderATransparentFrame) {
         for (int i = 0; i < 200; ++i) f.push_back({-10 + 0.1f * float(i), -12 + 8 * float(k), 0.5f * float(k)});
         fibers.push_back(f);
     }
-    const TempDir dir;
-    write_tck(dir.file("lines.tck"), fibers);
-    const FftFile file(compress_into(dir, dir.file("lines.tck"), "lines.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(fibers);
+    const viewer::GpuScene& scene = compressed.scene;
     viewer::Renderer renderer(*viewer_gl().programs);
     viewer::RenderTarget target(200, 160);
     const Camera cam = viewer::camera_from_spec("top", scene, 200.0f / 160.0f, 35, 1);

@@ -163,9 +163,9 @@ viewer::RenderOptions flat_direction_colors() {
 
 TEST(ViewerRender, MatchesAReferenceRasterizationOfTheDecodedSegments) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(shared_data("bundles/CST_R-step0.1.tck"));
+    const FftFile& file = compressed.file;
+    const viewer::GpuScene& scene = compressed.scene;
     viewer::Renderer renderer(*viewer_gl().programs);
     const int w = 160, h = 120;
     viewer::RenderTarget target(w, h);
@@ -183,9 +183,9 @@ TEST(ViewerRender, MatchesAReferenceRasterizationOfTheDecodedSegments) {
 
 TEST(ViewerRender, LevelOfDetailMatchesTheReferenceOfCoarseBlocks) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("bundles/cingulum-2-step0.1.tck"), "cg.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(shared_data("bundles/cingulum-2-step0.1.tck"));
+    const FftFile& file = compressed.file;
+    const viewer::GpuScene& scene = compressed.scene;
     viewer::Renderer renderer(*viewer_gl().programs);
     const int w = 256, h = 192;
     viewer::RenderTarget target(w, h);
@@ -204,18 +204,17 @@ TEST(ViewerRender, LevelOfDetailMatchesTheReferenceOfCoarseBlocks) {
 
 TEST(ViewerRender, PngRoundTrip) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("bundles/AF_L.tck"), "af.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(shared_data("bundles/AF_L.tck"));
+    const viewer::GpuScene& scene = compressed.scene;
     viewer::Renderer renderer(*viewer_gl().programs);
     viewer::RenderTarget target(97, 61);  // odd sizes: no row padding assumptions
     const Camera cam = viewer::camera_from_spec("left", scene, 97.0f / 61.0f, 35, 1);
     renderer.render(scene, cam, {}, target);
     const viewer::RgbaImage image{97, 61, target.read_rgba()};
-    viewer::write_png(dir.file("a.png"), image, false);
-    const viewer::RgbaImage back = viewer::read_png(dir.file("a.png"));
+    viewer::write_png(compressed.dir.file("a.png"), image, false);
+    const viewer::RgbaImage back = viewer::read_png(compressed.dir.file("a.png"));
     ASSERT_EQ(back.width, 97);
     ASSERT_EQ(back.height, 61);
     EXPECT_EQ(back.rgba, image.rgba);  // opaque renders: alpha is 255 both sides
-    EXPECT_THROW(viewer::write_png(dir.file("a.png"), image, false), Error);  // exists
+    EXPECT_THROW(viewer::write_png(compressed.dir.file("a.png"), image, false), Error);  // exists
 }

@@ -31,9 +31,8 @@ double mean_intensity(const viewer::RgbaImage& im) {
 
 TEST(ViewerSupersample, EdgesTakeIntermediateValuesAndTheMeanIsKept) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("bundles/AF_L-step0.1.tck"), "af.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(shared_data("bundles/AF_L-step0.1.tck"));
+    const viewer::GpuScene& scene = compressed.scene;
     viewer::Renderer renderer(*viewer_gl().programs);
     const int w = 96, h = 72;
     const Camera cam = viewer::camera_from_spec("left", scene, float(w) / float(h), 35, 1);

@@ -19,6 +19,7 @@
 #include "fiblet/tck.hpp"
 #include "fiblet/view.hpp"
 #include "gpu_programs.hpp"
+#include "gpu_scene.hpp"
 #include "headless_context.hpp"
 #include "test_util.hpp"
 
@@ -87,6 +88,24 @@ inline void write_tck(const std::string& path, const std::vector<std::vector<Vec
     for (const auto& f : fibers) w.write(f);
     w.finish();
 }
+
+// Writes `fibers` as NAME.tck in `dir`, compresses it and returns the .fft path.
+inline std::string compress_fibers(const TempDir& dir, const std::vector<std::vector<Vec3f>>& fibers,
+                                   const std::string& name) {
+    write_tck(dir.file(name + ".tck"), fibers);
+    return compress_into(dir, dir.file(name + ".tck"), name + ".fft");
+}
+
+// Fibers (or a .tck file) compressed into a temporary file and uploaded: what most viewer tests draw.
+struct CompressedScene {
+    TempDir dir;
+    FftFile file;
+    viewer::GpuScene scene;
+    explicit CompressedScene(const std::vector<std::vector<Vec3f>>& fibers)
+        : file(compress_fibers(dir, fibers, "scene")), scene(file, *viewer_gl().programs) {}
+    explicit CompressedScene(const std::string& tck)
+        : file(compress_into(dir, tck, "scene.fft")), scene(file, *viewer_gl().programs) {}
+};
 
 // Every block of a file decoded by the scalar reference decoder (with the
 // file's last-step fractions, as every decoder of a file applies them): xyz of each

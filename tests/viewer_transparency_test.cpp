@@ -70,14 +70,33 @@ struct Fragment {
     double alpha;
 };
 
-// The exact composite (RGBA8, rows from the top as RenderTarget::read_rgba)
-// and the number of fragments of each pixel; colour by direction, no
-// lighting, black background. With `fiber_alpha` (one per fiber) a fragment
-// blends with opacity x its fiber's (the GPU's float product, fiber_colors.glsl).
+// An image and the number of fragments of each pixel.
 struct Reference {
     std::vector<std::uint8_t> rgba;
     std::vector<std::uint32_t> fragments;
 };
+
+// Each pixel's fragments blended far to near over black ("over", float64).
+Reference composite_back_to_front(std::vector<std::vector<Fragment>>& pixels) {
+    Reference ref{std::vector<std::uint8_t>(pixels.size() * 4, 255), std::vector<std::uint32_t>(pixels.size())};
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+        auto& frags = pixels[i];
+        std::stable_sort(frags.begin(), frags.end(), [](const Fragment& a, const Fragment& b) { return a.depth > b.depth; });
+        double c[3] = {0, 0, 0};
+        for (const Fragment& f : frags) {
+            const float rgb[3] = {f.r, f.g, f.b};
+            for (int k = 0; k < 3; ++k) c[k] = f.alpha * rgb[k] + (1 - f.alpha) * c[k];
+        }
+        for (int k = 0; k < 3; ++k) ref.rgba[4 * i + std::size_t(k)] = std::uint8_t(std::lround(std::clamp(c[k], 0.0, 1.0) * 255));
+        ref.fragments[i] = std::uint32_t(frags.size());
+    }
+    return ref;
+}
+
+// The exact composite (RGBA8, rows from the top as RenderTarget::read_rgba)
+// and the number of fragments of each pixel; colour by direction, no
+// lighting, black background. With `fiber_alpha` (one per fiber) a fragment
+// blends with opacity x its fiber's (the GPU's float product, fiber_colors.glsl).
 Reference exact_reference(const std::vector<Segment>& segments, const Camera& cam, double opacity,
                           const std::vector<float>* fiber_alpha = nullptr) {
     const Mat4 vp = view_projection_matrix(cam);
@@ -108,19 +127,7 @@ Reference exact_reference(const std::vector<Segment>& segments, const Camera& ca
                 if (exits_diamond(ax, ay, bx, by, float(x) + 0.5f, float(y) + 0.5f))
                     pixels[std::size_t(kSize - 1 - y) * kSize + std::size_t(x)].push_back(f);
     }
-    Reference ref{std::vector<std::uint8_t>(pixels.size() * 4, 255), std::vector<std::uint32_t>(pixels.size())};
-    for (std::size_t i = 0; i < pixels.size(); ++i) {
-        auto& frags = pixels[i];
-        std::stable_sort(frags.begin(), frags.end(), [](const Fragment& a, const Fragment& b) { return a.depth > b.depth; });
-        double c[3] = {0, 0, 0};
-        for (const Fragment& f : frags) {
-            const float rgb[3] = {f.r, f.g, f.b};
-            for (int k = 0; k < 3; ++k) c[k] = f.alpha * rgb[k] + (1 - f.alpha) * c[k];
-        }
-        for (int k = 0; k < 3; ++k) ref.rgba[4 * i + std::size_t(k)] = std::uint8_t(std::lround(std::clamp(c[k], 0.0, 1.0) * 255));
-        ref.fragments[i] = std::uint32_t(frags.size());
-    }
-    return ref;
+    return composite_back_to_front(pixels);
 }
 
 viewer::RenderOptions transparent_options(viewer::TransparencyMode mode, float opacity) {
@@ -209,10 +216,9 @@ TEST(ViewerTransparency, DiamondExitLinesMatchTheReferenceCoverage) {
     // The pixels the GPU lights are exactly those the reference gives a
     // fragment (same rule, same points; every colour is non-black).
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    write_tck(dir.file("s.tck"), separated_layers());
-    const FftFile file(compress_into(dir, dir.file("s.tck"), "s.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(separated_layers());
+    const FftFile& file = compressed.file;
+    const viewer::GpuScene& scene = compressed.scene;
     const Camera cam = frontal_camera();
     const Reference ref = exact_reference(decoded_segments(file, scene), cam, 0.5);
     const auto image = render(scene, cam, transparent_options(viewer::TransparencyMode::unsorted, 0.5f));
@@ -228,10 +234,9 @@ TEST(ViewerTransparency, DiamondExitLinesMatchTheReferenceCoverage) {
 
 TEST(ViewerTransparency, SeparatedInDepthMatchesTheReference) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    write_tck(dir.file("s.tck"), separated_layers());
-    const FftFile file(compress_into(dir, dir.file("s.tck"), "s.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(separated_layers());
+    const FftFile& file = compressed.file;
+    const viewer::GpuScene& scene = compressed.scene;
     const Camera cam = frontal_camera();
     const std::vector<Segment> segments = decoded_segments(file, scene);
     for (const float alpha : {0.2f, 0.5f}) {
@@ -293,8 +298,7 @@ void report_modes(const std::string& name, float alpha, const ImageError (&error
 // `check`, the bounds for the ordered modes.
 void compare_modes(const TempDir& dir, const BundleCase& bundle, bool check) {
     ASSERT_FALSE(bundle.fibers.empty()) << bundle.name;
-    write_tck(dir.file("b.tck"), bundle.fibers);
-    const FftFile file(compress_into(dir, dir.file("b.tck"), "b.fft"));
+    const FftFile file(compress_fibers(dir, bundle.fibers, "b"));
     const viewer::GpuScene scene(file, *viewer_gl().programs);
     const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 1);
     const std::vector<Segment> segments = decoded_segments(file, scene);
@@ -330,10 +334,9 @@ TEST(ViewerTransparency, DISABLED_WholeSmallIfod1Table) {
 // its fiber's product. The ordered modes meet the bounds.
 TEST(ViewerTransparency, PerFiberOpacityMatchesTheExactReference) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    write_tck(dir.file("b.tck"), read_tck_fibers(std::string(FIBLET_SHARED_DIR) + "/data/bundles/AF_L-step0.1.tck"));
-    const FftFile file(compress_into(dir, dir.file("b.tck"), "b.fft"));
-    viewer::GpuScene scene(file, *viewer_gl().programs);
+    CompressedScene compressed(read_tck_fibers(std::string(FIBLET_SHARED_DIR) + "/data/bundles/AF_L-step0.1.tck"));
+    const FftFile& file = compressed.file;
+    viewer::GpuScene& scene = compressed.scene;
     ASSERT_GT(scene.fiber_count(), 10u);
     std::mt19937 rng(1616);
     std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
@@ -360,8 +363,7 @@ TEST(ViewerTransparency, AFiberOfOpacityZeroDisappears) {
     const TempDir dir;
     const auto fibers = read_tck_fibers(std::string(FIBLET_SHARED_DIR) + "/data/bundles/AF_L-step0.1.tck");
     ASSERT_GT(fibers.size(), 10u);
-    write_tck(dir.file("b.tck"), fibers);
-    const FftFile file(compress_into(dir, dir.file("b.tck"), "b.fft"));
+    const FftFile file(compress_fibers(dir, fibers, "b"));
     viewer::GpuScene scene(file, *viewer_gl().programs);
     const std::uint64_t last = scene.fiber_count() - 1;
     ASSERT_EQ(scene.fiber_id(last), last);
@@ -408,8 +410,7 @@ TEST(ViewerTransparency, FiberOpacitiesOfOneAreTheGlobalOpacity) {
     const TempDir dir;
     auto fibers = read_tck_fibers(std::string(FIBLET_SHARED_DIR) + "/data/small-sdstream.tck");
     fibers.resize(300);
-    write_tck(dir.file("s.tck"), fibers);
-    const FftFile file(compress_into(dir, dir.file("s.tck"), "s.fft"));
+    const FftFile file(compress_fibers(dir, fibers, "s"));
     viewer::GpuScene scene(file, *viewer_gl().programs);
     scene.set_fiber_opacities(std::vector<float>(scene.fiber_count(), 1.0f));
     const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 1);
@@ -492,19 +493,7 @@ Reference capsule_reference(const std::vector<Segment>& segments, const Camera& 
                 pixels[std::size_t(y) * kSize + std::size_t(x)].push_back(g);
             }
     }
-    Reference ref{std::vector<std::uint8_t>(pixels.size() * 4, 255), std::vector<std::uint32_t>(pixels.size())};
-    for (std::size_t i = 0; i < pixels.size(); ++i) {
-        auto& frags = pixels[i];
-        std::stable_sort(frags.begin(), frags.end(), [](const Fragment& a, const Fragment& b) { return a.depth > b.depth; });
-        double c[3] = {0, 0, 0};
-        for (const Fragment& f : frags) {
-            const float rgb[3] = {f.r, f.g, f.b};
-            for (int k = 0; k < 3; ++k) c[k] = f.alpha * rgb[k] + (1 - f.alpha) * c[k];
-        }
-        for (int k = 0; k < 3; ++k) ref.rgba[4 * i + std::size_t(k)] = std::uint8_t(std::lround(std::clamp(c[k], 0.0, 1.0) * 255));
-        ref.fragments[i] = std::uint32_t(frags.size());
-    }
-    return ref;
+    return composite_back_to_front(pixels);
 }
 
 }  // namespace
@@ -558,10 +547,9 @@ TEST(ViewerTransparency, SortedTubesAndCapsulesBlendBackToFront) {
 // capsule entry (capsule_reference).
 TEST(ViewerTransparency, SortedCapsulesMatchTheExactReference) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    write_tck(dir.file("b.tck"), read_tck_fibers(std::string(FIBLET_SHARED_DIR) + "/data/bundles/AF_L-step0.1.tck"));
-    const FftFile file(compress_into(dir, dir.file("b.tck"), "b.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(read_tck_fibers(std::string(FIBLET_SHARED_DIR) + "/data/bundles/AF_L-step0.1.tck"));
+    const FftFile& file = compressed.file;
+    const viewer::GpuScene& scene = compressed.scene;
     const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 1);
     const std::vector<Segment> segments = decoded_segments(file, scene);
     constexpr float kRadius = 0.3f;
@@ -622,8 +610,7 @@ TEST(ViewerTransparency, TwoRendersAreByteIdentical) {
     const TempDir dir;
     auto fibers = read_tck_fibers(std::string(FIBLET_SHARED_DIR) + "/data/small-sdstream.tck");
     fibers.resize(300);
-    write_tck(dir.file("s.tck"), fibers);
-    const FftFile file(compress_into(dir, dir.file("s.tck"), "s.fft"));
+    const FftFile file(compress_fibers(dir, fibers, "s"));
     const viewer::GpuScene scene(file, *viewer_gl().programs);
     const Camera cam = viewer::camera_from_spec("oblique", scene, 1.0f, 35, 1);
     for (const auto mode : kModes) {

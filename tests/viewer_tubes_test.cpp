@@ -318,6 +318,15 @@ TubeAgreement compare_tubes(const std::vector<OraclePixel>& ref, const std::vect
     return a;
 }
 
+// What every oracle comparison of this file asks of the GPU image.
+void expect_agreement(const TubeAgreement& a) {
+    EXPECT_GT(a.both_hit, 1500u);
+    EXPECT_GE(a.hit_rate(), 0.999);
+    EXPECT_GE(a.depth_rate(), 0.99);
+    EXPECT_GE(a.fiber_rate(), 0.99);
+    EXPECT_GE(a.normal_rate(), 0.99);
+}
+
 Camera test_camera() {
     Camera cam;
     cam.position = {4, -9, 28};
@@ -332,10 +341,9 @@ Camera test_camera() {
 
 TEST(ViewerTubes, BoxesContainTheSweptTube) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    write_tck(dir.file("s.tck"), synthetic_fibers());
-    const FftFile file(compress_into(dir, dir.file("s.tck"), "s.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    CompressedScene synthetic(synthetic_fibers());
+    const FftFile& file = synthetic.file;
+    const viewer::GpuScene& scene = synthetic.scene;
     viewer::BlockDecoder decoder(*viewer_gl().programs, file.header().points_per_block);
     decoder.decode(scene, viewer::default_decoder(), false, 0, scene.block_count(), true);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -402,10 +410,9 @@ TubeRender render_tubes(const viewer::GpuScene& scene, std::unique_ptr<viewer::D
 
 TEST(ViewerTubes, RayCastingMatchesADoublePrecisionOracle) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    write_tck(dir.file("s.tck"), synthetic_fibers());
-    const FftFile file(compress_into(dir, dir.file("s.tck"), "s.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    CompressedScene synthetic(synthetic_fibers());
+    const FftFile& file = synthetic.file;
+    const viewer::GpuScene& scene = synthetic.scene;
     const int w = 200, h = 200;
     const Camera cam = test_camera();
     const double radius = 0.4, tol = 1e-3 * radius;
@@ -417,11 +424,7 @@ TEST(ViewerTubes, RayCastingMatchesADoublePrecisionOracle) {
                 "1e-3 r %.5f (median %.2e mm, max %.2e mm), fiber %.5f, normal within 1 degree %.5f\n",
                 a.compared, a.hit_rate(), a.both_hit, a.depth_rate(), a.median_depth_error, a.max_depth_error,
                 a.fiber_rate(), a.normal_rate());
-    EXPECT_GT(a.both_hit, 1500u);
-    EXPECT_GE(a.hit_rate(), 0.999);
-    EXPECT_GE(a.depth_rate(), 0.99);
-    EXPECT_GE(a.fiber_rate(), 0.99);
-    EXPECT_GE(a.normal_rate(), 0.99);
+    expect_agreement(a);
 
     // The paper's c = 1/3 draws another curve: the same comparison fails.
     const TubeRender third =
@@ -433,10 +436,9 @@ TEST(ViewerTubes, RayCastingMatchesADoublePrecisionOracle) {
 
 TEST(ViewerCapsules, RayCastingMatchesADoublePrecisionOracle) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    write_tck(dir.file("s.tck"), synthetic_fibers());
-    const FftFile file(compress_into(dir, dir.file("s.tck"), "s.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    CompressedScene synthetic(synthetic_fibers());
+    const FftFile& file = synthetic.file;
+    const viewer::GpuScene& scene = synthetic.scene;
     const int w = 200, h = 200;
     const Camera cam = test_camera();
     const double radius = 0.4, tol = 1e-3 * radius;
@@ -447,20 +449,15 @@ TEST(ViewerCapsules, RayCastingMatchesADoublePrecisionOracle) {
                 "1e-3 r %.5f (median %.2e mm, max %.2e mm), fiber %.5f, normal within 1 degree %.5f\n",
                 a.compared, a.hit_rate(), a.both_hit, a.depth_rate(), a.median_depth_error, a.max_depth_error,
                 a.fiber_rate(), a.normal_rate());
-    EXPECT_GT(a.both_hit, 1500u);
-    EXPECT_GE(a.hit_rate(), 0.999);
-    EXPECT_GE(a.depth_rate(), 0.99);
-    EXPECT_GE(a.fiber_rate(), 0.99);
-    EXPECT_GE(a.normal_rate(), 0.99);
+    expect_agreement(a);
 }
 
 // Per-fiber radii (GpuScene::set_fiber_radii), for tubes and capsules.
 TEST(ViewerTubes, PerFiberRadiiMatchTheOracle) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    write_tck(dir.file("s.tck"), synthetic_fibers());
-    const FftFile file(compress_into(dir, dir.file("s.tck"), "s.fft"));
-    viewer::GpuScene scene(file, *viewer_gl().programs);
+    CompressedScene synthetic(synthetic_fibers());
+    const FftFile& file = synthetic.file;
+    viewer::GpuScene& scene = synthetic.scene;
     const std::vector<double> radii{0.2, 0.55, 0.3, 0.45, 0.25};
     scene.set_fiber_radii(std::vector<float>(radii.begin(), radii.end()));
     const int w = 200, h = 200;
@@ -484,11 +481,7 @@ TEST(ViewerTubes, PerFiberRadiiMatchTheOracle) {
             compare_tubes(ref, target.read_depth(), target.read_fibers(), target.read_rgba(), cam, w, h, tol);
         std::printf("%s with per-fiber radii: hit/miss %.5f, depth %.5f, fiber %.5f, normal %.5f\n",
                     viewer::draw_style_name(style), a.hit_rate(), a.depth_rate(), a.fiber_rate(), a.normal_rate());
-        EXPECT_GT(a.both_hit, 1500u);
-        EXPECT_GE(a.hit_rate(), 0.999);
-        EXPECT_GE(a.depth_rate(), 0.99);
-        EXPECT_GE(a.fiber_rate(), 0.99);
-        EXPECT_GE(a.normal_rate(), 0.99);
+        expect_agreement(a);
     }
     EXPECT_THROW(scene.set_fiber_radii({1, 2}), Error);
     EXPECT_THROW(scene.set_fiber_radii({0.2f, 0.2f, 0.0f, 0.2f, 0.2f}), Error);
@@ -506,8 +499,7 @@ TEST(ViewerTubes, TubesHideLinesBehindTheirSurface) {
         fibers[1].push_back({0, s, 0});
         fibers[2].push_back({1, s, 1});
     }
-    write_tck(dir.file("x.tck"), fibers);
-    const FftFile file(compress_into(dir, dir.file("x.tck"), "x.fft"));
+    const FftFile file(compress_fibers(dir, fibers, "x"));
     const viewer::GpuScene scene(file, *viewer_gl().programs);
     const int w = 128, h = 128;
     Camera cam;

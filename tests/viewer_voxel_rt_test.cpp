@@ -345,9 +345,9 @@ TEST(VoxelRtTrace, OpaqueImagesAgreeWithEmbree) {
     GTEST_SKIP() << "built without Embree (libembree-dev, scripts/setup.sh)";
 #else
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(shared_data("bundles/CST_R-step0.1.tck"));
+    const FftFile& file = compressed.file;
+    const viewer::GpuScene& scene = compressed.scene;
     const float radius = 0.3f;
     const EmbreeCapsules oracle(file, radius);
     for (const char* view : {"left", "oblique"}) {
@@ -364,9 +364,9 @@ TEST(VoxelRtTrace, PerFiberRadiiAgreeWithEmbree) {
     GTEST_SKIP() << "built without Embree (libembree-dev, scripts/setup.sh)";
 #else
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft"));
-    viewer::GpuScene scene(file, *viewer_gl().programs);
+    CompressedScene compressed(shared_data("bundles/CST_R-step0.1.tck"));
+    const FftFile& file = compressed.file;
+    viewer::GpuScene& scene = compressed.scene;
     // 0.1 to 0.6 mm, neighbours in file order differing.
     std::vector<float> radii(file.header().fibers);
     for (std::size_t f = 0; f < radii.size(); ++f) radii[f] = 0.1f + 0.125f * float((f * 7) % 5);
@@ -549,9 +549,9 @@ TEST(VoxelRtAmbientOcclusion, CorrelatesWithMonteCarloOcclusionRays) {
     GTEST_SKIP() << "built without Embree (libembree-dev, scripts/setup.sh)";
 #else
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(shared_data("bundles/CST_R-step0.1.tck"));
+    const FftFile& file = compressed.file;
+    const viewer::GpuScene& scene = compressed.scene;
     const float radius = 0.3f;
     const EmbreeCapsules oracle(file, radius);
     viewer::Renderer renderer(*viewer_gl().programs);
@@ -618,9 +618,8 @@ TEST(VoxelRtAmbientOcclusion, CorrelatesWithMonteCarloOcclusionRays) {
 
 TEST(VoxelRtAmbientOcclusion, OneChordPerBlockMatchesEverySegment) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("small-ifod1.tck"), "small.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(shared_data("small-ifod1.tck"));
+    const viewer::GpuScene& scene = compressed.scene;
     viewer::Renderer renderer(*viewer_gl().programs);
     viewer::RenderOptions o;
     o.engine = viewer::RenderEngine::voxel_rt;
@@ -664,9 +663,8 @@ TEST(VoxelRtAmbientOcclusion, OneChordPerBlockMatchesEverySegment) {
 
 TEST(VoxelRtCulling, ImagesWithAndWithoutCullingAgree) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("small-ifod1.tck"), "small.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(shared_data("small-ifod1.tck"));
+    const viewer::GpuScene& scene = compressed.scene;
     const int w = 256, h = 192;
     for (const char* view : {"oblique", "top"}) {
         SCOPED_TRACE(view);
@@ -704,9 +702,8 @@ TEST(VoxelRtCulling, ImagesWithAndWithoutCullingAgree) {
 // fragment list; the pyramid stops at an odd side (12 -> 6 -> 3).
 TEST(VoxelRtSkipping, OccupancyPyramidMarksExactlyTheCellsHoldingSomething) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("small-ifod1.tck"), "small.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(shared_data("small-ifod1.tck"));
+    const viewer::GpuScene& scene = compressed.scene;
     for (const int n : {64, 12}) {
         SCOPED_TRACE(n);
         viewer::Renderer renderer(*viewer_gl().programs);
@@ -752,9 +749,8 @@ TEST(VoxelRtSkipping, OccupancyPyramidMarksExactlyTheCellsHoldingSomething) {
 // transparent rays.
 TEST(VoxelRtSkipping, ImagesWithAndWithoutEmptySpaceSkippingAreTheSame) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("small-ifod1.tck"), "small.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(shared_data("small-ifod1.tck"));
+    const viewer::GpuScene& scene = compressed.scene;
     struct Case {
         const char* name;
         float opacity;
@@ -836,9 +832,8 @@ TEST(VoxelRtCli, RenderDrawsWithEveryOptionAndRefusesBadOnes) {
 
 TEST(VoxelRtMemory, SegmentsSplitOverSeveralBuffersRenderTheSameImage) {
     FIBLET_REQUIRE_GL();
-    const TempDir dir;
-    const FftFile file(compress_into(dir, shared_data("small-ifod1.tck"), "small.fft"));
-    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    const CompressedScene compressed(shared_data("small-ifod1.tck"));
+    const viewer::GpuScene& scene = compressed.scene;
     const std::uint64_t slot_bytes = std::uint64_t(scene.header().points_per_block + 1) * 16;
     const std::uint64_t total = slot_bytes * scene.block_count();
     struct Frame {
