@@ -2,7 +2,7 @@
 // (scripts/bench_table.sh runs each row in its own process, so that the peak
 // RSS it prints is that row's). Prints one JSON object.
 //
-//   decode FILE.fft [--decoder NAME] [--threads N] [--repeat R] [--cold 1]
+//   decode FILE.fft [--decoder NAME] [--threads N] [--repeat R] [--cold 1] [--chunk-blocks B]
 //       every fiber of the file decoded into float32 xyz + offsets, into
 //       buffers allocated (and touched) beforehand: best of R. --cold 1
 //       drops the file from the page cache before each run (read from disk).
@@ -10,10 +10,18 @@
 //   zstd FILE.tck --level L [--repeat R] the .tck through libzstd (one thread)
 //   float16 FILE.tck [--repeat R]        positions rounded to half precision
 //   sequential FILE.tck [--repeat R]     fiblet recurrence over whole fibers
+//   floor FILE.fft [--threads N] [--repeat R]
+//       what N threads of the pool can do at all on this machine, for the
+//       decode row's output size (12 bytes a point + 8 a fiber): write it
+//       into fresh memory (first-touch page faults; 4 kB pages and
+//       MADV_HUGEPAGE), into memory faulted in beforehand (store
+//       bandwidth), and a register-only loop of fixed work (compute).
+//       Each split into 4 tasks a thread, as decode splits its chunks.
 //
 // Decode timings of the .tck-based baselines include parsing the .tck (the
 // zstd row: decompression + the tck-parse time, measured in the same run).
 #include <fcntl.h>
+#include <sys/mman.h>
 #include <sys/resource.h>
 #include <unistd.h>
 #include <time.h>
@@ -23,6 +31,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -35,6 +44,7 @@
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
+#include "fiblet/parallel.hpp"
 
 namespace fb = fiblet::bench;
 using namespace fiblet;
@@ -106,6 +116,7 @@ void decode_row(const std::string& path, const std::map<std::string, std::string
     DecodeOptions o;
     o.decoder = parse_decoder(opt.count("decoder") ? opt.at("decoder") : "auto");
     o.threads = opt.count("threads") ? unsigned(std::stoul(opt.at("threads"))) : 0;
+    if (opt.count("chunk-blocks")) o.chunk_blocks = std::stoul(opt.at("chunk-blocks"));
     std::vector<float> xyz(3 * h.points, 1.0f);  // touched: no page faults in the timing
     std::vector<std::uint64_t> offsets(h.fibers + 1, 1);
     std::uint64_t points = 0;
@@ -227,11 +238,89 @@ void sequential_row(const std::string& path, int repeat) {
     print_lossy_row("sequential", t, double(coded.bytes.size()), encode, decode, cpu, e);
 }
 
+// Anonymous memory mapped without touching it (the pages fault in on first write).
+class FreshMemory {
+public:
+    FreshMemory(std::size_t bytes, bool huge) : bytes_(bytes) {
+        p_ = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        if (p_ == MAP_FAILED) throw std::runtime_error("mmap failed");
+        if (huge) ::madvise(p_, bytes, MADV_HUGEPAGE);
+    }
+    ~FreshMemory() { ::munmap(p_, bytes_); }
+    FreshMemory(const FreshMemory&) = delete;
+    FreshMemory& operator=(const FreshMemory&) = delete;
+    std::uint8_t* data() const { return static_cast<std::uint8_t*>(p_); }
+
+private:
+    void* p_;
+    std::size_t bytes_;
+};
+
+// Writes `bytes` at p on `threads` threads, 4 contiguous tasks a thread.
+void parallel_fill(std::uint8_t* p, std::size_t bytes, unsigned threads) {
+    const std::size_t tasks = 4 * std::size_t(threads);
+    parallel_for(tasks, threads, [&](std::size_t t) {
+        const std::size_t a = bytes * t / tasks, b = bytes * (t + 1) / tasks;
+        std::memset(p + a, int(t + 1), b - a);
+    });
+}
+
+// A fixed amount of register-only work (four multiply-xorshift chains), split like the fills.
+std::uint64_t parallel_compute(std::uint64_t steps, unsigned threads) {
+    const std::size_t tasks = 4 * std::size_t(threads);
+    std::vector<std::uint64_t> out(tasks);
+    parallel_for(tasks, threads, [&](std::size_t t) {
+        std::uint64_t x[4] = {t + 1, t + 2, t + 3, t + 4};
+        for (std::uint64_t i = steps / tasks; i > 0; --i)
+            for (std::uint64_t& v : x) v = (v ^ (v >> 29)) * 0xbf58476d1ce4e5b9u + 1;
+        out[t] = x[0] ^ x[1] ^ x[2] ^ x[3];
+    });
+    std::uint64_t r = 0;
+    for (const std::uint64_t v : out) r ^= v;
+    return r;
+}
+
+void floor_row(const std::string& path, const std::map<std::string, std::string>& opt, int repeat) {
+    const FftHeader h = FftFile(path).header();
+    const unsigned threads = opt.count("threads") ? unsigned(std::stoul(opt.at("threads"))) : 1;
+    const std::size_t bytes = 12 * std::size_t(h.points) + 8 * (std::size_t(h.fibers) + 1);
+    double fresh_cpu = 0, huge_cpu = 0, touched_cpu = 0, compute_cpu = 0;
+    const double fresh = best_seconds(repeat, [&] {
+        FreshMemory m(bytes, false);
+        parallel_fill(m.data(), bytes, threads);
+    }, &fresh_cpu);
+    const double huge = best_seconds(repeat, [&] {
+        FreshMemory m(bytes, true);
+        parallel_fill(m.data(), bytes, threads);
+    }, &huge_cpu);
+    FreshMemory touched_memory(bytes, false);
+    std::memset(touched_memory.data(), 1, bytes);
+    const double touched =
+        best_seconds(repeat, [&] { parallel_fill(touched_memory.data(), bytes, threads); }, &touched_cpu);
+    std::uint64_t sink = 0;
+    const double compute = best_seconds(repeat, [&] { sink ^= parallel_compute(std::uint64_t{1} << 27, threads); },
+                                        &compute_cpu);
+    Json()
+        .str("row", "floor")
+        .num("threads", threads)
+        .num("bytes", double(bytes))
+        .num("fresh_seconds", fresh)  // the munmap of the fresh mappings is timed too
+        .num("fresh_cpu_seconds", fresh_cpu)
+        .num("fresh_huge_seconds", huge)
+        .num("fresh_huge_cpu_seconds", huge_cpu)
+        .num("touched_seconds", touched)
+        .num("touched_cpu_seconds", touched_cpu)
+        .num("compute_seconds", compute)
+        .num("compute_cpu_seconds", compute_cpu)
+        .num("compute_result", double(sink & 0xffff))  // keeps the loop
+        .print();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     if (argc < 3) {
-        std::fprintf(stderr, "usage: %s decode|tck-parse|zstd|float16|sequential FILE [--option value ...]\n", argv[0]);
+        std::fprintf(stderr, "usage: %s decode|tck-parse|zstd|float16|sequential|floor FILE [--option value ...]\n", argv[0]);
         return 2;
     }
     const std::string mode = argv[1], path = argv[2];
@@ -252,6 +341,7 @@ int main(int argc, char** argv) {
         else if (mode == "zstd") zstd_row(path, opt.count("level") ? std::stoi(opt["level"]) : 3, repeat);
         else if (mode == "float16") float16_row(path, repeat);
         else if (mode == "sequential") sequential_row(path, repeat);
+        else if (mode == "floor") floor_row(path, opt, repeat);
         else {
             std::fprintf(stderr, "unknown mode %s\n", mode.c_str());
             return 2;

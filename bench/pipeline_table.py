@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Every row of the parallel-pipeline table (issue 14) from one run, with the
 machine's load: decompress and compress scaling (quiet and with a competing
-`yes > /dev/null`), decompress to a file against `cp`, compress speed,
+`yes > /dev/null`), the machine's own floor for 2 threads vs 1, decompress to a file against `cp`, compress speed,
 fiblet.load against numpy.fromfile of the .tck, selection of 10 % of the
 blocks against a full decode, the block index's share of the file, and the
 16-bit size and error.
@@ -92,6 +92,10 @@ def main():
         d = {t: json_of([table, "decode", fft, "--threads", str(t), "--repeat", str(R)]) for t in (1, 2)}
         res["decode_mem_s"] = {t: d[t]["decode_seconds"] for t in d}
         res["decode_mem_cpu_s"] = {t: d[t]["decode_cpu_seconds"] for t in d}
+        # What 2 threads can do at all on this machine, for the same output size
+        # (bench_table.cpp floor): register-only work, writing memory faulted in
+        # beforehand, and fresh memory (4 kB pages, MADV_HUGEPAGE).
+        res["floor"] = {t: json_of([table, "floor", fft, "--threads", str(t), "--repeat", str(R)]) for t in (1, 2)}
         # Decompress to a .tck file, 1 and 2 threads, and cp of the .tck, same tmpfs.
         out = os.path.join(work, "out.tck")
         rm = lambda: os.path.exists(out) and os.remove(out)
@@ -162,6 +166,13 @@ print(json.dumps({{"fromfile": med(lambda: np.fromfile(tck, dtype="<f4"), n),
     rows.append(("decompress `.fft` → memory, 2 threads vs 1",
                  f"**{dm[1] / dm[2]:.2f}×** ({f(dm[1])} s → {f(dm[2])} s; CPU {f(res['decode_mem_cpu_s'][1])} → {f(res['decode_mem_cpu_s'][2])} s)",
                  "≥ 1.8×"))
+    fl = res["floor"]
+    fr = lambda k: f"{fl[1][k + '_seconds'] / fl[2][k + '_seconds']:.2f}×"
+    rows.append(("floor: the same 2 threads vs 1 on this machine",
+                 f"compute {fr('compute')}; writing {fl[1]['bytes'] / 1e6:.0f} MB: faulted-in memory {fr('touched')} "
+                 f"({f(fl[1]['touched_seconds'])} s → {f(fl[2]['touched_seconds'])} s), fresh 4 kB pages {fr('fresh')} "
+                 f"({f(fl[1]['fresh_seconds'])} s → {f(fl[2]['fresh_seconds'])} s), fresh huge pages {fr('fresh_huge')} "
+                 f"({f(fl[1]['fresh_huge_seconds'])} s → {f(fl[2]['fresh_huge_seconds'])} s)", "—"))
     rows.append(("decompress `.fft` → `.tck` file, 2 threads vs 1",
                  f"{df[1][0] / df[2][0]:.2f}× ({f(df[1][0])} s → {f(df[2][0])} s; CPU {f(df[1][1])} → {f(df[2][1])} s); "
                  f"`.fftz` {dz[1][0] / dz[2][0]:.2f}×", "—"))

@@ -1,6 +1,7 @@
 // The worker pool and the pipelines on it (fiblet/parallel.hpp): every task
 // runs exactly once whatever the thread count, errors reach the caller,
-// nested and overlapping jobs finish; compression writes the same bytes with
+// nested and overlapping jobs finish, a wait that runs the next job
+// meanwhile keeps the two jobs' errors apart; compression writes the same bytes with
 // 1 or N threads (fixed-step and resampled input, with and without zstd),
 // a pipelined decode_file (overlap_sink) hands the sink the same chunks as
 // a serial one, its errors reaching the caller, and a .tck written a chunk
@@ -8,6 +9,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
+#include <thread>
 #include <filesystem>
 #include <limits>
 #include <span>
@@ -75,6 +78,33 @@ TEST(WorkerPool, NestedAndOverlappingJobsFinish) {
     std::atomic<int> n{0};
     { ParallelJob job(100, 3, [&](std::size_t) { ++n; }); }
     EXPECT_EQ(n.load(), 100);
+}
+
+TEST(WorkerPool, WaitRunsTheNextJobMeanwhileAndKeepsErrorsApart) {
+    // wait(&next) returns once its own job is done, whatever of `next` the
+    // caller ran meanwhile; next's tasks each run once, and the failure of
+    // one of them (run by either thread) reaches next.wait(), not wait().
+    for (unsigned threads : {1u, 2u, 3u}) {
+        std::vector<std::atomic<int>> first(4), second(200);
+        ParallelJob a(first.size(), threads, [&](std::size_t i) {
+            if (i == 0) std::this_thread::sleep_for(std::chrono::milliseconds(20));  // one slow task
+            first[i].fetch_add(1);
+        });
+        ParallelJob b(second.size(), threads, [&](std::size_t i) {
+            second[i].fetch_add(1);
+            if (i == 3) throw Error(Errc::io, "task 3 of the next job");
+        });
+        EXPECT_NO_THROW(a.wait(&b)) << "threads " << threads;
+        for (std::size_t i = 0; i < first.size(); ++i) ASSERT_EQ(first[i].load(), 1) << "threads " << threads;
+        try {
+            b.wait();
+            ADD_FAILURE() << "no exception, threads " << threads;
+        } catch (const Error& e) {
+            EXPECT_STREQ(e.what(), "task 3 of the next job");
+        }
+        for (std::size_t i = 0; i < second.size(); ++i) ASSERT_LE(second[i].load(), 1) << "threads " << threads;
+        EXPECT_EQ(second[3].load(), 1);
+    }
 }
 
 namespace {

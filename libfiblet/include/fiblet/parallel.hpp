@@ -34,7 +34,11 @@ public:
     ParallelJob& operator=(ParallelJob&&) noexcept;
     ~ParallelJob();
     // Takes part until every task has run; rethrows a task's exception.
-    void wait();
+    // With `meanwhile` (a job started after this one): once this job's
+    // tasks are all claimed, the caller runs meanwhile's tasks, one at a
+    // time, until this job's last task is done, instead of idling while
+    // another thread finishes it (a pipeline's next batch).
+    void wait(ParallelJob* meanwhile = nullptr);
     struct State;
 
 private:

@@ -8,8 +8,8 @@
 //   write_batch       the caller writes the previous batch's blocks,
 //                     checksum and index entries, in order
 //
-// so reading and writing overlap the encoding, and a thread the OS
-// schedules late only takes fewer tasks. Memory is bounded: two batches of
+// (batch_pipeline.hpp) so reading and writing overlap the encoding, and a
+// thread the OS schedules late only takes fewer tasks. Memory is bounded: two batches of
 // input (~3 MB each) and their blocks.
 #include <cmath>
 #include <cstring>
@@ -18,6 +18,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "codec/batch_pipeline.hpp"
 #include "codec/compress_stages.hpp"
 #include "codec/fiber_end_encoder.hpp"
 #include "fiblet/parallel.hpp"
@@ -159,36 +160,16 @@ void PointFieldResampler::finish() {
 EncodeStageResult encode_stage(StreamlineSource& reader, const EncodeStageInputs& in, FftSink& out,
                                FftChecksumBuilder& checksum, IndexBuilder& index, const CompressOptions& options) {
     reader.rewind();
-    // Two batches and two sets of slots: one being encoded, one being read
-    // (the batch) or written (its slots).
-    FiberBatch batch[2];
     std::vector<Slot> slots[2];
     const IndexBuilder empty_index = index;  // the file's layout, no blocks yet
-    auto add_slots = [&](int k) {
-        while (slots[k].size() < batch[k].tasks()) slots[k].emplace_back().index = empty_index;
-    };
-    auto progress = [&] {
-        if (options.progress && reader.data_bytes() > 0)
-            options.progress("encode", double(reader.bytes_consumed()) / double(reader.data_bytes()));
-    };
-
-    int cur = 0;
-    bool more = read_fiber_batch(reader, batch[cur], 0);
-    bool pending_write = false;  // slots[1 - cur] hold the previous batch's output
-    while (more) {
-        const FiberBatch& b = batch[cur];
-        add_slots(cur);
-        ParallelJob job(b.tasks(), in.threads, [&, cur](std::size_t t) { encode_task(in, batch[cur], t, slots[cur][t]); });
-        // While the pool encodes: write the previous batch, read the next.
-        if (pending_write) write_batch(batch[1 - cur], slots[1 - cur], out, checksum, index);
-        const auto next_first = std::uint32_t(b.first_fiber + b.count);
-        more = read_fiber_batch(reader, batch[1 - cur], next_first);
-        job.wait();
-        progress();
-        pending_write = true;
-        cur = 1 - cur;
-    }
-    if (pending_write) write_batch(batch[1 - cur], slots[1 - cur], out, checksum, index);
+    for_each_batch(
+        reader, in.threads, slots, [&](Slot& s) { s.index = empty_index; },
+        [&](const FiberBatch& b, std::size_t t, Slot& s) { encode_task(in, b, t, s); }, [](const FiberBatch&) {},
+        [&](const FiberBatch& b, std::vector<Slot>& batch_slots) {
+            write_batch(b, batch_slots, out, checksum, index);
+            if (options.progress && reader.data_bytes() > 0)
+                options.progress("encode", double(reader.bytes_consumed()) / double(reader.data_bytes()));
+        });
 
     EncodeStageResult r;
     for (int k = 0; k < 2; ++k)

@@ -1,9 +1,10 @@
 // The scan stage of compress_tck (compress_stages.hpp): pass 1 (counts,
 // bounds, spacing, turning angles) and, when resampling, pass 1b (the
 // resampled counts and turns). Both are pipelines over batches of whole
-// fibers: the caller's thread reads the next batch (read_fiber_batch) and
-// does the per-fiber bookkeeping that must follow the file's order while
-// the worker pool measures the current batch, a task at a time. Each task
+// fibers (batch_pipeline.hpp): the caller's thread reads the next batch
+// (read_fiber_batch) and does the per-fiber bookkeeping that must follow the
+// file's order while the worker pool measures the current batch, a task at
+// a time. Each task
 // index has its own partial statistics (one set per batch parity), merged in
 // index order at the end: the result does not depend on the thread count.
 #include <bit>
@@ -11,6 +12,7 @@
 #include <limits>
 #include <optional>
 
+#include "codec/batch_pipeline.hpp"
 #include "codec/compress_stages.hpp"
 #include "core/streamline_label.hpp"
 #include "fiblet/error.hpp"
@@ -128,35 +130,23 @@ ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_
                       .turns = TurnStatistics(points_per_block, sharp_blocks),
                       .sample = FiberSample(tuning_points),
                       .lengths = {}};
-    FiberBatch batch[2];
     std::vector<ScanSlot> slots[2];
-    auto add_slots = [&](int k) {
-        while (slots[k].size() < batch[k].tasks())
-            slots[k].emplace_back().turns.emplace(points_per_block, sharp_blocks);
-    };
-    int cur = 0;
-    bool more = read_fiber_batch(reader, batch[cur], 0);
-    while (more) {
-        const FiberBatch& b = batch[cur];
-        add_slots(cur);
-        ParallelJob job(b.tasks(), threads, [&, cur](std::size_t t) { scan_task(batch[cur], t, slots[cur][t]); });
-        // In file order, on the caller's thread while the pool measures.
-        for (std::size_t i = 0; i < b.count; ++i) {
-            const std::vector<Vec3f>& fiber = b.fibers[i];
-            if (fiber.size() > std::numeric_limits<std::uint32_t>::max())
-                throw Error(Errc::unsupported, reader.path() + ": a streamline with more than 2^32 points");
-            ++scan.fibers;
-            scan.points += fiber.size();
-            scan.empty_fibers += fiber.empty();
-            scan.single_point_fibers += fiber.size() == 1;
-            r.fiber_points.push_back(std::uint32_t(fiber.size()));
-            r.sample.offer(fiber);
-        }
-        more = read_fiber_batch(reader, batch[1 - cur], std::uint32_t(b.first_fiber + b.count));
-        job.wait();
-        report_progress(options, "scan", reader);
-        cur = 1 - cur;
-    }
+    for_each_batch(
+        reader, threads, slots, [&](ScanSlot& s) { s.turns.emplace(points_per_block, sharp_blocks); }, scan_task,
+        [&](const FiberBatch& b) {  // in file order, on the caller's thread while the pool measures
+            for (std::size_t i = 0; i < b.count; ++i) {
+                const std::vector<Vec3f>& fiber = b.fibers[i];
+                if (fiber.size() > std::numeric_limits<std::uint32_t>::max())
+                    throw Error(Errc::unsupported, reader.path() + ": a streamline with more than 2^32 points");
+                ++scan.fibers;
+                scan.points += fiber.size();
+                scan.empty_fibers += fiber.empty();
+                scan.single_point_fibers += fiber.size() == 1;
+                r.fiber_points.push_back(std::uint32_t(fiber.size()));
+                r.sample.offer(fiber);
+            }
+        },
+        [&](const FiberBatch&, const std::vector<ScanSlot>&) { report_progress(options, "scan", reader); });
     // Merged in slot order: the same sums whatever the thread count.
     scan.min = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
                 std::numeric_limits<double>::infinity()};
@@ -184,12 +174,7 @@ void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double
                          std::size_t sharp_blocks, unsigned threads, const CompressOptions& options) {
     const double step = resample.step_mm;
     reader.rewind();
-    FiberBatch batch[2];
     std::vector<ResampleSlot> slots[2];
-    auto add_slots = [&](int k) {
-        while (slots[k].size() < batch[k].tasks())
-            slots[k].emplace_back().turns.emplace(points_per_block, sharp_blocks);
-    };
     auto task = [&](const FiberBatch& b, std::size_t t, ResampleSlot& s) {
         s.too_long.reset();
         for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1]; ++i) {
@@ -213,22 +198,17 @@ void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double
                 s.off_step_segments += std::fabs(length(fiber[k - 1], fiber[k]) - step) > tolerance * step;
         }
     };
-    int cur = 0;
-    bool more = read_fiber_batch(reader, batch[cur], 0);
-    while (more) {
-        const FiberBatch& b = batch[cur];
-        add_slots(cur);
-        ParallelJob job(b.tasks(), threads, [&, cur](std::size_t t) { task(batch[cur], t, slots[cur][t]); });
-        more = read_fiber_batch(reader, batch[1 - cur], std::uint32_t(b.first_fiber + b.count));
-        job.wait();
-        for (std::size_t t = 0; t < b.tasks(); ++t)
-            if (const ResampleSlot& s = slots[cur][t]; s.too_long)
-                throw Error(Errc::unsupported, reader.path() + ": " + streamline_label(*s.too_long) + " (" +
-                                                   std::to_string(s.too_long_mm) + " mm) needs more than 65535 blocks at a " +
-                                                   std::to_string(step) + " mm step");
-        report_progress(options, "resample-scan", reader);
-        cur = 1 - cur;
-    }
+    for_each_batch(
+        reader, threads, slots, [&](ResampleSlot& s) { s.turns.emplace(points_per_block, sharp_blocks); }, task,
+        [](const FiberBatch&) {},
+        [&](const FiberBatch& b, const std::vector<ResampleSlot>& batch_slots) {
+            for (std::size_t t = 0; t < b.tasks(); ++t)
+                if (const ResampleSlot& s = batch_slots[t]; s.too_long)
+                    throw Error(Errc::unsupported, reader.path() + ": " + streamline_label(*s.too_long) + " (" +
+                                                       std::to_string(s.too_long_mm) + " mm) needs more than 65535 blocks at a " +
+                                                       std::to_string(step) + " mm step");
+            report_progress(options, "resample-scan", reader);
+        });
     turns = TurnStatistics(points_per_block, sharp_blocks);
     for (int k = 0; k < 2; ++k)
         for (const ResampleSlot& s : slots[k]) {

@@ -32,24 +32,31 @@ struct ParallelJob::State {
     std::mutex mutex;
     std::condition_variable finished;
 
-    // Claims and runs tasks until none is left.
-    void take_part() {
-        for (std::size_t i; (i = next.fetch_add(1, std::memory_order_relaxed)) < n;) {
-            if (!failed.load(std::memory_order_relaxed)) {
-                try {
-                    task(i);
-                } catch (...) {
-                    const std::lock_guard<std::mutex> lock(mutex);
-                    if (!error) error = std::current_exception();
-                    failed = true;
-                }
-            }
-            if (done.fetch_add(1, std::memory_order_acq_rel) + 1 == n) {
+    // Claims and runs one task; false when none was left.
+    bool take_one() {
+        const std::size_t i = next.fetch_add(1, std::memory_order_relaxed);
+        if (i >= n) return false;
+        if (!failed.load(std::memory_order_relaxed)) {
+            try {
+                task(i);
+            } catch (...) {
                 const std::lock_guard<std::mutex> lock(mutex);
-                finished.notify_all();
+                if (!error) error = std::current_exception();
+                failed = true;
             }
         }
+        if (done.fetch_add(1, std::memory_order_acq_rel) + 1 == n) {
+            const std::lock_guard<std::mutex> lock(mutex);
+            finished.notify_all();
+        }
+        return true;
     }
+    // Claims and runs tasks until none is left.
+    void take_part() {
+        while (take_one()) {
+        }
+    }
+    bool all_done() const { return done.load(std::memory_order_acquire) >= n; }
     bool open() const { return next.load(std::memory_order_relaxed) < n && workers < max_workers; }
 };
 
@@ -151,13 +158,16 @@ ParallelJob::~ParallelJob() {
     }
 }
 
-void ParallelJob::wait() {
+void ParallelJob::wait(ParallelJob* meanwhile) {
     const std::shared_ptr<State> s = std::move(state_);
     if (!s) return;
     s->take_part();
+    if (meanwhile && meanwhile->state_)
+        while (!s->all_done() && meanwhile->state_->take_one()) {
+        }
     {
         std::unique_lock<std::mutex> lock(s->mutex);
-        s->finished.wait(lock, [&] { return s->done.load(std::memory_order_acquire) >= s->n; });
+        s->finished.wait(lock, [&] { return s->all_done(); });
     }
     if (s->max_workers) WorkerPool::instance().retire(s);
     if (s->error) std::rethrow_exception(s->error);

@@ -23,14 +23,25 @@ namespace {
 
 class ChunkDecoder {
 public:
+    // decode_file reuses its chunks' outputs: 4096 blocks a thread (~3 MB
+    // of points) stay in cache (DecodeOptions::chunk_blocks).
     static constexpr std::size_t kBlocksPerThread = 4096;
+    // decode_fibers and decode_fibers_into write straight into the whole
+    // output; only the chunk's blocks are reused (5 MB of 76-byte blocks).
+    // Bigger chunks join the pool less often: each chunk is two jobs, and a
+    // job's end waits for its last run and wakes a worker (docs/parallel.md:
+    // 2 threads vs 1 went from 1.4x to 1.7x on the medium file; the whole
+    // file as one chunk is slower again, its blocks fall out of cache).
+    static constexpr std::size_t kWholeOutputChunkBlocks = std::size_t{1} << 16;
 
-    ChunkDecoder(const FftFile& file, const DecodeOptions& options)
+    ChunkDecoder(const FftFile& file, const DecodeOptions& options, std::size_t blocks_per_thread = kBlocksPerThread,
+                 std::size_t min_chunk_blocks = 0)
         : file_(file),
           ctx_(file),
           decoder_(resolve_decoder(options.decoder)),
           threads_(detail::resolve_threads(options.threads)),
-          chunk_blocks_(options.chunk_blocks ? options.chunk_blocks : kBlocksPerThread * threads_) {}
+          chunk_blocks_(options.chunk_blocks ? options.chunk_blocks
+                                             : std::max(blocks_per_thread * threads_, min_chunk_blocks)) {}
 
     std::size_t chunk_blocks() const { return chunk_blocks_; }
 
@@ -59,6 +70,8 @@ public:
         // Runs of at least a thousand blocks (below that handing one out
         // costs more than it saves), up to 4 per thread: taken one at a time
         // from the pool, so a thread scheduled late does less of the chunk.
+        // Not more: the thread that decodes a run is often not the one that
+        // read it, and 8 a thread cost 10 % more CPU (docs/parallel.md).
         runs_ = threads_ == 1 ? 1u : unsigned(std::clamp<std::uint64_t>(blocks_ / 1024, 1, 4 * threads_));
         first_.assign(runs_ + 1, 0);
         points_.assign(runs_ + 1, 0);
@@ -111,7 +124,7 @@ void check_range(const FftFile& file, std::uint64_t begin, std::uint64_t end) {
 
 Streamlines decode_fibers(const FftFile& file, std::uint64_t begin, std::uint64_t end, const DecodeOptions& options) {
     check_range(file, begin, end);
-    ChunkDecoder chunks(file, options);
+    ChunkDecoder chunks(file, options, ChunkDecoder::kBlocksPerThread, ChunkDecoder::kWholeOutputChunkBlocks);
     Streamlines out;
     out.offsets.resize(end - begin + 1);
     // Reserving the most the blocks can hold maps memory without touching it.
@@ -132,7 +145,7 @@ std::uint64_t decode_fibers_into(const FftFile& file, std::uint64_t begin, std::
     if (offsets.size() < end - begin + 1)
         throw Error(Errc::invalid_argument, "decode_fibers_into: " + std::to_string(end - begin + 1) +
                                                 " offsets needed, room for " + std::to_string(offsets.size()));
-    ChunkDecoder chunks(file, options);
+    ChunkDecoder chunks(file, options, ChunkDecoder::kBlocksPerThread, ChunkDecoder::kWholeOutputChunkBlocks);
     std::uint64_t done = 0;
     offsets[0] = 0;
     for (std::uint64_t f = begin; f < end;) {
