@@ -189,7 +189,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     // tail feedback do it (parameters.hpp, keep_fixed_step_lengths).
     const bool keep_lengths =
         !report.resampled &&
-        detail::keep_fixed_step_lengths(tuning_set, turns, tuned, h, options.search, step, fixed_ratio, step_scale);
+        detail::keep_fixed_step_lengths(tuning_set, turns, tuned, h, step, fixed_ratio, step_scale);
     h.ratio = tuned.ratio;
     report.step_scale = tuned.step_scale;
     h.step = float(step * report.step_scale / h.scaling);

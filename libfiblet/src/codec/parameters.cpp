@@ -220,8 +220,7 @@ TunedParameters tune_parameters(const TuningSet& given, const TurnStatistics& tu
 }
 
 bool keep_fixed_step_lengths(const TuningSet& set, const TurnStatistics& turns, TunedParameters& tuned, FftHeader h,
-                             const SearchOptions& search, double sampling_step_mm, std::optional<float> fixed_ratio,
-                             std::optional<double> fixed_scale) {
+                             double sampling_step_mm, std::optional<float> fixed_ratio, std::optional<double> fixed_scale) {
     if (h.direction_bits() == 16 || set.fibers.empty() || !(sampling_step_mm > 0)) return false;
     // The cap is tuned again at the sampling step among caps no larger than
     // the tuned one: there the rescue beam holds a small cap's outliers,

@@ -145,7 +145,7 @@ TunedParameters tune_parameters(const TuningSet& set, const TurnStatistics& turn
 // error; then `tuned` is replaced.
 inline constexpr double kKeepLengthsShare = 0.5;
 bool keep_fixed_step_lengths(const TuningSet& set, const TurnStatistics& turns, TunedParameters& tuned,
-                             FftHeader header, const SearchOptions& search, double sampling_step_mm,
-                             std::optional<float> fixed_ratio, std::optional<double> fixed_scale);
+                             FftHeader header, double sampling_step_mm, std::optional<float> fixed_ratio,
+                             std::optional<double> fixed_scale);
 
 }  // namespace fiblet::detail
