@@ -61,7 +61,10 @@ public:
     // (codec/length_feedback.hpp): the decoded length is steered towards
     // the targets' polyline length times `stretch` (the decoder's step over
     // the targets' spacing, for resampled input); 0 turns it off (default).
-    FiberEncoder with_length_feedback(float stretch) const;
+    // `tails_only` (fixed-step input, 8-bit codes): only where the fiber's
+    // length error exceeds a share of its point error, and only a block's
+    // last codes are searched again, with the block's own search.
+    FiberEncoder with_length_feedback(float stretch, bool tails_only = false) const;
 
     // Appends block_count(fiber.size()) blocks to `out`. When `decoded` is
     // given, the points fiblet's (float32) decoders will produce (world mm)
@@ -77,6 +80,7 @@ private:
     FftHeader header_;
     SearchOptions search_;
     float length_stretch_ = 0;
+    bool length_tails_only_ = false;
     std::shared_ptr<const Tables> tables_;
 };
 

@@ -182,15 +182,23 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     std::optional<float> fixed_ratio;
     if (options.cap_ratio) fixed_ratio = float(*options.cap_ratio);
     else if (options.turn_percentile) fixed_ratio = compute_ratio(h.scaling, step, turns.dot_at_percentile(*options.turn_percentile));
-    detail::TunedParameters tuned = detail::tune_parameters(
-        {sample.fibers(), turns.sharpest_blocks(), report.resampled ? step : 0.0}, turns, h, options.search, step,
-        fixed_ratio, step_scale);
+    const detail::TuningSet tuning_set{sample.fibers(), turns.sharpest_blocks(), report.resampled ? step : 0.0};
+    detail::TunedParameters tuned =
+        detail::tune_parameters(tuning_set, turns, h, options.search, step, fixed_ratio, step_scale);
+    // Fixed-step input keeps its lengths where the sampling step and the
+    // tail feedback do it (parameters.hpp, keep_fixed_step_lengths).
+    const bool keep_lengths =
+        !report.resampled &&
+        detail::keep_fixed_step_lengths(tuning_set, turns, tuned, h, step, fixed_ratio, step_scale);
     h.ratio = tuned.ratio;
     report.step_scale = tuned.step_scale;
     h.step = float(step * report.step_scale / h.scaling);
-    // Resampled fibers keep their length across blocks (length_feedback.hpp).
+    // Resampled fibers keep their length across blocks (length_feedback.hpp);
+    // fixed-step fibers where keep_lengths (their block tails only).
     const FiberEncoder encoder = (tuned.encoder ? std::move(*tuned.encoder) : FiberEncoder(h, tuned.search))
-                                     .with_length_feedback(report.resampled ? float(decoder_stretch(h.step, h.scaling, step)) : 0.0f);
+                                     .with_length_feedback(report.resampled ? float(decoder_stretch(h.step, h.scaling, step))
+                                                           : keep_lengths ? 1.0f : 0.0f,
+                                                           !report.resampled);
     report.search = encoder.search();
     std::vector<FiberLutEntry> lut(scan.fibers);
     const std::uint64_t per_buffer = fft_max_blocks_per_buffer(h.block_bytes());

@@ -190,9 +190,10 @@ FiberEncoder FiberEncoder::with_search(const SearchOptions& search) const {
     return e;
 }
 
-FiberEncoder FiberEncoder::with_length_feedback(float stretch) const {
+FiberEncoder FiberEncoder::with_length_feedback(float stretch, bool tails_only) const {
     FiberEncoder e = *this;
     e.length_stretch_ = stretch;
+    e.length_tails_only_ = tails_only;
     return e;
 }
 
@@ -326,16 +327,27 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
             }
             return worst;
         };
+        // Fixed-step input keeping its lengths walks the sampling step, where
+        // a few blocks at sharp turns stay above the retry's reach: those get
+        // a wider beam still (length_feedback.hpp, kLengthRescueBeam).
+        const bool rescue = length_stretch_ > 0 && length_tails_only_ && !wide;
+        const float rescue2 = kLengthRescueOverRetry * kLengthRescueOverRetry * threshold2;
         for (b = 0; b < n_blocks; ++b) {
             const std::size_t i0 = std::size_t(b) * ppb, m = block_points(b) >= 2 ? block_points(b) - 2 : 0;
             if (m == 0) continue;
-            const float first = max_error2(&points[i0 + 2], &targets[i0 + 2], m);
+            float first = max_error2(&points[i0 + 2], &targets[i0 + 2], m);
             if (!(first > threshold2)) continue;
             retry_points.resize(m);
             retry_codes8.resize(m);
             retry_codes16.resize(m);
-            search_block(b, retry_params, retry_codes8.data(), retry_codes16.data(), retry_points.data());
-            if (max_error2(retry_points.data(), &targets[i0 + 2], m) < first) {
+            for (int pass = 0; pass < 2; ++pass) {
+                const unsigned width = pass == 0 ? retry_params.beam : kLengthRescueBeam;
+                if (pass == 1 && !(rescue && first > rescue2 && width > retry_params.beam)) break;
+                search_block(b, SearchParams{width, retry_params.radius}, retry_codes8.data(), retry_codes16.data(),
+                             retry_points.data());
+                const float now = max_error2(retry_points.data(), &targets[i0 + 2], m);
+                if (!(now < first)) continue;
+                first = now;
                 std::copy(retry_points.begin(), retry_points.end(), &points[i0 + 2]);
                 if (wide) std::copy(retry_codes16.begin(), retry_codes16.end(), codes16.begin() + std::ptrdiff_t(i0));
                 else std::copy(retry_codes8.begin(), retry_codes8.end(), codes8_of(b));
@@ -382,7 +394,28 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
 
     // Length feedback across the blocks (length_feedback.hpp), with the
     // retry's beam; robust blocks keep the codes that suit both decoders.
-    if (length_stretch_ > 0) {
+    if (length_stretch_ > 0 && length_tails_only_ && !wide) {
+        const Codebook8 cb{*tables_->table8, *tables_->lut8};
+        retry_codes8.resize(ppb);
+        feed_back_length_tails(
+            std::span<const Vec3f>(targets), std::span<Vec3f>(points), ppb, kLengthFeedbackTail, kLengthFeedbackActShare,
+            [&](std::uint32_t blk) { return !(starts[blk].divergence > kRobustDivergence); },
+            [&](std::uint32_t blk, std::size_t j0, std::span<const Vec3f> t, Vec3f* dec) {
+                // The decoder's state before code j0, replayed from the block's start.
+                const std::size_t i0 = std::size_t(blk) * ppb;
+                Frame f = frames[blk];
+                const std::uint8_t* codes = codes8_of(blk);
+                for (std::size_t k = 0; k < j0; ++k) f = compose(f, cb.frame(codes[k]));
+                const Vec3f p = points[i0 + 1 + j0];
+                if (search_.beam_width <= 1 && search_.lookahead > 0)
+                    LookaheadSearch<Codebook8>(cb, h.step, search_.lookahead).run(f, p, t, retry_codes8.data(), dec);
+                else
+                    search_codes(cb, params, f, p, h.step, t, retry_codes8.data(), dec);
+            },
+            [&](std::uint32_t blk, std::size_t j0) {
+                std::copy_n(retry_codes8.begin(), block_points(blk) - 2 - j0, codes8_of(blk) + j0);
+            });
+    } else if (length_stretch_ > 0) {
         const SearchParams feedback_params{std::max({8u, search_.beam_width, search_.retry_beam_width}), 1};
         retry_codes8.resize(ppb);
         retry_codes16.resize(ppb);

@@ -12,6 +12,12 @@
 // kept when they leave a smaller length error without a larger point error
 // than the fiber already has. The fiber's last block is left to the end
 // fraction (fiber_end_encoder.hpp), which places the end point.
+//
+// Fixed-step input (no end fraction) takes a cheaper form,
+// feed_back_length_tails: only a block's last codes are searched again,
+// with the block's own search, and only where the fiber's running length
+// error exceeds a share of its point error; the fiber's last block, which
+// no code can change, is paid for by the bridge before it.
 #pragma once
 
 #include <algorithm>
@@ -29,6 +35,16 @@ namespace fiblet::detail {
 // most the point error the block may have).
 inline constexpr std::uint32_t kLengthFeedbackPoints = 12;
 inline constexpr float kLengthFeedbackShares[] = {1.0f, 0.5f, 0.25f};
+// Fixed-step form: the codes searched again at a block's end, and the share
+// of the fiber's largest point error its length error may reach untouched.
+inline constexpr std::uint32_t kLengthFeedbackTail = 24;
+inline constexpr float kLengthFeedbackActShare = 0.25f;
+// Fixed-step input keeping its lengths: blocks whose max error after the
+// retry's beam still exceeds this multiple of the retry threshold are
+// searched with this beam (at the sampling step, a smaller cap's rare
+// outliers at sharp turns; measured in docs/encode.md).
+inline constexpr float kLengthRescueOverRetry = 1.4f;
+inline constexpr unsigned kLengthRescueBeam = 32;
 
 // `targets` and `points` (decoded) of one fiber, normalized coordinates;
 // blocks of `ppb` points. Callbacks:
@@ -89,6 +105,76 @@ void feed_back_length(std::span<const Vec3f> targets, std::span<Vec3f> points, s
             best = now;
             std::copy(candidate.begin(), candidate.end(), points.begin() + std::ptrdiff_t(first));
             keep(b);
+        }
+    }
+}
+
+// Fixed-step form. The fiber's length error after each block's bridge
+// (the fiber's last block counted with the bridge before it: its codes
+// cannot change its length) is taken back, where it exceeds `act_share`
+// of the fiber's largest point error, by moving the targets of the block's
+// last `tail` points along the track (linearly more towards the end, by at
+// most that point error, in shares 1, 1/2, 1/4) and searching those points
+// again. Callbacks:
+//   adjustable(b)                 whether block b's codes may be searched again
+//   search(b, j0, t, decoded)     searches block b's codes j0.. (its points
+//                                 j0 + 2..) for targets t into a candidate
+//   keep(b, j0)                   the candidate becomes those codes
+template <class Adjustable, class Search, class Keep>
+void feed_back_length_tails(std::span<const Vec3f> targets, std::span<Vec3f> points, std::uint32_t ppb,
+                            std::uint32_t tail, float act_share, Adjustable&& adjustable, Search&& search,
+                            Keep&& keep) {
+    const std::size_t n_points = points.size();
+    if (n_points <= ppb) return;  // one block: its length is the anchors' and the steps'
+    thread_local std::vector<Vec3f> moved, candidate;
+    auto error_of = [&](std::size_t k) { return norm(points[k] - points[k - 1]) - norm(targets[k] - targets[k - 1]); };
+    auto max_error2 = [&](const Vec3f* decoded, std::size_t first, std::size_t m) {
+        float worst = 0;
+        for (std::size_t k = 0; k < m; ++k) {
+            const Vec3f d = decoded[k] - targets[first + k];
+            worst = std::max(worst, dot(d, d));
+        }
+        return worst;
+    };
+    const float fiber_max2 = max_error2(points.data(), 0, n_points);
+    const double act = act_share * std::sqrt(double(fiber_max2));
+    // The fiber's last block: its segments are the anchors' and whole
+    // steps whatever its codes; the block before it takes its error.
+    const std::size_t last_b0 = (n_points - 1) / ppb * ppb;
+    double last_block_error = 0;
+    for (std::size_t k = last_b0 + 1; k < n_points; ++k) last_block_error += error_of(k);
+    double error = 0;  // decoded minus target length, up to the current point
+    for (std::size_t b0 = 0; b0 < last_b0; b0 += ppb) {
+        const std::size_t n = std::min<std::size_t>(ppb, n_points - b0), last = b0 + n - 1;
+        for (std::size_t k = std::max<std::size_t>(b0, 1); k <= last; ++k) error += error_of(k);
+        if (n <= 2) continue;
+        const auto b = std::uint32_t(b0 / ppb);
+        double lag = error + error_of(last + 1);
+        if (last + 1 == last_b0) lag += last_block_error;
+        if (!(std::fabs(lag) > act) || !adjustable(b)) continue;
+        const std::size_t m = n - 2, first = b0 + 2, t = std::min<std::size_t>(tail, m), j0 = m - t;
+        const float allowed2 = fiber_max2;
+        double best = std::fabs(lag);
+        const float reach = std::sqrt(allowed2), move = std::clamp(float(lag), -reach, reach);
+        for (const float share : kLengthFeedbackShares) {
+            moved.assign(targets.begin() + std::ptrdiff_t(first + j0), targets.begin() + std::ptrdiff_t(last + 1));
+            for (std::size_t j = 0; j < t; ++j) {
+                const std::size_t k = last - j;
+                const Vec3f along = targets[k + 1] - targets[k - 1];
+                const float len = std::sqrt(dot(along, along));
+                if (!(len > 0)) continue;
+                const float w = float(t - j) / float(t);
+                moved[k - first - j0] = moved[k - first - j0] + (share * w * move / len) * along;
+            }
+            candidate.resize(t);
+            search(b, j0, std::span<const Vec3f>(moved), candidate.data());
+            if (max_error2(candidate.data(), first + j0, t) > allowed2) continue;
+            const double now = lag + (norm(points[last + 1] - candidate[t - 1]) - norm(points[last + 1] - points[last]));
+            if (!(std::fabs(now) < best)) continue;
+            best = std::fabs(now);
+            std::copy(candidate.begin(), candidate.end(), points.begin() + std::ptrdiff_t(first + j0));
+            keep(b, j0);
+            if (best <= act) break;  // close enough: the next blocks carry the rest
         }
     }
 }

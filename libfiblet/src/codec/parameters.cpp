@@ -117,29 +117,34 @@ void FiberSample::offer(std::span<const Vec3f> fiber) {
 SampleError measure(const TuningSet& set, const FiberEncoder& encoder) {
     std::vector<std::uint8_t> blocks;
     std::vector<Vec3f> decoded;
-    double sum = 0, max = 0;
+    double sum = 0, max = 0, length_change = 0;
     std::size_t n = 0;
+    auto distance = [](Vec3f a, Vec3f b) {
+        const double dx = double(a.x) - b.x, dy = double(a.y) - b.y, dz = double(a.z) - b.z;
+        return std::sqrt(dx * dx + dy * dy + dz * dz);
+    };
     auto encode = [&](std::span<const Vec3f> points, bool in_mean) {
         blocks.clear();
         decoded.clear();
         encoder.encode(points, 0, blocks, &decoded);
+        double change = 0;
         for (std::size_t k = 0; k < points.size(); ++k) {
-            const double dx = double(decoded[k].x) - points[k].x, dy = double(decoded[k].y) - points[k].y,
-                         dz = double(decoded[k].z) - points[k].z;
-            const double e = std::sqrt(dx * dx + dy * dy + dz * dz);
+            const double e = distance(decoded[k], points[k]);
             max = std::max(max, e);
             if (in_mean) sum += e;
+            if (k > 0) change += distance(decoded[k], decoded[k - 1]) - distance(points[k], points[k - 1]);
         }
-        if (in_mean) n += points.size();
+        if (in_mean) n += points.size(), length_change += std::fabs(change);
     };
     for (const auto& fiber : set.fibers) encode(fiber, true);
     for (const auto& block : set.sharp_blocks) encode(block, false);
-    return {n ? sum / double(n) : 0.0, max};
+    return {n ? sum / double(n) : 0.0, max, set.fibers.empty() ? 0.0 : length_change / double(set.fibers.size())};
 }
 
 TunedParameters tune_parameters(const TuningSet& given, const TurnStatistics& turns, FftHeader h,
                                 const SearchOptions& search, double sampling_step_mm,
-                                std::optional<float> fixed_ratio, std::optional<double> fixed_scale) {
+                                std::optional<float> fixed_ratio, std::optional<double> fixed_scale,
+                                bool keep_lengths, float max_ratio) {
     // Fibers to resample are resampled once here, not at every measure().
     TuningSet resampled_set;
     if (given.resample_step_mm > 0) {
@@ -179,8 +184,10 @@ TunedParameters tune_parameters(const TuningSet& given, const TurnStatistics& tu
         for (int i = 0; i < kRatios; ++i) {
             const double angle = hi - (hi - lo) * i / (kRatios - 1);
             const float r = compute_ratio(h.scaling, sampling_step_mm, std::cos(angle));
+            if (r > max_ratio * (1 + 1e-6f)) continue;
             if (ratios.empty() || std::fabs(r - ratios.back()) > 1e-4f * ratios.back()) ratios.push_back(r);
         }
+        if (ratios.empty()) ratios.push_back(max_ratio);
     }
     const double scale0 = fixed_scale.value_or(kDefaultScale);
     double best_objective = INFINITY;
@@ -188,7 +195,7 @@ TunedParameters tune_parameters(const TuningSet& given, const TurnStatistics& tu
     for (float r : ratios) {
         h.ratio = r;
         h.step = step_for(scale0);
-        FiberEncoder encoder(h, search);
+        FiberEncoder encoder = FiberEncoder(h, search).with_length_feedback(keep_lengths ? 1.0f : 0.0f, keep_lengths);
         if (auto_retry) {
             SearchOptions first = search;
             first.retry_beam_width = 0;
@@ -210,6 +217,24 @@ TunedParameters tune_parameters(const TuningSet& given, const TurnStatistics& tu
     best.encoder = best_encoder->with_step(step_for(best.step_scale));
     best.search = best.encoder->search();
     return best;
+}
+
+bool keep_fixed_step_lengths(const TuningSet& set, const TurnStatistics& turns, TunedParameters& tuned, FftHeader h,
+                             double sampling_step_mm, std::optional<float> fixed_ratio, std::optional<double> fixed_scale) {
+    if (h.direction_bits() == 16 || set.fibers.empty() || !(sampling_step_mm > 0)) return false;
+    // The cap is tuned again at the sampling step among caps no larger than
+    // the tuned one: there the rescue beam holds a small cap's outliers,
+    // which the sample's max cannot tell (measured on small-ifod1-step0.05:
+    // the cap tuned at x1.0005, 0.066, gives a mean of 0.92 um at the
+    // sampling step; the one the full sweep picks there, 0.084, 1.01 um).
+    // (With the retry threshold already tuned: one sample encode per cap.)
+    TunedParameters kept = tune_parameters(set, turns, h, tuned.search, sampling_step_mm, fixed_ratio,
+                                           fixed_scale.value_or(1.0), true, tuned.ratio);
+    if (!kept.encoder) return false;
+    const SampleError e = measure({set.fibers, {}, 0}, *kept.encoder);
+    if (!(e.length_change_mm <= kKeepLengthsShare * e.max_mm)) return false;
+    tuned = std::move(kept);
+    return true;
 }
 
 }  // namespace fiblet::detail

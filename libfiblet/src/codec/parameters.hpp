@@ -85,6 +85,7 @@ struct TuningSet {
 
 struct SampleError {
     double mean_mm = 0, max_mm = 0;
+    double length_change_mm = 0;  // mean |decoded - target polyline length| over the fibers
     // The tuning objective: mean + max / 3. The max alone is too noisy
     // (a few rare turns), the mean alone lets the cap shrink until the
     // sharpest turns blow up; a max of about three times the mean is what
@@ -121,9 +122,30 @@ struct TunedParameters {
 // - retry threshold (when `search` retries and sets none): a multiple of
 //   the mean error the first search makes on the sample.
 // `fixed_ratio` / `fixed_scale` skip the corresponding search. `header`
-// holds everything else (scaling, offset, block size, bits).
+// holds everything else (scaling, offset, block size, bits). `keep_lengths`:
+// the encoders measured keep fixed-step lengths (with_length_feedback(1, true));
+// `max_ratio`: caps larger than this are not tried.
 TunedParameters tune_parameters(const TuningSet& set, const TurnStatistics& turns, FftHeader header,
                                 const SearchOptions& search, double sampling_step_mm,
-                                std::optional<float> fixed_ratio, std::optional<double> fixed_scale);
+                                std::optional<float> fixed_ratio, std::optional<double> fixed_scale,
+                                bool keep_lengths = false, float max_ratio = 2.0f);
+
+// Fixed-step input (the targets are the input's own points): whether its
+// fibers keep their lengths with the decoder walking `scale` times the
+// sampling step (1 unless the user fixed it) and the tail feedback
+// (length_feedback.hpp). The tuned scale (x1.0005) makes every fiber that
+// much longer, and the sampling step alone leaves the codes' lag; the two
+// together keep iFOD1's lengths within the point error, but not where the
+// length excess is the across-track scatter of coarse codes along smooth
+// fibers (SD_STREAM: docs/encode.md), which then keep the tuned step and
+// no feedback. The cap is tuned again at that scale, with the feedback,
+// among caps no larger than the tuned one (finer codes; a wider beam holds
+// their rare outliers at the sampling step). Adopted when the
+// sample's mean length change is below kKeepLengthsShare of its max point
+// error; then `tuned` is replaced.
+inline constexpr double kKeepLengthsShare = 0.5;
+bool keep_fixed_step_lengths(const TuningSet& set, const TurnStatistics& turns, TunedParameters& tuned,
+                             FftHeader header, double sampling_step_mm, std::optional<float> fixed_ratio,
+                             std::optional<double> fixed_scale);
 
 }  // namespace fiblet::detail
