@@ -54,21 +54,24 @@ void add_bounds(std::span<const Vec3f> fiber, double* min, double* max) {
     for (int a = 0; a < 3; ++a) min[a] = std::min(min[a], double(lo[a])), max[a] = std::max(max[a], double(hi[a]));
 }
 
-void scan_task(const FiberBatch& b, std::size_t t, ScanSlot& s) {
+void scan_task(const FiberBatch& b, std::size_t t, ScanSlot& s, float* fiber_lengths) {
     double length_sum = 0;  // this task's, added to the slot's once (the same sums whatever the threads)
     thread_local std::vector<double> lengths;  // of a fiber's segments, shared with the turn statistics
     for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1]; ++i) {
         const std::vector<Vec3f>& fiber = b.fibers[i];
         add_bounds(fiber, s.min, s.max);
         lengths.resize(fiber.empty() ? 0 : fiber.size() - 1);
+        double fiber_length = 0;
         for (std::size_t k = 1; k < fiber.size(); ++k) {
             const double len = length(fiber[k - 1], fiber[k]);
             lengths[k - 1] = len;
             s.lengths.add(len);
-            length_sum += len;
+            fiber_length += len;
             s.step_min = std::min(s.step_min, len);
             s.step_max = std::max(s.step_max, len);
         }
+        length_sum += fiber_length;
+        fiber_lengths[i] = float(fiber_length);
         s.segments += lengths.size();
         s.turns->add_fiber(fiber, lengths);
     }
@@ -130,6 +133,7 @@ ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_
                       .lengths = {}};
     FiberBatch batch[2];
     std::vector<ScanSlot> slots[2];
+    std::vector<float> batch_lengths;  // of the current batch's fibers, written by its tasks
     auto add_slots = [&](int k) {
         while (slots[k].size() < batch[k].tasks())
             slots[k].emplace_back().turns.emplace(points_per_block, sharp_blocks);
@@ -139,7 +143,9 @@ ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_
     while (more) {
         const FiberBatch& b = batch[cur];
         add_slots(cur);
-        ParallelJob job(b.tasks(), threads, [&, cur](std::size_t t) { scan_task(batch[cur], t, slots[cur][t]); });
+        batch_lengths.resize(b.count);
+        ParallelJob job(b.tasks(), threads,
+                        [&, cur](std::size_t t) { scan_task(batch[cur], t, slots[cur][t], batch_lengths.data()); });
         // In file order, on the caller's thread while the pool measures.
         for (std::size_t i = 0; i < b.count; ++i) {
             const std::vector<Vec3f>& fiber = b.fibers[i];
@@ -154,6 +160,7 @@ ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_
         }
         more = read_fiber_batch(reader, batch[1 - cur], std::uint32_t(b.first_fiber + b.count));
         job.wait();
+        r.fiber_lengths.insert(r.fiber_lengths.end(), batch_lengths.begin(), batch_lengths.end());
         report_progress(options, "scan", reader);
         cur = 1 - cur;
     }
@@ -176,6 +183,22 @@ ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_
         }
     r.length_sum = length_sum;
     return r;
+}
+
+double block_keeping_step(std::span<const float> fiber_lengths, double step, std::uint32_t points_per_block) {
+    if (!(step > 0) || points_per_block < 4) return step;
+    double finest = 0;
+    for (const float len : fiber_lengths) {
+        if (!(len > 0)) continue;
+        // Its blocks at `step` counted low (chords 0.1 % short of its
+        // length, the first point and the kept end), so that a fiber near a
+        // block's end never gets a block more; then the smallest s with
+        // floor(len / s) + 3 points in as many blocks.
+        const double blocks = std::ceil((std::floor(len * (1 - 1e-3) / step) + 2) / points_per_block);
+        const double room = points_per_block * blocks - 3;
+        finest = std::max(finest, double(len) / (room + 1) * (1 + 1e-9));
+    }
+    return finest > 0 && finest <= kBlockKeepingShrink * step ? finest : step;
 }
 
 void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double tolerance,
@@ -201,9 +224,9 @@ void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double
                 s.too_long = f, s.too_long_mm = fiber_length;
                 return;  // reported in fiber order by the caller
             }
-            const double tension = length_keeping_tension(fiber, step, resample.stretch);
+            const double tension = length_keeping_tension(fiber, step, resample.stretch, kWrittenCurve);
             tensions[f] = std::uint16_t(std::lround(tension / kTensionQuantum));
-            const bool short_tail = resample_cubic_keeping_end(fiber, step, tension, s.resampled);
+            const bool short_tail = resample_cubic_keeping_end(fiber, step, tension, s.resampled, nullptr, kWrittenCurve);
             fiber_points[f] = std::uint32_t(s.resampled.size());
             // The turn towards a kept end is one step per fiber, often a
             // noisy short one: left out of the turn statistics, so the cap
