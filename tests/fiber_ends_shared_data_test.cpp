@@ -214,11 +214,12 @@ TEST(FiberEndsSharedData, ResampledLengthsWithinTheRecordedError) {
             worst_exact = std::max(worst_exact, std::fabs(le - li) - residual);
             worst_raw_exact = std::max(worst_raw_exact, std::fabs(le - li));
         }
-        // At 0.1 mm steps (the resampled bundles: 50-70 anchor quanta a
-        // step) every block's anchors and bridge carry a length error of
-        // about a quantum that codes within their 1-4 um point error cannot
-        // take back: there, a quarter of a step (measured: 20 um on
-        // cingulum-1-step0.1 for 4.1 um recorded; 36 um before).
+        // At 0.1 mm steps (the resampled bundles) the 8-bit codes' zig-zag
+        // lengthens every segment by |across-track error step|^2 / 2 step,
+        // ~2e-4 of the length where the cap is wide (docs/encode.md, "The
+        // 0.1 mm bundles"), more than the 1-4 um point error: there, a
+        // quarter of a step (measured: 19.5 um on cingulum-1-step0.1 for
+        // 4.6 um recorded; 36 um before the length feedback).
         const double bound = r.step_mm >= 0.25 ? recorded : 0.25 * r.step_mm;
         EXPECT_LE(worst, bound) << "a fiber's length changed by more than the recorded error (resampling kept all but "
                                 << unkept << " mm)";
