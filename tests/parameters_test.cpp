@@ -179,4 +179,7 @@ TEST(BlockKeepingStep, FinestStepAtWhichNoFiberNeedsAnotherBlock) {
     for (float& l : long_fibers) l = float(len(rng));
     EXPECT_EQ(block_keeping_step(long_fibers, 0.1, ppb), 0.1);
     EXPECT_EQ(block_keeping_step({}, 0.5, ppb), 0.5);
+    // Short fibers of few points: no finer than a quarter of the step.
+    const std::vector<float> short_fibers(10, 1.0f);
+    EXPECT_EQ(block_keeping_step(short_fibers, 0.5, ppb), kBlockKeepingFinest * 0.5);
 }

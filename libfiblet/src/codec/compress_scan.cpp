@@ -6,6 +6,7 @@
 // the worker pool measures the current batch, a task at a time. Each task
 // index has its own partial statistics (one set per batch parity), merged in
 // index order at the end: the result does not depend on the thread count.
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -198,7 +199,8 @@ double block_keeping_step(std::span<const float> fiber_lengths, double step, std
         const double room = points_per_block * blocks - 3;
         finest = std::max(finest, double(len) / (room + 1) * (1 + 1e-9));
     }
-    return finest > 0 && finest <= kBlockKeepingShrink * step ? finest : step;
+    if (!(finest > 0 && finest <= kBlockKeepingShrink * step)) return step;
+    return std::max(finest, kBlockKeepingFinest * step);
 }
 
 void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double tolerance,
