@@ -160,7 +160,8 @@ TEST(FiberEndsSharedData, TckstatsMeanLengthAgrees) {
 // is the input's within the error the header records, once what resampling
 // itself could not keep is set aside (the tension fit's residual, formats/
 // fft.md §5: zero to 10^-3 step unless a fiber's corners are much shorter
-// than the step, as on cingulum-1). Before the length feedback
+// than the step, as on cingulum-1 at its median spacing); from 0.25 mm
+// steps on, also with nothing set aside. Before the length feedback
 // (codec/length_feedback.hpp) the codes' lag at block ends added up to
 // 96 um on iFOD2 for 46 um recorded, and the end fraction left the raw
 // bundles 0.4-0.9 mm off. Checked for fiblet's decoder and for the float64
@@ -189,7 +190,7 @@ TEST(FiberEndsSharedData, ResampledLengthsWithinTheRecordedError) {
         const std::uint32_t ppb = exact.header.points_per_block;
         TckReader in(tck);
         std::vector<Vec3f> f, target;
-        double worst = 0, worst_exact = 0, unkept = 0;
+        double worst = 0, worst_exact = 0, unkept = 0, worst_raw = 0, worst_raw_exact = 0;
         for (std::size_t i = 0; in.next(f); ++i) {
             if (f.size() < 2) continue;
             const double li = length_of(&f[0].x, f.size());
@@ -198,7 +199,9 @@ TEST(FiberEndsSharedData, ResampledLengthsWithinTheRecordedError) {
             const double residual = std::fabs(how.stretch * length_of(&target[0].x, target.size()) - li);
             unkept = std::max(unkept, residual);
             const std::uint64_t n = s.offsets[i + 1] - s.offsets[i];
-            worst = std::max(worst, std::fabs(length_of(&s.xyz[3 * s.offsets[i]], n) - li) - residual);
+            const double change = std::fabs(length_of(&s.xyz[3 * s.offsets[i]], n) - li);
+            worst = std::max(worst, change - residual);
+            worst_raw = std::max(worst_raw, change);
             std::vector<test::exact::V3> e = exact.fibers[i];
             const auto q = std::uint16_t(std::uint8_t(ends[2 * i]) | std::uint8_t(ends[2 * i + 1]) << 8);
             const std::size_t last_block = e.size() - ppb * ((e.size() - 1) / ppb);
@@ -209,16 +212,27 @@ TEST(FiberEndsSharedData, ResampledLengthsWithinTheRecordedError) {
             double le = 0;
             for (std::size_t k = 1; k < e.size(); ++k) le += std::sqrt(test::exact::dot(e[k] - e[k - 1], e[k] - e[k - 1]));
             worst_exact = std::max(worst_exact, std::fabs(le - li) - residual);
+            worst_raw_exact = std::max(worst_raw_exact, std::fabs(le - li));
         }
-        // At 0.1 mm steps (the resampled bundles: 50-70 anchor quanta a
-        // step) every block's anchors and bridge carry a length error of
-        // about a quantum that codes within their 1-4 um point error cannot
-        // take back: there, a quarter of a step (measured: 20 um on
-        // cingulum-1-step0.1 for 4.1 um recorded; 36 um before).
+        // At 0.1 mm steps (the resampled bundles) the 8-bit codes' zig-zag
+        // lengthens every segment by |across-track error step|^2 / 2 step,
+        // ~2e-4 of the length where the cap is wide (docs/encode.md, "The
+        // 0.1 mm bundles"), more than the 1-4 um point error: there, a
+        // quarter of a step (measured: 19.5 um on cingulum-1-step0.1 for
+        // 4.6 um recorded; 36 um before the length feedback).
         const double bound = r.step_mm >= 0.25 ? recorded : 0.25 * r.step_mm;
         EXPECT_LE(worst, bound) << "a fiber's length changed by more than the recorded error (resampling kept all but "
                                 << unkept << " mm)";
         EXPECT_LE(worst_exact, std::max(1.05 * recorded, bound)) << "float64 decode";
+        // Brute force, nothing set aside: from 0.25 mm steps on (iFOD2, the
+        // raw bundles) every fiber is as long as its input within the
+        // recorded error. Before the rounded corners and the finer step for
+        // fibers of few points (docs/encode.md), cingulum-1 was 1.14 mm off
+        // for 0.63 mm recorded: fibers spaced 1.8 mm at a 3.75 mm step.
+        if (r.step_mm >= 0.25) {
+            EXPECT_LE(worst_raw, recorded) << "a fiber's length changed by more than the recorded error";
+            EXPECT_LE(worst_raw_exact, 1.05 * recorded) << "float64 decode";
+        }
     }
     EXPECT_GE(resampled_files, 6u);
 }
@@ -268,6 +282,28 @@ TEST(FiberEndsSharedData, FixedStepIfod1LengthsWithinTheRecordedError) {
         EXPECT_LE(worst_exact, 1.05 * recorded) << "float64 decode";
     }
     EXPECT_GE(checked, 3u);
+}
+
+// Fibers of few points (the raw bundles: 20 a fiber, one 60-point block
+// each) get the finest step at which every fiber keeps its block count
+// (block_keeping_step): the same bytes as at the median spacing, and the
+// resampled fibers follow their input's corners.
+TEST(FiberEndsSharedData, FewPointFibersGetAFinerStepInTheSameBytes) {
+    if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
+    test::TempDir dir;
+    for (const char* name : {"AF_L.tck", "CC_ForcepsMajor.tck", "CST_R.tck", "cingulum-1.tck", "cingulum-2.tck"}) {
+        const std::string tck = test::shared_data("bundles") + "/" + name;
+        SCOPED_TRACE(tck);
+        CompressOptions o;
+        o.overwrite = true;
+        const CompressReport finer = compress_tck(tck, dir.file("finer.fft"), o);
+        o.step_mm = finer.scan.step_median;
+        const CompressReport median = compress_tck(tck, dir.file("median.fft"), o);
+        EXPECT_LE(finer.step_mm, 0.95 * median.step_mm);
+        EXPECT_EQ(finer.header.blocks, median.header.blocks);
+        EXPECT_EQ(std::filesystem::file_size(dir.file("finer.fft")), std::filesystem::file_size(dir.file("median.fft")));
+        EXPECT_GT(finer.header.points, median.header.points);
+    }
 }
 
 // `tckedit -minlength 100` keeps as many streamlines of the decoded file as

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "codec/compress_stages.hpp"
 #include "codec/parameters.hpp"
 
 using namespace fiblet;
@@ -149,4 +150,36 @@ TEST(TuneParameters, SetsTheRetryThresholdFromTheMeanError) {
     const TunedParameters none = tune_parameters({}, TurnStatistics(60, 0), h, search_for_effort(1), 0.1,
                                                  std::nullopt, std::nullopt);
     EXPECT_EQ(none.search.retry_beam_width, 0u);
+}
+
+TEST(BlockKeepingStep, FinestStepAtWhichNoFiberNeedsAnotherBlock) {
+    // Brute force over fine steps: at the returned step every fiber's
+    // counted points (length / step + 3) fit the blocks it needs at the
+    // default step (counted low: 0.1 % short, + 2), and 0.1 % finer some
+    // fiber would not; a file of long fibers (many blocks each) keeps its step.
+    constexpr std::uint32_t ppb = 60;
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> len(20.0, 180.0);
+    std::vector<float> lengths(200);
+    for (float& l : lengths) l = float(len(rng));
+    const double step = 6.5;
+    auto blocks = [&](double l, double s, double spare) { return std::ceil((std::floor(l / s) + spare) / ppb); };
+    const double finer = block_keeping_step(lengths, step, ppb);
+    EXPECT_LT(finer, kBlockKeepingShrink * step);
+    EXPECT_GT(finer, 0.0);
+    bool tight = false;
+    for (const float l : lengths) {
+        const double at_default = blocks(l * (1 - 1e-3), step, 2);
+        EXPECT_LE(blocks(l, finer, 3), at_default) << l;
+        tight = tight || blocks(l, finer * 0.999, 3) > at_default;
+    }
+    EXPECT_TRUE(tight) << "a finer step would still fit: not the finest";
+    // Fibers of many points: no finer step keeps them all in their blocks.
+    std::vector<float> long_fibers(200);
+    for (float& l : long_fibers) l = float(len(rng));
+    EXPECT_EQ(block_keeping_step(long_fibers, 0.1, ppb), 0.1);
+    EXPECT_EQ(block_keeping_step({}, 0.5, ppb), 0.5);
+    // Short fibers of few points: no finer than a quarter of the step.
+    const std::vector<float> short_fibers(10, 1.0f);
+    EXPECT_EQ(block_keeping_step(short_fibers, 0.5, ppb), kBlockKeepingFinest * 0.5);
 }

@@ -218,8 +218,8 @@ TEST(TrailerIntegrity, TrailerValuesAreValidatedForEveryReader) {
         EXPECT_FALSE(std::filesystem::exists(fx.dir.file("x.fft")));
     }
     EXPECT_EQ(open_error(with_rsmp(step_mm, "ok.fft")), std::nullopt);
-    // The curve field: 0 (polyline) or 1 (cubic), then a zero word; other
-    // sizes are not RSMP chunks.
+    // The curve field: 0 (polyline) to 3 (rounded corners), then a zero
+    // word; other sizes are not RSMP chunks.
     auto with_curve = [&](std::vector<std::uint32_t> words, const std::string& name) {
         return fx.rewritten(name, {}, [&](std::vector<TrailerChunk>& chunks) {
             for (TrailerChunk& c : chunks)
@@ -229,10 +229,11 @@ TEST(TrailerIntegrity, TrailerValuesAreValidatedForEveryReader) {
                 }
         });
     };
-    EXPECT_EQ(FftFile(fx.fft).resampling()->curve, ResampleCurve::cubic_keeping_length);
+    EXPECT_EQ(FftFile(fx.fft).resampling()->curve, ResampleCurve::rounded_keeping_length);
+    EXPECT_EQ(FftFile(with_curve({2, 0}, "tension.fft")).resampling()->curve, ResampleCurve::cubic_keeping_length);
     EXPECT_EQ(FftFile(with_curve({1, 0}, "cubic.fft")).resampling()->curve, ResampleCurve::cubic);
     EXPECT_EQ(FftFile(with_curve({0, 0}, "polyline.fft")).resampling()->curve, ResampleCurve::polyline);
-    for (const auto& words : std::vector<std::vector<std::uint32_t>>{{3, 0}, {1, 1}, {1}, {1, 0, 0}}) {
+    for (const auto& words : std::vector<std::vector<std::uint32_t>>{{4, 0}, {1, 1}, {1}, {1, 0, 0}}) {
         SCOPED_TRACE(words.size());
         EXPECT_EQ(open_error(with_curve(words, "curve.fft")), Errc::fft_format);
     }

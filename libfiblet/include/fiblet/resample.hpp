@@ -23,9 +23,27 @@ enum class ResampleCurve : std::uint32_t {
     cubic = 1,
     // The same cubic with its tangents scaled by a tension fitted fiber by
     // fiber (length_keeping_tension) so that the resampled streamline, end
-    // point kept, is as long as the input polyline. What compress writes.
+    // point kept, is as long as the input polyline. Segments of 4 steps and
+    // more are straight, so no tension reaches the length of a fiber whose
+    // segments are long against the step and turn (chords cut their corners).
     cubic_keeping_length = 2,
+    // Curve 2 with rounded corners instead: a segment longer than
+    // 2 kCornerSteps steps is straight but for a Hermite piece of
+    // kCornerSteps steps at each end, from the tangent at its point to the
+    // segment's direction; shorter segments get the whole cubic. The
+    // tension rounds every corner, so it reaches the length at any step.
+    // What compress writes.
+    rounded_keeping_length = 3,
 };
+
+// Steps of chord length over which a long segment turns from its ends'
+// tangents to its own direction (rounded_keeping_length).
+inline constexpr double kCornerSteps = 2.0;
+
+// Whether a curve's tension is fitted per fiber to keep the length.
+inline constexpr bool keeps_length(ResampleCurve c) {
+    return c == ResampleCurve::cubic_keeping_length || c == ResampleCurve::rounded_keeping_length;
+}
 
 // Tensions the fit tries: 0 (the polyline) to this (rounder than Bessel's).
 inline constexpr double kMaxResampleTension = 4.0;
@@ -46,7 +64,8 @@ static_assert(kMaxResampleTension / kTensionQuantum < 65536);
 // decoder's (decoder_stretch): its steps are that much longer than the
 // chords they follow, the lateral zig-zag of the direction codes taking up
 // the difference. Deterministic: compress and stats find the same tension.
-double length_keeping_tension(std::span<const Vec3f> in, double step, double stretch = 1);
+double length_keeping_tension(std::span<const Vec3f> in, double step, double stretch = 1,
+                              ResampleCurve curve = ResampleCurve::rounded_keeping_length);
 
 // How much longer the decoder's step (header step × scaling, in float as
 // the header holds them) is than the resampling step: what compress and
@@ -79,7 +98,7 @@ struct Resampling {
 // first). A streamline shorter than one step keeps only its first point.
 // With `positions`, also says where each output point lies on the input.
 void resample_fixed_step(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out,
-                         ResampleCurve curve = ResampleCurve::cubic_keeping_length,
+                         ResampleCurve curve = ResampleCurve::rounded_keeping_length,
                          std::vector<PolylinePosition>* positions = nullptr);
 
 // A dropped tail shorter than this fraction of the step is not kept
@@ -93,13 +112,14 @@ inline constexpr double kKeptTailFraction = 1e-3;
 // Returns whether that end point was appended (the last segment is then
 // shorter than the step).
 bool resample_keeping_end(std::span<const Vec3f> in, double step, std::vector<Vec3f>& out,
-                          ResampleCurve curve = ResampleCurve::cubic_keeping_length,
+                          ResampleCurve curve = ResampleCurve::rounded_keeping_length,
                          std::vector<PolylinePosition>* positions = nullptr);
 
-// resample_keeping_end on the cubic_keeping_length curve whose tension is
-// already known (length_keeping_tension's).
+// resample_keeping_end on a length-keeping curve whose tension is already
+// known (length_keeping_tension's).
 bool resample_cubic_keeping_end(std::span<const Vec3f> in, double step, double tension, std::vector<Vec3f>& out,
-                                std::vector<PolylinePosition>* positions = nullptr);
+                                std::vector<PolylinePosition>* positions = nullptr,
+                                ResampleCurve curve = ResampleCurve::rounded_keeping_length);
 
 // The same, resampled as a file says (curve, step and, for the
 // length-keeping tension, the decoder's stretch): the points compress aimed

@@ -115,7 +115,8 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
 
     // The step: the mean over segments for fixed-step data; for variable
     // spacing the header's step_size when the data agrees with it, else the
-    // median spacing; --step overrides. Resample when the spacing departs
+    // median spacing, made finer where every fiber keeps its block count
+    // (block_keeping_step); --step overrides. Resample when the spacing departs
     // from the chosen step by more than the tolerance.
     const double tol = options.step_tolerance;
     const bool variable = scan.segments > 0 && (scan.step_max > scan.step_mean * (1 + tol) ||
@@ -127,7 +128,10 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         step = scan.header_step && std::fabs(*scan.header_step - scan.step_median) <= 0.05 * *scan.header_step
                    ? *scan.header_step
                    : scan.step_median;
+        // Fibers of few points (blocks are fixed-size): a finer step in as many blocks.
+        step = detail::block_keeping_step(scanned.fiber_lengths, step, points_per_block);
     }
+    std::vector<float>().swap(scanned.fiber_lengths);
     report.resampled = scan.segments > 0 && (variable || std::fabs(step - scan.step_mean) > tol * step);
     if (report.resampled && !(step > 0))
         throw Error(Errc::invalid_input, tck_path + ": cannot resample: the measured step is zero");

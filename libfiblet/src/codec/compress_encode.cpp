@@ -82,7 +82,7 @@ void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t
         if (in.step > 0) {
             const bool fields = in.point_fields && in.point_fields->active();
             const bool short_tail = resample_cubic_keeping_end(original, in.step, (*in.tensions)[f] * kTensionQuantum,
-                                                               w.resampled, fields ? &w.positions : nullptr);
+                                                               w.resampled, fields ? &w.positions : nullptr, kWrittenCurve);
             if (fields) in.point_fields->resample(f, w.positions);
             points = w.resampled;
             (*in.end_fractions)[f] = encode_keeping_end(in.encoder, points, short_tail, in.step, f, w.blocks,

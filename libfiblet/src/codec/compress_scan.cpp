@@ -7,6 +7,7 @@
 // a time. Each task
 // index has its own partial statistics (one set per batch parity), merged in
 // index order at the end: the result does not depend on the thread count.
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -40,6 +41,7 @@ struct ScanSlot {
     std::uint64_t segments = 0;
     LengthHistogram lengths;
     std::optional<TurnStatistics> turns;
+    std::vector<float> fiber_lengths;  // of this task's fibers in the current batch
 };
 
 // The bounds of a fiber's points into min / max. Float comparisons (exact:
@@ -59,18 +61,22 @@ void add_bounds(std::span<const Vec3f> fiber, double* min, double* max) {
 void scan_task(const FiberBatch& b, std::size_t t, ScanSlot& s) {
     double length_sum = 0;  // this task's, added to the slot's once (the same sums whatever the threads)
     thread_local std::vector<double> lengths;  // of a fiber's segments, shared with the turn statistics
+    s.fiber_lengths.clear();
     for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1]; ++i) {
         const std::vector<Vec3f>& fiber = b.fibers[i];
         add_bounds(fiber, s.min, s.max);
         lengths.resize(fiber.empty() ? 0 : fiber.size() - 1);
+        double fiber_length = 0;
         for (std::size_t k = 1; k < fiber.size(); ++k) {
             const double len = length(fiber[k - 1], fiber[k]);
             lengths[k - 1] = len;
             s.lengths.add(len);
-            length_sum += len;
+            fiber_length += len;
             s.step_min = std::min(s.step_min, len);
             s.step_max = std::max(s.step_max, len);
         }
+        length_sum += fiber_length;
+        s.fiber_lengths.push_back(float(fiber_length));
         s.segments += lengths.size();
         s.turns->add_fiber(fiber, lengths);
     }
@@ -146,7 +152,11 @@ ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_
                 r.sample.offer(fiber);
             }
         },
-        [&](const FiberBatch&, const std::vector<ScanSlot>&) { report_progress(options, "scan", reader); });
+        [&](const FiberBatch& b, const std::vector<ScanSlot>& done) {
+            for (std::size_t t = 0; t < b.tasks(); ++t)  // task order is file order
+                r.fiber_lengths.insert(r.fiber_lengths.end(), done[t].fiber_lengths.begin(), done[t].fiber_lengths.end());
+            report_progress(options, "scan", reader);
+        });
     // Merged in slot order: the same sums whatever the thread count.
     scan.min = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
                 std::numeric_limits<double>::infinity()};
@@ -168,6 +178,23 @@ ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_
     return r;
 }
 
+double block_keeping_step(std::span<const float> fiber_lengths, double step, std::uint32_t points_per_block) {
+    if (!(step > 0) || points_per_block < 4) return step;
+    double finest = 0;
+    for (const float len : fiber_lengths) {
+        if (!(len > 0)) continue;
+        // Its blocks at `step` counted low (chords 0.1 % short of its
+        // length, the first point and the kept end), so that a fiber near a
+        // block's end never gets a block more; then the smallest s with
+        // floor(len / s) + 3 points in as many blocks.
+        const double blocks = std::ceil((std::floor(len * (1 - 1e-3) / step) + 2) / points_per_block);
+        const double room = points_per_block * blocks - 3;
+        finest = std::max(finest, double(len) / (room + 1) * (1 + 1e-9));
+    }
+    if (!(finest > 0 && finest <= kBlockKeepingShrink * step)) return step;
+    return std::max(finest, kBlockKeepingFinest * step);
+}
+
 void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double tolerance,
                          std::size_t max_fiber_points, TckScan& scan, std::vector<std::uint32_t>& fiber_points,
                          std::vector<std::uint16_t>& tensions, TurnStatistics& turns, std::uint32_t points_per_block,
@@ -186,9 +213,9 @@ void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double
                 s.too_long = f, s.too_long_mm = fiber_length;
                 return;  // reported in fiber order by the caller
             }
-            const double tension = length_keeping_tension(fiber, step, resample.stretch);
+            const double tension = length_keeping_tension(fiber, step, resample.stretch, kWrittenCurve);
             tensions[f] = std::uint16_t(std::lround(tension / kTensionQuantum));
-            const bool short_tail = resample_cubic_keeping_end(fiber, step, tension, s.resampled);
+            const bool short_tail = resample_cubic_keeping_end(fiber, step, tension, s.resampled, nullptr, kWrittenCurve);
             fiber_points[f] = std::uint32_t(s.resampled.size());
             // The turn towards a kept end is one step per fiber, often a
             // noisy short one: left out of the turn statistics, so the cap

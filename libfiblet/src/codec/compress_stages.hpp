@@ -74,7 +74,22 @@ struct ScanStageResult {
     FiberSample sample;                       // fibers for tuning the encoder
     LengthHistogram lengths;                  // segment lengths (their median)
     double length_sum = 0;
+    std::vector<float> fiber_lengths;  // per fiber: its polyline length (mm), for block_keeping_step
 };
+
+// The resampling step for variable-step input whose default step is
+// `step`: the smallest step at which no fiber needs more blocks of
+// `points_per_block` than at `step` (a fiber of length L is counted
+// L / step + 3 points: the first, one a chord, the kept end and one to
+// spare), when that is at most kBlockKeepingShrink of `step` (else `step`),
+// but no finer than kBlockKeepingFinest of it: at most 4 times the points
+// (fibers of a few mm among a file of a few points each would otherwise
+// get steps near the anchors' quantum).
+// Blocks are fixed-size, so a fiber of few points (raw bundles: 20 a fiber,
+// one 60-point block) gets the finer step for no bytes: its chords then
+// follow its corners (docs/encode.md, "A finer step for fibers of few points").
+inline constexpr double kBlockKeepingShrink = 0.95, kBlockKeepingFinest = 0.25;
+double block_keeping_step(std::span<const float> fiber_lengths, double step, std::uint32_t points_per_block);
 
 // Pass 1 over `reader` (from where it stands: its start): fills scan's
 // counts, bounds and step extremes (not step_mean/median: from the result).

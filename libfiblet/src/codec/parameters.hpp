@@ -19,7 +19,7 @@ namespace fiblet::detail {
 
 // The curve compress resamples variable-step input on (its RSMP chunk):
 // lengths kept fiber by fiber.
-inline constexpr ResampleCurve kWrittenCurve = ResampleCurve::cubic_keeping_length;
+inline constexpr ResampleCurve kWrittenCurve = ResampleCurve::rounded_keeping_length;
 
 // The turning angles between consecutive unit segment directions
 // (zero-length segments carry no direction and are skipped): a histogram

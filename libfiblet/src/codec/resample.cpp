@@ -114,13 +114,37 @@ void walk_polyline(std::span<const Vec3f> in, ChordWalk& walk) {
     for (std::size_t i = 0; i + 1 < in.size(); ++i) walk.piece(to_v3(in[i]), to_v3(in[i + 1]), i);
 }
 
+// One Hermite piece from p0 to p1 (chord length d) with end tangents m0, m1
+// (per unit of chord length), fed to the walk as short straight pieces:
+// the part [t0, t1] of input segment `segment`.
+void walk_hermite(V3 p0, V3 m0, V3 p1, V3 m1, double d, std::size_t pieces, std::size_t segment, double t0,
+                  double t1, ChordWalk& walk) {
+    V3 from = p0;
+    for (std::size_t k = 1; k <= pieces; ++k) {
+        const double t = double(k) / double(pieces), t2 = t * t, t3 = t2 * t;
+        const V3 to = k == pieces ? p1
+                                  : add(add(mul(p0, 2 * t3 - 3 * t2 + 1), mul(m0, d * (t3 - 2 * t2 + t))),
+                                        add(mul(p1, 3 * t2 - 2 * t3), mul(m1, d * (t3 - t2))));
+        walk.piece(from, to, segment, t0 + (t1 - t0) * double(k - 1) / double(pieces), t0 + (t1 - t0) * t);
+        from = to;
+    }
+}
+
 // Feeds the walk the C¹ cubic (Hermite, Bessel tangents) through the input
-// points, as short straight pieces; it passes through every input point. On
-// long segments the tangents lean towards the segment (curve_weight): a
-// Hermite segment whose end tangents are its own direction is the segment.
+// points, as short straight pieces; it passes through every input point.
 // `tension` scales every tangent: 0 gives the polyline itself, 1 the Bessel
 // cubic, more a rounder curve (directions, hence C¹ joints, are kept).
-void walk_cubic(std::span<const Vec3f> in, double step, double tension, double pieces_per_step, ChordWalk& walk) {
+// Long segments (`rounded`: the rounded-corner curve; else the older one):
+//  - older: the tangents lean towards the segment (curve_weight), a
+//    Hermite segment whose end tangents are its own direction being the
+//    segment; from four steps on the segment is straight, so chords cut its
+//    corners whatever the tension;
+//  - rounded: the segment is straight but for a Hermite piece of
+//    kCornerSteps steps at each end, from the point's tangent to the
+//    segment's direction: the corner is rounded at the step's scale, and
+//    the tension still lengthens it.
+void walk_cubic(std::span<const Vec3f> in, double step, double tension, double pieces_per_step, bool rounded,
+                ChordWalk& walk) {
     thread_local std::vector<V3> p, m;
     thread_local std::vector<std::size_t> index;
     distinct_points(in, p, index);
@@ -132,21 +156,22 @@ void walk_cubic(std::span<const Vec3f> in, double step, double tension, double p
         return;
     }
     bessel_tangents(p, m);
+    const double corner = kCornerSteps * step;
     for (std::size_t i = 0; i + 1 < p.size(); ++i) {
         const double d = length(sub(p[i + 1], p[i]));
-        const double w = curve_weight(d, step);
         const V3 u = mul(sub(p[i + 1], p[i]), 1.0 / d);
+        if (rounded && d > 2 * corner) {
+            const V3 a = add(p[i], mul(u, corner)), b = sub(p[i + 1], mul(u, corner)), ut = mul(u, tension);
+            const std::size_t pieces = pieces_for(corner, step, pieces_per_step);
+            walk_hermite(p[i], mul(m[i], tension), a, ut, corner, pieces, segment(i), 0, corner / d, walk);
+            walk.piece(a, b, segment(i), corner / d, 1 - corner / d);
+            walk_hermite(b, ut, p[i + 1], mul(m[i + 1], tension), corner, pieces, segment(i), 1 - corner / d, 1, walk);
+            continue;
+        }
+        const double w = rounded ? 1.0 : curve_weight(d, step);
         const V3 m0 = mul(lerp(u, m[i], w), tension), m1 = mul(lerp(u, m[i + 1], w), tension);
         const std::size_t pieces = w > 0 ? pieces_for(d, step, pieces_per_step) : 1;
-        V3 from = p[i];
-        for (std::size_t k = 1; k <= pieces; ++k) {
-            const double t = double(k) / double(pieces), t2 = t * t, t3 = t2 * t;
-            const V3 to = k == pieces ? p[i + 1]
-                                      : add(add(mul(p[i], 2 * t3 - 3 * t2 + 1), mul(m0, d * (t3 - 2 * t2 + t))),
-                                            add(mul(p[i + 1], 3 * t2 - 2 * t3), mul(m1, d * (t3 - t2))));
-            walk.piece(from, to, segment(i), double(k - 1) / double(pieces), t);
-            from = to;
-        }
+        walk_hermite(p[i], m0, p[i + 1], m1, d, pieces, segment(i), 0, 1, walk);
     }
 }
 
@@ -161,7 +186,7 @@ bool resample_on(std::span<const Vec3f> in, double step, ResampleCurve curve, do
     if (in.empty()) return false;
     ChordWalk walk(to_v3(in[0]), step, out, positions);
     if (curve == ResampleCurve::polyline) walk_polyline(in, walk);
-    else walk_cubic(in, step, tension, pieces_per_step, walk);
+    else walk_cubic(in, step, tension, pieces_per_step, curve == ResampleCurve::rounded_keeping_length, walk);
     if (!keep_end || in.size() < 2) return false;
     const V3 tail = sub(to_v3(in.back()), to_v3(out.back()));
     if (!(std::sqrt(dot(tail, tail)) > kKeptTailFraction * step)) return false;
@@ -177,7 +202,7 @@ double polyline_length_of(std::span<const Vec3f> p) {
 }
 }  // namespace
 
-double length_keeping_tension(std::span<const Vec3f> in, double step, double stretch) {
+double length_keeping_tension(std::span<const Vec3f> in, double step, double stretch, ResampleCurve curve) {
     constexpr double kMax = kMaxResampleTension;
     const double target = polyline_length_of(in), tolerance = kLengthTolerance * step;
     thread_local std::vector<Vec3f> walked;
@@ -185,7 +210,7 @@ double length_keeping_tension(std::span<const Vec3f> in, double step, double str
     // chords between anchors, two a block, are not stretched: 0.1 % of a
     // step each, left out).
     auto excess = [&](double t) {
-        resample_on(in, step, ResampleCurve::cubic, t, true, kPiecesPerStep, walked, nullptr);
+        resample_on(in, step, curve, t, true, kPiecesPerStep, walked, nullptr);
         return stretch * polyline_length_of(walked) - target;
     };
     double best_t = 1, best = excess(1);
@@ -230,16 +255,15 @@ double length_keeping_tension(std::span<const Vec3f> in, double step, double str
 }
 
 bool resample_cubic_keeping_end(std::span<const Vec3f> in, double step, double tension, std::vector<Vec3f>& out,
-                                std::vector<PolylinePosition>* positions) {
-    return resample_on(in, step, ResampleCurve::cubic, tension, true, kPiecesPerStep, out, positions);
+                                std::vector<PolylinePosition>* positions, ResampleCurve curve) {
+    return resample_on(in, step, curve, tension, true, kPiecesPerStep, out, positions);
 }
 
 namespace {
 // The tension `how` resamples on: fitted for the length-keeping curve, else
 // Bessel's (1; the polyline walk ignores it).
 double tension_for(std::span<const Vec3f> in, const Resampling& how) {
-    return how.curve == ResampleCurve::cubic_keeping_length ? length_keeping_tension(in, how.step_mm, how.stretch)
-                                                            : 1.0;
+    return keeps_length(how.curve) ? length_keeping_tension(in, how.step_mm, how.stretch, how.curve) : 1.0;
 }
 }  // namespace
 

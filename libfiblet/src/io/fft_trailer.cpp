@@ -153,7 +153,7 @@ Resampling parse_resampling(const TrailerChunk& c, const FftHeader& h, const std
         std::uint32_t curve, reserved;
         std::memcpy(&curve, c.payload.data() + 8, 4);
         std::memcpy(&reserved, c.payload.data() + 12, 4);
-        if (curve > std::uint32_t(ResampleCurve::cubic_keeping_length) || reserved != 0)
+        if (curve > std::uint32_t(ResampleCurve::rounded_keeping_length) || reserved != 0)
             bad_chunk(name, c.tag, "unknown resampling curve " + std::to_string(curve) + "/" + std::to_string(reserved));
         r.curve = ResampleCurve(curve);
     }
