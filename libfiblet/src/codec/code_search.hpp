@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "codec/nearest_code_lut.hpp"
+#include "codec/row_frame.hpp"
 #include "core/vec_math.hpp"
 #include "fiblet/direction_code.hpp"
 
@@ -49,6 +50,8 @@ struct Codebook8 {
     Code nearest(Vec3f local) const { return lut.usable() ? lut(local) : table.nearest_code(local); }
     const Frame& frame(unsigned c) const { return table.frame(Code(c)); }
     const Vec3f& direction(unsigned c) const { return table.direction(Code(c)); }
+    const RowFrame& rows(unsigned c) const { return lut.rows(Code(c)); }
+    const NearestCodeLut::Neighbours& neighbours(unsigned c) const { return lut.neighbours(Code(c)); }
 };
 
 // The wide codes of 16-bit files (256 or 181 levels).
@@ -198,20 +201,31 @@ public:
     // targets, a step's error is the larger of its two squared errors.
     void start(Frame f, Vec3f p, std::span<const Vec3f> targets, Code* codes, Vec3f* decoded,
                std::span<const Vec3f> alt_targets = {}) {
-        f_ = f, p_ = p, targets_ = targets, alt_ = alt_targets, codes_ = codes, decoded_ = decoded, k_ = 0;
+        f_ = row_frame(f), p_ = f4_of(p), targets_ = targets, alt_ = alt_targets, codes_ = codes, decoded_ = decoded, k_ = 0;
         chain_ = &chains_[0], trial_ = &chains_[1];
         chain_->reset();
     }
     bool done() const { return k_ >= targets_.size(); }
-    // Chooses the code of the next point.
+    // Chooses the code of the next point: prepare() (the aimed code's
+    // path), then finish() (the rivals, the choice). Lanes run in lockstep
+    // call prepare() on every lane first: the aimed paths' long dependency
+    // chains then overlap instead of waiting behind each lane's branchy
+    // rival search.
     void step() {
-        const std::size_t k = k_++, end = std::min(targets_.size(), k + 1 + depth_);
+        prepare();
+        finish();
+    }
+    void prepare() {
+        const std::size_t k = k_, end = std::min(targets_.size(), k + 1 + depth_);
         extend(*chain_, k, end);
+    }
+    void finish() {
+        const std::size_t k = k_++, end = std::min(targets_.size(), k + 1 + depth_);
         if (end > k + 1) choose(k, end);
         const Step& s = (*chain_)[0];
         codes_[k] = Code(s.code);
         f_ = s.f, p_ = s.p;
-        decoded_[k] = p_;
+        decoded_[k] = vec3_of(p_);
         chain_->shift();
     }
     void run(Frame f, Vec3f p, std::span<const Vec3f> targets, Code* codes, Vec3f* decoded,
@@ -222,14 +236,16 @@ public:
 
 private:
     // One step of a path: at the point it is for, the target in the frame
-    // before the step (local), the code taken, its squared error, and the
-    // state after it.
+    // before the step (local) with its dot(local, local) + step^2 (base),
+    // the code taken, its squared error, and the state after it (frame as
+    // rows: row_frame.hpp).
     struct Step {
-        Vec3f local, alt_local;  // alt_local: robust search only
+        F4 local, alt_local;  // alt_local: robust search only
+        float base, alt_base;
         unsigned code;
         float error2;
-        Frame f;
-        Vec3f p;
+        RowFrame f;
+        F4 p;
     };
     // Steps for points k, k + 1, ... (k: the point being chosen), from
     // s[head]: shifting by one point moves `head`, the steps are copied back
@@ -255,30 +271,52 @@ private:
         }
     };
 
-    // The state after taking `code` from (f, p): the decoder's operations.
-    void take(Step& s, unsigned code, const Frame& f, Vec3f p) const {
+    // The state after taking `code` from (f, p): the decoder's operations
+    // (p + step * F.c0 with F = compose(f, frame(code))).
+    void take(Step& s, unsigned code, const RowFrame& f, F4 p) const {
         s.code = code;
-        s.f = compose(f, cb_.frame(code));
-        s.p = p + step_ * s.f.c[0];
+        s.f = compose(f, cb_.rows(code));
+        s.p = f4_add(p, f4_mul(f4_set1(step_), axis(s.f)));
     }
-    // |p + step d - t|^2 = |t - p|^2 + step^2 - 2 step d.(t - p), in the local frame.
-    // Clamped at 0 (rounding can take a tiny error below it) so that partial
-    // sums never decrease: the branch and bound below is then exact.
-    float error2(Vec3f local, unsigned code) const {
-        return std::max(0.0f, dot(local, local) + step2_ - two_step_ * dot(cb_.direction(code), local));
+    // |p + step d - t|^2 = |t - p|^2 + step^2 - 2 step d.(t - p), in the local frame
+    // (base = |t - p|^2 + step^2). Clamped at 0 (rounding can take a tiny
+    // error below it) so that partial sums never decrease: the branch and
+    // bound below is then exact.
+    float error2(F4 local, float base, unsigned code) const {
+        const Vec3f& d = cb_.direction(code);
+        return max0(base - two_step_ * (d.x * f4_lane<0>(local) + d.y * f4_lane<1>(local) + d.z * f4_lane<2>(local)));
     }
     float error2(const Step& s, unsigned code) const {
-        const float e = error2(s.local, code);
-        return alt_.empty() ? e : std::max(e, error2(s.alt_local, code));
+        const float e = error2(s.local, s.base, code);
+        return alt_.empty() ? e : std::max(e, error2(s.alt_local, s.alt_base, code));
+    }
+    // error2(s, code) of the 8 neighbours' codes (+inf past their count):
+    // the same products and sums, four lanes at a time.
+    void rival_errors(const Step& s, const NearestCodeLut::Neighbours& nb, float* out) const {
+        const F4 two_step = f4_set1(two_step_), zero = f4_set1(0.0f);
+        auto lanes = [&](F4 local, float base, int i) {
+            const F4 d = f4_add(f4_add(f4_mul(f4_load(nb.x + i), f4_splat<0>(local)), f4_mul(f4_load(nb.y + i), f4_splat<1>(local))),
+                                f4_mul(f4_load(nb.z + i), f4_splat<2>(local)));
+            return f4_max(zero, f4_sub(f4_set1(base), f4_mul(two_step, d)));
+        };
+        for (int i = 0; i < 8; i += 4) {
+            F4 e = lanes(s.local, s.base, i);
+            if (!alt_.empty()) e = f4_max(e, lanes(s.alt_local, s.alt_base, i));
+            f4_store(out + i, f4_add(e, f4_load(nb.pad + i)));
+        }
     }
     // The greedy step for point j from state (f, p), without its state after.
-    void aim(Step& s, std::size_t j, const Frame& f, Vec3f p) const {
-        s.local = apply_transposed(f, targets_[j] - p);
+    void aim(Step& s, std::size_t j, const RowFrame& f, F4 p) const {
+        const F4 t = f4_of(targets_[j]);
+        s.local = apply_transposed(f, f4_sub(t, p));
+        s.base = dot_self(s.local) + step2_;
         if (alt_.empty()) {
-            s.code = cb_.nearest(s.local);
+            s.code = cb_.nearest(vec3_of(s.local));
         } else {
-            s.alt_local = apply_transposed(f, alt_[j] - p);
-            s.code = cb_.nearest(apply_transposed(f, midpoint(targets_[j], alt_[j]) - p));
+            const F4 alt = f4_of(alt_[j]);
+            s.alt_local = apply_transposed(f, f4_sub(alt, p));
+            s.alt_base = dot_self(s.alt_local) + step2_;
+            s.code = cb_.nearest(vec3_of(apply_transposed(f, f4_sub(f4_of(midpoint(targets_[j], alt_[j])), p))));
         }
         s.error2 = error2(s, s.code);
     }
@@ -288,8 +326,8 @@ private:
         c.reserve(end - k);
         for (std::size_t j = k + c.n; j < end; ++j) {
             Step& s = c[c.n];
-            const Frame& fb = c.n ? c[c.n - 1].f : f_;
-            const Vec3f pb = c.n ? c[c.n - 1].p : p_;
+            const RowFrame& fb = c.n ? c[c.n - 1].f : f_;
+            const F4 pb = c.n ? c[c.n - 1].p : p_;
             aim(s, j, fb, pb);
             take(s, s.code, fb, pb);
             ++c.n;
@@ -297,26 +335,22 @@ private:
     }
 
     // Replaces the aimed code's path by a rival's where one is cheaper.
+    // A rival path's last step is taken (its state computed) only for the
+    // path that wins in the end: the losers never need it.
     void choose(std::size_t k, std::size_t end) {
         Step first;  // the aim's locals and code: copies, chain_ changes hands below
         first.local = (*chain_)[0].local, first.alt_local = (*chain_)[0].alt_local;
+        first.base = (*chain_)[0].base, first.alt_base = (*chain_)[0].alt_base;
         const unsigned aimed = (*chain_)[0].code;
-        // The rivals' own errors; tried cheapest first, each found by a
-        // branch-free scan (sorting them all costs more: most points try
-        // none or one).
-        float rival_error2[8];
-        unsigned rival_code[8];
-        unsigned n = 0;
-        const int L = cb_.levels();
-        const int h0 = int(aimed) / L, l0 = int(aimed) % L;
-        for (int h = std::max(h0 - 1, 0); h <= std::min(h0 + 1, L - 1); ++h)
-            for (int l = std::max(l0 - 1, 0); l <= std::min(l0 + 1, L - 1); ++l) {
-                const auto code = unsigned(h * L + l);
-                if (code == aimed) continue;
-                rival_error2[n] = error2(first, code), rival_code[n] = code, ++n;
-            }
-        for (unsigned i = n; i < 8; ++i) rival_error2[i] = INFINITY, rival_code[i] = 0;
+        // The rivals' own errors, four at a time; tried cheapest first, each
+        // found by a branch-free scan (sorting them all costs more: most
+        // points try none or one).
+        alignas(16) float rival_error2[8];
+        const auto& nb = cb_.neighbours(aimed);
+        rival_errors(first, nb, rival_error2);
         float best = chain_->sum();
+        const RowFrame* last_f = nullptr;  // the winning rival's last step still to take, from (last_f, last_p)
+        F4 last_p = p_;
         for (;;) {
             unsigned r = 0;
             for (unsigned i = 1; i < 8; ++i) r = rival_error2[i] < rival_error2[r] ? i : r;
@@ -327,27 +361,39 @@ private:
             Chain& t = *trial_;
             t.reset();
             t[0].local = first.local, t[0].alt_local = first.alt_local;
+            t[0].base = first.base, t[0].alt_base = first.alt_base;
             t[0].error2 = e0;
-            take(t[0], rival_code[r], f_, p_);
+            t[0].code = nb.code[r];
             t.n = 1;
             float e = e0;
+            // Each step's state is computed when the next step needs it:
+            // t[t.n - 1]'s is not yet.
             for (std::size_t j = k + 1; j < end; ++j) {
+                Step& prev = t[t.n - 1];
+                take(prev, prev.code, t.n > 1 ? t[t.n - 2].f : f_, t.n > 1 ? t[t.n - 2].p : p_);
                 Step& s = t[t.n];
-                aim(s, j, t[t.n - 1].f, t[t.n - 1].p);
+                aim(s, j, prev.f, prev.p);
                 e += s.error2;
                 if (!(e < best)) break;
-                take(s, s.code, t[t.n - 1].f, t[t.n - 1].p);
                 ++t.n;
             }
-            if (e < best) best = e, std::swap(chain_, trial_);
+            if (e < best) {
+                best = e, std::swap(chain_, trial_);
+                last_f = chain_->n > 1 ? &(*chain_)[chain_->n - 2].f : &f_;
+                last_p = chain_->n > 1 ? (*chain_)[chain_->n - 2].p : p_;
+            }
+        }
+        if (last_f) {
+            Step& s = (*chain_)[chain_->n - 1];
+            take(s, s.code, *last_f, last_p);
         }
     }
 
     const Codebook& cb_;
     const float step_, step2_, two_step_;
     const std::size_t depth_;
-    Frame f_;  // the decoder's state before point k_
-    Vec3f p_;
+    RowFrame f_;  // the decoder's state before point k_
+    F4 p_;
     std::span<const Vec3f> targets_, alt_;
     Code* codes_ = nullptr;
     Vec3f* decoded_ = nullptr;
