@@ -13,11 +13,15 @@ NearestCodeLut::NearestCodeLut(const DirectionTable& table) {
     for (unsigned c = 0; c < 256; ++c) {
         Neighbours& nb = neighbours_[c];
         nb.count = 0;
+        nb.before = 0;
         const int h0 = int(c >> 4), l0 = int(c & 15);
         for (int h = std::max(h0 - 1, 0); h <= std::min(h0 + 1, 15); ++h)
             for (int l = std::max(l0 - 1, 0); l <= std::min(l0 + 1, 15); ++l) {
                 const auto code = unsigned(h << 4 | l);
-                if (code == c) continue;
+                if (code == c) {
+                    nb.before = nb.count;
+                    continue;
+                }
                 const Vec3f& d = table.direction(std::uint8_t(code));
                 nb.x[nb.count] = d.x, nb.y[nb.count] = d.y, nb.z[nb.count] = d.z, nb.pad[nb.count] = 0.0f;
                 nb.code[nb.count++] = std::uint8_t(code);

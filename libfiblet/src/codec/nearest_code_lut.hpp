@@ -39,6 +39,7 @@ public:
         alignas(16) float x[8], y[8], z[8], pad[8];
         std::uint8_t code[8];
         unsigned count;
+        unsigned before;  // how many of them precede the code itself in grid order
     };
     const Neighbours& neighbours(std::uint8_t code) const { return neighbours_[code]; }
 
