@@ -29,7 +29,7 @@ public:
 
     explicit NearestCodeLut(const DirectionTable& table);
     bool usable() const { return !cells_.empty(); }
-    // The code's local frame as rows (row_frame.hpp), for the lookahead search.
+    // The code's local frame as rows (row_frame.hpp), for the code searches.
     const RowFrame& rows(std::uint8_t code) const { return rows_[code]; }
     // The codes of the 3x3 around a code (itself left out), in grid order
     // (level h, then level l, ascending), with their directions as columns
