@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "codec/code_search.hpp"
@@ -275,4 +276,75 @@ TEST(CodeSearch, LookaheadLowersTheSquaredErrorOfGreedyAiming) {
     EXPECT_LT(lookahead, 0.9 * greedy);
     with_lookahead.lookahead = detail::kMaxLookahead + 1;
     EXPECT_THROW(FiberEncoder(h, with_lookahead), Error);
+}
+
+namespace {
+
+// Codebook8 without its row frames and neighbour tables: search_codes then
+// runs its generic beam on Frames, the reference for beam_search_rows.
+struct PlainCodebook8 {
+    using Code = std::uint8_t;
+    const detail::Codebook8& cb;
+    static constexpr int levels() { return 16; }
+    Code nearest(Vec3f local) const { return cb.nearest(local); }
+    const Frame& frame(unsigned c) const { return cb.frame(c); }
+    const Vec3f& direction(unsigned c) const { return cb.direction(c); }
+};
+
+bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+}  // namespace
+
+TEST(CodeSearch, RowFramesComposeAndApplyBitForBitAsFrames) {
+    using namespace detail;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-1, 1);
+    const DirectionTable table(0.0968f);
+    for (int i = 0; i < 2000; ++i) {
+        const Frame f = frame_from_axis(normalize(Vec3f{u(rng), u(rng), u(rng)}));
+        const Frame& l = table.frame(std::uint8_t(rng() % 256));
+        const Vec3f v{100 * u(rng), 100 * u(rng), 100 * u(rng)};
+        const Frame want = compose(f, l);
+        const RowFrame got = compose(row_frame(f), row_frame(l));
+        const Vec3f axis_got = vec3_of(axis(got));
+        for (int r = 0; r < 3; ++r) {
+            const Vec3f row = vec3_of(got.r[r]);
+            const float* w[3] = {&want.c[0].x, &want.c[1].x, &want.c[2].x};
+            EXPECT_TRUE(same_bits(row.x, w[0][r]) && same_bits(row.y, w[1][r]) && same_bits(row.z, w[2][r]));
+        }
+        EXPECT_TRUE(same_bits(axis_got.x, want.c[0].x) && same_bits(axis_got.y, want.c[0].y) && same_bits(axis_got.z, want.c[0].z));
+        const Vec3f a = apply_transposed(f, v), b = vec3_of(apply_transposed(row_frame(f), f4_of(v)));
+        EXPECT_TRUE(same_bits(a.x, b.x) && same_bits(a.y, b.y) && same_bits(a.z, b.z));
+    }
+}
+
+TEST(CodeSearch, BeamOnRowFramesChoosesWhatTheGenericBeamChooses) {
+    using namespace detail;
+    const FftHeader h = header(0.0968f);
+    const DirectionTable table(h.ratio);
+    const NearestCodeLut lut(table);
+    const Codebook8 cb{table, lut};
+    const PlainCodebook8 plain{cb};
+    std::size_t compared = 0;
+    for (unsigned width : {2u, 8u, 16u})
+        for (bool robust : {false, true})
+            for (const auto& f : walks(6, 58, 20 + width)) {
+                std::vector<Vec3f> t(f.size()), alt;
+                for (std::size_t k = 0; k < f.size(); ++k)
+                    t[k] = {f[k].x / h.scaling + 0.5f, f[k].y / h.scaling + 0.5f, f[k].z / h.scaling + 0.5f};
+                const Frame f0 = frame_from_axis(normalize(t[1] - t[0]));
+                const std::vector<Vec3f> targets(t.begin() + 2, t.end());
+                if (robust)  // the second decoder's targets: a small rotation away
+                    for (const Vec3f& p : targets) alt.push_back({p.x + 1e-5f * (p.y - 0.5f), p.y - 1e-5f * (p.x - 0.5f), p.z});
+                std::vector<std::uint8_t> got(targets.size()), want(targets.size());
+                std::vector<Vec3f> got_points(targets.size()), want_points(targets.size());
+                search_codes(cb, {width, 1}, f0, t[1], h.step, targets, got.data(), got_points.data(), alt);
+                search_codes(plain, {width, 1}, f0, t[1], h.step, targets, want.data(), want_points.data(), alt);
+                EXPECT_EQ(got, want) << "width " << width << (robust ? ", robust" : "");
+                for (std::size_t k = 0; k < targets.size(); ++k)
+                    EXPECT_TRUE(same_bits(got_points[k].x, want_points[k].x) && same_bits(got_points[k].y, want_points[k].y) &&
+                                same_bits(got_points[k].z, want_points[k].z));
+                compared += targets.size();
+            }
+    EXPECT_EQ(compared, 3u * 2u * 6u * 56u);
 }

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "codec/nearest_code_lut.hpp"
+#include "codec/row_frame.hpp"
 #include "core/vec_math.hpp"
 #include "fiblet/direction_code.hpp"
 
@@ -49,6 +50,8 @@ struct Codebook8 {
     Code nearest(Vec3f local) const { return lut.usable() ? lut(local) : table.nearest_code(local); }
     const Frame& frame(unsigned c) const { return table.frame(Code(c)); }
     const Vec3f& direction(unsigned c) const { return table.direction(Code(c)); }
+    const RowFrame& rows(unsigned c) const { return lut.rows(Code(c)); }
+    const NearestCodeLut::Neighbours& neighbours(unsigned c) const { return lut.neighbours(Code(c)); }
 };
 
 // The wide codes of 16-bit files (256 or 181 levels).
@@ -63,6 +66,106 @@ struct Codebook16 {
 };
 
 inline Vec3f midpoint(Vec3f a, Vec3f b) { return 0.5f * (a + b); }
+
+// search_codes' beam (radius 1) for codebooks with frames as rows and
+// neighbour tables (Codebook8): the same costs, candidates in the same
+// order and the same states, computed four lanes at a time (row_frame.hpp).
+template <class Codebook>
+void beam_search_rows(const Codebook& cb, unsigned width, Frame f, Vec3f p, float step, std::span<const Vec3f> targets,
+                      typename Codebook::Code* codes, Vec3f* decoded, std::span<const Vec3f> alt_targets) {
+    using Code = typename Codebook::Code;
+    const std::size_t m = targets.size();
+    const bool robust = !alt_targets.empty();
+    struct State {
+        RowFrame f;
+        F4 p;
+        float cost;
+    };
+    struct Candidate {
+        float cost;
+        std::uint32_t parent;
+        std::uint32_t code;
+    };
+    struct Link {
+        std::uint32_t parent;
+        std::uint32_t code;
+    };
+    thread_local std::vector<State> states, next;
+    thread_local std::vector<Candidate> cand;
+    thread_local std::vector<Link> links;  // links[k * width + j]: how state j of step k was reached
+    states.assign(1, State{row_frame(f), f4_of(p), 0.0f});
+    next.resize(width);
+    cand.resize(width);
+    links.resize(m * width);
+    const float step2 = step * step, two_step = 2.0f * step;
+    const F4 two_step4 = f4_set1(two_step), step4 = f4_set1(step);
+    alignas(16) float costs[8];
+
+    for (std::size_t k = 0; k < m; ++k) {
+        std::size_t kept = 0;
+        const F4 target = f4_of(targets[k]), alt_target = robust ? f4_of(alt_targets[k]) : target;
+        for (std::uint32_t s = 0; s < states.size(); ++s) {
+            const State& st = states[s];
+            const F4 local = apply_transposed(st.f, f4_sub(target, st.p));
+            const float base = st.cost + dot_self(local) + step2;
+            const F4 alt_local = robust ? apply_transposed(st.f, f4_sub(alt_target, st.p)) : local;
+            const float alt_base = st.cost + dot_self(alt_local) + step2;
+            const unsigned aimed = cb.nearest(robust ? midpoint(vec3_of(local), vec3_of(alt_local)) : vec3_of(local));
+            const auto& nb = cb.neighbours(aimed);
+            auto lanes = [&](F4 l, float b, int i) {
+                const F4 d = f4_add(f4_add(f4_mul(f4_load(nb.x + i), f4_splat<0>(l)), f4_mul(f4_load(nb.y + i), f4_splat<1>(l))),
+                                    f4_mul(f4_load(nb.z + i), f4_splat<2>(l)));
+                return f4_sub(f4_set1(b), f4_mul(two_step4, d));
+            };
+            for (int i = 0; i < 8; i += 4) {
+                F4 c = lanes(local, base, i);
+                if (robust) c = f4_max(c, lanes(alt_local, alt_base, i));
+                f4_store(costs + i, c);
+            }
+            const Vec3f& da = cb.direction(aimed);
+            auto dot_a = [&](F4 l) { return da.x * f4_lane<0>(l) + da.y * f4_lane<1>(l) + da.z * f4_lane<2>(l); };
+            float aimed_cost = base - two_step * dot_a(local);
+            if (robust) aimed_cost = std::max(aimed_cost, alt_base - two_step * dot_a(alt_local));
+            // The 3x3 codes in grid order: the neighbours before the aimed
+            // code, the aimed code, the rest.
+            auto offer = [&](float cost, std::uint32_t code) {
+                if (kept == width && !(cost < cand[width - 1].cost)) return;
+                std::size_t i = kept < width ? kept++ : width - 1;
+                for (; i > 0 && cand[i - 1].cost > cost; --i) cand[i] = cand[i - 1];
+                cand[i] = {cost, s, code};
+            };
+            for (unsigned i = 0; i < nb.before; ++i) offer(costs[i], nb.code[i]);
+            offer(aimed_cost, aimed);
+            for (unsigned i = nb.before; i < nb.count; ++i) offer(costs[i], nb.code[i]);
+        }
+        for (std::size_t j = 0; j < kept; ++j) {
+            const Candidate& c = cand[j];
+            const State& parent = states[c.parent];
+            State& n = next[j];
+            n.f = compose(parent.f, cb.rows(c.code));
+            n.p = f4_add(parent.p, f4_mul(step4, axis(n.f)));
+            n.cost = c.cost;
+            links[k * width + j] = {c.parent, c.code};
+        }
+        next.resize(kept);
+        states.swap(next);
+        next.resize(width);
+    }
+
+    // Back-track the cheapest sequence, then replay it for the decoded points.
+    std::uint32_t j = 0;
+    for (std::uint32_t s = 1; s < states.size(); ++s)
+        if (states[s].cost < states[j].cost) j = s;
+    for (std::size_t k = m; k-- > 0;) {
+        codes[k] = Code(links[k * width + j].code);
+        j = links[k * width + j].parent;
+    }
+    for (std::size_t k = 0; k < m; ++k) {
+        f = compose(f, cb.frame(codes[k]));
+        p = p + step * f.c[0];
+        decoded[k] = p;
+    }
+}
 
 // Chooses codes[k] for targets[k] (normalized coordinates), starting from
 // the block's second anchor `p` and first frame `f`; writes the decoded
@@ -85,6 +188,10 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
             decoded[k] = p;
         }
         return;
+    }
+
+    if constexpr (requires { cb.neighbours(0u); }) {
+        if (sp.radius == 1) return beam_search_rows(cb, sp.beam, f, p, step, targets, codes, decoded, alt_targets);
     }
 
     struct State {
@@ -198,21 +305,33 @@ public:
     // targets, a step's error is the larger of its two squared errors.
     void start(Frame f, Vec3f p, std::span<const Vec3f> targets, Code* codes, Vec3f* decoded,
                std::span<const Vec3f> alt_targets = {}) {
-        f_ = f, p_ = p, targets_ = targets, alt_ = alt_targets, codes_ = codes, decoded_ = decoded, k_ = 0;
+        f_ = row_frame(f), p_ = f4_of(p), targets_ = targets, alt_ = alt_targets, codes_ = codes, decoded_ = decoded, k_ = 0;
         chain_ = &chains_[0], trial_ = &chains_[1];
         chain_->reset();
     }
     bool done() const { return k_ >= targets_.size(); }
     // Chooses the code of the next point.
-    void step() {
-        const std::size_t k = k_++, end = std::min(targets_.size(), k + 1 + depth_);
-        extend(*chain_, k, end);
-        if (end > k + 1) choose(k, end);
-        const Step& s = (*chain_)[0];
-        codes_[k] = Code(s.code);
-        f_ = s.f, p_ = s.p;
-        decoded_[k] = p_;
-        chain_->shift();
+    void step() { step_lanes<1>(this); }
+    // One step of N searches run in lockstep (lanes[0 .. N): blocks of the
+    // same length, started together): the same codes as step() on each,
+    // with the lanes' work interleaved phase by phase (the aimed paths,
+    // then each round of rivals step by step), so that their long
+    // dependency chains (frame -> aim -> nearest code -> frame) overlap in
+    // the CPU instead of waiting behind one lane's branchy rival search.
+    template <int N>
+    static void step_lanes(LookaheadSearch* lanes) {
+        const std::size_t k = lanes[0].k_, end = std::min(lanes[0].targets_.size(), k + 1 + lanes[0].depth_);
+        for (int i = 0; i < N; ++i) lanes[i].extend(*lanes[i].chain_, k, end);
+        if (end > k + 1) choose_lanes<N>(lanes, k, end);
+        for (int i = 0; i < N; ++i) {
+            LookaheadSearch& l = lanes[i];
+            const Step& s = (*l.chain_)[0];
+            l.codes_[k] = Code(s.code);
+            l.f_ = s.f, l.p_ = s.p;
+            l.decoded_[k] = vec3_of(l.p_);
+            l.chain_->shift();
+            ++l.k_;
+        }
     }
     void run(Frame f, Vec3f p, std::span<const Vec3f> targets, Code* codes, Vec3f* decoded,
              std::span<const Vec3f> alt_targets = {}) {
@@ -222,14 +341,16 @@ public:
 
 private:
     // One step of a path: at the point it is for, the target in the frame
-    // before the step (local), the code taken, its squared error, and the
-    // state after it.
+    // before the step (local) with its dot(local, local) + step^2 (base),
+    // the code taken, its squared error, and the state after it (frame as
+    // rows: row_frame.hpp).
     struct Step {
-        Vec3f local, alt_local;  // alt_local: robust search only
+        F4 local, alt_local;  // alt_local: robust search only
+        float base, alt_base;
         unsigned code;
         float error2;
-        Frame f;
-        Vec3f p;
+        RowFrame f;
+        F4 p;
     };
     // Steps for points k, k + 1, ... (k: the point being chosen), from
     // s[head]: shifting by one point moves `head`, the steps are copied back
@@ -255,30 +376,52 @@ private:
         }
     };
 
-    // The state after taking `code` from (f, p): the decoder's operations.
-    void take(Step& s, unsigned code, const Frame& f, Vec3f p) const {
+    // The state after taking `code` from (f, p): the decoder's operations
+    // (p + step * F.c0 with F = compose(f, frame(code))).
+    void take(Step& s, unsigned code, const RowFrame& f, F4 p) const {
         s.code = code;
-        s.f = compose(f, cb_.frame(code));
-        s.p = p + step_ * s.f.c[0];
+        s.f = compose(f, cb_.rows(code));
+        s.p = f4_add(p, f4_mul(f4_set1(step_), axis(s.f)));
     }
-    // |p + step d - t|^2 = |t - p|^2 + step^2 - 2 step d.(t - p), in the local frame.
-    // Clamped at 0 (rounding can take a tiny error below it) so that partial
-    // sums never decrease: the branch and bound below is then exact.
-    float error2(Vec3f local, unsigned code) const {
-        return std::max(0.0f, dot(local, local) + step2_ - two_step_ * dot(cb_.direction(code), local));
+    // |p + step d - t|^2 = |t - p|^2 + step^2 - 2 step d.(t - p), in the local frame
+    // (base = |t - p|^2 + step^2). Clamped at 0 (rounding can take a tiny
+    // error below it) so that partial sums never decrease: the branch and
+    // bound below is then exact.
+    float error2(F4 local, float base, unsigned code) const {
+        const Vec3f& d = cb_.direction(code);
+        return max0(base - two_step_ * (d.x * f4_lane<0>(local) + d.y * f4_lane<1>(local) + d.z * f4_lane<2>(local)));
     }
     float error2(const Step& s, unsigned code) const {
-        const float e = error2(s.local, code);
-        return alt_.empty() ? e : std::max(e, error2(s.alt_local, code));
+        const float e = error2(s.local, s.base, code);
+        return alt_.empty() ? e : std::max(e, error2(s.alt_local, s.alt_base, code));
+    }
+    // error2(s, code) of the 8 neighbours' codes (+inf past their count):
+    // the same products and sums, four lanes at a time.
+    void rival_errors(const Step& s, const NearestCodeLut::Neighbours& nb, float* out) const {
+        const F4 two_step = f4_set1(two_step_), zero = f4_set1(0.0f);
+        auto lanes = [&](F4 local, float base, int i) {
+            const F4 d = f4_add(f4_add(f4_mul(f4_load(nb.x + i), f4_splat<0>(local)), f4_mul(f4_load(nb.y + i), f4_splat<1>(local))),
+                                f4_mul(f4_load(nb.z + i), f4_splat<2>(local)));
+            return f4_max(zero, f4_sub(f4_set1(base), f4_mul(two_step, d)));
+        };
+        for (int i = 0; i < 8; i += 4) {
+            F4 e = lanes(s.local, s.base, i);
+            if (!alt_.empty()) e = f4_max(e, lanes(s.alt_local, s.alt_base, i));
+            f4_store(out + i, f4_add(e, f4_load(nb.pad + i)));
+        }
     }
     // The greedy step for point j from state (f, p), without its state after.
-    void aim(Step& s, std::size_t j, const Frame& f, Vec3f p) const {
-        s.local = apply_transposed(f, targets_[j] - p);
+    void aim(Step& s, std::size_t j, const RowFrame& f, F4 p) const {
+        const F4 t = f4_of(targets_[j]);
+        s.local = apply_transposed(f, f4_sub(t, p));
+        s.base = dot_self(s.local) + step2_;
         if (alt_.empty()) {
-            s.code = cb_.nearest(s.local);
+            s.code = cb_.nearest(vec3_of(s.local));
         } else {
-            s.alt_local = apply_transposed(f, alt_[j] - p);
-            s.code = cb_.nearest(apply_transposed(f, midpoint(targets_[j], alt_[j]) - p));
+            const F4 alt = f4_of(alt_[j]);
+            s.alt_local = apply_transposed(f, f4_sub(alt, p));
+            s.alt_base = dot_self(s.alt_local) + step2_;
+            s.code = cb_.nearest(vec3_of(apply_transposed(f, f4_sub(f4_of(midpoint(targets_[j], alt_[j])), p))));
         }
         s.error2 = error2(s, s.code);
     }
@@ -288,66 +431,109 @@ private:
         c.reserve(end - k);
         for (std::size_t j = k + c.n; j < end; ++j) {
             Step& s = c[c.n];
-            const Frame& fb = c.n ? c[c.n - 1].f : f_;
-            const Vec3f pb = c.n ? c[c.n - 1].p : p_;
+            const RowFrame& fb = c.n ? c[c.n - 1].f : f_;
+            const F4 pb = c.n ? c[c.n - 1].p : p_;
             aim(s, j, fb, pb);
             take(s, s.code, fb, pb);
             ++c.n;
         }
     }
 
-    // Replaces the aimed code's path by a rival's where one is cheaper.
-    void choose(std::size_t k, std::size_t end) {
-        Step first;  // the aim's locals and code: copies, chain_ changes hands below
-        first.local = (*chain_)[0].local, first.alt_local = (*chain_)[0].alt_local;
-        const unsigned aimed = (*chain_)[0].code;
-        // The rivals' own errors; tried cheapest first, each found by a
-        // branch-free scan (sorting them all costs more: most points try
-        // none or one).
-        float rival_error2[8];
-        unsigned rival_code[8];
-        unsigned n = 0;
-        const int L = cb_.levels();
-        const int h0 = int(aimed) / L, l0 = int(aimed) % L;
-        for (int h = std::max(h0 - 1, 0); h <= std::min(h0 + 1, L - 1); ++h)
-            for (int l = std::max(l0 - 1, 0); l <= std::min(l0 + 1, L - 1); ++l) {
-                const auto code = unsigned(h * L + l);
-                if (code == aimed) continue;
-                rival_error2[n] = error2(first, code), rival_code[n] = code, ++n;
-            }
-        for (unsigned i = n; i < 8; ++i) rival_error2[i] = INFINITY, rival_code[i] = 0;
-        float best = chain_->sum();
+    // Replaces each lane's aimed path by a rival's where one is cheaper.
+    // Per lane: rivals are tried cheapest own error first, each path
+    // abandoned once its partial sum reaches the lane's best (branch and
+    // bound), until the next rival's own error reaches the best. The lanes
+    // try their rivals in rounds (round r: every lane's r-th rival, step by
+    // step). A rival path's last step is taken (its state computed) only
+    // for the path that wins in the end: the losers never need it.
+    template <int N>
+    static void choose_lanes(LookaheadSearch* lanes, std::size_t k, std::size_t end) {
+        struct Lane {
+            Step first;  // the aim's locals: copies, chain_ changes hands below
+            alignas(16) float rival_error2[8];
+            const NearestCodeLut::Neighbours* nb;
+            float best, e;
+            bool trying, following, won;
+        };
+        Lane st[N];
+        for (int i = 0; i < N; ++i) {
+            LookaheadSearch& l = lanes[i];
+            Lane& a = st[i];
+            const Step& aim0 = (*l.chain_)[0];
+            a.first.local = aim0.local, a.first.alt_local = aim0.alt_local;
+            a.first.base = aim0.base, a.first.alt_base = aim0.alt_base;
+            a.nb = &l.cb_.neighbours(aim0.code);
+            l.rival_errors(a.first, *a.nb, a.rival_error2);
+            a.best = l.chain_->sum();
+            a.trying = true, a.won = false;
+        }
         for (;;) {
-            unsigned r = 0;
-            for (unsigned i = 1; i < 8; ++i) r = rival_error2[i] < rival_error2[r] ? i : r;
-            const float e0 = rival_error2[r];
-            if (!(e0 < best)) break;
-            rival_error2[r] = INFINITY;
-            // The rival's path into trial_, abandoned once it costs `best`.
-            Chain& t = *trial_;
-            t.reset();
-            t[0].local = first.local, t[0].alt_local = first.alt_local;
-            t[0].error2 = e0;
-            take(t[0], rival_code[r], f_, p_);
-            t.n = 1;
-            float e = e0;
-            for (std::size_t j = k + 1; j < end; ++j) {
-                Step& s = t[t.n];
-                aim(s, j, t[t.n - 1].f, t[t.n - 1].p);
-                e += s.error2;
-                if (!(e < best)) break;
-                take(s, s.code, t[t.n - 1].f, t[t.n - 1].p);
-                ++t.n;
+            // Each trying lane's next rival (the cheapest left, by a
+            // branch-free scan: most points try none or one), if its own
+            // error is below the lane's best.
+            bool any = false;
+            for (int i = 0; i < N; ++i) {
+                Lane& a = st[i];
+                a.following = false;
+                if (!a.trying) continue;
+                unsigned r = 0;
+                for (unsigned j = 1; j < 8; ++j) r = a.rival_error2[j] < a.rival_error2[r] ? j : r;
+                const float e0 = a.rival_error2[r];
+                if (!(e0 < a.best)) {
+                    a.trying = false;
+                    continue;
+                }
+                a.rival_error2[r] = INFINITY;
+                Chain& t = *lanes[i].trial_;
+                t.reset();
+                t[0].local = a.first.local, t[0].alt_local = a.first.alt_local;
+                t[0].base = a.first.base, t[0].alt_base = a.first.alt_base;
+                t[0].error2 = e0;
+                t[0].code = a.nb->code[r];
+                t.n = 1;
+                a.e = e0;
+                a.following = any = true;
             }
-            if (e < best) best = e, std::swap(chain_, trial_);
+            if (!any) break;
+            // The rivals' paths into trial_, step by step across the lanes;
+            // each step's state is computed when the next step needs it
+            // (t[t.n - 1]'s is not yet).
+            for (std::size_t j = k + 1; j < end; ++j) {
+                for (int i = 0; i < N; ++i) {
+                    if (!st[i].following) continue;
+                    LookaheadSearch& l = lanes[i];
+                    Chain& t = *l.trial_;
+                    Step& prev = t[t.n - 1];
+                    l.take(prev, prev.code, t.n > 1 ? t[t.n - 2].f : l.f_, t.n > 1 ? t[t.n - 2].p : l.p_);
+                }
+                for (int i = 0; i < N; ++i) {
+                    Lane& a = st[i];
+                    if (!a.following) continue;
+                    LookaheadSearch& l = lanes[i];
+                    Chain& t = *l.trial_;
+                    Step& s = t[t.n];
+                    l.aim(s, j, t[t.n - 1].f, t[t.n - 1].p);
+                    a.e += s.error2;
+                    if (!(a.e < a.best)) a.following = false;  // abandoned
+                    else ++t.n;
+                }
+            }
+            for (int i = 0; i < N; ++i)
+                if (st[i].following) st[i].best = st[i].e, st[i].won = true, std::swap(lanes[i].chain_, lanes[i].trial_);
+        }
+        for (int i = 0; i < N; ++i) {
+            if (!st[i].won) continue;
+            Chain& c = *lanes[i].chain_;
+            Step& last = c[c.n - 1];
+            lanes[i].take(last, last.code, c.n > 1 ? c[c.n - 2].f : lanes[i].f_, c.n > 1 ? c[c.n - 2].p : lanes[i].p_);
         }
     }
 
     const Codebook& cb_;
     const float step_, step2_, two_step_;
     const std::size_t depth_;
-    Frame f_;  // the decoder's state before point k_
-    Vec3f p_;
+    RowFrame f_;  // the decoder's state before point k_
+    F4 p_;
     std::span<const Vec3f> targets_, alt_;
     Code* codes_ = nullptr;
     Vec3f* decoded_ = nullptr;

@@ -282,8 +282,7 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
         };
         for (; b + kLanes <= n_blocks && block_points(b + kLanes - 1) == ppb; b += kLanes) {
             for (int i = 0; i < kLanes; ++i) start(lanes[i], b + i);
-            while (!lanes[0].done())
-                for (auto& lane : lanes) lane.step();
+            while (!lanes[0].done()) LookaheadSearch<Codebook8>::step_lanes<kLanes>(lanes);
         }
         for (; b < n_blocks; ++b)
             if (block_points(b) > 2) {

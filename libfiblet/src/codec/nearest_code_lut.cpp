@@ -7,6 +7,27 @@ namespace fiblet::detail {
 
 NearestCodeLut::NearestCodeLut(const DirectionTable& table) {
     const float ratio = table.ratio();
+    rows_.resize(256);
+    for (unsigned c = 0; c < 256; ++c) rows_[c] = row_frame(table.frame(std::uint8_t(c)));
+    neighbours_.resize(256);
+    for (unsigned c = 0; c < 256; ++c) {
+        Neighbours& nb = neighbours_[c];
+        nb.count = 0;
+        nb.before = 0;
+        const int h0 = int(c >> 4), l0 = int(c & 15);
+        for (int h = std::max(h0 - 1, 0); h <= std::min(h0 + 1, 15); ++h)
+            for (int l = std::max(l0 - 1, 0); l <= std::min(l0 + 1, 15); ++l) {
+                const auto code = unsigned(h << 4 | l);
+                if (code == c) {
+                    nb.before = nb.count;
+                    continue;
+                }
+                const Vec3f& d = table.direction(std::uint8_t(code));
+                nb.x[nb.count] = d.x, nb.y[nb.count] = d.y, nb.z[nb.count] = d.z, nb.pad[nb.count] = 0.0f;
+                nb.code[nb.count++] = std::uint8_t(code);
+            }
+        for (unsigned i = nb.count; i < 8; ++i) nb.x[i] = nb.y[i] = nb.z[i] = 0.0f, nb.pad[i] = INFINITY, nb.code[i] = 0;
+    }
     zero_code_ = table.nearest_code({0, 0, 0});
     back_code_ = table.nearest_code({-1, 0, 0});
     if (!(ratio < 1.0f)) return;  // the cap reaches the half sphere's rim: no gnomonic view of it

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "codec/row_frame.hpp"
 #include "core/vec_math.hpp"
 #include "fiblet/direction_code.hpp"
 
@@ -28,6 +29,19 @@ public:
 
     explicit NearestCodeLut(const DirectionTable& table);
     bool usable() const { return !cells_.empty(); }
+    // The code's local frame as rows (row_frame.hpp), for the code searches.
+    const RowFrame& rows(std::uint8_t code) const { return rows_[code]; }
+    // The codes of the 3x3 around a code (itself left out), in grid order
+    // (level h, then level l, ascending), with their directions as columns
+    // for evaluating them four at a time; lanes past `count` have direction
+    // 0 and pad = +inf (so pad + anything finite is +inf), the others pad = 0.
+    struct Neighbours {
+        alignas(16) float x[8], y[8], z[8], pad[8];
+        std::uint8_t code[8];
+        unsigned count;
+        unsigned before;  // how many of them precede the code itself in grid order
+    };
+    const Neighbours& neighbours(std::uint8_t code) const { return neighbours_[code]; }
 
     std::uint8_t operator()(Vec3f local) const {
         const float x = local.x, y = local.y, z = local.z;
@@ -50,6 +64,8 @@ private:
         return i < 0 ? 0 : (i >= kGrid ? kGrid - 1 : i);
     }
     std::vector<std::uint8_t> cells_;
+    std::vector<RowFrame> rows_;
+    std::vector<Neighbours> neighbours_;
     float rim_tan_ = 1, rim_tan2_ = 1, cell_scale_ = 1;
     std::uint8_t zero_code_ = 0, back_code_ = 0;
 };

@@ -38,41 +38,86 @@ void sqrt_all(double* v, std::size_t n) {
     for (; i < n; ++i) v[i] = std::sqrt(v[i]);
 }
 
+// The per-fiber buffers are thread_local and only ever grow: resizing a
+// vector up fills the new elements, which the code then overwrites (that
+// fill cost as much as a tenth of the metrics).
+template <class T>
+T* at_least(std::vector<T>& v, std::size_t n) {
+    if (v.size() < n) v.resize(n);
+    return v.data();
+}
+
 struct Segments {
     std::vector<double> ax, ay, az, ux, uy, uz, inv_uu, len;
+    std::size_t count = 0;  // segments (the columns hold kLanes padding segments more)
     double length = 0;
 };
-
-void segments_of(std::span<const Vec3f> line, Segments& out) {
-    const std::size_t n = line.size() > 1 ? line.size() - 1 : 1;  // a single point: one degenerate segment
-    // kLanes padding segments far away (their squared distance is +inf,
-    // never a nearest one), so a window of up to kLanes segments is always
-    // evaluated whole.
-    for (auto* v : {&out.ax, &out.ay, &out.az}) v->assign(n + kLanes, 1e300);
-    for (auto* v : {&out.ux, &out.uy, &out.uz, &out.inv_uu}) v->assign(n + kLanes, 0.0);
-    out.len.resize(n);
-    double length = 0;
-    for (std::size_t s = 0; s < n; ++s) {
-        const Vec3f a = line[s], b = line[std::min(s + 1, line.size() - 1)];
-        const double ux = double(b.x) - a.x, uy = double(b.y) - a.y, uz = double(b.z) - a.z;
-        const double uu = ux * ux + uy * uy + uz * uz;
-        out.ax[s] = a.x, out.ay[s] = a.y, out.az[s] = a.z;
-        out.ux[s] = ux, out.uy[s] = uy, out.uz[s] = uz;
-        out.inv_uu[s] = uu > 0 ? 1.0 / uu : 0.0;
-        out.len[s] = uu;
-    }
-    // The segments' lengths: square roots two at a time (correctly rounded,
-    // as std::sqrt), summed in order.
-    if (line.size() > 1) {
-        sqrt_all(out.len.data(), n);
-        for (std::size_t s = 0; s < n; ++s) length += out.len[s];
-    }
-    out.length = length;
-}
 
 #if defined(__GNUC__) && defined(__x86_64__)
 #define FIBLET_GEOMETRY_AVX2 1
 #endif
+
+bool have_avx2() {
+#ifdef FIBLET_GEOMETRY_AVX2
+    static const bool yes = __builtin_cpu_supports("avx2");
+    return yes;
+#else
+    return false;
+#endif
+}
+
+// From squared lengths uu (in len): inv[i] = uu > 0 ? 1 / uu : 0, then
+// len[i] = sqrt(uu), four at a time with AVX2 (vdivpd and vsqrtpd round
+// correctly, as / and std::sqrt do; the mask keeps +0, as the ternary).
+#ifdef FIBLET_GEOMETRY_AVX2
+__attribute__((target("avx2"))) void inverses_and_roots_avx2(double* len, double* inv, std::size_t n) {
+    const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
+    std::size_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+        const __m256d uu = _mm256_loadu_pd(len + i);
+        _mm256_storeu_pd(inv + i, _mm256_and_pd(_mm256_cmp_pd(uu, zero, _CMP_GT_OQ), _mm256_div_pd(one, uu)));
+        _mm256_storeu_pd(len + i, _mm256_sqrt_pd(uu));
+    }
+    for (; i < n; ++i) inv[i] = len[i] > 0 ? 1.0 / len[i] : 0.0, len[i] = std::sqrt(len[i]);
+}
+#endif
+
+void inverses_and_roots(double* len, double* inv, std::size_t n) {
+#ifdef FIBLET_GEOMETRY_AVX2
+    if (have_avx2()) return inverses_and_roots_avx2(len, inv, n);
+#endif
+    for (std::size_t i = 0; i < n; ++i) inv[i] = len[i] > 0 ? 1.0 / len[i] : 0.0;
+    sqrt_all(len, n);
+}
+
+void segments_of(std::span<const Vec3f> line, Segments& out) {
+    const std::size_t n = line.size() > 1 ? line.size() - 1 : 1;  // a single point: one degenerate segment
+    double *ax = at_least(out.ax, n + kLanes), *ay = at_least(out.ay, n + kLanes), *az = at_least(out.az, n + kLanes);
+    double *ux = at_least(out.ux, n + kLanes), *uy = at_least(out.uy, n + kLanes), *uz = at_least(out.uz, n + kLanes);
+    double *inv = at_least(out.inv_uu, n + kLanes), *len = at_least(out.len, n);
+    for (std::size_t s = 0; s < n; ++s) {
+        const Vec3f a = line[s], b = line[std::min(s + 1, line.size() - 1)];
+        const double dx = double(b.x) - a.x, dy = double(b.y) - a.y, dz = double(b.z) - a.z;
+        ax[s] = a.x, ay[s] = a.y, az[s] = a.z;
+        ux[s] = dx, uy[s] = dy, uz[s] = dz;
+        len[s] = dx * dx + dy * dy + dz * dz;
+    }
+    // kLanes padding segments far away (their squared distance is +inf,
+    // never a nearest one), so a window of up to kLanes segments is always
+    // evaluated whole.
+    for (std::size_t s = n; s < n + kLanes; ++s) {
+        ax[s] = ay[s] = az[s] = 1e300;
+        ux[s] = uy[s] = uz[s] = inv[s] = 0.0;
+    }
+    // The inverse squared lengths, and the lengths (the same double
+    // arithmetic and order as polyline_length).
+    inverses_and_roots(len, inv, n);
+    double length = 0;
+    if (line.size() > 1)
+        for (std::size_t s = 0; s < n; ++s) length += len[s];
+    out.count = n;
+    out.length = length;
+}
 
 // Squared distances of p to the kLanes segments from `base` into d: the
 // same double operations, in the same order, as the scalar dist2 below
@@ -99,15 +144,6 @@ __attribute__((target("avx2"))) inline void window_avx2(const Segments& g, doubl
 }
 #endif
 
-bool have_avx2() {
-#ifdef FIBLET_GEOMETRY_AVX2
-    static const bool yes = __builtin_cpu_supports("avx2");
-    return yes;
-#else
-    return false;
-#endif
-}
-
 // Every point of `from` against the polyline `to`, in order along both, so
 // the nearest segment moves forward with the point: the segments within
 // reach of the last nearest one are searched (squared distances, one square
@@ -127,10 +163,10 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
     thread_local Segments g;
     segments_of(to, g);
     if (from.empty()) return g.length;
-    const std::size_t n = g.ax.size() - kLanes;
+    const std::size_t n = g.count;
     const std::size_t ahead = 2 + (to.size() + from.size() - 1) / from.size();
     thread_local std::vector<double> d2;
-    d2.resize(ahead + 3);
+    at_least(d2, ahead + 3);
     const double *ax = g.ax.data(), *ay = g.ay.data(), *az = g.az.data(), *ux = g.ux.data(), *uy = g.uy.data(),
                  *uz = g.uz.data(), *inv = g.inv_uu.data();
     double* d = d2.data();
@@ -145,8 +181,8 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
     std::size_t hint = 0;
     const bool paired = from.size() == to.size() && have_avx2();
     alignas(32) double lanes[kLanes];
-    thread_local std::vector<double> nearest;  // squared distances, then distances
-    nearest.resize(from.size());
+    thread_local std::vector<double> nearest_buffer;  // squared distances, then distances
+    double* const nearest = at_least(nearest_buffer, from.size());
     for (std::size_t k = 0; k < from.size(); ++k) {
         const Vec3f& p = from[k];
         const std::size_t lo = hint > 2 ? hint - 2 : 0, hi = std::min(n, hint + ahead + 1), w = hi - lo;
@@ -171,8 +207,8 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
     }
     // Square roots two at a time (correctly rounded, as std::sqrt), then
     // the statistics in order.
-    sqrt_all(nearest.data(), nearest.size());
-    out.add_all(nearest.data(), nearest.size(), fiber);
+    sqrt_all(nearest, from.size());
+    out.add_all(nearest, from.size(), fiber);
     return g.length;
 }
 
