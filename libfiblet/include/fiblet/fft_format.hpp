@@ -182,14 +182,33 @@ struct BlockView {
                bytes[15];
     }
     // Anchor k (0 or 1) in normalized coordinates, as six unorm16 values.
-    std::array<std::uint16_t, 6> anchor_words() const;
-    std::array<float, 6> anchors_normalized() const;
+    // Inline: selections read the anchors of every candidate block.
+    inline std::array<std::uint16_t, 6> anchor_words() const;
+    inline std::array<float, 6> anchors_normalized() const;
     const std::uint8_t* directions() const { return bytes + kBlockDirectionsOffset; }
 };
 
 // unorm16 as GLSL packUnorm2x16 defines it: round(clamp(v, 0, 1) * 65535).
 std::uint16_t pack_unorm16(float v);
 inline float unpack_unorm16(std::uint16_t q) { return float(q) / 65535.0f; }
+
+std::array<std::uint16_t, 6> BlockView::anchor_words() const {
+    // Word k holds the pair (a, b) as a | b << 16, stored most-significant byte first.
+    std::array<std::uint16_t, 6> q{};
+    for (int k = 0; k < 3; ++k) {
+        const std::uint8_t* w = bytes + 4 * k;
+        q[2 * k] = static_cast<std::uint16_t>(w[2] << 8 | w[3]);
+        q[2 * k + 1] = static_cast<std::uint16_t>(w[0] << 8 | w[1]);
+    }
+    return q;
+}
+
+std::array<float, 6> BlockView::anchors_normalized() const {
+    const auto q = anchor_words();
+    std::array<float, 6> v{};
+    for (int i = 0; i < 6; ++i) v[i] = unpack_unorm16(q[i]);
+    return v;
+}
 
 // unorm24 (16-bit blocks): round(clamp(v, 0, 1) * (2^24 - 1)); every value
 // is exact in a float, so decoding rounds once.

@@ -57,22 +57,4 @@ TrailerChunk make_properties_chunk(const std::vector<std::pair<std::string, std:
     return c;
 }
 
-std::array<std::uint16_t, 6> BlockView::anchor_words() const {
-    // Word k holds the pair (a, b) as a | b << 16, stored most-significant byte first.
-    std::array<std::uint16_t, 6> q{};
-    for (int k = 0; k < 3; ++k) {
-        const std::uint8_t* w = bytes + 4 * k;
-        q[2 * k] = static_cast<std::uint16_t>(w[2] << 8 | w[3]);
-        q[2 * k + 1] = static_cast<std::uint16_t>(w[0] << 8 | w[1]);
-    }
-    return q;
-}
-
-std::array<float, 6> BlockView::anchors_normalized() const {
-    const auto q = anchor_words();
-    std::array<float, 6> v{};
-    for (int i = 0; i < 6; ++i) v[i] = unpack_unorm16(q[i]);
-    return v;
-}
-
 }  // namespace fiblet

@@ -16,6 +16,7 @@
 #include "fiblet/select.hpp"
 #include "select/block_batch_reader.hpp"
 #include "select/block_decoder.hpp"
+#include "select/block_spheres.hpp"
 #include "select/query_checks.hpp"
 
 namespace fiblet {
@@ -166,11 +167,12 @@ struct BlockBound {
     float radius;
 };
 
-BlockBound block_bound(const FftHeader& h, const std::uint8_t* block, const std::uint8_t* next, float join) {
-    const Sphere s = block_bounding_sphere(h, block);
+// `s` is the block's view sphere, `next` the next block's (its centre is
+// that block's first point), or null.
+BlockBound block_bound(const Sphere& s, const Sphere* next, float join) {
     BlockBound bound{s.center, s.center, s.radius};
     if (!next || join < 0) return bound;
-    const Vec3f b = first_point(h, next);
+    const Vec3f b = next->center;
     const double dx = double(b.x) - s.center.x, dy = double(b.y) - s.center.y, dz = double(b.z) - s.center.z;
     const double reach = double(s.radius) + double(join), d2 = dx * dx + dy * dy + dz * dz;
     if (d2 >= reach * reach) return bound;  // not a path the index describes: keep the sphere
@@ -446,6 +448,7 @@ private:
         std::vector<std::size_t> tested, first_point;
         while (candidates.next(batch_blocks(h_), blocks, fibers)) {
             reader_.read(blocks);
+            if (coarse_index_) spheres_of_read(blocks.size());
             // Decoded: the blocks whose bound from headers (block_bound)
             // meets a region they are tested against; the index's boxes
             // bound groups of blocks, block_bound each block.
@@ -458,8 +461,7 @@ private:
                     continue;
                 }
                 const bool has_next = i + 1 < blocks.size() && blocks[i + 1] == b + 1 && fibers[i + 1] == f;
-                const BlockBound c =
-                    block_bound(h_, reader_.block(i), has_next ? reader_.block(i + 1) : nullptr, index_.max_join());
+                const BlockBound c = block_bound(spheres_[i], has_next ? &spheres_[i + 1] : nullptr, index_.max_join());
                 bool test = !q_.exclude.empty() && has_bit(exc, b) && bound_may_meet(q_.exclude, c);
                 for (std::size_t k = 0; k < k_inc && !test; ++k)
                     test = !(met[f] >> k & 1) && has_bit(inc[k], b) && bound_may_meet(q_.include[k], c);
@@ -554,14 +556,13 @@ private:
             // regions (the index bounds groups of blocks, the sphere each block).
             kind.assign(blocks.size(), fine);
             const bool include_tests = coarse_index_ && blocks_mode && !q_.include.empty();
+            // Every header tested below, in one call (a call per block cost more than its arithmetic).
+            if (q_.view || include_tests) spheres_of_read(need.size());
             if (q_.view || include_tests)
                 for (std::size_t i = 0; i < blocks.size(); ++i) {
-                    // Scattered headers: fetch a few blocks ahead.
-                    if (i + 8 < blocks.size()) __builtin_prefetch(reader_.block(at_need[i + 8]));
                     const bool bound_test = include_tests && include_test(i);
                     if (!q_.view && !bound_test) continue;
-                    const std::uint8_t* block = reader_.block(at_need[i]);
-                    const Sphere s = block_bounding_sphere(h_, block);
+                    const Sphere& s = spheres_[at_need[i]];
                     if (cull && !sphere_intersects_frustum(frustum, s.center, s.radius)) {
                         kind[i] = dropped;
                         continue;
@@ -570,8 +571,8 @@ private:
                         const std::size_t k = at_need[i] + 1;
                         const bool has_next = k < need.size() && need[k] == blocks[i] + 1 &&
                                               std::uint64_t(blocks[i]) + 1 < file_.block_end(fibers[i] + 1);
-                        if (!bound_may_meet(q_.include, block_bound(h_, block, has_next ? reader_.block(k) : nullptr,
-                                                                    index_.max_join()))) {
+                        if (!bound_may_meet(q_.include,
+                                            block_bound(s, has_next ? &spheres_[k] : nullptr, index_.max_join()))) {
                             kind[i] = dropped;
                             continue;
                         }
@@ -632,6 +633,14 @@ private:
         out.finish();
     }
 
+    // spheres_[k]: the view sphere of the reader's block k, for k < count.
+    void spheres_of_read(std::size_t count) {
+        block_pointers_.resize(count);
+        for (std::size_t k = 0; k < count; ++k) block_pointers_[k] = reader_.block(k);
+        spheres_.resize(count);
+        detail::block_spheres(h_, block_pointers_.data(), count, spheres_.data());
+    }
+
     // The blocks blocks[items[0]], blocks[items[1]], ... one after the other
     // in memory: where they are when they follow each other in the file,
     // else copied into staging_ (76 bytes a block, against 720 decoded).
@@ -661,6 +670,8 @@ private:
     std::vector<float> scratch_;  // decoded points that are tested, not output
     std::vector<std::uint8_t> staging_;
     std::vector<std::size_t> segment_;
+    std::vector<const std::uint8_t*> block_pointers_;
+    std::vector<Sphere> spheres_;  // of the blocks read, in reading order
     SelectionStats stats_;
 };
 

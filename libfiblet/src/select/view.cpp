@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "core/vec_math.hpp"
+#include "select/block_spheres.hpp"
 
 namespace fiblet {
 using namespace detail;
@@ -100,18 +101,45 @@ bool block_is_coarse(const Camera& c, const Viewport& v, Vec3f center, float rad
     return LevelOfDetail(c, v, lod_pixels).coarse(center, radius);
 }
 
-Sphere block_bounding_sphere(const FftHeader& h, const std::uint8_t* bytes) {
-    const auto a = block_anchors_normalized(h, bytes);
-    return block_bounding_sphere(h, h.to_world(a[0], a[1], a[2]), h.to_world(a[3], a[4], a[5]),
-                                 block_flags(h, bytes).point_count);
-}
-
-Sphere block_bounding_sphere(const FftHeader& h, Vec3f a0, Vec3f a1, std::uint32_t n) {
+namespace {
+// block_bounding_sphere's arithmetic, inlined into both of its callers below
+// (libfiblet builds with -ffp-contract=off: the same operations give the
+// same floats in either).
+inline Sphere sphere_of(const FftHeader& h, Vec3f a0, Vec3f a1, std::uint32_t n) {
     if (n < 2) return {a0, 0.0f};
     // In double: the squares of a file's extent overflow a float beyond ~1e19 mm.
     const double dx = double(a1.x) - a0.x, dy = double(a1.y) - a0.y, dz = double(a1.z) - a0.z;
     const auto r = float(std::sqrt(dx * dx + dy * dy + dz * dz) + double(n - 2) * h.step * h.scaling);
     return {a0, r * (1 + 1e-5f) + 1e-5f * h.scaling};
 }
+
+template <class View>
+inline Sphere sphere_of_block(const FftHeader& h, const std::uint8_t* bytes) {
+    const View v{bytes};
+    const auto a = v.anchors_normalized();
+    return sphere_of(h, h.to_world(a[0], a[1], a[2]), h.to_world(a[3], a[4], a[5]), v.point_count());
+}
+}  // namespace
+
+Sphere block_bounding_sphere(const FftHeader& h, const std::uint8_t* bytes) {
+    return h.direction_bits() == 16 ? sphere_of_block<BlockView16>(h, bytes) : sphere_of_block<BlockView>(h, bytes);
+}
+
+Sphere block_bounding_sphere(const FftHeader& h, Vec3f a0, Vec3f a1, std::uint32_t n) { return sphere_of(h, a0, a1, n); }
+
+namespace detail {
+void block_spheres(const FftHeader& h, const std::uint8_t* const* blocks, std::size_t n, Sphere* out) {
+    // Blocks may be scattered (a memory mapping): fetch a few ahead.
+    auto all = [&](auto view) {
+        using View = decltype(view);
+        for (std::size_t i = 0; i < n; ++i) {
+            if (i + 8 < n) __builtin_prefetch(blocks[i + 8]);
+            out[i] = sphere_of_block<View>(h, blocks[i]);
+        }
+    };
+    if (h.direction_bits() == 16) all(BlockView16{});
+    else all(BlockView{});
+}
+}  // namespace detail
 
 }  // namespace fiblet
