@@ -142,7 +142,9 @@ TEST(CodeSearch, RetryNeverRaisesABlocksMaxErrorAndLowersTheWorst) {
         ASSERT_EQ(a.size(), b.size());
         for (std::size_t i = 0; i < a.size(); ++i) {
             EXPECT_LE(b[i], a[i]);
-            if (a[i] <= 3e-3) EXPECT_EQ(b[i], a[i]);  // below the threshold: untouched
+            if (a[i] <= 3e-3) {
+                EXPECT_EQ(b[i], a[i]);  // below the threshold: untouched
+            }
             retried_better += b[i] < a[i];
             worst_greedy = std::max(worst_greedy, a[i]), worst_retry = std::max(worst_retry, b[i]);
         }

@@ -67,13 +67,39 @@ struct Codebook16 {
 
 inline Vec3f midpoint(Vec3f a, Vec3f b) { return 0.5f * (a + b); }
 
+// How a beam state of step k was reached: links[k * width + j] for state j.
+struct BeamLink {
+    std::uint32_t parent;
+    std::uint32_t code;
+};
+
+// The beam's cheapest final state traced back through its links to its
+// codes, which are then replayed from the block's start (f, p) for the
+// decoded points.
+template <class Codebook, class State>
+void backtrack_cheapest(const Codebook& cb, const std::vector<State>& states, const std::vector<BeamLink>& links,
+                        std::size_t width, Frame f, Vec3f p, float step, std::size_t m,
+                        typename Codebook::Code* codes, Vec3f* decoded) {
+    std::uint32_t j = 0;
+    for (std::uint32_t s = 1; s < states.size(); ++s)
+        if (states[s].cost < states[j].cost) j = s;
+    for (std::size_t k = m; k-- > 0;) {
+        codes[k] = typename Codebook::Code(links[k * width + j].code);
+        j = links[k * width + j].parent;
+    }
+    for (std::size_t k = 0; k < m; ++k) {
+        f = compose(f, cb.frame(codes[k]));
+        p = p + step * f.c[0];
+        decoded[k] = p;
+    }
+}
+
 // search_codes' beam (radius 1) for codebooks with frames as rows and
 // neighbour tables (Codebook8): the same costs, candidates in the same
 // order and the same states, computed four lanes at a time (row_frame.hpp).
 template <class Codebook>
 void beam_search_rows(const Codebook& cb, unsigned width, Frame f, Vec3f p, float step, std::span<const Vec3f> targets,
                       typename Codebook::Code* codes, Vec3f* decoded, std::span<const Vec3f> alt_targets) {
-    using Code = typename Codebook::Code;
     const std::size_t m = targets.size();
     const bool robust = !alt_targets.empty();
     struct State {
@@ -86,13 +112,9 @@ void beam_search_rows(const Codebook& cb, unsigned width, Frame f, Vec3f p, floa
         std::uint32_t parent;
         std::uint32_t code;
     };
-    struct Link {
-        std::uint32_t parent;
-        std::uint32_t code;
-    };
     thread_local std::vector<State> states, next;
     thread_local std::vector<Candidate> cand;
-    thread_local std::vector<Link> links;  // links[k * width + j]: how state j of step k was reached
+    thread_local std::vector<BeamLink> links;  // links[k * width + j]: how state j of step k was reached
     states.assign(1, State{row_frame(f), f4_of(p), 0.0f});
     next.resize(width);
     cand.resize(width);
@@ -151,20 +173,7 @@ void beam_search_rows(const Codebook& cb, unsigned width, Frame f, Vec3f p, floa
         states.swap(next);
         next.resize(width);
     }
-
-    // Back-track the cheapest sequence, then replay it for the decoded points.
-    std::uint32_t j = 0;
-    for (std::uint32_t s = 1; s < states.size(); ++s)
-        if (states[s].cost < states[j].cost) j = s;
-    for (std::size_t k = m; k-- > 0;) {
-        codes[k] = Code(links[k * width + j].code);
-        j = links[k * width + j].parent;
-    }
-    for (std::size_t k = 0; k < m; ++k) {
-        f = compose(f, cb.frame(codes[k]));
-        p = p + step * f.c[0];
-        decoded[k] = p;
-    }
+    backtrack_cheapest(cb, states, links, width, f, p, step, m, codes, decoded);
 }
 
 // Chooses codes[k] for targets[k] (normalized coordinates), starting from
@@ -204,15 +213,11 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
         std::uint32_t parent;
         std::uint32_t code;
     };
-    struct Link {
-        std::uint32_t parent;
-        std::uint32_t code;
-    };
     const unsigned width = sp.beam;
     const int r = int(sp.radius);
     thread_local std::vector<State> states, next;
     thread_local std::vector<Candidate> cand;
-    thread_local std::vector<Link> links;  // links[k * width + j]: how state j of step k was reached
+    thread_local std::vector<BeamLink> links;  // links[k * width + j]: how state j of step k was reached
     states.assign(1, State{f, p, 0.0f});
     next.resize(width);
     cand.resize(width);
@@ -258,20 +263,7 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
         states.swap(next);
         next.resize(width);
     }
-
-    // Back-track the cheapest sequence, then replay it for the decoded points.
-    std::uint32_t j = 0;
-    for (std::uint32_t s = 1; s < states.size(); ++s)
-        if (states[s].cost < states[j].cost) j = s;
-    for (std::size_t k = m; k-- > 0;) {
-        codes[k] = Code(links[k * width + j].code);
-        j = links[k * width + j].parent;
-    }
-    for (std::size_t k = 0; k < m; ++k) {
-        f = compose(f, cb.frame(codes[k]));
-        p = p + step * f.c[0];
-        decoded[k] = p;
-    }
+    backtrack_cheapest(cb, states, links, width, f, p, step, m, codes, decoded);
 }
 
 // Greedy aiming with lookahead (a "pilot" search): at each point the aimed

@@ -46,6 +46,32 @@ inline constexpr float kLengthFeedbackActShare = 0.25f;
 inline constexpr float kLengthRescueOverRetry = 1.4f;
 inline constexpr unsigned kLengthRescueBeam = 32;
 
+// The largest squared distance of decoded[0, m) from targets[first, first + m).
+inline float max_distance2(std::span<const Vec3f> targets, const Vec3f* decoded, std::size_t first, std::size_t m) {
+    float worst = 0;
+    for (std::size_t k = 0; k < m; ++k) {
+        const Vec3f d = decoded[k] - targets[first + k];
+        worst = std::max(worst, dot(d, d));
+    }
+    return worst;
+}
+
+// targets[from, last] into `moved`, the last `count` of them moved along the
+// track by share x move (linearly less away from the end): a positive move
+// takes them on towards the next point (a shorter bridge), a negative one back.
+inline void move_tail_along_track(std::span<const Vec3f> targets, std::size_t from, std::size_t last, std::size_t count,
+                                  float share, float move, std::vector<Vec3f>& moved) {
+    moved.assign(targets.begin() + std::ptrdiff_t(from), targets.begin() + std::ptrdiff_t(last + 1));
+    for (std::size_t j = 0; j < count; ++j) {
+        const std::size_t k = last - j;
+        const Vec3f along = targets[k + 1] - targets[k - 1];
+        const float len = std::sqrt(dot(along, along));
+        if (!(len > 0)) continue;
+        const float w = float(count - j) / float(count);
+        moved[k - from] = moved[k - from] + (share * w * move / len) * along;
+    }
+}
+
 // `targets` and `points` (decoded) of one fiber, normalized coordinates;
 // blocks of `ppb` points. Callbacks:
 //   adjustable(b)          whether block b's codes may be searched again
@@ -60,12 +86,7 @@ void feed_back_length(std::span<const Vec3f> targets, std::span<Vec3f> points, s
     thread_local std::vector<Vec3f> moved, candidate;
     auto error_of = [&](std::size_t k) { return norm(points[k] - points[k - 1]) - stretch * norm(targets[k] - targets[k - 1]); };
     auto max_error2 = [&](const Vec3f* decoded, std::size_t first, std::size_t m) {
-        float worst = 0;
-        for (std::size_t k = 0; k < m; ++k) {
-            const Vec3f d = decoded[k] - targets[first + k];
-            worst = std::max(worst, dot(d, d));
-        }
-        return worst;
+        return max_distance2(targets, decoded, first, m);
     };
     // The point error the fiber has anyway: a block may go up to it.
     const float fiber_max2 = max_error2(points.data(), 0, n_points);
@@ -85,17 +106,7 @@ void feed_back_length(std::span<const Vec3f> targets, std::span<Vec3f> points, s
         // A move farther than the error the block may have cannot be followed.
         const float reach = std::sqrt(allowed2), move = std::clamp(float(lag), -reach, reach);
         for (const float share : kLengthFeedbackShares) {
-            // Too long: the last points move on towards the next anchor (a
-            // shorter bridge); too short: they fall back.
-            moved.assign(targets.begin() + std::ptrdiff_t(first), targets.begin() + std::ptrdiff_t(last + 1));
-            for (std::size_t j = 0; j < moved_points; ++j) {
-                const std::size_t k = last - j;
-                const Vec3f along = targets[k + 1] - targets[k - 1];
-                const float len = std::sqrt(dot(along, along));
-                if (!(len > 0)) continue;
-                const float w = float(moved_points - j) / float(moved_points);
-                moved[k - first] = moved[k - first] + (share * w * move / len) * along;
-            }
+            move_tail_along_track(targets, first, last, moved_points, share, move, moved);
             candidate.resize(m);
             search(b, std::span<const Vec3f>(moved), candidate.data());
             if (max_error2(candidate.data(), first, m) > allowed2) continue;
@@ -129,12 +140,7 @@ void feed_back_length_tails(std::span<const Vec3f> targets, std::span<Vec3f> poi
     thread_local std::vector<Vec3f> moved, candidate;
     auto error_of = [&](std::size_t k) { return norm(points[k] - points[k - 1]) - norm(targets[k] - targets[k - 1]); };
     auto max_error2 = [&](const Vec3f* decoded, std::size_t first, std::size_t m) {
-        float worst = 0;
-        for (std::size_t k = 0; k < m; ++k) {
-            const Vec3f d = decoded[k] - targets[first + k];
-            worst = std::max(worst, dot(d, d));
-        }
-        return worst;
+        return max_distance2(targets, decoded, first, m);
     };
     const float fiber_max2 = max_error2(points.data(), 0, n_points);
     const double act = act_share * std::sqrt(double(fiber_max2));
@@ -157,15 +163,7 @@ void feed_back_length_tails(std::span<const Vec3f> targets, std::span<Vec3f> poi
         double best = std::fabs(lag);
         const float reach = std::sqrt(allowed2), move = std::clamp(float(lag), -reach, reach);
         for (const float share : kLengthFeedbackShares) {
-            moved.assign(targets.begin() + std::ptrdiff_t(first + j0), targets.begin() + std::ptrdiff_t(last + 1));
-            for (std::size_t j = 0; j < t; ++j) {
-                const std::size_t k = last - j;
-                const Vec3f along = targets[k + 1] - targets[k - 1];
-                const float len = std::sqrt(dot(along, along));
-                if (!(len > 0)) continue;
-                const float w = float(t - j) / float(t);
-                moved[k - first - j0] = moved[k - first - j0] + (share * w * move / len) * along;
-            }
+            move_tail_along_track(targets, first + j0, last, t, share, move, moved);
             candidate.resize(t);
             search(b, j0, std::span<const Vec3f>(moved), candidate.data());
             if (max_error2(candidate.data(), first + j0, t) > allowed2) continue;
