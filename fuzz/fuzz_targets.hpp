@@ -162,6 +162,29 @@ inline void streamline_source_target(const std::uint8_t* data, std::size_t size)
     }
 }
 
+// An upper bound on the points compress may resample a .tck into: its
+// polyline length over a quarter of the smallest step it may pick (the
+// declared step_size or the median spacing; block_keeping_step goes down to
+// a quarter). A few points far apart can stand for millions of resampled
+// ones, which the point limit below does not see.
+inline double resampled_points_bound(const std::string& path) {
+    TckReader r(path, {});
+    std::vector<Vec3f> f;
+    std::vector<double> spacing;
+    double length = 0;
+    while (r.next(f))
+        for (std::size_t k = 1; k < f.size(); ++k) {
+            const double dx = double(f[k].x) - f[k - 1].x, dy = double(f[k].y) - f[k - 1].y, dz = double(f[k].z) - f[k - 1].z;
+            const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+            length += d;
+            if (d > 0) spacing.push_back(d);
+        }
+    if (spacing.empty()) return 0;
+    std::nth_element(spacing.begin(), spacing.begin() + std::ptrdiff_t(spacing.size() / 2), spacing.end());
+    const double step = std::min(spacing[spacing.size() / 2], r.header().step_size().value_or(INFINITY));
+    return length / (0.25 * step);
+}
+
 // The whole compression of small valid .tck inputs, and a decode of what it
 // wrote: same fibers, same point counts unless resampled, finite points.
 inline void compress_target(const std::uint8_t* data, std::size_t size) {
@@ -170,7 +193,7 @@ inline void compress_target(const std::uint8_t* data, std::size_t size) {
     const TckOutcome whole = read_tck(path, {});
     std::uint64_t points = 0;
     for (auto n : whole.sizes) points += n;
-    if (whole.error || points > 20000) return;
+    if (whole.error || points > 20000 || resampled_points_bound(path) > 200000) return;
 
     const std::string out = scratch_dir() + "/out.fft";
     CompressReport report;
