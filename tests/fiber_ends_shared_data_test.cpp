@@ -48,6 +48,13 @@ double length_of(const float* p, std::uint64_t n) {
     return l;
 }
 
+// The length of a float64 (reference decoder) polyline.
+double length_of(const std::vector<test::exact::V3>& e) {
+    double l = 0;
+    for (std::size_t k = 1; k < e.size(); ++k) l += std::sqrt(test::exact::dot(e[k] - e[k - 1], e[k] - e[k - 1]));
+    return l;
+}
+
 TEST(FiberEndsSharedData, EndpointsAndLengthsMatchTheInput) {
     if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
     const auto files = shared_tractograms();
@@ -209,8 +216,7 @@ TEST(FiberEndsSharedData, ResampledLengthsWithinTheRecordedError) {
                 const test::exact::V3 prev = e[e.size() - 2];
                 e.back() = prev + (double(q) / 65535.0) * (e.back() - prev);
             }
-            double le = 0;
-            for (std::size_t k = 1; k < e.size(); ++k) le += std::sqrt(test::exact::dot(e[k] - e[k - 1], e[k] - e[k - 1]));
+            const double le = length_of(e);
             worst_exact = std::max(worst_exact, std::fabs(le - li) - residual);
             worst_raw_exact = std::max(worst_raw_exact, std::fabs(le - li));
         }
@@ -274,9 +280,7 @@ TEST(FiberEndsSharedData, FixedStepIfod1LengthsWithinTheRecordedError) {
             worst = std::max(worst, std::fabs(length_of(&s.xyz[3 * s.offsets[i]], n) - li));
             const std::vector<test::exact::V3>& e = exact.fibers[i];
             ASSERT_EQ(e.size(), f.size());
-            double le = 0;
-            for (std::size_t k = 1; k < e.size(); ++k) le += std::sqrt(test::exact::dot(e[k] - e[k - 1], e[k] - e[k - 1]));
-            worst_exact = std::max(worst_exact, std::fabs(le - li));
+            worst_exact = std::max(worst_exact, std::fabs(length_of(e) - li));
         }
         EXPECT_LE(worst, recorded) << "a fiber's length changed by more than the recorded error";
         EXPECT_LE(worst_exact, 1.05 * recorded) << "float64 decode";
