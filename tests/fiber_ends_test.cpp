@@ -5,6 +5,8 @@
 // decoder and selection path; what a reader ignoring the chunk sees.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -13,6 +15,7 @@
 #include "fiblet/block_index.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/decode.hpp"
+#include "fiblet/encode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/fiber_ends.hpp"
 #include "fiblet/fft_subset.hpp"
@@ -360,6 +363,104 @@ TEST(FiberEnds, LengthKeepingFractionIsTheClosestAllowedByBruteForce) {
         // the length as the scan (whose grid may miss the interval's edge).
         EXPECT_LE(end_miss(f), allowed + 1e-6);
         EXPECT_LE(std::fabs(before + f * d(a, b) - target), best + 1e-5);
+    }
+}
+
+// The largest distance of decoded[from, to) from their targets, both decoders.
+double largest_error(const Fiber& targets, const Fiber& decoded, const Fiber& exact, std::size_t from, std::size_t to) {
+    double e = 0;
+    for (std::size_t k = from; k < to; ++k) e = std::max({e, dist(decoded[k], targets[k]), dist(exact[k], targets[k])});
+    return e;
+}
+
+// 0.1 mm walks turning up to 12 degrees a step, near the middle of the box.
+Fiber walk(std::mt19937& rng, std::size_t points) {
+    std::uniform_real_distribution<double> u(-1, 1);
+    double p[3] = {5 * u(rng), 5 * u(rng), 5 * u(rng)}, d[3] = {u(rng), u(rng), u(rng)};
+    Fiber f;
+    for (std::size_t k = 0; k < points; ++k) {
+        f.push_back({float(p[0]), float(p[1]), float(p[2])});
+        for (double& c : d) c += 0.2 * u(rng);
+        const double m = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (int a = 0; a < 3; ++a) d[a] /= m, p[a] += 0.1 * d[a];
+    }
+    return f;
+}
+
+FftHeader walk_header() {
+    FftHeader h;
+    h.scaling = 200;  // an anchor quantum of 3 um, about the point error (as on the 0.1 mm bundles)
+    h.offset = {0, 0, 0};
+    h.ratio = 0.1f;
+    h.step = float(0.1 / h.scaling);
+    return h;
+}
+
+// A fiber whose last block holds one or two points ends on anchors, which no
+// ENDS fraction moves (fiber_end_encoder.hpp): asked for a length 1.5 times
+// its point error away from what its codes give, the encoder rounds those
+// anchors to neighbouring quanta that keep the length within that error.
+// The nearest rounding (before) leaves the whole 1.5 times. Lengths and
+// errors by brute force over the decoded points, and the anchors checked
+// against the words written in the block.
+TEST(FiberEnds, EndAnchorsAreRoundedToKeepTheLength) {
+    const FftHeader h = walk_header();
+    const FiberEncoder encoder(h, {1, 1, 0, 1, 0});
+    std::mt19937 rng(7);
+    for (int trial = 0; trial < 40; ++trial) {
+        SCOPED_TRACE(trial);
+        const std::uint32_t last_points = 1 + std::uint32_t(trial % 2);
+        const Fiber f = walk(rng, 2 * h.points_per_block + last_points);
+        const std::size_t n = f.size(), i0 = n - last_points;
+        std::vector<std::uint8_t> blocks;
+        Fiber decoded, exact, scratch;
+        detail::encode_keeping_end(encoder, f, false, 0.1, 0, blocks, decoded, &exact, scratch, 0);  // length unknown
+        ASSERT_EQ(exact.size(), n);
+        const double coded = length_of(decoded), other = largest_error(f, decoded, exact, 0, i0);
+        const double target = coded + (trial % 4 < 2 ? 1.25 : -1.25) * other;
+        blocks.clear(), decoded.clear(), exact.clear();
+        const detail::FiberEnd end = detail::encode_keeping_end(encoder, f, false, 0.1, 0, blocks, decoded, &exact, scratch, target);
+        EXPECT_EQ(end.fraction, kWholeLastStep);
+        EXPECT_EQ(largest_error(f, decoded, exact, 0, i0), other) << "only the end anchors move";
+        EXPECT_LE(std::fabs(length_of(decoded) - target), other) << "the length within the fiber's point error";
+        EXPECT_LE(largest_error(f, decoded, exact, i0, n), other * (1 + 1e-9)) << "the anchors within it";
+        const BlockView last{&blocks[blocks.size() - h.block_bytes()]};
+        const std::array<float, 6> a = last.anchors_normalized();
+        for (std::uint32_t k = 0; k < last_points; ++k) {
+            const Vec3f written = h.to_world(a[3 * k], a[3 * k + 1], a[3 * k + 2]);
+            EXPECT_EQ(dist(written, decoded[i0 + k]), 0.0) << "what the decoders read";
+        }
+    }
+}
+
+// Given a budget (the file's recorded max error is at least that), a fiber's
+// end is placed again within it: the end fraction and the end anchors alike
+// take a length 2.5 times the fiber's own point error away to within the
+// budget of twice that error, which the fiber's own error does not allow.
+TEST(FiberEnds, EndsArePlacedAgainWithinABudget) {
+    const FftHeader h = walk_header();
+    const FiberEncoder encoder(h, {1, 1, 0, 1, 0});
+    std::mt19937 rng(8);
+    for (int trial = 0; trial < 30; ++trial) {
+        SCOPED_TRACE(trial);
+        const std::uint32_t last_points = trial % 3 == 0 ? 1 : trial % 3 == 1 ? 2 : 30;
+        const Fiber f = walk(rng, 2 * h.points_per_block + last_points);
+        const std::size_t n = f.size(), moved = last_points >= 3 ? 1 : last_points;
+        std::vector<std::uint8_t> blocks;
+        Fiber decoded, exact, scratch;
+        detail::encode_keeping_end(encoder, f, false, 0.1, 0, blocks, decoded, &exact, scratch, 0);
+        const double coded = length_of(decoded), other = largest_error(f, decoded, exact, 0, n - moved);
+        // (A fraction only shortens the last step: the codes' zig-zag makes fibers too long.)
+        const double target = coded + (trial % 2 && last_points < 3 ? 2.5 : -2.5) * other, budget = 2 * other;
+        blocks.clear(), decoded.clear(), exact.clear();
+        const detail::FiberEnd end = detail::encode_keeping_end(encoder, f, false, 0.1, 0, blocks, decoded, &exact, scratch, target);
+        EXPECT_GT(std::fabs(length_of(decoded) - target), 1.2 * other) << "the fiber's own error is not enough";
+        const std::uint16_t q = detail::place_end_within(h, end, &blocks[blocks.size() - h.block_bytes()], f, decoded,
+                                                         exact, target, budget);
+        EXPECT_EQ(q == kWholeLastStep, last_points < 3 && end.fraction == kWholeLastStep);
+        EXPECT_LE(std::fabs(length_of(decoded) - target), budget) << "the length within the budget";
+        EXPECT_LE(largest_error(f, decoded, exact, n - moved, n), budget) << "the moved points within it";
+        EXPECT_EQ(largest_error(f, decoded, exact, 0, n - moved), other) << "the others unmoved";
     }
 }
 

@@ -45,7 +45,8 @@ inline Vec3f place_end_point(Vec3f prev, Vec3f last, std::uint16_t q) {
 
 // Only a last block with three points or more has a direction-coded last
 // point; in shorter ones the last point is an anchor, which the encoder sets
-// to the true end point directly (the fraction is then ignored).
+// to the true end point (rounded to keep the fiber's length, within its point
+// error; formats/fft-ends.md) — the fraction is then ignored.
 inline bool end_fraction_applies(std::uint32_t block_points) { return block_points >= 3; }
 
 TrailerChunk make_fiber_ends_chunk(std::span<const std::uint16_t> fractions);

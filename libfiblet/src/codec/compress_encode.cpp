@@ -4,7 +4,9 @@
 //   read_fiber_batch  the caller's thread parses the next batch of the
 //                     input (compress_read.cpp)
 //   encode_task       the worker pool encodes the current batch, a task (a
-//                     contiguous run of ~16 k points) at a time
+//                     contiguous run of ~16 k points) at a time; ends that
+//                     miss their fiber's length are placed again once the
+//                     batch's error is known (finish_batch)
 //   write_batch       the caller writes the previous batch's blocks,
 //                     checksum and index entries, in order
 //
@@ -61,43 +63,141 @@ struct Slot {
     std::vector<std::uint8_t> blocks;  // in the in-memory layout (the index is of these)
     std::vector<std::uint8_t> packed;  // version 17: the blocks as stored (and checksummed)
     std::vector<std::uint32_t> packed_sizes;  // of each packed block
-    std::vector<Vec3f> decoded, decoded_exact, resampled, scratch;
+    // The fibers not measured yet (from first_pending of the batch on), one
+    // after the other: targets (resampled fibers), decoded points (both
+    // decoders), where each starts, where its blocks end, and its end.
+    std::vector<Vec3f> targets, decoded, decoded_exact, resampled, scratch;
+    std::vector<std::size_t> starts, block_ends;
+    std::vector<FiberEnd> ends;
+    std::vector<double> lengths;  // resampled: the input polylines' lengths
+    std::size_t first_pending = 0;
     std::vector<PolylinePosition> positions;  // of the resampled points on the input
     std::vector<double> point_errors;         // scratch of add_point_errors
+    double kept_max2 = 0;       // resampled 8-bit: the largest squared error of the points no end placement moves
+    bool ends_missing = false;  // some fiber's length misses by more than its point errors: measured later
     ErrorStats error;
     GeometryError geometry;  // both ways against the input polylines
     IndexBuilder index;      // bounds of this task's blocks (the BIDX chunk)
 };
 
-// Stage 2, one task: fibers [cuts[t], cuts[t + 1]) of the batch into the slot.
-void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t, Slot& w) {
-    w.blocks.clear();
-    w.index.clear();
-    for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1]; ++i) {
-        const std::vector<Vec3f>& original = b.fibers[i];
-        std::span<const Vec3f> points = original;
-        const auto f = std::uint32_t(b.first_fiber + i);
-        w.decoded.clear();
-        w.decoded_exact.clear();
-        if (in.step > 0) {
-            const bool fields = in.point_fields && in.point_fields->active();
-            const bool short_tail = resample_cubic_keeping_end(original, in.step, (*in.tensions)[f] * kTensionQuantum,
-                                                               w.resampled, fields ? &w.positions : nullptr, kWrittenCurve);
-            if (fields) in.point_fields->resample(f, w.positions);
-            points = w.resampled;
-            (*in.end_fractions)[f] = encode_keeping_end(in.encoder, points, short_tail, in.step, f, w.blocks,
-                                                        w.decoded, &w.decoded_exact, w.scratch, polyline_length(original));
-        } else {
-            in.encoder.encode(points, f, w.blocks, &w.decoded, &w.decoded_exact);
-        }
-        if (in.block_index) w.index.add_fiber(w.decoded);
-        add_point_errors(points, w.decoded, w.decoded_exact, f, w.point_errors, w.error);
-        w.geometry.add_fiber(original, w.decoded, f);
+// Resampled fibers whose length the end placement left off by more than
+// their own point errors (8-bit blocks: the 0.1 mm bundles' codes zig-zag
+// by more than those errors take back; docs/encode.md) get their end placed
+// again, allowed `budget`: the largest error of the batch's points that no
+// end placement moves, which the file's recorded max error is at least, so
+// the ends stay within it. Only the fibers the budget brings closer change.
+bool misses_its_length(const FiberEnd& end) { return end.length_miss_mm > end.other_error_mm; }
+
+// The points a fiber's end placement may move: its last, or its last block's anchors.
+std::size_t movable_end_points(const FiberEnd& end) {
+    return end_fraction_applies(end.last_block_points) ? 1 : end.last_block_points;
+}
+
+void place_missing_ends(const EncodeStageInputs& in, const FiberBatch& b, double budget, Slot& w) {
+    const std::uint32_t bb = in.encoder.header().block_bytes();
+    auto fiber = [&](std::size_t j, std::vector<Vec3f>& v) {
+        return std::span<Vec3f>(v).subspan(w.starts[j], w.starts[j + 1] - w.starts[j]);
+    };
+    for (std::size_t j = 0; j < w.ends.size(); ++j) {
+        const FiberEnd& end = w.ends[j];
+        if (!misses_its_length(end) || !(end.length_miss_mm > budget) || !(budget > end.other_error_mm)) continue;
+        const std::span<Vec3f> exact = w.decoded_exact.empty() ? std::span<Vec3f>() : fiber(j, w.decoded_exact);
+        (*in.end_fractions)[b.first_fiber + w.first_pending + j] =
+            place_end_within(in.encoder.header(), end, &w.blocks[w.block_ends[j] - bb], fiber(j, w.targets),
+                             fiber(j, w.decoded), exact, w.lengths[j], budget);
     }
+}
+
+// The pending fibers' statistics and block index, in fiber order; then
+// they are no longer pending.
+void measure_pending(const EncodeStageInputs& in, const FiberBatch& b, Slot& w) {
+    for (std::size_t j = 0; j + 1 < w.starts.size(); ++j) {
+        const std::size_t s = w.starts[j], n = w.starts[j + 1] - s, i = w.first_pending + j;
+        const std::span<const Vec3f> decoded(w.decoded.data() + s, n);
+        const std::span<const Vec3f> points =
+            in.step > 0 ? std::span<const Vec3f>(w.targets.data() + s, n) : std::span<const Vec3f>(b.fibers[i]);
+        const std::span<const Vec3f> decoded_exact =
+            w.decoded_exact.size() == w.decoded.size() ? std::span<const Vec3f>(w.decoded_exact.data() + s, n)
+                                                        : std::span<const Vec3f>();
+        const auto f = std::uint32_t(b.first_fiber + i);
+        if (in.block_index) w.index.add_fiber(decoded);
+        add_point_errors(points, decoded, decoded_exact, f, w.point_errors, w.error);
+        w.geometry.add_fiber(b.fibers[i], decoded, f);
+    }
+    w.targets.clear(), w.decoded.clear(), w.decoded_exact.clear();
+    w.starts.assign(1, 0), w.block_ends.clear(), w.ends.clear(), w.lengths.clear();
+}
+
+void pack_task(const EncodeStageInputs& in, Slot& w) {
     const FftHeader& h = in.encoder.header();
     w.packed.clear();
     w.packed_sizes.clear();
     if (h.packed()) pack_blocks16(h, w.blocks, w.packed, &w.packed_sizes);
+}
+
+// Stage 2, one task: fibers [cuts[t], cuts[t + 1]) of the batch into the
+// slot, each measured as soon as it is encoded — but from the first that
+// misses its length on, they wait for the batch's budget (finish_batch).
+void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t, Slot& w) {
+    w.blocks.clear();
+    w.index.clear();
+    w.targets.clear(), w.decoded.clear(), w.decoded_exact.clear();
+    w.starts.assign(1, 0), w.block_ends.clear(), w.ends.clear(), w.lengths.clear();
+    w.kept_max2 = 0, w.ends_missing = false;
+    const bool budgeted = in.step > 0 && in.encoder.header().direction_bits() == 8;
+    for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1]; ++i) {
+        const std::vector<Vec3f>& original = b.fibers[i];
+        const auto f = std::uint32_t(b.first_fiber + i);
+        if (w.starts.size() == 1) w.first_pending = i;
+        if (in.step > 0) {
+            const bool fields = in.point_fields && in.point_fields->active();
+            const std::size_t at = w.targets.size();
+            const bool short_tail = resample_cubic_keeping_end(original, in.step, (*in.tensions)[f] * kTensionQuantum,
+                                                               w.resampled, fields ? &w.positions : nullptr, kWrittenCurve);
+            if (fields) in.point_fields->resample(f, w.positions);
+            w.targets.insert(w.targets.end(), w.resampled.begin(), w.resampled.end());
+            const std::span<const Vec3f> points(w.targets.data() + at, w.targets.size() - at);
+            w.lengths.push_back(polyline_length(original));
+            w.ends.push_back(encode_keeping_end(in.encoder, points, short_tail, in.step, f, w.blocks, w.decoded,
+                                                &w.decoded_exact, w.scratch, w.lengths.back()));
+            (*in.end_fractions)[f] = w.ends.back().fraction;
+        } else {
+            in.encoder.encode(original, f, w.blocks, &w.decoded, &w.decoded_exact);
+        }
+        const std::size_t s = w.starts.back();
+        w.starts.push_back(w.decoded.size());
+        w.block_ends.push_back(w.blocks.size());
+        if (budgeted) {
+            const bool missing = misses_its_length(w.ends.back());
+            w.ends_missing = w.ends_missing || missing;
+            const std::size_t n = w.decoded.size() - s;
+            const std::size_t kept = missing ? n - std::min(n, movable_end_points(w.ends.back())) : n;
+            for (std::size_t k = s; k < s + kept; ++k) {
+                w.kept_max2 = std::max(w.kept_max2, length2(w.targets[k], w.decoded[k]));
+                if (!w.decoded_exact.empty()) w.kept_max2 = std::max(w.kept_max2, length2(w.targets[k], w.decoded_exact[k]));
+            }
+        }
+        if (!w.ends_missing) measure_pending(in, b, w);
+    }
+    if (!w.ends_missing) pack_task(in, w);
+}
+
+// Stage 2's end on the caller, once a batch's tasks are done: the fibers
+// that miss their length get their ends placed within the batch's budget,
+// and the tasks that waited are measured (in parallel). The budget depends
+// on the batch alone, not on the thread count.
+void finish_batch(const EncodeStageInputs& in, const FiberBatch& b, std::vector<Slot>& slots) {
+    double budget2 = 0;
+    bool missing = false;
+    for (std::size_t t = 0; t < b.tasks(); ++t) budget2 = std::max(budget2, slots[t].kept_max2), missing = missing || slots[t].ends_missing;
+    if (!missing) return;
+    parallel_for(b.tasks(), in.threads, [&](std::size_t t) {
+        Slot& w = slots[t];
+        if (!w.ends_missing) return;
+        place_missing_ends(in, b, std::sqrt(budget2), w);
+        measure_pending(in, b, w);
+        pack_task(in, w);
+    });
 }
 
 // Stage 3: a batch's blocks, checksums and index entries, in task order.
@@ -166,6 +266,7 @@ EncodeStageResult encode_stage(StreamlineSource& reader, const EncodeStageInputs
         reader, in.threads, slots, [&](Slot& s) { s.index = empty_index; },
         [&](const FiberBatch& b, std::size_t t, Slot& s) { encode_task(in, b, t, s); }, [](const FiberBatch&) {},
         [&](const FiberBatch& b, std::vector<Slot>& batch_slots) {
+            finish_batch(in, b, batch_slots);
             write_batch(b, batch_slots, out, checksum, index);
             if (options.progress && reader.data_bytes() > 0)
                 options.progress("encode", double(reader.bytes_consumed()) / double(reader.data_bytes()));
