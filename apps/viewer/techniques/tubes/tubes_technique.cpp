@@ -32,7 +32,8 @@ std::uint32_t TubesTechnique::build_pieces(const FrameInputs& in, const DecodedB
                                            std::uint32_t chunk_segments, std::uint32_t chunks_per_block) {
     const FftHeader& h = in.scene.header();
     const std::uint32_t s = tube_node_spacing(tube_radius_for_spacing(in.scene, in.options), h.step * h.scaling);
-    const std::uint32_t segments_per_slot = tube_segments_per_slot(h.points_per_block, s);
+    const std::uint32_t segments_per_slot =
+        chunks_per_block ? tube_segments_per_chunk(chunk_segments, s) : tube_segments_per_slot(h.points_per_block, s);
     const std::uint64_t segments = std::uint64_t(batch.count) * segments_per_slot;
     if (pieces_capacity_ < 2 * segments) {
         pieces_ = make_buffer(GLsizeiptr(2 * segments * kPieceBytes), nullptr, 0);
