@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "orbit_camera.hpp"
 #include "render_target.hpp"
 #include "renderer.hpp"
+#include "techniques/tubes/tubes_technique.hpp"
 #include "viewer_test_util.hpp"
 
 using namespace fiblet;
@@ -179,4 +181,40 @@ TEST(ViewerSixteenBit, CullingAndSelectionCountTheSameSegments) {
         if (scene16.fiber_id(f) >= 10 && scene16.fiber_id(f) <= 29) want += scene16.fiber_points(f) - 1;
     EXPECT_GT(want, 0u);
     EXPECT_EQ(renderer.render(scene16, cam, o, target).fine_segments, want);
+}
+
+// Tube pieces of a batch that would exceed the largest storage buffer (a
+// full batch of 254-point blocks: 190 MB) are built and drawn in runs of
+// slots: runs of a few slots draw the image of one run.
+TEST(ViewerSixteenBit, TubePiecesInRunsDrawTheSameImage) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile f16(compress16_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst16.fft", false));
+    const viewer::GpuScene scene(f16, *viewer_gl().programs);
+    const int w = 160, h = 120;
+    const Camera cam = viewer::camera_from_spec("oblique", scene, float(w) / float(h), 35, 1.5f);
+    for (const float opacity : {1.0f, 0.4f}) {
+        SCOPED_TRACE(opacity);
+        viewer::RenderOptions o;
+        o.level_of_detail = false;
+        o.style = viewer::DrawStyle::tubes;
+        o.opacity = opacity;
+        std::vector<Image> images;
+        for (const bool runs : {false, true}) {
+            auto tubes = std::make_unique<viewer::TubesTechnique>();
+            // Pieces of 3 segments (2 x 112 B each): runs of one slot (a
+            // block: ceil(254 / s) segments) or, sorted, of a few chunks.
+            if (runs) tubes->set_piece_buffer_limit(3 * 2 * 112);
+            viewer::Renderer renderer(*viewer_gl().programs);
+            renderer.use_technique(viewer::DrawStyle::tubes, std::move(tubes));
+            viewer::RenderTarget target(w, h);
+            renderer.render(scene, cam, o, target);
+            images.push_back({target.read_rgba(), target.read_fibers()});
+        }
+        EXPECT_EQ(images[0].rgba, images[1].rgba);
+        if (opacity == 1.0f) EXPECT_EQ(images[0].fibers, images[1].fibers);
+        EXPECT_GT(std::count_if(images[0].fibers.begin(), images[0].fibers.end(), [](std::uint32_t f) { return f != 0; }) +
+                      std::count_if(images[0].rgba.begin(), images[0].rgba.end(), [](std::uint8_t c) { return c != 0; }),
+                  1000);
+    }
 }

@@ -24,7 +24,7 @@ inline constexpr unsigned kFiberColors = 12;  // per fiber: RGB (vec4), when the
 inline constexpr unsigned kFiberRadii = 13;   // per fiber: tube radius (mm), when the scene has radii
 inline constexpr unsigned kGlyphCoefficients = 14;  // overlays/odf_glyphs: SH coefficients, glyph units
 inline constexpr unsigned kGlyphCenters = 15;       // overlays/odf_glyphs: centre, radius (mm) and box (glyph_boxes.glsl)
-inline constexpr unsigned kLocalFrames = 16;  // the frames of the file's direction code (256, or levels^2 for 16-bit)
+inline constexpr unsigned kWideFrames = 16;  // the levels^2 frames of a 16-bit direction code (DirectionTable16)
 inline constexpr unsigned kStorageCount = 17;
 // Transparent frames (transparency/) reuse the binding points of buffers
 // that no pass using them binds (no level of detail, no decisions; tube
@@ -36,6 +36,8 @@ inline constexpr unsigned kSortedChunks = kDecisions;    // per sorted slot: blo
 inline constexpr unsigned kSortedBlocks = kTubePieces;   // per sorted slot: its block
 inline constexpr unsigned kVoxlineSegments = kTangents;  // voxlines: both ends of every segment
 inline constexpr unsigned kVoxlineOrders = kTubePieces;  // voxlines: the three axis orders of every voxel
+// Uniform buffers.
+inline constexpr unsigned kLocalFrames = 0;  // the 256 frames of the 8-bit direction code (DirectionTable)
 }  // namespace binding
 
 // Per-block decisions written by the culling pass.

@@ -30,10 +30,11 @@ std::uint64_t max_storage_buffer_bytes() {
 
 namespace {
 
-// The frames of the file's direction code as std430 mat3[] (each column
-// padded to a vec4), from the decoders' own tables: DirectionTable's 256 for
-// 8-bit blocks, DirectionTable16's levels^2 for 16-bit blocks.
-std::vector<float> local_frames_std430(const DecodeContext& ctx) {
+// The frames of the file's direction code as mat3[] with each column padded
+// to a vec4 (std140 and std430 alike), from the decoders' own tables:
+// DirectionTable's 256 for 8-bit blocks, DirectionTable16's levels^2 for
+// 16-bit blocks.
+std::vector<float> local_frames(const DecodeContext& ctx) {
     std::vector<float> out;
     auto add = [&](const Frame& f) {
         for (const Vec3f& c : f.c) out.insert(out.end(), {c.x, c.y, c.z, 0.0f});
@@ -117,7 +118,7 @@ GpuScene::GpuScene(const FftFile& file, const GpuPrograms& programs, std::option
     const float no_colors[4] = {1, 1, 1, 1};
     fiber_colors_ = make_buffer(16, no_colors, 0);
     fiber_radii_ = make_buffer(16, no_colors, 0);
-    const std::vector<float> frames = local_frames_std430(ctx);
+    const std::vector<float> frames = local_frames(ctx);
     local_frames_ = make_buffer(GLsizeiptr(frames.size() * 4), frames.data(), 0);
 
     // The last point of every fiber, decoded on the GPU over the list of last blocks.
@@ -197,7 +198,10 @@ void GpuScene::bind(const GlProgram& program) const {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberEndFraction, fiber_end_fraction_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberColors, fiber_colors_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberRadii, fiber_radii_.get());
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kLocalFrames, local_frames_.get());
+    if (header_.direction_bits() == 16)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kWideFrames, local_frames_.get());
+    else
+        glBindBufferBase(GL_UNIFORM_BUFFER, binding::kLocalFrames, local_frames_.get());
     const GLuint p = program.get();
     glProgramUniform1ui(p, uniform(program, "uBlockCount"), header_.blocks);
     glProgramUniform1ui(p, uniform(program, "uBlockWords"), header_.block_bytes() / 4);

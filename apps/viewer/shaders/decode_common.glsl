@@ -3,11 +3,16 @@
 // direction_code.hpp).
 
 // The local frames of the file's direction code, frame k's columns (axis
-// first; std430 pads each to a vec4): fiblet::DirectionTable's 256 for 8-bit
-// blocks, DirectionTable16's levels^2 (181^2 for version 17, 256^2 for
-// version 16) for 16-bit blocks. Every code the reader lets through is below
-// the count (it rejects larger ones).
-layout(std430, binding = BINDING_LOCAL_FRAMES) readonly buffer LocalFrames { mat3 localFrames[]; };
+// first, each padded to a vec4): fiblet::DirectionTable's 256 for 8-bit
+// blocks (std140 mat3[256]), DirectionTable16's levels^2 (181^2 for version
+// 17, 256^2 for version 16: too many for a uniform block) for 16-bit blocks.
+// Every code the reader lets through is below the count (it rejects larger
+// ones). The decoders are built for one layout (WIDE_BLOCKS).
+#if WIDE_BLOCKS
+layout(std430, binding = BINDING_WIDE_FRAMES) readonly buffer WideFrames { mat3 localFrames[]; };
+#else
+layout(std140, binding = BINDING_LOCAL_FRAMES) uniform LocalFrames { mat3 localFrames[256]; };
+#endif
 layout(std430, binding = BINDING_FINE_LIST) readonly buffer FineList { uint fineList[]; };
 layout(std430, binding = BINDING_POINTS) writeonly buffer Points { vec4 points[]; };
 // The unit tangent of each point, same layout, when uWriteTangents: the

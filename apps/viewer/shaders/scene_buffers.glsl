@@ -1,7 +1,9 @@
 // The scene as uploaded: the file's blocks as fiblet's reader holds them in
 // memory (never decoded on the CPU) and the small per-block / per-fiber
-// tables built from the fiber LUT. Two block layouts, chosen per file by
-// uWideBlocks (every accessor below branches on it; the branch is uniform):
+// tables built from the fiber LUT. Two block layouts, chosen per file:
+// programs built for one (WIDE_BLOCKS defined 0 or 1: the decoders, which
+// read a code per point) fix it at compile time, the others (which read a
+// few fields per block) branch on the uniform uWideBlocks:
 // 8-bit blocks (version 2, libfiblet/include/fiblet/fft_format.hpp): bytes
 // 0..11 the two anchors as six unorm16 (word k = a | b << 16, most-significant
 // byte first), 12..15 the fiber ID (big-endian), 16 flags (low 6 bits: point
@@ -21,7 +23,12 @@ uniform uint uPointsPerBlock;
 uniform float uScaling;    // mm per normalized unit
 uniform vec3 uOffset;      // mm
 uniform float uStep;       // normalized units
-uniform bool uWideBlocks;  // the 16-bit layout
+uniform bool uWideBlocks;  // the 16-bit layout, for programs built for both
+#ifdef WIDE_BLOCKS
+#define WIDE (WIDE_BLOCKS != 0)
+#else
+#define WIDE uWideBlocks
+#endif
 // Version 17: the first axis is normalize(q1 - q0) of the anchors' unorm24
 // integers (formats/fft16.md), not of the float anchors.
 uniform bool uAxisFromAnchorIntegers;
@@ -47,7 +54,7 @@ void blockAnchorIntegers(uint block, out uvec3 q0, out uvec3 q1) {
 // The two anchors in normalized coordinates. 8-bit: the buffer's uint loads
 // are little-endian, so a byte swap gives the stored big-endian word a | b << 16.
 void blockAnchors(uint block, out vec3 a0, out vec3 a1) {
-    if (uWideBlocks) {
+    if (WIDE) {
         uvec3 q0, q1;
         blockAnchorIntegers(block, q0, q1);
         a0 = vec3(q0) / 16777215.0;
@@ -66,17 +73,17 @@ vec3 blockAnchor0(uint block) {
 }
 
 uint blockFiberId(uint block) {
-    return uWideBlocks ? (blockWord(block, 4u) >> 16) | (blockWord(block, 5u) << 16) : byteSwap(blockWord(block, 3u));
+    return WIDE ? (blockWord(block, 4u) >> 16) | (blockWord(block, 5u) << 16) : byteSwap(blockWord(block, 3u));
 }
 
 // Point count from the flags, validated at upload to 1..pointsPerBlock.
 uint blockPointCount(uint block) {
-    return uWideBlocks ? (blockWord(block, 5u) >> 16) & 0x3fffu : blockWord(block, 4u) & 0x3fu;
+    return WIDE ? (blockWord(block, 5u) >> 16) & 0x3fffu : blockWord(block, 4u) & 0x3fu;
 }
 
 // The direction code of point k + 2.
 uint blockCode(uint block, uint k) {
-    if (uWideBlocks) return (blockWord(block, 6u + (k >> 1)) >> ((k & 1u) * 16u)) & 0xffffu;
+    if (WIDE) return (blockWord(block, 6u + (k >> 1)) >> ((k & 1u) * 16u)) & 0xffffu;
     return blockByte(block, 18u + k);
 }
 
@@ -85,7 +92,7 @@ uint blockCode(uint block, uint k) {
 // (exact in a float); coinciding anchors fall back to +x.
 vec3 blockFirstAxis(uint block, vec3 a0, vec3 a1) {
     vec3 d = a1 - a0;
-    if (uAxisFromAnchorIntegers) {
+    if (WIDE && uAxisFromAnchorIntegers) {
         uvec3 q0, q1;
         blockAnchorIntegers(block, q0, q1);
         d = vec3(ivec3(q1) - ivec3(q0));

@@ -21,6 +21,7 @@ layout(std430, binding = BINDING_TUBE_PIECES) writeonly buffer Pieces { TubePiec
 uniform bool uUseList;
 uniform uint uFirst;
 uniform uint uCount;            // slots in the batch
+uniform uint uFirstSlot;        // the run's first slot (runs keep the pieces buffer under the storage limit)
 uniform uint uNodeSpacing;      // points between nodes
 uniform uint uSegmentsPerSlot;  // tube_segments_per_slot, or tube_segments_per_chunk with chunks
 uniform float uTangentScale;    // c of tube_spline.hpp (1/4)
@@ -88,8 +89,8 @@ TubePiece makePiece(vec3 p0, vec3 p1, vec3 p2, float r, uint fiber) {
 }
 
 void main() {
-    uint id = gl_GlobalInvocationID.x;
-    uint slot = id / uSegmentsPerSlot, segment = id % uSegmentsPerSlot;
+    uint id = gl_GlobalInvocationID.x;  // piece pair id of this run
+    uint slot = uFirstSlot + id / uSegmentsPerSlot, segment = id % uSegmentsPerSlot;
     if (slot >= uCount) return;
     uint entry = uUseList ? fineList[uFirst + slot] : uFirst + slot;
     uint block = uChunksPerBlock > 0u ? entry / uChunksPerBlock : entry;
