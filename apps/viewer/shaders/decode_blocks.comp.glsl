@@ -41,6 +41,7 @@ void main() {
     // workgroup, so every invocation runs the same chunks and barriers).
     mat3 carryFrame = first;
     vec3 carryPoint = a1;
+    vec3 lastPoint = a1;  // invocation 63: the block's last point once it has codes
     uint codes = n > 2u ? n - 2u : 0u;
     for (uint c0 = 0u; c0 < codes; c0 += 64u) {
         uint k = c0 + t;  // point k + 2 turns the frame by the local frame of code k
@@ -61,6 +62,7 @@ void main() {
             barrier();
         }
         vec3 p = carryPoint + offset;  // point k + 2
+        if (t == 63u) lastPoint = p;   // the chunk's end (never shortened: a join needs a next block)
         // A fiber's last point keeps only a fraction of its step (ENDS chunk).
         if (hasCode && k + 3u == n) p -= (1.0 - keptLastStep(block, n)) * ownStep;
         if (uEndsOnly) {
@@ -69,17 +71,20 @@ void main() {
             points[base + k + 2u] = vec4(toWorld(p), 1.0);
             if (uWriteTangents) tangents[base + k + 2u] = vec4(normalize(carryFrame * running[0]), 0.0);
         }
-        // Invocation 63 holds the whole chunk's product and sum.
-        if (t == 63u) sChunkFrame = running, sChunkStep = offset;
-        barrier();
-        carryFrame = carryFrame * sChunkFrame;
-        carryPoint = carryPoint + sChunkStep;
-        barrier();  // before the next chunk overwrites them
+        // Another chunk follows (the same for the whole workgroup): it starts
+        // from invocation 63's product and sum. 8-bit blocks never get here.
+        if (c0 + 64u < codes) {
+            if (t == 63u) sChunkFrame = running, sChunkStep = offset;
+            barrier();
+            carryFrame = carryFrame * sChunkFrame;
+            carryPoint = carryPoint + sChunkStep;
+            barrier();  // before the next chunk overwrites them
+        }
     }
 
     if (uEndsOnly || t != 63u || isLastBlockOfFiber(block)) return;
-    // The point joining the next block; carryPoint is the block's last point when it has codes.
-    vec3 last = n >= 3u ? carryPoint : n == 2u ? a1 : a0;
+    // The point joining the next block.
+    vec3 last = n >= 3u ? lastPoint : n == 2u ? a1 : a0;
     vec3 next = toWorld(blockAnchor0(block + 1u));
     points[base + n] = vec4(next, 1.0);
     if (uWriteTangents) tangents[base + n] = vec4(directionOr(toWorld(last), next, first[0]), 0.0);
