@@ -16,6 +16,13 @@ layout(local_size_x = 64) in;
 
 shared mat3 sFrames[64];
 shared vec3 sSteps[64];
+// 8-bit blocks hold at most 61 codes: one chunk, a loop the compiler can drop.
+#if WIDE_BLOCKS
+const uint kMaxChunks = (16383u + 63u) / 64u;
+#else
+const uint kMaxChunks = 1u;
+#endif
+
 shared mat3 sChunkFrame;  // the product of a chunk's frames (invocation 63's)
 shared vec3 sChunkStep;   // the sum of its steps
 
@@ -43,7 +50,9 @@ void main() {
     vec3 carryPoint = a1;
     vec3 lastPoint = a1;  // invocation 63: the block's last point once it has codes
     uint codes = n > 2u ? n - 2u : 0u;
-    for (uint c0 = 0u; c0 < codes; c0 += 64u) {
+    for (uint chunk = 0u; chunk < kMaxChunks; ++chunk) {
+        uint c0 = chunk * 64u;
+        if (c0 >= codes) break;  // the same for the whole workgroup
         uint k = c0 + t;  // point k + 2 turns the frame by the local frame of code k
         bool hasCode = k < codes;
         mat3 running = hasCode ? localFrames[blockCode(block, k)] : mat3(1.0);
