@@ -83,13 +83,29 @@ TEST(ViewerCli, RenderRefusesBadArgumentsAndExistingOutputs) {
     EXPECT_EQ(no_output.status, 2) << no_output.output;
     const CommandResult bad_file = run_cli("render " + shared_data("conformance/no_magic_number.tck") + " -o " + dir.file("x.png"));
     EXPECT_EQ(bad_file.status, 4) << bad_file.output;
-    // 16-bit files: refused (unsupported), not drawn as 8-bit codes.
-    const std::string wide = dir.file("af16.fft");
-    ASSERT_EQ(run_cli("compress -q --bits 16 " + shared_data("bundles/AF_L.tck") + " -o " + wide).status, 0);
-    const CommandResult r16 = run_cli("render " + wide + " -o " + dir.file("x.png") + " --size 32x32");
-    EXPECT_EQ(r16.status, 6) << r16.output;
-    EXPECT_NE(r16.output.find("16-bit"), std::string::npos) << r16.output;
     EXPECT_FALSE(std::filesystem::exists(dir.file("x.png")));
+}
+
+// 16-bit files (formats/fft16.md, version 17 .fft and version 16 .fftz) render
+// as the 8-bit file of the same fibers does (pixel by pixel: viewer_sixteen_bit_test).
+TEST(ViewerCli, RenderDrawsSixteenBitFiles) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const std::string tck = shared_data("bundles/CST_R-step0.1.tck");
+    const std::string narrow = compress_into(dir, tck, "cst.fft");
+    const std::string args = " --size 160x120 --camera left --zoom 2 --no-lod";
+    ASSERT_EQ(run_cli("render " + narrow + " -o " + dir.file("8.png") + args).status, 0);
+    const std::size_t lit8 = lit_pixels(viewer::read_png(dir.file("8.png")));
+    for (const char* out : {"cst16.fft", "cst16.fftz"}) {
+        const std::string wide = dir.file(out);
+        const std::string zstd = std::string(out).ends_with(".fftz") ? " --zstd" : "";
+        ASSERT_EQ(run_cli("compress -q --bits 16" + zstd + " " + tck + " -o " + wide).status, 0);
+        const CommandResult r = run_cli("render " + wide + " -o " + dir.file("16.png") + " -f" + args);
+        ASSERT_EQ(r.status, 0) << r.output;
+        const std::size_t lit16 = lit_pixels(viewer::read_png(dir.file("16.png")));
+        EXPECT_GT(lit8, 500u);
+        EXPECT_NEAR(double(lit16), double(lit8), 0.03 * double(lit8)) << out;
+    }
 }
 
 TEST(ViewerCli, BenchPrintsEveryStageForEveryCase) {

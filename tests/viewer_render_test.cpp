@@ -181,25 +181,56 @@ TEST(ViewerRender, MatchesAReferenceRasterizationOfTheDecodedSegments) {
     }
 }
 
-TEST(ViewerRender, LevelOfDetailMatchesTheReferenceOfCoarseBlocks) {
-    FIBLET_REQUIRE_GL();
-    const CompressedScene compressed(shared_data("bundles/cingulum-2-step0.1.tck"));
-    const FftFile& file = compressed.file;
-    const viewer::GpuScene& scene = compressed.scene;
+namespace {
+// The level of detail of `file` against view.hpp's decisions on the CPU.
+void expect_lod_matches_reference(const FftFile& file, const viewer::GpuScene& scene, float lod_pixels) {
     viewer::Renderer renderer(*viewer_gl().programs);
     const int w = 256, h = 192;
     viewer::RenderTarget target(w, h);
-    // A level-of-detail threshold of 16 pixels makes most blocks coarse in an
-    // image large enough to compare.
+    // A level-of-detail threshold of 16 pixels (60-point blocks) makes most
+    // blocks coarse in an image large enough to compare.
     const Camera cam = viewer::camera_from_spec("oblique", scene, float(w) / float(h), 35, 0.5f);
     viewer::RenderOptions o = flat_direction_colors();
-    o.lod_pixels = 16;
+    o.lod_pixels = lod_pixels;
     const viewer::FrameStats stats = renderer.render(scene, cam, o, target);
     std::size_t coarse = 0;
     const auto ref = rasterize(lod_segments(file, cam, {w, h}, o.lod_pixels, coarse), cam, w, h);
     EXPECT_GT(stats.coarse_blocks, scene.block_count() / 2);
     EXPECT_NEAR(double(stats.coarse_blocks), double(coarse), 2.0);
     expect_agreement(compare(target.read_fibers(), target.read_rgba(), ref, w, h), 400);
+}
+}  // namespace
+
+TEST(ViewerRender, LevelOfDetailMatchesTheReferenceOfCoarseBlocks) {
+    FIBLET_REQUIRE_GL();
+    const CompressedScene compressed(shared_data("bundles/cingulum-2-step0.1.tck"));
+    expect_lod_matches_reference(compressed.file, compressed.scene, 16);
+}
+
+// 16-bit blocks (254 points, unorm24 anchors): the culling pass's spheres,
+// coarse chords and fiber ends read the wide layout.
+TEST(ViewerRender, LevelOfDetailOfSixteenBitFiles) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress16_into(dir, shared_data("bundles/cingulum-2-step0.1.tck"), "c16.fft", false));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    expect_lod_matches_reference(file, scene, 64);  // blocks four times as long
+}
+
+TEST(ViewerRender, MatchesAReferenceRasterizationOfSixteenBitFiles) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const FftFile file(compress16_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst16.fft", false));
+    const viewer::GpuScene scene(file, *viewer_gl().programs);
+    viewer::Renderer renderer(*viewer_gl().programs);
+    const int w = 160, h = 120;
+    viewer::RenderTarget target(w, h);
+    const Camera cam = viewer::camera_from_spec("oblique", scene, float(w) / float(h), 35, 1);
+    viewer::RenderOptions o = flat_direction_colors();
+    o.level_of_detail = false;
+    EXPECT_EQ(renderer.render(scene, cam, o, target).fine_segments, file.header().points - file.header().fibers);
+    expect_agreement(compare(target.read_fibers(), target.read_rgba(), rasterize(all_segments(file), cam, w, h), w, h),
+                     500);
 }
 
 TEST(ViewerRender, PngRoundTrip) {

@@ -96,6 +96,22 @@ inline std::string compress_fibers(const TempDir& dir, const std::vector<std::ve
     return compress_into(dir, dir.file(name + ".tck"), name + ".fft");
 }
 
+// Compresses `tck` into `dir` with 16-bit direction codes (formats/fft16.md):
+// version 17 in a .fft, or version 16 in a .fftz with `zstd`.
+// `points_per_block` 0: the encoder's default (254, 126 in a .fftz).
+inline std::string compress16_into(const TempDir& dir, const std::string& tck, const std::string& name, bool zstd,
+                                   std::uint32_t points_per_block = 0) {
+    const std::string out = dir.file(name);
+    CompressOptions o;
+    o.threads = 1;
+    o.overwrite = true;
+    o.direction_bits = 16;
+    o.points_per_block = points_per_block;
+    if (zstd) o.zstd = ZstdOptions{};
+    compress_tck(tck, out, o);
+    return out;
+}
+
 // Fibers (or a .tck file) compressed into a temporary file and uploaded: what most viewer tests draw.
 struct CompressedScene {
     TempDir dir;
@@ -124,7 +140,7 @@ inline CpuDecoded cpu_decode_blocks(const FftFile& f) {
     const std::uint32_t bb = f.header().block_bytes();
     d.block_first.push_back(0);
     for (std::uint32_t b = 0; b < f.header().blocks; ++b)
-        d.block_first.push_back(d.block_first.back() + BlockView{&blocks[std::size_t(b) * bb]}.point_count());
+        d.block_first.push_back(d.block_first.back() + block_flags(f.header(), &blocks[std::size_t(b) * bb]).point_count);
     return d;
 }
 

@@ -29,7 +29,7 @@ constexpr std::uint32_t kPointBytes = 16;  // vec4
 
 void dispatch_decode(const GpuPrograms& programs, DecoderKind kind, const GpuScene& scene, bool use_list,
                      std::uint32_t first, std::uint32_t count, bool ends_only, bool tangents) {
-    const GlProgram& p = kind == DecoderKind::scan ? programs.decode_scan : programs.decode_sequential;
+    const GlProgram& p = programs.decoder(kind, scene.header().direction_bits() == 16);
     glUseProgram(p.get());
     scene.bind(p);
     glProgramUniform1i(p.get(), uniform(p, "uUseList"), use_list ? 1 : 0);

@@ -24,7 +24,8 @@ inline constexpr unsigned kFiberColors = 12;  // per fiber: RGB (vec4), when the
 inline constexpr unsigned kFiberRadii = 13;   // per fiber: tube radius (mm), when the scene has radii
 inline constexpr unsigned kGlyphCoefficients = 14;  // overlays/odf_glyphs: SH coefficients, glyph units
 inline constexpr unsigned kGlyphCenters = 15;       // overlays/odf_glyphs: centre, radius (mm) and box (glyph_boxes.glsl)
-inline constexpr unsigned kStorageCount = 16;
+inline constexpr unsigned kWideFrames = 16;  // the levels^2 frames of a 16-bit direction code (DirectionTable16)
+inline constexpr unsigned kStorageCount = 17;
 // Transparent frames (transparency/) reuse the binding points of buffers
 // that no pass using them binds (no level of detail, no decisions; tube
 // pieces and tangents only in the draw passes, after the sort), so that the
@@ -36,7 +37,7 @@ inline constexpr unsigned kSortedBlocks = kTubePieces;   // per sorted slot: its
 inline constexpr unsigned kVoxlineSegments = kTangents;  // voxlines: both ends of every segment
 inline constexpr unsigned kVoxlineOrders = kTubePieces;  // voxlines: the three axis orders of every voxel
 // Uniform buffers.
-inline constexpr unsigned kLocalFrames = 0;  // the 256 frames of the direction code (DirectionTable)
+inline constexpr unsigned kLocalFrames = 0;  // the 256 frames of the 8-bit direction code (DirectionTable)
 }  // namespace binding
 
 // Per-block decisions written by the culling pass.

@@ -30,13 +30,22 @@ std::uint64_t max_storage_buffer_bytes() {
 
 namespace {
 
-// The DirectionTable as std140 mat3[256] (each column padded to a vec4).
-std::vector<float> local_frames_std140(float ratio) {
-    const DirectionTable table(ratio);
+// The frames of the file's direction code as mat3[] with each column padded
+// to a vec4 (std140 and std430 alike), from the decoders' own tables:
+// DirectionTable's 256 for 8-bit blocks, DirectionTable16's levels^2 for
+// 16-bit blocks.
+std::vector<float> local_frames(const DecodeContext& ctx) {
     std::vector<float> out;
-    out.reserve(256 * 12);
-    for (int k = 0; k < 256; ++k)
-        for (const Vec3f& c : table.frame(std::uint8_t(k)).c) out.insert(out.end(), {c.x, c.y, c.z, 0.0f});
+    auto add = [&](const Frame& f) {
+        for (const Vec3f& c : f.c) out.insert(out.end(), {c.x, c.y, c.z, 0.0f});
+    };
+    if (ctx.table16) {
+        out.reserve(std::size_t(ctx.table16->code_count()) * 12);
+        for (std::uint32_t k = 0; k < ctx.table16->code_count(); ++k) add(ctx.table16->frame(std::uint16_t(k)));
+    } else {
+        out.reserve(256 * 12);
+        for (int k = 0; k < 256; ++k) add(ctx.table.frame(std::uint8_t(k)));
+    }
     return out;
 }
 
@@ -53,10 +62,6 @@ void check_fits(std::uint64_t bytes, const char* what) {
 GpuScene::GpuScene(const FftFile& file, const GpuPrograms& programs, std::optional<DecoderKind> decoder)
     : header_(file.header()) {
     const FftHeader& h = header_;
-    // The shaders decode the 8-bit layout only: a 16-bit file would draw as noise.
-    if (h.direction_bits() != 8)
-        throw Error(Errc::unsupported, file.path() + ": 16-bit direction files (formats/fft16.md) are not drawn by "
-                                                     "the GPU decoder; `fiblet decompress` it and render the .tck");
     const std::uint32_t bb = h.block_bytes();
     check_fits(std::uint64_t(h.blocks) * bb, "blocks");
     const std::vector<std::uint8_t> blocks = file.read_blocks(0, h.blocks);
@@ -72,14 +77,14 @@ GpuScene::GpuScene(const FftFile& file, const GpuPrograms& programs, std::option
     fiber_points_.assign(fibers, 0);
     block_points_.resize(h.blocks);
     for (std::uint32_t b = 0; b < h.blocks; ++b)
-        block_points_[b] = std::uint8_t(BlockView{&blocks[std::size_t(b) * bb]}.point_count());
+        block_points_[b] = std::uint16_t(block_flags(h, &blocks[std::size_t(b) * bb]).point_count);
     for (std::uint64_t f = 0; f < fibers; ++f) {
         const std::uint64_t first = file.first_block(f), count = file.block_count(f);
         for (std::uint64_t b = first; b < first + count; ++b) {
             block_fiber[b] = std::uint32_t(f);
             fiber_points_[f] += block_points_[b];
         }
-        fiber_ids_[f] = count ? BlockView{&blocks[first * bb]}.fiber_id() : std::uint32_t(f);
+        fiber_ids_[f] = count ? block_flags(h, &blocks[first * bb]).fiber_id : std::uint32_t(f);
         if (count) last_blocks.push_back(std::uint32_t(first + count - 1));
         if (fiber_points_[f] > 1) segments_ += fiber_points_[f] - 1;
     }
@@ -113,7 +118,7 @@ GpuScene::GpuScene(const FftFile& file, const GpuPrograms& programs, std::option
     const float no_colors[4] = {1, 1, 1, 1};
     fiber_colors_ = make_buffer(16, no_colors, 0);
     fiber_radii_ = make_buffer(16, no_colors, 0);
-    const std::vector<float> frames = local_frames_std140(h.ratio);
+    const std::vector<float> frames = local_frames(ctx);
     local_frames_ = make_buffer(GLsizeiptr(frames.size() * 4), frames.data(), 0);
 
     // The last point of every fiber, decoded on the GPU over the list of last blocks.
@@ -193,7 +198,10 @@ void GpuScene::bind(const GlProgram& program) const {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberEndFraction, fiber_end_fraction_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberColors, fiber_colors_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberRadii, fiber_radii_.get());
-    glBindBufferBase(GL_UNIFORM_BUFFER, binding::kLocalFrames, local_frames_.get());
+    if (header_.direction_bits() == 16)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kWideFrames, local_frames_.get());
+    else
+        glBindBufferBase(GL_UNIFORM_BUFFER, binding::kLocalFrames, local_frames_.get());
     const GLuint p = program.get();
     glProgramUniform1ui(p, uniform(program, "uBlockCount"), header_.blocks);
     glProgramUniform1ui(p, uniform(program, "uBlockWords"), header_.block_bytes() / 4);
@@ -201,6 +209,8 @@ void GpuScene::bind(const GlProgram& program) const {
     glProgramUniform1f(p, uniform(program, "uScaling"), header_.scaling);
     glProgramUniform3f(p, uniform(program, "uOffset"), header_.offset[0], header_.offset[1], header_.offset[2]);
     glProgramUniform1f(p, uniform(program, "uStep"), header_.step);
+    glProgramUniform1i(p, uniform(program, "uWideBlocks"), header_.direction_bits() == 16 ? 1 : 0);
+    glProgramUniform1i(p, uniform(program, "uAxisFromAnchorIntegers"), header_.packed() ? 1 : 0);
 }
 
 }  // namespace fiblet::viewer

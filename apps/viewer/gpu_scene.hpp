@@ -1,6 +1,8 @@
-// A .fft file on the GPU: its blocks uploaded as they are in the file (76
-// bytes each for 60 points; never decoded on the CPU), the 256 local frames
-// of its direction code, and small tables built from the fiber LUT (fiber of
+// A .fft file on the GPU: its blocks uploaded as fiblet's reader holds them
+// (8-bit: as in the file, 76 bytes each for 60 points; 16-bit: version 16's
+// fixed-size layout, version 17's packed blocks expanded to it; never decoded
+// on the CPU), the local frames of its direction code (256, or 181^2 / 256^2
+// for 16-bit codes), and small tables built from the fiber LUT (fiber of
 // each block, points of each fiber). The last point of every fiber, which the
 // level of detail needs, is decoded once on the GPU at load.
 #pragma once
@@ -80,7 +82,7 @@ public:
 private:
     FftHeader header_;
     std::vector<std::uint32_t> fiber_ids_, fiber_points_;
-    std::vector<std::uint8_t> block_points_;
+    std::vector<std::uint16_t> block_points_;
     std::uint64_t segments_ = 0;
     SceneBounds bounds_;
     std::vector<Vec3f> sample_points_;

@@ -17,7 +17,7 @@ void main() {
     uint n = blockPointCount(block);
     vec3 a0, a1;
     blockAnchors(block, a0, a1);
-    mat3 frame = frameFromAxis(anchorAxis(a0, a1));
+    mat3 frame = frameFromAxis(blockFirstAxis(block, a0, a1));
     vec3 p = n == 1u ? a0 : a1;
     uint base = slot * (uPointsPerBlock + 1u);
     vec3 tangent = frame[0];

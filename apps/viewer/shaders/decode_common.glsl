@@ -2,8 +2,17 @@
 // frame of a block, computed as the CPU does (block_geometry.hpp,
 // direction_code.hpp).
 
-// fiblet::DirectionTable: frame k's columns (axis first), std140 mat3.
+// The local frames of the file's direction code, frame k's columns (axis
+// first, each padded to a vec4): fiblet::DirectionTable's 256 for 8-bit
+// blocks (std140 mat3[256]), DirectionTable16's levels^2 (181^2 for version
+// 17, 256^2 for version 16: too many for a uniform block) for 16-bit blocks.
+// Every code the reader lets through is below the count (it rejects larger
+// ones). The decoders are built for one layout (WIDE_BLOCKS).
+#if WIDE_BLOCKS
+layout(std430, binding = BINDING_WIDE_FRAMES) readonly buffer WideFrames { mat3 localFrames[]; };
+#else
 layout(std140, binding = BINDING_LOCAL_FRAMES) uniform LocalFrames { mat3 localFrames[256]; };
+#endif
 layout(std430, binding = BINDING_FINE_LIST) readonly buffer FineList { uint fineList[]; };
 layout(std430, binding = BINDING_POINTS) writeonly buffer Points { vec4 points[]; };
 // The unit tangent of each point, same layout, when uWriteTangents: the
@@ -46,11 +55,4 @@ mat3 frameFromAxis(vec3 axis) {
     c1 = normalize(c1);
     vec3 c2 = normalize(cross(axis, c1));
     return mat3(axis, c1, c2);
-}
-
-// The first axis; coinciding anchors fall back to +x (block_geometry.hpp).
-vec3 anchorAxis(vec3 a0, vec3 a1) {
-    vec3 d = a1 - a0;
-    float n2 = dot(d, d);
-    return n2 > 0.0 ? (1.0 / sqrt(n2)) * d : vec3(1.0, 0.0, 0.0);
 }

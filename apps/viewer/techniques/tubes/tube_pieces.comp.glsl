@@ -4,8 +4,9 @@
 // the decoder's unit tangents (tube_spline.hpp), two quadratic Bézier
 // pieces per segment, each with its oriented bounding box. With
 // uChunksPerBlock > 0 (sorted transparency) the list holds block x
-// uChunksPerBlock + chunk and a slot keeps only the segments whose first
-// node lies in its chunk (points [chunk, chunk + 1) x uChunkSegments).
+// uChunksPerBlock + chunk and a slot builds only the segments whose first
+// node lies in its chunk (points [chunk, chunk + 1) x uChunkSegments):
+// segment i of the slot starts at the chunk's i-th node.
 layout(local_size_x = 64) in;
 
 #include "scene_buffers.glsl"
@@ -20,8 +21,9 @@ layout(std430, binding = BINDING_TUBE_PIECES) writeonly buffer Pieces { TubePiec
 uniform bool uUseList;
 uniform uint uFirst;
 uniform uint uCount;            // slots in the batch
+uniform uint uFirstSlot;        // the run's first slot (runs keep the pieces buffer under the storage limit)
 uniform uint uNodeSpacing;      // points between nodes
-uniform uint uSegmentsPerSlot;  // tube_segments_per_slot
+uniform uint uSegmentsPerSlot;  // tube_segments_per_slot, or tube_segments_per_chunk with chunks
 uniform float uTangentScale;    // c of tube_spline.hpp (1/4)
 uniform uint uChunksPerBlock;   // 0: slots are whole blocks
 uniform uint uChunkSegments;
@@ -87,14 +89,19 @@ TubePiece makePiece(vec3 p0, vec3 p1, vec3 p2, float r, uint fiber) {
 }
 
 void main() {
-    uint id = gl_GlobalInvocationID.x;
-    uint slot = id / uSegmentsPerSlot, segment = id % uSegmentsPerSlot;
+    uint id = gl_GlobalInvocationID.x;  // piece pair id of this run
+    uint slot = uFirstSlot + id / uSegmentsPerSlot, segment = id % uSegmentsPerSlot;
     if (slot >= uCount) return;
     uint entry = uUseList ? fineList[uFirst + slot] : uFirst + slot;
     uint block = uChunksPerBlock > 0u ? entry / uChunksPerBlock : entry;
     uint last = blockSegmentCount(block);  // the slot's points are 0..last
     uint k0 = segment * uNodeSpacing;
-    bool otherChunk = uChunksPerBlock > 0u && k0 / uChunkSegments != entry % uChunksPerBlock;
+    bool otherChunk = false;
+    if (uChunksPerBlock > 0u) {
+        uint chunkFirst = (entry % uChunksPerBlock) * uChunkSegments;
+        k0 += (chunkFirst + uNodeSpacing - 1u) / uNodeSpacing * uNodeSpacing;  // the chunk's first node
+        otherChunk = k0 >= chunkFirst + uChunkSegments;
+    }
     if (k0 >= last || otherChunk) {
         pieces[2u * id].c0.w = -1.0;
         pieces[2u * id + 1u].c0.w = -1.0;

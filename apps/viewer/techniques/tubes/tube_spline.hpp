@@ -51,5 +51,12 @@ inline float tube_radius_for_spacing(const GpuScene& scene, const RenderOptions&
 inline std::uint32_t tube_segments_per_slot(std::uint32_t points_per_block, std::uint32_t s) {
     return (points_per_block + s - 1) / s;
 }
+// Hermite segments starting in a chunk of `chunk_segments` points (sorted
+// transparency): the nodes, multiples of s, among them. Building only these
+// keeps the pieces of a batch of chunks proportional to the chunks, not to
+// chunks x block length (16-bit files: 26 chunks of blocks of 254 points).
+inline std::uint32_t tube_segments_per_chunk(std::uint32_t chunk_segments, std::uint32_t s) {
+    return (chunk_segments + s - 1) / s;
+}
 
 }  // namespace fiblet::viewer

@@ -33,15 +33,26 @@ public:
     // pieces the buffer holds (empty ones included).
     std::uint32_t build_pieces(const FrameInputs& in, const DecodedBatch& batch);
     GLuint pieces_buffer() const { return pieces_.get(); }
+    // Largest pieces buffer (default: the driver's largest storage buffer);
+    // a batch whose pieces take more is built and drawn in runs of slots.
+    // Tests lower it to check that runs draw the same image.
+    void set_piece_buffer_limit(std::uint64_t bytes) { piece_buffer_limit_ = bytes; }
 
 private:
+    std::uint32_t segments_per_slot(const FrameInputs& in, std::uint32_t chunk_segments,
+                                    std::uint32_t chunks_per_block) const;
+    // The pieces of slots [first_slot, first_slot + slots) of the batch.
     std::uint32_t build_pieces(const FrameInputs& in, const DecodedBatch& batch, bool use_list,
-                               std::uint32_t chunk_segments, std::uint32_t chunks_per_block);
+                               std::uint32_t chunk_segments, std::uint32_t chunks_per_block, std::uint32_t first_slot,
+                               std::uint32_t slots);
+    void draw_slots(const FrameInputs& in, const DecodedBatch& batch, bool use_list, std::uint32_t chunk_segments,
+                    std::uint32_t chunks_per_block);
     void draw_pieces(std::uint32_t pieces);
     float tangent_scale_;
     GlProgram build_, draw_;
     GlBuffer pieces_;
     std::uint64_t pieces_capacity_ = 0;
+    std::uint64_t piece_buffer_limit_;
     LinesTechnique coarse_lines_;
 };
 
