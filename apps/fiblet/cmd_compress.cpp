@@ -168,7 +168,7 @@ void add_compress(CLI::App& app) {
     cmd->add_option("--bits", args->bits,
                     "Bits per direction: 8 (.fft version 2), 16 (formats/fft16.md: 15-bit codes in packed blocks; with "
                     "--zstd, version 16) or auto (default): 8 unless 8-bit codes would change the sampled fibers' "
-                    "lengths by more than their point error (smooth fixed-step fibers; docs/encode.md)")
+                    "lengths by more than their point error (smooth fibers at fine steps; docs/encode.md)")
         ->check(CLI::IsMember({"auto", "8", "16"}));
     cmd->add_option("--block-points", args->block_points, "Points per block (default 60 for 8 bits; 254 for 16, 126 for 16 with --zstd)");
     cmd->add_option("-e,--effort", args->effort,

@@ -151,7 +151,8 @@ ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_
                 scan.single_point_fibers += fiber.size() == 1;
                 r.fiber_points.push_back(std::uint32_t(fiber.size()));
                 r.sample.offer(fiber);
-                if (bits_sample_points) r.bits_sample.offer(fiber);
+                // Fibers with a length only: 2^21 empty fibers would otherwise all be kept (48 MB).
+                if (bits_sample_points && fiber.size() >= 2) r.bits_sample.offer(fiber);
             }
         },
         [&](const FiberBatch& b, const std::vector<ScanSlot>& done) {

@@ -72,7 +72,7 @@ struct ScanStageResult {
     std::vector<std::uint32_t> fiber_points;  // per fiber
     TurnStatistics turns;                     // turning angles and the sharpest blocks
     FiberSample sample;                       // fibers for tuning the encoder
-    FiberSample bits_sample;                  // more fibers at the same strides, for the direction bits
+    FiberSample bits_sample;                  // more fibers (of 2 points or more), for the direction bits
     LengthHistogram lengths;                  // segment lengths (their median)
     double length_sum = 0;
     std::vector<float> fiber_lengths;  // per fiber: its polyline length (mm), for block_keeping_step

@@ -24,14 +24,14 @@ struct SampleResampling {
 };
 
 // Points in the sample the bits are chosen on (FiberSample: every k-th
-// fiber, the tuning sample's fibers among them). Larger than the tuning
+// fiber of two points or more). Larger than the tuning
 // sample (16 k points): the length change that decides is a max over
 // fibers, and 16 k points are 7 of CST_R-step0.1's 50 fibers and 15 of
 // cingulum-2-step0.1's 113, which miss the few whose lengths 8-bit codes
 // change beyond the point error; 64 k points catch them, 128 k hold every
 // shared 0.1 mm bundle whole (docs/encode.md, "Why smooth fibers need 16
-// bits"). Encoding them costs ~0.06 s of CPU (~8 % of compressing a
-// 2 M-point file, 0.3 % of a 46 M-point one).
+// bits"). Encoding them costs ~7 % of compressing a 2 M-point file
+// (0.05 s of CPU on small-ifod1), 0.3 % of a 46 M-point one.
 inline constexpr std::size_t kBitsSamplePoints = std::size_t{1} << 17;
 
 // Encodes each of `fibers` as pass 2 would with `encoder` (resampled first
