@@ -17,6 +17,7 @@
 #include "fiblet/compress.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/fft_file.hpp"
+#include "fiblet/fiber_ends.hpp"
 #include "fiblet/tck.hpp"
 #include "test_util.hpp"
 
@@ -27,15 +28,17 @@ constexpr double kStep = 0.1;  // mm, as SD_STREAM and the 0.1 mm bundles
 
 // Long, smooth fibers at a fixed 0.1 mm step, like SD_STREAM's: bending
 // gently (1/150 mm^-1), with a 15 degree corner every 20 mm, which sizes
-// the cap as the sharpest turns of real data do; 60 to 83 mm long.
-void write_smooth_fibers(const std::string& path) {
+// the cap as the sharpest turns of real data do; 60 to 83 mm long. With
+// `drop_every` > 0 every drop_every-th point is left out (variable spacing:
+// compress resamples them, as the 0.1 mm bundles).
+void write_smooth_fibers(const std::string& path, int drop_every = 0) {
     TckWriter w(path, {{"step_size", "0.1"}}, true);
     for (int i = 0; i < 24; ++i) {
         const double plane = 0.26 * i;
         double heading = 0, x = 0.3 * i, y = 0, z = -40;
         std::vector<Vec3f> f;
         for (int k = 0; k < 600 + 10 * i; ++k) {
-            f.push_back({float(x), float(y), float(z)});
+            if (drop_every == 0 || k % drop_every != drop_every - 1) f.push_back({float(x), float(y), float(z)});
             heading += kStep / 150 + (k % 200 == 199 ? 0.26 : 0.0);
             const double u = std::sin(heading), v = std::cos(heading);
             x += kStep * u * std::cos(plane), y += kStep * u * std::sin(plane), z += kStep * v;
@@ -86,18 +89,29 @@ struct LengthChanges {
     double fiblet = 0, exact = 0;  // largest |decoded - input length|, mm
 };
 
-// Every fiber's length change in `fft` against `tck`, by brute force.
+// Every fiber's length change in `fft` against `tck`, by brute force (the
+// float64 decode with its ENDS fraction applied as formats/fft-ends.md says).
 LengthChanges length_changes(const std::string& tck, const std::string& fft) {
     const FftFile file(fft);
     const Streamlines s = decode_fibers(file, 0, file.header().fibers);
-    const test::exact::Decoded exact = test::exact::decode(test::read_file(fft));
+    const std::string bytes = test::read_file(fft);
+    const test::exact::Decoded exact = test::exact::decode(bytes);
+    const std::string ends = test::exact::trailer_chunk(bytes, "ENDS");
+    const std::uint32_t ppb = exact.header.points_per_block;
     TckReader in(tck);
     std::vector<Vec3f> f;
     LengthChanges out;
     for (std::size_t i = 0; in.next(f); ++i) {
         const double li = length_of(&f[0].x, f.size());
         out.fiblet = std::max(out.fiblet, std::fabs(length_of(&s.xyz[3 * s.offsets[i]], s.offsets[i + 1] - s.offsets[i]) - li));
-        out.exact = std::max(out.exact, std::fabs(length_of(exact.fibers[i]) - li));
+        std::vector<test::exact::V3> e = exact.fibers[i];
+        if (!ends.empty()) {
+            const auto q = std::uint16_t(std::uint8_t(ends[2 * i]) | std::uint8_t(ends[2 * i + 1]) << 8);
+            const std::size_t last_block = e.size() - ppb * ((e.size() - 1) / ppb);
+            if (q != kWholeLastStep && end_fraction_applies(std::uint32_t(last_block)))
+                e.back() = e[e.size() - 2] + (double(q) / 65535.0) * (e.back() - e[e.size() - 2]);
+        }
+        out.exact = std::max(out.exact, std::fabs(length_of(e) - li));
     }
     return out;
 }
@@ -141,6 +155,26 @@ TEST(DirectionBits, SmoothFibersGetSixteenBitsAndKeepTheirLengths) {
     // The same file as asking for 16 bits (fixed-step input: tuned alike).
     compress(dir.file("smooth.tck"), dir.file("16.fft"), 16u);
     EXPECT_TRUE(test::read_file(dir.file("auto.fft")) == test::read_file(dir.file("16.fft")));
+}
+
+// Resampled input is measured as pass 2 encodes it: resampled with its
+// fitted tension, its end kept (ENDS). The sample is the whole file here,
+// so what it measured is what the 8-bit file shows. These smooth fibers
+// keep their lengths at 8 bits once resampled (the length feedback across
+// blocks: 0.8 um for 1.3 um measured), so they stay 8-bit.
+TEST(DirectionBits, ResampledInputIsMeasuredAsPassTwoEncodesIt) {
+    test::TempDir dir;
+    write_smooth_fibers(dir.file("gaps.tck"), 4);  // spacing 0.1, 0.1, 0.2 mm
+    const CompressReport r = compress(dir.file("gaps.tck"), dir.file("auto.fft"), std::nullopt);
+    ASSERT_TRUE(r.resampled);
+    EXPECT_EQ(r.header.direction_bits(), 8u) << r.bits.reason;
+    EXPECT_EQ(r.bits.sample_fibers, 24u);
+    const LengthChanges c = length_changes(dir.file("gaps.tck"), dir.file("auto.fft"));
+    EXPECT_NEAR(r.bits.length_change_max_mm, std::max(c.fiblet, c.exact), 1e-5);
+    EXPECT_NEAR(r.bits.point_error_max_mm, double(r.header.max_error_mm), 1e-6);
+    EXPECT_LE(c.fiblet, double(r.header.max_error_mm) * (1 + 1e-6) + 1e-7);
+    compress(dir.file("gaps.tck"), dir.file("8.fft"), 8u);
+    EXPECT_TRUE(test::read_file(dir.file("auto.fft")) == test::read_file(dir.file("8.fft")));
 }
 
 TEST(DirectionBits, JitteryFibersKeepEightBits) {

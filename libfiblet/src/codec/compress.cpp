@@ -144,7 +144,8 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     // Turning angles and a sample of fibers, for the encoder's choices (parameters.cpp).
     constexpr std::size_t kSharpBlocks = 32;
     // The bits are measured on a larger sample than the tuning's (direction_bits.hpp).
-    const std::size_t bits_sample_points = choose_bits ? std::max(options.tuning_points, detail::kBitsSamplePoints) : 0;
+    const std::size_t bits_sample_points =
+        choose_bits && !wide_blocks_asked ? std::max(options.tuning_points, detail::kBitsSamplePoints) : 0;
     detail::ScanStageResult scanned = detail::scan_stage(reader, scan, points_per_block, kSharpBlocks,
                                                          options.tuning_points, bits_sample_points, threads, options);
     std::vector<std::uint32_t>& fiber_points = scanned.fiber_points;
