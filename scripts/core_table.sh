@@ -2,7 +2,11 @@
 # Compresses every shared tractogram and prints a Markdown table: sizes,
 # ratio, max/mean error (µm, measured by `fiblet stats` against the input),
 # the symmetric metrics (Hausdorff, endpoint displacement, length change),
-# compress and decompress wall time. Usage: scripts/core_table.sh [fiblet args...]
+# compress and decompress wall time. The direction bits are the default's
+# choice per file (`--bits auto`: 16 where 8-bit codes would change the
+# fibers' lengths beyond their point error; "16-bit" after the ratio);
+# `scripts/core_table.sh --bits 8` measures the 8-bit codec on every file.
+# Usage: scripts/core_table.sh [fiblet args...]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 fiblet="${FIBLET:-$root/build/bin/fiblet}"
@@ -24,10 +28,12 @@ for f in "${files[@]}"; do
   "$fiblet" decompress -q "$out" -o "$work/back.tck" --force
   t2=$(date +%s.%N)
   "$fiblet" stats "$out" -r "$in" --json -q > "$work/stats.json"
-  /usr/bin/python3 - "$f" "$work/stats.json" "$t0" "$t1" "$t2" <<'PY'
+  "$fiblet" info "$out" --json > "$work/info.json"
+  /usr/bin/python3 - "$f" "$work/stats.json" "$work/info.json" "$t0" "$t1" "$t2" <<'PY'
 import json, sys
-name, path, t0, t1, t2 = sys.argv[1], sys.argv[2], *map(float, sys.argv[3:])
+name, path, info, t0, t1, t2 = sys.argv[1], sys.argv[2], sys.argv[3], *map(float, sys.argv[4:])
 s = json.load(open(path))
+bits = " (16-bit)" if json.load(open(info))["version"] in (16, 17) else ""
 e = s["error"]
 extra = ""
 if s["resampled"]:
@@ -35,7 +41,7 @@ if s["resampled"]:
     extra = f" (resampled; vs original polyline {o['max_um']:.2f} / {o['mean_um']:.2f})"
 g = s["geometry"]
 ends, length = g["endpoint"], g["length_change"]
-print(f"| {name} | {s['reference_bytes']/1e6:.2f} MB | {s['fft_bytes']/1e6:.3f} MB | {s['ratio']:.2f}× | "
+print(f"| {name} | {s['reference_bytes']/1e6:.2f} MB | {s['fft_bytes']/1e6:.3f} MB | {s['ratio']:.2f}×{bits} | "
       f"{e['max_um']:.2f} / {e['mean_um']:.2f}{extra} | {g['hausdorff_um']:.2f} | "
       f"{ends['max_um']:.2f} / {ends['mean_um']:.2f} | {length['max_um']:.1f} / {length['mean_um']:.1f} "
       f"({length['mean_percent']:.3f} %) | {t1-t0:.2f} | {t2-t1:.2f} |")

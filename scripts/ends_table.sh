@@ -8,6 +8,8 @@
 # newer file's header records (µm), tckstats mean length and `tckedit
 # -minlength 100` count of the input and of each decoded file, .fft size and
 # its change (%).
+# Both compress with `--bits 8`: the table compares the 8-bit codec (the
+# default chooses 16 bits for smooth fixed-step fibers, codec/direction_bits.hpp).
 # Usage: FIBLET_BEFORE=old/bin/fiblet [FIBLET=build/bin/fiblet] scripts/ends_table.sh
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -34,7 +36,7 @@ for f in "${files[@]}"; do
   [ -f "$in" ] || continue
   for which in before after; do
     bin=$before; [ $which = after ] && bin=$after
-    "$bin" compress -q --force "$in" -o "$work/$which.fft"
+    "$bin" compress -q --force --bits 8 "$in" -o "$work/$which.fft"
     "$after" stats --json -q "$work/$which.fft" -r "$in" > "$work/$which.json"
     "$after" decompress -q --force "$work/$which.fft" -o "$work/$which.tck"
     tckmean "$work/$which.tck" > "$work/$which.tckstats"

@@ -72,10 +72,12 @@ inline ViewerGl& viewer_gl() {
             GTEST_SKIP() << "no headless OpenGL 4.5 context: " << ::fiblet::test::viewer_gl().error; \
     } while (0)
 
-// Compresses `tck` into `dir` and returns the .fft path.
+// Compresses `tck` into `dir` with 8-bit directions (what the viewer's GPU
+// decoders read) and returns the .fft path.
 inline std::string compress_into(const TempDir& dir, const std::string& tck, const std::string& name) {
     const std::string out = dir.file(name);
     CompressOptions o;
+    o.direction_bits = 8;  // the default chooses 16 for smooth fibers (codec/direction_bits.hpp)
     o.threads = 1;
     o.overwrite = true;
     compress_tck(tck, out, o);

@@ -20,7 +20,7 @@ struct CompressArgs {
     std::optional<double> step;
     unsigned threads = 0;
     // Encoder choices.
-    unsigned bits = 8;
+    std::string bits = "auto";  // auto, 8 or 16
     std::uint32_t block_points = 0;
     int effort = kDefaultEffort;
     std::optional<unsigned> beam, radius, retry_beam, lookahead;
@@ -50,6 +50,10 @@ std::string report_json(const std::string& in, const std::string& out, const Com
     j.num("ratio", r.output_bytes ? double(r.input_bytes) / double(r.output_bytes) : 0.0);
     j.num("step_mm", r.step_mm).num("step_scale", r.step_scale).num("cap_ratio", r.header.ratio);
     j.boolean("resampled", r.resampled).integer("direction_bits", r.header.direction_bits());
+    j.boolean("bits_automatic", r.bits.automatic).str("bits_reason", r.bits.reason);
+    if (r.bits.sample_fibers)
+        j.num("bits_sample_length_change_max_um", r.bits.length_change_max_mm * 1e3)
+            .num("bits_sample_max_error_um", r.bits.point_error_max_mm * 1e3);
     j.num("max_error_um", r.error.max_mm() * 1e3).num("mean_error_um", r.error.mean_mm() * 1e3);
     if (r.resampled)
         j.num("max_error_vs_original_um", r.error_vs_original.max_mm() * 1e3)
@@ -67,6 +71,7 @@ void print_report(std::FILE* to, const std::string& in, const std::string& out, 
     fmt::print(to, "  step {:.6g} mm{}, decoder step x{:.5f}, cap ratio {:.4f}\n", r.step_mm,
                r.resampled ? " (variable spacing in the input: resampled to this fixed step)" : "", r.step_scale,
                r.header.ratio);
+    fmt::print(to, "  {}\n", r.bits.reason);
     fmt::print(to, "  {} -> {} ({:.2f}x smaller)\n", human_bytes(r.input_bytes), human_bytes(r.output_bytes),
                double(r.input_bytes) / double(r.output_bytes));
     fmt::print(to, "  error vs {}: {}\n", r.resampled ? "resampled points" : "input", describe_errors(r.error));
@@ -87,7 +92,7 @@ void run(const CompressArgs& a) {
         o.overwrite = a.force;
         o.threads = a.threads;
         o.allow_count_mismatch = a.allow_count_mismatch;
-        o.direction_bits = a.bits;
+        if (a.bits != "auto") o.direction_bits = unsigned(std::stoul(a.bits));
         o.points_per_block = a.block_points;
         o.search = search_for_effort(a.effort);
         if (a.beam) o.search.beam_width = *a.beam;
@@ -160,8 +165,11 @@ void add_compress(CLI::App& app) {
     cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs); created if missing");
     cmd->add_option("--step", args->step, "Fixed step in mm (default: measured; variable spacing is resampled)");
     add_threads_option(cmd, args->threads, "Encoding");
-    cmd->add_option("--bits", args->bits, "Bits per direction: 8 (.fft version 2) or 16 (formats/fft16.md: 15-bit codes in packed blocks; with --zstd, version 16)")
-        ->check(CLI::IsMember({8u, 16u}));
+    cmd->add_option("--bits", args->bits,
+                    "Bits per direction: 8 (.fft version 2), 16 (formats/fft16.md: 15-bit codes in packed blocks; with "
+                    "--zstd, version 16) or auto (default): 8 unless 8-bit codes would change the sampled fibers' "
+                    "lengths by more than their point error (smooth fibers at fine steps; docs/encode.md)")
+        ->check(CLI::IsMember({"auto", "8", "16"}));
     cmd->add_option("--block-points", args->block_points, "Points per block (default 60 for 8 bits; 254 for 16, 126 for 16 with --zstd)");
     cmd->add_option("-e,--effort", args->effort,
                     "Code search effort 0..4 (default 1): slower searches give smaller errors, same decoder")

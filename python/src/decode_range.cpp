@@ -45,6 +45,19 @@ bool fast_block_decoder_available() { return has_fast_decoder<DecodeContext>; }
 DecodedRange decode_range(const FftFile& file, std::uint64_t begin, std::uint64_t end, unsigned threads) {
     if (begin > end || end > file.header().fibers)
         throw Error(Errc::invalid_argument, file.path() + ": fiber range past the end");
+    // The fast path reads fixed-size 8-bit blocks; 16-bit files (formats/fft16.md,
+    // which compress writes by default for smooth fibers) take the library's path.
+    if (file.header().direction_bits() != 8) {
+        DecodeOptions o;
+        o.threads = threads;
+        const Streamlines s = decode_fibers(file, begin, end, o);
+        DecodedRange out;
+        out.points = s.point_count();
+        out.xyz = PopulatedBuffer(out.points * 3 * sizeof(float), output_page_mode());
+        if (out.points) std::memcpy(out.xyz.as<float>(), s.xyz.data(), out.points * 3 * sizeof(float));
+        out.offsets.assign(s.offsets.begin(), s.offsets.end());
+        return out;
+    }
     const DecodeContext ctx(file);
     const std::uint32_t bb = ctx.header.block_bytes();
     const std::uint64_t b0 = file.block_end(begin), nblocks = file.block_end(end) - b0;

@@ -374,6 +374,10 @@ py::dict compress(const std::string& tck_path, const std::string& fft_path, std:
     d["ratio"] = r.output_bytes ? double(r.input_bytes) / double(r.output_bytes) : 0.0;
     d["step_mm"] = r.step_mm, d["step_scale"] = r.step_scale, d["cap_ratio"] = r.header.ratio, d["resampled"] = r.resampled;
     d["direction_bits"] = r.header.direction_bits();
+    d["bits_automatic"] = r.bits.automatic, d["bits_reason"] = r.bits.reason;
+    if (r.bits.sample_fibers)
+        d["bits_sample_length_change_max_um"] = r.bits.length_change_max_mm * 1e3,
+        d["bits_sample_max_error_um"] = r.bits.point_error_max_mm * 1e3;
     d["max_error_um"] = r.error.max_mm() * 1e3, d["mean_error_um"] = r.error.mean_mm() * 1e3;
     if (r.resampled)
         d["max_error_vs_original_um"] = r.error_vs_original.max_mm() * 1e3,

@@ -37,7 +37,10 @@ struct CompressOptions {
     std::optional<double> step_mm;            // overrides the measured step
     std::uint32_t points_per_block = 0;       // 0: 60 for 8-bit codes; 16-bit: 254 (.fft), 126 (.fftz)
     // Encoder choices; the decoder is the same whatever they are (docs/encode.md).
-    unsigned direction_bits = 8;              // 8: version-2 .fft; 16: version 17 (.fft) or 16 (.fftz) (formats/fft16.md)
+    // 8: version-2 .fft; 16: version 17 (.fft) or 16 (.fftz) (formats/fft16.md);
+    // unset: 8 unless 8-bit codes would change the sampled fibers' lengths by
+    // more than their point error (docs/encode.md, "Why smooth fibers need 16 bits").
+    std::optional<unsigned> direction_bits;
     bool fixed_blocks16 = false;              // 16-bit codes in version 16's fixed-size blocks in a .fft too
     SearchOptions search = search_for_effort(kDefaultEffort);  // code search (see search_for_effort)
     std::optional<double> cap_ratio;          // cap ratio; default: tuned on a sample
@@ -54,8 +57,20 @@ struct CompressOptions {
     std::function<void(const char*, double)> progress;
 };
 
+// Why the direction bits are what they are: what 8-bit codes do to the
+// lengths of a sample of the fibers (measured when the bits are chosen;
+// else zero).
+struct DirectionBitsChoice {
+    bool automatic = false;              // chosen from the data (CompressOptions::direction_bits unset)
+    std::size_t sample_fibers = 0;       // fibers the 8-bit codes were measured on
+    double length_change_max_mm = 0;     // their largest |decoded - input length|, float32 or exact decode
+    double point_error_max_mm = 0;       // their largest point error, float32 or exact decode (the header's measure)
+    std::string reason;                  // one sentence, for the report
+};
+
 struct CompressReport {
     TckScan scan;
+    DirectionBitsChoice bits;
     FftHeader header;
     double step_mm = 0;              // sampling step: the spacing of the encoded points
     double step_scale = 1;           // decoder step / sampling step (header step = step_mm * step_scale)

@@ -6,6 +6,7 @@
 // (compress_stages.hpp).
 #include "fiblet/compress.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <chrono>
 #include <cmath>
@@ -17,6 +18,7 @@
 #include <utility>
 
 #include "codec/compress_stages.hpp"
+#include "codec/direction_bits.hpp"
 #include "codec/fiber_end_encoder.hpp"
 #include "codec/parameters.hpp"
 #include "core/streamline_label.hpp"
@@ -63,16 +65,17 @@ void check_step_resolvable(const std::string& path, double step_mm, double exten
                     " mm step: beyond the 2^20 steps per extent that the format's float decoder and 16-bit anchors resolve");
 }
 
-}  // namespace
+// The block layout for a number of direction bits: 16 bits in packed blocks
+// (version 17) in a .fft; in fixed-size blocks (version 16) in a .fftz,
+// whose block groups are transposed whole, or when asked for.
+struct BlockLayout {
+    unsigned bits = 8;
+    bool packed = false;
+    std::uint32_t points_per_block = kDefaultPointsPerBlock;
+};
 
-CompressReport compress_tck(const std::string& tck_path, const std::string& fft_path, const CompressOptions& options) {
-    const Timer timer;
-    if (options.direction_bits != 8 && options.direction_bits != 16)
-        throw Error(Errc::invalid_argument, "direction bits must be 8 or 16");
-    const bool wide = options.direction_bits == 16;
-    // 16 bits: packed blocks (version 17) in a .fft; fixed-size blocks
-    // (version 16) in a .fftz, whose block groups are transposed whole, or
-    // when asked for.
+BlockLayout block_layout(unsigned bits, const CompressOptions& options) {
+    const bool wide = bits == 16;
     const bool packed = wide && !options.zstd && !options.fixed_blocks16;
     const std::uint32_t points_per_block =
         options.points_per_block ? options.points_per_block
@@ -81,14 +84,56 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     const std::uint32_t max_points_per_block = wide ? kMaxPointsPerBlock16 : kMaxPointsPerBlock;
     if (points_per_block < 2 || points_per_block > max_points_per_block)
         throw Error(Errc::invalid_argument, "points per block must be in [2, " + std::to_string(max_points_per_block) + "]");
+    return {bits, packed, points_per_block};
+}
+
+void set_layout(FftHeader& h, const BlockLayout& layout) {
+    h.version = layout.packed ? kFft16PackedVersion : layout.bits == 16 ? kFft16Version : kFftVersion;
+    h.points_per_block = layout.points_per_block;
+}
+
+std::string micrometres_g(double mm) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g µm", mm * 1e3);
+    return buf;
+}
+
+// The report's sentence on the bits (DirectionBitsChoice::reason).
+std::string bits_reason(const DirectionBitsChoice& c, unsigned bits, bool wide_blocks_asked, std::uint32_t points_per_block) {
+    if (wide_blocks_asked)
+        return "16 bits: blocks of " + std::to_string(points_per_block) + " points are beyond 8-bit blocks' " +
+               std::to_string(kMaxPointsPerBlock);
+    if (c.sample_fibers == 0) return bits == 16 ? "16 bits as asked" : c.automatic ? "8 bits: no fiber to measure" : "8 bits as asked";
+    const std::string measured = "lengths by up to " + micrometres_g(c.length_change_max_mm) + " for a point error of " +
+                                 micrometres_g(c.point_error_max_mm) + " (sample of " + std::to_string(c.sample_fibers) +
+                                 " fibers)";
+    if (bits == 16) return "16 bits: 8-bit codes would change " + measured;
+    return std::string(c.automatic ? "8 bits: " : "8 bits as asked: ") + "8-bit codes change " + measured;
+}
+
+}  // namespace
+
+CompressReport compress_tck(const std::string& tck_path, const std::string& fft_path, const CompressOptions& options) {
+    const Timer timer;
+    if (options.direction_bits && *options.direction_bits != 8 && *options.direction_bits != 16)
+        throw Error(Errc::invalid_argument, "direction bits must be 8 or 16");
+    // Unset bits: 8 unless the sample says otherwise after tuning (or the
+    // block size asks for 16-bit blocks).
+    const bool choose_bits = !options.direction_bits;
+    const bool wide_blocks_asked = choose_bits && options.points_per_block > kMaxPointsPerBlock;
+    BlockLayout layout = block_layout(options.direction_bits.value_or(wide_blocks_asked ? 16 : 8), options);
+    std::uint32_t points_per_block = layout.points_per_block;
     if (options.step_mm && !(std::isfinite(*options.step_mm) && *options.step_mm > 0))
         throw Error(Errc::invalid_argument, "--step must be a positive number of millimetres");
     const unsigned threads = detail::resolve_threads(options.threads);  // checked before any work
 
     CompressReport report;
     TckScan& scan = report.scan;
-    // The longest streamline a file can hold bounds the one in memory too.
-    const std::size_t max_fiber_points = std::size_t{0xffff} * points_per_block;
+    // The longest streamline a file can hold bounds the one in memory too
+    // (either layout's while the bits are still to choose).
+    const std::size_t max_fiber_points =
+        std::size_t{0xffff} *
+        (choose_bits ? std::max(points_per_block, block_layout(16, options).points_per_block) : points_per_block);
     const auto source = open_streamline_source(
         tck_path, {.allow_count_mismatch = options.allow_count_mismatch, .max_points = max_fiber_points});
     StreamlineSource& reader = *source;
@@ -98,8 +143,11 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     // Pass 1: counts, bounding box, spacing, turning angles (compress_scan.cpp).
     // Turning angles and a sample of fibers, for the encoder's choices (parameters.cpp).
     constexpr std::size_t kSharpBlocks = 32;
-    detail::ScanStageResult scanned =
-        detail::scan_stage(reader, scan, points_per_block, kSharpBlocks, options.tuning_points, threads, options);
+    // The bits are measured on a larger sample than the tuning's (direction_bits.hpp).
+    const std::size_t bits_sample_points =
+        choose_bits && !wide_blocks_asked ? std::max(options.tuning_points, detail::kBitsSamplePoints) : 0;
+    detail::ScanStageResult scanned = detail::scan_stage(reader, scan, points_per_block, kSharpBlocks,
+                                                         options.tuning_points, bits_sample_points, threads, options);
     std::vector<std::uint32_t>& fiber_points = scanned.fiber_points;
     detail::TurnStatistics& turns = scanned.turns;
     detail::FiberSample& sample = scanned.sample;
@@ -139,8 +187,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     // Normalization into the unit cube; the step is what the decoder will
     // use (float, normalized), and resampling uses exactly that length.
     FftHeader& h = report.header;
-    h.version = packed ? kFft16PackedVersion : wide ? kFft16Version : kFftVersion;
-    h.points_per_block = points_per_block;
+    set_layout(h, layout);
     h.fibers = scan.fibers;
     double extent = 0;
     for (int a = 0; a < 3; ++a) {
@@ -187,22 +234,50 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     if (options.cap_ratio) fixed_ratio = float(*options.cap_ratio);
     else if (options.turn_percentile) fixed_ratio = compute_ratio(h.scaling, step, turns.dot_at_percentile(*options.turn_percentile));
     const detail::TuningSet tuning_set{sample.fibers(), turns.sharpest_blocks(), report.resampled ? step : 0.0};
-    detail::TunedParameters tuned =
-        detail::tune_parameters(tuning_set, turns, h, options.search, step, fixed_ratio, step_scale);
-    // Fixed-step input keeps its lengths where the sampling step and the
-    // tail feedback do it (parameters.hpp, keep_fixed_step_lengths).
-    const bool keep_lengths =
-        !report.resampled &&
-        detail::keep_fixed_step_lengths(tuning_set, turns, tuned, h, step, fixed_ratio, step_scale);
-    h.ratio = tuned.ratio;
-    report.step_scale = tuned.step_scale;
-    h.step = float(step * report.step_scale / h.scaling);
-    // Resampled fibers keep their length across blocks (length_feedback.hpp);
-    // fixed-step fibers where keep_lengths (their block tails only).
-    const FiberEncoder encoder = (tuned.encoder ? std::move(*tuned.encoder) : FiberEncoder(h, tuned.search))
-                                     .with_length_feedback(report.resampled ? float(decoder_stretch(h.step, h.scaling, step))
-                                                           : keep_lengths ? 1.0f : 0.0f,
-                                                           !report.resampled);
+    // The cap, the decoder step and the encoder for the header's bits.
+    auto tuned_encoder = [&] {
+        detail::TunedParameters tuned =
+            detail::tune_parameters(tuning_set, turns, h, options.search, step, fixed_ratio, step_scale);
+        // Fixed-step input keeps its lengths where the sampling step and the
+        // tail feedback do it (parameters.hpp, keep_fixed_step_lengths).
+        const bool keep_lengths =
+            !report.resampled &&
+            detail::keep_fixed_step_lengths(tuning_set, turns, tuned, h, step, fixed_ratio, step_scale);
+        h.ratio = tuned.ratio;
+        report.step_scale = tuned.step_scale;
+        h.step = float(step * report.step_scale / h.scaling);
+        // Resampled fibers keep their length across blocks (length_feedback.hpp);
+        // fixed-step fibers where keep_lengths (their block tails only).
+        return (tuned.encoder ? std::move(*tuned.encoder) : FiberEncoder(h, tuned.search))
+            .with_length_feedback(report.resampled ? float(decoder_stretch(h.step, h.scaling, step))
+                                  : keep_lengths   ? 1.0f
+                                                   : 0.0f,
+                                  !report.resampled);
+    };
+    FiberEncoder encoder = tuned_encoder();
+    // Bits to choose: what 8-bit codes do to the sample's lengths; 16 bits when they would
+    // not keep them (direction_bits.hpp), or when a fiber needs more 8-bit
+    // blocks than a file holds. The 16-bit encoder is tuned as for --bits 16
+    // on the same sample (fixed-step input: the same bytes); resampled input
+    // keeps the step and the decoder step pass 1b fitted its tensions to.
+    if (choose_bits && h.direction_bits() == 8)
+        report.bits = detail::measure_sample_lengths(scanned.bits_sample.fibers(), encoder,
+                                                      {report.resampled ? step : 0.0, stretch}, threads);
+    report.bits.automatic = choose_bits;
+    report.bits.reason = bits_reason(report.bits, h.direction_bits(), wide_blocks_asked, points_per_block);
+    if (choose_bits && h.direction_bits() == 8) {
+        const std::uint32_t longest = fiber_points.empty() ? 0 : *std::max_element(fiber_points.begin(), fiber_points.end());
+        const bool too_long = encoder.block_count(longest) > 0xffff;
+        if (too_long || !detail::eight_bits_keep_lengths(report.bits)) {
+            report.bits.reason = too_long ? "16 bits: a fiber of " + std::to_string(longest) +
+                                                " points needs more than 65535 blocks of 8-bit codes"
+                                          : bits_reason(report.bits, 16, false, 0);
+            layout = block_layout(16, options);
+            points_per_block = layout.points_per_block;
+            set_layout(h, layout);
+            encoder = tuned_encoder();
+        }
+    }
     report.search = encoder.search();
     std::vector<FiberLutEntry> lut(scan.fibers);
     const std::uint64_t per_buffer = fft_max_blocks_per_buffer(h.block_bytes());
@@ -215,8 +290,8 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         if (h.buffer_ends.size() > 254)
             throw Error(Errc::unsupported, tck_path + ": more than 255 GPU buffers of blocks");
         // Version 17 stores the fiber's point count where version 16 has its first block.
-        lut[f] = {std::uint32_t(h.buffer_ends.size()) << 16 | nb, packed ? fiber_points[f] : std::uint32_t(in_buffer)};
-        if (packed && nb > 0)
+        lut[f] = {std::uint32_t(h.buffer_ends.size()) << 16 | nb, layout.packed ? fiber_points[f] : std::uint32_t(in_buffer)};
+        if (layout.packed && nb > 0)
             h.packed_block_bytes += (nb - 1) * std::uint64_t{packed16_block_bytes(points_per_block)} +
                                     packed16_block_bytes(fiber_points[f] - (nb - 1) * points_per_block);
         blocks += nb, in_buffer += nb;

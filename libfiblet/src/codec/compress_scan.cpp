@@ -130,11 +130,12 @@ double LengthHistogram::median() const {
 }
 
 ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_t points_per_block,
-                           std::size_t sharp_blocks, std::size_t tuning_points, unsigned threads,
-                           const CompressOptions& options) {
+                           std::size_t sharp_blocks, std::size_t tuning_points, std::size_t bits_sample_points,
+                           unsigned threads, const CompressOptions& options) {
     ScanStageResult r{.fiber_points = {},
                       .turns = TurnStatistics(points_per_block, sharp_blocks),
                       .sample = FiberSample(tuning_points),
+                      .bits_sample = FiberSample(bits_sample_points),
                       .lengths = {}};
     std::vector<ScanSlot> slots[2];
     for_each_batch(
@@ -150,6 +151,8 @@ ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_
                 scan.single_point_fibers += fiber.size() == 1;
                 r.fiber_points.push_back(std::uint32_t(fiber.size()));
                 r.sample.offer(fiber);
+                // Fibers with a length only: 2^21 empty fibers would otherwise all be kept (48 MB).
+                if (bits_sample_points && fiber.size() >= 2) r.bits_sample.offer(fiber);
             }
         },
         [&](const FiberBatch& b, const std::vector<ScanSlot>& done) {

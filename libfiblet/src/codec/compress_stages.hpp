@@ -72,6 +72,7 @@ struct ScanStageResult {
     std::vector<std::uint32_t> fiber_points;  // per fiber
     TurnStatistics turns;                     // turning angles and the sharpest blocks
     FiberSample sample;                       // fibers for tuning the encoder
+    FiberSample bits_sample;                  // more fibers (of 2 points or more), for the direction bits
     LengthHistogram lengths;                  // segment lengths (their median)
     double length_sum = 0;
     std::vector<float> fiber_lengths;  // per fiber: its polyline length (mm), for block_keeping_step
@@ -93,9 +94,10 @@ double block_keeping_step(std::span<const float> fiber_lengths, double step, std
 
 // Pass 1 over `reader` (from where it stands: its start): fills scan's
 // counts, bounds and step extremes (not step_mean/median: from the result).
+// `bits_sample_points` 0: no bits sample.
 ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_t points_per_block,
-                           std::size_t sharp_blocks, std::size_t tuning_points, unsigned threads,
-                           const CompressOptions& options);
+                           std::size_t sharp_blocks, std::size_t tuning_points, std::size_t bits_sample_points,
+                           unsigned threads, const CompressOptions& options);
 
 // How pass 1b resamples: the step (mm) and the decoder's stretch of it
 // that the length-keeping tension allows for (length_keeping_tension).
