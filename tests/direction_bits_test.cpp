@@ -116,6 +116,14 @@ LengthChanges length_changes(const std::string& tck, const std::string& fft) {
     return out;
 }
 
+// Every fiber within the header's max error (fiblet's decoder), 1.05x it
+// (float64).
+void expect_lengths_within_the_recorded_error(const LengthChanges& c, const FftHeader& h) {
+    const double recorded = double(h.max_error_mm) * (1 + 1e-6) + 1e-7;
+    EXPECT_LE(c.fiblet, recorded);
+    EXPECT_LE(c.exact, 1.05 * recorded);
+}
+
 CompressReport compress(const std::string& tck, const std::string& fft, std::optional<unsigned> bits,
                         unsigned threads = 0) {
     CompressOptions o;
@@ -148,10 +156,7 @@ TEST(DirectionBits, SmoothFibersGetSixteenBitsAndKeepTheirLengths) {
     EXPECT_EQ(r.bits.sample_fibers, 24u);
     EXPECT_NEAR(r.bits.length_change_max_mm, std::max(c8.fiblet, c8.exact), 1e-5);
     EXPECT_NEAR(r.bits.point_error_max_mm, double(r8.header.max_error_mm), 1e-6);
-    const double recorded = double(r.header.max_error_mm) * (1 + 1e-6) + 1e-7;
-    const LengthChanges c = length_changes(dir.file("smooth.tck"), dir.file("auto.fft"));
-    EXPECT_LE(c.fiblet, recorded);
-    EXPECT_LE(c.exact, 1.05 * recorded);
+    expect_lengths_within_the_recorded_error(length_changes(dir.file("smooth.tck"), dir.file("auto.fft")), r.header);
     // The same file as asking for 16 bits (fixed-step input: tuned alike).
     compress(dir.file("smooth.tck"), dir.file("16.fft"), 16u);
     EXPECT_TRUE(test::read_file(dir.file("auto.fft")) == test::read_file(dir.file("16.fft")));
@@ -172,7 +177,7 @@ TEST(DirectionBits, ResampledInputIsMeasuredAsPassTwoEncodesIt) {
     const LengthChanges c = length_changes(dir.file("gaps.tck"), dir.file("auto.fft"));
     EXPECT_NEAR(r.bits.length_change_max_mm, std::max(c.fiblet, c.exact), 1e-5);
     EXPECT_NEAR(r.bits.point_error_max_mm, double(r.header.max_error_mm), 1e-6);
-    EXPECT_LE(c.fiblet, double(r.header.max_error_mm) * (1 + 1e-6) + 1e-7);
+    expect_lengths_within_the_recorded_error(c, r.header);
     compress(dir.file("gaps.tck"), dir.file("8.fft"), 8u);
     EXPECT_TRUE(test::read_file(dir.file("auto.fft")) == test::read_file(dir.file("8.fft")));
 }
@@ -186,10 +191,7 @@ TEST(DirectionBits, JitteryFibersKeepEightBits) {
     EXPECT_EQ(r.bits.sample_fibers, 40u);
     EXPECT_LE(r.bits.length_change_max_mm, r.bits.point_error_max_mm);
     // And the whole file keeps them, as the sample said.
-    const double recorded = double(r.header.max_error_mm) * (1 + 1e-6) + 1e-7;
-    const LengthChanges c = length_changes(dir.file("walk.tck"), dir.file("auto.fft"));
-    EXPECT_LE(c.fiblet, recorded);
-    EXPECT_LE(c.exact, 1.05 * recorded);
+    expect_lengths_within_the_recorded_error(length_changes(dir.file("walk.tck"), dir.file("auto.fft")), r.header);
     // The choice is the same as asking for 8 bits: the same bytes.
     compress(dir.file("walk.tck"), dir.file("8.fft"), 8u);
     EXPECT_TRUE(test::read_file(dir.file("auto.fft")) == test::read_file(dir.file("8.fft")));
