@@ -69,6 +69,38 @@ void write_jittery_fibers(const std::string& path) {
     w.finish();
 }
 
+// A file the sample misreads: 299 iFOD1-like walks (turning up to ~14
+// degrees a step: their codes keep their lengths) and, at index 1, one
+// smooth 100 mm fiber, whose 8-bit zig-zag grows it beyond the point error.
+// 150 k points: the bits sample keeps every other fiber, not fiber 1.
+void write_walks_and_one_smooth_fiber(const std::string& path) {
+    TckWriter w(path, {{"step_size", "0.1"}}, true);
+    std::mt19937 rng(5);
+    auto uniform = [&] { return double(rng()) / 4294967296.0 - 0.5; };  // [-0.5, 0.5)
+    for (int i = 0; i < 300; ++i) {
+        std::vector<Vec3f> f;
+        if (i == 1) {
+            double heading = 0, x = 0.5, z = -40;
+            for (int k = 0; k < 1000; ++k) {
+                f.push_back({float(x), 0, float(z)});
+                heading += kStep / 150;
+                x += kStep * std::sin(heading), z += kStep * std::cos(heading);
+            }
+        } else {
+            double dx = 1, dy = 0, dz = 0, x = 0.1 * i, y = 0, z = 0;
+            for (int k = 0; k < 500; ++k) {
+                f.push_back({float(x), float(y), float(z)});
+                dx += 0.5 * uniform(), dy += 0.5 * uniform(), dz += 0.5 * uniform();
+                const double n = std::sqrt(dx * dx + dy * dy + dz * dz);
+                dx /= n, dy /= n, dz /= n;
+                x += kStep * dx, y += kStep * dy, z += kStep * dz;
+            }
+        }
+        w.write(f);
+    }
+    w.finish();
+}
+
 double length_of(const float* p, std::uint64_t n) {
     double l = 0;
     for (std::uint64_t k = 1; k < n; ++k) {
@@ -234,6 +266,33 @@ TEST(DirectionBits, CliBitsOptionAndStandardInput) {
     // Anything else is refused.
     const auto bad = test::run_cli("compress -q -f --bits 12 " + dir.file("smooth.tck") + " -o " + dir.file("e.fft"));
     EXPECT_NE(bad.status, 0);
+}
+
+// Where the sample keeps its lengths at 8 bits but the whole file does not
+// (the sample left out the fiber that grows), compress says so and what
+// keeps them; --bits 16 does.
+TEST(DirectionBits, CliNotesLengthsTheSampleMissed) {
+    test::TempDir dir;
+    write_walks_and_one_smooth_fiber(dir.file("mix.tck"));
+    const auto r = test::run_cli("compress -f " + dir.file("mix.tck") + " -o " + dir.file("a.fft"));
+    ASSERT_EQ(r.status, 0) << r.output;
+    const FftFile a(dir.file("a.fft"));
+    ASSERT_EQ(a.header().version, kFftVersion) << r.output;
+    const LengthChanges eight = length_changes(dir.file("mix.tck"), dir.file("a.fft"));
+    EXPECT_GT(eight.fiblet, double(a.header().max_error_mm) * 1.5) << "the test file no longer shows the miss";
+    EXPECT_NE(r.output.find("fiblet: note: " + dir.file("a.fft") + ": a fiber's length changed by"), std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("(fiber 1;"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("--bits 16 keeps them"), std::string::npos) << r.output;
+    // Quiet means quiet; a file that keeps its lengths gets no note.
+    EXPECT_EQ(test::run_cli("compress -q -f " + dir.file("mix.tck") + " -o " + dir.file("b.fft")).output, "");
+    write_jittery_fibers(dir.file("walk.tck"));
+    const auto kept = test::run_cli("compress -f " + dir.file("walk.tck") + " -o " + dir.file("c.fft"));
+    EXPECT_EQ(kept.output.find("note:"), std::string::npos) << kept.output;
+    // What the note says holds.
+    ASSERT_EQ(test::run_cli("compress -q -f --bits 16 " + dir.file("mix.tck") + " -o " + dir.file("d.fft")).status, 0);
+    expect_lengths_within_the_recorded_error(length_changes(dir.file("mix.tck"), dir.file("d.fft")),
+                                             FftFile(dir.file("d.fft")).header());
 }
 
 }  // namespace fiblet

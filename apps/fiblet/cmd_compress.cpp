@@ -79,6 +79,19 @@ void print_report(std::FILE* to, const std::string& in, const std::string& out, 
     fmt::print(to, "  {:.2f} s ({:.1f} M points/s)\n", r.seconds, r.header.points / r.seconds / 1e6);
 }
 
+// The bits were chosen on a sample (--bits auto): where the whole file's
+// lengths then changed by more than its point error at 8 bits, the sample
+// missed the fibers that do (docs/encode.md, "Why smooth fibers need 16
+// bits"); say so and what keeps them.
+void note_lengths_not_kept(const std::string& out, const CompressReport& r) {
+    const double length_um = r.geometry.length_change_mm().max * 1e3, error_um = double(r.header.max_error_mm) * 1e3;
+    if (!r.bits.automatic || r.header.direction_bits() != 8 || !(length_um > error_um * (1 + 1e-6))) return;
+    fmt::print(stderr,
+               "fiblet: note: {}: a fiber's length changed by {:.3g} µm, more than the {:.3g} µm point error (fiber {}; "
+               "the sample the bits were chosen on kept its lengths): --bits 16 keeps them\n",
+               out, length_um, error_um, r.geometry.length_change_mm().worst_fiber);
+}
+
 void run(const CompressArgs& a) {
     const auto jobs = plan_file_jobs(
         a.inputs, {{".tck", ".trk", ".trx"}, {".trx"}, a.zstd ? ".fftz" : ".fft", a.output, a.output_dir, a.recursive});
@@ -119,6 +132,7 @@ void run(const CompressArgs& a) {
             } else if (!a.quiet) {
                 print_report(report_stream(out), in, out, r);
             }
+            if (!a.quiet) note_lengths_not_kept(out, r);
             if (a.max_error_um && !metrics_above(r.error, r.geometry, *a.max_error_um).empty()) {
                 try {
                     check_error_bound(out, r.error, r.geometry, a.max_error_um);
