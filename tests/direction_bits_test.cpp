@@ -48,24 +48,28 @@ void write_smooth_fibers(const std::string& path, int drop_every = 0) {
     w.finish();
 }
 
-// iFOD1-like fibers: random walks at a fixed 0.1 mm step turning up to
-// ~10 degrees a step (deterministic: mt19937's raw output).
+// A random walk of `points` at a fixed 0.1 mm step from (x0, 0, 0), its
+// direction jittered by up to `turn` / 2 per axis a step (deterministic:
+// mt19937's raw output).
+std::vector<Vec3f> random_walk(std::mt19937& rng, double x0, int points, double turn) {
+    auto uniform = [&] { return double(rng()) / 4294967296.0 - 0.5; };  // [-0.5, 0.5)
+    double dx = 1, dy = 0, dz = 0, x = x0, y = 0, z = 0;
+    std::vector<Vec3f> f;
+    for (int k = 0; k < points; ++k) {
+        f.push_back({float(x), float(y), float(z)});
+        dx += turn * uniform(), dy += turn * uniform(), dz += turn * uniform();
+        const double n = std::sqrt(dx * dx + dy * dy + dz * dz);
+        dx /= n, dy /= n, dz /= n;
+        x += kStep * dx, y += kStep * dy, z += kStep * dz;
+    }
+    return f;
+}
+
+// iFOD1-like fibers: random walks turning up to ~10 degrees a step.
 void write_jittery_fibers(const std::string& path) {
     TckWriter w(path, {{"step_size", "0.1"}}, true);
     std::mt19937 rng(11);
-    auto uniform = [&] { return double(rng()) / 4294967296.0 - 0.5; };  // [-0.5, 0.5)
-    for (int i = 0; i < 40; ++i) {
-        double dx = 1, dy = 0, dz = 0, x = i, y = 0, z = 0;
-        std::vector<Vec3f> f;
-        for (int k = 0; k < 500; ++k) {
-            f.push_back({float(x), float(y), float(z)});
-            dx += 0.35 * uniform(), dy += 0.35 * uniform(), dz += 0.35 * uniform();
-            const double n = std::sqrt(dx * dx + dy * dy + dz * dz);
-            dx /= n, dy /= n, dz /= n;
-            x += kStep * dx, y += kStep * dy, z += kStep * dz;
-        }
-        w.write(f);
-    }
+    for (int i = 0; i < 40; ++i) w.write(random_walk(rng, i, 500, 0.35));
     w.finish();
 }
 
@@ -76,25 +80,17 @@ void write_jittery_fibers(const std::string& path) {
 void write_walks_and_one_smooth_fiber(const std::string& path) {
     TckWriter w(path, {{"step_size", "0.1"}}, true);
     std::mt19937 rng(5);
-    auto uniform = [&] { return double(rng()) / 4294967296.0 - 0.5; };  // [-0.5, 0.5)
     for (int i = 0; i < 300; ++i) {
+        if (i != 1) {
+            w.write(random_walk(rng, 0.1 * i, 500, 0.5));
+            continue;
+        }
         std::vector<Vec3f> f;
-        if (i == 1) {
-            double heading = 0, x = 0.5, z = -40;
-            for (int k = 0; k < 1000; ++k) {
-                f.push_back({float(x), 0, float(z)});
-                heading += kStep / 150;
-                x += kStep * std::sin(heading), z += kStep * std::cos(heading);
-            }
-        } else {
-            double dx = 1, dy = 0, dz = 0, x = 0.1 * i, y = 0, z = 0;
-            for (int k = 0; k < 500; ++k) {
-                f.push_back({float(x), float(y), float(z)});
-                dx += 0.5 * uniform(), dy += 0.5 * uniform(), dz += 0.5 * uniform();
-                const double n = std::sqrt(dx * dx + dy * dy + dz * dz);
-                dx /= n, dy /= n, dz /= n;
-                x += kStep * dx, y += kStep * dy, z += kStep * dz;
-            }
+        double heading = 0, x = 0.5, z = -40;
+        for (int k = 0; k < 1000; ++k) {
+            f.push_back({float(x), 0, float(z)});
+            heading += kStep / 150;
+            x += kStep * std::sin(heading), z += kStep * std::cos(heading);
         }
         w.write(f);
     }
