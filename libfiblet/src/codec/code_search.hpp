@@ -73,6 +73,41 @@ struct BeamLink {
     std::uint32_t code;
 };
 
+// A beam search's candidate: a state (`parent`) extended by a code.
+struct BeamCandidate {
+    float cost;
+    std::uint32_t parent;
+    std::uint32_t code;
+};
+
+// Offers `c` to the step's candidates cand[0, kept): the cand.size()
+// cheapest so far, sorted by cost (insertion from the end; most candidates
+// are rejected by the first comparison; equal costs keep the order offered).
+inline void offer_cheapest(std::span<BeamCandidate> cand, std::size_t& kept, BeamCandidate c) {
+    const std::size_t width = cand.size();
+    if (kept == width && !(c.cost < cand[width - 1].cost)) return;
+    std::size_t i = kept < width ? kept++ : width - 1;
+    for (; i > 0 && cand[i - 1].cost > c.cost; --i) cand[i] = cand[i - 1];
+    cand[i] = c;
+}
+
+// The beam's next states: each kept candidate's parent advanced by its code
+// (`advance(parent, code)` gives the new state's frame and point), its cost
+// the candidate's; `step_links` records how each was reached.
+template <class State, class Advance>
+void advance_beam(std::vector<State>& states, std::vector<State>& next, std::span<const BeamCandidate> kept,
+                  BeamLink* step_links, std::size_t width, Advance advance) {
+    for (std::size_t j = 0; j < kept.size(); ++j) {
+        const auto& c = kept[j];
+        next[j] = advance(states[c.parent], c.code);
+        next[j].cost = c.cost;
+        step_links[j] = {c.parent, c.code};
+    }
+    next.resize(kept.size());
+    states.swap(next);
+    next.resize(width);
+}
+
 // The beam's cheapest final state traced back through its links to its
 // codes, which are then replayed from the block's start (f, p) for the
 // decoded points.
@@ -107,13 +142,8 @@ void beam_search_rows(const Codebook& cb, unsigned width, Frame f, Vec3f p, floa
         F4 p;
         float cost;
     };
-    struct Candidate {
-        float cost;
-        std::uint32_t parent;
-        std::uint32_t code;
-    };
     thread_local std::vector<State> states, next;
-    thread_local std::vector<Candidate> cand;
+    thread_local std::vector<BeamCandidate> cand;
     thread_local std::vector<BeamLink> links;  // links[k * width + j]: how state j of step k was reached
     states.assign(1, State{row_frame(f), f4_of(p), 0.0f});
     next.resize(width);
@@ -150,28 +180,17 @@ void beam_search_rows(const Codebook& cb, unsigned width, Frame f, Vec3f p, floa
             if (robust) aimed_cost = std::max(aimed_cost, alt_base - two_step * dot_a(alt_local));
             // The 3x3 codes in grid order: the neighbours before the aimed
             // code, the aimed code, the rest.
-            auto offer = [&](float cost, std::uint32_t code) {
-                if (kept == width && !(cost < cand[width - 1].cost)) return;
-                std::size_t i = kept < width ? kept++ : width - 1;
-                for (; i > 0 && cand[i - 1].cost > cost; --i) cand[i] = cand[i - 1];
-                cand[i] = {cost, s, code};
-            };
-            for (unsigned i = 0; i < nb.before; ++i) offer(costs[i], nb.code[i]);
-            offer(aimed_cost, aimed);
-            for (unsigned i = nb.before; i < nb.count; ++i) offer(costs[i], nb.code[i]);
+            for (unsigned i = 0; i < nb.before; ++i) offer_cheapest(cand, kept, {costs[i], s, nb.code[i]});
+            offer_cheapest(cand, kept, {aimed_cost, s, aimed});
+            for (unsigned i = nb.before; i < nb.count; ++i) offer_cheapest(cand, kept, {costs[i], s, nb.code[i]});
         }
-        for (std::size_t j = 0; j < kept; ++j) {
-            const Candidate& c = cand[j];
-            const State& parent = states[c.parent];
-            State& n = next[j];
-            n.f = compose(parent.f, cb.rows(c.code));
+        const std::span<const BeamCandidate> step_cand(cand.data(), kept);
+        advance_beam(states, next, step_cand, &links[k * width], width, [&](const State& parent, std::uint32_t code) {
+            State n;
+            n.f = compose(parent.f, cb.rows(code));
             n.p = f4_add(parent.p, f4_mul(step4, axis(n.f)));
-            n.cost = c.cost;
-            links[k * width + j] = {c.parent, c.code};
-        }
-        next.resize(kept);
-        states.swap(next);
-        next.resize(width);
+            return n;
+        });
     }
     backtrack_cheapest(cb, states, links, width, f, p, step, m, codes, decoded);
 }
@@ -208,15 +227,10 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
         Vec3f p;
         float cost;
     };
-    struct Candidate {
-        float cost;
-        std::uint32_t parent;
-        std::uint32_t code;
-    };
     const unsigned width = sp.beam;
     const int r = int(sp.radius);
     thread_local std::vector<State> states, next;
-    thread_local std::vector<Candidate> cand;
+    thread_local std::vector<BeamCandidate> cand;
     thread_local std::vector<BeamLink> links;  // links[k * width + j]: how state j of step k was reached
     states.assign(1, State{f, p, 0.0f});
     next.resize(width);
@@ -225,8 +239,6 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
     const float step2 = step * step, two_step = 2.0f * step;
 
     for (std::size_t k = 0; k < m; ++k) {
-        // The `width` cheapest candidates, kept sorted by cost (insertion from
-        // the end; most candidates are rejected by the first comparison).
         std::size_t kept = 0;
         for (std::uint32_t s = 0; s < states.size(); ++s) {
             const State& st = states[s];
@@ -244,24 +256,16 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
                     const auto code = std::uint32_t(h * levels + l);
                     float cost = base - two_step * dot(cb.direction(code), local);
                     if (robust) cost = std::max(cost, alt_base - two_step * dot(cb.direction(code), alt_local));
-                    if (kept == width && !(cost < cand[width - 1].cost)) continue;
-                    std::size_t i = kept < width ? kept++ : width - 1;
-                    for (; i > 0 && cand[i - 1].cost > cost; --i) cand[i] = cand[i - 1];
-                    cand[i] = {cost, s, code};
+                    offer_cheapest(cand, kept, {cost, s, code});
                 }
         }
-        for (std::size_t j = 0; j < kept; ++j) {
-            const Candidate& c = cand[j];
-            const State& parent = states[c.parent];
-            State& n = next[j];
-            n.f = compose(parent.f, cb.frame(c.code));
+        const std::span<const BeamCandidate> step_cand(cand.data(), kept);
+        advance_beam(states, next, step_cand, &links[k * width], width, [&](const State& parent, std::uint32_t code) {
+            State n;
+            n.f = compose(parent.f, cb.frame(code));
             n.p = parent.p + step * n.f.c[0];
-            n.cost = c.cost;
-            links[k * width + j] = {c.parent, c.code};
-        }
-        next.resize(kept);
-        states.swap(next);
-        next.resize(width);
+            return n;
+        });
     }
     backtrack_cheapest(cb, states, links, width, f, p, step, m, codes, decoded);
 }
