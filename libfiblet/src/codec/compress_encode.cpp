@@ -23,17 +23,13 @@
 #include "codec/batch_pipeline.hpp"
 #include "codec/compress_stages.hpp"
 #include "codec/fiber_end_encoder.hpp"
+#include "core/vec_math.hpp"
 #include "fiblet/parallel.hpp"
 #include "format/packed_blocks16.hpp"
 
 namespace fiblet::detail {
 
 namespace {
-
-double length2(Vec3f a, Vec3f b) {
-    const double dx = double(b.x) - a.x, dy = double(b.y) - a.y, dz = double(b.z) - a.z;
-    return dx * dx + dy * dy + dz * dz;
-}
 
 // The header's error of each point: the worse of fiblet's float decode and
 // the exact decode (when given), so it holds for every decoder. One square
@@ -45,9 +41,9 @@ void add_point_errors(std::span<const Vec3f> targets, std::span<const Vec3f> dec
     const std::size_t n = targets.size();
     scratch.resize(n);
     double* e = scratch.data();
-    for (std::size_t k = 0; k < n; ++k) e[k] = length2(targets[k], decoded[k]);
+    for (std::size_t k = 0; k < n; ++k) e[k] = distance2(targets[k], decoded[k]);
     if (!decoded_exact.empty())
-        for (std::size_t k = 0; k < n; ++k) e[k] = std::max(e[k], length2(targets[k], decoded_exact[k]));
+        for (std::size_t k = 0; k < n; ++k) e[k] = std::max(e[k], distance2(targets[k], decoded_exact[k]));
     std::size_t k = 0;
 #ifdef __SSE2__
     for (; k + 2 <= n; k += 2) _mm_storeu_pd(e + k, _mm_sqrt_pd(_mm_loadu_pd(e + k)));  // correctly rounded, as std::sqrt
@@ -152,7 +148,7 @@ void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t
         if (in.step > 0) {
             const bool fields = in.point_fields && in.point_fields->active();
             const std::size_t at = w.targets.size();
-            const bool short_tail = resample_cubic_keeping_end(original, in.step, (*in.tensions)[f] * kTensionQuantum,
+            const bool short_tail = resample_cubic_keeping_end(original, in.step, tension_of((*in.tensions)[f]),
                                                                w.resampled, fields ? &w.positions : nullptr, kWrittenCurve);
             if (fields) in.point_fields->resample(f, w.positions);
             w.targets.insert(w.targets.end(), w.resampled.begin(), w.resampled.end());
@@ -173,8 +169,8 @@ void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t
             const std::size_t n = w.decoded.size() - s;
             const std::size_t kept = missing ? n - std::min(n, movable_end_points(w.ends.back())) : n;
             for (std::size_t k = s; k < s + kept; ++k) {
-                w.kept_max2 = std::max(w.kept_max2, length2(w.targets[k], w.decoded[k]));
-                if (!w.decoded_exact.empty()) w.kept_max2 = std::max(w.kept_max2, length2(w.targets[k], w.decoded_exact[k]));
+                w.kept_max2 = std::max(w.kept_max2, distance2(w.targets[k], w.decoded[k]));
+                if (!w.decoded_exact.empty()) w.kept_max2 = std::max(w.kept_max2, distance2(w.targets[k], w.decoded_exact[k]));
             }
         }
         if (!w.ends_missing) measure_pending(in, b, w);

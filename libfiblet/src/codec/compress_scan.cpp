@@ -17,16 +17,12 @@
 #include "codec/compress_stages.hpp"
 #include "core/streamline_label.hpp"
 #include "fiblet/error.hpp"
+#include "core/vec_math.hpp"
 #include "fiblet/parallel.hpp"
 
 namespace fiblet::detail {
 
 namespace {
-
-double length(Vec3f a, Vec3f b) {
-    const double dx = double(b.x) - a.x, dy = double(b.y) - a.y, dz = double(b.z) - a.z;
-    return std::sqrt(dx * dx + dy * dy + dz * dz);
-}
 
 void report_progress(const CompressOptions& o, const char* phase, const StreamlineSource& r) {
     if (o.progress && r.data_bytes() > 0) o.progress(phase, double(r.bytes_consumed()) / double(r.data_bytes()));
@@ -68,7 +64,7 @@ void scan_task(const FiberBatch& b, std::size_t t, ScanSlot& s) {
         lengths.resize(fiber.empty() ? 0 : fiber.size() - 1);
         double fiber_length = 0;
         for (std::size_t k = 1; k < fiber.size(); ++k) {
-            const double len = length(fiber[k - 1], fiber[k]);
+            const double len = distance(fiber[k - 1], fiber[k]);
             lengths[k - 1] = len;
             s.lengths.add(len);
             fiber_length += len;
@@ -210,14 +206,13 @@ void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double
         for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1]; ++i) {
             const std::vector<Vec3f>& fiber = b.fibers[i];
             const std::uint64_t f = b.first_fiber + i;
-            double fiber_length = 0;
-            for (std::size_t k = 1; k < fiber.size(); ++k) fiber_length += length(fiber[k - 1], fiber[k]);
+            const double fiber_length = polyline_length(fiber);
             if (!(fiber_length / step < double(max_fiber_points))) {
                 s.too_long = f, s.too_long_mm = fiber_length;
                 return;  // reported in fiber order by the caller
             }
             const double tension = length_keeping_tension(fiber, step, resample.stretch, kWrittenCurve);
-            tensions[f] = std::uint16_t(std::lround(tension / kTensionQuantum));
+            tensions[f] = tension_code(tension);
             const bool short_tail = resample_cubic_keeping_end(fiber, step, tension, s.resampled, nullptr, kWrittenCurve);
             fiber_points[f] = std::uint32_t(s.resampled.size());
             // The turn towards a kept end is one step per fiber, often a
@@ -225,7 +220,7 @@ void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double
             // (sized for the whole-step turns) stays as fine as before.
             s.turns->add_fiber(std::span<const Vec3f>(s.resampled).first(s.resampled.size() - short_tail));
             for (std::size_t k = 1; k < fiber.size(); ++k)
-                s.off_step_segments += std::fabs(length(fiber[k - 1], fiber[k]) - step) > tolerance * step;
+                s.off_step_segments += std::fabs(distance(fiber[k - 1], fiber[k]) - step) > tolerance * step;
         }
     };
     for_each_batch(

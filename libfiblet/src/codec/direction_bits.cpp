@@ -6,6 +6,7 @@
 
 #include "codec/fiber_end_encoder.hpp"
 #include "codec/parameters.hpp"
+#include "core/vec_math.hpp"
 #include "fiblet/geometry_error.hpp"
 #include "fiblet/parallel.hpp"
 #include "fiblet/resample.hpp"
@@ -16,10 +17,7 @@ namespace {
 
 double largest_distance(std::span<const Vec3f> a, std::span<const Vec3f> b) {
     double max2 = 0;
-    for (std::size_t k = 0; k < a.size() && k < b.size(); ++k) {
-        const double dx = double(a[k].x) - b[k].x, dy = double(a[k].y) - b[k].y, dz = double(a[k].z) - b[k].z;
-        max2 = std::max(max2, dx * dx + dy * dy + dz * dz);
-    }
+    for (std::size_t k = 0; k < a.size() && k < b.size(); ++k) max2 = std::max(max2, distance2(a[k], b[k]));
     return std::sqrt(max2);
 }
 
@@ -42,10 +40,8 @@ DirectionBitsChoice measure_sample_lengths(std::span<const std::vector<Vec3f>> f
         const double input_length = polyline_length(original);
         if (resampling.step_mm > 0) {
             // As pass 1b fits the tension (quantized as the file stores it) and pass 2 encodes.
-            const double tension =
-                double(std::lround(length_keeping_tension(original, resampling.step_mm, resampling.stretch, kWrittenCurve) /
-                                   kTensionQuantum)) *
-                kTensionQuantum;
+            const double tension = tension_of(
+                tension_code(length_keeping_tension(original, resampling.step_mm, resampling.stretch, kWrittenCurve)));
             const bool short_tail =
                 resample_cubic_keeping_end(original, resampling.step_mm, tension, resampled, nullptr, kWrittenCurve);
             points = resampled;

@@ -5,17 +5,13 @@
 #include <vector>
 #include <cmath>
 
+#include "core/vec_math.hpp"
 #include "fiblet/fft_format.hpp"
 #include "fiblet/fiber_ends.hpp"
 
 namespace fiblet::detail {
 
 namespace {
-
-double distance2(Vec3f a, Vec3f b) {
-    const double dx = double(a.x) - b.x, dy = double(a.y) - b.y, dz = double(a.z) - b.z;
-    return dx * dx + dy * dy + dz * dz;
-}
 
 // The point one full step from `from` towards `to`.
 Vec3f step_towards(Vec3f from, Vec3f to, double step) {
@@ -37,7 +33,6 @@ double projected_fraction(Vec3f a, Vec3f b, Vec3f end) {
 // one, at most (up to 7^3 candidates an anchor).
 constexpr int kEndAnchorReach = 3;
 
-double distance(Vec3f a, Vec3f b) { return std::sqrt(distance2(a, b)); }
 
 // An anchor's world point for fiblet's float decoders and for an exact
 // decoder (rounded to float, as compress keeps the exact decode).

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/vec_math.hpp"
 #include "fiblet/resample.hpp"
 
 namespace fiblet::detail {
@@ -119,10 +120,6 @@ SampleError measure(const TuningSet& set, const FiberEncoder& encoder) {
     std::vector<Vec3f> decoded;
     double sum = 0, max = 0, length_change = 0;
     std::size_t n = 0;
-    auto distance = [](Vec3f a, Vec3f b) {
-        const double dx = double(a.x) - b.x, dy = double(a.y) - b.y, dz = double(a.z) - b.z;
-        return std::sqrt(dx * dx + dy * dy + dz * dz);
-    };
     auto encode = [&](std::span<const Vec3f> points, bool in_mean) {
         blocks.clear();
         decoded.clear();

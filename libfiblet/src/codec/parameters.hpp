@@ -4,6 +4,7 @@
 // any choice gives a valid file; these pick the ones that measure best.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -20,6 +21,10 @@ namespace fiblet::detail {
 // The curve compress resamples variable-step input on (its RSMP chunk):
 // lengths kept fiber by fiber.
 inline constexpr ResampleCurve kWrittenCurve = ResampleCurve::rounded_keeping_length;
+// A fitted tension as compress keeps it from pass 1b to pass 2 (16 bits,
+// in kTensionQuantum units), and back.
+inline std::uint16_t tension_code(double tension) { return std::uint16_t(std::lround(tension / kTensionQuantum)); }
+inline double tension_of(std::uint16_t code) { return code * kTensionQuantum; }
 
 // The turning angles between consecutive unit segment directions
 // (zero-length segments carry no direction and are skipped): a histogram

@@ -21,6 +21,15 @@ inline Vec3f cross(Vec3f a, Vec3f b) {
 inline float norm(Vec3f a) { return std::sqrt(dot(a, a)); }
 inline Vec3f normalize(Vec3f a) { return (1.0f / norm(a)) * a; }
 
+// Distances between float points, computed in double: compress's point
+// errors and lengths, the end placement and the tuning all measure with
+// these, so their figures agree to the last bit.
+inline double distance2(Vec3f a, Vec3f b) {
+    const double dx = double(a.x) - b.x, dy = double(a.y) - b.y, dz = double(a.z) - b.z;
+    return dx * dx + dy * dy + dz * dz;
+}
+inline double distance(Vec3f a, Vec3f b) { return std::sqrt(distance2(a, b)); }
+
 // Frame applied to a local vector: F * v = v.x c0 + v.y c1 + v.z c2.
 inline Vec3f apply(const Frame& f, Vec3f v) {
     return {f.c[0].x * v.x + f.c[1].x * v.y + f.c[2].x * v.z, f.c[0].y * v.x + f.c[1].y * v.y + f.c[2].y * v.z,

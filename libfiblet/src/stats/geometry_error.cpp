@@ -12,14 +12,13 @@
 #include <emmintrin.h>
 #endif
 
+#include "core/vec_math.hpp"
+
 namespace fiblet {
 
-namespace {
+using detail::distance;
 
-double distance(Vec3f a, Vec3f b) {
-    const double dx = double(a.x) - b.x, dy = double(a.y) - b.y, dz = double(a.z) - b.z;
-    return std::sqrt(dx * dx + dy * dy + dz * dz);
-}
+namespace {
 
 // The segments of the polyline measured against, as columns (start,
 // direction, inverse squared length), computed once per fiber: the window
