@@ -260,24 +260,23 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     // blocks than a file holds. The 16-bit encoder is tuned as for --bits 16
     // on the same sample (fixed-step input: the same bytes); resampled input
     // keeps the step and the decoder step pass 1b fitted its tensions to.
-    if (choose_bits && h.direction_bits() == 8)
+    std::optional<std::uint32_t> too_long;  // points of a fiber 8-bit blocks cannot hold
+    if (choose_bits && h.direction_bits() == 8) {
         report.bits = detail::measure_sample_lengths(scanned.bits_sample.fibers(), encoder,
                                                       {report.resampled ? step : 0.0, stretch}, threads);
-    report.bits.automatic = choose_bits;
-    report.bits.reason = bits_reason(report.bits, h.direction_bits(), wide_blocks_asked, points_per_block);
-    if (choose_bits && h.direction_bits() == 8) {
         const std::uint32_t longest = fiber_points.empty() ? 0 : *std::max_element(fiber_points.begin(), fiber_points.end());
-        const bool too_long = encoder.block_count(longest) > 0xffff;
+        if (encoder.block_count(longest) > 0xffff) too_long = longest;
         if (too_long || !detail::eight_bits_keep_lengths(report.bits)) {
-            report.bits.reason = too_long ? "16 bits: a fiber of " + std::to_string(longest) +
-                                                " points needs more than 65535 blocks of 8-bit codes"
-                                          : bits_reason(report.bits, 16, false, 0);
             layout = block_layout(16, options);
             points_per_block = layout.points_per_block;
             set_layout(h, layout);
             encoder = tuned_encoder();
         }
     }
+    report.bits.automatic = choose_bits;
+    report.bits.reason = too_long ? "16 bits: a fiber of " + std::to_string(*too_long) +
+                                        " points needs more than 65535 blocks of 8-bit codes"
+                                  : bits_reason(report.bits, h.direction_bits(), wide_blocks_asked, points_per_block);
     report.search = encoder.search();
     std::vector<FiberLutEntry> lut(scan.fibers);
     const std::uint64_t per_buffer = fft_max_blocks_per_buffer(h.block_bytes());
