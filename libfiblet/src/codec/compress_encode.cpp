@@ -69,7 +69,7 @@ struct Slot {
     std::size_t first_pending = 0;
     std::vector<PolylinePosition> positions;  // of the resampled points on the input
     std::vector<double> point_errors;         // scratch of add_point_errors
-    double kept_max2 = 0;       // resampled 8-bit: the largest squared error of the points no end placement moves
+    double kept_max = 0;        // resampled 8-bit: the largest error of the points no end placement moves, mm
     bool ends_missing = false;  // some fiber's length misses by more than its point errors: measured later
     ErrorStats error;
     GeometryError geometry;  // both ways against the input polylines
@@ -139,7 +139,7 @@ void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t
     w.index.clear();
     w.targets.clear(), w.decoded.clear(), w.decoded_exact.clear();
     w.starts.assign(1, 0), w.block_ends.clear(), w.ends.clear(), w.lengths.clear();
-    w.kept_max2 = 0, w.ends_missing = false;
+    w.kept_max = 0, w.ends_missing = false;
     const bool budgeted = in.step > 0 && in.encoder.header().direction_bits() == 8;
     for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1]; ++i) {
         const std::vector<Vec3f>& original = b.fibers[i];
@@ -168,10 +168,8 @@ void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t
             w.ends_missing = w.ends_missing || missing;
             const std::size_t n = w.decoded.size() - s;
             const std::size_t kept = missing ? n - std::min(n, movable_end_points(w.ends.back())) : n;
-            for (std::size_t k = s; k < s + kept; ++k) {
-                w.kept_max2 = std::max(w.kept_max2, distance2(w.targets[k], w.decoded[k]));
-                if (!w.decoded_exact.empty()) w.kept_max2 = std::max(w.kept_max2, distance2(w.targets[k], w.decoded_exact[k]));
-            }
+            auto fiber = [&](const std::vector<Vec3f>& v) { return v.empty() ? std::span<const Vec3f>() : std::span<const Vec3f>(v).subspan(s); };
+            w.kept_max = std::max(w.kept_max, largest_error(fiber(w.targets), fiber(w.decoded), fiber(w.decoded_exact), kept));
         }
         if (!w.ends_missing) measure_pending(in, b, w);
     }
@@ -183,14 +181,14 @@ void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t
 // and the tasks that waited are measured (in parallel). The budget depends
 // on the batch alone, not on the thread count.
 void finish_batch(const EncodeStageInputs& in, const FiberBatch& b, std::vector<Slot>& slots) {
-    double budget2 = 0;
+    double budget = 0;
     bool missing = false;
-    for (std::size_t t = 0; t < b.tasks(); ++t) budget2 = std::max(budget2, slots[t].kept_max2), missing = missing || slots[t].ends_missing;
+    for (std::size_t t = 0; t < b.tasks(); ++t) budget = std::max(budget, slots[t].kept_max), missing = missing || slots[t].ends_missing;
     if (!missing) return;
     parallel_for(b.tasks(), in.threads, [&](std::size_t t) {
         Slot& w = slots[t];
         if (!w.ends_missing) return;
-        place_missing_ends(in, b, std::sqrt(budget2), w);
+        place_missing_ends(in, b, budget, w);
         measure_pending(in, b, w);
         pack_task(in, w);
     });

@@ -6,22 +6,11 @@
 
 #include "codec/fiber_end_encoder.hpp"
 #include "codec/parameters.hpp"
-#include "core/vec_math.hpp"
 #include "fiblet/geometry_error.hpp"
 #include "fiblet/parallel.hpp"
 #include "fiblet/resample.hpp"
 
 namespace fiblet::detail {
-
-namespace {
-
-double largest_distance(std::span<const Vec3f> a, std::span<const Vec3f> b) {
-    double max2 = 0;
-    for (std::size_t k = 0; k < a.size() && k < b.size(); ++k) max2 = std::max(max2, distance2(a[k], b[k]));
-    return std::sqrt(max2);
-}
-
-}  // namespace
 
 DirectionBitsChoice measure_sample_lengths(std::span<const std::vector<Vec3f>> fibers, const FiberEncoder& encoder,
                                            SampleResampling resampling, unsigned threads) {
@@ -52,11 +41,9 @@ DirectionBitsChoice measure_sample_lengths(std::span<const std::vector<Vec3f>> f
         }
         Measured& m = per_fiber[i];
         m.length_change = std::fabs(polyline_length(decoded) - input_length);
-        m.error = largest_distance(points, decoded);
-        if (!decoded_exact.empty()) {
+        if (!decoded_exact.empty())
             m.length_change = std::max(m.length_change, std::fabs(polyline_length(decoded_exact) - input_length));
-            m.error = std::max(m.error, largest_distance(points, decoded_exact));
-        }
+        m.error = largest_error(points, decoded, decoded_exact, points.size());
         m.counted = true;
     });
     DirectionBitsChoice out;

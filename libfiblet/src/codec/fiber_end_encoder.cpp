@@ -7,6 +7,7 @@
 
 #include "core/vec_math.hpp"
 #include "fiblet/fft_format.hpp"
+#include "fiblet/geometry_error.hpp"
 #include "fiblet/fiber_ends.hpp"
 
 namespace fiblet::detail {
@@ -155,9 +156,6 @@ bool round_end_anchors_keeping_length(const FftHeader& h, std::uint8_t* block, s
     return true;
 }
 
-namespace {
-
-// The largest error of decoded[0, m) against points (both decoders), mm.
 double largest_error(std::span<const Vec3f> points, std::span<const Vec3f> decoded, std::span<const Vec3f> decoded_exact,
                      std::size_t m) {
     double worst2 = 0;
@@ -168,11 +166,7 @@ double largest_error(std::span<const Vec3f> points, std::span<const Vec3f> decod
     return std::sqrt(worst2);
 }
 
-double polyline_length_of(std::span<const Vec3f> p) {
-    double l = 0;
-    for (std::size_t k = 1; k < p.size(); ++k) l += distance(p[k - 1], p[k]);
-    return l;
-}
+namespace {
 
 // The fraction `q` placed on the whole last step, for both decoders.
 void place_fraction(const FiberEnd& end, std::uint16_t q, std::span<Vec3f> decoded, std::span<Vec3f> decoded_exact) {
@@ -215,7 +209,7 @@ void place_end(const FftHeader& h, FiberEnd& end, std::uint8_t* last_block, std:
     } else {
         return;  // an end anchor with no codes before it (or 16-bit): nothing to place
     }
-    end.length_miss_mm = target_length_mm > 0 ? std::fabs(polyline_length_of(decoded) - target_length_mm) : 0.0;
+    end.length_miss_mm = target_length_mm > 0 ? std::fabs(polyline_length(decoded) - target_length_mm) : 0.0;
 }
 
 }  // namespace

@@ -37,6 +37,11 @@ struct FiberEnd {
 // (the input's polyline length; 0: unknown) steers the end fraction
 // (length_keeping_fraction) and, where the end is an anchor after codes,
 // the rounding of the last block's anchors (round_end_anchors_keeping_length).
+// The largest error of decoded[0, m) against points[0, m), over fiblet's
+// decode and, when not empty, the exact one (the header's measure), mm.
+double largest_error(std::span<const Vec3f> points, std::span<const Vec3f> decoded, std::span<const Vec3f> decoded_exact,
+                     std::size_t m);
+
 FiberEnd encode_keeping_end(const FiberEncoder& encoder, std::span<const Vec3f> points, bool short_tail,
                             double step_mm, std::uint32_t fiber_id, std::vector<std::uint8_t>& blocks,
                             std::vector<Vec3f>& decoded, std::vector<Vec3f>* decoded_exact,

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "fiblet/geometry_error.hpp"
+
 namespace fiblet {
 
 namespace {
@@ -195,23 +197,18 @@ bool resample_on(std::span<const Vec3f> in, double step, ResampleCurve curve, do
     return true;
 }
 
-double polyline_length_of(std::span<const Vec3f> p) {
-    double len = 0;
-    for (std::size_t i = 1; i < p.size(); ++i) len += length(sub(to_v3(p[i]), to_v3(p[i - 1])));
-    return len;
-}
 }  // namespace
 
 double length_keeping_tension(std::span<const Vec3f> in, double step, double stretch, ResampleCurve curve) {
     constexpr double kMax = kMaxResampleTension;
-    const double target = polyline_length_of(in), tolerance = kLengthTolerance * step;
+    const double target = polyline_length(in), tolerance = kLengthTolerance * step;
     thread_local std::vector<Vec3f> walked;
     // Length of the decoded fiber minus the input's, at tension t (the
     // chords between anchors, two a block, are not stretched: 0.1 % of a
     // step each, left out).
     auto excess = [&](double t) {
         resample_on(in, step, curve, t, true, kPiecesPerStep, walked, nullptr);
-        return stretch * polyline_length_of(walked) - target;
+        return stretch * polyline_length(walked) - target;
     };
     double best_t = 1, best = excess(1);
     if (!(std::fabs(best) > tolerance)) return best_t;
