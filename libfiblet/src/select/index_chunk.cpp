@@ -42,15 +42,22 @@ IndexGrid IndexGrid::for_header(const FftHeader& h, unsigned bits, std::uint32_t
     // never wrongly culled).
     const double extent = double(group_blocks) * double(h.points_per_block) * double(h.step) * double(h.scaling);
     const std::uint32_t v = max_axis_levels(bits);
-    double best = std::numeric_limits<double>::infinity();
     // A box of extent x spans i..j with j - i < x / cell + 2 + 2 * slack
     // (floor below, ceil above), so e < extent_levels needs
     // extent <= (extent_levels - 2 - 2 * slack) * cell.
-    for (std::uint32_t e = 3; e <= v / 2; ++e) {
-        const std::uint32_t n = v / e;
-        const double cell = std::max(extent / (double(e) - 2 - 2 * kSlackCells), range / double(n - 1));
-        if (cell < best) best = cell, g.extent_levels = e, g.min_levels = n;
-    }
+    auto smallest_cell = [&](double box_extent) {
+        double best = std::numeric_limits<double>::infinity();
+        for (std::uint32_t e = 3; e <= v / 2; ++e) {
+            const std::uint32_t n = v / e;
+            const double cell = std::max(box_extent / (double(e) - 2 - 2 * kSlackCells), range / double(n - 1));
+            if (cell < best) best = cell, g.extent_levels = e, g.min_levels = n;
+        }
+        return best;
+    };
+    double best = smallest_cell(extent);
+    // Coordinates near the float range (a step of 1e38 mm): that cell is no
+    // float. No box spans more than the range, so size the cell for that.
+    if (!(float(best) < std::numeric_limits<float>::infinity())) best = smallest_cell(std::min(extent, range));
     // Round the cell up to a float, then make sure the grid still covers the range.
     g.cell = std::nextafter(float(best), std::numeric_limits<float>::infinity());
     return g;
