@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "fiblet/geometry_error.hpp"
+#include "stats/geometry_shortcut.hpp"
 
 namespace fiblet {
 namespace {
@@ -168,6 +169,51 @@ TEST(GeometryError, MatchesBruteForceOnFixedStepPairs) {
         pairs.emplace_back(in, dec);
     }
     expect_matches_brute(pairs);
+}
+
+// Fixed-step pairs where a point's two own segments are not provably the
+// nearest (the shortcut of geometry_error.cpp): fibers that fold back by up
+// to 178 degrees, repeated points, decoded points up to 40 % of a step off.
+// The shortcut must give the full window's figures bit for bit (the window
+// itself is a heuristic: folded fibers can fool it, so brute force is not
+// the reference here), and must be taken on most points of well-behaved
+// fixed-step fibers, where both match brute force (previous test).
+TEST(GeometryError, ShortcutEqualsTheWindowOnFoldedFixedStepPairs) {
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<double> turn(100, 178);
+    std::vector<std::pair<Line, Line>> pairs;
+    for (int k = 0; k < 40; ++k) {
+        const double step = 0.1;
+        Line in{{0, 0, 0}};
+        double heading = 0, climb = k % 2 ? 0.3 : 0.0;  // flat ones fold back onto themselves
+        for (int i = 1; i < 40 + 5 * k; ++i) {
+            heading += i % 7 == 0 ? (i % 2 ? 1 : -1) * turn(rng) * M_PI / 180 : 0.05;
+            const Vec3f q = in.back();
+            in.push_back({float(q.x + step * std::cos(heading) * std::cos(climb)),
+                          float(q.y + step * std::sin(heading) * std::cos(climb)), float(q.z + step * std::sin(climb))});
+        }
+        if (k % 4 == 0) in[10] = in[9];  // a zero-length segment
+        std::normal_distribution<double> e(0, step * (k % 3 == 0 ? 0.15 : 0.05));
+        Line dec = in;
+        for (Vec3f& p : dec) p = {float(p.x + e(rng)), float(p.y + e(rng)), float(p.z + e(rng))};
+        pairs.emplace_back(in, dec);
+    }
+    auto measure = [&](bool shortcut) {
+        detail::geometry_shortcut_enabled() = shortcut;
+        GeometryError g;
+        for (std::size_t i = 0; i < pairs.size(); ++i) g.add_fiber(pairs[i].first, pairs[i].second, i);
+        detail::geometry_shortcut_enabled() = true;
+        return g;
+    };
+    const GeometryError with = measure(true), without = measure(false);
+    for (auto pick : {&GeometryError::decoded_to_input, &GeometryError::input_to_decoded}) {
+        const ErrorStats &a = (with.*pick)(), &b = (without.*pick)();
+        EXPECT_EQ(a.max_mm(), b.max_mm());
+        EXPECT_EQ(a.mean_mm(), b.mean_mm());
+        EXPECT_EQ(a.rms_mm(), b.rms_mm());
+        EXPECT_EQ(a.percentile_mm(50), b.percentile_mm(50));
+        EXPECT_EQ(a.worst_fiber(), b.worst_fiber());
+    }
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #endif
 
 #include "core/vec_math.hpp"
+#include "stats/geometry_shortcut.hpp"
 
 namespace fiblet {
 
@@ -143,6 +144,138 @@ __attribute__((target("avx2"))) inline void window_avx2(const Segments& g, doubl
 }
 #endif
 
+// Fixed-step pairs (as many points on both polylines; point k was encoded
+// from to[k]): for each point p = from[k], its squared distances to to[k]'s
+// own segments k - 1 and k, and whether one of them is provably the nearest
+// segment of the window, without evaluating the others. The window around
+// a hint of k - 2, k - 1 or k holds segments k - 4 .. k + 3. Where the
+// segments after to[k] up to k + 3 have no component against segment k's
+// direction, every point x of segments k + 1 .. k + 3 has (x - to[k]) . u_k
+// >= |u_k|, so |x - to[k]| >= |u_k|; likewise back to segment k - 4 from
+// segment k - 1. Then those
+// segments are at least s - e from p (s: the shorter own segment, e =
+// |p - to[k]|), and the nearest own segment at most e: when 2e < s (with
+// room for rounding) no other segment can be nearer or tie. Every point of
+// a fixed-step fiber whose error is well below half a step and whose turns
+// over three steps stay under 90 degrees is proven so: two segments instead
+// of the window, the same result bit for bit. Each quantity is one loop
+// over the fiber that the compiler vectorizes (the same double operations
+// as dist2 below, no fused multiply-add: -ffp-contract=off).
+struct OwnSegments {
+    std::vector<double> before, after;  // squared distances to segments k - 1 and k (+inf where none)
+    std::vector<std::uint8_t> proven;   // one of them is the window's nearest
+};
+
+// Squared distance of p to segment s (its start when it has no length): the
+// arithmetic of every distance here.
+inline double segment_dist2(const Segments& g, double px, double py, double pz, std::size_t s) {
+    const double wx = px - g.ax[s], wy = py - g.ay[s], wz = pz - g.az[s];
+    double t = (wx * g.ux[s] + wy * g.uy[s] + wz * g.uz[s]) * g.inv_uu[s];
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    const double dx = wx - t * g.ux[s], dy = wy - t * g.uy[s], dz = wz - t * g.uz[s];
+    return dx * dx + dy * dy + dz * dz;
+}
+
+// Point k of own_segments (any k; the edges of the fiber and machines without AVX2).
+void own_segments_at(const Segments& g, std::span<const Vec3f> from, std::span<const Vec3f> to, std::size_t k,
+                     OwnSegments& out) {
+    const std::size_t n = g.count;
+    auto dot = [&](std::size_t a, std::size_t b) { return g.ux[a] * g.ux[b] + g.uy[a] * g.uy[b] + g.uz[a] * g.uz[b]; };
+    const Vec3f p = from[k];
+    const double ex = double(p.x) - to[k].x, ey = double(p.y) - to[k].y, ez = double(p.z) - to[k].z;
+    const double e4 = 4 * (ex * ex + ey * ey + ez * ez);
+    bool proven = true;
+    out.before[k] = out.after[k] = std::numeric_limits<double>::infinity();
+    if (k > 0) {  // segment k - 1 and the three before it
+        out.before[k] = segment_dist2(g, p.x, p.y, p.z, k - 1);
+        proven = proven && e4 < 0.98 * g.len[k - 1] * g.len[k - 1];
+        for (std::size_t j = k >= 4 ? k - 4 : 0; j + 1 < k; ++j) proven = proven && dot(j, k - 1) >= 0;
+    }
+    if (k < n) {  // segment k and the three after it (the padding's direction is 0)
+        out.after[k] = segment_dist2(g, p.x, p.y, p.z, k);
+        proven = proven && e4 < 0.98 * g.len[k] * g.len[k];
+        for (std::size_t j = k + 1; j <= k + 3; ++j) proven = proven && dot(j, k) >= 0;
+    }
+    out.proven[k] = proven;
+}
+
+#ifdef FIBLET_GEOMETRY_AVX2
+#define FIBLET_AVX2 __attribute__((target("avx2"))) inline
+FIBLET_AVX2 __m256d column(const std::vector<double>& c, std::size_t s) { return _mm256_loadu_pd(c.data() + s); }
+
+// segment_dist2 of four points to segments s .. s + 3 (window_avx2's operations).
+FIBLET_AVX2 __m256d segment_dist2_avx2(const Segments& g, __m256d x, __m256d y, __m256d z, std::size_t s) {
+    const __m256d ux = column(g.ux, s), uy = column(g.uy, s), uz = column(g.uz, s);
+    const __m256d wx = _mm256_sub_pd(x, column(g.ax, s)), wy = _mm256_sub_pd(y, column(g.ay, s)),
+                  wz = _mm256_sub_pd(z, column(g.az, s));
+    __m256d t = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(wx, ux), _mm256_mul_pd(wy, uy)), _mm256_mul_pd(wz, uz));
+    t = _mm256_min_pd(_mm256_set1_pd(1.0), _mm256_max_pd(_mm256_setzero_pd(), _mm256_mul_pd(t, column(g.inv_uu, s))));
+    const __m256d dx = _mm256_sub_pd(wx, _mm256_mul_pd(t, ux)), dy = _mm256_sub_pd(wy, _mm256_mul_pd(t, uy)),
+                  dz = _mm256_sub_pd(wz, _mm256_mul_pd(t, uz));
+    return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)), _mm256_mul_pd(dz, dz));
+}
+
+// Whether the directions of segments a .. a + 3 and b .. b + 3 are not against each other.
+FIBLET_AVX2 __m256d not_against(const Segments& g, std::size_t a, std::size_t b) {
+    const __m256d d = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(column(g.ux, a), column(g.ux, b)),
+                                                  _mm256_mul_pd(column(g.uy, a), column(g.uy, b))),
+                                    _mm256_mul_pd(column(g.uz, a), column(g.uz, b)));
+    return _mm256_cmp_pd(d, _mm256_setzero_pd(), _CMP_GE_OQ);
+}
+
+// Coordinate c (0, 1, 2) of points k .. k + 3, in double.
+FIBLET_AVX2 __m256d coordinate(std::span<const Vec3f> v, std::size_t k, int c) {
+    return _mm256_cvtps_pd(_mm_i32gather_ps(&v[k].x + c, _mm_setr_epi32(0, 3, 6, 9), 4));
+}
+
+// e4 < 0.98 len^2 for lengths len .. len + 3.
+FIBLET_AVX2 __m256d within_half_step(__m256d e4, const Segments& g, std::size_t s) {
+    const __m256d len = column(g.len, s);
+    return _mm256_cmp_pd(e4, _mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(0.98), len), len), _CMP_LT_OQ);
+}
+
+// own_segments_at for points [k0, k1) (4 <= k0, k1 <= n), four at a time:
+// the same distances bit for bit, the same proof.
+__attribute__((target("avx2"))) void own_segments_avx2(const Segments& g, std::span<const Vec3f> from,
+                                                       std::span<const Vec3f> to, std::size_t k0, std::size_t k1,
+                                                       OwnSegments& out) {
+    std::size_t k = k0;
+    for (; k + 4 <= k1; k += 4) {
+        const __m256d x = coordinate(from, k, 0), y = coordinate(from, k, 1), z = coordinate(from, k, 2);
+        const __m256d ex = _mm256_sub_pd(x, coordinate(to, k, 0)), ey = _mm256_sub_pd(y, coordinate(to, k, 1)),
+                      ez = _mm256_sub_pd(z, coordinate(to, k, 2));
+        const __m256d e4 = _mm256_mul_pd(
+            _mm256_set1_pd(4.0),
+            _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(ex, ex), _mm256_mul_pd(ey, ey)), _mm256_mul_pd(ez, ez)));
+        _mm256_storeu_pd(&out.before[k], segment_dist2_avx2(g, x, y, z, k - 1));
+        _mm256_storeu_pd(&out.after[k], segment_dist2_avx2(g, x, y, z, k));
+        __m256d ok = _mm256_and_pd(within_half_step(e4, g, k - 1), within_half_step(e4, g, k));
+        for (std::size_t d = 1; d <= 3; ++d)
+            ok = _mm256_and_pd(ok, _mm256_and_pd(not_against(g, k + d, k), not_against(g, k - 1 - d, k - 1)));
+        const int mask = _mm256_movemask_pd(ok);
+        for (int i = 0; i < 4; ++i) out.proven[k + i] = (mask >> i) & 1;
+    }
+    for (; k < k1; ++k) own_segments_at(g, from, to, k, out);
+}
+#undef FIBLET_AVX2
+#endif
+
+// own_segments_at for every point of a fixed-step pair.
+void own_segments(const Segments& g, std::span<const Vec3f> from, std::span<const Vec3f> to, OwnSegments& out) {
+    const std::size_t n = g.count, points = n + 1;  // to.size() == from.size() == n + 1
+    at_least(out.before, points), at_least(out.after, points), at_least(out.proven, points);
+    std::size_t k = 0;
+#ifdef FIBLET_GEOMETRY_AVX2
+    // The vector loop reads segments k - 5 .. k + 6 and lengths to k + 3.
+    if (have_avx2() && n > 8) {
+        for (; k < 4; ++k) own_segments_at(g, from, to, k, out);
+        own_segments_avx2(g, from, to, 4, n, out);
+        k = n;
+    }
+#endif
+    for (; k < points; ++k) own_segments_at(g, from, to, k, out);
+}
+
 // Every point of `from` against the polyline `to`, in order along both, so
 // the nearest segment moves forward with the point: the segments within
 // reach of the last nearest one are searched (squared distances, one square
@@ -178,8 +311,11 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
         return dx * dx + dy * dy + dz * dz;
     };
     std::size_t hint = 0;
+    const bool same_count = from.size() == to.size() && to.size() > 1 && detail::geometry_shortcut_enabled();
     const bool paired = from.size() == to.size() && have_avx2();
     alignas(32) double lanes[kLanes];
+    thread_local OwnSegments own;
+    if (same_count) own_segments(g, from, to, own);
     thread_local std::vector<double> nearest_buffer;  // squared distances, then distances
     double* const nearest = at_least(nearest_buffer, from.size());
     for (std::size_t k = 0; k < from.size(); ++k) {
@@ -187,6 +323,13 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
         const std::size_t lo = hint > 2 ? hint - 2 : 0, hi = std::min(n, hint + ahead + 1), w = hi - lo;
         const double px = p.x, py = p.y, pz = p.z;
         double best = std::numeric_limits<double>::infinity();
+        if (same_count && hint <= k && hint + 2 >= k && own.proven[k]) {
+            // The window's nearest is k - 1 or k (the first on a tie, as below).
+            const double before = own.before[k], after = own.after[k];
+            hint = after < before ? k : k - 1;
+            nearest[k] = after < before ? after : before;
+            continue;
+        }
 #ifdef FIBLET_GEOMETRY_AVX2
         if (paired) {
             const std::size_t base = k >= 4 ? k - 4 : 0;
@@ -212,6 +355,11 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
 }
 
 }  // namespace
+
+bool& detail::geometry_shortcut_enabled() {
+    thread_local bool enabled = true;
+    return enabled;
+}
 
 void FiberMax::add(double v, std::uint64_t fiber) {
     if (count == 0 || v > max) max = v, worst_fiber = fiber;
