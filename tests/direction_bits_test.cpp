@@ -239,8 +239,8 @@ TEST(DirectionBits, CliBitsOptionAndStandardInput) {
     test::TempDir dir;
     write_smooth_fibers(dir.file("smooth.tck"));
     const std::string cli = FIBLET_CLI;
-    // Default and --bits auto: chosen, said in the report.
-    const auto json = test::run_cli("compress -q -f --json " + dir.file("smooth.tck") + " -o " + dir.file("a.fft"));
+    // --bits auto: chosen, said in the report.
+    const auto json = test::run_cli("compress -q -f --json --bits auto " + dir.file("smooth.tck") + " -o " + dir.file("a.fft"));
     ASSERT_EQ(json.status, 0) << json.output;
     EXPECT_NE(json.output.find("\"direction_bits\": 16"), std::string::npos) << json.output;
     EXPECT_NE(json.output.find("\"bits_automatic\": true"), std::string::npos) << json.output;
@@ -251,10 +251,10 @@ TEST(DirectionBits, CliBitsOptionAndStandardInput) {
     EXPECT_NE(text.output.find("16 bits: 8-bit codes would change lengths by up to"), std::string::npos) << text.output;
     EXPECT_TRUE(test::read_file(dir.file("a.fft")) == test::read_file(dir.file("b.fft")));
     // Standard input: the same choice from the one read the CLI spools, the same bytes.
-    ASSERT_EQ(test::run_command("cat " + dir.file("smooth.tck") + " | " + cli + " compress -q - -o " + dir.file("c.fft")).status, 0);
+    ASSERT_EQ(test::run_command("cat " + dir.file("smooth.tck") + " | " + cli + " compress -q --bits auto - -o " + dir.file("c.fft")).status, 0);
     EXPECT_TRUE(test::read_file(dir.file("a.fft")) == test::read_file(dir.file("c.fft")));
-    // --bits 8 is respected.
-    const auto eight = test::run_cli("compress -q -f --json --bits 8 " + dir.file("smooth.tck") + " -o " + dir.file("d.fft"));
+    // The default is 8 bits, the official layout, whatever the data.
+    const auto eight = test::run_cli("compress -q -f --json " + dir.file("smooth.tck") + " -o " + dir.file("d.fft"));
     ASSERT_EQ(eight.status, 0) << eight.output;
     EXPECT_NE(eight.output.find("\"direction_bits\": 8"), std::string::npos) << eight.output;
     EXPECT_NE(eight.output.find("\"bits_automatic\": false"), std::string::npos) << eight.output;
@@ -270,7 +270,7 @@ TEST(DirectionBits, CliBitsOptionAndStandardInput) {
 TEST(DirectionBits, CliNotesLengthsTheSampleMissed) {
     test::TempDir dir;
     write_walks_and_one_smooth_fiber(dir.file("mix.tck"));
-    const auto r = test::run_cli("compress -f " + dir.file("mix.tck") + " -o " + dir.file("a.fft"));
+    const auto r = test::run_cli("compress -f --bits auto " + dir.file("mix.tck") + " -o " + dir.file("a.fft"));
     ASSERT_EQ(r.status, 0) << r.output;
     const FftFile a(dir.file("a.fft"));
     ASSERT_EQ(a.header().version, kFftVersion) << r.output;
@@ -279,7 +279,11 @@ TEST(DirectionBits, CliNotesLengthsTheSampleMissed) {
     EXPECT_NE(r.output.find("fiblet: note: " + dir.file("a.fft") + ": a fiber's length changed by"), std::string::npos)
         << r.output;
     EXPECT_NE(r.output.find("(fiber 1;"), std::string::npos) << r.output;
-    EXPECT_NE(r.output.find("--bits 16 keeps them"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("--bits 16 keeps lengths"), std::string::npos) << r.output;
+    // At the default 8 bits the same note points to --bits auto.
+    const auto by_default = test::run_cli("compress -f " + dir.file("mix.tck") + " -o " + dir.file("e.fft"));
+    EXPECT_NE(by_default.output.find("(fiber 1): --bits auto (16 bits where 8 would not) keeps lengths"), std::string::npos)
+        << by_default.output;
     // Quiet means quiet; a file that keeps its lengths gets no note.
     EXPECT_EQ(test::run_cli("compress -q -f " + dir.file("mix.tck") + " -o " + dir.file("b.fft")).output, "");
     write_jittery_fibers(dir.file("walk.tck"));

@@ -223,8 +223,8 @@ void expect_lengths_within_the_recorded_error(const ResampledLengthChanges& m) {
 // float64 reference decoder within 1.05x. Before the length feedback
 // (codec/length_feedback.hpp) the codes' lag at block ends added up to
 // 96 um on iFOD2 for 46 um recorded, and the end fraction left the raw
-// bundles 0.4-0.9 mm off. The 0.1 mm bundles whose fibers 8-bit codes would
-// zig-zag longer than the point error are written with 16-bit codes
+// bundles 0.4-0.9 mm off. With --bits auto the 0.1 mm bundles whose fibers
+// 8-bit codes would zig-zag longer than the point error are written with 16-bit codes
 // (codec/direction_bits.hpp): at 8 bits, cingulum-1-step0.1 was 19.3 um
 // off for 4.6 um recorded (36 um before the length feedback); before the
 // rounded corners and the finer step for fibers of few points
@@ -238,6 +238,7 @@ TEST(FiberEndsSharedData, ResampledLengthsWithinTheRecordedError) {
         SCOPED_TRACE(tck);
         CompressOptions o;
         o.overwrite = true;
+        o.direction_bits = std::nullopt;  // --bits auto: 16 where 8-bit codes would not keep the lengths
         const ResampledLengthChanges m = measure_resampled_lengths(tck, dir.file("f.fft"), o);
         if (!m.resampled) continue;
         ++resampled_files;
@@ -278,7 +279,7 @@ TEST(FiberEndsSharedData, FineStepBundlesKeepLengthsWithinTheRecordedErrorAtEigh
 // decoder's tuned step (x1.0005) and the codes' lag made fibers up to
 // 52 um (small-ifod1) and 83 um (small-ifod1-step0.05) longer for 5.6 and
 // 2.6 um recorded. small-sdstream's smooth fibers zig-zag across the 8-bit
-// code grid (54 um for 5.4 um recorded, docs/encode.md); at the defaults
+// code grid (54 um for 5.4 um recorded, docs/encode.md); with --bits auto
 // they get 16-bit codes (codec/direction_bits.hpp), checked here too.
 TEST(FiberEndsSharedData, FixedStepLengthsWithinTheRecordedError) {
     if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
@@ -288,6 +289,7 @@ TEST(FiberEndsSharedData, FixedStepLengthsWithinTheRecordedError) {
         SCOPED_TRACE(tck);
         CompressOptions o;
         o.overwrite = true;
+        o.direction_bits = std::nullopt;  // --bits auto (the default's 8 bits: compress says so, CompressLengthNote)
         const CompressReport r = compress_tck(tck, dir.file("f.fft"), o);
         if (r.resampled) continue;
         ++checked;

@@ -20,7 +20,7 @@ struct CompressArgs {
     std::optional<double> step;
     unsigned threads = 0;
     // Encoder choices.
-    std::string bits = "auto";  // auto, 8 or 16
+    std::string bits = "8";  // 8, 16 or auto
     std::uint32_t block_points = 0;
     int effort = kDefaultEffort;
     std::optional<unsigned> beam, radius, retry_beam, lookahead;
@@ -61,6 +61,11 @@ std::string report_json(const std::string& in, const std::string& out, const Com
     j.raw("geometry", geometry_json(r.geometry));
     if (a_max_error) j.boolean("within_bound", metrics_above(r.error, r.geometry, *a_max_error).empty());
     j.num("seconds", r.seconds);
+    const CompressTimings& t = r.timings;
+    Json timings;
+    timings.num("read", t.read).num("scan", t.scan).num("tune", t.tune).num("encode", t.encode);
+    timings.num("metrics", t.metrics).num("index", t.index).num("write", t.write);
+    j.raw("timings", timings.render());
     return j.render();
 }
 
@@ -79,17 +84,19 @@ void print_report(std::FILE* to, const std::string& in, const std::string& out, 
     fmt::print(to, "  {:.2f} s ({:.1f} M points/s)\n", r.seconds, r.header.points / r.seconds / 1e6);
 }
 
-// The bits were chosen on a sample (--bits auto): where the whole file's
-// lengths then changed by more than its point error at 8 bits, the sample
-// missed the fibers that do (docs/encode.md, "Why smooth fibers need 16
-// bits"); say so and what keeps them.
+// 8-bit codes changed a fiber's length by more than the file's point error
+// (smooth fibers at fine steps zig-zag across the code grid: docs/encode.md,
+// "Why smooth fibers need 16 bits"): say so and what keeps them. Under
+// --bits auto this means the sample the bits were chosen on missed them.
 void note_lengths_not_kept(const std::string& out, const CompressReport& r) {
     const double length_um = r.geometry.length_change_mm().max * 1e3, error_um = double(r.header.max_error_mm) * 1e3;
-    if (!r.bits.automatic || r.header.direction_bits() != 8 || !(length_um > error_um * (1 + 1e-6))) return;
+    if (r.header.direction_bits() != 8 || !(length_um > error_um * (1 + 1e-6))) return;
     fmt::print(stderr,
-               "fiblet: note: {}: a fiber's length changed by {:.3g} µm, more than the {:.3g} µm point error (fiber {}; "
-               "the sample the bits were chosen on kept its lengths): --bits 16 keeps them\n",
-               out, length_um, error_um, r.geometry.length_change_mm().worst_fiber);
+               "fiblet: note: {}: a fiber's length changed by {:.3g} µm, more than the {:.3g} µm point error (fiber {}{}): "
+               "{} keeps lengths\n",
+               out, length_um, error_um, r.geometry.length_change_mm().worst_fiber,
+               r.bits.automatic ? "; the sample the bits were chosen on kept its lengths" : "",
+               r.bits.automatic ? "--bits 16" : "--bits auto (16 bits where 8 would not)");
 }
 
 void run(const CompressArgs& a) {
@@ -105,7 +112,7 @@ void run(const CompressArgs& a) {
         o.overwrite = a.force;
         o.threads = a.threads;
         o.allow_count_mismatch = a.allow_count_mismatch;
-        if (a.bits != "auto") o.direction_bits = unsigned(std::stoul(a.bits));
+        o.direction_bits = a.bits == "auto" ? std::nullopt : std::optional<unsigned>(unsigned(std::stoul(a.bits)));
         o.points_per_block = a.block_points;
         o.search = search_for_effort(a.effort);
         if (a.beam) o.search.beam_width = *a.beam;
@@ -180,9 +187,10 @@ void add_compress(CLI::App& app) {
     cmd->add_option("--step", args->step, "Fixed step in mm (default: measured; variable spacing is resampled)");
     add_threads_option(cmd, args->threads, "Encoding");
     cmd->add_option("--bits", args->bits,
-                    "Bits per direction: 8 (.fft version 2), 16 (formats/fft16.md: 15-bit codes in packed blocks; with "
-                    "--zstd, version 16) or auto (default): 8 unless 8-bit codes would change the sampled fibers' "
-                    "lengths by more than their point error (smooth fibers at fine steps; docs/encode.md)")
+                    "Bits per direction: 8 (default: .fft version 2, the official layout), 16 (formats/fft16.md: "
+                    "15-bit codes in packed blocks; with --zstd, version 16) or auto: 8 unless 8-bit codes would "
+                    "change the sampled fibers' lengths by more than their point error (smooth fibers at fine "
+                    "steps; docs/encode.md)")
         ->check(CLI::IsMember({"auto", "8", "16"}));
     cmd->add_option("--block-points", args->block_points, "Points per block (default 60 for 8 bits; 254 for 16, 126 for 16 with --zstd)");
     cmd->add_option("-e,--effort", args->effort,

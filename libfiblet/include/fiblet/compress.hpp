@@ -37,10 +37,11 @@ struct CompressOptions {
     std::optional<double> step_mm;            // overrides the measured step
     std::uint32_t points_per_block = 0;       // 0: 60 for 8-bit codes; 16-bit: 254 (.fft), 126 (.fftz)
     // Encoder choices; the decoder is the same whatever they are (docs/encode.md).
-    // 8: version-2 .fft; 16: version 17 (.fft) or 16 (.fftz) (formats/fft16.md);
-    // unset: 8 unless 8-bit codes would change the sampled fibers' lengths by
-    // more than their point error (docs/encode.md, "Why smooth fibers need 16 bits").
-    std::optional<unsigned> direction_bits;
+    // 8 (default): version-2 .fft, the official layout and size; 16: version 17
+    // (.fft) or 16 (.fftz) (formats/fft16.md); unset (`--bits auto`): 8 unless
+    // 8-bit codes would change the sampled fibers' lengths by more than their
+    // point error (docs/encode.md, "Why smooth fibers need 16 bits").
+    std::optional<unsigned> direction_bits = 8u;
     bool fixed_blocks16 = false;              // 16-bit codes in version 16's fixed-size blocks in a .fft too
     SearchOptions search = search_for_effort(kDefaultEffort);  // code search (see search_for_effort)
     std::optional<double> cap_ratio;          // cap ratio; default: tuned on a sample
@@ -68,6 +69,20 @@ struct DirectionBitsChoice {
     std::string reason;                  // one sentence, for the report
 };
 
+// Where compress spent its time: seconds in each stage, summed over the
+// threads that ran it (the worker pool encodes while the caller reads and
+// writes, so the sum can exceed CompressReport::seconds).
+struct CompressTimings {
+    double read = 0;     // parsing the input, every pass
+    double scan = 0;     // pass 1 (and 1b when resampling): bounds, spacing, turns
+    double tune = 0;     // the cap, the decoder step and the bits, chosen on samples
+    double encode = 0;   // resampling, the code search, the end placement, packing
+    double metrics = 0;  // the header's error and the symmetric report
+    double index = 0;    // the block index (BIDX chunk)
+    double write = 0;    // blocks, checksums, trailer, committing the file
+    double total() const { return read + scan + tune + encode + metrics + index + write; }
+};
+
 struct CompressReport {
     TckScan scan;
     DirectionBitsChoice bits;
@@ -81,6 +96,7 @@ struct CompressReport {
     GeometryError geometry;          // decoded vs input polylines, both ways; endpoints, lengths
     std::uint64_t input_bytes = 0, output_bytes = 0;
     double seconds = 0;
+    CompressTimings timings;
 };
 
 // Compresses `tck_path` (a .tck, .trk or TRX: open_streamline_source) into
