@@ -123,3 +123,21 @@ TEST(CompressPasses, AnInputCutWhileReadIsNamedAsChangedNotAsTruncated) {
         EXPECT_NE(std::string(e.what()).find("changed while it was being read"), std::string::npos) << e.what();
     }
 }
+
+// The report times each stage (CompressTimings: what --json prints as
+// "timings"). On one thread the stages do not overlap: their sum is at most
+// the run's time, and every stage that has work to do takes some.
+TEST(CompressPasses, TheStagesAreTimedWithinTheRunsTime) {
+    test::TempDir dir;
+    write_tck(dir.file("in.tck"));
+    CompressOptions o;
+    o.threads = 1;
+    const CompressReport r = compress_tck(dir.file("in.tck"), dir.file("out.fft"), o);
+    const CompressTimings& t = r.timings;
+    for (const double s : {t.read, t.scan, t.tune, t.encode, t.metrics, t.index, t.write}) EXPECT_GT(s, 0.0);
+    EXPECT_LE(t.total(), r.seconds);
+    // No index asked: no time in it.
+    o.block_index = false;
+    o.overwrite = true;
+    EXPECT_EQ(compress_tck(dir.file("in.tck"), dir.file("out.fft"), o).timings.index, 0.0);
+}

@@ -23,9 +23,14 @@ namespace fiblet::detail {
 // where it stands), the slot being slots[batch parity][t] (new ones made
 // with new_slot); in_order(batch) on the caller while its tasks run;
 // after(batch, its slots) on the caller once they are done, in batch order.
+// The reading's seconds are added to `read_seconds`.
 template <class Slot, class NewSlot, class Task, class InOrder, class After>
 void for_each_batch(StreamlineSource& reader, unsigned threads, std::vector<Slot> (&slots)[2], NewSlot new_slot,
-                    Task task, InOrder in_order, After after) {
+                    Task task, InOrder in_order, After after, double& read_seconds) {
+    auto read = [&](FiberBatch& b, std::uint32_t first) {
+        const StageClock clock(read_seconds);
+        return read_fiber_batch(reader, b, first);
+    };
     FiberBatch batch[2];
     ParallelJob job[2];  // after batch and slots: destroyed (waited for) first
     auto start = [&](int k) {
@@ -33,13 +38,13 @@ void for_each_batch(StreamlineSource& reader, unsigned threads, std::vector<Slot
         job[k] = ParallelJob(batch[k].tasks(), threads, [&, k](std::size_t t) { task(batch[k], t, slots[k][t]); });
     };
     int cur = 0;
-    if (!read_fiber_batch(reader, batch[cur], 0)) return;
+    if (!read(batch[cur], 0)) return;
     start(cur);
     for (;;) {
         const FiberBatch& b = batch[cur];
         in_order(b);
         // The other batch's job is done and its slots were used by `after`.
-        const bool more = read_fiber_batch(reader, batch[1 - cur], std::uint32_t(b.first_fiber + b.count));
+        const bool more = read(batch[1 - cur], std::uint32_t(b.first_fiber + b.count));
         if (more) start(1 - cur);
         job[cur].wait(more ? &job[1 - cur] : nullptr);
         after(b, slots[cur]);

@@ -83,7 +83,10 @@ BlockLayout block_layout(unsigned bits, const CompressOptions& options) {
                                            : wide ? kDefaultPointsPerBlock16 : kDefaultPointsPerBlock);
     const std::uint32_t max_points_per_block = wide ? kMaxPointsPerBlock16 : kMaxPointsPerBlock;
     if (points_per_block < 2 || points_per_block > max_points_per_block)
-        throw Error(Errc::invalid_argument, "points per block must be in [2, " + std::to_string(max_points_per_block) + "]");
+        throw Error(Errc::invalid_argument,
+                    "points per block must be in [2, " + std::to_string(max_points_per_block) + "] for " +
+                        std::to_string(bits) + "-bit codes" +
+                        (wide ? "" : " (16-bit codes allow up to " + std::to_string(kMaxPointsPerBlock16) + ")"));
     return {bits, packed, points_per_block};
 }
 
@@ -146,8 +149,9 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     // The bits are measured on a larger sample than the tuning's (direction_bits.hpp).
     const std::size_t bits_sample_points =
         choose_bits && !wide_blocks_asked ? std::max(options.tuning_points, detail::kBitsSamplePoints) : 0;
-    detail::ScanStageResult scanned = detail::scan_stage(reader, scan, points_per_block, kSharpBlocks,
-                                                         options.tuning_points, bits_sample_points, threads, options);
+    CompressTimings& timings = report.timings;
+    detail::ScanStageResult scanned = detail::scan_stage(reader, scan, points_per_block, kSharpBlocks, options.tuning_points,
+                                                         bits_sample_points, threads, options, timings);
     std::vector<std::uint32_t>& fiber_points = scanned.fiber_points;
     detail::TurnStatistics& turns = scanned.turns;
     detail::FiberSample& sample = scanned.sample;
@@ -216,14 +220,16 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     if (options.step_scale && !(*options.step_scale > 0.5 && *options.step_scale < 2))
         throw Error(Errc::invalid_argument, "the step scale must be in (0.5, 2)");
     std::optional<double> step_scale = options.step_scale;
-    if (report.resampled && !step_scale)
+    if (report.resampled && !step_scale) {
+        const detail::StageClock clock(timings.tune);
         step_scale = detail::tune_parameters({sample.fibers(), {}, step}, turns, h, options.search, step, std::nullopt,
                                              std::nullopt)
                          .step_scale;
+    }
     const double stretch = step_scale ? decoder_stretch(float(step * *step_scale / h.scaling), h.scaling, step) : 1.0;
     if (report.resampled)
         detail::resample_scan_stage(reader, {step, stretch}, tol, max_fiber_points, scan, fiber_points, tensions, turns,
-                                    points_per_block, kSharpBlocks, threads, options);
+                                    points_per_block, kSharpBlocks, threads, options, timings);
 
     point_fields.set_resampled_points(fiber_points);
     // Header: the encoder's choices (parameters.cpp), block layout and buffer table.
@@ -236,6 +242,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     const detail::TuningSet tuning_set{sample.fibers(), turns.sharpest_blocks(), report.resampled ? step : 0.0};
     // The cap, the decoder step and the encoder for the header's bits.
     auto tuned_encoder = [&] {
+        const detail::StageClock clock(timings.tune);
         detail::TunedParameters tuned =
             detail::tune_parameters(tuning_set, turns, h, options.search, step, fixed_ratio, step_scale);
         // Fixed-step input keeps its lengths where the sampling step and the
@@ -262,8 +269,11 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     // keeps the step and the decoder step pass 1b fitted its tensions to.
     std::optional<std::uint32_t> too_long;  // points of a fiber 8-bit blocks cannot hold
     if (choose_bits && h.direction_bits() == 8) {
-        report.bits = detail::measure_sample_lengths(scanned.bits_sample.fibers(), encoder,
-                                                      {report.resampled ? step : 0.0, stretch}, threads);
+        {
+            const detail::StageClock clock(timings.tune);
+            report.bits = detail::measure_sample_lengths(scanned.bits_sample.fibers(), encoder,
+                                                          {report.resampled ? step : 0.0, stretch}, threads);
+        }
         const std::uint32_t longest = fiber_points.empty() ? 0 : *std::max_element(fiber_points.begin(), fiber_points.end());
         if (encoder.block_count(longest) > 0xffff) too_long = longest;
         if (too_long || !detail::eight_bits_keep_lengths(report.bits)) {
@@ -330,7 +340,12 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         detail::EncodeStageResult r = detail::encode_stage(reader, in, *out, checksum, index, options);
         report.error = std::move(r.error);
         report.geometry = std::move(r.geometry);
+        timings.read += r.timings.read, timings.encode += r.timings.encode, timings.metrics += r.timings.metrics;
+        timings.index += r.timings.index, timings.write += r.timings.write;
     }
+    // The trailer and the commit (the index chunk made on the way is the index's).
+    std::optional<detail::StageClock> writing(std::in_place, timings.write);
+    const double index_before_trailer = timings.index;
     if (report.resampled) report.error_vs_original = report.geometry.decoded_to_input();
     h.max_error_mm = float(report.error.max_mm());
     h.mean_error_mm = float(report.error.mean_mm());
@@ -354,14 +369,18 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             FiberEndFractions().swap(end_fractions);
         }
         // The builder goes as soon as its chunk is made (its codes are larger than the chunk).
-        if (options.block_index)
+        if (options.block_index) {
+            const detail::StageClock clock(timings.index);
             if (auto bidx = std::exchange(index, IndexBuilder(h)).finish()) chunks.push_back(std::move(*bidx));
+        }
         chunks.push_back(checksum.finish(final_head, chunks));  // last: it covers the chunks before it
         trailer = serialize_trailer(chunks, at);
     }
     out->finish(trailer, final_head);
     report.output_bytes = out->stored_size();
     out->commit();
+    writing.reset();
+    timings.write -= timings.index - index_before_trailer;
     if (options.progress) options.progress("encode", 1.0);
 
     report.input_bytes = tractogram_bytes(tck_path);  // a TRX directory: its files

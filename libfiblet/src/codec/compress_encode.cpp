@@ -14,6 +14,7 @@
 // thread the OS schedules late only takes fewer tasks. Memory is bounded: two batches of
 // input (~3 MB each) and their blocks.
 #include <cmath>
+#include <optional>
 #include <cstring>
 #include <utility>
 #ifdef __SSE2__
@@ -74,6 +75,7 @@ struct Slot {
     ErrorStats error;
     GeometryError geometry;  // both ways against the input polylines
     IndexBuilder index;      // bounds of this task's blocks (the BIDX chunk)
+    CompressTimings timings;  // encode, metrics, index
 };
 
 // Resampled fibers whose length the end placement left off by more than
@@ -116,7 +118,11 @@ void measure_pending(const EncodeStageInputs& in, const FiberBatch& b, Slot& w) 
             w.decoded_exact.size() == w.decoded.size() ? std::span<const Vec3f>(w.decoded_exact.data() + s, n)
                                                         : std::span<const Vec3f>();
         const auto f = std::uint32_t(b.first_fiber + i);
-        if (in.block_index) w.index.add_fiber(decoded);
+        if (in.block_index) {
+            const StageClock clock(w.timings.index);
+            w.index.add_fiber(decoded);
+        }
+        const StageClock clock(w.timings.metrics);
         add_point_errors(points, decoded, decoded_exact, f, w.point_errors, w.error);
         w.geometry.add_fiber(b.fibers[i], decoded, f);
     }
@@ -125,6 +131,7 @@ void measure_pending(const EncodeStageInputs& in, const FiberBatch& b, Slot& w) 
 }
 
 void pack_task(const EncodeStageInputs& in, Slot& w) {
+    const StageClock clock(w.timings.encode);
     const FftHeader& h = in.encoder.header();
     w.packed.clear();
     w.packed_sizes.clear();
@@ -145,6 +152,7 @@ void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t
         const std::vector<Vec3f>& original = b.fibers[i];
         const auto f = std::uint32_t(b.first_fiber + i);
         if (w.starts.size() == 1) w.first_pending = i;
+        std::optional<StageClock> encoding(std::in_place, w.timings.encode);
         if (in.step > 0) {
             const bool fields = in.point_fields && in.point_fields->active();
             const std::size_t at = w.targets.size();
@@ -160,10 +168,12 @@ void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t
         } else {
             in.encoder.encode(original, f, w.blocks, &w.decoded, &w.decoded_exact);
         }
+        encoding.reset();
         const std::size_t s = w.starts.back();
         w.starts.push_back(w.decoded.size());
         w.block_ends.push_back(w.blocks.size());
         if (budgeted) {
+            const StageClock clock(w.timings.metrics);
             const bool missing = misses_its_length(w.ends.back());
             w.ends_missing = w.ends_missing || missing;
             const std::size_t n = w.decoded.size() - s;
@@ -188,7 +198,10 @@ void finish_batch(const EncodeStageInputs& in, const FiberBatch& b, std::vector<
     parallel_for(b.tasks(), in.threads, [&](std::size_t t) {
         Slot& w = slots[t];
         if (!w.ends_missing) return;
-        place_missing_ends(in, b, budget, w);
+        {
+            const StageClock clock(w.timings.encode);
+            place_missing_ends(in, b, budget, w);
+        }
         measure_pending(in, b, w);
         pack_task(in, w);
     });
@@ -196,7 +209,8 @@ void finish_batch(const EncodeStageInputs& in, const FiberBatch& b, std::vector<
 
 // Stage 3: a batch's blocks, checksums and index entries, in task order.
 void write_batch(const FiberBatch& b, std::vector<Slot>& slots, FftSink& out, FftChecksumBuilder& checksum,
-                 IndexBuilder& index) {
+                 IndexBuilder& index, CompressTimings& timings) {
+    const StageClock clock(timings.write);
     for (std::size_t t = 0; t < b.tasks(); ++t) {
         const Slot& s = slots[t];
         out.write_blocks(s.packed.empty() ? s.blocks : s.packed);
@@ -254,6 +268,7 @@ void PointFieldResampler::finish() {
 EncodeStageResult encode_stage(StreamlineSource& reader, const EncodeStageInputs& in, FftSink& out,
                                FftChecksumBuilder& checksum, IndexBuilder& index, const CompressOptions& options) {
     reader.rewind();
+    EncodeStageResult r;
     std::vector<Slot> slots[2];
     const IndexBuilder empty_index = index;  // the file's layout, no blocks yet
     for_each_batch(
@@ -261,14 +276,18 @@ EncodeStageResult encode_stage(StreamlineSource& reader, const EncodeStageInputs
         [&](const FiberBatch& b, std::size_t t, Slot& s) { encode_task(in, b, t, s); }, [](const FiberBatch&) {},
         [&](const FiberBatch& b, std::vector<Slot>& batch_slots) {
             finish_batch(in, b, batch_slots);
-            write_batch(b, batch_slots, out, checksum, index);
+            write_batch(b, batch_slots, out, checksum, index, r.timings);
             if (options.progress && reader.data_bytes() > 0)
                 options.progress("encode", double(reader.bytes_consumed()) / double(reader.data_bytes()));
-        });
+        },
+        r.timings.read);
 
-    EncodeStageResult r;
     for (int k = 0; k < 2; ++k)
-        for (const Slot& w : slots[k]) r.error.merge(w.error), r.geometry.merge(w.geometry);
+        for (const Slot& w : slots[k]) {
+            r.error.merge(w.error), r.geometry.merge(w.geometry);
+            r.timings.encode += w.timings.encode, r.timings.metrics += w.timings.metrics;
+            r.timings.index += w.timings.index;
+        }
     return r;
 }
 

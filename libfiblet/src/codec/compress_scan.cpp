@@ -38,6 +38,7 @@ struct ScanSlot {
     LengthHistogram lengths;
     std::optional<TurnStatistics> turns;
     std::vector<float> fiber_lengths;  // of this task's fibers in the current batch
+    double seconds = 0;                // in scan_task
 };
 
 // The bounds of a fiber's points into min / max. Float comparisons (exact:
@@ -55,6 +56,7 @@ void add_bounds(std::span<const Vec3f> fiber, double* min, double* max) {
 }
 
 void scan_task(const FiberBatch& b, std::size_t t, ScanSlot& s) {
+    const StageClock clock(s.seconds);
     double length_sum = 0;  // this task's, added to the slot's once (the same sums whatever the threads)
     thread_local std::vector<double> lengths;  // of a fiber's segments, shared with the turn statistics
     s.fiber_lengths.clear();
@@ -86,6 +88,7 @@ struct ResampleSlot {
     std::uint64_t off_step_segments = 0;
     std::optional<std::uint64_t> too_long;  // the first fiber of this batch's task needing > 65535 blocks
     double too_long_mm = 0;
+    double seconds = 0;  // in the task
 };
 
 }  // namespace
@@ -127,7 +130,7 @@ double LengthHistogram::median() const {
 
 ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_t points_per_block,
                            std::size_t sharp_blocks, std::size_t tuning_points, std::size_t bits_sample_points,
-                           unsigned threads, const CompressOptions& options) {
+                           unsigned threads, const CompressOptions& options, CompressTimings& timings) {
     ScanStageResult r{.fiber_points = {},
                       .turns = TurnStatistics(points_per_block, sharp_blocks),
                       .sample = FiberSample(tuning_points),
@@ -155,7 +158,8 @@ ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_
             for (std::size_t t = 0; t < b.tasks(); ++t)  // task order is file order
                 r.fiber_lengths.insert(r.fiber_lengths.end(), done[t].fiber_lengths.begin(), done[t].fiber_lengths.end());
             report_progress(options, "scan", reader);
-        });
+        },
+        timings.read);
     // Merged in slot order: the same sums whatever the thread count.
     scan.min = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
                 std::numeric_limits<double>::infinity()};
@@ -172,6 +176,7 @@ ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_
             length_sum += s.length_sum;
             r.lengths.merge(s.lengths);
             r.turns.merge(*s.turns);
+            timings.scan += s.seconds;
         }
     r.length_sum = length_sum;
     return r;
@@ -197,11 +202,13 @@ double block_keeping_step(std::span<const float> fiber_lengths, double step, std
 void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double tolerance,
                          std::size_t max_fiber_points, TckScan& scan, std::vector<std::uint32_t>& fiber_points,
                          std::vector<std::uint16_t>& tensions, TurnStatistics& turns, std::uint32_t points_per_block,
-                         std::size_t sharp_blocks, unsigned threads, const CompressOptions& options) {
+                         std::size_t sharp_blocks, unsigned threads, const CompressOptions& options,
+                         CompressTimings& timings) {
     const double step = resample.step_mm;
     reader.rewind();
     std::vector<ResampleSlot> slots[2];
     auto task = [&](const FiberBatch& b, std::size_t t, ResampleSlot& s) {
+        const StageClock clock(s.seconds);
         s.too_long.reset();
         for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1]; ++i) {
             const std::vector<Vec3f>& fiber = b.fibers[i];
@@ -233,12 +240,14 @@ void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double
                                                        std::to_string(s.too_long_mm) + " mm) needs more than 65535 blocks at a " +
                                                        std::to_string(step) + " mm step");
             report_progress(options, "resample-scan", reader);
-        });
+        },
+        timings.read);
     turns = TurnStatistics(points_per_block, sharp_blocks);
     for (int k = 0; k < 2; ++k)
         for (const ResampleSlot& s : slots[k]) {
             turns.merge(*s.turns);
             scan.off_step_segments += s.off_step_segments;
+            timings.scan += s.seconds;
         }
 }
 

@@ -11,6 +11,7 @@
 
 #include <array>
 #include <bit>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -29,6 +30,20 @@
 #include "io/fft_sink.hpp"
 
 namespace fiblet::detail {
+
+// Adds the seconds from its construction to its destruction to `total`
+// (CompressReport::timings; ~20 ns a clock read, taken per fiber or batch).
+class StageClock {
+public:
+    explicit StageClock(double& total) : total_(total) {}
+    ~StageClock() { total_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count(); }
+    StageClock(const StageClock&) = delete;
+    StageClock& operator=(const StageClock&) = delete;
+
+private:
+    double& total_;
+    std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
+};
 
 // A batch: ~256 k points of whole fibers (at least one fiber), cut into tasks
 // of ~16 k points; neither depends on the thread count, so no output does.
@@ -97,7 +112,7 @@ double block_keeping_step(std::span<const float> fiber_lengths, double step, std
 // `bits_sample_points` 0: no bits sample.
 ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_t points_per_block,
                            std::size_t sharp_blocks, std::size_t tuning_points, std::size_t bits_sample_points,
-                           unsigned threads, const CompressOptions& options);
+                           unsigned threads, const CompressOptions& options, CompressTimings& timings);
 
 // How pass 1b resamples: the step (mm) and the decoder's stretch of it
 // that the length-keeping tension allows for (length_keeping_tension).
@@ -113,7 +128,8 @@ struct ResampleStep {
 void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double tolerance,
                          std::size_t max_fiber_points, TckScan& scan, std::vector<std::uint32_t>& fiber_points,
                          std::vector<std::uint16_t>& tensions, TurnStatistics& turns, std::uint32_t points_per_block,
-                         std::size_t sharp_blocks, unsigned threads, const CompressOptions& options);
+                         std::size_t sharp_blocks, unsigned threads, const CompressOptions& options,
+                         CompressTimings& timings);
 
 // Per-point fields of resampled input, re-made at the resampled points
 // (float32, linear between the two input points of the piece each lies on:
@@ -152,6 +168,7 @@ struct EncodeStageInputs {
 struct EncodeStageResult {
     ErrorStats error;
     GeometryError geometry;
+    CompressTimings timings;  // read, encode, metrics, index, write
 };
 
 // Pass 2: reads `reader` from its start, encodes every fiber and writes the
