@@ -13,6 +13,7 @@ PACKAGES=(
   python3-dev python3-pybind11 pybind11-dev python3-pytest snakemake
   python3-dipy  # fiblet.load_sft() and its test
   mrtrix3 zstd time
+  valgrind  # callgrind: the compress instruction budget (bench/instruction_budget.py)
   slurm-wlm munge  # the cohort workflow on a single-node SLURM (ecosystem.cohort_workflow_slurm)
   clang-14 libclang-rt-14-dev  # libFuzzer harnesses (scripts/fuzz.sh)
   libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libspng-dev

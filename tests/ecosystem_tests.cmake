@@ -43,3 +43,13 @@ if(DEFINED Python_EXECUTABLE)
   set_tests_properties(ecosystem.cli_conventions PROPERTIES TIMEOUT 120
     ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA};FIBLET_CLI=$<TARGET_FILE:fiblet_cli>;FIBLET_VERSION=${PROJECT_VERSION}")
 endif()
+
+# The compress speed guard (bench/instruction_budget.py): callgrind's
+# instruction count of compress, default and --effort 0, within 25 % of the
+# committed budget (valgrind: scripts/setup.sh).
+if(DEFINED Python_EXECUTABLE)
+  add_test(NAME bench.compress_instruction_budget
+    COMMAND ${Python_EXECUTABLE} ${PROJECT_SOURCE_DIR}/bench/instruction_budget.py
+            --fiblet $<TARGET_FILE:fiblet_cli> --tck ${FIBLET_SHARED_DATA}/small-ifod1.tck)
+  set_tests_properties(bench.compress_instruction_budget PROPERTIES TIMEOUT 300)
+endif()
