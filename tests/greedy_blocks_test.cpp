@@ -284,6 +284,13 @@ TEST(GreedyBlocks, EdgeCasesMatchTheScalarSearchAtEveryLevel) {
         return p + scale * Vec3f{u(rng), u(rng), u(rng)};
     });
     for (float step : {1.0f, 1e3f, 1e18f, 1e30f, 3e38f}) expect_same_at_every_level(cb, step, far, "huge");
+    // Along the axis at 1e20, across at 1e30 (first step, identity frame):
+    // both squares overflow, the cap test passes on inf <= inf and
+    // u = y / x = 1e10 is out of int range, where the scalar cell() gives 0.
+    const Blocks overflow = blocks([&](std::size_t, std::size_t k, Vec3f p) {
+        return p + Vec3f{1e20f * float(k + 1), 1e30f * u(rng), 1e29f * u(rng)};
+    });
+    for (float step : {1e-3f, 1e25f}) expect_same_at_every_level(cb, step, overflow, "overflowing squares");
     // Tiny steps near the denormals.
     const Blocks near = blocks([&](std::size_t, std::size_t k, Vec3f p) {
         return p + float(k + 1) * 1e-38f * Vec3f{1.0f, u(rng), u(rng)};
