@@ -22,7 +22,6 @@
 
 #include <atomic>
 #include <climits>
-#include <cstring>
 #include <cstdlib>
 #include <string>
 
@@ -37,12 +36,9 @@ namespace hn = hwy::HWY_NAMESPACE;
 constexpr std::size_t kMaxLanes = 16;
 
 // Blocks j0 .. j0 + active - 1 of the batch, one per lane of `d` (lanes
-// past `active` repeat the last block; their results are dropped). The
-// decoded points and codes go through `scratch` (lane-minor per step),
-// then to each block's own place.
+// past `active` repeat the last block; their results are dropped).
 template <class D>
-void GreedyVector(D d, const Codebook8& cb, float step, const GreedyBatch& batch, std::size_t j0, std::size_t active,
-                  std::vector<float>& scratch) {
+void GreedyVector(D d, const Codebook8& cb, float step, const GreedyBatch& batch, std::size_t j0, std::size_t active) {
     const hn::RebindToSigned<D> di;
     using VF = hn::Vec<D>;
     using VI = hn::Vec<decltype(di)>;
@@ -94,9 +90,14 @@ void GreedyVector(D d, const Codebook8& cb, float step, const GreedyBatch& batch
     // target once its block is done (a shorter last block).
     VI at = hn::Load(di, first_at);
     const VI at_end = hn::Load(di, last_at), three = hn::Set(di, 3);
-    scratch.resize(4 * steps * lanes);
-    float* out = scratch.data();  // per step: x, y, z, code (as int32 bits) for each lane
-    for (std::size_t k = 0; k < steps; ++k, out += 4 * lanes) {
+    // Where each active lane writes; the lanes whose block is done by step k drop out.
+    Vec3f* decoded[kMaxLanes];
+    std::uint8_t* codes[kMaxLanes];
+    for (std::size_t i = 0; i < active; ++i)
+        decoded[i] = batch.decoded + (j0 + i) * stride, codes[i] = batch.codes + (j0 + i) * batch.code_stride;
+    alignas(64) float out[3][kMaxLanes];
+    alignas(64) std::int32_t out_code[kMaxLanes];
+    for (std::size_t k = 0; k < steps; ++k) {
         // apply_transposed(f, t - p): dot(c_j, v) = (c_j.x v.x + c_j.y v.y) + c_j.z v.z.
         const VF vx = hn::Sub(hn::GatherIndex(d, targets, at), px);
         const VF vy = hn::Sub(hn::GatherIndex(d, targets + 1, at), py);
@@ -110,9 +111,14 @@ void GreedyVector(D d, const Codebook8& cb, float step, const GreedyBatch& batch
         const VF lateral2 = hn::Add(hn::Mul(y, y), hn::Mul(z, z));
         const auto in_cap = hn::And(hn::Gt(x, zero), hn::Le(lateral2, hn::Mul(rim_tan2, hn::Mul(x, x))));
         const VF inv = hn::Div(one, x);
-        const VF s = hn::Div(rim_tan, hn::Sqrt(lateral2));
-        const VF u = hn::IfThenElse(in_cap, hn::Mul(y, inv), hn::Mul(y, s));
-        const VF v = hn::IfThenElse(in_cap, hn::Mul(z, inv), hn::Mul(z, s));
+        VF u = hn::Mul(y, inv), v = hn::Mul(z, inv);
+        // The rim's square root and division only when a lane needs them
+        // (rare: they would lengthen every step's dependency chain).
+        if (!hn::AllTrue(d, in_cap)) {
+            const VF s = hn::Div(rim_tan, hn::Sqrt(lateral2));
+            u = hn::IfThenElse(in_cap, u, hn::Mul(y, s));
+            v = hn::IfThenElse(in_cap, v, hn::Mul(z, s));
+        }
         const VI index = hn::Add(hn::ShiftLeft<8>(cell(u)), cell(v));
         // The cell's byte: a 32-bit gather at its offset, moved back from
         // the table's last 3 bytes so that it never reads past the end.
@@ -140,22 +146,17 @@ void GreedyVector(D d, const Codebook8& cb, float step, const GreedyBatch& batch
         py = hn::Add(py, hn::Mul(stepv, f[1]));
         pz = hn::Add(pz, hn::Mul(stepv, f[2]));
 
-        hn::StoreU(px, d, out);
-        hn::StoreU(py, d, out + lanes);
-        hn::StoreU(pz, d, out + 2 * lanes);
-        hn::StoreU(hn::BitCast(d, code), d, out + 3 * lanes);
         at = hn::Min(hn::Add(at, three), at_end);
-    }
-    for (std::size_t i = 0; i < active; ++i) {
-        const std::size_t j = j0 + i;
-        Vec3f* decoded = batch.decoded + j * stride;
-        std::uint8_t* codes = batch.codes + j * batch.code_stride;
-        const float* o = scratch.data() + i;
-        for (std::size_t k = 0; k < m_of[i]; ++k, o += 4 * lanes) {
-            decoded[k] = {o[0], o[lanes], o[2 * lanes]};
-            std::int32_t code;
-            std::memcpy(&code, o + 3 * lanes, sizeof code);
-            codes[k] = std::uint8_t(code);
+        // The step's results to their blocks: scalar stores, which the CPU
+        // overlaps with the next step's dependency chain.
+        hn::Store(px, d, out[0]);
+        hn::Store(py, d, out[1]);
+        hn::Store(pz, d, out[2]);
+        hn::Store(code, di, out_code);
+        for (std::size_t i = 0; i < active; ++i) {
+            if (k >= m_of[i]) continue;
+            decoded[i][k] = {out[0][i], out[1][i], out[2][i]};
+            codes[i][k] = std::uint8_t(out_code[i]);
         }
     }
 }
@@ -164,22 +165,21 @@ void GreedyVector(D d, const Codebook8& cb, float step, const GreedyBatch& batch
 // then the rest in the narrowest width that holds it (at least 2 blocks
 // a vector); returns n (the few left are the scalar search's).
 std::size_t GreedyVectors(const Codebook8& cb, float step, const GreedyBatch& batch) {
-    thread_local std::vector<float> scratch;
     const hn::ScalableTag<float> d;
     const std::size_t lanes = hn::Lanes(d);
     std::size_t j = 0;
-    for (; j + lanes <= batch.blocks; j += lanes) GreedyVector(d, cb, step, batch, j, lanes, scratch);
+    for (; j + lanes <= batch.blocks; j += lanes) GreedyVector(d, cb, step, batch, j, lanes);
     const std::size_t left = batch.blocks - j;
     if (left < 2) return j;
 #if HWY_TARGET == HWY_AVX3
-    if (left > 8) GreedyVector(d, cb, step, batch, j, left, scratch);
-    else if (left > 4) GreedyVector(hn::CappedTag<float, 8>(), cb, step, batch, j, left, scratch);
-    else GreedyVector(hn::CappedTag<float, 4>(), cb, step, batch, j, left, scratch);
+    if (left > 8) GreedyVector(d, cb, step, batch, j, left);
+    else if (left > 4) GreedyVector(hn::CappedTag<float, 8>(), cb, step, batch, j, left);
+    else GreedyVector(hn::CappedTag<float, 4>(), cb, step, batch, j, left);
 #elif HWY_TARGET == HWY_AVX2
-    if (left > 4) GreedyVector(d, cb, step, batch, j, left, scratch);
-    else GreedyVector(hn::CappedTag<float, 4>(), cb, step, batch, j, left, scratch);
+    if (left > 4) GreedyVector(d, cb, step, batch, j, left);
+    else GreedyVector(hn::CappedTag<float, 4>(), cb, step, batch, j, left);
 #else
-    GreedyVector(d, cb, step, batch, j, left, scratch);
+    GreedyVector(d, cb, step, batch, j, left);
 #endif
     return batch.blocks;
 }
