@@ -5,6 +5,7 @@
 #include "codec/anchor_conditioning.hpp"
 #include "codec/code_search.hpp"
 #include "codec/exact_model.hpp"
+#include "codec/greedy_blocks.hpp"
 #include "codec/length_feedback.hpp"
 #include "codec/nearest_code_lut.hpp"
 #include "core/block_geometry.hpp"
@@ -290,23 +291,17 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
                 while (!lanes[0].done()) lanes[0].step();
             }
     } else if (params.beam <= 1 && !wide) {
-        // Greedy: four full blocks at a time (16-bit codes gain nothing: their
-        // nearest-code search is branchy and dominates).
-        constexpr int kLanes = 4;
-        using Lanes = GreedyLanes<Codebook8, kLanes>;
-        const Codebook8 cb{*tables_->table8, *tables_->lut8};
-        for (; b + kLanes <= n_blocks && block_points(b + kLanes - 1) == ppb; b += kLanes) {
-            Lanes lanes;
-            for (int i = 0; i < kLanes; ++i) {
-                const std::size_t i0 = std::size_t(b + i) * ppb;
-                lanes.f[i] = frames[b + i];
-                lanes.p[i] = points[i0 + 1];
-                lanes.targets[i] = &targets[i0 + 2];
-                lanes.codes[i] = codes8_of(b + i);
-                lanes.decoded[i] = &points[i0 + 2];
-            }
-            lanes.run(cb, h.step, ppb - 2);
-        }
+        // Greedy: the blocks one per SIMD lane (greedy_blocks.hpp; the same
+        // codes as search_codes), the last one too when it has codes.
+        // 16-bit codes gain nothing from lanes: their nearest-code search is
+        // branchy and dominates.
+        const std::size_t full = n_points / ppb, rest = n_points % ppb;
+        const std::size_t blocks = rest > 2 ? full + 1 : full;
+        if (blocks > 0 && ppb > 2)
+            greedy_blocks(Codebook8{*tables_->table8, *tables_->lut8}, h.step,
+                          GreedyBatch{&frames[0], &points[1], &targets[2], &points[2], ppb, codes8_of(0), bb, blocks,
+                                      ppb - 2, rest > 2 ? rest - 2 : ppb - 2});
+        b = n_blocks;
     }
     for (; b < n_blocks; ++b)
         if (block_points(b) > 2)

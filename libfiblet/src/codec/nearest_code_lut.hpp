@@ -42,6 +42,14 @@ public:
         unsigned before;  // how many of them precede the code itself in grid order
     };
     const Neighbours& neighbours(std::uint8_t code) const { return neighbours_[code]; }
+    // What operator() reads, for the SIMD search that repeats its
+    // operations lane by lane (greedy_blocks.cpp); cells: kGrid * kGrid bytes.
+    struct Gnomonic {
+        const std::uint8_t* cells;
+        float rim_tan, rim_tan2, cell_scale;
+        std::uint8_t zero_code, back_code;
+    };
+    Gnomonic gnomonic() const { return {cells_.data(), rim_tan_, rim_tan2_, cell_scale_, zero_code_, back_code_}; }
 
     std::uint8_t operator()(Vec3f local) const {
         const float x = local.x, y = local.y, z = local.z;
