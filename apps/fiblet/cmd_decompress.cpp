@@ -117,12 +117,13 @@ void add_decompress(CLI::App& app) {
                   "Decompress every .fft/.fftz below the directories given (tree mirrored in --output-dir)");
     add_threads_option(cmd, args->threads, "Decoding");
     cmd->add_option("--decoder", args->decoder,
-                    "auto (the fastest), scalar, lanes, warp, or one with its SIMD level: " +
+                    "auto (the fastest this CPU runs), scalar, lanes, warp, or one with its SIMD level: " +
                         [] {
                             std::string all;
-                            for (const std::string& n : available_decoders()) all += (all.empty() ? "" : ", ") + n;
+                            for (const std::string& n : compiled_decoders()) all += (all.empty() ? "" : ", ") + n;
                             return all;
-                        }())
+                        }() +
+                        " (the CPU must have the level)")
         ->default_str("auto");
     cmd->add_flag("-f,--force", args->force, "Overwrite an existing output");
     cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");

@@ -78,6 +78,9 @@ std::string decoder_name(Decoder decoder);  // of the resolved decoder
 // Every concrete decoder this CPU runs, by name; the first is the one
 // `auto` picks.
 std::vector<std::string> available_decoders();
+// Every concrete decoder this build of the library has, whatever the CPU
+// (a level the CPU lacks is refused when asked for).
+std::vector<std::string> compiled_decoders();
 
 // Number of points held by `count` blocks; throws Error{fft_format} on a
 // block whose point count is 0 or above the file's points per block.

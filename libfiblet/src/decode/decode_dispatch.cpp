@@ -22,6 +22,15 @@ namespace fiblet {
 
 namespace {
 
+// Whether the library was built with kernels of this level.
+bool compiled(SimdLevel level) {
+#ifdef FIBLET_HAVE_X86_KERNELS
+    return true;
+#else
+    return level == SimdLevel::portable;
+#endif
+}
+
 bool cpu_has(SimdLevel level) {
 #ifdef FIBLET_HAVE_X86_KERNELS
     __builtin_cpu_init();  // needed when called from a static initializer
@@ -203,6 +212,14 @@ std::vector<std::string> available_decoders() {
     add("scalar");
     for (SimdLevel level : {SimdLevel::avx512, SimdLevel::avx2, SimdLevel::portable})
         if (cpu_has(level)) add(std::string("warp-") + level_name(level));
+    return names;
+}
+
+std::vector<std::string> compiled_decoders() {
+    std::vector<std::string> names{"scalar"};
+    for (const char* kind : {"lanes-", "warp-"})
+        for (SimdLevel level : {SimdLevel::avx512, SimdLevel::avx2, SimdLevel::portable})
+            if (compiled(level)) names.push_back(kind + std::string(level_name(level)));
     return names;
 }
 
