@@ -77,6 +77,7 @@ public:
 
 private:
     struct Tables;
+    struct Encoding;  // one fiber's passes (fiber_encoder.cpp)
     FftHeader header_;
     SearchOptions search_;
     float length_stretch_ = 0;

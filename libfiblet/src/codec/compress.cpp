@@ -114,6 +114,78 @@ std::string bits_reason(const DirectionBitsChoice& c, unsigned bits, bool wide_b
     return std::string(c.automatic ? "8 bits: " : "8 bits as asked: ") + "8-bit codes change " + measured;
 }
 
+// The step: the mean over segments for fixed-step data; for variable
+// spacing the header's step_size when the data agrees with it, else the
+// median spacing, made finer where every fiber keeps its block count
+// (block_keeping_step); options.step_mm overrides. `resampled`: whether the
+// spacing departs from the chosen step by more than the tolerance.
+double choose_step(const TckScan& scan, std::span<const float> fiber_lengths, const CompressOptions& options,
+                   std::uint32_t points_per_block, bool& resampled) {
+    const double tol = options.step_tolerance;
+    const bool variable = scan.segments > 0 && (scan.step_max > scan.step_mean * (1 + tol) ||
+                                                scan.step_min < scan.step_mean * (1 - tol));
+    double step = scan.step_mean;
+    if (options.step_mm) {
+        step = *options.step_mm;
+    } else if (variable) {
+        step = scan.header_step && std::fabs(*scan.header_step - scan.step_median) <= 0.05 * *scan.header_step
+                   ? *scan.header_step
+                   : scan.step_median;
+        // Fibers of few points (blocks are fixed-size): a finer step in as many blocks.
+        step = detail::block_keeping_step(fiber_lengths, step, points_per_block);
+    }
+    resampled = scan.segments > 0 && (variable || std::fabs(step - scan.step_mean) > tol * step);
+    return step;
+}
+
+// Normalization into the unit cube: the header's offset, scaling and step.
+// Returns the step the decoder will walk (float, normalized) in mm:
+// resampling uses exactly that length.
+double normalize(FftHeader& h, const TckScan& scan, double step, const std::string& path) {
+    double extent = 0;
+    for (int a = 0; a < 3; ++a) {
+        h.offset[a] = float(-0.5 * (scan.min[a] + scan.max[a]));
+        extent = std::max(extent, scan.max[a] - scan.min[a]);
+    }
+    // A step longer than the largest side (a diagonal segment) would leave [0, 1): widen.
+    if (step >= extent) extent = step * 1.01;
+    h.scaling = extent > 0 ? float(extent * (1 + 1e-6)) : 1.0f;  // a hair larger: float offsets stay inside [0,1]
+    if (!std::isfinite(h.scaling))
+        throw Error(Errc::invalid_input,
+                    path + ": coordinates span more than the float range (" + std::to_string(extent) + " mm)");
+    h.step = float(step / h.scaling);
+    check_step_resolvable(path, step, extent, h.step);
+    return double(h.step) * double(h.scaling);
+}
+
+// The fiber table (LUT) and the header's block counts and buffer table:
+// each fiber's blocks in one GPU buffer of at most
+// fft_max_blocks_per_buffer blocks (formats/fft.md §3); version 17 stores
+// the fiber's point count where version 2 / 16 store its first block.
+std::vector<FiberLutEntry> plan_blocks(FftHeader& h, const std::vector<std::uint32_t>& fiber_points,
+                                       const FiberEncoder& encoder, const BlockLayout& layout, const std::string& path) {
+    std::vector<FiberLutEntry> lut(fiber_points.size());
+    const std::uint64_t per_buffer = fft_max_blocks_per_buffer(h.block_bytes());
+    std::uint64_t blocks = 0, in_buffer = 0;
+    for (std::size_t f = 0; f < fiber_points.size(); ++f) {
+        const std::uint32_t nb = encoder.block_count(fiber_points[f]);
+        if (nb > 0xffff)
+            throw Error(Errc::unsupported, path + ": " + detail::streamline_label(f) + " needs more than 65535 blocks");
+        if (in_buffer + nb > per_buffer) h.buffer_ends.push_back(blocks), in_buffer = 0;
+        if (h.buffer_ends.size() > 254) throw Error(Errc::unsupported, path + ": more than 255 GPU buffers of blocks");
+        lut[f] = {std::uint32_t(h.buffer_ends.size()) << 16 | nb, layout.packed ? fiber_points[f] : std::uint32_t(in_buffer)};
+        if (layout.packed && nb > 0)
+            h.packed_block_bytes += (nb - 1) * std::uint64_t{packed16_block_bytes(layout.points_per_block)} +
+                                    packed16_block_bytes(fiber_points[f] - (nb - 1) * layout.points_per_block);
+        blocks += nb, in_buffer += nb;
+        h.points += fiber_points[f];
+    }
+    if (blocks > std::numeric_limits<std::uint32_t>::max()) throw Error(Errc::unsupported, path + ": more than 2^32 - 1 blocks");
+    if (blocks > 0) h.buffer_ends.push_back(blocks);
+    h.blocks = std::uint32_t(blocks);
+    return lut;
+}
+
 }  // namespace
 
 CompressReport compress_tck(const std::string& tck_path, const std::string& fft_path, const CompressOptions& options) {
@@ -127,7 +199,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     BlockLayout layout = block_layout(options.direction_bits.value_or(wide_blocks_asked ? 16 : 8), options);
     std::uint32_t points_per_block = layout.points_per_block;
     if (options.step_mm && !(std::isfinite(*options.step_mm) && *options.step_mm > 0))
-        throw Error(Errc::invalid_argument, "--step must be a positive number of millimetres");
+        throw Error(Errc::invalid_argument, "the step must be a positive number of millimetres");
     const unsigned threads = detail::resolve_threads(options.threads);  // checked before any work
 
     CompressReport report;
@@ -165,48 +237,15 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     scan.step_mean = scan.segments ? length_sum / double(scan.segments) : 0.0;
     scan.step_median = scanned.lengths.median();
 
-    // The step: the mean over segments for fixed-step data; for variable
-    // spacing the header's step_size when the data agrees with it, else the
-    // median spacing, made finer where every fiber keeps its block count
-    // (block_keeping_step); --step overrides. Resample when the spacing departs
-    // from the chosen step by more than the tolerance.
     const double tol = options.step_tolerance;
-    const bool variable = scan.segments > 0 && (scan.step_max > scan.step_mean * (1 + tol) ||
-                                                scan.step_min < scan.step_mean * (1 - tol));
-    double step = scan.step_mean;
-    if (options.step_mm) {
-        step = *options.step_mm;
-    } else if (variable) {
-        step = scan.header_step && std::fabs(*scan.header_step - scan.step_median) <= 0.05 * *scan.header_step
-                   ? *scan.header_step
-                   : scan.step_median;
-        // Fibers of few points (blocks are fixed-size): a finer step in as many blocks.
-        step = detail::block_keeping_step(scanned.fiber_lengths, step, points_per_block);
-    }
+    double step = choose_step(scan, scanned.fiber_lengths, options, points_per_block, report.resampled);
     std::vector<float>().swap(scanned.fiber_lengths);
-    report.resampled = scan.segments > 0 && (variable || std::fabs(step - scan.step_mean) > tol * step);
     if (report.resampled && !(step > 0))
         throw Error(Errc::invalid_input, tck_path + ": cannot resample: the measured step is zero");
-
-    // Normalization into the unit cube; the step is what the decoder will
-    // use (float, normalized), and resampling uses exactly that length.
     FftHeader& h = report.header;
     set_layout(h, layout);
     h.fibers = scan.fibers;
-    double extent = 0;
-    for (int a = 0; a < 3; ++a) {
-        h.offset[a] = float(-0.5 * (scan.min[a] + scan.max[a]));
-        extent = std::max(extent, scan.max[a] - scan.min[a]);
-    }
-    // A step longer than the largest side (a diagonal segment) would leave [0, 1): widen.
-    if (step >= extent) extent = step * 1.01;
-    h.scaling = extent > 0 ? float(extent * (1 + 1e-6)) : 1.0f;  // a hair larger: float offsets stay inside [0,1]
-    if (!std::isfinite(h.scaling))
-        throw Error(Errc::invalid_input, tck_path + ": coordinates span more than the float range (" +
-                                             std::to_string(extent) + " mm)");
-    h.step = float(step / h.scaling);
-    check_step_resolvable(tck_path, step, extent, h.step);
-    step = double(h.step) * double(h.scaling);
+    step = normalize(h, scan, step, tck_path);
     report.step_mm = step;
 
     // Pass 1b (resampling only): the counts and turning angles change.
@@ -288,28 +327,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
                                         " points needs more than 65535 blocks of 8-bit codes"
                                   : bits_reason(report.bits, h.direction_bits(), wide_blocks_asked, points_per_block);
     report.search = encoder.search();
-    std::vector<FiberLutEntry> lut(scan.fibers);
-    const std::uint64_t per_buffer = fft_max_blocks_per_buffer(h.block_bytes());
-    std::uint64_t blocks = 0, in_buffer = 0;
-    for (std::size_t f = 0; f < fiber_points.size(); ++f) {
-        const std::uint32_t nb = encoder.block_count(fiber_points[f]);
-        if (nb > 0xffff)
-            throw Error(Errc::unsupported, tck_path + ": " + detail::streamline_label(f) + " needs more than 65535 blocks");
-        if (in_buffer + nb > per_buffer) h.buffer_ends.push_back(blocks), in_buffer = 0;
-        if (h.buffer_ends.size() > 254)
-            throw Error(Errc::unsupported, tck_path + ": more than 255 GPU buffers of blocks");
-        // Version 17 stores the fiber's point count where version 16 has its first block.
-        lut[f] = {std::uint32_t(h.buffer_ends.size()) << 16 | nb, layout.packed ? fiber_points[f] : std::uint32_t(in_buffer)};
-        if (layout.packed && nb > 0)
-            h.packed_block_bytes += (nb - 1) * std::uint64_t{packed16_block_bytes(points_per_block)} +
-                                    packed16_block_bytes(fiber_points[f] - (nb - 1) * points_per_block);
-        blocks += nb, in_buffer += nb;
-        h.points += fiber_points[f];
-    }
-    if (blocks > std::numeric_limits<std::uint32_t>::max())
-        throw Error(Errc::unsupported, tck_path + ": more than 2^32 - 1 blocks");
-    if (blocks > 0) h.buffer_ends.push_back(blocks);
-    h.blocks = std::uint32_t(blocks);
+    std::vector<FiberLutEntry> lut = plan_blocks(h, fiber_points, encoder, layout, tck_path);
 
     // Pass 2: encode, measure, write.
     const auto out = detail::open_fft_sink(fft_path, options.overwrite, options.zstd, h.direction_bits(),

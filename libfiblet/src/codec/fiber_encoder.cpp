@@ -198,46 +198,90 @@ FiberEncoder FiberEncoder::with_length_feedback(float stretch, bool tails_only) 
     return e;
 }
 
-void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, std::vector<std::uint8_t>& out,
-                          std::vector<Vec3f>* decoded, std::vector<Vec3f>* decoded_exact) const {
-    const FftHeader& h = header_;
-    const std::uint32_t ppb = h.points_per_block, bb = h.block_bytes();
-    const std::size_t n_points = fiber.size();
-    const std::uint32_t n_blocks = block_count(n_points);
-    if (n_blocks > 0xffff)
-        throw Error(Errc::unsupported, "fiber " + std::to_string(fiber_id) + " has " + std::to_string(n_points) +
-                                           " points: more than 65535 blocks");
-    const bool wide = tables_->table16.has_value();
-    const std::size_t base = out.size();
-    out.resize(base + std::size_t(n_blocks) * bb, 0);
+// One fiber being encoded: what the passes of FiberEncoder::encode share.
+// Per point: the target and the decoded point (normalized coordinates); per
+// block: the first frame and (8-bit) the decoders' starts. Codes go straight
+// into the blocks (8-bit) or through `codes16`. The vectors are per-thread
+// scratch, reused from fiber to fiber.
+struct FiberEncoder::Encoding {
+    struct Scratch {
+        std::vector<Vec3f> targets, points, retry_points, alt;
+        std::vector<Frame> frames;
+        std::vector<DecoderStarts> starts;
+        std::vector<std::uint16_t> codes16, retry_codes16;
+        std::vector<std::uint8_t> retry_codes8;
+        std::vector<Vec3d> walked;
+    };
 
-    // Per point of the fiber: the target and the decoded point (normalized
-    // coordinates); per block: the first frame. Codes go straight into the
-    // blocks (8-bit) or through `codes16`.
-    thread_local std::vector<Vec3f> targets, points, retry_points;
-    thread_local std::vector<Frame> frames;
-    thread_local std::vector<DecoderStarts> starts;
-    thread_local std::vector<std::uint16_t> codes16, retry_codes16;
-    thread_local std::vector<std::uint8_t> retry_codes8;
-    targets.resize(n_points);
-    points.resize(n_points);
-    frames.resize(n_blocks);
-    starts.resize(wide ? 0 : n_blocks);
-    // How far a block of n points reaches from its second anchor (normalized).
-    auto block_reach = [&](std::uint32_t n) { return n > 2 ? double(h.step) * double(n - 2) * 1.01 : 0.0; };
-    if (wide) codes16.assign(n_points, 0);
-    const double inv_scaling = 1.0 / double(h.scaling);
-    for (std::size_t k = 0; k < n_points; ++k) {
-        const Vec3f& s = fiber[k];
-        targets[k] = {float((double(s.x) + h.offset[0]) * inv_scaling + 0.5),
-                      float((double(s.y) + h.offset[1]) * inv_scaling + 0.5),
-                      float((double(s.z) + h.offset[2]) * inv_scaling + 0.5)};
+    const FiberEncoder& enc;
+    const FftHeader& h;
+    std::span<const Vec3f> fiber;
+    std::uint32_t fiber_id;
+    std::vector<std::uint8_t>& out;
+    Scratch& s;
+    const std::uint32_t ppb, bb;
+    const std::size_t n_points, base;
+    const std::uint32_t n_blocks;
+    const bool wide;
+
+    Encoding(const FiberEncoder& e, std::span<const Vec3f> f, std::uint32_t id, std::vector<std::uint8_t>& o, Scratch& scratch)
+        : enc(e), h(e.header_), fiber(f), fiber_id(id), out(o), s(scratch), ppb(h.points_per_block),
+          bb(h.block_bytes()), n_points(f.size()), base(o.size()), n_blocks(e.block_count(f.size())),
+          wide(e.tables_->table16.has_value()) {
+        out.resize(base + std::size_t(n_blocks) * bb, 0);
+        s.targets.resize(n_points);
+        s.points.resize(n_points);
+        s.frames.resize(n_blocks);
+        s.starts.resize(wide ? 0 : n_blocks);
+        if (wide) s.codes16.assign(n_points, 0);
+        const double inv_scaling = 1.0 / double(h.scaling);
+        for (std::size_t k = 0; k < n_points; ++k) {
+            const Vec3f& p = fiber[k];
+            s.targets[k] = {float((double(p.x) + h.offset[0]) * inv_scaling + 0.5),
+                            float((double(p.y) + h.offset[1]) * inv_scaling + 0.5),
+                            float((double(p.z) + h.offset[2]) * inv_scaling + 0.5)};
+        }
     }
-    auto block_points = [&](std::uint32_t b) { return std::uint32_t(std::min<std::size_t>(ppb, n_points - std::size_t(b) * ppb)); };
 
-    // Block heads. Anchors: the block's first two points; a one-point block
-    // stores the point extrapolated from the previous segment as its second
-    // anchor (the tangent a renderer needs), a one-point fiber the point itself.
+    std::uint32_t block_points(std::uint32_t b) const {
+        return std::uint32_t(std::min<std::size_t>(ppb, n_points - std::size_t(b) * ppb));
+    }
+    // How far a block of n points reaches from its second anchor (normalized).
+    double block_reach(std::uint32_t n) const { return n > 2 ? double(h.step) * double(n - 2) * 1.01 : 0.0; }
+    // The codes of block b: points i0 + 2 .. i0 + n.
+    std::uint8_t* codes8_of(std::uint32_t b) { return &out[base + std::size_t(b) * bb + kBlockDirectionsOffset]; }
+    Codebook8 codebook8() const { return {*enc.tables_->table8, *enc.tables_->lut8}; }
+    bool robust(std::uint32_t b) const { return s.starts[b].divergence > kRobustDivergence; }
+    const SearchOptions& search() const { return enc.search_; }
+    Vec3f world(Vec3d p) const {
+        return Vec3f{float((p.x - 0.5) * double(h.scaling) - double(h.offset[0])),
+                     float((p.y - 0.5) * double(h.scaling) - double(h.offset[1])),
+                     float((p.z - 0.5) * double(h.scaling) - double(h.offset[2]))};
+    }
+
+    // Block b's codes with the beam search `sp`, into c8 / c16 and `dec`.
+    void search_block(std::uint32_t b, const SearchParams& sp, std::uint8_t* c8, std::uint16_t* c16, Vec3f* dec) const {
+        const std::size_t i0 = std::size_t(b) * ppb;
+        const std::span<const Vec3f> t(&s.targets[i0 + 2], block_points(b) - 2);
+        if (wide) search_codes(Codebook16{*enc.tables_->table16}, sp, s.frames[b], s.points[i0 + 1], h.step, t, c16, dec);
+        else search_codes(codebook8(), sp, s.frames[b], s.points[i0 + 1], h.step, t, c8, dec);
+    }
+
+    void write_block_heads();
+    void search_blocks();
+    void retry_worst_blocks();
+    void search_robust_blocks();
+    void keep_lengths();
+    void store_codes16();
+    void append_decoded(std::vector<Vec3f>& decoded) const;
+    void append_exact16(std::vector<Vec3f>& decoded_exact);
+    void append_exact8(std::vector<Vec3f>& decoded_exact);
+};
+
+// Anchors: the block's first two points; a one-point block stores the point
+// extrapolated from the previous segment as its second anchor (the tangent
+// a renderer needs), a one-point fiber the point itself.
+void FiberEncoder::Encoding::write_block_heads() {
     for (std::uint32_t b = 0; b < n_blocks; ++b) {
         const std::size_t i0 = std::size_t(b) * ppb;
         const std::uint32_t n = block_points(b);
@@ -250,36 +294,31 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
         }
         const DecoderStarts head =
             write_block_head(h, &out[base + std::size_t(b) * bb], p0, p1, fiber_id, b, n_blocks, n, block_reach(n));
-        points[i0] = head.a0;
-        if (n >= 2) points[i0 + 1] = head.a1;
+        s.points[i0] = head.a0;
+        if (n >= 2) s.points[i0 + 1] = head.a1;
         const BlockView16 written{&out[base + std::size_t(b) * bb]};
-        if (wide) frames[b] = frame_from_axis(h.packed() ? packed16_anchor_axis(written) : anchor_axis(head.a0, head.a1));
-        else frames[b] = head.frame;
-        if (!wide) starts[b] = head;
+        if (wide) s.frames[b] = frame_from_axis(h.packed() ? packed16_anchor_axis(written) : anchor_axis(head.a0, head.a1));
+        else s.frames[b] = head.frame;
+        if (!wide) s.starts[b] = head;
     }
+}
 
-    // The codes of block b: points i0 + 2 .. i0 + n.
-    auto codes8_of = [&](std::uint32_t b) { return &out[base + std::size_t(b) * bb + kBlockDirectionsOffset]; };
-    auto search_block = [&](std::uint32_t b, const SearchParams& sp, std::uint8_t* c8, std::uint16_t* c16, Vec3f* dec) {
-        const std::size_t i0 = std::size_t(b) * ppb;
-        const std::span<const Vec3f> t(&targets[i0 + 2], block_points(b) - 2);
-        if (wide) search_codes(Codebook16{*tables_->table16}, sp, frames[b], points[i0 + 1], h.step, t, c16, dec);
-        else search_codes(Codebook8{*tables_->table8, *tables_->lut8}, sp, frames[b], points[i0 + 1], h.step, t, c8, dec);
-    };
-    const SearchParams params{search_.beam_width, search_.radius};
+// The first search of every block: lookahead, greedy (SIMD lanes) or beam.
+void FiberEncoder::Encoding::search_blocks() {
+    const SearchParams params{search().beam_width, search().radius};
     std::uint32_t b = 0;
-    if (params.beam <= 1 && !wide && search_.lookahead > 0) {
+    if (params.beam <= 1 && !wide && search().lookahead > 0) {
         // Lookahead: four blocks at a time, in lockstep, so that their
         // independent dependency chains overlap in the CPU (the blocks'
         // searches do not interact: the same codes as one at a time).
-        const Codebook8 cb{*tables_->table8, *tables_->lut8};
+        const Codebook8 cb = codebook8();
         constexpr int kLanes = 4;
-        const std::size_t depth = search_.lookahead;
+        const std::size_t depth = search().lookahead;
         LookaheadSearch<Codebook8> lanes[kLanes]{{cb, h.step, depth}, {cb, h.step, depth}, {cb, h.step, depth}, {cb, h.step, depth}};
         auto start = [&](LookaheadSearch<Codebook8>& lane, std::uint32_t blk) {
             const std::size_t i0 = std::size_t(blk) * ppb;
-            lane.start(frames[blk], points[i0 + 1], std::span<const Vec3f>(&targets[i0 + 2], block_points(blk) - 2),
-                       codes8_of(blk), &points[i0 + 2]);
+            lane.start(s.frames[blk], s.points[i0 + 1], std::span<const Vec3f>(&s.targets[i0 + 2], block_points(blk) - 2),
+                       codes8_of(blk), &s.points[i0 + 2]);
         };
         for (; b + kLanes <= n_blocks && block_points(b + kLanes - 1) == ppb; b += kLanes) {
             for (int i = 0; i < kLanes; ++i) start(lanes[i], b + i);
@@ -298,201 +337,221 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
         const std::size_t full = n_points / ppb, rest = n_points % ppb;
         const std::size_t blocks = rest > 2 ? full + 1 : full;
         if (blocks > 0 && ppb > 2)
-            greedy_blocks(Codebook8{*tables_->table8, *tables_->lut8}, h.step,
-                          GreedyBatch{&frames[0], &points[1], &targets[2], &points[2], ppb, codes8_of(0), bb, blocks,
+            greedy_blocks(codebook8(), h.step,
+                          GreedyBatch{&s.frames[0], &s.points[1], &s.targets[2], &s.points[2], ppb, codes8_of(0), bb, blocks,
                                       ppb - 2, rest > 2 ? rest - 2 : ppb - 2});
         b = n_blocks;
     }
     for (; b < n_blocks; ++b)
         if (block_points(b) > 2)
-            search_block(b, params, wide ? nullptr : codes8_of(b), wide ? codes16.data() + std::size_t(b) * ppb : nullptr,
-                         &points[std::size_t(b) * ppb + 2]);
+            search_block(b, params, wide ? nullptr : codes8_of(b), wide ? s.codes16.data() + std::size_t(b) * ppb : nullptr,
+                         &s.points[std::size_t(b) * ppb + 2]);
+}
 
-    // Retry: blocks whose largest error exceeds the threshold are searched
-    // again with the retry beam; the smaller max error wins.
-    if (search_.retry_beam_width > 0 && search_.retry_error_mm > 0) {
-        const float threshold2 = float(search_.retry_error_mm / h.scaling) * float(search_.retry_error_mm / h.scaling);
-        const SearchParams retry_params{search_.retry_beam_width, search_.retry_radius};
-        auto max_error2 = [&](const Vec3f* decoded_points, const Vec3f* target, std::size_t m) {
-            float worst = 0;
-            for (std::size_t k = 0; k < m; ++k) {
-                const Vec3f d = decoded_points[k] - target[k];
-                worst = std::max(worst, dot(d, d));
-            }
-            return worst;
-        };
-        // Fixed-step input keeping its lengths walks the sampling step, where
-        // a few blocks at sharp turns stay above the retry's reach: those get
-        // a wider beam still (length_feedback.hpp, kLengthRescueBeam).
-        const bool rescue = length_stretch_ > 0 && length_tails_only_ && !wide;
-        const float rescue2 = kLengthRescueOverRetry * kLengthRescueOverRetry * threshold2;
-        for (b = 0; b < n_blocks; ++b) {
-            const std::size_t i0 = std::size_t(b) * ppb, m = block_points(b) >= 2 ? block_points(b) - 2 : 0;
-            if (m == 0) continue;
-            float first = max_error2(&points[i0 + 2], &targets[i0 + 2], m);
-            if (!(first > threshold2)) continue;
-            retry_points.resize(m);
-            retry_codes8.resize(m);
-            retry_codes16.resize(m);
-            for (int pass = 0; pass < 2; ++pass) {
-                const unsigned width = pass == 0 ? retry_params.beam : kLengthRescueBeam;
-                if (pass == 1 && !(rescue && first > rescue2 && width > retry_params.beam)) break;
-                search_block(b, SearchParams{width, retry_params.radius}, retry_codes8.data(), retry_codes16.data(),
-                             retry_points.data());
-                const float now = max_error2(retry_points.data(), &targets[i0 + 2], m);
-                if (!(now < first)) continue;
-                first = now;
-                std::copy(retry_points.begin(), retry_points.end(), &points[i0 + 2]);
-                if (wide) std::copy(retry_codes16.begin(), retry_codes16.end(), codes16.begin() + std::ptrdiff_t(i0));
-                else std::copy(retry_codes8.begin(), retry_codes8.end(), codes8_of(b));
-            }
+// Blocks whose largest error exceeds the retry threshold are searched
+// again with the retry beam; the smaller max error wins.
+void FiberEncoder::Encoding::retry_worst_blocks() {
+    if (!(search().retry_beam_width > 0 && search().retry_error_mm > 0)) return;
+    const float threshold2 = float(search().retry_error_mm / h.scaling) * float(search().retry_error_mm / h.scaling);
+    const SearchParams retry_params{search().retry_beam_width, search().retry_radius};
+    // Fixed-step input keeping its lengths walks the sampling step, where
+    // a few blocks at sharp turns stay above the retry's reach: those get
+    // a wider beam still (length_feedback.hpp, kLengthRescueBeam).
+    const bool rescue = enc.length_stretch_ > 0 && enc.length_tails_only_ && !wide;
+    const float rescue2 = kLengthRescueOverRetry * kLengthRescueOverRetry * threshold2;
+    for (std::uint32_t b = 0; b < n_blocks; ++b) {
+        const std::size_t i0 = std::size_t(b) * ppb, m = block_points(b) >= 2 ? block_points(b) - 2 : 0;
+        if (m == 0) continue;
+        float first = max_distance2(&s.points[i0 + 2], &s.targets[i0 + 2], m);
+        if (!(first > threshold2)) continue;
+        s.retry_points.resize(m);
+        s.retry_codes8.resize(m);
+        s.retry_codes16.resize(m);
+        for (int pass = 0; pass < 2; ++pass) {
+            const unsigned width = pass == 0 ? retry_params.beam : kLengthRescueBeam;
+            if (pass == 1 && !(rescue && first > rescue2 && width > retry_params.beam)) break;
+            search_block(b, SearchParams{width, retry_params.radius}, s.retry_codes8.data(), s.retry_codes16.data(),
+                         s.retry_points.data());
+            const float now = max_distance2(s.retry_points.data(), &s.targets[i0 + 2], m);
+            if (!(now < first)) continue;
+            first = now;
+            std::copy(s.retry_points.begin(), s.retry_points.end(), &s.points[i0 + 2]);
+            if (wide) std::copy(s.retry_codes16.begin(), s.retry_codes16.end(), s.codes16.begin() + std::ptrdiff_t(i0));
+            else std::copy(s.retry_codes8.begin(), s.retry_codes8.end(), codes8_of(b));
         }
     }
+}
 
-    // Robust blocks (8-bit): where the exact decoder's first frame departs
-    // from the float one, search again for codes that suit both (aiming at
-    // the middle of the two decoders' targets), and keep whichever codes
-    // have the smaller worst error over both decoders.
-    if (!wide) {
-        const Codebook8 cb{*tables_->table8, *tables_->lut8};
-        const unsigned robust_beam = std::max({8u, search_.beam_width, search_.retry_beam_width});
-        thread_local std::vector<Vec3f> alt;
-        for (b = 0; b < n_blocks; ++b) {
-            const std::size_t i0 = std::size_t(b) * ppb, m = block_points(b) > 2 ? block_points(b) - 2 : 0;
-            if (m == 0 || !(starts[b].divergence > kRobustDivergence)) continue;
-            const std::span<const Vec3f> t(&targets[i0 + 2], m);
-            alt.resize(m);
-            exact_decoder_targets(starts[b], t, alt.data());
-            float best = worst_error2(&points[i0 + 2], t.data(), alt.data(), m);
-            // What the float decoder alone gets: once the robust codes come
-            // within 10 % of it for both decoders, the wide beam is not worth its cost.
-            const float float_only = max_distance2(&points[i0 + 2], t.data(), m);
-            retry_points.resize(m);
-            retry_codes8.resize(m);
-            for (unsigned width : {1u, robust_beam}) {
-                if (width > 1 && best <= 1.21f * float_only) break;
-                if (width == 1 && search_.lookahead > 0)  // as the first search: greedy aiming with lookahead
-                    LookaheadSearch<Codebook8>(cb, h.step, search_.lookahead)
-                        .run(frames[b], points[i0 + 1], t, retry_codes8.data(), retry_points.data(), std::span<const Vec3f>(alt));
-                else
-                    search_codes(cb, SearchParams{width, 1}, frames[b], points[i0 + 1], h.step, t, retry_codes8.data(),
-                                 retry_points.data(), std::span<const Vec3f>(alt));
-                const float worst = worst_error2(retry_points.data(), t.data(), alt.data(), m);
-                if (!(worst < best)) continue;
-                best = worst;
-                std::copy(retry_points.begin(), retry_points.end(), &points[i0 + 2]);
-                std::copy(retry_codes8.begin(), retry_codes8.end(), codes8_of(b));
-            }
+// Robust blocks (8-bit): where the exact decoder's first frame departs
+// from the float one, search again for codes that suit both (aiming at
+// the middle of the two decoders' targets), and keep whichever codes
+// have the smaller worst error over both decoders.
+void FiberEncoder::Encoding::search_robust_blocks() {
+    const Codebook8 cb = codebook8();
+    const unsigned robust_beam = std::max({8u, search().beam_width, search().retry_beam_width});
+    for (std::uint32_t b = 0; b < n_blocks; ++b) {
+        const std::size_t i0 = std::size_t(b) * ppb, m = block_points(b) > 2 ? block_points(b) - 2 : 0;
+        if (m == 0 || !robust(b)) continue;
+        const std::span<const Vec3f> t(&s.targets[i0 + 2], m);
+        s.alt.resize(m);
+        exact_decoder_targets(s.starts[b], t, s.alt.data());
+        float best = worst_error2(&s.points[i0 + 2], t.data(), s.alt.data(), m);
+        // What the float decoder alone gets: once the robust codes come
+        // within 10 % of it for both decoders, the wide beam is not worth its cost.
+        const float float_only = max_distance2(&s.points[i0 + 2], t.data(), m);
+        s.retry_points.resize(m);
+        s.retry_codes8.resize(m);
+        for (unsigned width : {1u, robust_beam}) {
+            if (width > 1 && best <= 1.21f * float_only) break;
+            if (width == 1 && search().lookahead > 0)  // as the first search: greedy aiming with lookahead
+                LookaheadSearch<Codebook8>(cb, h.step, search().lookahead)
+                    .run(s.frames[b], s.points[i0 + 1], t, s.retry_codes8.data(), s.retry_points.data(),
+                         std::span<const Vec3f>(s.alt));
+            else
+                search_codes(cb, SearchParams{width, 1}, s.frames[b], s.points[i0 + 1], h.step, t, s.retry_codes8.data(),
+                             s.retry_points.data(), std::span<const Vec3f>(s.alt));
+            const float worst = worst_error2(s.retry_points.data(), t.data(), s.alt.data(), m);
+            if (!(worst < best)) continue;
+            best = worst;
+            std::copy(s.retry_points.begin(), s.retry_points.end(), &s.points[i0 + 2]);
+            std::copy(s.retry_codes8.begin(), s.retry_codes8.end(), codes8_of(b));
         }
     }
+}
 
-    // Length feedback across the blocks (length_feedback.hpp), with the
-    // retry's beam; robust blocks keep the codes that suit both decoders.
-    if (length_stretch_ > 0 && length_tails_only_ && !wide) {
-        const Codebook8 cb{*tables_->table8, *tables_->lut8};
-        retry_codes8.resize(ppb);
+// Length feedback across the blocks (length_feedback.hpp), with the
+// block's own search (fixed-step tails) or the retry's beam; robust blocks
+// keep the codes that suit both decoders.
+void FiberEncoder::Encoding::keep_lengths() {
+    const float stretch = enc.length_stretch_;
+    if (!(stretch > 0)) return;
+    const SearchParams params{search().beam_width, search().radius};
+    if (enc.length_tails_only_ && !wide) {
+        const Codebook8 cb = codebook8();
+        s.retry_codes8.resize(ppb);
         feed_back_length_tails(
-            std::span<const Vec3f>(targets), std::span<Vec3f>(points), ppb, kLengthFeedbackTail, kLengthFeedbackActShare,
-            [&](std::uint32_t blk) { return !(starts[blk].divergence > kRobustDivergence); },
+            std::span<const Vec3f>(s.targets), std::span<Vec3f>(s.points), ppb, kLengthFeedbackTail, kLengthFeedbackActShare,
+            [&](std::uint32_t blk) { return !robust(blk); },
             [&](std::uint32_t blk, std::size_t j0, std::span<const Vec3f> t, Vec3f* dec) {
                 // The decoder's state before code j0, replayed from the block's start.
                 const std::size_t i0 = std::size_t(blk) * ppb;
-                Frame f = frames[blk];
+                Frame f = s.frames[blk];
                 const std::uint8_t* codes = codes8_of(blk);
                 for (std::size_t k = 0; k < j0; ++k) f = compose(f, cb.frame(codes[k]));
-                const Vec3f p = points[i0 + 1 + j0];
-                if (search_.beam_width <= 1 && search_.lookahead > 0)
-                    LookaheadSearch<Codebook8>(cb, h.step, search_.lookahead).run(f, p, t, retry_codes8.data(), dec);
+                const Vec3f p = s.points[i0 + 1 + j0];
+                if (search().beam_width <= 1 && search().lookahead > 0)
+                    LookaheadSearch<Codebook8>(cb, h.step, search().lookahead).run(f, p, t, s.retry_codes8.data(), dec);
                 else
-                    search_codes(cb, params, f, p, h.step, t, retry_codes8.data(), dec);
+                    search_codes(cb, params, f, p, h.step, t, s.retry_codes8.data(), dec);
             },
             [&](std::uint32_t blk, std::size_t j0) {
-                std::copy_n(retry_codes8.begin(), block_points(blk) - 2 - j0, codes8_of(blk) + j0);
+                std::copy_n(s.retry_codes8.begin(), block_points(blk) - 2 - j0, codes8_of(blk) + j0);
             });
-    } else if (length_stretch_ > 0) {
-        const SearchParams feedback_params{std::max({8u, search_.beam_width, search_.retry_beam_width}), 1};
-        retry_codes8.resize(ppb);
-        retry_codes16.resize(ppb);
-        feed_back_length(
-            std::span<const Vec3f>(targets), std::span<Vec3f>(points), ppb, length_stretch_,
-            [&](std::uint32_t blk) { return wide || !(starts[blk].divergence > kRobustDivergence); },
-            [&](std::uint32_t blk, std::span<const Vec3f> t, Vec3f* dec) {
-                const std::size_t i0 = std::size_t(blk) * ppb;
-                if (wide) search_codes(Codebook16{*tables_->table16}, feedback_params, frames[blk], points[i0 + 1], h.step, t, retry_codes16.data(), dec);
-                else search_codes(Codebook8{*tables_->table8, *tables_->lut8}, feedback_params, frames[blk], points[i0 + 1], h.step, t, retry_codes8.data(), dec);
-            },
-            [&](std::uint32_t blk) {
-                const std::size_t i0 = std::size_t(blk) * ppb, m = block_points(blk) - 2;
-                if (wide) std::copy_n(retry_codes16.begin(), m, codes16.begin() + std::ptrdiff_t(i0));
-                else std::copy_n(retry_codes8.begin(), m, codes8_of(blk));
-            });
+        return;
     }
-
-    if (wide)
-        for (b = 0; b < n_blocks; ++b)
-            for (std::size_t k = 0; k + 2 < block_points(b); ++k)
-                put_le(&out[base + std::size_t(b) * bb + kBlock16DirectionsOffset + 2 * k], codes16[std::size_t(b) * ppb + k], 2);
-    if (decoded) {
-        decoded->reserve(decoded->size() + n_points);
-        for (std::size_t k = 0; k < n_points; ++k) decoded->push_back(h.to_world(points[k].x, points[k].y, points[k].z));
-    }
-    auto world = [&](Vec3d p) {
-        return Vec3f{float((p.x - 0.5) * double(h.scaling) - double(h.offset[0])),
-                     float((p.y - 0.5) * double(h.scaling) - double(h.offset[1])),
-                     float((p.z - 0.5) * double(h.scaling) - double(h.offset[2]))};
-    };
-    if (decoded_exact && wide) {
-        // The exact decode of every block: no bound on the walks' divergence
-        // is tight enough at 254 points to skip blocks (walk_divergence
-        // gives ~3 um where they differ by ~0.1 um).
-        thread_local std::vector<Vec3d> walked;
-        walked.resize(ppb);
-        decoded_exact->reserve(decoded_exact->size() + n_points);
-        for (b = 0; b < n_blocks; ++b) {
-            const BlockView16 blk{&out[base + std::size_t(b) * bb]};
-            const std::array<std::uint32_t, 3> q0{blk.anchor_word(0), blk.anchor_word(1), blk.anchor_word(2)};
-            const std::array<std::uint32_t, 3> q1{blk.anchor_word(3), blk.anchor_word(4), blk.anchor_word(5)};
-            auto anchor = [](const std::array<std::uint32_t, 3>& q) {
-                return Vec3d{double(q[0]) / kUnorm24Max, double(q[1]) / kUnorm24Max, double(q[2]) / kUnorm24Max};
-            };
-            const std::size_t i0 = std::size_t(b) * ppb, n = block_points(b), m = n > 2 ? n - 2 : 0;
-            decoded_exact->push_back(world(anchor(q0)));
-            if (n < 2) continue;
-            decoded_exact->push_back(world(anchor(q1)));
-            exact_walk(*tables_->exact16, exact_block_frame24(q0, q1), anchor(q1), double(h.step), codes16.data() + i0, m,
-                       walked.data());
-            for (std::size_t k = 0; k < m; ++k) decoded_exact->push_back(world(walked[k]));
-        }
-    }
-    if (decoded_exact && !wide) {
-        // The exact decode, block by block; a block whose float errors plus
-        // the bound on the two decoders' divergence stay below the fiber's
-        // largest float error cannot raise the max error: it gets the float
-        // points (most blocks), which keeps the cost of this pass small.
-        thread_local std::vector<Vec3d> walked;
-        walked.resize(ppb);
-        const double out_slack = 4 * 0x1p-24 * (1 + std::max({std::fabs(h.offset[0]), std::fabs(h.offset[1]), std::fabs(h.offset[2])}) / h.scaling);
-        auto block_error = [&](std::uint32_t blk) {
+    const SearchParams feedback_params{std::max({8u, search().beam_width, search().retry_beam_width}), 1};
+    s.retry_codes8.resize(ppb);
+    s.retry_codes16.resize(ppb);
+    feed_back_length(
+        std::span<const Vec3f>(s.targets), std::span<Vec3f>(s.points), ppb, stretch,
+        [&](std::uint32_t blk) { return wide || !robust(blk); },
+        [&](std::uint32_t blk, std::span<const Vec3f> t, Vec3f* dec) {
             const std::size_t i0 = std::size_t(blk) * ppb;
-            return std::sqrt(double(max_distance2(&points[i0], &targets[i0], block_points(blk))));
+            if (wide)
+                search_codes(Codebook16{*enc.tables_->table16}, feedback_params, s.frames[blk], s.points[i0 + 1], h.step, t,
+                             s.retry_codes16.data(), dec);
+            else
+                search_codes(codebook8(), feedback_params, s.frames[blk], s.points[i0 + 1], h.step, t,
+                             s.retry_codes8.data(), dec);
+        },
+        [&](std::uint32_t blk) {
+            const std::size_t i0 = std::size_t(blk) * ppb, m = block_points(blk) - 2;
+            if (wide) std::copy_n(s.retry_codes16.begin(), m, s.codes16.begin() + std::ptrdiff_t(i0));
+            else std::copy_n(s.retry_codes8.begin(), m, codes8_of(blk));
+        });
+}
+
+void FiberEncoder::Encoding::store_codes16() {
+    for (std::uint32_t b = 0; b < n_blocks; ++b)
+        for (std::size_t k = 0; k + 2 < block_points(b); ++k)
+            put_le(&out[base + std::size_t(b) * bb + kBlock16DirectionsOffset + 2 * k], s.codes16[std::size_t(b) * ppb + k], 2);
+}
+
+void FiberEncoder::Encoding::append_decoded(std::vector<Vec3f>& decoded) const {
+    decoded.reserve(decoded.size() + n_points);
+    for (std::size_t k = 0; k < n_points; ++k) decoded.push_back(h.to_world(s.points[k].x, s.points[k].y, s.points[k].z));
+}
+
+// The exact decode of every 16-bit block: no bound on the walks' divergence
+// is tight enough at 254 points to skip blocks (walk_divergence gives ~3 um
+// where they differ by ~0.1 um).
+void FiberEncoder::Encoding::append_exact16(std::vector<Vec3f>& decoded_exact) {
+    s.walked.resize(ppb);
+    decoded_exact.reserve(decoded_exact.size() + n_points);
+    for (std::uint32_t b = 0; b < n_blocks; ++b) {
+        const BlockView16 blk{&out[base + std::size_t(b) * bb]};
+        const std::array<std::uint32_t, 3> q0{blk.anchor_word(0), blk.anchor_word(1), blk.anchor_word(2)};
+        const std::array<std::uint32_t, 3> q1{blk.anchor_word(3), blk.anchor_word(4), blk.anchor_word(5)};
+        auto anchor = [](const std::array<std::uint32_t, 3>& q) {
+            return Vec3d{double(q[0]) / kUnorm24Max, double(q[1]) / kUnorm24Max, double(q[2]) / kUnorm24Max};
         };
-        double fiber_max = 0;
-        for (b = 0; b < n_blocks; ++b) fiber_max = std::max(fiber_max, block_error(b));
-        decoded_exact->reserve(decoded_exact->size() + n_points);
-        for (b = 0; b < n_blocks; ++b) {
-            const DecoderStarts& e = starts[b];
-            const std::size_t i0 = std::size_t(b) * ppb, n = block_points(b), m = n > 2 ? n - 2 : 0;
-            const double bound = e.divergence + walk_divergence(m, double(h.step)) + out_slack;
-            if (block_error(b) + bound <= fiber_max) {
-                for (std::size_t k = 0; k < n; ++k) decoded_exact->push_back(h.to_world(points[i0 + k].x, points[i0 + k].y, points[i0 + k].z));
-                continue;
-            }
-            exact_walk(*tables_->exact8, e.exact_frame, e.exact1, double(h.step), codes8_of(b), m, walked.data());
-            decoded_exact->push_back(world(e.exact0));
-            if (n >= 2) decoded_exact->push_back(world(e.exact1));
-            for (std::size_t k = 0; k < m; ++k) decoded_exact->push_back(world(walked[k]));
-        }
+        const std::size_t i0 = std::size_t(b) * ppb, n = block_points(b), m = n > 2 ? n - 2 : 0;
+        decoded_exact.push_back(world(anchor(q0)));
+        if (n < 2) continue;
+        decoded_exact.push_back(world(anchor(q1)));
+        exact_walk(*enc.tables_->exact16, exact_block_frame24(q0, q1), anchor(q1), double(h.step), s.codes16.data() + i0,
+                   m, s.walked.data());
+        for (std::size_t k = 0; k < m; ++k) decoded_exact.push_back(world(s.walked[k]));
     }
+}
+
+// The exact decode of 8-bit blocks; a block whose float errors plus the
+// bound on the two decoders' divergence stay below the fiber's largest
+// float error cannot raise the max error: it gets the float points (most
+// blocks), which keeps the cost of this pass small.
+void FiberEncoder::Encoding::append_exact8(std::vector<Vec3f>& decoded_exact) {
+    s.walked.resize(ppb);
+    const double out_slack =
+        4 * 0x1p-24 * (1 + std::max({std::fabs(h.offset[0]), std::fabs(h.offset[1]), std::fabs(h.offset[2])}) / h.scaling);
+    auto block_error = [&](std::uint32_t blk) {
+        const std::size_t i0 = std::size_t(blk) * ppb;
+        return std::sqrt(double(max_distance2(&s.points[i0], &s.targets[i0], block_points(blk))));
+    };
+    double fiber_max = 0;
+    for (std::uint32_t b = 0; b < n_blocks; ++b) fiber_max = std::max(fiber_max, block_error(b));
+    decoded_exact.reserve(decoded_exact.size() + n_points);
+    for (std::uint32_t b = 0; b < n_blocks; ++b) {
+        const DecoderStarts& e = s.starts[b];
+        const std::size_t i0 = std::size_t(b) * ppb, n = block_points(b), m = n > 2 ? n - 2 : 0;
+        const double bound = e.divergence + walk_divergence(m, double(h.step)) + out_slack;
+        if (block_error(b) + bound <= fiber_max) {
+            for (std::size_t k = 0; k < n; ++k)
+                decoded_exact.push_back(h.to_world(s.points[i0 + k].x, s.points[i0 + k].y, s.points[i0 + k].z));
+            continue;
+        }
+        exact_walk(*enc.tables_->exact8, e.exact_frame, e.exact1, double(h.step), codes8_of(b), m, s.walked.data());
+        decoded_exact.push_back(world(e.exact0));
+        if (n >= 2) decoded_exact.push_back(world(e.exact1));
+        for (std::size_t k = 0; k < m; ++k) decoded_exact.push_back(world(s.walked[k]));
+    }
+}
+
+// The passes over one fiber, in order (each one's comment says what it does).
+void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, std::vector<std::uint8_t>& out,
+                          std::vector<Vec3f>* decoded, std::vector<Vec3f>* decoded_exact) const {
+    if (block_count(fiber.size()) > 0xffff)
+        throw Error(Errc::unsupported, "fiber " + std::to_string(fiber_id) + " has " + std::to_string(fiber.size()) +
+                                           " points: more than 65535 blocks");
+    thread_local Encoding::Scratch scratch;
+    Encoding e(*this, fiber, fiber_id, out, scratch);
+    e.write_block_heads();
+    e.search_blocks();
+    e.retry_worst_blocks();
+    if (!e.wide) e.search_robust_blocks();
+    e.keep_lengths();
+    if (e.wide) e.store_codes16();
+    if (decoded) e.append_decoded(*decoded);
+    if (decoded_exact) e.wide ? e.append_exact16(*decoded_exact) : e.append_exact8(*decoded_exact);
 }
 
 }  // namespace fiblet
