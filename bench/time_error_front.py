@@ -76,11 +76,12 @@ class Encoder:
 
 
 def encoders(args, work):
-    fiblet = [args.fiblet, "compress", "-q", "-f", "-j", "1"]
+    fiblet = [args.fiblet, "compress", "-q", "-f"]
     out = []
 
     def f(name, extra, group, effort=None, ext="fft"):
-        out.append(Encoder(name, "fiblet", lambda i, o, e=extra: fiblet + e + [i, "-o", o], ext, group, effort))
+        threads = [] if "-j" in extra else ["-j", "1"]
+        out.append(Encoder(name, "fiblet", lambda i, o, e=threads + extra: fiblet + e + [i, "-o", o], ext, group, effort))
 
     f("fiblet default", [], "fiblet default")
     for e in range(args.max_effort + 1):
@@ -88,6 +89,14 @@ def encoders(args, work):
     for e in (0, 1):
         f(f"fiblet --bits 16 --effort {e}", ["--bits", "16", "--effort", str(e)], "fiblet 16-bit", e)
     f("fiblet --zstd", ["--zstd"], "fiblet --zstd", ext="fftz")
+    f("fiblet -j 2", ["-j", "2"], "fiblet 2 threads")
+    if args.baseline:  # an earlier build: before and after in the same run
+        before = [args.baseline, "compress", "-q", "-f", "-j", "1"]
+        label = args.baseline_label or "before"
+        out.append(Encoder(f"fiblet default ({label})", "fiblet", lambda i, o: before + [i, "-o", o], "fft",
+                           f"fiblet {label}"))
+        out.append(Encoder(f"fiblet --effort 0 --bits 8 ({label})", "fiblet",
+                           lambda i, o: before + ["--effort", "0", "--bits", "8", i, "-o", o], "fft", f"fiblet {label}"))
     official = os.environ.get("FIBLET_OFFICIAL_ENCODER")
     if official:
         out.append(Encoder("official Fiblets", "official", lambda i, o: [official, i, o], "fft", "official"))
@@ -108,7 +117,9 @@ def encoders(args, work):
 
 
 def run_timed(cmd, core):
-    full = ["taskset", "-c", str(core)] + cmd if shutil.which("taskset") else cmd
+    # Pinned to one core; "-j 2" runs get the core and the next one.
+    cores = f"{core},{(core + 1) % os.cpu_count()}" if "-j" in cmd and cmd[cmd.index("-j") + 1] == "2" else str(core)
+    full = ["taskset", "-c", cores] + cmd if shutil.which("taskset") else cmd
     t0 = time.perf_counter()
     r = subprocess.run(full, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     dt = time.perf_counter() - t0
@@ -146,6 +157,8 @@ def main():
     p.add_argument("--max-effort", type=int, default=3)
     p.add_argument("--out", required=True)
     p.add_argument("--command", default="", help="the command line recorded beside the figures")
+    p.add_argument("--baseline", help="an earlier fiblet binary, measured in the same run")
+    p.add_argument("--baseline-label", help="its name in the table (e.g. a commit)")
     args = p.parse_args()
     os.makedirs(args.out, exist_ok=True)
     points = int(np.count_nonzero(~read_tck(args.tck)[1]))
@@ -154,9 +167,10 @@ def main():
     try:
         encs, skipped = encoders(args, work)
         outputs = {e.name: os.path.join(work, re.sub(r"[^a-z0-9]+", "-", e.name.lower()) + "." + e.ext) for e in encs}
-        # A warm-up round, not counted: the input in the page cache, the programs loaded.
-        for e in encs:
-            run_timed(e.command(args.tck, outputs[e.name]), args.core)
+        # The input in the page cache before the first round.
+        with open(args.tck, "rb") as f:
+            while f.read(1 << 24):
+                pass
         for r in range(args.rounds):
             for e in encs:
                 e.seconds.append(run_timed(e.command(args.tck, outputs[e.name]), args.core))
@@ -209,8 +223,9 @@ def plot(result, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    rows = [r for r in result["rows"] if r["group"] != "cp"]
+    rows = [r for r in result["rows"] if r["group"] not in ("cp", "fiblet 2 threads")]
     colours = {"fiblet 8-bit": "tab:blue", "fiblet default": "tab:red", "fiblet 16-bit": "tab:cyan",
+               "fiblet 2 threads": "tab:pink", "fiblet before": "tab:olive",
                "fiblet --zstd": "tab:purple", "official": "tab:orange", "QFib": "tab:green", "zstd": "tab:gray"}
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
     for ax, key, title in ((axes[0], "max_um_f64", "max error"), (axes[1], "mean_um_f64", "mean error")):

@@ -3,9 +3,9 @@
 # ratio, max/mean error (µm, measured by `fiblet stats` against the input),
 # the symmetric metrics (Hausdorff, endpoint displacement, length change),
 # compress and decompress wall time. The direction bits are the default's
-# choice per file (`--bits auto`: 16 where 8-bit codes would change the
-# fibers' lengths beyond their point error; "16-bit" after the ratio);
-# `scripts/core_table.sh --bits 8` measures the 8-bit codec on every file.
+# (8); `scripts/core_table.sh --bits auto` lets the data choose per file (16
+# where 8-bit codes would change the fibers' lengths beyond their point
+# error; "16-bit" after the ratio).
 # Usage: scripts/core_table.sh [fiblet args...]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"

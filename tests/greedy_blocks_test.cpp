@@ -15,6 +15,8 @@
 #include "core/vec_math.hpp"
 #include "fiblet/encode.hpp"
 #include "fiblet/error.hpp"
+#include "cli_runner.hpp"
+#include "fiblet/compress.hpp"
 #include "test_util.hpp"
 
 using namespace fiblet;
@@ -296,4 +298,34 @@ TEST(GreedyBlocks, EdgeCasesMatchTheScalarSearchAtEveryLevel) {
         return p + float(k + 1) * 1e-38f * Vec3f{1.0f, u(rng), u(rng)};
     });
     for (float step : {1e-38f, 1e-44f}) expect_same_at_every_level(cb, step, near, "tiny");
+}
+
+// compress says which level its search ran at (--json "simd"), writes the
+// same bytes at every level, and refuses an unknown FIBLET_SIMD before any work.
+TEST(GreedyBlocks, CompressReportsItsLevelAndTheSameBytesAtEach) {
+    test::TempDir dir;
+    const std::string tck = test::shared_data("small-ifod1.tck");
+    if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
+    CompressOptions o;
+    o.overwrite = true;
+    o.search = search_for_effort(0);
+    o.threads = 1;
+    std::string first;
+    for (const SimdLevel level : detail::supported_simd_levels()) {
+        SCOPED_TRACE(detail::simd_level_name(level));
+        CompressReport r;
+        {
+            const ForcedLevel forced(level);
+            r = compress_tck(tck, dir.file("x.fft"), o);
+        }
+        EXPECT_EQ(r.simd, detail::simd_level_name(level));
+        const std::string bytes = test::read_file(dir.file("x.fft"));
+        if (first.empty()) first = bytes;
+        EXPECT_TRUE(bytes == first);
+    }
+    const auto json = test::run_cli("compress -q -f --json " + tck + " -o " + dir.file("y.fft"), "FIBLET_SIMD=scalar");
+    EXPECT_NE(json.output.find("\"simd\": \"scalar\""), std::string::npos) << json.output;
+    const auto bad = test::run_cli("compress -q -f " + tck + " -o " + dir.file("z.fft"), "FIBLET_SIMD=bogus");
+    EXPECT_EQ(bad.status, 2) << bad.output;
+    EXPECT_NE(bad.output.find("FIBLET_SIMD=bogus"), std::string::npos) << bad.output;
 }

@@ -60,7 +60,7 @@ std::string report_json(const std::string& in, const std::string& out, const Com
             .num("mean_error_vs_original_um", r.error_vs_original.mean_mm() * 1e3);
     j.raw("geometry", geometry_json(r.geometry));
     if (a_max_error) j.boolean("within_bound", metrics_above(r.error, r.geometry, *a_max_error).empty());
-    j.num("seconds", r.seconds);
+    j.num("seconds", r.seconds).str("simd", r.simd);
     const CompressTimings& t = r.timings;
     Json timings;
     timings.num("read", t.read).num("scan", t.scan).num("tune", t.tune).num("encode", t.encode);

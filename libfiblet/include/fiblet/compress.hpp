@@ -97,6 +97,7 @@ struct CompressReport {
     std::uint64_t input_bytes = 0, output_bytes = 0;
     double seconds = 0;
     CompressTimings timings;
+    std::string simd;  // the code search's SIMD level: avx512, avx2, sse4 or scalar (FIBLET_SIMD forces one)
 };
 
 // Compresses `tck_path` (a .tck, .trk or TRX: open_streamline_source) into

@@ -19,6 +19,7 @@
 
 #include "codec/compress_stages.hpp"
 #include "codec/direction_bits.hpp"
+#include "codec/greedy_blocks.hpp"
 #include "codec/fiber_end_encoder.hpp"
 #include "codec/parameters.hpp"
 #include "core/streamline_label.hpp"
@@ -201,8 +202,9 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     if (options.step_mm && !(std::isfinite(*options.step_mm) && *options.step_mm > 0))
         throw Error(Errc::invalid_argument, "the step must be a positive number of millimetres");
     const unsigned threads = detail::resolve_threads(options.threads);  // checked before any work
-
     CompressReport report;
+    report.simd = detail::simd_level_name(detail::simd_level());  // a bad FIBLET_SIMD: refused before any work
+
     TckScan& scan = report.scan;
     // The longest streamline a file can hold bounds the one in memory too
     // (either layout's while the bits are still to choose).

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Compress run time against error (bench/time_error_front.py): fiblet at
+# every effort, 8 and 16 bits, --zstd, 2 threads, and the peers, in one
+# interleaved run on one pinned core; writes bench/front.png (the README's
+# picture), bench/results-front.md, and the last section of bench/results.md.
+# Makes the medium tractogram if missing (shared/data/make-tractograms.sh).
+#   scripts/bench_front.sh [TCK] [time_error_front.py options: --rounds N --max-effort E --baseline OLD_FIBLET]
+# Peers (built out of tree, never part of fiblet; skipped with a note when unset):
+#   FIBLET_OFFICIAL_ENCODER  the official Fiblets encoder (ENC IN.tck OUT.fft)
+#   FIBLET_QFIB              QFib's qfib program
+# Environment: FIBLET_BUILD_DIR (default build/), OUT (default bench/).
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+build="${FIBLET_BUILD_DIR:-$root/build}"
+out="${OUT:-$root/bench}"
+data="${FIBLET_BENCH_DATA:-$build/bench-data}"
+tck="$data/medium-ifod1.tck"
+if [ $# -gt 0 ] && [ "${1#--}" = "$1" ]; then tck="$1"; shift; fi
+if [ ! -f "$tck" ]; then
+  mkdir -p "$data"
+  "$root/../shared/data/make-tractograms.sh" -o "$data" medium
+fi
+cmake --build "$build" --target fiblet_cli fiblet_exact_error >/dev/null
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+/usr/bin/python3 "$root/bench/time_error_front.py" --tck "$tck" --fiblet "$build/bin/fiblet" \
+  --exact-error "$build/tests/fiblet_exact_error" --out "$work" --command "scripts/bench_front.sh $*" "$@"
+cp "$work/front.png" "$out/front.png"
+{
+  echo "## Compress time against error (scripts/bench_front.sh)"
+  echo
+  echo "Commit $(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo '?'); picture: [front.png](front.png); what each column measures: bench/time_error_front.py."
+  echo
+  cat "$work/front.md"
+} >"$out/results-front.md"
+cp "$work/front.json" "$out/results-front.json"
+if [ -f "$out/results.md" ]; then
+  # The section is replaced in place (the sections after it are kept).
+  /usr/bin/python3 - "$out/results.md" "$out/results-front.md" <<'EOF'
+import re, sys
+doc, section = open(sys.argv[1]).read(), open(sys.argv[2]).read()
+head = "## Compress time against error (scripts/bench_front.sh)"
+if head in doc:
+    start = doc.index(head)
+    nxt = doc.find("\n## ", start + len(head))
+    doc = doc[:start] + section + ("\n" + doc[nxt + 1:] if nxt >= 0 else "")
+else:
+    doc = doc.rstrip("\n") + "\n\n" + section
+open(sys.argv[1], "w").write(doc)
+EOF
+fi
