@@ -149,9 +149,10 @@ def measure_error(enc, output, args, work):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--tck", required=True)
-    p.add_argument("--fiblet", required=True)
-    p.add_argument("--exact-error", required=True, help="build/tests/fiblet_exact_error")
+    p.add_argument("--tck", help="the tractogram (required unless --replot)")
+    p.add_argument("--replot", help="draw front.png and front.md again from a front.json")
+    p.add_argument("--fiblet")
+    p.add_argument("--exact-error", help="build/tests/fiblet_exact_error")
     p.add_argument("--rounds", type=int, default=5)
     p.add_argument("--core", type=int, default=1, help="the core every encoder is pinned to")
     p.add_argument("--max-effort", type=int, default=3)
@@ -161,6 +162,15 @@ def main():
     p.add_argument("--baseline-label", help="its name in the table (e.g. a commit)")
     args = p.parse_args()
     os.makedirs(args.out, exist_ok=True)
+    if args.replot:
+        with open(args.replot) as f:
+            result = json.load(f)
+        cp = next((r["seconds"] for r in result["rows"] if r["encoder"] == "cp"), None)
+        write_markdown(result, cp, os.path.join(args.out, "front.md"))
+        plot(result, os.path.join(args.out, "front.png"))
+        return
+    if not (args.tck and args.fiblet and args.exact_error):
+        p.error("--tck, --fiblet and --exact-error are required")
     points = int(np.count_nonzero(~read_tck(args.tck)[1]))
     in_bytes = os.path.getsize(args.tck)
     work = tempfile.mkdtemp(prefix="fiblet-front-")
@@ -239,8 +249,10 @@ def plot(result, path):
             g = [r for r in rows if r["group"] == group]
             xs = [r["mpoints_per_s"] for r in g]
             ys = [r[key] for r in g]
-            ax.scatter(xs, ys, s=[12 * r["ratio"] for r in g], color=colours.get(group, "k"), label=group, alpha=0.8,
-                       edgecolors="k", linewidths=0.5)
+            default = group == "fiblet default"  # drawn on top: it is one of the efforts too
+            ax.scatter(xs, ys, s=[(30 if default else 12) * r["ratio"] for r in g], color=colours.get(group, "k"),
+                       label=group, alpha=0.9, edgecolors="k", linewidths=0.5, marker="*" if default else "o",
+                       zorder=3 if default else 2)
             if len(g) > 1:
                 ax.plot(xs, ys, color=colours.get(group, "k"), linewidth=1)
             for r in g:

@@ -107,12 +107,12 @@ std::string bits_reason(const DirectionBitsChoice& c, unsigned bits, bool wide_b
     if (wide_blocks_asked)
         return "16 bits: blocks of " + std::to_string(points_per_block) + " points are beyond 8-bit blocks' " +
                std::to_string(kMaxPointsPerBlock);
-    if (c.sample_fibers == 0) return bits == 16 ? "16 bits as asked" : c.automatic ? "8 bits: no fiber to measure" : "8 bits as asked";
+    if (c.sample_fibers == 0) return bits == 16 ? "16 bits" : c.automatic ? "8 bits: no fiber to measure" : "8 bits";
     const std::string measured = "lengths by up to " + micrometres_g(c.length_change_max_mm) + " for a point error of " +
                                  micrometres_g(c.point_error_max_mm) + " (sample of " + std::to_string(c.sample_fibers) +
                                  " fibers)";
     if (bits == 16) return "16 bits: 8-bit codes would change " + measured;
-    return std::string(c.automatic ? "8 bits: " : "8 bits as asked: ") + "8-bit codes change " + measured;
+    return "8 bits: 8-bit codes change " + measured;
 }
 
 // The step: the mean over segments for fixed-step data; for variable
