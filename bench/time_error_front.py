@@ -28,6 +28,9 @@ import time
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from make_results import machine  # noqa: E402  (the CPU, its SIMD and the load, as bench/results.md words it)
+
 
 def read_tck(path):
     """The points of a float32 little-endian .tck, and where each streamline ends."""
@@ -55,18 +58,6 @@ def pointwise_error(decoded_tck, input_tck):
     keep = ~sa
     d = np.sqrt(((a[keep].astype(np.float64) - b[keep].astype(np.float64)) ** 2).sum(axis=1))
     return float(d.max()), float(d.mean())
-
-
-def machine():
-    cpu, flags = "unknown CPU", set()
-    with open("/proc/cpuinfo") as f:
-        for line in f:
-            if line.startswith("model name") and cpu == "unknown CPU":
-                cpu = line.split(":", 1)[1].strip()
-            if line.startswith("flags"):
-                flags = set(line.split(":", 1)[1].split())
-    simd = "AVX-512" if "avx512bw" in flags else "AVX2" if "avx2" in flags else "SSE only"
-    return f"{cpu}, {os.cpu_count()} cores, {simd}"
 
 
 class Encoder:

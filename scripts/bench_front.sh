@@ -8,18 +8,10 @@
 # Peers (built out of tree, never part of fiblet; skipped with a note when unset):
 #   FIBLET_OFFICIAL_ENCODER  the official Fiblets encoder (ENC IN.tck OUT.fft)
 #   FIBLET_QFIB              QFib's qfib program
-# Environment: FIBLET_BUILD_DIR (default build/), OUT (default bench/).
+# Environment: scripts/bench_env.sh.
 set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
-build="${FIBLET_BUILD_DIR:-$root/build}"
-out="${OUT:-$root/bench}"
-data="${FIBLET_BENCH_DATA:-$build/bench-data}"
-tck="$data/medium-ifod1.tck"
-if [ $# -gt 0 ] && [ "${1#--}" = "$1" ]; then tck="$1"; shift; fi
-if [ ! -f "$tck" ]; then
-  mkdir -p "$data"
-  "$root/../shared/data/make-tractograms.sh" -o "$data" medium
-fi
+source "$(dirname "$0")/bench_env.sh"
+if [ $# -gt 0 ] && [ "${1#--}" = "$1" ]; then tck="$1"; shift; else tck="$(medium_tractogram)"; fi
 cmake --build "$build" --target fiblet_cli fiblet_exact_error >/dev/null
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT

@@ -5,18 +5,10 @@
 # Makes the medium tractogram if missing (shared/data/make-tractograms.sh,
 # about 80 s on a quiet machine).
 #   scripts/bench_pipeline.sh [TCK] [pipeline_table.py options: --repeat N --json OUT --skip-select]
-# Environment: FIBLET_BUILD_DIR (default build/), OUT (default bench/).
+# Environment: scripts/bench_env.sh.
 set -euo pipefail
-root="$(cd "$(dirname "$0")/.." && pwd)"
-build="${FIBLET_BUILD_DIR:-$root/build}"
-out="${OUT:-$root/bench}"
-data="${FIBLET_BENCH_DATA:-$build/bench-data}"
-tck="$data/medium-ifod1.tck"
-if [ $# -gt 0 ] && [ "${1#--}" = "$1" ]; then tck="$1"; shift; fi
-if [ ! -f "$tck" ]; then
-  mkdir -p "$data"
-  "$root/../shared/data/make-tractograms.sh" -o "$data" medium
-fi
+source "$(dirname "$0")/bench_env.sh"
+if [ $# -gt 0 ] && [ "${1#--}" = "$1" ]; then tck="$1"; shift; else tck="$(medium_tractogram)"; fi
 cmake --build "$build" --target fiblet_cli fiblet_bench_table fiblet_bench >/dev/null
 cmake --build "$build" --target fiblet_python >/dev/null 2>&1 || echo "bench_pipeline: no Python module target" >&2
 table="$(mktemp)"
