@@ -90,12 +90,20 @@ void inverses_and_roots(double* len, double* inv, std::size_t n) {
     sqrt_all(len, n);
 }
 
+#ifdef FIBLET_GEOMETRY_AVX2
+std::size_t segment_columns_avx2(std::span<const Vec3f> line, std::size_t n, Segments& out);
+#endif
+
 void segments_of(std::span<const Vec3f> line, Segments& out) {
     const std::size_t n = line.size() > 1 ? line.size() - 1 : 1;  // a single point: one degenerate segment
     double *ax = at_least(out.ax, n + kLanes), *ay = at_least(out.ay, n + kLanes), *az = at_least(out.az, n + kLanes);
     double *ux = at_least(out.ux, n + kLanes), *uy = at_least(out.uy, n + kLanes), *uz = at_least(out.uz, n + kLanes);
     double *inv = at_least(out.inv_uu, n + kLanes), *len = at_least(out.len, n);
-    for (std::size_t s = 0; s < n; ++s) {
+    std::size_t s = 0;
+#ifdef FIBLET_GEOMETRY_AVX2
+    if (have_avx2()) s = segment_columns_avx2(line, n, out);
+#endif
+    for (; s < n; ++s) {
         const Vec3f a = line[s], b = line[std::min(s + 1, line.size() - 1)];
         const double dx = double(b.x) - a.x, dy = double(b.y) - a.y, dz = double(b.z) - a.z;
         ax[s] = a.x, ay[s] = a.y, az[s] = a.z;
@@ -162,8 +170,9 @@ __attribute__((target("avx2"))) inline void window_avx2(const Segments& g, doubl
 // over the fiber that the compiler vectorizes (the same double operations
 // as dist2 below, no fused multiply-add: -ffp-contract=off).
 struct OwnSegments {
-    std::vector<double> before, after;  // squared distances to segments k - 1 and k (+inf where none)
-    std::vector<std::uint8_t> proven;   // one of them is the window's nearest
+    std::vector<double> nearest;        // squared distance to the nearer of segments k - 1 and k (the first on a tie)
+    std::vector<std::uint8_t> later;    // 1 where that is segment k
+    std::vector<std::uint8_t> proven;   // it is the window's nearest
 };
 
 // Squared distance of p to segment s (its start when it has no length): the
@@ -185,17 +194,19 @@ void own_segments_at(const Segments& g, std::span<const Vec3f> from, std::span<c
     const double ex = double(p.x) - to[k].x, ey = double(p.y) - to[k].y, ez = double(p.z) - to[k].z;
     const double e4 = 4 * (ex * ex + ey * ey + ez * ez);
     bool proven = true;
-    out.before[k] = out.after[k] = std::numeric_limits<double>::infinity();
+    double before = std::numeric_limits<double>::infinity(), after = before;
     if (k > 0) {  // segment k - 1 and the three before it
-        out.before[k] = segment_dist2(g, p.x, p.y, p.z, k - 1);
+        before = segment_dist2(g, p.x, p.y, p.z, k - 1);
         proven = proven && e4 < 0.98 * g.len[k - 1] * g.len[k - 1];
         for (std::size_t j = k >= 4 ? k - 4 : 0; j + 1 < k; ++j) proven = proven && dot(j, k - 1) >= 0;
     }
     if (k < n) {  // segment k and the three after it (the padding's direction is 0)
-        out.after[k] = segment_dist2(g, p.x, p.y, p.z, k);
+        after = segment_dist2(g, p.x, p.y, p.z, k);
         proven = proven && e4 < 0.98 * g.len[k] * g.len[k];
         for (std::size_t j = k + 1; j <= k + 3; ++j) proven = proven && dot(j, k) >= 0;
     }
+    out.later[k] = after < before;
+    out.nearest[k] = after < before ? after : before;
     out.proven[k] = proven;
 }
 
@@ -228,6 +239,24 @@ FIBLET_AVX2 __m256d coordinate(std::span<const Vec3f> v, std::size_t k, int c) {
     return _mm256_cvtps_pd(_mm_i32gather_ps(&v[k].x + c, _mm_setr_epi32(0, 3, 6, 9), 4));
 }
 
+// segments_of's columns for segments [0, s) four at a time (the same
+// double operations); returns s, the segments left to the scalar loop.
+__attribute__((target("avx2"))) std::size_t segment_columns_avx2(std::span<const Vec3f> line, std::size_t n,
+                                                                 Segments& out) {
+    std::size_t s = 0;
+    for (; s + 4 <= n && s + 4 < line.size(); s += 4) {
+        for (int c = 0; c < 3; ++c) {
+            const __m256d a = coordinate(line, s, c), d = _mm256_sub_pd(coordinate(line, s + 1, c), a);
+            _mm256_storeu_pd((c == 0 ? out.ax : c == 1 ? out.ay : out.az).data() + s, a);
+            _mm256_storeu_pd((c == 0 ? out.ux : c == 1 ? out.uy : out.uz).data() + s, d);
+        }
+        const __m256d dx = column(out.ux, s), dy = column(out.uy, s), dz = column(out.uz, s);
+        _mm256_storeu_pd(out.len.data() + s, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)),
+                                                           _mm256_mul_pd(dz, dz)));
+    }
+    return s;
+}
+
 // e4 < 0.98 len^2 for lengths len .. len + 3.
 FIBLET_AVX2 __m256d within_half_step(__m256d e4, const Segments& g, std::size_t s) {
     const __m256d len = column(g.len, s);
@@ -247,13 +276,15 @@ __attribute__((target("avx2"))) void own_segments_avx2(const Segments& g, std::s
         const __m256d e4 = _mm256_mul_pd(
             _mm256_set1_pd(4.0),
             _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(ex, ex), _mm256_mul_pd(ey, ey)), _mm256_mul_pd(ez, ez)));
-        _mm256_storeu_pd(&out.before[k], segment_dist2_avx2(g, x, y, z, k - 1));
-        _mm256_storeu_pd(&out.after[k], segment_dist2_avx2(g, x, y, z, k));
+        const __m256d before = segment_dist2_avx2(g, x, y, z, k - 1), after = segment_dist2_avx2(g, x, y, z, k);
+        const __m256d later = _mm256_cmp_pd(after, before, _CMP_LT_OQ);
+        _mm256_storeu_pd(&out.nearest[k], _mm256_blendv_pd(before, after, later));  // after < before ? after : before
+        const int later_mask = _mm256_movemask_pd(later);
         __m256d ok = _mm256_and_pd(within_half_step(e4, g, k - 1), within_half_step(e4, g, k));
         for (std::size_t d = 1; d <= 3; ++d)
             ok = _mm256_and_pd(ok, _mm256_and_pd(not_against(g, k + d, k), not_against(g, k - 1 - d, k - 1)));
         const int mask = _mm256_movemask_pd(ok);
-        for (int i = 0; i < 4; ++i) out.proven[k + i] = (mask >> i) & 1;
+        for (int i = 0; i < 4; ++i) out.proven[k + i] = (mask >> i) & 1, out.later[k + i] = (later_mask >> i) & 1;
     }
     for (; k < k1; ++k) own_segments_at(g, from, to, k, out);
 }
@@ -263,7 +294,7 @@ __attribute__((target("avx2"))) void own_segments_avx2(const Segments& g, std::s
 // own_segments_at for every point of a fixed-step pair.
 void own_segments(const Segments& g, std::span<const Vec3f> from, std::span<const Vec3f> to, OwnSegments& out) {
     const std::size_t n = g.count, points = n + 1;  // to.size() == from.size() == n + 1
-    at_least(out.before, points), at_least(out.after, points), at_least(out.proven, points);
+    at_least(out.nearest, points), at_least(out.later, points), at_least(out.proven, points);
     std::size_t k = 0;
 #ifdef FIBLET_GEOMETRY_AVX2
     // The vector loop reads segments k - 5 .. k + 6 and lengths to k + 3.
@@ -316,20 +347,21 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
     alignas(32) double lanes[kLanes];
     thread_local OwnSegments own;
     if (same_count) own_segments(g, from, to, own);
+    const std::uint8_t *proven = own.proven.data(), *later = own.later.data();
+    const double* own_nearest = own.nearest.data();
     thread_local std::vector<double> nearest_buffer;  // squared distances, then distances
     double* const nearest = at_least(nearest_buffer, from.size());
     for (std::size_t k = 0; k < from.size(); ++k) {
+        if (same_count && proven[k] && hint <= k && hint + 2 >= k) {
+            // The window's nearest is k - 1 or k (the first on a tie, as below).
+            hint = k - 1 + later[k];
+            nearest[k] = own_nearest[k];
+            continue;
+        }
         const Vec3f& p = from[k];
         const std::size_t lo = hint > 2 ? hint - 2 : 0, hi = std::min(n, hint + ahead + 1), w = hi - lo;
         const double px = p.x, py = p.y, pz = p.z;
         double best = std::numeric_limits<double>::infinity();
-        if (same_count && hint <= k && hint + 2 >= k && own.proven[k]) {
-            // The window's nearest is k - 1 or k (the first on a tie, as below).
-            const double before = own.before[k], after = own.after[k];
-            hint = after < before ? k : k - 1;
-            nearest[k] = after < before ? after : before;
-            continue;
-        }
 #ifdef FIBLET_GEOMETRY_AVX2
         if (paired) {
             const std::size_t base = k >= 4 ? k - 4 : 0;
