@@ -14,8 +14,8 @@
 // thread the OS schedules late only takes fewer tasks. Memory is bounded: two batches of
 // input (~3 MB each) and their blocks.
 #include <cmath>
-#include <optional>
 #include <cstring>
+#include <optional>
 #include <utility>
 #ifdef __SSE2__
 #include <emmintrin.h>
