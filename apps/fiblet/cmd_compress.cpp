@@ -61,10 +61,8 @@ std::string report_json(const std::string& in, const std::string& out, const Com
     j.raw("geometry", geometry_json(r.geometry));
     if (a_max_error) j.boolean("within_bound", metrics_above(r.error, r.geometry, *a_max_error).empty());
     j.num("seconds", r.seconds).str("simd", r.simd);
-    const CompressTimings& t = r.timings;
     Json timings;
-    timings.num("read", t.read).num("scan", t.scan).num("tune", t.tune).num("encode", t.encode);
-    timings.num("metrics", t.metrics).num("index", t.index).num("write", t.write);
+    for (const auto& [stage, seconds] : r.timings.stages()) timings.num(stage, seconds);
     j.raw("timings", timings.render());
     return j.render();
 }

@@ -6,6 +6,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "fiblet/encode.hpp"
 #include "fiblet/error_stats.hpp"
@@ -80,7 +81,22 @@ struct CompressTimings {
     double metrics = 0;  // the header's error and the symmetric report
     double index = 0;    // the block index (BIDX chunk)
     double write = 0;    // blocks, checksums, trailer, committing the file
-    double total() const { return read + scan + tune + encode + metrics + index + write; }
+
+    // Each stage by name, in pipeline order (what --json and Python print).
+    std::array<std::pair<const char*, double>, 7> stages() const {
+        return {{{"read", read}, {"scan", scan}, {"tune", tune}, {"encode", encode}, {"metrics", metrics},
+                 {"index", index}, {"write", write}}};
+    }
+    double total() const {
+        double sum = 0;
+        for (const auto& [name, seconds] : stages()) sum += seconds;
+        return sum;
+    }
+    CompressTimings& operator+=(const CompressTimings& o) {
+        read += o.read, scan += o.scan, tune += o.tune, encode += o.encode;
+        metrics += o.metrics, index += o.index, write += o.write;
+        return *this;
+    }
 };
 
 struct CompressReport {

@@ -19,8 +19,8 @@
 
 #include "codec/compress_stages.hpp"
 #include "codec/direction_bits.hpp"
-#include "codec/greedy_blocks.hpp"
 #include "codec/fiber_end_encoder.hpp"
+#include "codec/greedy_blocks.hpp"
 #include "codec/parameters.hpp"
 #include "core/streamline_label.hpp"
 #include "core/thread_count.hpp"
@@ -360,18 +360,20 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         detail::EncodeStageResult r = detail::encode_stage(reader, in, *out, checksum, index, options);
         report.error = std::move(r.error);
         report.geometry = std::move(r.geometry);
-        timings.read += r.timings.read, timings.encode += r.timings.encode, timings.metrics += r.timings.metrics;
-        timings.index += r.timings.index, timings.write += r.timings.write;
+        timings += r.timings;
     }
-    // The trailer and the commit (the index chunk made on the way is the index's).
-    std::optional<detail::StageClock> writing(std::in_place, timings.write);
-    const double index_before_trailer = timings.index;
-    if (report.resampled) report.error_vs_original = report.geometry.decoded_to_input();
-    h.max_error_mm = float(report.error.max_mm());
-    h.mean_error_mm = float(report.error.mean_mm());
-    const auto final_head = serialize_fft_header(h);
-    std::vector<std::uint8_t> trailer;
+    // The block index's chunk first: its builder's codes are larger than the chunk.
+    std::optional<TrailerChunk> index_chunk;
+    if (options.block_index) {
+        const detail::StageClock clock(timings.index);
+        index_chunk = std::exchange(index, IndexBuilder(h)).finish();
+    }
     {
+        const detail::StageClock clock(timings.write);  // the trailer and the commit
+        if (report.resampled) report.error_vs_original = report.geometry.decoded_to_input();
+        h.max_error_mm = float(report.error.max_mm());
+        h.mean_error_mm = float(report.error.mean_mm());
+        const auto final_head = serialize_fft_header(h);
         const std::uint64_t at = out->logical_size();
         std::vector<TrailerChunk> chunks{make_properties_chunk(reader.properties())};
         if (!fields.empty()) {
@@ -388,19 +390,12 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
             chunks.push_back(make_fiber_ends_chunk(end_fractions));
             FiberEndFractions().swap(end_fractions);
         }
-        // The builder goes as soon as its chunk is made (its codes are larger than the chunk).
-        if (options.block_index) {
-            const detail::StageClock clock(timings.index);
-            if (auto bidx = std::exchange(index, IndexBuilder(h)).finish()) chunks.push_back(std::move(*bidx));
-        }
+        if (index_chunk) chunks.push_back(std::move(*index_chunk));
         chunks.push_back(checksum.finish(final_head, chunks));  // last: it covers the chunks before it
-        trailer = serialize_trailer(chunks, at);
+        out->finish(serialize_trailer(chunks, at), final_head);
+        report.output_bytes = out->stored_size();
+        out->commit();
     }
-    out->finish(trailer, final_head);
-    report.output_bytes = out->stored_size();
-    out->commit();
-    writing.reset();
-    timings.write -= timings.index - index_before_trailer;
     if (options.progress) options.progress("encode", 1.0);
 
     report.input_bytes = tractogram_bytes(tck_path);  // a TRX directory: its files

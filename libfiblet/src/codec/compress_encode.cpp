@@ -285,8 +285,7 @@ EncodeStageResult encode_stage(StreamlineSource& reader, const EncodeStageInputs
     for (int k = 0; k < 2; ++k)
         for (const Slot& w : slots[k]) {
             r.error.merge(w.error), r.geometry.merge(w.geometry);
-            r.timings.encode += w.timings.encode, r.timings.metrics += w.timings.metrics;
-            r.timings.index += w.timings.index;
+            r.timings += w.timings;
         }
     return r;
 }

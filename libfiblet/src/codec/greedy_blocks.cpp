@@ -198,6 +198,14 @@ namespace {
 
 using VectorSearch = std::size_t (*)(const Codebook8&, float, const GreedyBatch&);
 
+constexpr SimdLevel kLevels[] = {SimdLevel::scalar, SimdLevel::sse4, SimdLevel::avx2, SimdLevel::avx512};
+
+void require_supported(SimdLevel level) {
+    if (!simd_level_supported(level))
+        throw Error(Errc::invalid_argument, std::string("SIMD level ") + simd_level_name(level) +
+                                                ": this CPU or build does not support it");
+}
+
 VectorSearch vector_search(SimdLevel level) {
     switch (level) {
 #if FIBLET_GREEDY_HWY && (HWY_TARGETS & HWY_AVX3)
@@ -321,7 +329,7 @@ const char* simd_level_name(SimdLevel level) {
 }
 
 std::optional<SimdLevel> parse_simd_level(std::string_view name) {
-    for (SimdLevel l : {SimdLevel::scalar, SimdLevel::sse4, SimdLevel::avx2, SimdLevel::avx512})
+    for (SimdLevel l : kLevels)
         if (name == simd_level_name(l)) return l;
     return std::nullopt;
 }
@@ -332,7 +340,7 @@ bool simd_level_supported(SimdLevel level) {
 
 std::vector<SimdLevel> supported_simd_levels() {
     std::vector<SimdLevel> out;
-    for (SimdLevel l : {SimdLevel::scalar, SimdLevel::sse4, SimdLevel::avx2, SimdLevel::avx512})
+    for (SimdLevel l : kLevels)
         if (simd_level_supported(l)) out.push_back(l);
     return out;
 }
@@ -347,9 +355,7 @@ SimdLevel simd_level() {
 }
 
 void force_simd_level(std::optional<SimdLevel> level) {
-    if (level && !simd_level_supported(*level))
-        throw Error(Errc::invalid_argument, std::string("SIMD level ") + simd_level_name(*level) +
-                                                ": this CPU or build does not support it");
+    if (level) require_supported(*level);
     forced_level.store(level ? int(*level) : -1, std::memory_order_relaxed);
 }
 
@@ -358,9 +364,7 @@ void greedy_blocks(const Codebook8& cb, float step, const GreedyBatch& batch) {
 }
 
 void greedy_blocks(const Codebook8& cb, float step, const GreedyBatch& batch, SimdLevel level) {
-    if (!simd_level_supported(level))
-        throw Error(Errc::invalid_argument, std::string("SIMD level ") + simd_level_name(level) +
-                                                ": this CPU or build does not support it");
+    require_supported(level);
     if (batch.blocks == 0) return;
     std::size_t done = 0;
     // The lanes address a vector's points with 32-bit offsets (3 floats a point).

@@ -90,8 +90,63 @@ void inverses_and_roots(double* len, double* inv, std::size_t n) {
     sqrt_all(len, n);
 }
 
+// Squared distance of p to segment s (its start when it has no length): the
+// arithmetic of every distance here.
+inline double segment_dist2(const Segments& g, double px, double py, double pz, std::size_t s) {
+    const double wx = px - g.ax[s], wy = py - g.ay[s], wz = pz - g.az[s];
+    double t = (wx * g.ux[s] + wy * g.uy[s] + wz * g.uz[s]) * g.inv_uu[s];
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    const double dx = wx - t * g.ux[s], dy = wy - t * g.uy[s], dz = wz - t * g.uz[s];
+    return dx * dx + dy * dy + dz * dz;
+}
+
 #ifdef FIBLET_GEOMETRY_AVX2
-std::size_t segment_columns_avx2(std::span<const Vec3f> line, std::size_t n, Segments& out);
+#define FIBLET_AVX2 __attribute__((target("avx2"))) inline
+FIBLET_AVX2 __m256d column(const std::vector<double>& c, std::size_t s) { return _mm256_loadu_pd(c.data() + s); }
+
+// Coordinate c (0, 1, 2) of points k .. k + 3, in double.
+FIBLET_AVX2 __m256d coordinate(std::span<const Vec3f> v, std::size_t k, int c) {
+    return _mm256_cvtps_pd(_mm_i32gather_ps(&v[k].x + c, _mm_setr_epi32(0, 3, 6, 9), 4));
+}
+
+// segment_dist2 of the points (x, y, z) to segments s .. s + 3: the same
+// double operations in the same order (max(0, t) and min(1, t) return t
+// for a NaN and keep -0, as the ternaries do; no fused multiply-add:
+// -ffp-contract=off).
+FIBLET_AVX2 __m256d segment_dist2_avx2(const Segments& g, __m256d x, __m256d y, __m256d z, std::size_t s) {
+    const __m256d ux = column(g.ux, s), uy = column(g.uy, s), uz = column(g.uz, s);
+    const __m256d wx = _mm256_sub_pd(x, column(g.ax, s)), wy = _mm256_sub_pd(y, column(g.ay, s)),
+                  wz = _mm256_sub_pd(z, column(g.az, s));
+    __m256d t = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(wx, ux), _mm256_mul_pd(wy, uy)), _mm256_mul_pd(wz, uz));
+    t = _mm256_min_pd(_mm256_set1_pd(1.0), _mm256_max_pd(_mm256_setzero_pd(), _mm256_mul_pd(t, column(g.inv_uu, s))));
+    const __m256d dx = _mm256_sub_pd(wx, _mm256_mul_pd(t, ux)), dy = _mm256_sub_pd(wy, _mm256_mul_pd(t, uy)),
+                  dz = _mm256_sub_pd(wz, _mm256_mul_pd(t, uz));
+    return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)), _mm256_mul_pd(dz, dz));
+}
+
+// Squared distances of p to the kLanes segments from `base` into d.
+FIBLET_AVX2 void window_avx2(const Segments& g, double px, double py, double pz, std::size_t base, double* d) {
+    const __m256d x = _mm256_set1_pd(px), y = _mm256_set1_pd(py), z = _mm256_set1_pd(pz);
+    for (std::size_t h = 0; h < kLanes; h += 4) _mm256_storeu_pd(d + h, segment_dist2_avx2(g, x, y, z, base + h));
+}
+
+// segments_of's columns for segments [0, s) four at a time (the same
+// double operations); returns s, the segments left to the scalar loop.
+__attribute__((target("avx2"))) std::size_t segment_columns_avx2(std::span<const Vec3f> line, std::size_t n,
+                                                                 Segments& out) {
+    std::size_t s = 0;
+    for (; s + 4 <= n && s + 4 < line.size(); s += 4) {
+        for (int c = 0; c < 3; ++c) {
+            const __m256d a = coordinate(line, s, c), d = _mm256_sub_pd(coordinate(line, s + 1, c), a);
+            _mm256_storeu_pd((c == 0 ? out.ax : c == 1 ? out.ay : out.az).data() + s, a);
+            _mm256_storeu_pd((c == 0 ? out.ux : c == 1 ? out.uy : out.uz).data() + s, d);
+        }
+        const __m256d dx = column(out.ux, s), dy = column(out.uy, s), dz = column(out.uz, s);
+        _mm256_storeu_pd(out.len.data() + s, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)),
+                                                           _mm256_mul_pd(dz, dz)));
+    }
+    return s;
+}
 #endif
 
 void segments_of(std::span<const Vec3f> line, Segments& out) {
@@ -127,31 +182,6 @@ void segments_of(std::span<const Vec3f> line, Segments& out) {
     out.length = length;
 }
 
-// Squared distances of p to the kLanes segments from `base` into d: the
-// same double operations, in the same order, as the scalar dist2 below
-// (max(0, t) and min(1, t) return t for a NaN and keep -0, as the
-// ternaries do; no fused multiply-add: -ffp-contract=off).
-#ifdef FIBLET_GEOMETRY_AVX2
-__attribute__((target("avx2"))) inline void window_avx2(const Segments& g, double px, double py, double pz,
-                                                        std::size_t base, double* d) {
-    const __m256d x = _mm256_set1_pd(px), y = _mm256_set1_pd(py), z = _mm256_set1_pd(pz);
-    const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
-    for (std::size_t h = 0; h < kLanes; h += 4) {
-        const std::size_t s = base + h;
-        const __m256d ux = _mm256_loadu_pd(&g.ux[s]), uy = _mm256_loadu_pd(&g.uy[s]), uz = _mm256_loadu_pd(&g.uz[s]);
-        const __m256d wx = _mm256_sub_pd(x, _mm256_loadu_pd(&g.ax[s])), wy = _mm256_sub_pd(y, _mm256_loadu_pd(&g.ay[s])),
-                      wz = _mm256_sub_pd(z, _mm256_loadu_pd(&g.az[s]));
-        __m256d t = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(wx, ux), _mm256_mul_pd(wy, uy)), _mm256_mul_pd(wz, uz));
-        t = _mm256_mul_pd(t, _mm256_loadu_pd(&g.inv_uu[s]));
-        t = _mm256_min_pd(one, _mm256_max_pd(zero, t));  // (0 > t ? 0 : t), then (1 < t ? 1 : t)
-        const __m256d dx = _mm256_sub_pd(wx, _mm256_mul_pd(t, ux)), dy = _mm256_sub_pd(wy, _mm256_mul_pd(t, uy)),
-                      dz = _mm256_sub_pd(wz, _mm256_mul_pd(t, uz));
-        _mm256_storeu_pd(d + h, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)),
-                                              _mm256_mul_pd(dz, dz)));
-    }
-}
-#endif
-
 // Fixed-step pairs (as many points on both polylines; point k was encoded
 // from to[k]): for each point p = from[k], its squared distances to to[k]'s
 // own segments k - 1 and k, and whether one of them is provably the nearest
@@ -166,24 +196,12 @@ __attribute__((target("avx2"))) inline void window_avx2(const Segments& g, doubl
 // room for rounding) no other segment can be nearer or tie. Every point of
 // a fixed-step fiber whose error is well below half a step and whose turns
 // over three steps stay under 90 degrees is proven so: two segments instead
-// of the window, the same result bit for bit. Each quantity is one loop
-// over the fiber that the compiler vectorizes (the same double operations
-// as dist2 below, no fused multiply-add: -ffp-contract=off).
+// of the window, the same result bit for bit.
 struct OwnSegments {
     std::vector<double> nearest;        // squared distance to the nearer of segments k - 1 and k (the first on a tie)
     std::vector<std::uint8_t> later;    // 1 where that is segment k
     std::vector<std::uint8_t> proven;   // it is the window's nearest
 };
-
-// Squared distance of p to segment s (its start when it has no length): the
-// arithmetic of every distance here.
-inline double segment_dist2(const Segments& g, double px, double py, double pz, std::size_t s) {
-    const double wx = px - g.ax[s], wy = py - g.ay[s], wz = pz - g.az[s];
-    double t = (wx * g.ux[s] + wy * g.uy[s] + wz * g.uz[s]) * g.inv_uu[s];
-    t = t < 0 ? 0 : (t > 1 ? 1 : t);
-    const double dx = wx - t * g.ux[s], dy = wy - t * g.uy[s], dz = wz - t * g.uz[s];
-    return dx * dx + dy * dy + dz * dz;
-}
 
 // Point k of own_segments (any k; the edges of the fiber and machines without AVX2).
 void own_segments_at(const Segments& g, std::span<const Vec3f> from, std::span<const Vec3f> to, std::size_t k,
@@ -211,50 +229,12 @@ void own_segments_at(const Segments& g, std::span<const Vec3f> from, std::span<c
 }
 
 #ifdef FIBLET_GEOMETRY_AVX2
-#define FIBLET_AVX2 __attribute__((target("avx2"))) inline
-FIBLET_AVX2 __m256d column(const std::vector<double>& c, std::size_t s) { return _mm256_loadu_pd(c.data() + s); }
-
-// segment_dist2 of four points to segments s .. s + 3 (window_avx2's operations).
-FIBLET_AVX2 __m256d segment_dist2_avx2(const Segments& g, __m256d x, __m256d y, __m256d z, std::size_t s) {
-    const __m256d ux = column(g.ux, s), uy = column(g.uy, s), uz = column(g.uz, s);
-    const __m256d wx = _mm256_sub_pd(x, column(g.ax, s)), wy = _mm256_sub_pd(y, column(g.ay, s)),
-                  wz = _mm256_sub_pd(z, column(g.az, s));
-    __m256d t = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(wx, ux), _mm256_mul_pd(wy, uy)), _mm256_mul_pd(wz, uz));
-    t = _mm256_min_pd(_mm256_set1_pd(1.0), _mm256_max_pd(_mm256_setzero_pd(), _mm256_mul_pd(t, column(g.inv_uu, s))));
-    const __m256d dx = _mm256_sub_pd(wx, _mm256_mul_pd(t, ux)), dy = _mm256_sub_pd(wy, _mm256_mul_pd(t, uy)),
-                  dz = _mm256_sub_pd(wz, _mm256_mul_pd(t, uz));
-    return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)), _mm256_mul_pd(dz, dz));
-}
-
 // Whether the directions of segments a .. a + 3 and b .. b + 3 are not against each other.
 FIBLET_AVX2 __m256d not_against(const Segments& g, std::size_t a, std::size_t b) {
     const __m256d d = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(column(g.ux, a), column(g.ux, b)),
                                                   _mm256_mul_pd(column(g.uy, a), column(g.uy, b))),
                                     _mm256_mul_pd(column(g.uz, a), column(g.uz, b)));
     return _mm256_cmp_pd(d, _mm256_setzero_pd(), _CMP_GE_OQ);
-}
-
-// Coordinate c (0, 1, 2) of points k .. k + 3, in double.
-FIBLET_AVX2 __m256d coordinate(std::span<const Vec3f> v, std::size_t k, int c) {
-    return _mm256_cvtps_pd(_mm_i32gather_ps(&v[k].x + c, _mm_setr_epi32(0, 3, 6, 9), 4));
-}
-
-// segments_of's columns for segments [0, s) four at a time (the same
-// double operations); returns s, the segments left to the scalar loop.
-__attribute__((target("avx2"))) std::size_t segment_columns_avx2(std::span<const Vec3f> line, std::size_t n,
-                                                                 Segments& out) {
-    std::size_t s = 0;
-    for (; s + 4 <= n && s + 4 < line.size(); s += 4) {
-        for (int c = 0; c < 3; ++c) {
-            const __m256d a = coordinate(line, s, c), d = _mm256_sub_pd(coordinate(line, s + 1, c), a);
-            _mm256_storeu_pd((c == 0 ? out.ax : c == 1 ? out.ay : out.az).data() + s, a);
-            _mm256_storeu_pd((c == 0 ? out.ux : c == 1 ? out.uy : out.uz).data() + s, d);
-        }
-        const __m256d dx = column(out.ux, s), dy = column(out.uy, s), dz = column(out.uz, s);
-        _mm256_storeu_pd(out.len.data() + s, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)),
-                                                           _mm256_mul_pd(dz, dz)));
-    }
-    return s;
 }
 
 // e4 < 0.98 len^2 for lengths len .. len + 3.
@@ -330,17 +310,7 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
     const std::size_t ahead = 2 + (to.size() + from.size() - 1) / from.size();
     thread_local std::vector<double> d2;
     at_least(d2, ahead + 3);
-    const double *ax = g.ax.data(), *ay = g.ay.data(), *az = g.az.data(), *ux = g.ux.data(), *uy = g.uy.data(),
-                 *uz = g.uz.data(), *inv = g.inv_uu.data();
     double* d = d2.data();
-    // Squared distance of p to segment s (its start when it has no length).
-    auto dist2 = [&](double px, double py, double pz, std::size_t s) {
-        const double wx = px - ax[s], wy = py - ay[s], wz = pz - az[s];
-        double t = (wx * ux[s] + wy * uy[s] + wz * uz[s]) * inv[s];
-        t = t < 0 ? 0 : (t > 1 ? 1 : t);
-        const double dx = wx - t * ux[s], dy = wy - t * uy[s], dz = wz - t * uz[s];
-        return dx * dx + dy * dy + dz * dz;
-    };
     std::size_t hint = 0;
     const bool same_count = from.size() == to.size() && to.size() > 1 && detail::geometry_shortcut_enabled();
     const bool paired = from.size() == to.size() && have_avx2();
@@ -374,7 +344,7 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
             }
         }
 #endif
-        for (std::size_t j = 0; j < w; ++j) d[j] = dist2(px, py, pz, lo + j);
+        for (std::size_t j = 0; j < w; ++j) d[j] = segment_dist2(g, px, py, pz, lo + j);
         for (std::size_t j = 0; j < w; ++j)
             if (d[j] < best) best = d[j], hint = lo + j;
         nearest[k] = best;
