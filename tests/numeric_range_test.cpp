@@ -100,22 +100,29 @@ TEST(NumericRange, StepLostAgainstTheExtentIsRefused) {
 // found by compress_fuzz): the block index's cell for a group of blocks of
 // such steps is no float, so the file used to be unreadable ("grid cell is
 // not a positive number"); it reads back, verifies and decodes finite, at
-// either direction width.
+// either direction width. Likewise a three-point fiber whose block's
+// bounding sphere (anchor distance plus a step, 6.4e38 mm) is no float:
+// the index chunk saturates it rather than store an infinite radius.
 TEST(NumericRange, StepsNearTheFloatRangeKeepTheFileReadable) {
     const test::TempDir dir;
     const std::string tck = dir.file("huge.tck");
-    write_tck(tck, {{{0, 0, 0}, {4.7e-38f, 2.2995644e38f, 0}}});
-    for (const unsigned bits : {8u, 16u}) {
-        SCOPED_TRACE(bits);
-        CompressOptions o;
-        o.overwrite = true;
-        o.direction_bits = bits;
-        compress_tck(tck, dir.file("huge.fft"), o);
-        const FftFile f(dir.file("huge.fft"));
-        const Streamlines s = decode_fibers(f, 0, f.header().fibers);
-        ASSERT_EQ(s.offsets.back(), 2u);
-        for (const float v : s.xyz) EXPECT_TRUE(std::isfinite(v));
-        EXPECT_EQ(test::run_cli("verify " + dir.file("huge.fft")).status, 0);
+    const std::vector<std::vector<Fiber>> tractograms = {
+        {{{0, 0, 0}, {4.7e-38f, 2.2995644e38f, 0}}},
+        {{{1, 2, 3}}, {{4, 1.9e34f, 2.8e20f}, {1.2e-32f, 2.8e20f, 3.1964534e38f}, {1, 2, 3}}}};
+    for (std::size_t t = 0; t < tractograms.size(); ++t) {
+        for (const unsigned bits : {8u, 16u}) {
+            SCOPED_TRACE(::testing::Message() << "tractogram " << t << ", " << bits << " bits");
+            write_tck(tck, tractograms[t]);
+            CompressOptions o;
+            o.overwrite = true;
+            o.direction_bits = bits;
+            compress_tck(tck, dir.file("huge.fft"), o);
+            const FftFile f(dir.file("huge.fft"));
+            const Streamlines s = decode_fibers(f, 0, f.header().fibers);
+            ASSERT_EQ(s.offsets.back(), t == 0 ? 2u : 4u);
+            for (const float v : s.xyz) EXPECT_TRUE(std::isfinite(v));
+            EXPECT_EQ(test::run_cli("verify " + dir.file("huge.fft")).status, 0);
+        }
     }
 }
 

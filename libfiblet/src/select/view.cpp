@@ -110,7 +110,10 @@ inline Sphere sphere_of(const FftHeader& h, Vec3f a0, Vec3f a1, std::uint32_t n)
     // In double: the squares of a file's extent overflow a float beyond ~1e19 mm.
     const double dx = double(a1.x) - a0.x, dy = double(a1.y) - a0.y, dz = double(a1.z) - a0.z;
     const auto r = float(std::sqrt(dx * dx + dy * dy + dz * dz) + double(n - 2) * h.step * h.scaling);
-    return {a0, r * (1 + 1e-5f) + 1e-5f * h.scaling};
+    const float padded = r * (1 + 1e-5f) + 1e-5f * h.scaling;
+    // A foreign file whose blocks span near the float range: saturate, as
+    // the index chunk holds finite radii and float distances that far are inf.
+    return {a0, std::min(padded, std::numeric_limits<float>::max())};
 }
 
 template <class View>
