@@ -1,7 +1,7 @@
 // Round trip .tck -> .fft -> points on the shared tractograms: structure
 // (fibers, points per fiber, IDs, flags) is preserved, the header's recorded
-// error equals a brute-force measurement, every point is within the
-// closed-loop bound, and every step is the best one the 256 codes allow.
+// error equals a brute-force measurement, and every point is within the
+// closed-loop bound of codes at most one level from the aimed one.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,6 +12,7 @@
 #include "fiblet/encode.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/tck.hpp"
+#include "error_bound.hpp"
 #include "exact_error.hpp"
 #include "test_util.hpp"
 
@@ -95,7 +96,10 @@ TEST_P(CodecRoundTrip, PreservesStructureAndStaysWithinTheErrorBound) {
     //   e_{k+1} <= |D - delta| + sqrt(delta * D) * theta,  D = |t_{k+1} - p_k| <= s_k + e_k
     // so b_{k+1} = b_k + |s_k - delta| + sqrt(delta * (s_k + b_k)) * theta bounds e_{k+1}.
     const DirectionTable table(h.ratio);
-    const double theta = covering_angle(table);
+    // The default search (lookahead, retry beam) may take any code of the
+    // aimed one's 3x3 (formats/error-bound.md, "Setting"): its reach adds to
+    // the covering angle.
+    const double theta = covering_angle(table) + test::neighbourhood_reach(table, 1);
     const double delta = double(h.step) * h.scaling;
     // A full quantum: the encoder may round anchors the other way where the
     // first frame is ill-conditioned (codec/anchor_conditioning.hpp).

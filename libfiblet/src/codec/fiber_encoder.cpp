@@ -150,7 +150,7 @@ SearchOptions search_for_effort(int effort) {
     // beam), so every level searches the 3x3 neighbourhood.
     switch (effort) {
         case 0: return {1, 1, 0, 1, 0};    // greedy aiming
-        case 1: return {1, 1, 8, 1, 0, 2};  // greedy judged over the next two points + a beam of 8 for the worst blocks
+        case 1: return {1, 1, 8, 1, 0, 1};  // greedy judged over the next point + a beam of 8 for the worst blocks
         case 2: return {2, 1, 8, 1, 0};
         case 3: return {8, 1, 32, 1, 0};
         case 4: return {16, 1, 64, 1, 0};
@@ -440,7 +440,8 @@ void FiberEncoder::Encoding::keep_lengths() {
                 for (std::size_t k = 0; k < j0; ++k) f = compose(f, cb.frame(codes[k]));
                 const Vec3f p = s.points[i0 + 1 + j0];
                 if (search().beam_width <= 1 && search().lookahead > 0)
-                    LookaheadSearch<Codebook8>(cb, h.step, search().lookahead).run(f, p, t, s.retry_codes8.data(), dec);
+                    LookaheadSearch<Codebook8>(cb, h.step, std::max(search().lookahead, kLengthFeedbackLookahead))
+                        .run(f, p, t, s.retry_codes8.data(), dec);
                 else
                     search_codes(cb, params, f, p, h.step, t, s.retry_codes8.data(), dec);
             },

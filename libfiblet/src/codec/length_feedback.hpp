@@ -17,7 +17,8 @@
 // feed_back_length_tails: only a block's last codes are searched again,
 // with the block's own search, and only where the fiber's running length
 // error exceeds a share of its point error; the fiber's last block, which
-// no code can change, is paid for by the bridge before it.
+// no code can change, is paid for by the bridge before it (whose whole
+// block is searched again when its tail could not).
 #pragma once
 
 #include <algorithm>
@@ -39,6 +40,11 @@ inline constexpr float kLengthFeedbackShares[] = {1.0f, 0.5f, 0.25f};
 // of the fiber's largest point error its length error may reach untouched.
 inline constexpr std::uint32_t kLengthFeedbackTail = 24;
 inline constexpr float kLengthFeedbackActShare = 0.25f;
+// The tails' lookahead search looks at least this far ahead: a tail's
+// codes place the block's end, which one point of lookahead places less
+// well (small-ifod1-step0.05, lookahead 1: lengths 3.25 um over a
+// 2.76 um max error; tails at 2: 1.54 um; docs/encode.md).
+inline constexpr unsigned kLengthFeedbackLookahead = 2;
 // Fixed-step input keeping its lengths: blocks whose max error after the
 // retry's beam still exceeds this multiple of the retry threshold are
 // searched with this beam (at the sampling step, a smaller cap's rare
@@ -126,7 +132,8 @@ void feed_back_length(std::span<const Vec3f> targets, std::span<Vec3f> points, s
 // of the fiber's largest point error, by moving the targets of the block's
 // last `tail` points along the track (linearly more towards the end, by at
 // most that point error, in shares 1, 1/2, 1/4) and searching those points
-// again. Callbacks:
+// again; in the fiber's last adjustable block, all its points when the tail
+// left more than `act`. Callbacks:
 //   adjustable(b)                 whether block b's codes may be searched again
 //   search(b, j0, t, decoded)     searches block b's codes j0.. (its points
 //                                 j0 + 2..) for targets t into a candidate
@@ -158,21 +165,30 @@ void feed_back_length_tails(std::span<const Vec3f> targets, std::span<Vec3f> poi
         double lag = error + error_of(last + 1);
         if (last + 1 == last_b0) lag += last_block_error;
         if (!(std::fabs(lag) > act) || !adjustable(b)) continue;
-        const std::size_t m = n - 2, first = b0 + 2, t = std::min<std::size_t>(tail, m), j0 = m - t;
+        const std::size_t m = n - 2, first = b0 + 2, tail_codes = std::min<std::size_t>(tail, m);
         const float allowed2 = fiber_max2;
         double best = std::fabs(lag);
         const float reach = std::sqrt(allowed2), move = std::clamp(float(lag), -reach, reach);
-        for (const float share : kLengthFeedbackShares) {
-            move_tail_along_track(targets, first + j0, last, t, share, move, moved);
-            candidate.resize(t);
-            search(b, j0, std::span<const Vec3f>(moved), candidate.data());
-            if (max_error2(candidate.data(), first + j0, t) > allowed2) continue;
-            const double now = lag + (norm(points[last + 1] - candidate[t - 1]) - norm(points[last + 1] - points[last]));
-            if (!(std::fabs(now) < best)) continue;
-            best = std::fabs(now);
-            std::copy(candidate.begin(), candidate.end(), points.begin() + std::ptrdiff_t(first + j0));
-            keep(b, j0);
-            if (best <= act) break;  // close enough: the next blocks carry the rest
+        // The block's tail, and where that leaves more than `act` in the
+        // fiber's last adjustable block (no later block takes the rest),
+        // the whole block.
+        const bool last_chance = last + 1 == last_b0;
+        for (const std::size_t codes : {tail_codes, m}) {
+            if (codes != tail_codes && !(last_chance && best > act)) break;
+            const std::size_t j0 = m - codes;
+            for (const float share : kLengthFeedbackShares) {
+                move_tail_along_track(targets, first + j0, last, codes, share, move, moved);
+                candidate.resize(codes);
+                search(b, j0, std::span<const Vec3f>(moved), candidate.data());
+                if (max_error2(candidate.data(), first + j0, codes) > allowed2) continue;
+                const double now =
+                    lag + (norm(points[last + 1] - candidate[codes - 1]) - norm(points[last + 1] - points[last]));
+                if (!(std::fabs(now) < best)) continue;
+                best = std::fabs(now);
+                std::copy(candidate.begin(), candidate.end(), points.begin() + std::ptrdiff_t(first + j0));
+                keep(b, j0);
+                if (best <= act) break;  // close enough: the next blocks carry the rest
+            }
         }
     }
 }

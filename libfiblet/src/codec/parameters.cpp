@@ -118,24 +118,29 @@ void FiberSample::offer(std::span<const Vec3f> fiber) {
 SampleError measure(const TuningSet& set, const FiberEncoder& encoder) {
     std::vector<std::uint8_t> blocks;
     std::vector<Vec3f> decoded;
-    double sum = 0, max = 0, length_change = 0;
+    double sum = 0, max = 0, length_change = 0, length_drift = 0, length = 0;
     std::size_t n = 0;
     auto encode = [&](std::span<const Vec3f> points, bool in_mean) {
         blocks.clear();
         decoded.clear();
         encoder.encode(points, 0, blocks, &decoded);
-        double change = 0;
+        double change = 0, target_length = 0;
         for (std::size_t k = 0; k < points.size(); ++k) {
             const double e = distance(decoded[k], points[k]);
             max = std::max(max, e);
             if (in_mean) sum += e;
-            if (k > 0) change += distance(decoded[k], decoded[k - 1]) - distance(points[k], points[k - 1]);
+            if (k == 0) continue;
+            const double segment = distance(points[k], points[k - 1]);
+            change += distance(decoded[k], decoded[k - 1]) - segment;
+            target_length += segment;
         }
-        if (in_mean) n += points.size(), length_change += std::fabs(change);
+        if (in_mean) n += points.size(), length_change += std::fabs(change), length_drift += change, length += target_length;
     };
     for (const auto& fiber : set.fibers) encode(fiber, true);
     for (const auto& block : set.sharp_blocks) encode(block, false);
-    return {n ? sum / double(n) : 0.0, max, set.fibers.empty() ? 0.0 : length_change / double(set.fibers.size())};
+    const double fibers = double(set.fibers.size());
+    if (set.fibers.empty()) return {n ? sum / double(n) : 0.0, max};
+    return {n ? sum / double(n) : 0.0, max, length_change / fibers, length_drift / fibers, length / fibers};
 }
 
 TunedParameters tune_parameters(const TuningSet& given, const TurnStatistics& turns, FftHeader h,
@@ -216,6 +221,25 @@ TunedParameters tune_parameters(const TuningSet& given, const TurnStatistics& tu
     return best;
 }
 
+namespace {
+// The search's codes leave a systematic length drift at the sampling step
+// (the lookahead's paths run a little longer than the input's, greedy
+// aiming's zig-zag a little shorter): the decoder step is scaled against
+// the sample's mean drift, so that the tail feedback is left with each
+// fiber's own scatter (fewer blocks to search again, smaller length errors).
+// Measured without the feedback, which would hide the drift.
+constexpr double kMaxDriftCorrection = 1e-3;
+void centre_length_drift(const TuningSet& fibers, const FftHeader& h, double sampling_step_mm, TunedParameters& kept) {
+    const SampleError drift = measure(fibers, kept.encoder->with_length_feedback(0.0f, false));
+    if (!(drift.length_mm > 0)) return;
+    // In steps of 1e-5 (the report prints the scale; a float step resolves 6e-8).
+    const double wanted = std::round(kept.step_scale * (1 - drift.length_drift_mm / drift.length_mm) * 1e5) / 1e5;
+    const double scale = std::clamp(wanted, 1 - kMaxDriftCorrection, 1 + kMaxDriftCorrection);
+    kept.step_scale = scale;
+    kept.encoder = kept.encoder->with_step(float(sampling_step_mm * scale / h.scaling));
+}
+}  // namespace
+
 bool keep_fixed_step_lengths(const TuningSet& set, const TurnStatistics& turns, TunedParameters& tuned, FftHeader h,
                              double sampling_step_mm, std::optional<float> fixed_ratio, std::optional<double> fixed_scale) {
     if (h.direction_bits() == 16 || set.fibers.empty() || !(sampling_step_mm > 0)) return false;
@@ -228,8 +252,10 @@ bool keep_fixed_step_lengths(const TuningSet& set, const TurnStatistics& turns, 
     TunedParameters kept = tune_parameters(set, turns, h, tuned.search, sampling_step_mm, fixed_ratio,
                                            fixed_scale.value_or(1.0), true, tuned.ratio);
     if (!kept.encoder) return false;
-    const SampleError e = measure({set.fibers, {}, 0}, *kept.encoder);
+    const TuningSet fibers{set.fibers, {}, 0};
+    const SampleError e = measure(fibers, *kept.encoder);
     if (!(e.length_change_mm <= kKeepLengthsShare * e.max_mm)) return false;
+    if (!fixed_scale) centre_length_drift(fibers, h, sampling_step_mm, kept);
     tuned = std::move(kept);
     return true;
 }

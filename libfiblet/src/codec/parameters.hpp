@@ -91,6 +91,8 @@ struct TuningSet {
 struct SampleError {
     double mean_mm = 0, max_mm = 0;
     double length_change_mm = 0;  // mean |decoded - target polyline length| over the fibers
+    double length_drift_mm = 0;   // mean (decoded - target polyline length), signed
+    double length_mm = 0;         // mean target polyline length
     // The tuning objective: mean + max / 3. The max alone is too noisy
     // (a few rare turns), the mean alone lets the cap shrink until the
     // sharpest turns blow up; a max of about three times the mean is what
