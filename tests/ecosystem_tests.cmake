@@ -20,8 +20,8 @@ add_test(NAME ecosystem.cli_docs_up_to_date
 # The Snakemake cohort workflow on 3 generated subjects.
 if(DEFINED Python_EXECUTABLE)
   add_test(NAME ecosystem.cohort_workflow
-    COMMAND ${Python_EXECUTABLE} -m pytest -q -p no:cacheprovider ${PROJECT_SOURCE_DIR}/scripts/workflow/test_workflow.py)
-  set_tests_properties(ecosystem.cohort_workflow PROPERTIES TIMEOUT 300
+    COMMAND ${Python_EXECUTABLE} ${FIBLET_PYTEST} ${PROJECT_SOURCE_DIR}/scripts/workflow/test_workflow.py)
+  set_tests_properties(ecosystem.cohort_workflow PROPERTIES TIMEOUT 300 SKIP_REGULAR_EXPRESSION "${FIBLET_PYTEST_SKIPPED}"
     ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA};FIBLET_CLI=$<TARGET_FILE:fiblet_cli>;FIBLET_VERSION=${PROJECT_VERSION}")
 endif()
 
@@ -31,16 +31,16 @@ endif()
 # if it is killed.
 if(DEFINED Python_EXECUTABLE)
   add_test(NAME ecosystem.cohort_workflow_slurm
-    COMMAND ${Python_EXECUTABLE} -m pytest -q -p no:cacheprovider ${PROJECT_SOURCE_DIR}/scripts/workflow/test_workflow_slurm.py)
-  set_tests_properties(ecosystem.cohort_workflow_slurm PROPERTIES TIMEOUT 500
+    COMMAND ${Python_EXECUTABLE} ${FIBLET_PYTEST} ${PROJECT_SOURCE_DIR}/scripts/workflow/test_workflow_slurm.py)
+  set_tests_properties(ecosystem.cohort_workflow_slurm PROPERTIES TIMEOUT 500 SKIP_REGULAR_EXPRESSION "${FIBLET_PYTEST_SKIPPED}"
     ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA};FIBLET_CLI=$<TARGET_FILE:fiblet_cli>;FIBLET_SLURM_DIR=${PROJECT_BINARY_DIR}/slurm")
 endif()
 
 # CLI conventions: help, --version, --json, documented exit codes.
 if(DEFINED Python_EXECUTABLE)
   add_test(NAME ecosystem.cli_conventions
-    COMMAND ${Python_EXECUTABLE} -m pytest -q -p no:cacheprovider ${PROJECT_SOURCE_DIR}/tests/test_cli_conventions.py)
-  set_tests_properties(ecosystem.cli_conventions PROPERTIES TIMEOUT 120
+    COMMAND ${Python_EXECUTABLE} ${FIBLET_PYTEST} ${PROJECT_SOURCE_DIR}/tests/test_cli_conventions.py)
+  set_tests_properties(ecosystem.cli_conventions PROPERTIES TIMEOUT 120 SKIP_REGULAR_EXPRESSION "${FIBLET_PYTEST_SKIPPED}"
     ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA};FIBLET_CLI=$<TARGET_FILE:fiblet_cli>;FIBLET_VERSION=${PROJECT_VERSION}")
 endif()
 
@@ -52,4 +52,10 @@ if(DEFINED Python_EXECUTABLE)
     COMMAND ${Python_EXECUTABLE} ${PROJECT_SOURCE_DIR}/bench/instruction_budget.py
             --fiblet $<TARGET_FILE:fiblet_cli> --tck ${FIBLET_SHARED_DATA}/small-ifod1.tck)
   set_tests_properties(bench.compress_instruction_budget PROPERTIES TIMEOUT 300)
+endif()
+
+# The skip check scripts/test.sh runs after CTest (scripts/check_skips.py).
+if(DEFINED Python_EXECUTABLE)
+  add_test(NAME ecosystem.check_skips COMMAND ${Python_EXECUTABLE} ${FIBLET_PYTEST} ${PROJECT_SOURCE_DIR}/tests/test_check_skips.py)
+  set_tests_properties(ecosystem.check_skips PROPERTIES TIMEOUT 60 SKIP_REGULAR_EXPRESSION "${FIBLET_PYTEST_SKIPPED}")
 endif()

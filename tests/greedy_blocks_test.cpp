@@ -182,7 +182,7 @@ TEST(GreedyBlocks, AnyNumberOfBlocksAndAShorterLastBlock) {
 
 TEST(GreedyBlocks, SharedTractogramBlocksMatchTheScalarSearchAtEveryLevel) {
     const std::string path = test::shared_data("small-ifod1.tck");
-    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no shared data: " << path;
     const auto fibers = test::read_tck_fibers(path);
     ASSERT_FALSE(fibers.empty());
     // The encoder's normalization: a box around every point, the step 0.1 mm.
@@ -214,7 +214,7 @@ TEST(GreedyBlocks, SharedTractogramBlocksMatchTheScalarSearchAtEveryLevel) {
 
 TEST(GreedyBlocks, EncoderWritesTheSameBlocksAtEveryLevel) {
     const std::string path = test::shared_data("small-ifod1.tck");
-    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "no shared data: " << path;
     auto fibers = test::read_tck_fibers(path);
     fibers.resize(std::min<std::size_t>(fibers.size(), 500));
     FftHeader h;

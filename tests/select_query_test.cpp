@@ -343,7 +343,7 @@ TEST_P(SelectQuery, SubsetFileDecodesToTheSelection) {
 INSTANTIATE_TEST_SUITE_P(Files, SelectQuery, ::testing::Values(0, 1, 2, 3, 4));
 
 TEST(SelectQueryErrors, BadQueriesAreRejectedBeforeReading) {
-    if (!shared_data_available()) GTEST_SKIP();
+    if (!shared_data_available()) GTEST_SKIP() << "no shared data";
     const FftFile file(shared_data("reference/small-sdstream.fft"));
     const BlockIndex index = BlockIndex::load(file);
     auto rejects = [&](const Query& q) {
@@ -390,7 +390,7 @@ TEST(SelectQueryErrors, BadQueriesAreRejectedBeforeReading) {
 }
 
 TEST(SelectQueryErrors, LevelOfDetailCannotBeWrittenAsFft) {
-    if (!shared_data_available()) GTEST_SKIP();
+    if (!shared_data_available()) GTEST_SKIP() << "no shared data";
     const FftFile file(shared_data("reference/small-sdstream.fft"));
     const BlockIndex index = BlockIndex::load(file);
     Query q;
