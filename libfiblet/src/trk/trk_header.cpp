@@ -86,7 +86,7 @@ TrkHeader read_trk_header(const std::string& path) {
     if (in.get<std::int32_t>(kHdrSize) != 1000)
         bad(path, "hdr_size is " + std::to_string(le.get<std::int32_t>(kHdrSize)) + " (1000 in either byte order expected)");
     h.version = in.get<std::int32_t>(kVersion);
-    if (h.version < 1 || h.version > 3)
+    if (h.version < 1 || h.version > 2)
         throw Error(Errc::unsupported, path + ": TrackVis .trk version " + std::to_string(h.version) +
                                            " is not supported (fiblet reads versions 1 and 2)");
     for (int k = 0; k < 3; ++k) {
@@ -94,6 +94,9 @@ TrkHeader read_trk_header(const std::string& path) {
         h.space.voxel_sizes[std::size_t(k)] = in.get<float>(kVoxelSize + 4 * std::size_t(k));
         h.origin[std::size_t(k)] = in.get<float>(kOrigin + 4 * std::size_t(k));
     }
+    for (int k = 0; k < 3; ++k)
+        if (h.space.dimensions[std::size_t(k)] < 0)
+            bad(path, "dimension " + std::to_string(h.space.dimensions[std::size_t(k)]) + " is negative");
     for (int k = 0; k < 3; ++k)
         if (!(h.space.voxel_sizes[std::size_t(k)] > 0 && std::isfinite(h.space.voxel_sizes[std::size_t(k)])))
             bad(path, "voxel size " + std::to_string(h.space.voxel_sizes[std::size_t(k)]) + " is not positive");

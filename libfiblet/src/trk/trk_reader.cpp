@@ -7,6 +7,7 @@
 #include <cstring>
 #include <memory>
 
+#include "core/finite_points.hpp"
 #include "core/streamline_label.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/trk.hpp"
@@ -113,6 +114,8 @@ struct TrkReader::Impl {
                          narrow_to_float(a[4] * x + a[5] * y + a[6] * z + a[7]),
                          narrow_to_float(a[8] * x + a[9] * y + a[10] * z + a[11])};
         }
+        if (const auto k = detail::first_non_finite(points))
+            bad(detail::streamline_label(streamlines) + " " + detail::non_finite_point_message(points, *k));
         if (first_pass && header.n_scalars > 0 && n > 0)
             append(scalars, header.scalars, values.data() + 3, stride, points.size());
         if (first_pass && header.n_properties > 0)

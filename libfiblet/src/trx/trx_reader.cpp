@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "core/bytes.hpp"
+#include "core/finite_points.hpp"
 #include "core/streamline_label.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/tractogram_format.hpp"
@@ -20,6 +22,23 @@ using detail::TrxEntryName;
 
 [[noreturn]] void bad(const std::string& path, const std::string& what) {
     throw Error(Errc::trx_format, path + ": not a valid TRX file: " + what);
+}
+
+// Counts no file can hold more of: sizes computed from them (count x 3 x 8
+// bytes) stay far from overflowing 64 bits.
+constexpr std::uint64_t kMaxCount = std::uint64_t(1) << 56;
+
+// A JSON count: an integer in [0, max] (a float only where it is one
+// exactly), checked before any cast.
+std::uint64_t json_count(const nlohmann::json& v, const char* key, std::uint64_t max, const std::string& path) {
+    if (v.is_number_unsigned() && v.get<std::uint64_t>() <= max) return v.get<std::uint64_t>();
+    if (v.is_number_integer() && v.get<std::int64_t>() >= 0 && std::uint64_t(v.get<std::int64_t>()) <= max)
+        return std::uint64_t(v.get<std::int64_t>());
+    if (v.is_number_float()) {
+        const double x = v.get<double>();
+        if (x >= 0 && x <= double(max) && x == std::floor(x)) return std::uint64_t(x);
+    }
+    bad(path, std::string("header.json: ") + key + " is " + v.dump() + ", not an integer in [0, " + std::to_string(max) + "]");
 }
 
 struct TrxHeaderJson {
@@ -40,20 +59,16 @@ TrxHeaderJson parse_header(const std::vector<std::uint8_t>& text, const std::str
         }
         const auto& d = j.at("DIMENSIONS");
         if (!d.is_array() || d.size() != 3) bad(path, "header.json: DIMENSIONS is not 3 numbers");
-        for (std::size_t k = 0; k < 3; ++k) {
-            const auto v = d[k].get<std::int64_t>();
-            if (v < 0 || v > 65535) bad(path, "header.json: DIMENSIONS " + std::to_string(v) + " out of uint16 range");
-            h.dimensions[k] = int(v);
-        }
-        const auto s = j.at("NB_STREAMLINES").get<std::int64_t>();
-        const auto v = j.at("NB_VERTICES").get<std::int64_t>();
-        if (s < 0 || v < 0) bad(path, "header.json: negative NB_STREAMLINES or NB_VERTICES");
-        h.streamlines = std::uint64_t(s), h.vertices = std::uint64_t(v);
+        for (std::size_t k = 0; k < 3; ++k) h.dimensions[k] = int(json_count(d[k], "DIMENSIONS", 65535, path));
+        h.streamlines = json_count(j.at("NB_STREAMLINES"), "NB_STREAMLINES", kMaxCount, path);
+        h.vertices = json_count(j.at("NB_VERTICES"), "NB_VERTICES", kMaxCount, path);
     } catch (const nlohmann::json::exception& e) {
         bad(path, std::string("header.json: ") + e.what());
     }
+    // Finite, and within float32 (the affine and its voxel sizes are stored as floats).
     for (double x : h.affine)
-        if (!std::isfinite(x)) bad(path, "header.json: VOXEL_TO_RASMM holds a non-finite number");
+        if (!(std::fabs(x) <= double(std::numeric_limits<float>::max())))
+            bad(path, "header.json: VOXEL_TO_RASMM holds " + std::to_string(x) + ", not a float32 number");
     return h;
 }
 
@@ -144,6 +159,9 @@ struct TrxReader::Impl {
             } else {
                 StreamlineField f{n->name, dtype(*n, entry, path), n->components, {}};
                 if (!f.scope()) throw Error(Errc::unsupported, path + ": TRX entry " + entry + " is not one fiblet reads");
+                // One array per name: dps/w.float32 beside dps/w.float64 would be one field twice.
+                for (const StreamlineField& earlier : fields)
+                    if (earlier.name == f.name) bad(path, "more than one array named " + f.name + " (" + entry + ")");
                 check_plausible_size(f, entry);
                 f.bytes = archive->read_all(entry);
                 const std::string problem = check_streamline_field(f, header.streamlines, header.vertices);
@@ -178,6 +196,8 @@ struct TrxReader::Impl {
         if (positions_type == FieldType::float32) std::memcpy(out, raw.data(), raw.size());
         else
             for (std::size_t i = 0; i < 3 * n; ++i) out[i] = narrow_to_float(field_value(positions_type, &raw[i * size]));
+        if (const auto k = detail::first_non_finite(points))
+            bad(path, detail::streamline_label(next_fiber) + " " + detail::non_finite_point_message(points, *k));
         ++next_fiber;
         return true;
     }

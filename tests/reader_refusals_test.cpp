@@ -1,0 +1,180 @@
+// What the .trk and TRX readers refuse where they read it, so that compress
+// never writes a file its own readers then refuse: non-finite coordinates
+// (named by streamline and point), a .trk version or dimension no reader
+// takes, a TRX affine beyond float32, one TRX array under two dtypes, and
+// header counts that are not integers in range (checked before any cast).
+// Each case: the reader's category through the API, and compress exiting 4
+// with no output left.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "cli_runner.hpp"
+#include "fiblet/error.hpp"
+#include "fiblet/streamline_io.hpp"
+#include "fiblet/trk.hpp"
+#include "test_util.hpp"
+
+namespace fiblet {
+namespace {
+
+using test::TempDir;
+
+void read_all(const std::string& path) {
+    auto s = open_streamline_source(path);
+    std::vector<Vec3f> points;
+    while (s->next(points)) {
+    }
+}
+
+// The reader's error (category and message) for `path`.
+struct Refusal {
+    std::optional<Errc> code;
+    std::string message;
+};
+Refusal refusal(const std::string& path) {
+    try {
+        read_all(path);
+    } catch (const Error& e) {
+        return {e.code(), e.what()};
+    }
+    return {};
+}
+
+// compress refuses it as bad input (exit 4) and leaves no output.
+void expect_compress_refuses(const TempDir& dir, const std::string& input) {
+    const std::string out = dir.file("out.fft");
+    const auto r = test::run_cli("compress -q " + input + " -o " + out);
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+std::string le32(std::int32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); }
+std::string le16(std::int16_t v) { return std::string(reinterpret_cast<const char*>(&v), 2); }
+std::string f32(float v) { return std::string(reinterpret_cast<const char*>(&v), 4); }
+
+// A .trk of two 3-point streamlines (identity space), written by fiblet.
+std::string trk_file(const TempDir& dir, const std::string& name) {
+    const std::string path = dir.file(name);
+    SinkHeader h;
+    h.fibers = 2, h.points = 6;
+    TrkWriter w(path, h, true);
+    const float xyz[] = {1, 2, 3, 1.5f, 2, 3, 2, 2, 3, 5, 5, 5, 5, 5.5f, 5, 5, 6, 5};
+    w.write(xyz, 3);
+    w.write(xyz + 9, 3);
+    w.finish();
+    return path;
+}
+
+// `src` with `bytes` written at `offset`, as `name`.
+std::string patched(const TempDir& dir, const std::string& src, std::size_t offset, const std::string& bytes,
+                    const std::string& name) {
+    std::string data = test::read_file(src);
+    data.replace(offset, bytes.size(), bytes);
+    test::write_file(dir.file(name), data);
+    return dir.file(name);
+}
+
+// The first point's y of the second streamline: after the 1000-byte header,
+// streamline 0 (a count and 3 points), the count of streamline 1, x.
+constexpr std::size_t kTrkSecondY = 1000 + 4 + 36 + 4 + 4;
+constexpr std::size_t kTrkDimY = 6 + 2;  // int16 dim[3] after "TRACK\0"
+constexpr std::size_t kTrkVersion = 992;
+
+TEST(ReaderRefusals, TrkNonFiniteCoordinatesNameTheirStreamlineAndPoint) {
+    TempDir dir;
+    const std::string good = trk_file(dir, "good.trk");
+    ASSERT_FALSE(refusal(good).code);
+    for (const float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+        const std::string path = patched(dir, good, kTrkSecondY, f32(bad), "bad.trk");
+        const Refusal r = refusal(path);
+        EXPECT_EQ(r.code, Errc::trk_format);
+        EXPECT_NE(r.message.find("streamline 1 (0-based) point 0 (0-based) is not finite"), std::string::npos) << r.message;
+        expect_compress_refuses(dir, path);
+    }
+}
+
+TEST(ReaderRefusals, TrkVersionThreeAndNegativeDimensions) {
+    TempDir dir;
+    const std::string good = trk_file(dir, "good.trk");
+    EXPECT_EQ(refusal(patched(dir, good, kTrkVersion, le32(3), "v3.trk")).code, Errc::unsupported);
+    const std::string negative = patched(dir, good, kTrkDimY, le16(-4), "dim.trk");
+    const Refusal r = refusal(negative);
+    EXPECT_EQ(r.code, Errc::trk_format);
+    EXPECT_NE(r.message.find("dimension -4 is negative"), std::string::npos) << r.message;
+    expect_compress_refuses(dir, negative);
+}
+
+// A TRX directory: header.json as given, two streamlines of 1 and 2 float32 points.
+std::string trx_dir(const TempDir& dir, const std::string& name, const std::string& header_json,
+                    std::vector<float> positions = {1, 2, 3, 4, 5, 6, 4, 5, 7}) {
+    const std::string root = dir.file(name);
+    std::filesystem::create_directories(root);
+    test::write_file(root + "/header.json", header_json);
+    test::write_file(root + "/positions.3.float32",
+                     std::string(reinterpret_cast<const char*>(positions.data()), positions.size() * 4));
+    const std::uint32_t offsets[2] = {0, 1};
+    test::write_file(root + "/offsets.uint32", std::string(reinterpret_cast<const char*>(offsets), sizeof offsets));
+    return root;
+}
+
+std::string trx_header(const std::string& affine_scale, const std::string& streamlines, const std::string& vertices) {
+    return R"({"VOXEL_TO_RASMM": [[)" + affine_scale + R"(,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]], "DIMENSIONS": [10, 10, 10], )" +
+           R"("NB_STREAMLINES": )" + streamlines + R"(, "NB_VERTICES": )" + vertices + "}";
+}
+
+TEST(ReaderRefusals, TrxNonFinitePositionsNameTheirStreamlineAndPoint) {
+    TempDir dir;
+    ASSERT_FALSE(refusal(trx_dir(dir, "good.trx", trx_header("1", "2", "3"))).code);
+    const std::string path =
+        trx_dir(dir, "nan.trx", trx_header("1", "2", "3"), {1, 2, 3, 4, 5, 6, 4, std::nanf(""), 7});
+    const Refusal r = refusal(path);
+    EXPECT_EQ(r.code, Errc::trx_format);
+    EXPECT_NE(r.message.find("streamline 1 (0-based) point 1 (0-based) is not finite"), std::string::npos) << r.message;
+    expect_compress_refuses(dir, path);
+}
+
+TEST(ReaderRefusals, TrxAffineBeyondFloat32) {
+    TempDir dir;
+    const std::string path = trx_dir(dir, "huge.trx", trx_header("1e300", "2", "3"));
+    const Refusal r = refusal(path);
+    EXPECT_EQ(r.code, Errc::trx_format);
+    EXPECT_NE(r.message.find("not a float32 number"), std::string::npos) << r.message;
+    expect_compress_refuses(dir, path);
+}
+
+TEST(ReaderRefusals, TrxOneArrayUnderTwoDtypes) {
+    TempDir dir;
+    const std::string root = trx_dir(dir, "twice.trx", trx_header("1", "2", "3"));
+    std::filesystem::create_directories(root + "/dps");
+    const float w32[2] = {1, 2};
+    const double w64[2] = {1, 2};
+    test::write_file(root + "/dps/w.float32", std::string(reinterpret_cast<const char*>(w32), sizeof w32));
+    test::write_file(root + "/dps/w.float64", std::string(reinterpret_cast<const char*>(w64), sizeof w64));
+    const Refusal r = refusal(root);
+    EXPECT_EQ(r.code, Errc::trx_format);
+    EXPECT_NE(r.message.find("more than one array named dps/w"), std::string::npos) << r.message;
+    expect_compress_refuses(dir, root);
+}
+
+TEST(ReaderRefusals, TrxCountsAreIntegersInRangeBeforeAnyCast) {
+    TempDir dir;
+    // 1e30 and 2^62 + 1 overflowed (or wrapped a size product); 10.5 was cut to 10; -3 is no count.
+    for (const std::string& vertices : {"1e30", "4611686018427387905", "10.5", "-3", "\"3\""}) {
+        SCOPED_TRACE(vertices);
+        const Refusal r = refusal(trx_dir(dir, "count.trx", trx_header("1", "2", vertices)));
+        EXPECT_EQ(r.code, Errc::trx_format);
+        EXPECT_NE(r.message.find("NB_VERTICES is"), std::string::npos) << r.message;
+        std::filesystem::remove_all(dir.file("count.trx"));
+    }
+    // An integral float is a count.
+    EXPECT_FALSE(refusal(trx_dir(dir, "float.trx", trx_header("1", "2.0", "3.0"))).code);
+}
+
+}  // namespace
+}  // namespace fiblet
