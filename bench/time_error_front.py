@@ -24,6 +24,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import textwrap
 import time
 
 import numpy as np
@@ -258,8 +259,9 @@ def plot(result, path):
         ax.set_title(f"{title}: lower right is better")
         ax.grid(True, which="both", alpha=0.3)
     axes[0].legend(fontsize=8, loc="best")
-    fig.suptitle(f"{result['tck']}: {result['machine']} (marker area ∝ compression ratio)",
-                 fontsize=9)
+    # Wrapped: the machine's description (CPU, SIMD, kernel, load) is longer than the figure.
+    title = f"{result['tck']}: {result['machine']} (marker area ∝ compression ratio)"
+    fig.suptitle("\n".join(textwrap.wrap(title, 160)), fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 
