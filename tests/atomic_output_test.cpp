@@ -191,3 +191,38 @@ TEST_P(SignalDuringWrite, LeavesNoTemporaryAndNoOutput) {
 
 INSTANTIATE_TEST_SUITE_P(Signals, SignalDuringWrite, ::testing::Values(SIGINT, SIGTERM),
                          [](const auto& info) { return info.param == SIGINT ? "SIGINT" : "SIGTERM"; });
+
+// Standard input and output go through spools in $TMPDIR: a signal while
+// compress waits on standard input that does not end removes both, the
+// input's partial copy and the output's spool.
+class SignalDuringSpool : public ::testing::TestWithParam<int> {};
+
+TEST_P(SignalDuringSpool, LeavesNoSpoolInTmpdir) {
+    const int sig = GetParam();
+    test::TempDir dir, tmp;
+    // set -m: a background job of a shell without job control ignores SIGINT.
+    // Standard input is a FIFO the script holds open: compress waits on it.
+    test::write_file(dir.file("run.sh"),
+                     "set -m\n"
+                     "export TMPDIR=" + tmp.path() + "\n"
+                     "mkfifo " + dir.file("in") + "\n" +
+                     std::string(FIBLET_CLI) + " compress - -o - < " + dir.file("in") + " >/dev/null 2>&1 &\n"
+                     "pid=$!\n"
+                     "exec 3>" + dir.file("in") + "\n"
+                     "printf 'mrtrix tracks\\n' >&3\n"
+                     "for i in $(seq 100); do [ $(ls " + tmp.path() + " | wc -l) -ge 2 ] && break; sleep 0.05; done\n"
+                     "ls " + tmp.path() + " | sed 's/stdio-.*[.]/stdio-*./' | sort\n"
+                     "kill -" + std::to_string(sig) + " $pid\n"
+                     "wait $pid\n"
+                     "echo status $?\n"
+                     "exec 3>&-\n"
+                     "ls " + tmp.path() + "\n");
+    const auto r = test::run_command("bash " + dir.file("run.sh"));
+    // Both spools existed while compress waited, and none is left.
+    EXPECT_EQ(r.output, "fiblet-stdio-*.fft\nfiblet-stdio-*.tck\nstatus " + std::to_string(128 + sig) + "\n");
+}
+
+INSTANTIATE_TEST_SUITE_P(Signals, SignalDuringSpool, ::testing::Values(SIGINT, SIGTERM, SIGHUP),
+                         [](const auto& info) {
+                             return info.param == SIGINT ? "SIGINT" : info.param == SIGTERM ? "SIGTERM" : "SIGHUP";
+                         });

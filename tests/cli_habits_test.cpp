@@ -310,3 +310,51 @@ TEST(CliHabits, ATrxDirectoryIsOneInputWithOrWithoutRecursion) {
     EXPECT_EQ(FftFile(fx.dir.file("out/sub-01/dwi.fft")).header().fibers, 3u);
     EXPECT_EQ(test::read_file(fx.dir.file("out/sub-01/dwi.fft")), test::read_file(fx.dir.file("one.fft")));
 }
+
+// -r confines its outputs to --output-dir: a symlinked input maps to the
+// link's own path in the tree, never its target's (which may lie outside
+// the tree: "..", and folders created on the way).
+TEST(CliHabits, RecursiveOutputsStayInTheOutputDirForSymlinkedInputs) {
+    Fixture fx;
+    fs::create_directories(fx.dir.file("elsewhere/deep"));
+    fs::create_directories(fx.dir.file("tree/sub"));
+    fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("elsewhere/deep/x.tck"));
+    fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("tree/a.tck"));
+    fs::create_symlink("../../elsewhere/deep/x.tck", fx.dir.file("tree/sub/link.tck"));
+    const auto r = run_in(fx.dir, "compress -q -r tree --output-dir out");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(FftFile(fx.dir.file("out/a.fft")).header().fibers, 3u);
+    EXPECT_EQ(FftFile(fx.dir.file("out/sub/link.fft")).header().fibers, 3u);
+    // Nothing beside the tree, nothing next to the link's target.
+    EXPECT_FALSE(fs::exists(fx.dir.file("elsewhere/deep/x.fft")));
+    EXPECT_FALSE(fs::exists(fx.dir.file("deep")));
+    std::size_t outputs = 0;
+    for (const auto& e : fs::recursive_directory_iterator(fx.dir.path()))
+        outputs += e.path().extension() == ".fft" && e.path().filename() != "in.fft";
+    EXPECT_EQ(outputs, 2u);
+}
+
+// Two inputs that would write one output are refused before anything is
+// written (exit 2, both named): x.tck beside x.trk, or two x.tck into one
+// --output-dir.
+TEST(CliHabits, InputsThatWouldWriteOneOutputAreRefusedUpFront) {
+    Fixture fx;
+    fs::create_directories(fx.dir.file("tree"));
+    fs::create_directories(fx.dir.file("a"));
+    fs::create_directories(fx.dir.file("b"));
+    fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("tree/x.tck"));
+    ASSERT_EQ(run_in(fx.dir, "decompress -q in.fft -o tree/x.trk").status, 0);
+    const auto pair = run_in(fx.dir, "compress -q -f -r tree --output-dir out");
+    EXPECT_EQ(pair.status, 2) << pair.output;
+    EXPECT_TRUE(mentions(pair, "tree/x.tck and tree/x.trk -> out/x.fft")) << pair.output;
+    EXPECT_FALSE(fs::exists(fx.dir.file("out")));
+    const auto beside = run_in(fx.dir, "compress -q -f -r tree");
+    EXPECT_EQ(beside.status, 2) << beside.output;
+    EXPECT_FALSE(fs::exists(fx.dir.file("tree/x.fft")));
+    fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("a/x.tck"));
+    fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("b/x.tck"));
+    const auto flat = run_in(fx.dir, "compress -q a/x.tck b/x.tck --output-dir flat");
+    EXPECT_EQ(flat.status, 2) << flat.output;
+    EXPECT_TRUE(mentions(flat, "a/x.tck and b/x.tck -> flat/x.fft")) << flat.output;
+    EXPECT_FALSE(fs::exists(fx.dir.file("flat")));
+}

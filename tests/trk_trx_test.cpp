@@ -105,6 +105,29 @@ TEST(TrkFormat, RoundTripKeepsPointsSpaceAndFields) {
 
 // The bundles' .tck twins were written by nibabel from the .trk's
 // load(...).streamlines: the .trk reader must give those floats.
+// A property of 20000 values is written "w\020000" (nibabel's encoding,
+// int16 counts): fiblet's reader takes back what its writer writes.
+TEST(TrkFormat, FiveDigitValueCountsRoundTrip) {
+    TempDir dir;
+    const std::string path = dir.path() + "/wide.trk";
+    SinkHeader h;
+    h.fibers = 3, h.points = 6;
+    std::vector<float> values(3 * 20000);
+    for (std::size_t i = 0; i < values.size(); ++i) values[i] = float(i % 977);
+    h.fields = {float_field("dps/w", 20000, values)};
+    {
+        TrkWriter w(path, h, false);
+        write(w, three_fibers());
+    }
+    TrkReader r(path);
+    expect_near(read_all(r), three_fibers(), 2e-5);
+    const auto fields = r.take_fields();
+    ASSERT_EQ(fields.size(), 1u);
+    EXPECT_EQ(fields[0].name, "dps/w");
+    EXPECT_EQ(fields[0].components, 20000u);
+    EXPECT_EQ(fields[0].bytes, h.fields[0].bytes);
+}
+
 TEST(TrkFormat, GivesNibabelsCoordinatesOnSharedBundles) {
     if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
     for (const char* name : {"AF_L", "CC_ForcepsMajor", "CST_R"}) {

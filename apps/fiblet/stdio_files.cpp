@@ -40,6 +40,7 @@ SpoolFile::SpoolFile(const std::string& suffix) {
     std::string name = std::string(tmp && *tmp ? tmp : "/tmp") + "/fiblet-stdio-XXXXXX" + suffix;
     const int fd = ::mkstemps(name.data(), int(suffix.size()));
     if (fd < 0) fail("cannot create a temporary file for - in " + name.substr(0, name.rfind('/')));
+    pending_.emplace(name);
     ::close(fd);
     path_ = name;
 }

@@ -11,6 +11,8 @@
 #include <optional>
 #include <string>
 
+#include "fiblet/output_file.hpp"
+
 namespace fiblet::cli {
 
 inline bool is_stdio(const std::string& path) { return path == "-"; }
@@ -28,6 +30,7 @@ public:
 
 private:
     std::string path_;
+    std::optional<PendingTemporary> pending_;  // removed on a fatal signal too
 };
 
 // The file to read for `input`: itself, or for `-` a spool filled from stdin.

@@ -71,6 +71,19 @@ private:
 // it from its fatal-signal handler before exiting.
 void remove_pending_outputs() noexcept;
 
+// A temporary file of the caller's own (a CLI's spool of standard input or
+// output): remove_pending_outputs() removes it too, until this is destroyed.
+class PendingTemporary {
+public:
+    explicit PendingTemporary(const std::string& path);
+    ~PendingTemporary();
+    PendingTemporary(const PendingTemporary&) = delete;
+    PendingTemporary& operator=(const PendingTemporary&) = delete;
+
+private:
+    int slot_ = -1;
+};
+
 // Installs handlers for every catchable signal that ends a process by
 // default (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE, SIGXFSZ, SIGXCPU,
 // SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF) that remove pending

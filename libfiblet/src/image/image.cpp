@@ -6,6 +6,7 @@
 #include "fiblet/error.hpp"
 #include "fiblet/image.hpp"
 #include "image/image_readers.hpp"
+#include "io/regular_input.hpp"
 
 namespace fiblet {
 
@@ -22,6 +23,7 @@ std::int64_t Image::volumes() const {
 }
 
 Image read_image(const std::string& path) {
+    detail::require_regular_input(path);
     if (ends_with(path, ".nii") || ends_with(path, ".nii.gz")) return detail::read_nifti(path);
     if (ends_with(path, ".mif") || ends_with(path, ".mih")) return detail::read_mif(path);
     if (ends_with(path, ".mif.gz"))

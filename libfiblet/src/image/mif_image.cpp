@@ -12,6 +12,7 @@
 #include "fiblet/error.hpp"
 #include "image/image_readers.hpp"
 #include "io/key_value_header.hpp"
+#include "io/regular_input.hpp"
 
 namespace fiblet::detail {
 namespace {
@@ -137,6 +138,7 @@ std::pair<std::string, std::uint64_t> data_file(const std::string& path, const s
 }
 
 std::vector<std::uint8_t> read_bytes(const std::string& path, std::uint64_t offset, std::uint64_t n) {
+    require_regular_input(path);  // a .mih's file: may name any path
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
     in.seekg(0, std::ios::end);

@@ -19,6 +19,7 @@
 #include "fiblet/tractogram_format.hpp"
 #include "io/fftz_reader.hpp"
 #include "io/open_inputs.hpp"
+#include "io/regular_input.hpp"
 
 namespace fiblet {
 using detail::get_le;
@@ -108,6 +109,7 @@ struct FftFile::Mapping {
 
 FftFile::FftFile(const std::string& path, FftOpenOptions options)
     : path_(path), options_(options), mapping_(std::make_unique<Mapping>()) {
+    detail::require_regular_input(path);
     fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd_ < 0) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
     input_ = std::make_unique<detail::InputRegistration>(fd_);

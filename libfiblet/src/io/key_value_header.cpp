@@ -2,6 +2,7 @@
 // a file descriptor, so that a binary file without newlines fails fast and in
 // bounded memory.
 #include "io/key_value_header.hpp"
+#include "io/regular_input.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -113,6 +114,7 @@ KeyValueHeader read_key_value_header(const std::string& path, std::string_view m
                                      std::string_view what) {
     auto bad = [&](const std::string& why) { fail(path, code, what, why); };
     Fd f;
+    detail::require_regular_input(path);
     f.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (f.fd < 0) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
     struct stat st {};

@@ -76,6 +76,16 @@ void remove_pending_outputs() noexcept {
         if (s.ready.load()) ::unlink(s.path);
 }
 
+PendingTemporary::PendingTemporary(const std::string& path) {
+    const SignalBlock block;
+    slot_ = register_temporary(path);
+}
+
+PendingTemporary::~PendingTemporary() {
+    const SignalBlock block;
+    unregister_temporary(slot_);
+}
+
 void AtomicOutputFile::check_destination(const std::string& path, bool overwrite) {
     const detail::OutputTarget target = detail::resolve_output_target(path);
     if (!overwrite && target.exists && !target.write_through)

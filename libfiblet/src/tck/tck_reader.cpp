@@ -14,6 +14,7 @@
 #include "fiblet/tck.hpp"
 #include "core/streamline_label.hpp"
 #include "io/open_inputs.hpp"
+#include "io/regular_input.hpp"
 
 namespace fiblet {
 namespace {
@@ -290,6 +291,7 @@ TckReader::TckReader(const std::string& path, TckReadOptions options) : impl_(st
     Impl& m = *impl_;
     m.path = path;
     m.options = options;
+    detail::require_regular_input(path);
     m.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (m.fd < 0) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
     struct stat& st = m.opened;

@@ -12,6 +12,7 @@
 #include "fiblet/tck.hpp"
 #include "fiblet/trk.hpp"
 #include "fiblet/trx.hpp"
+#include "io/regular_input.hpp"
 
 namespace fiblet {
 namespace {
@@ -60,6 +61,7 @@ void check_readable(const std::string& path) {
 }  // namespace
 
 std::unique_ptr<StreamlineSource> open_streamline_source(const std::string& path, const SourceOptions& options) {
+    detail::require_regular_input(path, true);
     TractogramFormat f = detect_tractogram_format(path);
     if (f == TractogramFormat::unknown) {
         check_readable(path);

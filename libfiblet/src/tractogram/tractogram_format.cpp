@@ -1,5 +1,6 @@
 // Recognising a tractogram file by its first bytes, then by its name.
 #include "fiblet/tractogram_format.hpp"
+#include "io/regular_input.hpp"
 
 #include <sys/stat.h>
 
@@ -76,6 +77,7 @@ TractogramFormat format_from_extension(const std::string& path) {
 TractogramFormat detect_tractogram_format(const std::string& path) {
     if (is_directory(path))
         return file_exists(path + "/header.json") ? TractogramFormat::trx : TractogramFormat::unknown;
+    if (!detail::is_regular_input(path)) return TractogramFormat::unknown;  // never opened: no hang, nothing consumed
     std::FILE* f = std::fopen(path.c_str(), "rb");
     if (!f) return TractogramFormat::unknown;
     std::array<char, 64> buf{};

@@ -42,7 +42,8 @@ TrkHeader::Named decode_name(const std::uint8_t* p, const std::string& path) {
     const auto nul = s.find('\0');
     if (nul == std::string::npos) return {s, 1};
     const std::string count = s.substr(nul + 1);
-    if (count.empty() || count.size() > 4 || !std::all_of(count.begin(), count.end(), ::isdigit))
+    // Up to 5 digits: n_scalars and n_properties are int16 (nibabel writes "w\020000").
+    if (count.empty() || count.size() > 5 || !std::all_of(count.begin(), count.end(), ::isdigit))
         bad(path, "field name \"" + s.substr(0, nul) + "\" is followed by \"" + count + "\", not a value count");
     return {s.substr(0, nul), std::stoi(count)};
 }
