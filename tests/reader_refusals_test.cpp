@@ -6,11 +6,14 @@
 // Each case: the reader's category through the API, and compress exiting 4
 // with no output left.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -174,6 +177,62 @@ TEST(ReaderRefusals, TrxCountsAreIntegersInRangeBeforeAnyCast) {
     }
     // An integral float is a count.
     EXPECT_FALSE(refusal(trx_dir(dir, "float.trx", trx_header("1", "2.0", "3.0"))).code);
+}
+
+// The CLI's exit status and peak RSS (MB) for `args`.
+std::pair<int, double> status_and_peak_rss_mb(const std::vector<std::string>& args) {
+    const pid_t pid = test::spawn_cli(args);
+    int status = 0;
+    rusage usage{};
+    ::wait4(pid, &status, 0, &usage);
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, double(usage.ru_maxrss) / 1024.0};
+}
+
+// Small files that claimed gigabytes were given them: memory follows what the
+// file holds, not what it says (issue 32, class 3). Peak RSS before the fix:
+// 1.27 GB (header.json of nested '['), ~1.5 GB (the gzip mask).
+TEST(ReaderRefusals, SmallFilesClaimingGigabytesStayWithinAFewMegabytes) {
+    TempDir dir;
+    const double bound_mb = test::kSanitized ? 1024 : 200;
+    // header.json of 8 MiB of '[': the parser built ~80 bytes per level.
+    const std::string deep = trx_dir(dir, "deep.trx", std::string(8u << 20, '['));
+    const Refusal r = refusal(deep);
+    EXPECT_EQ(r.code, Errc::trx_format);
+    EXPECT_NE(r.message.find("nests deeper than 32 levels"), std::string::npos) << r.message;
+    const auto [deep_status, deep_mb] = status_and_peak_rss_mb({"compress", "-q", deep, "-o", dir.file("deep.fft")});
+    EXPECT_EQ(deep_status, 4);
+    EXPECT_LT(deep_mb, bound_mb);
+
+    // A .nii.gz whose header claims 1000 x 1000 x 1500 uint8 voxels (1.5 GB,
+    // within the 1032:1 deflate ratio of its 1.5 MB) and holds 1.5 MB.
+    std::string nii(352, '\0');
+    auto put16 = [&](std::size_t at, std::int16_t v) { std::memcpy(&nii[at], &v, 2); };
+    auto put32 = [&](std::size_t at, std::int32_t v) { std::memcpy(&nii[at], &v, 4); };
+    auto putf = [&](std::size_t at, float v) { std::memcpy(&nii[at], &v, 4); };
+    put32(0, 348);
+    const std::int16_t dims[4] = {3, 1000, 1000, 1500};
+    for (int i = 0; i < 4; ++i) put16(40 + 2 * std::size_t(i), dims[i]);
+    for (int i = 4; i < 8; ++i) put16(40 + 2 * std::size_t(i), 1);
+    put16(70, 2), put16(72, 8);  // uint8, 8 bits
+    for (int i = 0; i < 8; ++i) putf(76 + 4 * std::size_t(i), 1.0f);
+    putf(108, 352.0f);
+    std::memcpy(&nii[344], "n+1", 4);
+    std::mt19937 rng(7);
+    std::string noise(std::size_t(1.5 * (1 << 20)), '\0');
+    for (char& c : noise) c = char(rng());
+    test::write_file(dir.file("mask.nii"), nii + noise);
+    ASSERT_EQ(test::run_command("gzip -1 " + dir.file("mask.nii")).status, 0);
+    const std::string tck = dir.file("t.tck"), fft = dir.file("t.fft");
+    std::string data = "mrtrix tracks\ndatatype: Float32LE\nfile: . 64\nEND\n";
+    data.resize(64, '\0');
+    const float pts[] = {0, 0, 0, 1, 0, 0, NAN, NAN, NAN, INFINITY, INFINITY, INFINITY};
+    data.append(reinterpret_cast<const char*>(pts), sizeof pts);
+    test::write_file(tck, data);
+    ASSERT_EQ(test::run_cli("compress -q " + tck + " -o " + fft).status, 0);
+    const auto [mask_status, mask_mb] = status_and_peak_rss_mb(
+        {"extract", "-q", fft, "--include", dir.file("mask.nii.gz"), "-o", dir.file("o.tck")});
+    EXPECT_EQ(mask_status, 4);
+    EXPECT_LT(mask_mb, bound_mb);
 }
 
 }  // namespace

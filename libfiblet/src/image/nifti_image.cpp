@@ -61,9 +61,21 @@ std::vector<std::uint8_t> read_voxel_bytes(const std::string& path, const nifti_
     znzFile f = znzopen(path.c_str(), "rb", gz ? 1 : 0);
     if (znz_isnull(f)) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
     const std::size_t bytes = n * std::size_t(h.nbyper);
-    std::vector<std::uint8_t> data(bytes);
-    const bool seeked = znzseek(f, znz_off_t(h.iname_offset), SEEK_SET) >= 0;
-    const std::size_t got = seeked ? znzread(data.data(), 1, bytes, f) : 0;
+    // Grown as the data arrives (64 MiB at a time): a gzip header may claim up
+    // to 1032x its file (deflate's best ratio) and be a lie; memory then
+    // follows the bytes that exist, not the claim.
+    constexpr std::size_t kChunk = std::size_t(64) << 20;
+    std::vector<std::uint8_t> data;
+    std::size_t got = 0;
+    if (znzseek(f, znz_off_t(h.iname_offset), SEEK_SET) >= 0) {
+        while (got < bytes) {
+            const std::size_t want = std::min(kChunk, bytes - got);
+            data.resize(got + want);
+            const std::size_t n_read = znzread(data.data() + got, 1, want, f);
+            got += n_read;
+            if (n_read < want) break;
+        }
+    }
     znzclose(f);
     if (got != bytes)
         throw Error(Errc::image_format, path + ": voxel data truncated (" + std::to_string(bytes) +

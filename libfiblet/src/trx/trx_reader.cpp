@@ -50,7 +50,14 @@ struct TrxHeaderJson {
 TrxHeaderJson parse_header(const std::vector<std::uint8_t>& text, const std::string& path) {
     TrxHeaderJson h;
     try {
-        const auto j = nlohmann::json::parse(text.begin(), text.end());
+        // header.json is two levels deep; a file of nested '[' made the
+        // parser build ~80 bytes per level (16 MiB of them: 1.3 GB).
+        constexpr int kMaxDepth = 32;
+        const auto shallow = [&](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
+            if (depth > kMaxDepth) bad(path, "header.json nests deeper than " + std::to_string(kMaxDepth) + " levels");
+            return true;
+        };
+        const auto j = nlohmann::json::parse(text.begin(), text.end(), shallow);
         const auto& m = j.at("VOXEL_TO_RASMM");
         if (!m.is_array() || m.size() != 4) bad(path, "header.json: VOXEL_TO_RASMM is not 4 rows");
         for (std::size_t r = 0; r < 4; ++r) {
