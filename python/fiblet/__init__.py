@@ -210,11 +210,20 @@ def _fiber_indices(key, count):
         if len(a) != count:
             raise IndexError(f"boolean mask of {len(a)} values for {count} fibers")
         return _np.flatnonzero(a).astype(_np.int64)
+    out_of_range = IndexError(f"fiber index out of range ({count} fibers)")
+    if a.dtype == object and all(isinstance(x, _numbers.Integral) and not isinstance(x, bool) for x in a):
+        # Python ints beyond int64 (10**30): compared as ints, never cast.
+        if any(x < -count or x >= count for x in a):
+            raise out_of_range
+        a = a.astype(_np.int64)
     if a.size and not _np.issubdtype(a.dtype, _np.integer):
         raise TypeError(f"fibers are selected by ints, a slice or a boolean mask, got {a.dtype} values")
+    # Unsigned values are compared before the cast to int64, which would wrap 2**64 - 1 to -1.
+    if a.size and _np.issubdtype(a.dtype, _np.unsignedinteger) and a.max() >= count:
+        raise out_of_range
     a = a.astype(_np.int64, copy=False)
     if a.size and (a.min() < -count or a.max() >= count):
-        raise IndexError(f"fiber index out of range ({count} fibers)")
+        raise out_of_range
     return _np.where(a < 0, a + count, a)
 
 
@@ -236,9 +245,12 @@ def _threads(threads):
     if threads is None:
         return 0
     threads = int(threads)
-    if threads < 1:
-        raise ValueError(f"threads must be >= 1 (or None for all cores), got {threads}")
+    if not 1 <= threads <= _MAX_THREADS:
+        raise ValueError(f"threads must be in [1, {_MAX_THREADS}] (or None for all cores), got {threads}")
     return threads
+
+
+_MAX_THREADS = 1024  # as the CLI and the library (src/core/thread_count.hpp)
 
 
 def load(path, *, roi=None, fibers=None, threads=None, ignore_trailer=False):

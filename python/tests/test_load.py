@@ -149,6 +149,15 @@ def test_bad_arguments_and_bad_files(tmp_path, compressed, shared):
         fiblet.load(fft, roi=fiblet.Box((0, 0, 0), (-1, 1, 1)))
     with pytest.raises(ValueError):
         fiblet.load(fft, threads=0)
+    with pytest.raises(ValueError, match=r"\[1, 1024\]"):
+        fiblet.load(fft, threads=10**6)  # the CLI's and the library's limit
+    # Indices beyond int64 or unsigned near 2**64 are out of range, never wrapped to -1 (the last fiber).
+    with pytest.raises(IndexError):
+        fiblet.load(fft, fibers=np.array([2**64 - 1], np.uint64))
+    with pytest.raises(IndexError):
+        fiblet.load(fft, fibers=10**30)
+    with pytest.raises(IndexError):
+        fiblet.load(fft, fibers=[0, -(10**30)])
     with pytest.raises(fiblet.FibletError) as e:
         fiblet.load(tck)  # a .tck is not a .fft: named, a format fiblet knows but load does not take
     assert e.value.category == "unsupported" and "MRtrix3 .tck" in str(e.value)
