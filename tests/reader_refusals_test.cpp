@@ -235,5 +235,24 @@ TEST(ReaderRefusals, SmallFilesClaimingGigabytesStayWithinAFewMegabytes) {
     EXPECT_LT(mask_mb, bound_mb);
 }
 
+// 2^21 empty streamlines (an 8 MiB offsets array, 131 kB zipped at 2^24):
+// compress's memory follows the per-fiber tables of its output, no longer
+// one batch of them all and a tuning sample of every one (2^21: 297 MB
+// before, 90 MB now; 2^24: 1.84 GB before, 486 MB for a 151 MB output).
+TEST(ReaderRefusals, EmptyStreamlinesCostTheirTablesOnly) {
+    TempDir dir;
+    const std::uint32_t n = 1u << 21;
+    const std::string root = dir.file("empty.trx");
+    std::filesystem::create_directories(root);
+    test::write_file(root + "/header.json", trx_header("1", std::to_string(n), "0"));
+    test::write_file(root + "/positions.3.float32", "");
+    test::write_file(root + "/offsets.uint32", std::string(std::size_t(n) * 4, '\0'));
+    const auto [status, mb] = status_and_peak_rss_mb({"compress", "-q", root, "-o", dir.file("e.fft")});
+    EXPECT_EQ(status, 0);
+    EXPECT_LT(mb, test::kSanitized ? 2048 : 160);
+    const auto info = test::run_cli("info --json " + dir.file("e.fft"));
+    EXPECT_NE(info.output.find("\"fibers\": " + std::to_string(n)), std::string::npos) << info.output.substr(0, 300);
+}
+
 }  // namespace
 }  // namespace fiblet

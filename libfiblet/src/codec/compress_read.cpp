@@ -1,6 +1,7 @@
 // The read stage of compress_tck (compress_stages.hpp): batches of whole
 // fibers, parsed by the caller's thread while the worker pool works on the
 // batch before.
+#include <algorithm>
 #include <limits>
 
 #include "codec/compress_stages.hpp"
@@ -22,7 +23,9 @@ bool read_fiber_batch(StreamlineSource& reader, FiberBatch& b, std::uint32_t fir
             throw Error(Errc::unsupported, reader.path() + ": more than 2^32 - 1 streamlines (fiber IDs are 32-bit)");
         }
         if (!reader.next(b.fibers[b.count])) break;
-        const std::size_t n = b.fibers[b.count++].size();
+        // An empty fiber counts as one point: it still costs per-fiber
+        // tables, and 2^24 of them made one batch of 1.8 GB.
+        const std::size_t n = std::max<std::size_t>(b.fibers[b.count++].size(), 1);
         points += n, task_points += n;
         if (task_points >= kTaskPoints) b.cuts.push_back(b.count), task_points = 0;
     }

@@ -45,8 +45,9 @@ private:
     std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
 };
 
-// A batch: ~256 k points of whole fibers (at least one fiber), cut into tasks
-// of ~16 k points; neither depends on the thread count, so no output does.
+// A batch: ~256 k points of whole fibers (at least one fiber; an empty fiber
+// counts as one point), cut into tasks of ~16 k points; neither depends on
+// the thread count, so no output does.
 inline constexpr std::size_t kBatchPoints = std::size_t{1} << 18;
 inline constexpr std::size_t kTaskPoints = std::size_t{1} << 14;
 

@@ -100,14 +100,17 @@ std::vector<std::vector<Vec3f>> TurnStatistics::sharpest_blocks() const {
 
 void FiberSample::offer(std::span<const Vec3f> fiber) {
     if (seen_++ % stride_ != 0) return;
+    // An empty fiber counts as one point, so that the budget bounds the
+    // sample's fibers too (2^24 empty streamlines were all kept).
+    auto weight = [](std::size_t n) { return std::max<std::size_t>(n, 1); };
     fibers_.emplace_back(fiber.begin(), fiber.end());
-    points_ += fiber.size();
+    points_ += weight(fiber.size());
     while (points_ > max_points_ && fibers_.size() > 1) {
         // Keep every other fiber of the sample: those at multiples of 2 * stride.
         std::size_t w = 0;
         points_ = 0;
         for (std::size_t i = 0; i < fibers_.size(); i += 2, ++w) {
-            points_ += fibers_[i].size();
+            points_ += weight(fibers_[i].size());
             if (w != i) fibers_[w] = std::move(fibers_[i]);
         }
         fibers_.resize(w);

@@ -117,6 +117,7 @@ struct TrxReader::Impl {
         if (bytes.size() % size || (count != header.streamlines && count != header.streamlines + 1))
             bad(path, entry + " holds " + std::to_string(bytes.size()) + " bytes for NB_STREAMLINES = " +
                           std::to_string(header.streamlines));
+        offsets.reserve(count + 1);  // the sentinel below must not double the table
         offsets.resize(count);
         for (std::uint64_t i = 0; i < count; ++i) {  // integers as stored (a double is not exact above 2^53)
             if (t == FieldType::uint64) std::memcpy(&offsets[i], &bytes[i * 8], 8);
