@@ -134,9 +134,45 @@ inline void tck_target(const std::uint8_t* data, std::size_t size) {
 
 // ---------------------------------------------------------------- .trk, TRX
 
+inline double resampled_points_bound(const std::string& path);
+
+// Whatever compress accepts, every reader accepts: a streamline file (any
+// format) that compress turns into a .fft gives a file that verifies
+// (verify_fft_file) and decodes to as many fibers, every coordinate finite. A refusal is fine
+// (bad content, exit 4/6) if it leaves no output.
+inline void compress_reads_back(const std::string& path) {
+    if (resampled_points_bound(path) > 200000) return;
+    const std::string out = scratch_dir() + "/any.fft";
+    std::uint64_t fibers = 0;
+    try {
+        CompressOptions options;
+        options.threads = 1;
+        options.overwrite = true;
+        fibers = compress_tck(path, out, options).header.fibers;
+    } catch (const Error&) {
+        check(!std::filesystem::exists(out), "compress left an output after failing");
+        return;
+    }
+    try {
+        verify_fft_file(out);  // structure, every checksum, the index, finite points
+        const FftFile f(out);
+        check(f.header().fibers == fibers, "the .fft holds another fiber count than compress reported");
+        std::uint64_t decoded = 0;
+        decode_file(f, [&](std::uint64_t, const Streamlines& s) {
+            decoded += s.size();
+            for (float v : s.xyz) check(std::isfinite(v), "decoded a non-finite coordinate from compress output");
+        });
+        check(decoded == fibers, "decode_file missed fibers");
+    } catch (const Error&) {
+        throw HarnessFailure("compress wrote a file its own reader refuses");
+    }
+    std::filesystem::remove(out);
+}
+
 // Any file through open_streamline_source (a .trk, a TRX zip, or whatever
 // the bytes are): only fiblet::Error; a second pass after rewind() reads the
-// same points; the fields match the streamlines read (rows, names, groups).
+// same points; the fields match the streamlines read (rows, names, groups);
+// then, for small inputs, compress_reads_back.
 inline void streamline_source_target(const std::uint8_t* data, std::size_t size) {
     static MemFile input;
     const std::string path = input.set(data, size);
@@ -157,9 +193,12 @@ inline void streamline_source_target(const std::uint8_t* data, std::size_t size)
                           "a field does not match the streamlines read");
         }
         check(sizes[0] == sizes[1], "a second pass read other streamlines");
+        if (points > 20000) return;
     } catch (const Error&) {
         // any category: the input is malformed, unsupported or unreadable
+        return;
     }
+    compress_reads_back(path);
 }
 
 // An upper bound on the points compress may resample a .tck into: its
@@ -168,7 +207,8 @@ inline void streamline_source_target(const std::uint8_t* data, std::size_t size)
 // a quarter). A few points far apart can stand for millions of resampled
 // ones, which the point limit below does not see.
 inline double resampled_points_bound(const std::string& path) {
-    TckReader r(path, {});
+    const auto source = open_streamline_source(path, {});
+    StreamlineSource& r = *source;
     std::vector<Vec3f> f;
     std::vector<double> spacing;
     double length = 0;
@@ -181,7 +221,7 @@ inline double resampled_points_bound(const std::string& path) {
         }
     if (spacing.empty()) return 0;
     std::nth_element(spacing.begin(), spacing.begin() + std::ptrdiff_t(spacing.size() / 2), spacing.end());
-    const double step = std::min(spacing[spacing.size() / 2], r.header().step_size().value_or(INFINITY));
+    const double step = std::min(spacing[spacing.size() / 2], r.step_size().value_or(INFINITY));
     return length / (0.25 * step);
 }
 
