@@ -289,6 +289,15 @@ TEST(CliHabits, DashIsStandardInputAndOutput) {
     const auto r = in_dir("cat in.tck | " + cli + " compress - 2>&1");
     EXPECT_EQ(r.status, 2) << r.output;
     EXPECT_TRUE(mentions(r, "standard input (-) needs -o")) << r.output;
+    // Bad data on standard input is named so, not by the spool's temporary name.
+    const auto bad = in_dir("echo garbage | " + cli + " compress - -o bad.fft 2>&1");
+    EXPECT_EQ(bad.status, 4) << bad.output;
+    EXPECT_TRUE(mentions(bad, "standard input: invalid .tck header")) << bad.output;
+    EXPECT_FALSE(mentions(bad, "fiblet-stdio-")) << bad.output;
+    const auto bad_fft = in_dir("echo garbage | " + cli + " decompress - -o bad.tck 2>&1");
+    EXPECT_EQ(bad_fft.status, 4) << bad_fft.output;
+    EXPECT_TRUE(mentions(bad_fft, "standard input: not a valid .fft file")) << bad_fft.output;
+    EXPECT_FALSE(mentions(bad_fft, "fiblet-stdio-")) << bad_fft.output;
     EXPECT_TRUE(fs::is_empty(fx.dir.file("spool")));
 }
 

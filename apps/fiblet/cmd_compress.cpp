@@ -129,7 +129,13 @@ void run(const CompressArgs& a) {
             std::optional<SpoolFile> stdin_spool, stdout_spool;
             const std::string out_path = writable_path(out, a.zstd ? ".fftz" : ".fft", stdout_spool);
             o.overwrite = a.force || stdout_spool;
-            const CompressReport r = compress_tck(readable_path(in, ".tck", stdin_spool), out_path, o);
+            const CompressReport r = [&] {
+                try {
+                    return compress_tck(readable_path(in, ".tck", stdin_spool), out_path, o);
+                } catch (const Error& e) {
+                    throw named_for_user(e, stdin_spool, stdout_spool);
+                }
+            }();
             progress.done();
             if (stdout_spool) stdout_spool->copy_to_stdout();
             if (a.json) {

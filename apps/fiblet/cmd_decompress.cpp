@@ -23,10 +23,11 @@ struct DecompressArgs {
     bool force = false, quiet = false, json = false, recursive = false;
 };
 
-// Decodes one file; returns its JSON report (empty without --json).
-std::string decompress_one(const DecompressArgs& a, const std::string& input, const std::string& output) {
+// Decodes one file through the spools of `-` (if any); returns its JSON
+// report (empty without --json).
+std::string decompress_through(const DecompressArgs& a, const std::string& input, const std::string& output,
+                               std::optional<SpoolFile>& stdin_spool, std::optional<SpoolFile>& stdout_spool) {
     const auto t0 = std::chrono::steady_clock::now();
-    std::optional<SpoolFile> stdin_spool, stdout_spool;
     const FftFile file = open_fft_input(readable_path(input, ".fft", stdin_spool), a.ignore_trailer);
     const FftHeader& h = file.header();
     // The source's header properties (kept in the trailer), with the step
@@ -75,6 +76,15 @@ std::string decompress_one(const DecompressArgs& a, const std::string& input, co
         fmt::print(report_stream(output), "{} -> {}: {} fibers, {} points in {:.2f} s\n", input, output, h.fibers,
                    h.points, s);
     return {};
+}
+
+std::string decompress_one(const DecompressArgs& a, const std::string& input, const std::string& output) {
+    std::optional<SpoolFile> stdin_spool, stdout_spool;
+    try {
+        return decompress_through(a, input, output, stdin_spool, stdout_spool);
+    } catch (const Error& e) {
+        throw named_for_user(e, stdin_spool, stdout_spool);
+    }
 }
 
 // Every input is tried; with several, a failed one is reported and the

@@ -75,6 +75,19 @@ void SpoolFile::copy_to_stdout() const {
     std::fclose(f);
 }
 
+Error named_for_user(const Error& e, const std::optional<SpoolFile>& stdin_spool,
+                     const std::optional<SpoolFile>& stdout_spool) {
+    std::string message = e.what();
+    auto rename = [&](const std::optional<SpoolFile>& spool, const std::string& name) {
+        if (!spool) return;
+        for (std::size_t at; (at = message.find(spool->path())) != std::string::npos;)
+            message.replace(at, spool->path().size(), name);
+    };
+    rename(stdin_spool, "standard input");
+    rename(stdout_spool, "standard output");
+    return Error(e.code(), message);
+}
+
 CLI::Validator existing_path_or_stdin() {
     return CLI::Validator([](std::string& s) { return is_stdio(s) ? std::string() : CLI::ExistingPath(s); },
                           "PATH or -");

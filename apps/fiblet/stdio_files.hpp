@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "fiblet/error.hpp"
 #include "fiblet/output_file.hpp"
 
 namespace fiblet::cli {
@@ -37,6 +38,12 @@ private:
 std::string readable_path(const std::string& input, const std::string& suffix, std::optional<SpoolFile>& spool);
 // The file to write for `output`: itself, or for `-` a spool (copy_to_stdout() once complete).
 std::string writable_path(const std::string& output, const std::string& suffix, std::optional<SpoolFile>& spool);
+
+// `e` with the spools' temporary names replaced by what the user gave:
+// "standard input" / "standard output" (an error about bad input on `-`
+// named /tmp/fiblet-stdio-XXXXXX.tck, a file the user never saw).
+Error named_for_user(const Error& e, const std::optional<SpoolFile>& stdin_spool,
+                     const std::optional<SpoolFile>& stdout_spool);
 
 // CLI11 check of an input operand: an existing path, or - (standard input).
 CLI::Validator existing_path_or_stdin();
