@@ -4,8 +4,11 @@
 // world transform as `mrinfo -transform -spacing` reports it; malformed
 // images are refused with Error{image_format}.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
+#include <functional>
 #include <random>
 #include <sstream>
 
@@ -178,6 +181,23 @@ TEST_F(ImageReader, NiftiQformOnlyAndNoTransform) {
     expect_affine_near(read_image(none).voxel_to_world, *mr, 1e-6, "no transform vs mrinfo");
 }
 
+// What `fn` writes to the process's stderr (file descriptor 2).
+std::string stderr_of(const std::function<void()>& fn) {
+    std::fflush(stderr);
+    const int saved = ::dup(2);
+    std::FILE* capture = std::tmpfile();
+    ::dup2(fileno(capture), 2);
+    fn();
+    std::fflush(stderr);
+    ::dup2(saved, 2);
+    ::close(saved);
+    std::string out;
+    std::rewind(capture);
+    for (int c; (c = std::fgetc(capture)) != EOF;) out += char(c);
+    std::fclose(capture);
+    return out;
+}
+
 TEST_F(ImageReader, MalformedImagesAreRefused) {
     const SourceImage src = oblique_source({6, 5, 4});
     const std::string source = dir_.file("good.mif"), nii = dir_.file("good.nii"), gz = dir_.file("good.nii.gz");
@@ -200,6 +220,7 @@ TEST_F(ImageReader, MalformedImagesAreRefused) {
         {"truncated.nii", good_nii.substr(0, good_nii.size() - 40)},
         {"header-only.nii", good_nii.substr(0, 200)},
         {"garbage.nii", std::string(2000, '\x7f')},
+        {"zero-axis.nii", good_nii.substr(0, 44) + std::string(2, '\0') + good_nii.substr(46)},  // dim[2] = 0
         {"truncated.nii.gz", good_gz.substr(0, good_gz.size() / 2)},
         {"truncated.mif", good_mif.substr(0, good_mif.size() - 4)},
         {"no-end.mif", good_mif.substr(0, good_mif.find("END"))},
@@ -216,6 +237,17 @@ TEST_F(ImageReader, MalformedImagesAreRefused) {
         const std::string path = variant(name, bytes);
         EXPECT_EQ(error_of([&] { read_image(path); }), Errc::image_format) << name;
     }
+    // Said by fiblet in its error, not by libnifti on stderr ("** ERROR: ... bad dim[2]").
+    std::string message;
+    const std::string printed = stderr_of([&] {
+        try {
+            read_image(dir_.file("zero-axis.nii"));
+        } catch (const Error& e) {
+            message = e.what();
+        }
+    });
+    EXPECT_NE(message.find("dim[2] is 0"), std::string::npos) << message;
+    EXPECT_EQ(printed, "");
     EXPECT_EQ(error_of([&] { read_image(dir_.file("missing.nii")); }), Errc::io);
     EXPECT_EQ(error_of([&] { read_image(dir_.file("missing.mif")); }), Errc::io);
     EXPECT_EQ(error_of([&] { read_image(variant("image.png", "x")); }), Errc::unsupported);

@@ -32,7 +32,7 @@ T field(const std::uint8_t* p, bool swap) {
 
 // The header fields libnifti trusts, checked first: libnifti 3.0.1 crashes
 // on a NIfTI-2 dim[0] out of 1..7, and prints its own messages on stderr
-// for a short header or an unknown datatype.
+// for a short header, an axis of no voxels or an unknown datatype.
 void check_header(const std::string& path, bool gz) {
     std::uint8_t h[540] = {};
     znzFile f = znzopen(path.c_str(), "rb", gz ? 1 : 0);
@@ -50,6 +50,10 @@ void check_header(const std::string& path, bool gz) {
     const bool v2 = header_bytes == 540;
     const std::int64_t ndim = v2 ? field<std::int64_t>(h + 16, swap) : field<std::int16_t>(h + 40, swap);
     if (ndim < 1 || ndim > 7) bad("dim[0] is " + std::to_string(ndim) + " (1 to 7 axes)");
+    for (int a = 1; a <= ndim; ++a) {  // libnifti would print "** ERROR ... bad dim[a]" on stderr
+        const std::int64_t d = v2 ? field<std::int64_t>(h + 16 + 8 * a, swap) : field<std::int16_t>(h + 40 + 2 * a, swap);
+        if (d < 1) bad("dim[" + std::to_string(a) + "] is " + std::to_string(d) + " (at least 1 voxel per axis)");
+    }
     const int datatype = field<std::int16_t>(h + (v2 ? 12 : 70), swap);
     if (!nifti_is_valid_datatype(datatype)) bad("unknown datatype code " + std::to_string(datatype));
 }
