@@ -36,7 +36,7 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-// The CLI's documented exit code for each category (README, "Exit codes").
+// The CLI's documented exit code for each category (docs/tour.md, "Exit codes, in detail").
 int exit_code(Errc c) {
     switch (c) {
         case Errc::io: return 3;

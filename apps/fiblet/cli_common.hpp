@@ -15,7 +15,7 @@
 
 namespace fiblet::cli {
 
-// Exit codes (documented in README.md, "Exit codes").
+// Exit codes (documented in docs/tour.md, "Exit codes, in detail", and docs/cli.md).
 enum ExitCode : int {
     kOk = 0,
     kInternal = 1,     // a bug: unexpected exception
