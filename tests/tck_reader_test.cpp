@@ -235,7 +235,12 @@ TEST(TckReaderShared, InvalidConformanceFilesRejected) {
 TEST(TckReaderShared, MatlabNanCountMismatch) {
     SKIP_WITHOUT_SHARED_DATA();
     const std::string p = shared_data("conformance/matlab_nan.tck");
-    expect_error([&] { read_all(p); }, Errc::tck_format, {"615000", "1 streamlines", "allow_count_mismatch"});
+    expect_error([&] { read_all(p); }, Errc::tck_format, {"615000", "1 streamlines"});
+    try {
+        read_all(p);
+    } catch (const Error& e) {
+        EXPECT_EQ(e.remedy(), Remedy::allow_count_mismatch);  // what reads it anyway (below)
+    }
     TckReadOptions o;
     o.allow_count_mismatch = true;
     const Streamlines s = read_all(p, o);
@@ -524,8 +529,14 @@ TEST_F(TckReaderData, CountMismatch) {
     const std::string data = f32({1, 2, 3, kNaN, kNaN, kNaN, 4, 5, 6, kNaN, kNaN, kNaN, kInf, kInf, kInf});
     EXPECT_EQ(read(data, "Float32LE", "count: 0000000002\n").size(), 2u);
     test::write_file(path, make_tck(data, "Float32LE", "count: 3\n"));
-    expect_error([&] { read_all(path); }, Errc::tck_format,
-                 {"t.tck", "count: 3", "2 streamlines", "allow_count_mismatch", "--allow-count-mismatch"});
+    expect_error([&] { read_all(path); }, Errc::tck_format, {"t.tck", "count: 3", "2 streamlines"});
+    // The option that reads it anyway, for each front end to name (the library's message does not).
+    try {
+        read_all(path);
+    } catch (const Error& e) {
+        EXPECT_EQ(e.remedy(), Remedy::allow_count_mismatch);
+        EXPECT_EQ(std::string(e.what()).find("--"), std::string::npos) << e.what();
+    }
     TckReadOptions o;
     o.allow_count_mismatch = true;
     EXPECT_EQ(read(data, "Float32LE", "count: 3\n", o).size(), 2u);

@@ -15,6 +15,16 @@
 
 namespace fiblet::cli {
 
+std::string cli_message(const Error& e) {
+    switch (e.remedy()) {
+        case Remedy::overwrite: return std::string(e.what()) + " (use --force to overwrite)";
+        case Remedy::ignore_trailer: return std::string(e.what()) + "; --ignore-trailer reads the blocks without it";
+        case Remedy::allow_count_mismatch: return std::string(e.what()) + "; --allow-count-mismatch reads it anyway";
+        case Remedy::none: break;
+    }
+    return e.what();
+}
+
 int exit_code_for(Errc c) {
     switch (c) {
         case Errc::io: return kIo;

@@ -28,6 +28,10 @@ enum ExitCode : int {
     kErrorBound = 8,   // a measured error exceeds --max-error (the report is printed, outputs kept)
 };
 int exit_code_for(Errc c);
+// A library error as the CLI says it: the message, and the option that would
+// have allowed what failed under its command-line name (Remedy: --force,
+// --ignore-trailer, --allow-count-mismatch).
+std::string cli_message(const Error& e);
 // Every code the CLI returns, with its meaning (for `fiblet help --markdown`).
 struct ExitCodeInfo {
     int code;

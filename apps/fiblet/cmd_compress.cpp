@@ -154,7 +154,7 @@ void run(const CompressArgs& a) {
             }
         } catch (const Error& e) {
             progress.done();
-            fmt::print(stderr, "fiblet: error: {}\n", e.what());
+            fmt::print(stderr, "fiblet: error: {}\n", cli_message(e));
             if (!first_failure) first_failure = e;
         }
     }

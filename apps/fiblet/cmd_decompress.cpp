@@ -98,7 +98,7 @@ void run(const DecompressArgs& a) {
             json.push_back(decompress_one(a, in, out));
         } catch (const Error& e) {
             if (jobs.size() == 1) throw;
-            fmt::print(stderr, "fiblet: error: {}\n", e.what());
+            fmt::print(stderr, "fiblet: error: {}\n", cli_message(e));
             if (!first_failure) first_failure = e;
         }
     }

@@ -190,7 +190,7 @@ void run(const RenderArgs& a) {
     if (!a.output.empty())
         for (int i = 0; i < std::max(movie, 1); ++i) outputs.push_back(movie ? frame_path(a.output, i, movie) : a.output);
     for (const std::string& out : outputs)
-        if (!a.force && std::filesystem::exists(out)) throw Error(Errc::exists, out + " exists (use --force to overwrite)");
+        if (!a.force && std::filesystem::exists(out)) throw Error(Errc::exists, out + ": output exists", Remedy::overwrite);
     if (a.frames < 1) throw Error(Errc::invalid_argument, "--frames must be at least 1");
 
     const viewer::HeadlessContext context;

@@ -51,13 +51,13 @@ void run(const VerifyArgs& a) {
             }
             if (!r.has_checksum && a.require_checksum) {
                 const Error e(Errc::checksum, in + ": no checksum and --require-checksum given");
-                fmt::print(stderr, "fiblet: error: {}\n", e.what());
+                fmt::print(stderr, "fiblet: error: {}\n", cli_message(e));
                 if (!first_failure) first_failure = e;
             }
         } catch (const Error& e) {
             progress.done();
             if (a.json) json.push_back(Json{}.str("file", in).str("status", errc_name(e.code())).str("error", e.what()).render());
-            fmt::print(stderr, "fiblet: error: {}\n", e.what());
+            fmt::print(stderr, "fiblet: error: {}\n", cli_message(e));
             if (!first_failure) first_failure = e;
         }
     }

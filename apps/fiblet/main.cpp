@@ -12,8 +12,8 @@
 
 #include "cli_common.hpp"
 #include "geometry_report.hpp"
+#include "signal_cleanup.hpp"
 #include "single_dash_options.hpp"
-#include "fiblet/output_file.hpp"
 
 namespace {
 
@@ -49,7 +49,7 @@ int run(CLI::App& app, int argc, char** argv) {
         fmt::print(stderr, "fiblet: {}\n", e.what());
         return kErrorBound;
     } catch (const fiblet::Error& e) {
-        fmt::print(stderr, "fiblet: error: {}\n", e.what());
+        fmt::print(stderr, "fiblet: error: {}\n", cli_message(e));
         return exit_code_for(e.code());
     } catch (const std::system_error& e) {
         // fmt reports a failed write to stdout this way.
@@ -83,6 +83,6 @@ int main(int argc, char** argv) {
 #endif
     add_help(app);
 
-    fiblet::install_signal_cleanup();
+    fiblet::cli::install_signal_cleanup();
     return finish(run(app, argc, argv));
 }

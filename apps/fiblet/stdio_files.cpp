@@ -85,7 +85,7 @@ Error named_for_user(const Error& e, const std::optional<SpoolFile>& stdin_spool
     };
     rename(stdin_spool, "standard input");
     rename(stdout_spool, "standard output");
-    return Error(e.code(), message);
+    return Error(e.code(), message, e.remedy());
 }
 
 CLI::Validator existing_path_or_stdin() {

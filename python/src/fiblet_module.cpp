@@ -468,7 +468,11 @@ PYBIND11_MODULE(_fiblet, m) {
         try {
             if (p) std::rethrow_exception(p);
         } catch (const fiblet::Error& e) {
-            py::object instance = py::reinterpret_borrow<py::object>(error_type.ptr())(e.what());
+            // The option that would have allowed it, as Python's keyword names it.
+            std::string message = e.what();
+            if (e.remedy() == fiblet::Remedy::overwrite) message += " (overwrite=True replaces it)";
+            if (e.remedy() == fiblet::Remedy::ignore_trailer) message += "; ignore_trailer=True reads the blocks without it";
+            py::object instance = py::reinterpret_borrow<py::object>(error_type.ptr())(message);
             instance.attr("category") = fiblet::errc_name(e.code());
             PyErr_SetObject(error_type.ptr(), instance.ptr());
         }

@@ -29,13 +29,23 @@ enum class Errc : int {
 // Short stable name of a category ("tck_format", ...), for --json output.
 const char* errc_name(Errc c) noexcept;
 
+// The caller's option that would have allowed what failed, named by the
+// library option it is (CompressOptions::overwrite, FftOpenOptions::
+// ignore_trailer, TckReadOptions::allow_count_mismatch). The message says
+// nothing of it: each front end names it in its own terms (the CLI's
+// --force, Python's overwrite=True).
+enum class Remedy : int { none, overwrite, ignore_trailer, allow_count_mismatch };
+
 class Error : public std::runtime_error {
 public:
-    Error(Errc code, const std::string& message) : std::runtime_error(message), code_(code) {}
+    Error(Errc code, const std::string& message, Remedy remedy = Remedy::none)
+        : std::runtime_error(message), code_(code), remedy_(remedy) {}
     Errc code() const noexcept { return code_; }
+    Remedy remedy() const noexcept { return remedy_; }
 
 private:
     Errc code_;
+    Remedy remedy_;
 };
 
 }  // namespace fiblet

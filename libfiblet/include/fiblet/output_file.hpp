@@ -21,6 +21,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 
 namespace fiblet {
@@ -84,11 +85,11 @@ private:
     int slot_ = -1;
 };
 
-// Installs handlers for every catchable signal that ends a process by
-// default (SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE, SIGXFSZ, SIGXCPU,
-// SIGUSR1, SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF) that remove pending
-// outputs, print which signal stopped the process (not for SIGINT) and exit
-// with 128+signal (the shell convention). Signals the parent ignored stay ignored.
-void install_signal_cleanup();
+// The signals after which a program should call remove_pending_outputs()
+// (every catchable one whose default action ends the process: SIGINT,
+// SIGTERM, SIGHUP, SIGQUIT, SIGPIPE, SIGXFSZ, SIGXCPU, SIGUSR1, SIGUSR2,
+// SIGALRM, SIGVTALRM, SIGPROF). The library blocks them while its registry
+// of pending outputs changes, so a handler never sees half an entry.
+std::span<const int> fatal_signals() noexcept;
 
 }  // namespace fiblet

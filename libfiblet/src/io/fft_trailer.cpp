@@ -57,9 +57,10 @@ TrailerChunks read_trailer_chunks(const ReadAt& read_at, std::uint64_t end, std:
     TrailerChunks t;
     if (logical_size <= end) return t;  // nothing after the blocks: an official-encoder file
     auto damaged = [&](const std::string& what) {
-        throw Error(Errc::checksum, name + ": damaged trailer: " + what +
-                                        " (the bytes after the last block are not a complete fiblet trailer;"
-                                        " --ignore-trailer reads the blocks without it)");
+        throw Error(Errc::checksum,
+                    name + ": damaged trailer: " + what +
+                        " (the bytes after the last block are not a complete fiblet trailer; the blocks can be read without it)",
+                    Remedy::ignore_trailer);
     };
     if (logical_size - end < kTrailerFooterBytes)
         damaged(std::to_string(logical_size - end) + " bytes after the last block, too few for a footer");

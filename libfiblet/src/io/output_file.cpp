@@ -56,12 +56,12 @@ std::string errno_text() { return std::strerror(errno); }
 // appeared while we were writing (another process) is never replaced.
 void rename_no_replace(const std::string& from, const std::string& to, const std::string& shown) {
     if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return;
-    if (errno == EEXIST) throw Error(Errc::exists, shown + ": output exists (use --force to overwrite)");
+    if (errno == EEXIST) throw Error(Errc::exists, shown + ": output exists", Remedy::overwrite);
     if (errno != EINVAL && errno != ENOSYS)
         throw Error(Errc::io, shown + ": cannot rename temporary into place: " + errno_text());
     // File systems without RENAME_NOREPLACE: link() fails on an existing target too.
     if (::link(from.c_str(), to.c_str()) != 0) {
-        if (errno == EEXIST) throw Error(Errc::exists, shown + ": output exists (use --force to overwrite)");
+        if (errno == EEXIST) throw Error(Errc::exists, shown + ": output exists", Remedy::overwrite);
         throw Error(Errc::io, shown + ": cannot move temporary into place: " + errno_text());
     }
     ::unlink(from.c_str());
@@ -70,6 +70,8 @@ void rename_no_replace(const std::string& from, const std::string& to, const std
 using detail::SignalBlock;
 
 }  // namespace
+
+std::span<const int> fatal_signals() noexcept { return detail::kCleanupSignals; }
 
 void remove_pending_outputs() noexcept {
     for (auto& s : g_slots)
@@ -89,7 +91,7 @@ PendingTemporary::~PendingTemporary() {
 void AtomicOutputFile::check_destination(const std::string& path, bool overwrite) {
     const detail::OutputTarget target = detail::resolve_output_target(path);
     if (!overwrite && target.exists && !target.write_through)
-        throw Error(Errc::exists, path + ": output exists (use --force to overwrite)");
+        throw Error(Errc::exists, path + ": output exists", Remedy::overwrite);
 }
 
 AtomicOutputFile::AtomicOutputFile(const std::string& path, bool overwrite) : path_(path), overwrite_(overwrite) {
@@ -98,7 +100,7 @@ AtomicOutputFile::AtomicOutputFile(const std::string& path, bool overwrite) : pa
     if (target.write_through) {
         open_in_place();
     } else {
-        if (!overwrite && target.exists) throw Error(Errc::exists, path + ": output exists (use --force to overwrite)");
+        if (!overwrite && target.exists) throw Error(Errc::exists, path + ": output exists", Remedy::overwrite);
         create_temporary();
     }
     buffer_.reserve(1u << 20);

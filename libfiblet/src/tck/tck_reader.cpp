@@ -119,10 +119,10 @@ struct TckReader::Impl {
         if (options.allow_count_mismatch) return;
         const auto c = header.count();
         if (c && *c != streamlines)
-            throw Error(Errc::tck_format, path + ": header says count: " + std::to_string(*c) + " but the data holds " +
-                                              std::to_string(streamlines) +
-                                              " streamlines (truncated or edited file? use allow_count_mismatch / "
-                                              "--allow-count-mismatch to read it anyway)");
+            throw Error(Errc::tck_format,
+                        path + ": header says count: " + std::to_string(*c) + " but the data holds " +
+                            std::to_string(streamlines) + " streamlines (truncated or edited file?)",
+                        Remedy::allow_count_mismatch);
     }
 
     void check_length(const std::vector<Vec3f>& out) const {

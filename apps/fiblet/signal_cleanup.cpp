@@ -1,15 +1,18 @@
 // Fatal signals in the CLI: remove the pending temporary outputs, say which
 // signal stopped the command (a silent death after `ulimit -f` leaves the
-// user guessing), exit with 128 + signal, the shell convention.
+// user guessing), exit with 128 + signal, the shell convention. The policy
+// is the CLI's; the library only keeps its pending outputs removable
+// (fiblet::remove_pending_outputs, fiblet::fatal_signals).
+#include "signal_cleanup.hpp"
+
 #include <signal.h>
 #include <unistd.h>
 
 #include <cstring>
 
 #include "fiblet/output_file.hpp"
-#include "io/cleanup_signals.hpp"
 
-namespace fiblet {
+namespace fiblet::cli {
 namespace {
 
 const char* signal_text(int sig) {
@@ -57,8 +60,8 @@ void install_signal_cleanup() {
     struct sigaction sa {};
     sa.sa_handler = handle_signal;
     sigemptyset(&sa.sa_mask);
-    for (int sig : detail::kCleanupSignals) sigaddset(&sa.sa_mask, sig);  // one handler at a time
-    for (int sig : detail::kCleanupSignals) {
+    for (int sig : fatal_signals()) sigaddset(&sa.sa_mask, sig);  // one handler at a time
+    for (int sig : fatal_signals()) {
         struct sigaction old {};
         // A signal ignored by whoever started us (nohup: SIGHUP) stays ignored.
         if (::sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
@@ -66,4 +69,4 @@ void install_signal_cleanup() {
     }
 }
 
-}  // namespace fiblet
+}  // namespace fiblet::cli
