@@ -136,33 +136,42 @@ inline void tck_target(const std::uint8_t* data, std::size_t size) {
 
 inline double resampled_points_bound(const std::string& path);
 
-// Whatever compress accepts, every reader accepts: a streamline file (any
-// format) that compress turns into a .fft gives a file that verifies
-// (verify_fft_file) and decodes to as many fibers, every coordinate finite. A refusal is fine
-// (bad content, exit 4/6) if it leaves no output.
-inline void compress_reads_back(const std::string& path) {
+// Whatever compress accepts, every reader accepts: compress the streamline
+// file at `path` (any format; `sizes`: its streamlines' point counts as
+// read) and check that its output verifies (verify_fft_file: structure,
+// every checksum, the index) and decodes to the same fibers, with the same
+// point counts unless resampled, every coordinate finite. A refusal must
+// leave no output; where `content_refusals_only`, it must also be about the
+// content (invalid_input, unsupported), never the format.
+inline void compress_reads_back(const std::string& path, const std::vector<std::uint32_t>& sizes,
+                                bool content_refusals_only) {
     if (resampled_points_bound(path) > 200000) return;
-    const std::string out = scratch_dir() + "/any.fft";
-    std::uint64_t fibers = 0;
+    const std::string out = scratch_dir() + "/out.fft";
+    CompressReport report;
     try {
         CompressOptions options;
         options.threads = 1;
         options.overwrite = true;
-        fibers = compress_tck(path, out, options).header.fibers;
-    } catch (const Error&) {
+        report = compress_tck(path, out, options);
+    } catch (const Error& e) {
+        if (content_refusals_only)
+            check(e.code() == Errc::invalid_input || e.code() == Errc::unsupported, "compress failed on a valid input's format");
         check(!std::filesystem::exists(out), "compress left an output after failing");
         return;
     }
     try {
-        verify_fft_file(out);  // structure, every checksum, the index, finite points
+        verify_fft_file(out);
         const FftFile f(out);
-        check(f.header().fibers == fibers, "the .fft holds another fiber count than compress reported");
-        std::uint64_t decoded = 0;
-        decode_file(f, [&](std::uint64_t, const Streamlines& s) {
-            decoded += s.size();
+        check(f.header().fibers == sizes.size(), "fiber count changed");
+        check(f.checksums() != nullptr, "compress wrote no checksum");
+        std::uint64_t fiber = 0;
+        decode_file(f, [&](std::uint64_t first, const Streamlines& s) {
+            check(first == fiber, "decode_file skipped fibers");
+            for (std::size_t i = 0; i < s.size(); ++i, ++fiber)
+                if (!report.resampled) check(s.offsets[i + 1] - s.offsets[i] == sizes[fiber], "point count changed");
             for (float v : s.xyz) check(std::isfinite(v), "decoded a non-finite coordinate from compress output");
         });
-        check(decoded == fibers, "decode_file missed fibers");
+        check(fiber == sizes.size(), "decode_file missed fibers");
     } catch (const Error&) {
         throw HarnessFailure("compress wrote a file its own reader refuses");
     }
@@ -176,6 +185,7 @@ inline void compress_reads_back(const std::string& path) {
 inline void streamline_source_target(const std::uint8_t* data, std::size_t size) {
     static MemFile input;
     const std::string path = input.set(data, size);
+    std::vector<std::uint32_t> read;
     try {
         const auto source = open_streamline_source(path, {.max_points = 1u << 20});
         std::vector<std::uint32_t> sizes[2];
@@ -194,11 +204,12 @@ inline void streamline_source_target(const std::uint8_t* data, std::size_t size)
         }
         check(sizes[0] == sizes[1], "a second pass read other streamlines");
         if (points > 20000) return;
+        read = std::move(sizes[0]);
     } catch (const Error&) {
         // any category: the input is malformed, unsupported or unreadable
         return;
     }
-    compress_reads_back(path);
+    compress_reads_back(path, read, false);
 }
 
 // An upper bound on the points compress may resample a .tck into: its
@@ -226,42 +237,15 @@ inline double resampled_points_bound(const std::string& path) {
 }
 
 // The whole compression of small valid .tck inputs, and a decode of what it
-// wrote: same fibers, same point counts unless resampled, finite points.
+// wrote (compress_reads_back).
 inline void compress_target(const std::uint8_t* data, std::size_t size) {
     static MemFile input;
     const std::string path = input.set(data, size);
     const TckOutcome whole = read_tck(path, {});
     std::uint64_t points = 0;
     for (auto n : whole.sizes) points += n;
-    if (whole.error || points > 20000 || resampled_points_bound(path) > 200000) return;
-
-    const std::string out = scratch_dir() + "/out.fft";
-    CompressReport report;
-    try {
-        CompressOptions options;
-        options.threads = 1;
-        options.overwrite = true;
-        report = compress_tck(path, out, options);
-    } catch (const Error& e) {
-        // Refusing a valid .tck is fine for content it cannot encode, never for its format.
-        check(e.code() == Errc::invalid_input || e.code() == Errc::unsupported, "compress failed on a valid .tck");
-        check(!std::filesystem::exists(out), "compress left an output after failing");
-        return;
-    }
-    // What compress writes must read back: same fibers, same point counts unless resampled.
-    const FftFile f(out);
-    check(f.header().fibers == whole.sizes.size(), "fiber count changed");
-    check(f.checksums() != nullptr, "compress wrote no checksum");
-    std::uint64_t fiber = 0;
-    decode_file(f, [&](std::uint64_t first, const Streamlines& s) {
-        check(first == fiber, "decode_file skipped fibers");
-        for (std::size_t i = 0; i < s.size(); ++i, ++fiber)
-            if (!report.resampled)
-                check(s.offsets[i + 1] - s.offsets[i] == whole.sizes[fiber], "point count changed");
-        for (float v : s.xyz) check(std::isfinite(v), "decoded a non-finite coordinate from compress output");
-    });
-    check(fiber == whole.sizes.size(), "decode_file missed fibers");
-    std::filesystem::remove(out);
+    if (whole.error || points > 20000) return;
+    compress_reads_back(path, whole.sizes, true);
 }
 
 // ---------------------------------------------------------------- .fft

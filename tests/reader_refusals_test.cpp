@@ -57,6 +57,15 @@ void expect_compress_refuses(const TempDir& dir, const std::string& input) {
     EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+// `path` is refused by its reader with `code` and a message holding `what`,
+// and by compress.
+void expect_refused(const TempDir& dir, const std::string& path, Errc code, const std::string& what) {
+    const Refusal r = refusal(path);
+    EXPECT_EQ(r.code, code);
+    EXPECT_NE(r.message.find(what), std::string::npos) << r.message;
+    expect_compress_refuses(dir, path);
+}
+
 std::string le32(std::int32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); }
 std::string le16(std::int16_t v) { return std::string(reinterpret_cast<const char*>(&v), 2); }
 std::string f32(float v) { return std::string(reinterpret_cast<const char*>(&v), 4); }
@@ -95,10 +104,7 @@ TEST(ReaderRefusals, TrkNonFiniteCoordinatesNameTheirStreamlineAndPoint) {
     ASSERT_FALSE(refusal(good).code);
     for (const float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
         const std::string path = patched(dir, good, kTrkSecondY, f32(bad), "bad.trk");
-        const Refusal r = refusal(path);
-        EXPECT_EQ(r.code, Errc::trk_format);
-        EXPECT_NE(r.message.find("streamline 1 (0-based) point 0 (0-based) is not finite"), std::string::npos) << r.message;
-        expect_compress_refuses(dir, path);
+        expect_refused(dir, path, Errc::trk_format, "streamline 1 (0-based) point 0 (0-based) is not finite");
     }
 }
 
@@ -107,10 +113,7 @@ TEST(ReaderRefusals, TrkVersionThreeAndNegativeDimensions) {
     const std::string good = trk_file(dir, "good.trk");
     EXPECT_EQ(refusal(patched(dir, good, kTrkVersion, le32(3), "v3.trk")).code, Errc::unsupported);
     const std::string negative = patched(dir, good, kTrkDimY, le16(-4), "dim.trk");
-    const Refusal r = refusal(negative);
-    EXPECT_EQ(r.code, Errc::trk_format);
-    EXPECT_NE(r.message.find("dimension -4 is negative"), std::string::npos) << r.message;
-    expect_compress_refuses(dir, negative);
+    expect_refused(dir, negative, Errc::trk_format, "dimension -4 is negative");
 }
 
 // A TRX directory: header.json as given, two streamlines of 1 and 2 float32 points.
@@ -136,19 +139,13 @@ TEST(ReaderRefusals, TrxNonFinitePositionsNameTheirStreamlineAndPoint) {
     ASSERT_FALSE(refusal(trx_dir(dir, "good.trx", trx_header("1", "2", "3"))).code);
     const std::string path =
         trx_dir(dir, "nan.trx", trx_header("1", "2", "3"), {1, 2, 3, 4, 5, 6, 4, std::nanf(""), 7});
-    const Refusal r = refusal(path);
-    EXPECT_EQ(r.code, Errc::trx_format);
-    EXPECT_NE(r.message.find("streamline 1 (0-based) point 1 (0-based) is not finite"), std::string::npos) << r.message;
-    expect_compress_refuses(dir, path);
+    expect_refused(dir, path, Errc::trx_format, "streamline 1 (0-based) point 1 (0-based) is not finite");
 }
 
 TEST(ReaderRefusals, TrxAffineBeyondFloat32) {
     TempDir dir;
     const std::string path = trx_dir(dir, "huge.trx", trx_header("1e300", "2", "3"));
-    const Refusal r = refusal(path);
-    EXPECT_EQ(r.code, Errc::trx_format);
-    EXPECT_NE(r.message.find("not a float32 number"), std::string::npos) << r.message;
-    expect_compress_refuses(dir, path);
+    expect_refused(dir, path, Errc::trx_format, "not a float32 number");
 }
 
 TEST(ReaderRefusals, TrxOneArrayUnderTwoDtypes) {
@@ -159,10 +156,7 @@ TEST(ReaderRefusals, TrxOneArrayUnderTwoDtypes) {
     const double w64[2] = {1, 2};
     test::write_file(root + "/dps/w.float32", std::string(reinterpret_cast<const char*>(w32), sizeof w32));
     test::write_file(root + "/dps/w.float64", std::string(reinterpret_cast<const char*>(w64), sizeof w64));
-    const Refusal r = refusal(root);
-    EXPECT_EQ(r.code, Errc::trx_format);
-    EXPECT_NE(r.message.find("more than one array named dps/w"), std::string::npos) << r.message;
-    expect_compress_refuses(dir, root);
+    expect_refused(dir, root, Errc::trx_format, "more than one array named dps/w");
 }
 
 TEST(ReaderRefusals, TrxCountsAreIntegersInRangeBeforeAnyCast) {

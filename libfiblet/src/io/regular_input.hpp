@@ -24,9 +24,8 @@ inline bool is_regular_input(const std::string& path, bool directory_ok = false)
 
 // Throws Error{io} (exit 3) for a pipe, a device, a socket or a directory.
 inline void require_regular_input(const std::string& path, bool directory_ok = false) {
-    if (is_regular_input(path, directory_ok)) return;
     struct stat st {};
-    ::stat(path.c_str(), &st);
+    if (::stat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode) || (directory_ok && S_ISDIR(st.st_mode))) return;
     if (S_ISDIR(st.st_mode)) throw Error(Errc::io, path + ": is a directory");
     const char* kind = S_ISFIFO(st.st_mode) ? "a pipe" : S_ISSOCK(st.st_mode) ? "a socket" : "a device";
     throw Error(Errc::io, path + ": not a regular file (" + kind +
