@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <random>
 
 #include "fiblet/image.hpp"
@@ -25,6 +26,7 @@
 #include "overlays/odf_glyphs/odf_glyphs_overlay.hpp"
 #include "overlays/sh_basis/sh_basis.hpp"
 #include "cli_runner.hpp"
+#include "image_source.hpp"
 #include "png_file.hpp"
 #include "render_target.hpp"
 #include "renderer.hpp"
@@ -214,7 +216,27 @@ struct GlyphAgreement {
     double p99_dt = 0, max_dt = 0, max_radius_error = 0, max_box_excess = 0;
     double p99_normal_deg = 0;   // GPU normal (8-bit colour) vs the CPU's (the same closed form in double)
     double p99_cpu_normal_deg = 0;  // the CPU's closed-form normal vs a central difference of F in double
+    // Every 4th pixel on both axes against a march along the ray (no
+    // polynomial, no root finder): hit/miss agreement of the CPU reference
+    // and of the GPU with it, and the largest |t - t_march| where all hit.
+    int marched = 0, march_agree_cpu = 0, march_agree_gpu = 0;
+    double max_march_dt = 0;
 };
+
+// The first t in [t_min, t_min + span] where the ray o + t d enters the
+// glyph {x : |x| <= |f(x / |x|)|}, sampled every span / steps: an
+// independent reference for the root finder.
+std::optional<double> march_glyph(const std::vector<double>& c, int lmax, const V3& o, const V3& d, double t_min,
+                                  double span, int steps) {
+    for (int i = 0; i <= steps; ++i) {
+        const double t = t_min + span * i / steps;
+        const V3 x = add(o, mul(t, d));
+        const double r = norm(x);
+        if (r == 0) continue;
+        if (r <= std::abs(viewer::sh_value<double>(c, lmax, x[0] / r, x[1] / r, x[2] / r))) return t;
+    }
+    return std::nullopt;
+}
 
 // F(x) = f_h(x)² − ‖x‖^{2k+2} (glyph_ray.hpp), for a normal by differences.
 template <class Coefficients>
@@ -225,8 +247,9 @@ double glyph_function(const Coefficients& c, int k, const V3& x) {
 
 // One glyph of `coefficients` truncated to `lmax` at the origin (radius 1
 // mm: glyph units are mm) drawn at 256² from an oblique camera, against
-// trace_glyph<double> per pixel.
-GlyphAgreement compare_single_glyph(const std::vector<float>& coefficients, int lmax) {
+// trace_glyph<double> per pixel. At the default field of view the glyph's
+// middle fills the image; at 40° its whole outline is in view.
+GlyphAgreement compare_single_glyph(const std::vector<float>& coefficients, int lmax, float fov_y_deg = 18) {
     viewer::GlyphSet set;
     set.lmax = lmax;
     set.coefficients_per_glyph = viewer::sh_coefficient_count(lmax);
@@ -240,7 +263,7 @@ GlyphAgreement compare_single_glyph(const std::vector<float>& coefficients, int 
     cam.position = {2.2f, -2.9f, 1.7f};
     cam.target = {0, 0, 0};
     cam.up = {0, 0, 1};
-    cam.fov_y_deg = 18;
+    cam.fov_y_deg = fov_y_deg;
     cam.aspect = 1;
     cam.near_mm = 2, cam.far_mm = 6;
     const int w = 256, h = 256;
@@ -259,6 +282,15 @@ GlyphAgreement compare_single_glyph(const std::vector<float>& coefficients, int 
             const auto ref = viewer::trace_glyph<double>(ref_coefficients, lmax, minv, o, ray.dir, -along, 1e-12);
             const float depth = frame.depth[std::size_t(y * w + x)];
             const bool gpu = depth < 1.0f;
+            if (x % 4 == 0 && y % 4 == 0) {
+                // The whole chord of a sphere of radius 1.25 around the centre.
+                const auto march = march_glyph(ref_coefficients, lmax, o, ray.dir, -1.25, 2.5, 2500);
+                ++a.marched;
+                a.march_agree_cpu += bool(march) == bool(ref);
+                a.march_agree_gpu += bool(march) == gpu;
+                if (march && ref && gpu)
+                    a.max_march_dt = std::max(a.max_march_dt, std::abs(*march - ref->t));
+            }
             ++a.pixels;
             a.agree += gpu == bool(ref);
             if (!gpu) continue;
@@ -427,6 +459,50 @@ TEST_P(OdfGlyphsSingle, GpuMatchesCpuRootFindingInDouble) {
     EXPECT_LE(a.p99_cpu_normal_deg, 0.01);
 }
 INSTANTIATE_TEST_SUITE_P(OdfLmax, OdfGlyphsSingle, ::testing::Values(4, 8));
+
+// Glyphs whose polynomial loses degree or touches the bounding sphere: an
+// isotropic ODF (l = 0 alone, as a CSF voxel or an lmax-0 image) is the
+// bounding sphere itself, and every ray's leading coefficient f(d)^2 - 1
+// vanishes; single coefficients of each order; negative lobes. Each is
+// drawn, matches the CPU reference, and both match a march along the ray.
+struct DegenerateGlyph {
+    const char* name;
+    int lmax;
+    std::vector<std::pair<std::pair<int, int>, float>> terms;  // (l, m) -> coefficient
+};
+class OdfGlyphsDegenerate : public ::testing::TestWithParam<DegenerateGlyph> {};
+
+TEST_P(OdfGlyphsDegenerate, DrawnAsTheCpuReferenceAndAMarchAlongTheRay) {
+    FIBLET_REQUIRE_GL();
+    const DegenerateGlyph& g = GetParam();
+    std::vector<float> c(std::size_t(viewer::sh_coefficient_count(g.lmax)), 0.0f);
+    for (const auto& [lm, v] : g.terms) c[std::size_t(viewer::sh_index(lm.first, lm.second))] = v;
+    const GlyphAgreement a = compare_single_glyph(c, g.lmax, 40);
+    std::printf("%s (lmax %d): GPU and CPU hit %d of %d pixels, agree %.3f%%, |dt| max %.3g, radius error %.3g; "
+                "march (%d rays): CPU agrees %.3f%%, GPU %.3f%%, |t - t_march| max %.3g\n",
+                g.name, g.lmax, a.both, a.pixels, 100.0 * a.agree / a.pixels, a.max_dt,
+                a.max_radius_error, a.marched, 100.0 * a.march_agree_cpu / a.marched,
+                100.0 * a.march_agree_gpu / a.marched, a.max_march_dt);
+    EXPECT_GT(a.both, 1000);
+    EXPECT_LT(a.both, a.pixels);  // the outline is in view
+    EXPECT_GE(double(a.agree) / a.pixels, 0.999);
+    EXPECT_GE(double(a.march_agree_cpu) / a.marched, 0.997);
+    EXPECT_GE(double(a.march_agree_gpu) / a.marched, 0.997);
+    EXPECT_LE(a.max_march_dt, 1.5e-3);  // the march's step is 1e-3
+    EXPECT_LE(a.max_radius_error, 1e-3);
+    EXPECT_LE(a.max_box_excess, 1e-4);
+}
+INSTANTIATE_TEST_SUITE_P(
+    Odf, OdfGlyphsDegenerate,
+    ::testing::Values(DegenerateGlyph{"isotropic_lmax8", 8, {{{0, 0}, 0.28f}}},
+                      DegenerateGlyph{"isotropic_negative", 4, {{{0, 0}, -0.5f}}},
+                      DegenerateGlyph{"isotropic_lmax0", 0, {{{0, 0}, 1.0f}}},
+                      DegenerateGlyph{"nearly_isotropic", 8, {{{0, 0}, 1.0f}, {{2, 0}, 1e-3f}}},
+                      DegenerateGlyph{"only_y20", 2, {{{2, 0}, 1.0f}}},
+                      DegenerateGlyph{"only_y4_3", 8, {{{4, 3}, 0.7f}}},
+                      DegenerateGlyph{"only_y8_minus5", 8, {{{8, -5}, -0.3f}}},
+                      DegenerateGlyph{"negative_lobes", 4, {{{0, 0}, 0.2f}, {{2, 0}, -1.0f}, {{4, 2}, 0.4f}}}),
+    [](const ::testing::TestParamInfo<DegenerateGlyph>& info) { return std::string(info.param.name); });
 
 TEST(OdfGlyphs, BoundingBoxesHoldTheSurface) {
     FIBLET_REQUIRE_PHANTOM_FOD();
@@ -656,6 +732,40 @@ TEST(OdfCli, RenderDrawsGlyphsOverASliceAndChecksItsOptions) {
 }
 
 // --slab: every fiber pixel drawn, in each style, lies within the slab.
+// The reproduction: a 3x3x3 SH image (lmax 2) with only the centre
+// voxel's Y00 set draws a sphere, as large as the same glyph with 1e-3 Y20
+// added (which was drawn right before the chord's ends moved off the
+// bounding sphere); and an lmax-0 image (one volume) draws it too.
+TEST(OdfCli, IsotropicGlyphsAreDrawn) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const std::string fft = compress_fibers(dir, {{{40, 40, 40}, {40.5f, 40, 40}, {41, 40, 40}}}, "far");
+    const auto glyph_pixels = [&](const std::string& name, std::int64_t volumes, float y20) {
+        SourceImage image;
+        image.dims = {3, 3, 3, volumes};
+        image.fill([&](std::int64_t i, std::int64_t j, std::int64_t k, std::int64_t v) {
+            if (i != 1 || j != 1 || k != 1) return 0.0f;
+            return v == 0 ? 1.0f : v == 3 ? y20 : 0.0f;  // Y00; Y20 is volume 3
+        });
+        const std::string mif = dir.file(name + ".mif"), png = dir.file(name + ".png");
+        image.write_mif(mif);
+        const CommandResult r = run_cli("render " + fft + " --odf " + mif + " --odf-slice z:1 --camera 1,-6,1,1,1,1,0,0,1 " +
+                                        "--size 128x128 -f -o " + png);
+        EXPECT_EQ(r.status, 0) << r.output;
+        const viewer::RgbaImage im = viewer::read_png(png);
+        std::size_t drawn = 0;  // pixels unlike the corner's background
+        for (std::size_t i = 0; i < im.rgba.size(); i += 4)
+            drawn += !std::equal(im.rgba.begin() + long(i), im.rgba.begin() + long(i) + 3, im.rgba.begin());
+        return drawn;
+    };
+    const std::size_t iso = glyph_pixels("iso", 6, 0), nearly = glyph_pixels("nearly", 6, 1e-3f),
+                      lmax0 = glyph_pixels("lmax0", 1, 0);
+    std::printf("glyph pixels at 128x128: isotropic %zu, with 1e-3 Y20 %zu, lmax-0 image %zu\n", iso, nearly, lmax0);
+    EXPECT_GT(nearly, 500u);
+    EXPECT_NEAR(double(iso), double(nearly), 0.02 * double(nearly));
+    EXPECT_EQ(lmax0, iso);
+}
+
 TEST(ViewerSlab, OnlyFibersWithinTheSlabAreDrawn) {
     FIBLET_REQUIRE_GL();
     if (!shared_data_available()) GTEST_SKIP() << "no shared data";

@@ -4,6 +4,7 @@ const int kMaxLmax = 12;
 uniform int uLmax;
 // glyph_inverse_vandermonde(uLmax), row-major (uLmax + 1)².
 uniform float uInverseVandermonde[(kMaxLmax + 1) * (kMaxLmax + 1)];
+uniform float uTraceRadius;  // kGlyphTraceRadius
 
 float powi(float x, int n) {
     float r = 1.0;
@@ -32,7 +33,7 @@ bool traceGlyph(uint base, vec3 o, vec3 d, float tMin, float tolerance, out floa
     float t0 = -dot(o, d);
     vec3 closest = o + t0 * d;
     float rho = length(closest);
-    if (rho >= 1.0) return false;
+    if (rho >= uTraceRadius) return false;
     vec3 e1;
     if (rho > 1e-7) e1 = closest / rho;
     else e1 = normalize(cross(abs(d.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0), d));
@@ -62,7 +63,7 @@ bool traceGlyph(uint base, vec3 o, vec3 d, float tMin, float tolerance, out floa
         if (i > 0) binomial = binomial * float(k + 2 - i) / float(i);
         poly[2 * i] -= binomial * powi(rho2, k + 1 - i);
     }
-    float halfChord = sqrt(max(0.0, 1.0 - rho2));
+    float halfChord = sqrt(max(0.0, uTraceRadius * uTraceRadius - rho2));
     float lo = max(-halfChord, tMin - t0), hi = halfChord;
     if (!(lo < hi)) return false;
     float s;

@@ -30,6 +30,13 @@ std::vector<double> glyph_inverse_vandermonde(int lmax);
 template <class T>
 using Vec3 = std::array<T, 3>;
 
+// The radius (glyph units) of the sphere whose chord the root finder
+// searches. The glyph lies within the unit sphere but may touch it (an
+// isotropic ODF is the unit sphere itself): there F vanishes at the chord's
+// ends and the sign test at an end sees rounding noise, missing the hit.
+// Past the unit sphere F < 0 for certain, so the chord's ends are outside.
+inline constexpr double kGlyphTraceRadius = 1.0625;
+
 template <class T>
 struct GlyphHit {
     T t;              // along the ray, glyph units
@@ -116,7 +123,8 @@ template <class T, class Coefficients>
 std::optional<GlyphHit<T>> trace_glyph(const Coefficients& b, int k, const std::vector<double>& minv,
                                        const Vec3<T>& o, const Vec3<T>& d, T t_min, T tolerance) {
     const RayPlane<T> p = ray_plane(o, d);
-    if (p.rho >= 1) return std::nullopt;  // the glyph lies inside the unit sphere
+    const T radius = T(kGlyphTraceRadius);
+    if (p.rho >= radius) return std::nullopt;  // the glyph lies inside the unit sphere
     const std::array<T, kMaxShLmax + 1> a = plane_polynomial(b, k, minv, p);
     // g(s) = f_h(ρ e1 + s e2) = Σ c_j s^j with c_j = a_j ρ^{k−j}; s = t − t0.
     std::array<T, kMaxShLmax + 1> c{};
@@ -132,8 +140,8 @@ std::optional<GlyphHit<T>> trace_glyph(const Coefficients& b, int k, const std::
         if (i > 0) binomial = binomial * T(k + 2 - i) / T(i);
         poly[2 * i] -= binomial * std::pow(rho2, T(k + 1 - i));
     }
-    // The chord of the unit sphere, from t_min on.
-    const T half = std::sqrt(std::max(T(0), 1 - rho2));
+    // The chord of the trace sphere, from t_min on.
+    const T half = std::sqrt(std::max(T(0), radius * radius - rho2));
     const T lo = std::max(-half, t_min - p.t0), hi = half;
     if (!(lo < hi)) return std::nullopt;
     const std::optional<T> s = first_root(poly.data(), degree, lo, hi, tolerance);

@@ -41,6 +41,7 @@ OdfGlyphsOverlay::OdfGlyphsOverlay(const GlyphSet& g)
     const GLuint id = program_.get();
     glProgramUniform1fv(id, uniform(program_, "uInverseVandermonde"), GLsizei(inv_f.size()), inv_f.data());
     glProgramUniform1i(id, uniform(program_, "uLmax"), lmax_);
+    glProgramUniform1f(id, uniform(program_, "uTraceRadius"), float(kGlyphTraceRadius));
     glProgramUniform1ui(id, uniform(program_, "uCoefficientsPerGlyph"), GLuint(coefficients_per_glyph_));
     glProgramUniform1f(id, uniform(program_, "uTolerance"), kGlyphRootTolerance);
 }
