@@ -59,3 +59,13 @@ if(DEFINED Python_EXECUTABLE)
   add_test(NAME ecosystem.check_skips COMMAND ${Python_EXECUTABLE} ${FIBLET_PYTEST} ${PROJECT_SOURCE_DIR}/tests/test_check_skips.py)
   set_tests_properties(ecosystem.check_skips PROPERTIES TIMEOUT 60 SKIP_REGULAR_EXPRESSION "${FIBLET_PYTEST_SKIPPED}")
 endif()
+
+# The viewer benchmark's quick form on this machine's renderer, and the
+# build it carries to a GPU machine (scripts/bench_viewer.sh).
+if(DEFINED Python_EXECUTABLE AND FIBLET_BUILD_VIEWER)
+  add_test(NAME bench.viewer_quick
+    COMMAND ${Python_EXECUTABLE} ${FIBLET_PYTEST} ${PROJECT_SOURCE_DIR}/tests/test_bench_viewer.py)
+  set_tests_properties(bench.viewer_quick PROPERTIES TIMEOUT 600 SKIP_REGULAR_EXPRESSION "${FIBLET_PYTEST_SKIPPED}"
+    FIXTURES_REQUIRED phantom_fod
+    ENVIRONMENT "FIBLET_CLI=$<TARGET_FILE:fiblet_cli>;FIBLET_ODF=${PROJECT_BINARY_DIR}/tests/phantom-fod/phantom-fod-crop.nii")
+endif()

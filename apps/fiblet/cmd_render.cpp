@@ -34,6 +34,8 @@ struct RenderArgs {
     std::string output;
     bool force = false, quiet = false, bench = false, json = false;
     int frames = 5;
+    // Benchmark cases: views of kBenchViews, and "decode" (every block by each decoder).
+    std::vector<std::string> bench_views{"overview", "close-up", "far", "decode"};
     int orbit = 0;  // turntable frames (0: one image)
     std::string camera_path;  // a file of --camera specs, one frame each
 };
@@ -84,8 +86,13 @@ std::string transparency_json(const viewer::TransparencyBench& t, const viewer::
         .render();
 }
 
+// The full decodes' median times, when the benchmark ran them.
+struct FullDecodeTimes {
+    double scan_ms = 0, sequential_ms = 0;
+};
+
 void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::string& device, int width, int height,
-                 const std::vector<viewer::BenchCase>& cases, double scan_ms, double sequential_ms,
+                 const std::vector<viewer::BenchCase>& cases, const std::optional<FullDecodeTimes>& full,
                  viewer::DecoderKind decoder, viewer::DrawStyle style,
                  const std::optional<viewer::TransparencyBench>& transparency, const viewer::RenderOptions& options,
                  const viewer::Renderer& renderer) {
@@ -128,8 +135,8 @@ void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::
                                                          .render()
                                                    : "null")
                                .num("radius_mm", a.view.radius)
-                               .num("decode_all_scan_ms", scan_ms)
-                               .num("decode_all_sequential_ms", sequential_ms)
+                               .raw("decode_all_scan_ms", full ? fmt::format("{}", full->scan_ms) : "null")
+                               .raw("decode_all_sequential_ms", full ? fmt::format("{}", full->sequential_ms) : "null")
                                .raw("cases", list + "]")
                                .raw("transparency", transparency ? transparency_json(*transparency, options) : "null")
                                .render());
@@ -149,8 +156,9 @@ void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::
                    rt->last_decode_ms() + bt.total_ms(), rt->last_decode_ms(), bt.count_ms, bt.scan_ms, bt.fill_ms,
                    bt.occupancy_ms, bt.ambient_occlusion_ms, vs->fragment_count(),
                    double(vs->fragment_count()) * 4 / (1 << 20));
-    fmt::print("decoding all {} blocks: scan {:.2f} ms, sequential {:.2f} ms; frames below use the {} decoder\n",
-               scene.block_count(), scan_ms, sequential_ms, viewer::decoder_name(decoder));
+    if (full)
+        fmt::print("decoding all {} blocks: scan {:.2f} ms, sequential {:.2f} ms; frames below use the {} decoder\n",
+                   scene.block_count(), full->scan_ms, full->sequential_ms, viewer::decoder_name(decoder));
     fmt::print("{:<9} {:<12} {:>10} {:>10} {:>11} {:>9} {:>10} {:>9} {:>10} {:>9}\n", "view", "culling+LoD",
                "full blks", "coarse", "segments", "cull ms", "decode ms", "draw ms", "GPU ms", "frame ms");
     for (const auto& c : cases) {
@@ -209,13 +217,15 @@ void run(const RenderArgs& a) {
     };
 
     if (a.bench) {
-        const auto cases = viewer::run_render_bench(scene, renderer, target, camera_for, options, a.frames);
-        const double scan_ms = viewer::time_full_decode(scene, programs, viewer::DecoderKind::scan, a.frames);
-        const double sequential_ms = viewer::time_full_decode(scene, programs, viewer::DecoderKind::sequential, a.frames);
+        const auto cases = viewer::run_render_bench(scene, renderer, target, camera_for, options, a.frames, a.bench_views);
+        std::optional<FullDecodeTimes> full;
+        if (std::find(a.bench_views.begin(), a.bench_views.end(), "decode") != a.bench_views.end())
+            full = FullDecodeTimes{viewer::time_full_decode(scene, programs, viewer::DecoderKind::scan, a.frames),
+                                   viewer::time_full_decode(scene, programs, viewer::DecoderKind::sequential, a.frames)};
         std::optional<viewer::TransparencyBench> transparency;
         if (options.transparent())
             transparency = viewer::run_transparency_bench(scene, renderer, target, camera_for(1), options, a.frames);
-        print_bench(a, scene, context.description(), width, height, cases, scan_ms, sequential_ms,
+        print_bench(a, scene, context.description(), width, height, cases, full,
                     options.decoder.value_or(viewer::default_decoder()), options.style, transparency, options,
                     renderer);
     }
@@ -277,6 +287,12 @@ void add_render(CLI::App& app) {
                   "Time frames (cull / decode / draw: GL timer queries, glFinish on software renderers) "
                   "from three distances, with and without culling + LoD");
     cmd->add_option("--frames", args->frames, "Timed frames per benchmark case")->capture_default_str();
+    cmd->add_option("--bench-views", args->bench_views,
+                    "Benchmark cases, comma-separated: overview, close-up, far (each with and without culling + "
+                    "LoD), decode (every block by each GPU decoder)")
+        ->delimiter(',')
+        ->check(CLI::IsMember({"overview", "close-up", "far", "decode"}))
+        ->capture_default_str();
     cmd->add_option("--orbit", args->orbit,
                     "Write N frames turning once around the target about the camera's up axis, OUT-000.png "
                     "... (a turntable movie)");

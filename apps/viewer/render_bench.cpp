@@ -19,7 +19,7 @@ double median(std::vector<double> v) {
 
 std::vector<BenchCase> run_render_bench(const GpuScene& scene, Renderer& renderer, RenderTarget& target,
                                         const std::function<Camera(float zoom)>& camera_for,
-                                        const RenderOptions& base, int frames) {
+                                        const RenderOptions& base, int frames, const std::vector<std::string>& views) {
     struct View {
         const char* name;
         float zoom;
@@ -28,9 +28,10 @@ std::vector<BenchCase> run_render_bench(const GpuScene& scene, Renderer& rendere
     // off-screen; far away, the scene about 24 pixels tall, where most blocks
     // are under the level-of-detail size (a block's bounding sphere is about
     // 12 mm across in a 90 mm brain).
-    const View views[] = {{"overview", 1.0f}, {"close-up", 3.0f}, {"far", 24.0f / float(target.height())}};
+    const View all[] = {{kBenchViews[0], 1.0f}, {kBenchViews[1], 3.0f}, {kBenchViews[2], 24.0f / float(target.height())}};
     std::vector<BenchCase> out;
-    for (const View& v : views)
+    for (const View& v : all) {
+        if (std::find(views.begin(), views.end(), v.name) == views.end()) continue;
         for (bool selection : {true, false}) {
             RenderOptions o = base;
             o.frustum_culling = o.level_of_detail = selection;
@@ -51,6 +52,7 @@ std::vector<BenchCase> run_render_bench(const GpuScene& scene, Renderer& rendere
             c.median.cull_ms = median(cull), c.median.decode_ms = median(decode), c.median.draw_ms = median(draw);
             out.push_back(c);
         }
+    }
     return out;
 }
 

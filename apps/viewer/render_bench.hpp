@@ -22,11 +22,16 @@ struct BenchCase {
     double frame_ms;    // median wall time of a whole frame, glFinish included
 };
 
+// The benchmark's views, nearest last but one: the whole scene; a close-up
+// where about a third of the blocks are off-screen; far away.
+inline const char* const kBenchViews[] = {"overview", "close-up", "far"};
+
 // `camera_for(zoom)` places the camera (zoom 1 = the whole scene). Runs one
-// warm-up frame then `frames` timed frames per case.
+// warm-up frame then `frames` timed frames per case: each of `views` (names
+// of kBenchViews) with and without culling + LoD.
 std::vector<BenchCase> run_render_bench(const GpuScene& scene, Renderer& renderer, RenderTarget& target,
                                         const std::function<Camera(float zoom)>& camera_for,
-                                        const RenderOptions& base, int frames);
+                                        const RenderOptions& base, int frames, const std::vector<std::string>& views);
 
 // A transparent frame against the opaque one (the overview, culling on):
 // median wall times of both, and the GPU memory transparency added.
