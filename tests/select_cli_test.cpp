@@ -53,6 +53,7 @@ protected:
     }
     static std::string fft() { return dir_->file("s.fft"); }
     static std::string cli() { return FIBLET_CLI; }
+    static std::string b_path() { return dir_->file("refused.tck"); }
     static inline TempDir* dir_ = nullptr;
 };
 
@@ -128,6 +129,61 @@ TEST_F(SelectCli, AgreesWithTckedit) {
         EXPECT_EQ(test::read_tck_fibers(b), expected) << args;
     }
     EXPECT_GT(nonempty, 2);
+}
+
+// tckedit's -ends_only, -inverse, -number and -skip, in its spelling and
+// fiblet's. Where no region is given, tckedit 3.0.3's -inverse keeps every
+// streamline (its length criteria then ignored); fiblet keeps those that
+// fail them, as tckedit's help says: that case is checked against the
+// complement of the plain selection instead.
+TEST_F(SelectCli, EndsOnlyInverseNumberAndSkipAgreeWithTckedit) {
+    if (!have_tckedit()) GTEST_SKIP() << "MRtrix3 tckedit not installed";
+    const std::string full = dir_->file("full-eins.tck");
+    ASSERT_EQ(run(cli() + " decompress " + fft() + " -f -o " + full), 0);
+    const FftFile file(fft());
+    const DecodedFile d = decode_everything(file);
+    QueryGenerator gen(d, 5);
+    auto spec = [](Vec3f c, float r) {
+        char buf[128];
+        std::snprintf(buf, sizeof buf, "%.6g,%.6g,%.6g,%.6g", c.x, c.y, c.z, r);
+        return std::string(buf);
+    };
+    const std::vector<std::string> cases = {
+        " -include " + spec(gen.some_point(), 25) + " -ends_only",
+        " -exclude " + spec(gen.some_point(), 20) + " -ends_only",
+        " -include " + spec(gen.some_point(), 10) + " -inverse",
+        " -include " + spec(gen.some_point(), 10) + " -minlength 80.05 -inverse",
+        " -number 100 -skip 50",
+        " -include " + spec(gen.some_point(), 12) + " -number 7 -skip 3",
+        " -include " + spec(gen.some_point(), 30) + " -ends_only -inverse -number 20",
+    };
+    int nonempty = 0;
+    for (std::size_t i = 0; i < cases.size(); ++i) {
+        std::string ours = cases[i];
+        if (i % 2)  // fiblet's spelling
+            for (const auto& [mrtrix, fiblet] : std::vector<std::pair<std::string, std::string>>{
+                     {" -include ", " --include "}, {" -exclude ", " --exclude "}, {" -ends_only", " --ends-only"},
+                     {" -inverse", " --inverse"}, {" -minlength ", " --min-length "}, {" -number ", " --number "},
+                     {" -skip ", " --skip "}})
+                for (std::size_t at; (at = ours.find(mrtrix)) != std::string::npos;) ours.replace(at, mrtrix.size(), fiblet);
+        const std::string a = dir_->file("tckedit-e" + std::to_string(i) + ".tck");
+        const std::string b = dir_->file("fiblet-e" + std::to_string(i) + ".tck");
+        ASSERT_EQ(run("tckedit -quiet -force -nthreads 0 " + full + " " + a + cases[i]), 0) << cases[i];
+        ASSERT_EQ(run(cli() + " extract -q -f " + fft() + " -o " + b + ours), 0) << ours;
+        const auto expected = test::read_tck_fibers(a);
+        nonempty += !expected.empty() && expected.size() < file.header().fibers;
+        EXPECT_EQ(test::read_tck_fibers(b), expected) << cases[i];
+    }
+    EXPECT_GE(nonempty, 5);
+    // Lengths alone: --inverse keeps what --min-length drops.
+    const std::string kept = dir_->file("long.tck"), dropped = dir_->file("short.tck");
+    ASSERT_EQ(run(cli() + " extract -q -f " + fft() + " -o " + kept + " --min-length 80.05"), 0);
+    ASSERT_EQ(run(cli() + " extract -q -f " + fft() + " -o " + dropped + " --min-length 80.05 --inverse"), 0);
+    const auto long_fibers = test::read_tck_fibers(kept), short_fibers = test::read_tck_fibers(dropped);
+    EXPECT_EQ(long_fibers.size() + short_fibers.size(), file.header().fibers);
+    for (const auto& f : short_fibers) EXPECT_LT(double(f.size() - 1) * file.header().step * file.header().scaling, 80.05);
+    // Whole-fiber tests in blocks mode are refused.
+    EXPECT_EQ(run(cli() + " extract -q -f " + fft() + " -o " + b_path() + " --include 0,0,0,5 --mode blocks --inverse"), 2);
 }
 
 TEST_F(SelectCli, FftOutputIsAValidSubset) {

@@ -196,6 +196,34 @@ TEST_P(SelectQuery, FiberRegionsMatchBruteForce) {
     EXPECT_GT(nonempty, 4);  // the generator makes queries that keep something
 }
 
+// tckedit's -ends_only, -inverse, -skip and -number, alone and mixed with
+// the other fiber criteria and a view.
+TEST_P(SelectQuery, EndsInverseSkipAndNumberMatchBruteForce) {
+    const Subject& s = subject();
+    QueryGenerator gen(s.decoded, 31);
+    const std::uint64_t n = s.file->header().fibers;
+    int nonempty = 0;
+    for (int i = 0; i < 16; ++i) {
+        Query q;
+        for (int k = 0; k < 1 + i % 2; ++k) q.include.push_back(gen.region());
+        if (i % 3 == 1) q.exclude.push_back(gen.region());
+        q.ends_only = i % 2 == 0;
+        q.inverse = i % 4 >= 2;
+        if (i % 5 == 1) q.min_length_mm = gen.uniform(20, 90);
+        if (i % 3 == 2) q.skip = std::uint64_t(gen.uniform(0, float(n) / 3));
+        if (i % 3 != 0) q.number = std::uint64_t(gen.uniform(0, float(n) / 2));
+        if (i == 15) q.include.clear(), q.exclude.clear();  // skip / number / inverse on lengths alone
+        if (i == 7) {
+            ViewSelection v;
+            v.camera.position = {0, -200, 0}, v.camera.target = {0, 0, 0}, v.camera.up = {0, 0, 1};
+            q.view = v;
+        }
+        nonempty += !reference_select(*s.file, s.decoded, q).runs.empty();
+        check(q, "ends/inverse/skip/number " + std::to_string(i));
+    }
+    EXPECT_GE(nonempty, 6);  // random regions rarely hold a fiber's end: half of the queries keep something
+}
+
 TEST_P(SelectQuery, BlockRegionsMatchBruteForce) {
     const Subject& s = subject();
     QueryGenerator gen(s.decoded, 31);
@@ -387,6 +415,10 @@ TEST(SelectQueryErrors, BadQueriesAreRejectedBeforeReading) {
     EXPECT_TRUE(rejects(q));
     q.roi_mode = RoiMode::blocks;  // no per-fiber mask in blocks mode
     EXPECT_FALSE(rejects(q));
+    q.ends_only = true;  // ends-only and inverse decide whole fibers
+    EXPECT_TRUE(rejects(q));
+    q.ends_only = false, q.inverse = true;
+    EXPECT_TRUE(rejects(q));
 }
 
 TEST(SelectQueryErrors, LevelOfDetailCannotBeWrittenAsFft) {

@@ -93,6 +93,7 @@ inline ReferenceSelection reference_select(const FftFile& file, const DecodedFil
     std::vector<float>& xyz = out.lines.xyz;
     auto push = [&](Vec3f p) { xyz.push_back(p.x), xyz.push_back(p.y), xyz.push_back(p.z); };
     const Frustum frustum = q.view ? frustum_from_camera(q.view->camera) : Frustum{};
+    std::uint64_t counted = 0;  // kept fibers with points so far (skip / number)
     for (std::uint64_t f = 0; f < h.fibers; ++f) {
         const std::size_t p0 = d.points.offsets[f], np = d.points.offsets[f + 1] - p0;
         bool keep = q.fibers.empty();
@@ -105,8 +106,18 @@ inline ReferenceSelection reference_select(const FftFile& file, const DecodedFil
               *q.random_fraction))
             keep = false;
         if (keep && q.roi_mode == RoiMode::fibers) {
-            for (const Region& r : q.include) keep = keep && any_inside(d, p0, np, r);
-            for (const Region& r : q.exclude) keep = keep && !any_inside(d, p0, np, r);
+            // ends_only: the first and last points alone.
+            auto meets = [&](const Region& r) {
+                if (!q.ends_only) return any_inside(d, p0, np, r);
+                return np > 0 && (inside(r, point_at(d, p0)) || inside(r, point_at(d, p0 + np - 1)));
+            };
+            for (const Region& r : q.include) keep = keep && meets(r);
+            for (const Region& r : q.exclude) keep = keep && !meets(r);
+        }
+        if (q.inverse) keep = !keep;
+        if (keep && np > 0 && (q.skip > 0 || q.number)) {
+            const std::uint64_t i = counted++;
+            keep = i >= q.skip && (!q.number || i - q.skip < *q.number);
         }
         if (!keep) continue;
 

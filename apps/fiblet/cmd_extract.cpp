@@ -28,6 +28,9 @@ struct ExtractArgs {
     std::uint64_t seed = 0;
     std::vector<std::string> include, exclude;
     std::string mode = "fibers";
+    bool ends_only = false, inverse = false;
+    std::uint64_t skip = 0;
+    std::optional<std::uint64_t> number;
     std::string camera_position, camera_target, camera_up = "0,1,0", lod;
     float fov = 45, aspect = 16.0f / 9.0f, near_mm = 1, far_mm = 2000, lod_pixels = kDefaultLodPixels;
     bool no_cull = false, compute_index = false, force = false, quiet = false, json = false;
@@ -92,6 +95,9 @@ Query build_query(const ExtractArgs& a) {
     for (const auto& s : a.include) q.include.push_back(region("--include", s));
     for (const auto& s : a.exclude) q.exclude.push_back(region("--exclude", s));
     q.roi_mode = a.mode == "blocks" ? RoiMode::blocks : RoiMode::fibers;
+    if (q.roi_mode == RoiMode::blocks && (a.ends_only || a.inverse))
+        usage("--ends-only and --inverse decide whole fibers: not with --mode blocks");
+    q.ends_only = a.ends_only, q.inverse = a.inverse, q.skip = a.skip, q.number = a.number;
     if (a.camera_position.empty() != a.camera_target.empty())
         usage("--camera-position and --camera-target go together");
     if (!a.camera_position.empty()) {
@@ -168,6 +174,8 @@ void run(const ExtractArgs& a) {
         j.num("seconds", secs(t0, t1));
         fmt::print("{}\n", j.render());
     } else if (!a.quiet) {
+        if (a.number && stats.fibers < *a.number)
+            fmt::print(stderr, "fiblet: note: {} fibers kept, fewer than --number {}\n", stats.fibers, *a.number);
         fmt::print("{} -> {}: {} of {} fibers as {} streamlines, {} points\n", a.input, a.output, stats.fibers,
                    h.fibers, stats.runs, stats.points);
         fmt::print("  blocks kept {} of {} ({:.2f}%){}, read {}, decoded {}\n", stats.blocks, h.blocks,
@@ -199,6 +207,13 @@ void add_extract(CLI::App& app) {
     cmd->add_option("--exclude", args->exclude, "Exclude region, same forms; repeatable");
     cmd->add_option("--mode", args->mode, "fibers: keep whole fibers (tckedit); blocks: keep the blocks in the regions")
         ->check(CLI::IsMember({"fibers", "blocks"}));
+    cmd->add_flag("--ends-only", args->ends_only,
+                  "Test only each fiber's first and last points against the regions, as tckedit -ends_only");
+    cmd->add_flag("--inverse", args->inverse,
+                  "Keep the fibers that fail at least one fiber criterion (IDs, length, random subset, regions) "
+                  "instead, as tckedit -inverse");
+    cmd->add_option("--skip", args->skip, "Leave out the first N fibers kept (in file order), as tckedit -skip");
+    cmd->add_option("--number", args->number, "Keep at most N fibers (after --skip), as tckedit -number");
     cmd->add_option("--camera-position", args->camera_position, "Camera position x,y,z (mm): frustum culling");
     cmd->add_option("--camera-target", args->camera_target, "Point the camera looks at, x,y,z (mm)");
     cmd->add_option("--camera-up", args->camera_up, "Camera up vector x,y,z (default 0,1,0)");

@@ -15,6 +15,8 @@ const std::map<std::string, std::string>& mrtrix_spellings() {
         {"force", "--force"},         {"quiet", "--quiet"},         {"nthreads", "--threads"},
         {"help", "--help"},           {"version", "--version"},     {"include", "--include"},
         {"exclude", "--exclude"},     {"minlength", "--min-length"}, {"maxlength", "--max-length"},
+        {"number", "--number"},       {"skip", "--skip"},           {"inverse", "--inverse"},
+        {"ends_only", "--ends-only"},
     };
     return table;
 }

@@ -12,6 +12,14 @@
 //    kept when, for every include region, one of its points lies inside it,
 //    and none of its points lies inside any exclude region. Image masks
 //    test the voxel nearest to each point, as tckedit does.
+//    With ends_only (tckedit -ends_only) only each fiber's first and last
+//    points are tested against the regions.
+//  - inverse (tckedit -inverse): the fibers that fail at least one of the
+//    fiber criteria above (IDs, length, random subset, fibers-mode regions)
+//    are kept instead; the view still applies to their blocks.
+//  - skip / number (tckedit -skip / -number): of the fibers kept, in file
+//    order, the first `skip` are left out and at most `number` of the rest
+//    kept (fibers without points, never output, do not count).
 //  - regions (blocks mode): a block is kept when one of its points lies
 //    inside some include region (or there is none) and none lies inside an
 //    exclude region; the fiber-level criteria still apply first.
@@ -86,6 +94,10 @@ struct Query {
     std::uint64_t random_seed = 0;
     std::vector<Region> include, exclude;
     RoiMode roi_mode = RoiMode::fibers;
+    bool ends_only = false;               // fibers-mode regions test each fiber's end points only
+    bool inverse = false;                 // keep the fibers failing some fiber criterion (fibers mode)
+    std::uint64_t skip = 0;               // kept fibers left out first, in file order
+    std::optional<std::uint64_t> number;  // then at most this many kept
     std::optional<ViewSelection> view;
 
     bool has_level_of_detail() const { return view && view->lod; }

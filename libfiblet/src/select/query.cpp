@@ -79,6 +79,8 @@ void check_query(const Query& q) {
         bad_query("the random fraction must be in [0, 1]");
     for (const Region& r : q.include) check_region(r);
     for (const Region& r : q.exclude) check_region(r);
+    if (q.roi_mode == RoiMode::blocks && (q.ends_only || q.inverse))
+        bad_query("ends-only and inverse tests decide whole fibers: fibers mode only");
     if (q.roi_mode == RoiMode::fibers && q.include.size() > kMaxIncludeRegions)
         bad_query("at most " + std::to_string(kMaxIncludeRegions) + " include regions");
     if (q.view) {

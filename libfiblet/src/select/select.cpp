@@ -2,11 +2,14 @@
 //   1. fiber criteria (IDs, length, random subset): no I/O, the index knows
 //      every fiber's point count;
 //   2. fibers-mode regions: the blocks near a region (from the index) are
-//      decoded and their points tested, which decides whole fibers;
+//      decoded and their points tested, which decides whole fibers (with
+//      ends_only, each fiber's first and last blocks); then inverse, skip
+//      and number act on the fibers kept;
 //   3. the blocks of the kept fibers that the view / blocks-mode regions may
 //      keep (from the index) are read, tested on their header (sphere, level
 //      of detail) or points, decoded and handed out as runs.
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -355,7 +358,11 @@ public:
 
     SelectionStats run(const std::function<void(const SelectedChunk&)>& sink) {
         fiber_criteria();
-        if (q_.roi_mode == RoiMode::fibers && !(q_.include.empty() && q_.exclude.empty())) fiber_regions();
+        if (q_.roi_mode == RoiMode::fibers && !(q_.include.empty() && q_.exclude.empty()))
+            q_.ends_only ? fiber_region_ends() : fiber_regions();
+        if (q_.inverse)
+            for (auto& k : keep_) k = !k;
+        skip_and_number();
         blocks(sink);
         stats_.blocks_read = reader_.blocks_read();
         return stats_;
@@ -489,6 +496,63 @@ private:
         }
         for (std::uint64_t f = 0; f < h_.fibers; ++f)
             if (met[f] != all || excluded[f]) keep_[f] = 0;
+    }
+
+    // Pass 2 with ends_only: a fiber's first and last points must meet
+    // every include region and no exclude region. Decoded: the first and
+    // last block of each kept fiber.
+    void fiber_region_ends() {
+        Bits ends((h_.blocks + 63) / 64, 0);
+        for (std::uint64_t f = 0; f < h_.fibers; ++f) {
+            if (!keep_[f] || file_.block_count(f) == 0) continue;
+            for (const std::uint64_t b : {file_.first_block(f), file_.first_block(f) + file_.block_count(f) - 1})
+                ends[b >> 6] |= std::uint64_t{1} << (b & 63);
+        }
+        std::vector<std::array<Vec3f, 2>> end_points(h_.fibers);
+        CandidateBlocks candidates(file_, keep_, &ends);
+        std::vector<std::uint32_t> blocks;
+        std::vector<std::uint64_t> fibers;
+        std::vector<std::size_t> all;
+        const std::uint32_t bb = h_.block_bytes();
+        while (candidates.next(batch_blocks(h_), blocks, fibers)) {
+            reader_.read(blocks);
+            all.resize(blocks.size());
+            for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+            const std::uint8_t* bytes = contiguous(blocks, all, [&](std::size_t i) { return reader_.block(i); });
+            decode_into(ctx_, bytes, blocks.size(), scratch_, 0);
+            stats_.blocks_decoded += blocks.size();
+            std::size_t at = 0;
+            for (std::size_t i = 0; i < blocks.size(); ++i) {
+                const std::uint32_t n = block_flags(h_, bytes + i * bb).point_count;
+                const std::uint64_t f = fibers[i];
+                auto point = [&](std::size_t k) { return Vec3f{scratch_[3 * k], scratch_[3 * k + 1], scratch_[3 * k + 2]}; };
+                if (blocks[i] == file_.first_block(f)) end_points[f][0] = point(at);
+                if (blocks[i] + 1 == file_.first_block(f) + file_.block_count(f)) end_points[f][1] = point(at + n - 1);
+                at += n;
+            }
+        }
+        for (std::uint64_t f = 0; f < h_.fibers; ++f) {
+            if (!keep_[f]) continue;
+            if (file_.block_count(f) == 0) {  // no points: no end meets a region
+                keep_[f] = q_.include.empty();
+                continue;
+            }
+            const auto& e = end_points[f];
+            auto met = [&](const Region& r) { return r.contains(e[0]) || r.contains(e[1]); };
+            keep_[f] = std::all_of(q_.include.begin(), q_.include.end(), met) &&
+                       std::none_of(q_.exclude.begin(), q_.exclude.end(), met);
+        }
+    }
+
+    // skip / number over the kept fibers that have points, in file order.
+    void skip_and_number() {
+        if (q_.skip == 0 && !q_.number) return;
+        std::uint64_t seen = 0;
+        for (std::uint64_t f = 0; f < h_.fibers; ++f) {
+            if (!keep_[f] || file_.block_count(f) == 0) continue;
+            const std::uint64_t i = seen++;
+            keep_[f] = i >= q_.skip && (!q_.number || i - q_.skip < *q_.number);
+        }
     }
 
     // Pass 3: the blocks of the kept fibers.
