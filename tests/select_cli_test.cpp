@@ -12,6 +12,7 @@
 #include "fiblet/compress.hpp"
 #include "fiblet/select.hpp"
 #include "fiblet/tck.hpp"
+#include "image_source.hpp"
 #include "select_reference.hpp"
 #include "test_util.hpp"
 
@@ -184,6 +185,28 @@ TEST_F(SelectCli, EndsOnlyInverseNumberAndSkipAgreeWithTckedit) {
     for (const auto& f : short_fibers) EXPECT_LT(double(f.size() - 1) * file.header().step * file.header().scaling, 80.05);
     // Whole-fiber tests in blocks mode are refused.
     EXPECT_EQ(run(cli() + " extract -q -f " + fft() + " -o " + b_path() + " --include 0,0,0,5 --mode blocks --inverse"), 2);
+}
+
+// A region where the tractogram has no point (a mask in voxel space, a
+// sphere in another space) keeps nothing: said on stderr, not silently.
+TEST_F(SelectCli, RegionsMissingTheTractogramAreWarnedAbout) {
+    const std::string out = dir_->file("missed.tck");
+    SourceImage far;  // a 4 mm cube of ones, 500 mm away from the tractogram
+    far.dims = {4, 4, 4};
+    far.transform = {{{1, 0, 0, 500}, {0, 1, 0, 500}, {0, 0, 1, 500}}};
+    far.fill([](std::int64_t, std::int64_t, std::int64_t, std::int64_t) { return 1.0f; });
+    far.write_mif(dir_->file("far.mif"));
+    for (const std::string& region : std::vector<std::string>{"500,500,500,10", dir_->file("far.mif")}) {
+        const CommandResult r = run_command(cli() + " extract -f " + fft() + " -o " + out + " --include " + region + " 2>&1");
+        EXPECT_EQ(r.status, 0) << r.output;
+        EXPECT_NE(r.output.find("warning: --include " + region + " lies where"), std::string::npos) << r.output;
+        EXPECT_TRUE(test::read_tck_fibers(out).empty());
+    }
+    // A region that meets the tractogram: no warning.
+    const CommandResult hit = run_command(cli() + " extract -f " + fft() + " -o " + out + " --include 0,0,0,30 2>&1");
+    EXPECT_EQ(hit.status, 0);
+    EXPECT_EQ(hit.output.find("warning"), std::string::npos) << hit.output;
+    EXPECT_FALSE(test::read_tck_fibers(out).empty());
 }
 
 TEST_F(SelectCli, FftOutputIsAValidSubset) {

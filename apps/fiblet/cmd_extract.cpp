@@ -1,6 +1,7 @@
 // fiblet extract IN.fft -o OUT.tck|OUT.fft [criteria] — selective decoding.
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -123,6 +124,23 @@ Query build_query(const ExtractArgs& a) {
     return q;
 }
 
+// An include region that meets no block keeps nothing: most often a mask or
+// coordinates in another space than the tractogram's (voxels, not mm).
+void warn_about_regions_missing(const ExtractArgs& a, const Query& q, const BlockIndex& index) {
+    for (std::size_t i = 0; i < q.include.size(); ++i) {
+        const Region& r = q.include[i];
+        std::vector<std::uint64_t> near;
+        if (r.shape == Region::Shape::sphere) index.blocks_near_sphere(r.center, r.radius, near);
+        else if (r.shape == Region::Shape::box) index.blocks_near_box(r.box, near);
+        else index.blocks_near_mask(*r.mask, near);
+        if (std::any_of(near.begin(), near.end(), [](std::uint64_t w) { return w != 0; })) continue;
+        fmt::print(stderr,
+                   "fiblet: warning: --include {} lies where {} has no point: no fiber can be kept{}\n", a.include[i],
+                   a.input,
+                   q.roi_mode == RoiMode::fibers ? " (is it in the tractogram's world space, in mm, as the .tck?)" : "");
+    }
+}
+
 void run(const ExtractArgs& a) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::string ext = std::filesystem::path(a.output).extension().string();
@@ -138,6 +156,7 @@ void run(const ExtractArgs& a) {
     const auto t_open = std::chrono::steady_clock::now();
     const BlockIndex index = a.compute_index ? BlockIndex::compute(file) : BlockIndex::load(file);
     const auto t_index = std::chrono::steady_clock::now();
+    if (!a.quiet) warn_about_regions_missing(a, query, index);
 
     SelectionStats stats;
     std::uint64_t bytes = 0;
