@@ -318,6 +318,18 @@ TEST(CliHabits, ATrxDirectoryIsOneInputWithOrWithoutRecursion) {
     ASSERT_EQ(tree.status, 0) << tree.output;
     EXPECT_EQ(FftFile(fx.dir.file("out/sub-01/dwi.fft")).header().fibers, 3u);
     EXPECT_EQ(test::read_file(fx.dir.file("out/sub-01/dwi.fft")), test::read_file(fx.dir.file("one.fft")));
+    // A TRX directory is known by its header.json, whatever its name.
+    fs::rename(fx.dir.file("tree/sub-01/dwi.trx"), fx.dir.file("tree/sub-01/tractogram"));
+    const auto named = run_in(fx.dir, "compress -q tree/sub-01/tractogram -o named.fft");
+    ASSERT_EQ(named.status, 0) << named.output;
+    EXPECT_EQ(test::read_file(fx.dir.file("named.fft")), test::read_file(fx.dir.file("one.fft")));
+    const auto renamed_tree = run_in(fx.dir, "compress -q -r tree --output-dir out2");
+    ASSERT_EQ(renamed_tree.status, 0) << renamed_tree.output;
+    EXPECT_EQ(test::read_file(fx.dir.file("out2/sub-01/tractogram.fft")), test::read_file(fx.dir.file("one.fft")));
+    // A directory with no header.json is still a folder of inputs (-r).
+    const auto folder = run_in(fx.dir, "compress -q tree -o x.fft");
+    EXPECT_EQ(folder.status, 2);
+    EXPECT_TRUE(mentions(folder, "is a directory (-r reads the files below it)")) << folder.output;
 }
 
 // -r confines its outputs to --output-dir: a symlinked input maps to the

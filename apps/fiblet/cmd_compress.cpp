@@ -99,7 +99,8 @@ void note_lengths_not_kept(const std::string& out, const CompressReport& r) {
 
 void run(const CompressArgs& a) {
     const auto jobs = plan_file_jobs(
-        a.inputs, {{".tck", ".trk", ".trx"}, {".trx"}, a.zstd ? ".fftz" : ".fft", a.output, a.output_dir, a.recursive});
+        a.inputs, {{".tck", ".trk", ".trx"}, {".trx"}, "header.json", a.zstd ? ".fftz" : ".fft", a.output, a.output_dir,
+                   a.recursive});
     std::vector<std::string> json;
     std::optional<Error> first_failure;
     std::size_t above_bound = 0;

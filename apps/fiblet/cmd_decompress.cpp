@@ -90,7 +90,7 @@ std::string decompress_one(const DecompressArgs& a, const std::string& input, co
 // Every input is tried; with several, a failed one is reported and the
 // first failure's code is the exit status (as compress does).
 void run(const DecompressArgs& a) {
-    const auto jobs = plan_file_jobs(a.inputs, {{".fft", ".fftz"}, {}, ".tck", a.output, a.output_dir, a.recursive});
+    const auto jobs = plan_file_jobs(a.inputs, {{".fft", ".fftz"}, {}, "", ".tck", a.output, a.output_dir, a.recursive});
     std::vector<std::string> json;
     std::optional<Error> first_failure;
     for (const auto& [in, out] : jobs) {

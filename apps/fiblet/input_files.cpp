@@ -17,7 +17,10 @@ bool has_extension(const fs::path& p, const std::vector<std::string>& extensions
 
 // A directory that is one input (a TRX directory), not a folder of inputs.
 bool is_directory_input(const fs::path& p, const FileJobOptions& o) {
-    return fs::is_directory(p) && has_extension(p, o.directory_inputs);
+    if (!fs::is_directory(p)) return false;
+    std::error_code ec;
+    return has_extension(p, o.directory_inputs) ||
+           (!o.directory_marker.empty() && fs::is_regular_file(p / o.directory_marker, ec));
 }
 
 // The inputs below `dir`, sorted, as paths relative to it.
