@@ -160,3 +160,35 @@ TEST(CliMessages, AFlippedChecksumAlgorithmIsAnIntegrityFailure) {
         }
     }
 }
+
+// Sparse, unevenly spaced input (0.2 mm segments, then 20 mm ones) is
+// resampled to the fine step: the .fft grows past the input, and compress
+// says so and which --step keeps about the input's points. The report's
+// Hausdorff distance stays at the point error (it once read 61 mm: the
+// metric's window did not reach along the resampled polyline).
+TEST(CliMessages, AnOutputLargerThanItsSparseInputIsExplained) {
+    const test::TempDir dir;
+    {
+        TckWriter w(dir.file("sparse.tck"), {}, true);
+        for (int i = 0; i < 50; ++i) {
+            std::vector<Vec3f> f;
+            for (int k = 0; k < 16; ++k) f.push_back({0.2f * float(k), float(i), std::sin(0.02f * float(k))});
+            for (int k = 1; k <= 4; ++k) f.push_back({3.0f + 20.0f * float(k), float(i), std::sin(0.3f * float(k))});
+            w.write(f);
+        }
+        w.finish();
+    }
+    const auto r = test::run_cli("compress --json " + dir.file("sparse.tck") + " -o " + dir.file("sparse.fft"));
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_GT(fs::file_size(dir.file("sparse.fft")), fs::file_size(dir.file("sparse.tck")));
+    EXPECT_TRUE(mentions(r, "is larger than " + dir.file("sparse.tck"))) << r.output;
+    EXPECT_TRUE(mentions(r, "its 1000 points were resampled to")) << r.output;
+    EXPECT_TRUE(mentions(r, "keeps about the input's point count")) << r.output;
+    const std::size_t at = r.output.find("\"hausdorff_um\": ");
+    ASSERT_NE(at, std::string::npos) << r.output;
+    EXPECT_LT(std::stod(r.output.substr(at + 16)), 50.0) << r.output;
+    // An input the .fft is smaller than: no note.
+    const auto dense = test::run_cli("compress -f " + test::shared_data("bundles/CST_R.tck") + " -o " + dir.file("cst.fft"));
+    EXPECT_EQ(dense.status, 0);
+    EXPECT_FALSE(mentions(dense, "is larger than")) << dense.output;
+}

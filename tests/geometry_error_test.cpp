@@ -119,6 +119,33 @@ TEST(GeometryError, MatchesBruteForceOnLoopsAndSparseInput) {
     expect_matches_brute(pairs);
 }
 
+// A sparse input spaced unevenly (0.2 mm segments, then 20 mm ones), as
+// compress resamples it: input -> decoded must find the dense polyline's
+// segments 100 ahead (the window once reached 23 and reported 61 mm).
+TEST(GeometryError, MatchesBruteForceOnUnevenlySpacedSparseInput) {
+    std::mt19937 rng(9);
+    std::normal_distribution<double> noise(0, 0.002);
+    std::vector<std::pair<Line, Line>> pairs;
+    for (int k = 0; k < 6; ++k) {
+        Line in;
+        for (int i = 0; i < 16; ++i) in.push_back({0.2f * float(i), float(k), std::sin(0.02f * float(i))});
+        for (int i = 1; i <= 4 + k; ++i) in.push_back({3.0f + 20.0f * float(i), float(k), std::sin(0.3f * float(i))});
+        Line dec;  // the input resampled every ~0.2 mm, with noise
+        for (std::size_t s = 0; s + 1 < in.size(); ++s) {
+            const int parts = std::max(1, int(std::lround(std::sqrt(double(brute_segment(in[s], in[s + 1], in[s + 1]))) / 0.2)));
+            for (int j = 0; j < parts; ++j) {
+                const float t = float(j) / float(parts);
+                dec.push_back({in[s].x + t * (in[s + 1].x - in[s].x) + float(noise(rng)),
+                               in[s].y + t * (in[s + 1].y - in[s].y) + float(noise(rng)),
+                               in[s].z + t * (in[s + 1].z - in[s].z) + float(noise(rng))});
+            }
+        }
+        dec.push_back(in.back());
+        pairs.emplace_back(in, dec);
+    }
+    expect_matches_brute(pairs);
+}
+
 TEST(GeometryError, ADroppedTailCountsOneWayOnly) {
     Line in, dec;
     for (int i = 0; i <= 100; ++i) in.push_back({float(0.1 * i), 0, 0});

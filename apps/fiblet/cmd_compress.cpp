@@ -97,6 +97,21 @@ void note_lengths_not_kept(const std::string& out, const CompressReport& r) {
                r.bits.automatic ? "--bits 16" : "--bits auto (16 bits where 8 would not)");
 }
 
+// A .fft larger than its input: sparse input (a few points per streamline,
+// millimetres apart) resampled to a much finer step. Say so and what keeps
+// about the input's points.
+void note_larger_than_input(const std::string& in, const std::string& out, const CompressReport& r) {
+    if (!(r.output_bytes > r.input_bytes)) return;
+    fmt::print(stderr, "fiblet: note: {} ({}) is larger than {} ({})", out, human_bytes(r.output_bytes), in,
+               human_bytes(r.input_bytes));
+    if (r.header.points > r.scan.points && r.scan.step_mean > r.step_mm)
+        fmt::print(stderr,
+                   ": its {} points were resampled to {} at a {:.3g} mm step (the input's spacing averages {:.3g} mm); "
+                   "--step {:.3g} keeps about the input's point count",
+                   r.scan.points, r.header.points, r.step_mm, r.scan.step_mean, r.scan.step_mean);
+    fmt::print(stderr, "\n");
+}
+
 void run(const CompressArgs& a) {
     const auto jobs = plan_file_jobs(
         a.inputs, {{".tck", ".trk", ".trx"}, {".trx"}, "header.json", a.zstd ? ".fftz" : ".fft", a.output, a.output_dir,
@@ -144,7 +159,7 @@ void run(const CompressArgs& a) {
             } else if (!a.quiet) {
                 print_report(report_stream(out), in, out, r);
             }
-            if (!a.quiet) note_lengths_not_kept(out, r);
+            if (!a.quiet) note_lengths_not_kept(out, r), note_larger_than_input(in, out, r);
             if (a.max_error_um && !metrics_above(r.error, r.geometry, *a.max_error_um).empty()) {
                 try {
                     check_error_bound(out, r.error, r.geometry, a.max_error_um);

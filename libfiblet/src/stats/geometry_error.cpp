@@ -321,6 +321,17 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
     const double* own_nearest = own.nearest.data();
     thread_local std::vector<double> nearest_buffer;  // squared distances, then distances
     double* const nearest = at_least(nearest_buffer, from.size());
+    // Polylines of different point counts may be spaced unevenly (a sparse
+    // input resampled: 0.2 mm segments, then 20 mm ones): the window reaches
+    // ahead along `to` by at least the distance the nearest point can have
+    // moved, 2 (|p_k - p_k-1| + d_k-1), in arc length (cumulative lengths).
+    const bool uneven = from.size() != to.size();
+    thread_local std::vector<double> arc_buffer;
+    double* const arc = uneven ? at_least(arc_buffer, n + 1) : nullptr;
+    if (uneven) {
+        arc[0] = 0;
+        for (std::size_t s = 0; s < n; ++s) arc[s + 1] = arc[s] + g.len[s];
+    }
     for (std::size_t k = 0; k < from.size(); ++k) {
         if (same_count && proven[k] && hint <= k && hint + 2 >= k) {
             // The window's nearest is k - 1 or k (the first on a tie, as below).
@@ -329,7 +340,14 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
             continue;
         }
         const Vec3f& p = from[k];
-        const std::size_t lo = hint > 2 ? hint - 2 : 0, hi = std::min(n, hint + ahead + 1), w = hi - lo;
+        std::size_t hi = std::min(n, hint + ahead + 1);
+        if (uneven && k > 0) {
+            const double moved = 2 * (distance(from[k], from[k - 1]) + std::sqrt(nearest[k - 1]));
+            while (hi < n && arc[hi] - arc[hint] < moved) ++hi;
+            at_least(d2, hi - hint + 3);
+            d = d2.data();
+        }
+        const std::size_t lo = hint > 2 ? hint - 2 : 0, w = hi - lo;
         const double px = p.x, py = p.y, pz = p.z;
         double best = std::numeric_limits<double>::infinity();
 #ifdef FIBLET_GEOMETRY_AVX2
