@@ -367,3 +367,38 @@ TEST(CliHabits, InputsThatWouldWriteOneOutputAreRefusedUpFront) {
     EXPECT_TRUE(mentions(flat, "a/x.tck and b/x.tck -> flat/x.fft")) << flat.output;
     EXPECT_FALSE(fs::exists(fx.dir.file("flat")));
 }
+
+// An option the subcommand does not have is named first, before any path is
+// checked (CLI11 alone took `x.fft` after --optput for a missing input), with
+// the options it is closest to; exit 2 and nothing written.
+TEST(CliHabits, UnknownOptionsAreNamedWithTheClosestOnes) {
+    Fixture fx;
+    struct Case {
+        std::string args, message;
+    };
+    for (const Case& c : {Case{"compress --optput x.fft in.tck", "unknown option --optput (did you mean --output?); see fiblet compress --help"},
+                          Case{"compress in.tck --optput=x.fft", "unknown option --optput (did you mean --output?)"},
+                          Case{"compress in.tck -o x.fft --foce", "unknown option --foce (did you mean --force?)"},
+                          Case{"compress in.tck --out x.fft", "unknown option --out (did you mean --output or --output-dir?)"},
+                          Case{"decompress in.fft -o x.tck --jsn", "unknown option --jsn (did you mean --json?); see fiblet decompress --help"},
+                          Case{"compress --hlep", "unknown option --hlep (did you mean --help?)"},
+                          Case{"--verison", "unknown option --verison (did you mean --version?); see fiblet --help"},
+                          Case{"compress in.tck -o x.fft -forse", "'-forse': not an option of fiblet compress (did you mean --force?)"},
+                          Case{"compress in.tck -o x.fft -k", "unknown option -k; see fiblet compress --help"},
+                          Case{"compress in.tck -o x.fft --zzzzzz", "unknown option --zzzzzz; see fiblet compress --help"}}) {
+        const auto r = run_in(fx.dir, c.args);
+        EXPECT_EQ(r.status, 2) << c.args << "\n" << r.output;
+        EXPECT_TRUE(mentions(r, "fiblet: error: " + c.message)) << c.args << "\n" << r.output;
+        EXPECT_FALSE(mentions(r, "Path does not exist")) << c.args << "\n" << r.output;
+        EXPECT_FALSE(fs::exists(fx.dir.file("x.fft")) || fs::exists(fx.dir.file("x.tck"))) << c.args;
+    }
+    // Only close names are offered: nothing like --zzzzzz, and no single letter for -k.
+    EXPECT_FALSE(mentions(run_in(fx.dir, "compress in.tck -o x.fft --zzzzzz"), "did you mean"));
+    EXPECT_EQ(std::distance(fs::directory_iterator(fx.dir.path()), fs::directory_iterator{}), 2);
+    // An option's value and an operand after -- are not options, whatever they look like.
+    EXPECT_EQ(run_in(fx.dir, "compress -q in.tck -o --odd.fft").status, 0);
+    EXPECT_EQ(FftFile(fx.dir.file("--odd.fft")).header().fibers, 3u);
+    fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("--in.tck"));
+    EXPECT_EQ(run_in(fx.dir, "compress -q -o dashes.fft -- --in.tck").status, 0);
+    EXPECT_TRUE(fs::exists(fx.dir.file("dashes.fft")));
+}

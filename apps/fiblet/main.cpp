@@ -14,6 +14,7 @@
 #include "geometry_report.hpp"
 #include "signal_cleanup.hpp"
 #include "single_dash_options.hpp"
+#include "unknown_options.hpp"
 
 namespace {
 
@@ -35,6 +36,7 @@ int run(CLI::App& app, int argc, char** argv) {
     using namespace fiblet::cli;
     try {
         std::vector<std::string> args = translate_single_dash_options(app, {argv + 1, argv + argc});
+        reject_unknown_options(app, args);  // before CLI11 checks the operands
         std::vector<char*> translated{argv[0]};
         for (std::string& a : args) translated.push_back(a.data());
         app.parse(int(translated.size()), translated.data());
