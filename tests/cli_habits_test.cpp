@@ -402,3 +402,39 @@ TEST(CliHabits, UnknownOptionsAreNamedWithTheClosestOnes) {
     EXPECT_EQ(run_in(fx.dir, "compress -q -o dashes.fft -- --in.tck").status, 0);
     EXPECT_TRUE(fs::exists(fx.dir.file("dashes.fft")));
 }
+
+// MRtrix3's order, `compress IN OUT.fft`: the last operand, a .fft name that
+// does not exist yet, is the output when no -o, --output-dir or -r says
+// otherwise; two existing inputs are still two inputs.
+TEST(CliHabits, CompressTakesMrtrixOrderInputThenOutput) {
+    Fixture fx;
+    const auto r = run_in(fx.dir, "compress -q in.tck out.fft");
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(run_in(fx.dir, "verify -q out.fft").status, 0);
+    const auto decoded = run_in(fx.dir, "decompress -q out.fft -o back.tck");
+    EXPECT_EQ(decoded.status, 0) << decoded.output;
+    EXPECT_EQ(read_tck_fibers(fx.dir.file("back.tck")).size(), 3u);
+    // After -- too, and with the options before the operands.
+    const auto dashed = run_in(fx.dir, "compress -q -j1 -- in.tck out2.fft");
+    EXPECT_EQ(dashed.status, 0) << dashed.output;
+    EXPECT_EQ(FftFile(fx.dir.file("out2.fft")).header().fibers, 3u);
+
+    // Two existing inputs: two outputs, each beside its input.
+    fs::create_directories(fx.dir.file("two"));
+    fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("two/a.tck"));
+    fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("two/b.tck"));
+    const auto two = run_in(fx.dir, "compress -q two/a.tck two/b.tck");
+    EXPECT_EQ(two.status, 0) << two.output;
+    EXPECT_EQ(FftFile(fx.dir.file("two/a.fft")).header().fibers, 3u);
+    EXPECT_EQ(FftFile(fx.dir.file("two/b.fft")).header().fibers, 3u);
+
+    // With -o given, a second operand stays an input (which does not exist: exit 2, nothing written).
+    const auto with_o = run_in(fx.dir, "compress -q in.tck other.fft -o x.fft");
+    EXPECT_EQ(with_o.status, 2) << with_o.output;
+    EXPECT_TRUE(mentions(with_o, "other.fft")) << with_o.output;
+    EXPECT_FALSE(fs::exists(fx.dir.file("x.fft")) || fs::exists(fx.dir.file("other.fft")));
+    // Three operands are not MRtrix3's order either.
+    EXPECT_EQ(run_in(fx.dir, "compress -q in.tck two/a.tck three.fft").status, 2);
+    EXPECT_FALSE(fs::exists(fx.dir.file("three.fft")));
+    EXPECT_TRUE(mentions(run_in(fx.dir, "compress --help"), "MRtrix3's order"));
+}

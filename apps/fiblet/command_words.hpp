@@ -1,6 +1,6 @@
 // What each word of a fiblet command line is, as CLI11 will read it: the
 // subcommand, an option, an option's value, or an operand. For the checks
-// and rewrites made before parsing (unknown_options).
+// and rewrites made before parsing (unknown_options, mrtrix_output_order).
 #pragma once
 
 #include <CLI/CLI.hpp>
