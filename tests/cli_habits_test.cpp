@@ -379,3 +379,74 @@ TEST(CliHabits, InputsThatWouldWriteOneOutputAreRefusedUpFront) {
     EXPECT_TRUE(mentions(flat, "a/x.tck and b/x.tck -> flat/x.fft")) << flat.output;
     EXPECT_FALSE(fs::exists(fx.dir.file("flat")));
 }
+
+// An option the subcommand does not have is named first, before any path is
+// checked (CLI11 alone took `x.fft` after --optput for a missing input), with
+// the options it is closest to; exit 2 and nothing written.
+TEST(CliHabits, UnknownOptionsAreNamedWithTheClosestOnes) {
+    Fixture fx;
+    struct Case {
+        std::string args, message;
+    };
+    for (const Case& c : {Case{"compress --optput x.fft in.tck", "unknown option --optput (did you mean --output?); see fiblet compress --help"},
+                          Case{"compress in.tck --optput=x.fft", "unknown option --optput (did you mean --output?)"},
+                          Case{"compress in.tck -o x.fft --foce", "unknown option --foce (did you mean --force?)"},
+                          Case{"compress in.tck --out x.fft", "unknown option --out (did you mean --output or --output-dir?)"},
+                          Case{"decompress in.fft -o x.tck --jsn", "unknown option --jsn (did you mean --json?); see fiblet decompress --help"},
+                          Case{"compress --hlep", "unknown option --hlep (did you mean --help?)"},
+                          Case{"--verison", "unknown option --verison (did you mean --version?); see fiblet --help"},
+                          Case{"compress in.tck -o x.fft -forse", "'-forse': not an option of fiblet compress (did you mean --force?)"},
+                          Case{"compress in.tck -o x.fft -k", "unknown option -k; see fiblet compress --help"},
+                          Case{"compress in.tck -o x.fft --zzzzzz", "unknown option --zzzzzz; see fiblet compress --help"}}) {
+        const auto r = run_in(fx.dir, c.args);
+        EXPECT_EQ(r.status, 2) << c.args << "\n" << r.output;
+        EXPECT_TRUE(mentions(r, "fiblet: error: " + c.message)) << c.args << "\n" << r.output;
+        EXPECT_FALSE(mentions(r, "Path does not exist")) << c.args << "\n" << r.output;
+        EXPECT_FALSE(fs::exists(fx.dir.file("x.fft")) || fs::exists(fx.dir.file("x.tck"))) << c.args;
+    }
+    // Only close names are offered: nothing like --zzzzzz, and no single letter for -k.
+    EXPECT_FALSE(mentions(run_in(fx.dir, "compress in.tck -o x.fft --zzzzzz"), "did you mean"));
+    EXPECT_EQ(std::distance(fs::directory_iterator(fx.dir.path()), fs::directory_iterator{}), 2);
+    // An option's value and an operand after -- are not options, whatever they look like.
+    EXPECT_EQ(run_in(fx.dir, "compress -q in.tck -o --odd.fft").status, 0);
+    EXPECT_EQ(FftFile(fx.dir.file("--odd.fft")).header().fibers, 3u);
+    fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("--in.tck"));
+    EXPECT_EQ(run_in(fx.dir, "compress -q -o dashes.fft -- --in.tck").status, 0);
+    EXPECT_TRUE(fs::exists(fx.dir.file("dashes.fft")));
+}
+
+// MRtrix3's order, `compress IN OUT.fft`: the last operand, a .fft name that
+// does not exist yet, is the output when no -o, --output-dir or -r says
+// otherwise; two existing inputs are still two inputs.
+TEST(CliHabits, CompressTakesMrtrixOrderInputThenOutput) {
+    Fixture fx;
+    const auto r = run_in(fx.dir, "compress -q in.tck out.fft");
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(run_in(fx.dir, "verify -q out.fft").status, 0);
+    const auto decoded = run_in(fx.dir, "decompress -q out.fft -o back.tck");
+    EXPECT_EQ(decoded.status, 0) << decoded.output;
+    EXPECT_EQ(read_tck_fibers(fx.dir.file("back.tck")).size(), 3u);
+    // After -- too, and with the options before the operands.
+    const auto dashed = run_in(fx.dir, "compress -q -j1 -- in.tck out2.fft");
+    EXPECT_EQ(dashed.status, 0) << dashed.output;
+    EXPECT_EQ(FftFile(fx.dir.file("out2.fft")).header().fibers, 3u);
+
+    // Two existing inputs: two outputs, each beside its input.
+    fs::create_directories(fx.dir.file("two"));
+    fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("two/a.tck"));
+    fs::copy_file(fx.dir.file("in.tck"), fx.dir.file("two/b.tck"));
+    const auto two = run_in(fx.dir, "compress -q two/a.tck two/b.tck");
+    EXPECT_EQ(two.status, 0) << two.output;
+    EXPECT_EQ(FftFile(fx.dir.file("two/a.fft")).header().fibers, 3u);
+    EXPECT_EQ(FftFile(fx.dir.file("two/b.fft")).header().fibers, 3u);
+
+    // With -o given, a second operand stays an input (which does not exist: exit 2, nothing written).
+    const auto with_o = run_in(fx.dir, "compress -q in.tck other.fft -o x.fft");
+    EXPECT_EQ(with_o.status, 2) << with_o.output;
+    EXPECT_TRUE(mentions(with_o, "other.fft")) << with_o.output;
+    EXPECT_FALSE(fs::exists(fx.dir.file("x.fft")) || fs::exists(fx.dir.file("other.fft")));
+    // Three operands are not MRtrix3's order either.
+    EXPECT_EQ(run_in(fx.dir, "compress -q in.tck two/a.tck three.fft").status, 2);
+    EXPECT_FALSE(fs::exists(fx.dir.file("three.fft")));
+    EXPECT_TRUE(mentions(run_in(fx.dir, "compress --help"), "MRtrix3's order"));
+}

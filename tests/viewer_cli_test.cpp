@@ -126,3 +126,20 @@ TEST(ViewerCli, ViewWithoutADisplayFailsClearly) {
     EXPECT_NE(r.output.find("display"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("fiblet render"), std::string::npos) << r.output;
 }
+
+// A mistyped option of render or view is named, with the option meant,
+// before the input is opened (here it does not even exist) or a window is
+// asked for: exit 2, no image written.
+TEST(ViewerCli, MistypedOptionsAreNamedBeforeAnythingElse) {
+    const TempDir dir;
+    const std::string missing = dir.file("missing.fft");
+    const CommandResult render = run_cli("render " + missing + " -o " + dir.file("x.png") + " --stye tubes");
+    EXPECT_EQ(render.status, 2) << render.output;
+    EXPECT_NE(render.output.find("unknown option --stye (did you mean --style?); see fiblet render --help"),
+              std::string::npos) << render.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("x.png")));
+    const CommandResult view = run_cli("view " + missing + " --stye tubes", "env -u DISPLAY -u WAYLAND_DISPLAY");
+    EXPECT_EQ(view.status, 2) << view.output;
+    EXPECT_NE(view.output.find("unknown option --stye (did you mean --style?); see fiblet view --help"),
+              std::string::npos) << view.output;
+}

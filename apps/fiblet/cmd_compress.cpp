@@ -202,7 +202,10 @@ void add_compress(CLI::App& app) {
         ->check(existing_path_or_stdin());
     cmd->add_flag("-r,--recursive", args->recursive,
                   "Compress every .tck, .trk and .trx below the directories given (tree mirrored in --output-dir)");
-    cmd->add_option("-o,--output", args->output, "Output .fft file (one input; - for standard output, the report then on stderr)");
+    cmd->add_option("-o,--output", args->output,
+                    "Output .fft file (one input; - for standard output, the report then on stderr). MRtrix3's order "
+                    "`fiblet compress IN OUT.fft` means -o OUT.fft when OUT.fft (or .fftz) does not exist yet and "
+                    "neither -o, --output-dir nor -r is given");
     cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs); created if missing");
     cmd->add_option("--step", args->step, "Fixed step in mm (default: measured; variable spacing is resampled)");
     add_threads_option(cmd, args->threads, "Encoding");

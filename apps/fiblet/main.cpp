@@ -12,8 +12,10 @@
 
 #include "cli_common.hpp"
 #include "geometry_report.hpp"
+#include "mrtrix_output_order.hpp"
 #include "signal_cleanup.hpp"
 #include "single_dash_options.hpp"
+#include "unknown_options.hpp"
 
 namespace {
 
@@ -35,6 +37,8 @@ int run(CLI::App& app, int argc, char** argv) {
     using namespace fiblet::cli;
     try {
         std::vector<std::string> args = translate_single_dash_options(app, {argv + 1, argv + argc});
+        reject_unknown_options(app, args);  // before CLI11 checks the operands
+        args = mrtrix_output_order(app, std::move(args));
         std::vector<char*> translated{argv[0]};
         for (std::string& a : args) translated.push_back(a.data());
         app.parse(int(translated.size()), translated.data());

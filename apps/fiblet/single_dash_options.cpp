@@ -4,6 +4,8 @@
 #include <cctype>
 #include <map>
 
+#include "command_words.hpp"
+#include "unknown_options.hpp"
 #include "fiblet/error.hpp"
 
 namespace fiblet::cli {
@@ -50,10 +52,6 @@ bool is_single_dash_word(const std::string& w) {
     return w.find_first_not_of("0123456789", 2) != std::string::npos;
 }
 
-std::string command_name(const CLI::App& app) {
-    return app.get_parent() ? "fiblet " + app.get_name() : "fiblet";
-}
-
 // `-name` or `-name=value`: fiblet's spelling, or Error(invalid_argument) saying which one is meant.
 std::string translate(const CLI::App& app, const std::string& word) {
     const std::size_t equals = std::min(word.find('='), word.size());
@@ -71,6 +69,7 @@ std::string translate(const CLI::App& app, const std::string& word) {
         throw Error(Errc::invalid_argument,
                     "'" + word + "': long options take two dashes: --" + name + value);
     throw Error(Errc::invalid_argument, "'" + word + "': not an option of " + command_name(app) +
+                                            did_you_mean(app, "--" + name) +
                                             " (a single dash is followed by one letter, e.g. -o FILE; long options "
                                             "take two dashes); see " + command_name(app) + " --help");
 }

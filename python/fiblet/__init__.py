@@ -13,6 +13,7 @@
 
     tractogram = fiblet.load_tractogram("tracks.fft")   # nibabel Tractogram
     fiblet.save("out.fft", tractogram.streamlines)      # from nibabel, lists, ...
+    fiblet.save("out.trk", s)       # the format its name says: .fft, .fftz, .tck, .trk, .trx
     fiblet.stats("out.fft", "in.tck")                   # measured error
 
 The decoded points are handed to numpy without a copy: the arrays own the
@@ -377,44 +378,93 @@ def read_streamlines(path):
     return Streamlines(r["points"], r["offsets"]), r["data"]
 
 
+# What save() writes, by the output's extension (any case).
+_COMPRESSED = (".fft", ".fftz")         # compressed (.fftz: the seekable zstd container, `fiblet compress --zstd`)
+_STREAMLINE_FILES = (".tck", ".trk", ".trx")  # written by the writers of `fiblet decompress`
+_SAVE_EXTENSIONS = _COMPRESSED + _STREAMLINE_FILES
+
+
+def _output_kind(path):
+    """The extension of `path` that save() writes, lower-cased; ValueError for any other."""
+    ext = _os.path.splitext(path)[1].lower()
+    if ext not in _SAVE_EXTENSIONS:
+        raise ValueError(f"save: cannot write {path!r}: the file name must end in one of "
+                         f"{', '.join(_SAVE_EXTENSIONS)} (the format is chosen by the extension)")
+    return ext
+
+
 def save(path, streamlines, step=None, *, overwrite=False, threads=None):
-    """Compresses streamlines into a .fft file; returns the compression report
-    (the keys of ``fiblet compress --json``: ratio, max_error_um, ...).
+    """Writes streamlines to ``path`` in the format its extension names.
+
+    - ``.fft``: compressed, as ``fiblet compress``; ``.fftz``: compressed
+      into the seekable zstd container, as ``fiblet compress --zstd``.
+      Returns the compression report (the keys of ``fiblet compress
+      --json``: ratio, max_error_um, ...).
+    - ``.tck``, ``.trk``, ``.trx``: the points as they are, written by the
+      writers of ``fiblet decompress`` (a .trk or .trx of points gets the
+      identity space: RAS+, 1 mm voxels). Returns ``{"output", "fibers",
+      "points", "output_bytes"}``.
+    - Any other extension raises ValueError and writes nothing.
 
     streamlines: a :class:`Streamlines`, a nibabel ArraySequence, Tractogram or
         loaded tractogram file, a list of (n, 3) arrays, or (points, offsets).
         Coordinates are world millimetres. Or the path of a .tck, .trk or
-        TRX file, compressed directly by the same readers as
-        ``fiblet compress`` (its per-streamline and per-point data kept).
-    step: the fixed step in mm (default: measured; input with variable
-        spacing is resampled to it).
+        TRX file, read by the same readers as ``fiblet compress`` (its
+        per-streamline and per-point data kept in a .fft, .fftz, .trk or
+        .trx; a .tck holds points only, and a warning says what was left out).
+    step: the fixed step in mm, for .fft/.fftz (default: measured; input with
+        variable spacing is resampled to it); refused for other outputs.
+    overwrite: replace an existing file (else FileExistsError).
+    threads: compression threads (None: all cores).
 
-    The points go through a temporary .tck file (in the default temporary
-    directory, see ``tempfile``), which is removed afterwards; the .fft is
-    written atomically.
+    Points for a .fft/.fftz go through a temporary .tck file (in the default
+    temporary directory, see ``tempfile``), which is removed afterwards.
+    Every output is written atomically: complete, or not at all.
     """
     if not isinstance(path, (str, _os.PathLike)):
         raise TypeError(f"save(path, streamlines): path must be a file name, got {type(path).__name__}")
     path = _os.fspath(path)
+    ext = _output_kind(path)
+    if step is not None and ext not in _COMPRESSED:
+        raise ValueError(f"save: step= resamples for compression (.fft, .fftz); {path!r} gets the points as they are")
     if _os.path.exists(path) and not overwrite:
         raise FileExistsError(f"{path} exists (pass overwrite=True)")
+    zstd, nthreads = ext == ".fftz", _threads(threads)
     if isinstance(streamlines, (str, _os.PathLike)):
-        return _fiblet.compress(_existing(streamlines), path, None if step is None else float(step),
-                                bool(overwrite), _threads(threads))
+        source = _existing(streamlines)
+        if ext in _COMPRESSED:
+            return _fiblet.compress(source, path, None if step is None else float(step), bool(overwrite),
+                                    nthreads, zstd)
+        written = _fiblet.convert(source, path, bool(overwrite))
+        if written.pop("fields_dropped"):
+            import warnings
+            warnings.warn(f"save: the data arrays of {source} are not in {path}: a .tck holds points only "
+                          f"(write a .trk or .trx to keep them)", stacklevel=2)
+        return _written(path, written)
     points, offsets = _flatten(streamlines)
     points = _np.ascontiguousarray(points, dtype=_np.float32)
     if points.ndim != 2 or points.shape[1] != 3:
         raise ValueError(f"points must be (N, 3), got {points.shape}")
     if not _np.all(_np.isfinite(points)):
         raise ValueError("points must be finite (no NaN or Inf)")
+    offsets = _np.ascontiguousarray(offsets, dtype=_np.int64)
+    if ext not in _COMPRESSED:
+        _fiblet.write_streamlines(path, points, offsets, [], bool(overwrite))
+        return _written(path, {"fibers": len(offsets) - 1, "points": len(points)})
     properties = [] if step is None else [("step_size", repr(float(step)))]
     with _tempfile.TemporaryDirectory(prefix="fiblet-save-") as tmp:
         tck = _os.path.join(tmp, "streamlines.tck")
-        _fiblet.write_tck(tck, points, _np.ascontiguousarray(offsets, dtype=_np.int64), properties, False)
+        _fiblet.write_streamlines(tck, points, offsets, properties, False)
         report = _fiblet.compress(tck, path, None if step is None else float(step), bool(overwrite),
-                                  _threads(threads))
+                                  nthreads, zstd)
     report["input"] = None  # the temporary .tck is gone
     return report
+
+
+def _written(path, counts):
+    """save()'s report for a .tck, .trk or .trx."""
+    return {"output": path, "fibers": int(counts["fibers"]), "points": int(counts["points"]),
+            "output_bytes": _os.path.getsize(path)}
 
 
 def stats(fft, reference):

@@ -18,6 +18,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
@@ -32,10 +33,10 @@
 #include "fiblet/parallel.hpp"
 #include "fiblet/select.hpp"
 #include "fiblet/streamline_io.hpp"
-#include "fiblet/tck.hpp"
 #include "decode_range.hpp"
 #include "owned_array.hpp"
 #include "gather_fibers.hpp"
+#include "write_streamlines.hpp"
 
 namespace py = pybind11;
 
@@ -358,10 +359,12 @@ py::dict stats(const std::string& fft_path, const std::string& reference) {
 }
 
 // Same keys as `fiblet compress --json`.
+// zstd: the seekable zstd container (.fftz) with the defaults of `fiblet compress --zstd`.
 py::dict compress(const std::string& tck_path, const std::string& fft_path, std::optional<double> step_mm,
-                  bool overwrite, unsigned threads) {
+                  bool overwrite, unsigned threads, bool zstd) {
     CompressOptions o;
     o.step_mm = step_mm, o.overwrite = overwrite, o.threads = threads;
+    if (zstd) o.zstd = ZstdOptions{};
     CompressReport r;
     {
         py::gil_scoped_release release;
@@ -391,24 +394,33 @@ py::dict compress(const std::string& tck_path, const std::string& fft_path, std:
 }
 
 // Writes streamlines given as points (N,3) float32 and offsets (F+1) to a
-// .tck file (atomically, through TckWriter).
-void write_tck(const std::string& path, py::array_t<float, py::array::c_style | py::array::forcecast> points,
-               py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> offsets,
-               const std::vector<std::pair<std::string, std::string>>& properties, bool overwrite) {
+// .tck, .trk or .trx file (atomically, through the library's sinks).
+void write_streamlines_array(const std::string& path,
+                             py::array_t<float, py::array::c_style | py::array::forcecast> points,
+                             py::array_t<std::int64_t, py::array::c_style | py::array::forcecast> offsets,
+                             const std::vector<std::pair<std::string, std::string>>& properties, bool overwrite) {
     if (points.ndim() != 2 || points.shape(1) != 3) throw Error(Errc::invalid_argument, "points must be an (N, 3) array");
     if (offsets.ndim() != 1 || offsets.shape(0) < 1) throw Error(Errc::invalid_argument, "offsets must be 1-D, F+1 long");
-    const float* xyz = points.data();
-    const std::int64_t* off = offsets.data();
-    const auto n_offsets = std::size_t(offsets.shape(0));
+    const std::span<const std::int64_t> off(offsets.data(), std::size_t(offsets.shape(0)));
     const auto n_points = std::int64_t(points.shape(0));
-    if (off[0] != 0 || off[n_offsets - 1] != n_points)
+    if (off.front() != 0 || off.back() != n_points)
         throw Error(Errc::invalid_argument, "offsets must start at 0 and end at the number of points");
-    for (std::size_t i = 1; i < n_offsets; ++i)
+    for (std::size_t i = 1; i < off.size(); ++i)
         if (off[i] < off[i - 1]) throw Error(Errc::invalid_argument, "offsets must not decrease");
     py::gil_scoped_release release;
-    TckWriter writer(path, properties, overwrite);
-    for (std::size_t i = 0; i + 1 < n_offsets; ++i) writer.write(xyz + 3 * off[i], std::size_t(off[i + 1] - off[i]));
-    writer.finish();
+    write_streamlines(path, points.data(), off, properties, overwrite);
+}
+
+// A .tck, .trk or TRX file rewritten as another of them: {fibers, points, fields_dropped}.
+py::dict convert(const std::string& input, const std::string& output, bool overwrite) {
+    Conversion c;
+    {
+        py::gil_scoped_release release;
+        c = convert_streamlines(input, output, overwrite);
+    }
+    py::dict d;
+    d["fibers"] = c.fibers, d["points"] = c.points, d["fields_dropped"] = c.fields_dropped;
+    return d;
 }
 
 // numpy's dtype name for a field type ("float16", "uint32", ...: the same names).
@@ -483,8 +495,9 @@ PYBIND11_MODULE(_fiblet, m) {
     m.def("info", &info, py::arg("path"), py::arg("ignore_trailer"));
     m.def("stats", &stats, py::arg("fft"), py::arg("reference"));
     m.def("compress", &compress, py::arg("tck"), py::arg("fft"), py::arg("step_mm"), py::arg("overwrite"),
-          py::arg("threads"));
+          py::arg("threads"), py::arg("zstd"));
     m.def("read_streamlines", &read_streamlines, py::arg("path"));
-    m.def("write_tck", &write_tck, py::arg("path"), py::arg("points"), py::arg("offsets"), py::arg("properties"),
-          py::arg("overwrite"));
+    m.def("write_streamlines", &write_streamlines_array, py::arg("path"), py::arg("points"), py::arg("offsets"),
+          py::arg("properties"), py::arg("overwrite"));
+    m.def("convert", &convert, py::arg("input"), py::arg("output"), py::arg("overwrite"));
 }

@@ -1,7 +1,11 @@
 """fiblet.save: streamlines from Python objects into .fft, read back and
-measured against the points given."""
+measured against the points given; the format chosen by the output's
+extension (.fft, .fftz, .tck, .trk, .trx), each read back by another reader
+(nibabel, the TRX layout read with zipfile and numpy), any other refused."""
 import json
+import struct
 import subprocess
+import zipfile
 
 import numpy as np
 import pytest
@@ -97,3 +101,140 @@ def test_save_report_has_the_cli_json_keys(tmp_path, shared, cli):
     assert set(py_report) == set(cli_report)
     for key in ("fibers", "points", "blocks", "max_error_um", "mean_error_um", "step_mm"):
         assert py_report[key] == pytest.approx(cli_report[key], rel=1e-6), key
+
+
+# ---- The output's extension chooses the format ----
+
+@pytest.fixture(scope="module")
+def dwi_seq(shared):
+    return nib.streamlines.load(str(shared / "dwi-small64d-ifod1.tck")).streamlines
+
+
+def assert_same_fibers(points, lengths, seq, atol=0.0):
+    np.testing.assert_array_equal(lengths, seq._lengths)
+    if atol:
+        np.testing.assert_allclose(points, seq.get_data(), rtol=0, atol=atol)
+    else:
+        np.testing.assert_array_equal(points, seq.get_data())
+
+
+@pytest.mark.parametrize("name, magic", [("out.tck", b"mrtrix tracks\n"), ("out.trk", b"TRACK"),
+                                         ("OUT.TCK", b"mrtrix tracks\n")])
+def test_save_tck_and_trk_are_what_nibabel_reads(tmp_path, dwi_seq, name, magic):
+    out = tmp_path / name
+    report = fiblet.save(out, dwi_seq)
+    # The bytes of the format named, not a .fft under that name.
+    assert out.read_bytes().startswith(magic)
+    assert report == {"output": str(out), "fibers": len(dwi_seq), "points": len(dwi_seq.get_data()),
+                      "output_bytes": out.stat().st_size}
+    back = nib.streamlines.load(str(out))
+    if name.lower().endswith(".tck"):  # float32 points, stored as given
+        assert_same_fibers(back.streamlines.get_data(), back.streamlines._lengths, dwi_seq)
+    else:  # through the .trk's voxmm coordinates of the identity space (RAS+, 1 mm voxels)
+        np.testing.assert_array_equal(back.header["voxel_to_rasmm"], np.eye(4))
+        assert_same_fibers(back.streamlines.get_data(), back.streamlines._lengths, dwi_seq, atol=1e-4)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [name]  # nothing else left behind
+
+
+def test_save_trx_read_back_and_laid_out_as_the_specification_says(tmp_path, dwi_seq):
+    out = tmp_path / "out.trx"
+    report = fiblet.save(out, dwi_seq)
+    assert report["fibers"] == len(dwi_seq) and report["points"] == len(dwi_seq.get_data())
+    s, data = fiblet.read_streamlines(out)
+    assert_same_fibers(s.points, s.lengths, dwi_seq)
+    assert data == {}
+    # The TRX specification (github.com/tee-ar-ex/trx-spec): a zip of
+    # header.json and arrays named NAME[.COMPONENTS].DTYPE, little-endian.
+    with zipfile.ZipFile(out) as z:
+        header = json.loads(z.read("header.json"))
+        assert header["NB_STREAMLINES"] == len(dwi_seq) and header["NB_VERTICES"] == len(dwi_seq.get_data())
+        np.testing.assert_array_equal(header["VOXEL_TO_RASMM"], np.eye(4))
+        assert list(header["DIMENSIONS"]) == [1, 1, 1]
+        names = {n.split(".", 1)[0]: n for n in z.namelist()}
+        _, components, dtype = names["positions"].split(".")
+        assert components == "3"
+        positions = np.frombuffer(z.read(names["positions"]), np.dtype(dtype).newbyteorder("<")).reshape(-1, 3)
+        np.testing.assert_array_equal(positions, dwi_seq.get_data())
+        offsets = np.frombuffer(z.read(names["offsets"]), np.dtype(names["offsets"].split(".")[1]).newbyteorder("<"))
+    starts = np.concatenate([[0], np.cumsum(dwi_seq._lengths)])
+    np.testing.assert_array_equal(offsets, starts[:len(offsets)])
+    assert len(offsets) in (len(dwi_seq), len(dwi_seq) + 1)  # with or without the end sentinel
+
+
+ZSTD_SKIPPABLE = struct.pack("<I", 0x184D2A50)  # the first frame of a .fftz (formats/fftz.md)
+
+
+@pytest.mark.parametrize("ext", [".fft", ".fftz"])
+def test_save_fft_and_fftz_compress_as_the_cli_does(tmp_path, shared, cli, dwi_seq, ext):
+    out = tmp_path / f"points{ext}"
+    report = fiblet.save(out, dwi_seq)
+    head = out.read_bytes()[:12]
+    if ext == ".fftz":
+        assert head[:4] == ZSTD_SKIPPABLE and head[8:12] == b"FFTZ"
+    else:
+        assert head[0] == 2  # a version-2 .fft, no container
+    worst = max_distance(fiblet.load(out), dwi_seq)
+    assert worst <= report["max_error_um"] * 1e-3 * (1 + 1e-4) + 1e-7
+    assert subprocess.run([cli, "verify", "-q", str(out)], capture_output=True).returncode == 0
+    # From a file: the bytes of `fiblet compress` (with --zstd for .fftz).
+    tck = shared / "dwi-small64d-ifod1.tck"
+    fiblet.save(tmp_path / f"py{ext}", tck)
+    subprocess.run([cli, "compress", "-q", str(tck), "-o", str(tmp_path / f"cli{ext}")]
+                   + (["--zstd"] if ext == ".fftz" else []), check=True)
+    assert (tmp_path / f"py{ext}").read_bytes() == (tmp_path / f"cli{ext}").read_bytes()
+
+
+@pytest.mark.parametrize("name", ["out.vtk", "out.txt", "out", "out.fft.gz", "out.tck.bak", "out.nii"])
+def test_save_refuses_other_extensions_and_writes_nothing(tmp_path, shared, name):
+    fibers = [np.array([[0, 0, 0], [0.1, 0, 0], [0.2, 0, 0]], np.float32)]
+    for streamlines in (fibers, shared / "dwi-small64d-ifod1.tck"):
+        with pytest.raises(ValueError, match=r"must end in one of \.fft, \.fftz, \.tck, \.trk, \.trx") as e:
+            fiblet.save(tmp_path / name, streamlines)
+        assert repr(str(tmp_path / name)) in str(e.value)
+    assert list(tmp_path.iterdir()) == []
+    # An existing file of that name is left as it was, overwrite or not.
+    (tmp_path / name).write_bytes(b"old")
+    with pytest.raises(ValueError):
+        fiblet.save(tmp_path / name, fibers, overwrite=True)
+    assert (tmp_path / name).read_bytes() == b"old"
+
+
+def test_save_to_tck_keeps_the_overwrite_rules(tmp_path):
+    fibers = [np.array([[0, 0, 0], [0.1, 0, 0], [0.2, 0, 0]], np.float32)]
+    out = tmp_path / "x.tck"
+    out.write_bytes(b"old")
+    with pytest.raises(FileExistsError):
+        fiblet.save(out, fibers)
+    assert out.read_bytes() == b"old"
+    fiblet.save(out, fibers, overwrite=True)
+    np.testing.assert_array_equal(nib.streamlines.load(str(out)).streamlines[0], fibers[0])
+    # step= resamples for compression: refused where the points are written as they are.
+    with pytest.raises(ValueError, match="step="):
+        fiblet.save(tmp_path / "y.trk", fibers, step=0.5)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["x.tck"]
+
+
+def test_save_of_a_file_converts_it_keeping_its_data(tmp_path, shared):
+    src = shared / "conformance" / "complex.trk"
+    s0, data0 = fiblet.read_streamlines(src)
+    assert len(data0) == 5
+    fiblet.save(tmp_path / "c.trx", src)
+    s, data = fiblet.read_streamlines(tmp_path / "c.trx")
+    np.testing.assert_array_equal(s.points, s0.points)
+    np.testing.assert_array_equal(s.offsets, s0.offsets)
+    assert data.keys() == data0.keys()
+    for k in data0:
+        np.testing.assert_array_equal(data[k], data0[k])
+    # A .trk keeps the source's space and data, as nibabel reads them.
+    fiblet.save(tmp_path / "c.trk", src)
+    a, b = nib.streamlines.load(str(src)), nib.streamlines.load(str(tmp_path / "c.trk"))
+    np.testing.assert_array_equal(b.header["voxel_to_rasmm"], a.header["voxel_to_rasmm"])
+    np.testing.assert_allclose(b.streamlines.get_data(), a.streamlines.get_data(), rtol=0, atol=1e-4)
+    assert b.tractogram.data_per_point.keys() == a.tractogram.data_per_point.keys()
+    for k, v in a.tractogram.data_per_streamline.items():
+        np.testing.assert_array_equal(b.tractogram.data_per_streamline[k], v)
+    # A .tck holds points only: said, not silent.
+    with pytest.warns(UserWarning, match="holds points only"):
+        fiblet.save(tmp_path / "c.tck", src)
+    np.testing.assert_allclose(nib.streamlines.load(str(tmp_path / "c.tck")).streamlines.get_data(),
+                               a.streamlines.get_data(), rtol=0, atol=1e-4)
