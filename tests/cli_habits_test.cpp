@@ -12,6 +12,7 @@
 #include "cli_runner.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/tck.hpp"
+#include "fiblet/tractogram_format.hpp"
 #include "test_util.hpp"
 
 using namespace fiblet;
@@ -449,4 +450,24 @@ TEST(CliHabits, CompressTakesMrtrixOrderInputThenOutput) {
     EXPECT_EQ(run_in(fx.dir, "compress -q in.tck two/a.tck three.fft").status, 2);
     EXPECT_FALSE(fs::exists(fx.dir.file("three.fft")));
     EXPECT_TRUE(mentions(run_in(fx.dir, "compress --help"), "MRtrix3's order"));
+}
+
+// The output's name says its container, as fiblet.save: -o x.fftz is the
+// zstd container without -z, -z -o x.fft and other names are refused
+// before anything is written.
+TEST(CliHabits, CompressWritesTheContainerItsOutputNames) {
+    Fixture fx;
+    const auto z = run_in(fx.dir, "compress -q in.tck -o named.fftz");
+    ASSERT_EQ(z.status, 0) << z.output;
+    EXPECT_EQ(detect_tractogram_format(fx.dir.file("named.fftz")), TractogramFormat::fftz);
+    const auto mrtrix = run_in(fx.dir, "compress -q in.tck positional.fftz");
+    ASSERT_EQ(mrtrix.status, 0) << mrtrix.output;
+    EXPECT_EQ(detect_tractogram_format(fx.dir.file("positional.fftz")), TractogramFormat::fftz);
+    EXPECT_EQ(detect_tractogram_format(fx.dir.file("in.fft")), TractogramFormat::fft);
+    for (const std::string& args : {std::string("-z -o plain.fft"), std::string("-o out.tck"), std::string("-o out")}) {
+        const auto bad = run_in(fx.dir, "compress -q in.tck " + args);
+        EXPECT_EQ(bad.status, 2) << args << ": " << bad.output;
+        EXPECT_TRUE(mentions(bad, ".fftz")) << bad.output;
+    }
+    EXPECT_FALSE(fs::exists(fx.dir.file("plain.fft")) || fs::exists(fx.dir.file("out.tck")) || fs::exists(fx.dir.file("out")));
 }

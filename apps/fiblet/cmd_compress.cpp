@@ -1,6 +1,8 @@
 // fiblet compress IN.tck|IN.trk|IN.trx [IN2 ...] [-o OUT.fft | --output-dir DIR] [-r DIR]
 #include <fmt/core.h>
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <optional>
 
@@ -112,7 +114,25 @@ void note_larger_than_input(const std::string& in, const std::string& out, const
     fmt::print(stderr, "\n");
 }
 
-void run(const CompressArgs& a) {
+// The container follows the output's name, as fiblet.save does: -o x.fftz
+// is the zstd container (as -z), -o x.fft the plain one; any other name
+// would hold bytes its extension does not say. Standard output (-) takes -z.
+bool zstd_container(const CompressArgs& a) {
+    if (a.output.empty() || a.output == "-") return a.zstd;
+    std::string ext = std::filesystem::path(a.output).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext == ".fftz") return true;
+    if (ext != ".fft")
+        throw Error(Errc::invalid_argument,
+                    "-o " + a.output + ": compress writes a .fft (or, with --zstd, a .fftz); name the output so");
+    if (a.zstd) throw Error(Errc::invalid_argument, "--zstd writes the .fftz container: name the output " +
+                                                        std::filesystem::path(a.output).replace_extension(".fftz").string());
+    return false;
+}
+
+void run(const CompressArgs& args) {
+    CompressArgs a = args;
+    a.zstd = zstd_container(a);
     const auto jobs = plan_file_jobs(
         a.inputs, {{".tck", ".trk", ".trx"}, {".trx"}, "header.json", a.zstd ? ".fftz" : ".fft", a.output, a.output_dir,
                    a.recursive});
@@ -236,7 +256,8 @@ void add_compress(CLI::App& app) {
     cmd->add_flag("--no-index", args->no_index,
                   "Leave out the block index (BIDX chunk, under 1 % of the file; extract and render compute it on load)");
     cmd->add_flag("-z,--zstd", args->zstd,
-                  "Write the seekable zstd container (.fftz, formats/fftz.md): smaller, still random access");
+                  "Write the seekable zstd container (.fftz, formats/fftz.md): smaller, still random access "
+                  "(-o x.fftz implies it)");
     cmd->add_option("--zstd-level", args->zstd_level, "zstd level (default 3; 17: 4 % smaller, the stage ~12x slower)")->check(CLI::Range(1, 22));
     cmd->add_option("--zstd-group", args->zstd_group, "Blocks per zstd frame, the unit of random access (default 4096)")
         ->check(CLI::Range(1u, 1u << 24));
