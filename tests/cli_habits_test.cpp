@@ -471,3 +471,27 @@ TEST(CliHabits, CompressWritesTheContainerItsOutputNames) {
     }
     EXPECT_FALSE(fs::exists(fx.dir.file("plain.fft")) || fs::exists(fx.dir.file("out.tck")) || fs::exists(fx.dir.file("out")));
 }
+
+// The man page's and docs/cli.md's examples use only options their
+// subcommand has (each --option and -x in it appears in that help).
+TEST(CliHabits, ExamplesUseOnlyRealOptions) {
+    const auto page = test::run_cli("help --man").output;
+    ASSERT_NE(page.find(".SH EXAMPLES"), std::string::npos);
+    std::size_t examples = 0;
+    for (std::size_t at = 0; (at = page.find("\n.B fiblet ", at)) != std::string::npos; ++at) {
+        std::string line = page.substr(at + 4, page.find('\n', at + 1) - at - 4);
+        for (std::size_t d; (d = line.find("\\-")) != std::string::npos;) line.replace(d, 2, "-");
+        if (line.find(" [OPTIONS]") != std::string::npos) continue;  // a synopsis line
+        ++examples;
+        std::istringstream words(line);
+        std::string word, sub, help;
+        while (words >> word) {
+            if (word == "&&") sub.clear();
+            else if (word == "fiblet") continue;
+            else if (sub.empty()) sub = word, help = test::run_cli(sub + " --help").output;
+            else if (word.size() > 1 && word[0] == '-' && !std::isdigit(static_cast<unsigned char>(word[1])))
+                EXPECT_NE(help.find(word), std::string::npos) << sub << " has no " << word << " (" << line << ")";
+        }
+    }
+    EXPECT_GE(examples, 6u);
+}

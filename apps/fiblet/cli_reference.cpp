@@ -41,4 +41,23 @@ std::string usage_line(const CLI::App* cmd) {
     return u;
 }
 
+const std::vector<CliExample>& cli_examples() {
+    static const std::vector<CliExample> examples = {
+        {"Compress a tractogram (the official .fft layout; the report names the error)",
+         "fiblet compress tracks.tck -o tracks.fft"},
+        {"Compress a cohort's tree into another, in parallel, as the seekable zstd container",
+         "fiblet compress -r subjects/ --output-dir compressed/ -z -j 8"},
+        {"Decode back to MRtrix3's .tck (or .trk, TRX: the output's name says which)", "fiblet decompress tracks.fft -o tracks.tck"},
+        {"Keep the fibers through two regions, as tckedit -include", "fiblet extract tracks.fft -o af.tck --include "
+                                                                   "-40,-10,20,8 --include wm_mask.nii.gz"},
+        {"The first 1000 fibers longer than 50 mm, as tckedit -number 1000 -minlength 50",
+         "fiblet extract tracks.fft -o long.tck --min-length 50 --number 1000"},
+        {"Check a file's integrity, and its error against the source", "fiblet verify tracks.fft && fiblet stats "
+                                                                       "tracks.fft --reference tracks.tck"},
+        {"Draw it as ray-cast tubes to a PNG, without a window", "fiblet render tracks.fft --style tubes -o tracks.png"},
+        {"Explore it in a window, with the FOD glyphs of a slice", "fiblet view tracks.fft --odf fod.mif --odf-slice z:40"},
+    };
+    return examples;
+}
+
 }  // namespace fiblet::cli

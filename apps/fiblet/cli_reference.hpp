@@ -19,6 +19,13 @@ std::string option_value(const CLI::Option* o);
 // The description with its default and whether it is required.
 std::string option_description(const CLI::Option* o);
 
+// Worked examples for the man page and docs/cli.md: what it does, the command.
+struct CliExample {
+    const char* what;
+    const char* command;
+};
+const std::vector<CliExample>& cli_examples();
+
 std::string markdown_reference(CLI::App& app);
 std::string man_page(CLI::App& app);
 std::string bash_completion(CLI::App& app);

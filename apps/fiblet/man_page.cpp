@@ -45,6 +45,8 @@ std::string man_page(CLI::App& app) {
          "is not given.\n.TP\n.B MRTRIX_NTHREADS\nThe same, when FIBLET_NTHREADS is not set.\n";
     m += ".SH EXIT STATUS\n";
     for (const ExitCodeInfo& e : exit_code_table()) m += fmt::format(".TP\n.B {}\n{}\n", e.code, roff(e.meaning));
+    m += ".SH EXAMPLES\n";
+    for (const CliExample& e : cli_examples()) m += ".PP\n" + roff(e.what) + ":\n.RS\n.B " + roff(e.command) + "\n.RE\n";
     m += ".SH SEE ALSO\n.BR tckinfo (1),\n.BR tckedit (1),\n.BR zstd (1)\n";
     return m;
 }

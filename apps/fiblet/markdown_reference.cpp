@@ -42,7 +42,9 @@ std::string markdown_reference(CLI::App& app) {
                               escape_cell(option_description(o)));
         }
     }
-    md += "\n## Exit codes\n\n| code | meaning |\n|---|---|\n";
+    md += "\n## Examples\n\n";
+    for (const CliExample& e : cli_examples()) md += fmt::format("{}:\n\n```\n{}\n```\n\n", e.what, e.command);
+    md += "## Exit codes\n\n| code | meaning |\n|---|---|\n";
     for (const ExitCodeInfo& e : exit_code_table()) md += fmt::format("| {} | {} |\n", e.code, e.meaning);
     return md;
 }
