@@ -123,11 +123,12 @@ TEST(OutputTarget, TheCliRefusesInputAsOutputWithForce) {
     ASSERT_EQ(test::run_cli("compress -q " + dir.file("in.tck") + " -o " + dir.file("in.fft")).status, 0);
     const std::string tck = test::read_file(dir.file("in.tck")), fft = test::read_file(dir.file("in.fft"));
     fs::create_symlink("in.fft", dir.file("link.fft"));
+    fs::create_symlink("in.tck", dir.file("tck-link.fft"));  // a .fft name (compress refuses others) on the input
     for (const std::string& args :
          {"decompress -q -f " + dir.file("in.fft") + " -o " + dir.file("link.fft"),
           "decompress -q -f " + dir.file("link.fft") + " -o " + dir.file("in.fft"),
           "extract -q -f " + dir.file("in.fft") + " -o " + dir.file("link.fft"),
-          "compress -q -f " + dir.file("in.tck") + " -o " + dir.file("in.tck")}) {
+          "compress -q -f " + dir.file("in.tck") + " -o " + dir.file("tck-link.fft")}) {
         const auto r = test::run_cli(args);
         EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
         EXPECT_NE(r.output.find("is an input of this command"), std::string::npos) << r.output;

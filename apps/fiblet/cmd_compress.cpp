@@ -116,9 +116,14 @@ void note_larger_than_input(const std::string& in, const std::string& out, const
 
 // The container follows the output's name, as fiblet.save does: -o x.fftz
 // is the zstd container (as -z), -o x.fft the plain one; any other name
-// would hold bytes its extension does not say. Standard output (-) takes -z.
+// would hold bytes its extension does not say. Standard output (-) and
+// devices take -z.
 bool zstd_container(const CompressArgs& a) {
-    if (a.output.empty() || a.output == "-") return a.zstd;
+    std::error_code ec;
+    const auto type = std::filesystem::status(a.output, ec).type();  // a device (/dev/null) has no name to keep
+    if (a.output.empty() || a.output == "-" || type == std::filesystem::file_type::character ||
+        type == std::filesystem::file_type::fifo)
+        return a.zstd;
     std::string ext = std::filesystem::path(a.output).extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
     if (ext == ".fftz") return true;
