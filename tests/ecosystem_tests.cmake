@@ -69,3 +69,11 @@ if(DEFINED Python_EXECUTABLE AND FIBLET_BUILD_VIEWER)
     FIXTURES_REQUIRED phantom_fod
     ENVIRONMENT "FIBLET_CLI=$<TARGET_FILE:fiblet_cli>;FIBLET_ODF=${PROJECT_BINARY_DIR}/tests/phantom-fod/phantom-fod-crop.nii")
 endif()
+
+# --reference IMAGE gives .tck sources a space, checked through nibabel.
+if(DEFINED Python_EXECUTABLE)
+  add_test(NAME ecosystem.reference_space
+    COMMAND ${Python_EXECUTABLE} ${FIBLET_PYTEST} ${PROJECT_SOURCE_DIR}/tests/test_reference_space.py)
+  set_tests_properties(ecosystem.reference_space PROPERTIES TIMEOUT 120 SKIP_REGULAR_EXPRESSION "${FIBLET_PYTEST_SKIPPED}"
+    ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA};FIBLET_CLI=$<TARGET_FILE:fiblet_cli>")
+endif()

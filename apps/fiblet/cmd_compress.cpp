@@ -19,6 +19,7 @@ namespace {
 struct CompressArgs {
     std::vector<std::string> inputs;
     std::string output, output_dir;
+    std::string reference;  // a NIfTI/.mif image: the space of .tck sources
     std::optional<double> step;
     unsigned threads = 0;
     // Encoder choices.
@@ -138,6 +139,8 @@ bool zstd_container(const CompressArgs& a) {
 void run(const CompressArgs& args) {
     CompressArgs a = args;
     a.zstd = zstd_container(a);
+    std::optional<TractogramSpace> reference_space;
+    if (!a.reference.empty()) reference_space = space_of_image(a.reference);
     const auto jobs = plan_file_jobs(
         a.inputs, {{".tck", ".trk", ".trx"}, {".trx"}, "header.json", a.zstd ? ".fftz" : ".fft", a.output, a.output_dir,
                    a.recursive});
@@ -151,6 +154,7 @@ void run(const CompressArgs& args) {
         o.overwrite = a.force;
         o.threads = a.threads;
         o.allow_count_mismatch = a.allow_count_mismatch;
+        o.reference_space = reference_space;
         o.direction_bits = a.bits == "auto" ? std::nullopt : std::optional<unsigned>(unsigned(std::stoul(a.bits)));
         o.points_per_block = a.block_points;
         o.search = search_for_effort(a.effort);
@@ -232,6 +236,10 @@ void add_compress(CLI::App& app) {
                     "`fiblet compress IN OUT.fft` means -o OUT.fft when OUT.fft (or .fftz) does not exist yet and "
                     "neither -o, --output-dir nor -r is given");
     cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs); created if missing");
+    cmd->add_option("--reference", args->reference,
+                    "A NIfTI or .mif image whose space (affine, dimensions) a .tck source is stored with, so that "
+                    ".trk/.trx outputs get it (as tckconvert's and DIPY's reference; .trk/TRX sources carry their own)")
+        ->check(CLI::ExistingFile);
     cmd->add_option("--step", args->step, "Fixed step in mm (default: measured; variable spacing is resampled)");
     add_threads_option(cmd, args->threads, "Encoding");
     cmd->add_option("--bits", args->bits,

@@ -11,6 +11,7 @@
 #include "fiblet/fft_file.hpp"
 #include "fiblet/streamline_io.hpp"
 #include "fiblet/tck.hpp"
+#include "fiblet/tractogram_space.hpp"
 
 namespace fiblet::cli {
 namespace {
@@ -18,7 +19,8 @@ namespace {
 struct DecompressArgs {
     bool ignore_trailer = false;
     std::vector<std::string> inputs;
-    std::string output, output_dir, decoder = "auto";
+    std::string output, output_dir, decoder = "auto", reference;
+    std::optional<TractogramSpace> reference_space;  // read from `reference` once
     unsigned threads = 0;
     bool force = false, quiet = false, json = false, recursive = false;
 };
@@ -40,6 +42,18 @@ std::string decompress_through(const DecompressArgs& a, const std::string& input
                            h.fibers, h.points};
     const TractogramFormat out_format = format_from_extension(output);  // .trk, .trx; else a .tck
     const bool points_only = out_format != TractogramFormat::trk && out_format != TractogramFormat::trx;
+    if (a.reference_space) {
+        if (sink_header.space)
+            throw Error(Errc::invalid_argument, input + " carries its own space (from its .trk or TRX source): "
+                                                        "--reference is for files made from a .tck");
+        sink_header.space = a.reference_space;
+    } else if (!points_only && !sink_header.space && !a.quiet) {
+        fmt::print(stderr,
+                   "fiblet: warning: {} carries no space (made from a .tck): {} gets an identity affine and 1x1x1 "
+                   "dimensions, which TRX and DIPY tools treat as out of bounds; --reference IMAGE gives it the "
+                   "image's (as tckconvert and DIPY)\n",
+                   input, output);
+    }
     if (points_only && !sink_header.fields.empty() && !a.quiet)
         fmt::print(stderr, "fiblet: note: {} data arrays of {} not written: a .tck holds points only (write a .trk or .trx)\n",
                    sink_header.fields.size(), input);
@@ -89,7 +103,9 @@ std::string decompress_one(const DecompressArgs& a, const std::string& input, co
 
 // Every input is tried; with several, a failed one is reported and the
 // first failure's code is the exit status (as compress does).
-void run(const DecompressArgs& a) {
+void run(const DecompressArgs& args) {
+    DecompressArgs a = args;
+    if (!a.reference.empty()) a.reference_space = space_of_image(a.reference);
     const auto jobs = plan_file_jobs(a.inputs, {{".fft", ".fftz"}, {}, "", ".tck", a.output, a.output_dir, a.recursive});
     std::vector<std::string> json;
     std::optional<Error> first_failure;
@@ -123,6 +139,10 @@ void add_decompress(CLI::App& app) {
                     "data; default: the input's name with .tck; - for standard output as .tck, the report then on "
                     "stderr)");
     cmd->add_option("--output-dir", args->output_dir, "Directory for the outputs (several inputs); created if missing");
+    cmd->add_option("--reference", args->reference,
+                    "A NIfTI or .mif image whose space (affine, dimensions) .trk/.trx outputs get, for files made "
+                    "from a .tck (as tckconvert's and DIPY's reference)")
+        ->check(CLI::ExistingFile);
     cmd->add_flag("-r,--recursive", args->recursive,
                   "Decompress every .fft/.fftz below the directories given (tree mirrored in --output-dir)");
     add_threads_option(cmd, args->threads, "Decoding");

@@ -12,6 +12,7 @@
 #include "fiblet/error_stats.hpp"
 #include "fiblet/fft_format.hpp"
 #include "fiblet/geometry_error.hpp"
+#include "fiblet/tractogram_space.hpp"
 
 namespace fiblet {
 
@@ -55,6 +56,10 @@ struct CompressOptions {
     unsigned threads = 0;                     // encoding threads; 0 = all cores
     bool overwrite = false;
     bool allow_count_mismatch = false;
+    // The reference space of a source that carries none (a .tck: tckconvert's
+    // and DIPY's reference image, space_of_image), stored in the PROP chunk
+    // as a .trk's or TRX's is. Error{invalid_argument} for a source with its own.
+    std::optional<TractogramSpace> reference_space;
     // progress(phase, fraction in [0,1]); phases "scan", "resample-scan", "encode".
     std::function<void(const char*, double)> progress;
 };

@@ -47,6 +47,8 @@ struct Image {
 // malformed, Error{unsupported} for a valid image fiblet does not read
 // (complex voxels, .mif.gz, another extension).
 Image read_image(const std::string& path);
+// The same without the voxels (values empty): dims, spacing, voxel_to_world.
+Image read_image_header(const std::string& path);
 
 // world = M * (v, 1) and its inverse (throws Error{image_format} when the
 // 3x3 part is singular).

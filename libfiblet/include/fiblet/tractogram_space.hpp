@@ -30,6 +30,11 @@ struct TractogramSpace {
     static TractogramSpace from_affine(const Affine& a, std::array<int, 3> dimensions);
 };
 
+// The space of a reference image (NIfTI or .mif: its voxel-to-world
+// affine, as MRtrix3 reads it, and its first three dimensions), the
+// reference tckconvert and DIPY take for a .tck. Throws as read_image does.
+TractogramSpace space_of_image(const std::string& path);
+
 // The axis codes of an affine ("RAS", "LPS", ...), as nibabel's
 // aff2axcodes; nullopt when the axes cannot be told apart.
 std::optional<std::string> affine_axis_codes(const Affine& a);

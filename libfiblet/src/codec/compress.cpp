@@ -35,6 +35,7 @@
 #include "fiblet/streamline_data_chunk.hpp"
 #include "fiblet/streamline_io.hpp"
 #include "fiblet/tractogram_format.hpp"
+#include "fiblet/tractogram_space.hpp"
 
 namespace fiblet {
 
@@ -214,6 +215,13 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     const auto source = open_streamline_source(
         tck_path, {.allow_count_mismatch = options.allow_count_mismatch, .max_points = max_fiber_points});
     StreamlineSource& reader = *source;
+    std::vector<std::pair<std::string, std::string>> properties = reader.properties();
+    if (options.reference_space) {
+        if (space_from_properties(properties, tck_path))
+            throw Error(Errc::invalid_argument, tck_path + " carries its own space (a .trk or TRX header): a reference "
+                                                           "image is for sources without one (.tck)");
+        add_space_properties(properties, *options.reference_space);
+    }
     scan.header_step = reader.step_size();
     AtomicOutputFile::check_destination(fft_path, options.overwrite);  // before the passes, not after
 
@@ -375,7 +383,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         h.mean_error_mm = float(report.error.mean_mm());
         const auto final_head = serialize_fft_header(h);
         const std::uint64_t at = out->logical_size();
-        std::vector<TrailerChunk> chunks{make_properties_chunk(reader.properties())};
+        std::vector<TrailerChunk> chunks{make_properties_chunk(properties)};
         if (!fields.empty()) {
             point_fields.finish();
             chunks.push_back(make_streamline_data_chunk(fields));

@@ -22,15 +22,20 @@ std::int64_t Image::volumes() const {
     return n;
 }
 
-Image read_image(const std::string& path) {
+namespace {
+Image read_any(const std::string& path, bool values) {
     detail::require_regular_input(path);
-    if (ends_with(path, ".nii") || ends_with(path, ".nii.gz")) return detail::read_nifti(path);
-    if (ends_with(path, ".mif") || ends_with(path, ".mih")) return detail::read_mif(path);
+    if (ends_with(path, ".nii") || ends_with(path, ".nii.gz")) return detail::read_nifti(path, values);
+    if (ends_with(path, ".mif") || ends_with(path, ".mih")) return detail::read_mif(path, values);
     if (ends_with(path, ".mif.gz"))
         throw Error(Errc::unsupported, path + ": compressed .mif.gz images are not supported: "
                                               "mrconvert it to .mif or .nii.gz");
     throw Error(Errc::unsupported, path + ": not an image fiblet reads (expected .nii, .nii.gz or .mif)");
 }
+}  // namespace
+
+Image read_image(const std::string& path) { return read_any(path, true); }
+Image read_image_header(const std::string& path) { return read_any(path, false); }
 
 std::array<double, 3> transform_point(const Affine3x4& m, const std::array<double, 3>& v) {
     std::array<double, 3> out{};

@@ -8,8 +8,9 @@
 
 namespace fiblet::detail {
 
-Image read_nifti(const std::string& path);
-Image read_mif(const std::string& path);
+// `values`: false reads the header alone (dims, spacing, voxel_to_world).
+Image read_nifti(const std::string& path, bool values = true);
+Image read_mif(const std::string& path, bool values = true);
 
 // Axes in `rotation` (3x3 part; translation in column 3) scaled by the voxel
 // sizes: the voxel -> world map. Cosine vectors that are not unit length are

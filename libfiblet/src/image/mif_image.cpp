@@ -155,7 +155,7 @@ std::vector<std::uint8_t> read_bytes(const std::string& path, std::uint64_t offs
 
 }  // namespace
 
-Image read_mif(const std::string& path) {
+Image read_mif(const std::string& path, bool values) {
     const KeyValueHeader kv = read_key_value_header(path, "mrtrix image", Errc::image_format, ".mif");
     Image img;
     img.path = path;
@@ -195,6 +195,7 @@ Image read_mif(const std::string& path) {
     }
     img.voxel_to_world = voxel_to_world(m, img.spacing);
     check_transform(img);
+    if (!values) return img;
 
     // "scaling: offset,scale" applies to integer data only, as MRtrix 3.0
     // reads it (float data is used as stored; tests/image_test.cpp).

@@ -181,7 +181,7 @@ Affine3x4 rotation_and_spacing(const nifti_image& nim, std::array<double, 3>& sp
 
 }  // namespace
 
-Image read_nifti(const std::string& path) {
+Image read_nifti(const std::string& path, bool values) {
     struct stat st {};
     if (::stat(path.c_str(), &st) != 0) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
     const bool gz = path.size() > 3 && path.compare(path.size() - 3, 3, ".gz") == 0;
@@ -203,8 +203,10 @@ Image read_nifti(const std::string& path) {
         throw Error(Errc::image_format, path + ": the header describes " + std::to_string(n) +
                                             " voxels, more than the file holds (truncated or malformed image)");
     if (h.iname_offset < 0) throw Error(Errc::image_format, path + ": negative data offset");
-    const std::vector<std::uint8_t> bytes = read_voxel_bytes(path, h, n, gz);
-    convert_values(path, h, bytes.data(), n, img.values);
+    if (values) {
+        const std::vector<std::uint8_t> bytes = read_voxel_bytes(path, h, n, gz);
+        convert_values(path, h, bytes.data(), n, img.values);
+    }
 
     for (int c = 0; c < 3; ++c) img.spacing[c] = c < ndim ? std::abs(h.pixdim[c + 1]) : 1.0;
     for (double& s : img.spacing)
