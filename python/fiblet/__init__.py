@@ -42,23 +42,127 @@ class Streamlines:
     """Fibers in the TRX layout: one (N, 3) float32 point array and offsets.
 
     ``fiber_ids`` gives, for each fiber, its index in the file it came from
-    (useful after a ``fibers=`` or ``roi=`` selection).
+    (useful after a ``fibers=`` or ``roi=`` selection; -1 for a fiber added
+    by :meth:`append` or :meth:`extend`).
+
+    It answers as nibabel's ``ArraySequence`` does (compared member by
+    member in python/tests/test_api.py): ``len``, ``s[i]`` (a view),
+    ``s[slice | ints | mask]``, iteration, ``_data``, ``_offsets``,
+    ``_lengths``, ``get_data()`` (a copy), ``copy()``, ``common_shape``,
+    ``total_nb_rows``, ``is_sliced_view``, ``append()``, ``extend()``,
+    ``finalize_append()``. Differences:
+
+    - ``offsets`` has F + 1 entries (the TRX layout: fiber i is
+      ``points[offsets[i]:offsets[i + 1]]``); nibabel's ``_offsets`` (F
+      entries, the first point of each fiber) is ``offsets[:-1]``.
+      ``lengths`` and ``_lengths`` are the same (F,) points per fiber.
+    - A step-1 slice ``s[a:b]`` is a view whose ``_data`` holds only the
+      sliced fibers' points, so its ``_offsets`` start at 0 (nibabel's keep
+      the parent's, with ``is_sliced_view`` True; here it is always False).
+    - Points are always float32 with 3 columns: appended elements are cast
+      to float32 (as nibabel casts into an existing float32 sequence), and
+      one of another shape raises ValueError. Appending copies the points
+      (the decoded arrays cannot grow in place): ``extend`` copies once, as
+      does a series of ``append(x, cache_build=True)`` ended by
+      ``finalize_append()``.
+    - No arithmetic or comparison operators, ``__setitem__``,
+      ``shrink_data``, ``save``/``load``: :meth:`to_array_sequence` gives a
+      real ArraySequence sharing the memory.
     """
 
-    __slots__ = ("points", "offsets", "fiber_ids", "_lengths")
+    __slots__ = ("points", "offsets", "fiber_ids", "_lengths_cache", "_pending")
 
     def __init__(self, points, offsets, fiber_ids=None):
         self.points = points
         self.offsets = offsets
         self.fiber_ids = _np.arange(len(offsets) - 1) if fiber_ids is None else fiber_ids
-        self._lengths = None
+        self._lengths_cache = None
+        self._pending = None  # elements of append(cache_build=True), until finalize_append()
 
     @property
     def lengths(self):
         """Points per fiber, (F,) int64."""
-        if self._lengths is None:
-            self._lengths = _np.diff(self.offsets)
-        return self._lengths
+        if self._lengths_cache is None:
+            self._lengths_cache = _np.diff(self.offsets)
+        return self._lengths_cache
+
+    # nibabel's ArraySequence fields.
+    @property
+    def _data(self):
+        """The (N, 3) points (nibabel's ``ArraySequence._data``)."""
+        return self.points
+
+    @property
+    def _offsets(self):
+        """(F,) first point of each fiber in ``_data``: ``offsets[:-1]``."""
+        return self.offsets[:-1]
+
+    @property
+    def _lengths(self):
+        """(F,) points per fiber: ``lengths``."""
+        return self.lengths
+
+    @property
+    def common_shape(self):
+        return self.points.shape[1:]
+
+    @property
+    def total_nb_rows(self):
+        """Points in all fibers (as nibabel: ``np.sum(_lengths)``)."""
+        return _np.sum(self.lengths)
+
+    @property
+    def is_sliced_view(self):
+        return self.lengths.sum() != self.points.shape[0]
+
+    @property
+    def is_array_sequence(self):
+        return True
+
+    def get_data(self):
+        """A copy of the points of all fibers, (total_nb_rows, 3) float32."""
+        return self.points[self.offsets[0]:self.offsets[-1]].copy()
+
+    def copy(self):
+        """A Streamlines with its own copy of the points, offsets and fiber_ids."""
+        return Streamlines(self.get_data(), self.offsets - self.offsets[0], self.fiber_ids.copy())
+
+    def append(self, element, cache_build=False):
+        """Adds one fiber, an (n, 3) array (cast to float32). As nibabel, an
+        empty element is not added; with ``cache_build=True`` the fibers are
+        added by :meth:`finalize_append`."""
+        element = _element(element)
+        if element is None:
+            return
+        if cache_build or self._pending is not None:
+            if self._pending is None:
+                self._pending = []
+            self._pending.append(element)
+            return
+        self._add([element])
+
+    def finalize_append(self):
+        """Adds the fibers of ``append(..., cache_build=True)``."""
+        pending, self._pending = self._pending, None
+        if pending:
+            self._add(pending)
+
+    def extend(self, elements):
+        """Adds every element of an iterable of (n, 3) arrays (a list, an
+        ArraySequence, a Streamlines, a generator); empty ones are skipped,
+        as nibabel does."""
+        self.finalize_append()
+        self._add([e for e in map(_element, elements) if e is not None])
+
+    def _add(self, elements):
+        if not elements:
+            return
+        lengths = _np.array([len(e) for e in elements], dtype=_np.int64)
+        first = self.offsets[0]
+        self.points = _np.concatenate([self.points[first:self.offsets[-1]]] + elements)
+        self.offsets = _np.concatenate([self.offsets - first, self.offsets[-1] - first + _np.cumsum(lengths)])
+        self.fiber_ids = _np.concatenate([self.fiber_ids, _np.full(len(elements), -1, dtype=_np.int64)])
+        self._lengths_cache = None
 
     def __len__(self):
         return len(self.offsets) - 1
@@ -107,6 +211,16 @@ class Streamlines:
         seq._offsets = self.offsets[:-1]
         seq._lengths = self.lengths
         return seq
+
+
+def _element(element):
+    """One fiber for append/extend: an (n, 3) float32 array, or None when empty."""
+    element = _np.asarray(element)
+    if element.size == 0:
+        return None
+    if element.ndim != 2 or element.shape[1] != 3:
+        raise ValueError(f"a fiber is an (n, 3) array of points, got shape {element.shape}")
+    return element.astype(_np.float32, copy=False)
 
 
 @_dataclass(frozen=True)
