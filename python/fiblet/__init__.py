@@ -9,6 +9,7 @@
     s[10:20], s[[3, 1]], s[s.lengths > 100]   # Streamlines, as ArraySequence
     fiblet.load("t.fft", roi=(0, 0, 0, 10))       # sphere x,y,z,r (or a box, a mask)
     fiblet.load("t.fft", roi=fiblet.Mask("wm.nii.gz"))
+    s, data = fiblet.load("t.fft", data=True)     # + {"dps/NAME": (F, c), "dpv/NAME": (N, c), "groups/NAME": ...}
     sft = fiblet.load_sft("t.fft", "t1.nii.gz")   # DIPY StatefulTractogram
 
     tractogram = fiblet.load_tractogram("tracks.fft")   # nibabel Tractogram
@@ -368,8 +369,9 @@ def _threads(threads):
 _MAX_THREADS = 1024  # as the CLI and the library (src/core/thread_count.hpp)
 
 
-def load(path, *, roi=None, fibers=None, threads=None, ignore_trailer=False):
-    """Decodes a .fft file into a :class:`Streamlines`.
+def load(path, *, roi=None, fibers=None, threads=None, ignore_trailer=False, data=False):
+    """Decodes a .fft or .fftz file into a :class:`Streamlines` (with
+    ``data=True``: ``(Streamlines, data)``).
 
     fibers: None (all), an int, a slice or range, a sequence/array of fiber
         indices (any order; negative indices count from the end, as in
@@ -386,12 +388,29 @@ def load(path, *, roi=None, fibers=None, threads=None, ignore_trailer=False):
     ignore_trailer: read only the header, LUT and blocks, not the trailer
         after them: salvages a file whose trailer is damaged (which otherwise
         raises a "checksum" FibletError); nothing is then verified.
+    data: also return the arrays the file keeps from a .trk or TRX source
+        (its DATA chunk, formats/fft-data.md) as a dict of numpy arrays in
+        their stored dtypes, each (rows, components): "dps/NAME" one row per
+        fiber, "dpv/NAME" one per point, "groups/NAME" (uint32 fiber
+        positions), "dpg/GROUP/NAME" (per group); {} for a file made from a
+        .tck. The rows follow the returned fibers, also with ``fibers=`` and
+        ``roi=``: "dps" rows are those of the returned fibers, in their order
+        (repeats repeated), "dpv" rows those of their points, a group lists
+        the positions in the returned Streamlines of its fibers that were
+        returned, "dpg" arrays are whole. A file whose input was resampled
+        (``info(path)["resampled"]``) keeps per-point arrays made for the
+        encoded points: float32, interpolated linearly between the input
+        points each new point lies between; the other arrays are the
+        source's. Refused (ValueError) with ``ignore_trailer=True``, which
+        skips the chunk.
 
     Raises FileNotFoundError, ValueError/IndexError/TypeError on bad
     arguments, and fiblet.FibletError (with ``.category``, e.g.
     "fft_format", "image_format") on bad files.
     """
     path = _existing(path)
+    if data and ignore_trailer:
+        raise ValueError("load: data=True reads the DATA chunk of the trailer, which ignore_trailer=True skips")
     regions = _regions(roi)
     begin, end, indices = 0, None, None
     if fibers is not None:
@@ -404,7 +423,39 @@ def load(path, *, roi=None, fibers=None, threads=None, ignore_trailer=False):
         else:
             indices = chosen.astype(_np.uint64)
     points, offsets, ids = _fiblet.decode(path, begin, end, indices, regions, _threads(threads), ignore_trailer)
-    return Streamlines(points, offsets, ids)
+    s = Streamlines(points, offsets, ids)
+    if not data:
+        return s
+    subset = fibers is not None or bool(regions)
+    d = _fiblet.data(path, subset)
+    if not subset:
+        return s, dict(d["fields"])
+    return s, _fields_of(d["fields"], s, d["fiber_points"])
+
+
+def _fields_of(fields, s, fiber_points):
+    """The rows of the file's arrays `fields` that belong to the fibers of
+    `s` (positions s.fiber_ids in the file, which has fiber_points[f] points
+    in fiber f)."""
+    ids = s.fiber_ids
+    if not _np.array_equal(fiber_points[ids], s.lengths):  # the index and the decoder disagree: never expected
+        raise RuntimeError("fiblet: the block index's point counts differ from the decoded fibers'")
+    first = _np.zeros(len(fiber_points) + 1, dtype=_np.int64)
+    _np.cumsum(fiber_points, out=first[1:])
+    # Point k of returned fiber i is row first[ids[i]] + k of a per-point array.
+    rows = _np.repeat(first[:-1][ids] - s.offsets[:-1], s.lengths) + _np.arange(s.offsets[-1], dtype=_np.int64)
+    out = {}
+    for name, a in fields.items():
+        scope = name.split("/", 1)[0]
+        if scope == "dps":
+            out[name] = a[ids]
+        elif scope == "dpv":
+            out[name] = a[rows]
+        elif scope == "groups":
+            out[name] = _np.flatnonzero(_np.isin(ids, a[:, 0])).astype(a.dtype).reshape(-1, 1)
+        else:  # dpg: one row per group element, not per fiber
+            out[name] = a
+    return out
 
 
 def load_array_sequence(path, **options):
@@ -484,11 +535,16 @@ def _flatten(streamlines):
 
 def read_streamlines(path):
     """Reads a .tck, .trk or TRX file through the readers ``fiblet compress``
-    uses; returns ``(Streamlines, data)``: points in world RAS+ mm (for a
-    .trk exactly as nibabel's ``load(path).streamlines``), and a dict of the
-    per-streamline ("dps/NAME"), per-point ("dpv/NAME") and group arrays,
-    each (rows, components)."""
-    r = _fiblet.read_streamlines(_existing(path))
+    uses, or decodes a .fft/.fftz; returns ``(Streamlines, data)``: points in
+    world RAS+ mm (for a .trk exactly as nibabel's ``load(path).streamlines``),
+    and a dict of the per-streamline ("dps/NAME"), per-point ("dpv/NAME") and
+    group arrays, each (rows, components). A .fft (recognised by its content)
+    gives ``load(path, data=True)``: the decoded points and the arrays it
+    keeps from its source (resampled per-point arrays as :func:`load` says)."""
+    path = _existing(path)
+    if _fiblet.container(path) != "other":
+        return load(path, data=True)
+    r = _fiblet.read_streamlines(path)
     return Streamlines(r["points"], r["offsets"]), r["data"]
 
 
