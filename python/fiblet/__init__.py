@@ -10,7 +10,7 @@
     fiblet.load("t.fft", roi=(0, 0, 0, 10))       # sphere x,y,z,r (or a box, a mask)
     fiblet.load("t.fft", roi=fiblet.Mask("wm.nii.gz"))
     s, data = fiblet.load("t.fft", data=True)     # + {"dps/NAME": (F, c), "dpv/NAME": (N, c), "groups/NAME": ...}
-    sft = fiblet.load_sft("t.fft", "t1.nii.gz")   # DIPY StatefulTractogram
+    sft = fiblet.load_sft("t.fft", "t1.nii.gz")   # DIPY StatefulTractogram (reference="same": the .trk's space)
 
     tractogram = fiblet.load_tractogram("tracks.fft")   # nibabel Tractogram
     fiblet.save("out.fft", tractogram.streamlines)      # from nibabel, lists, ...
@@ -471,19 +471,90 @@ def load_tractogram(path, **options):
     return Tractogram(load_array_sequence(path, **options), affine_to_rasmm=_np.eye(4))
 
 
-def load_sft(path, reference, **options):
-    """Decodes a .fft file into DIPY's StatefulTractogram (world millimetres,
-    ``Space.RASMM``), as ``dipy.io.streamline.load_tractogram`` gives for a
-    .tck file. reference: what DIPY accepts as one (a NIfTI path or image, a
-    .trk file, a header dict), giving the voxel grid of the tractogram.
-    options: those of :func:`load`. Needs DIPY (Debian: python3-dipy)."""
+def load_sft(path, reference, *, to_space=None, to_origin=None, bbox_valid_check=True, **options):
+    """Decodes a .fft file into DIPY's StatefulTractogram, as
+    ``dipy.io.streamline.load_tractogram`` loads a .trk or .tck.
+
+    reference: what DIPY accepts as one (a NIfTI path or image, a .trk
+        file, a header dict), or "same": the space the file keeps from its
+        .trk or TRX source (the PROP keys of formats/fft-data.md: the
+        voxel-to-RAS+ affine, dimensions, voxel sizes and order); ValueError
+        when the file keeps none (made from a .tck).
+    to_space, to_origin: DIPY's ``Space`` and ``Origin`` (or their names
+        or values: "rasmm", "vox", "voxmm"; "nifti"/"center",
+        "trackvis"/"corner"); default
+        ``Space.RASMM``, ``Origin.NIFTI``, as load_tractogram.
+    bbox_valid_check: as load_tractogram, raise ValueError when a point
+        lies outside the reference's voxel grid
+        (``sft.is_bbox_in_vox_valid()`` False); False skips the check.
+    options: those of :func:`load` (``fibers=``, ``roi=``, ...). The file's
+        per-streamline and per-point arrays (``load(data=True)``, aligned
+        with a subset) become ``data_per_streamline`` and ``data_per_point``
+        under their names without "dps/" or "dpv/"; groups have no place in
+        a StatefulTractogram (``load(data=True)`` gives them). With
+        ``ignore_trailer=True`` there are none (and no "same" space).
+    Needs DIPY (Debian: python3-dipy)."""
     try:
-        from dipy.io.stateful_tractogram import Space, StatefulTractogram
+        from dipy.io.stateful_tractogram import Origin, Space, StatefulTractogram
     except ImportError as e:
         raise ImportError("fiblet.load_sft needs DIPY (pip install dipy, or Debian's python3-dipy)") from e
+    from nibabel.streamlines import ArraySequence
+
+    path = _existing(path)
+    to_space = Space.RASMM if to_space is None else _dipy_enum(Space, to_space, "to_space")
+    to_origin = Origin.NIFTI if to_origin is None else _dipy_enum(Origin, to_origin, "to_origin")
+    with_data = not options.get("ignore_trailer", False)
     if isinstance(reference, _os.PathLike):
         reference = _os.fspath(reference)
-    return StatefulTractogram(load_array_sequence(path, **options), reference, Space.RASMM)
+    if isinstance(reference, str) and reference == "same":
+        if not with_data:
+            raise ValueError("load_sft: reference='same' reads the space from the file's trailer, "
+                             "which ignore_trailer=True skips")
+        reference = _trk_header(path, _fiblet.data(path, False)["space"])
+    if with_data:
+        s, data = load(path, data=True, **options)
+    else:
+        s, data = load(path, **options), {}
+    seq = s.to_array_sequence()
+    per_streamline = {name[4:]: a for name, a in data.items() if name.startswith("dps/")}
+    per_point = {}
+    for name, a in data.items():
+        if name.startswith("dpv/"):
+            values = ArraySequence()
+            values._data, values._offsets, values._lengths = a, seq._offsets, seq._lengths
+            per_point[name[4:]] = values
+    sft = StatefulTractogram(seq, reference, Space.RASMM, origin=Origin.NIFTI,
+                             data_per_point=per_point, data_per_streamline=per_streamline)
+    sft.to_space(to_space)
+    sft.to_origin(to_origin)
+    if bbox_valid_check and not sft.is_bbox_in_vox_valid():
+        raise ValueError(f"load_sft: {path}: the bounding box is not valid in voxel space of the reference "
+                         f"(points outside its grid), as dipy.io.streamline.load_tractogram refuses; pass "
+                         f"bbox_valid_check=False, then remove_invalid_streamlines() to discard them")
+    return sft
+
+
+def _dipy_enum(kind, value, what):
+    """A DIPY Space or Origin from itself, its name ("VOX", "trackvis") or its value ("vox", "corner")."""
+    if isinstance(value, kind):
+        return value
+    if isinstance(value, str):
+        if value.upper() in kind.__members__:
+            return kind[value.upper()]
+        if value in {m.value for m in kind}:
+            return kind(value)
+    raise ValueError(f"load_sft: {what} must be a dipy {kind.__name__} or one of "
+                     f"{', '.join(sorted({m.name.lower() for m in kind} | {m.value for m in kind}))}; got {value!r}")
+
+
+def _trk_header(path, space):
+    """The space a .fft keeps, as the TrackVis header dict DIPY takes as a reference."""
+    if space is None:
+        raise ValueError(f"load_sft: {path} keeps no reference space (it was made from a .tck, or points): "
+                         f"reference='same' needs a .fft made from a .trk or TRX; pass a reference image")
+    return {"magic_number": b"TRACK", "voxel_to_rasmm": space["voxel_to_rasmm"].astype(_np.float32),
+            "dimensions": space["dimensions"].astype(_np.int16), "voxel_sizes": space["voxel_sizes"].astype(_np.float32),
+            "voxel_order": space["voxel_order"]}
 
 
 def _flatten(streamlines):

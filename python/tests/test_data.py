@@ -1,7 +1,9 @@
 """The data a .fft keeps from a .trk or TRX source, in Python as DIPY and
-nibabel users expect it: load(data=True) and read_streamlines of a .fft
-against nibabel's reading of the source .trk (written here by nibabel, an
-independent writer), aligned with fibers=/roi= subsets."""
+nibabel users expect it: load(data=True), read_streamlines of a .fft and
+load_sft's data_per_streamline / data_per_point against nibabel's reading of
+the source .trk (written here by nibabel, an independent writer), aligned
+with fibers=/roi= subsets; load_sft(reference="same") against nibabel's
+header of the .trk and DIPY's load_tractogram; DIPY's bounding-box check."""
 import numpy as np
 import pytest
 
@@ -203,3 +205,70 @@ def test_data_of_a_tck_made_file_and_refusals(tmp_path, trk):
     assert data == {} and len(s) == 1
     with pytest.raises(ValueError, match="ignore_trailer"):
         fiblet.load(fft, data=True, ignore_trailer=True)
+
+
+# ---- load_sft: DIPY's reference="same", bounding-box check, spaces ----
+
+def test_load_sft_same_is_the_trk_space_with_its_data(trk):
+    pytest.importorskip("dipy")
+    from dipy.io.stateful_tractogram import Origin, Space
+    from dipy.io.streamline import load_tractogram
+
+    trk_path, trk_file, fft, report = trk
+    sft = fiblet.load_sft(fft, "same")
+    header = trk_file.header
+    np.testing.assert_array_equal(sft.affine, header[Field.VOXEL_TO_RASMM])
+    np.testing.assert_array_equal(sft.dimensions, header[Field.DIMENSIONS])
+    np.testing.assert_array_equal(sft.voxel_sizes, header[Field.VOXEL_SIZES])
+    assert sft.voxel_order == "LAS"
+    assert sft.space == Space.RASMM and sft.origin == Origin.NIFTI and sft.is_bbox_in_vox_valid()
+    theirs = load_tractogram(str(trk_path), "same")
+    for a, b in zip(sft.space_attributes, theirs.space_attributes):
+        np.testing.assert_array_equal(a, b)
+    within_error(sft.streamlines, theirs.streamlines, report)
+    assert set(sft.data_per_streamline) == set(DPS) and set(sft.data_per_point) == set(DPP)
+    for k in DPS:
+        np.testing.assert_array_equal(sft.data_per_streamline[k], theirs.data_per_streamline[k])
+    for k in DPP:
+        assert len(sft.data_per_point[k]) == len(theirs.data_per_point[k])
+        for a, b in zip(sft.data_per_point[k], theirs.data_per_point[k]):
+            np.testing.assert_array_equal(a, b)
+    # to_space / to_origin as load_tractogram's.
+    vox = fiblet.load_sft(fft, "same", to_space=Space.VOX, to_origin="trackvis")
+    theirs_vox = load_tractogram(str(trk_path), "same", to_space=Space.VOX, to_origin=Origin.TRACKVIS)
+    assert vox.space == Space.VOX and vox.origin == Origin.TRACKVIS
+    bound_vox = report["max_error_um"] * 1e-3 / 2.0 + 1e-4  # 2 mm and 2.5 mm voxels
+    assert np.abs(vox.streamlines.get_data() - theirs_vox.streamlines.get_data()).max() <= bound_vox
+    # A subset keeps its data aligned.
+    sub = fiblet.load_sft(fft, "same", fibers=[3, 1])
+    np.testing.assert_array_equal(sub.data_per_streamline["id"][:, 0], [3 * 7 + 3, 1 * 7 + 3])
+    np.testing.assert_array_equal(sub.data_per_point["fa"][1], theirs.data_per_point["fa"][1])
+
+
+def test_load_sft_same_needs_a_file_that_keeps_a_space(tmp_path):
+    pytest.importorskip("dipy")
+    fiblet.save(tmp_path / "p.fft", [np.array([[0, 0, 0], [0, 0, 1], [0, 0, 2]], np.float32)])
+    with pytest.raises(ValueError, match="no reference space"):
+        fiblet.load_sft(tmp_path / "p.fft", "same")
+
+
+def test_load_sft_checks_the_bounding_box_as_dipy(trk, tmp_path):
+    pytest.importorskip("dipy")
+    from dipy.io.streamline import load_tractogram
+
+    trk_path, _, fft, _ = trk
+    far = AFFINE.copy()
+    far[:3, 3] += [300.0, 0, 0]  # the same grid 300 mm to the left
+    ref = tmp_path / "far.nii.gz"
+    nib.Nifti1Image(np.zeros(DIMS, np.float32), far).to_filename(str(ref))
+    with pytest.raises(ValueError, match="(?i)bounding box"):
+        load_tractogram(str(trk_path), str(ref), trk_header_check=False)  # DIPY refuses it too
+    with pytest.raises(ValueError, match="bbox_valid_check=False"):
+        fiblet.load_sft(fft, ref)
+    sft = fiblet.load_sft(fft, ref, bbox_valid_check=False)
+    assert len(sft.streamlines) == 30 and not sft.is_bbox_in_vox_valid()
+    np.testing.assert_array_equal(sft.affine, far)
+    # The file's own grid passes.
+    near = tmp_path / "near.nii.gz"
+    nib.Nifti1Image(np.zeros(DIMS, np.float32), AFFINE).to_filename(str(near))
+    assert fiblet.load_sft(fft, near).is_bbox_in_vox_valid()
