@@ -9,7 +9,8 @@
     s[10:20], s[[3, 1]], s[s.lengths > 100]   # Streamlines, as ArraySequence
     fiblet.load("t.fft", roi=(0, 0, 0, 10))       # sphere x,y,z,r (or a box, a mask)
     fiblet.load("t.fft", roi=fiblet.Mask("wm.nii.gz"))
-    sft = fiblet.load_sft("t.fft", "t1.nii.gz")   # DIPY StatefulTractogram
+    s, data = fiblet.load("t.fft", data=True)     # + {"dps/NAME": (F, c), "dpv/NAME": (N, c), "groups/NAME": ...}
+    sft = fiblet.load_sft("t.fft", "t1.nii.gz")   # DIPY StatefulTractogram (reference="same": the .trk's space)
 
     tractogram = fiblet.load_tractogram("tracks.fft")   # nibabel Tractogram
     fiblet.save("out.fft", tractogram.streamlines)      # from nibabel, lists, ...
@@ -42,23 +43,127 @@ class Streamlines:
     """Fibers in the TRX layout: one (N, 3) float32 point array and offsets.
 
     ``fiber_ids`` gives, for each fiber, its index in the file it came from
-    (useful after a ``fibers=`` or ``roi=`` selection).
+    (useful after a ``fibers=`` or ``roi=`` selection; -1 for a fiber added
+    by :meth:`append` or :meth:`extend`).
+
+    It answers as nibabel's ``ArraySequence`` does (compared member by
+    member in python/tests/test_api.py): ``len``, ``s[i]`` (a view),
+    ``s[slice | ints | mask]``, iteration, ``_data``, ``_offsets``,
+    ``_lengths``, ``get_data()`` (a copy), ``copy()``, ``common_shape``,
+    ``total_nb_rows``, ``is_sliced_view``, ``append()``, ``extend()``,
+    ``finalize_append()``. Differences:
+
+    - ``offsets`` has F + 1 entries (the TRX layout: fiber i is
+      ``points[offsets[i]:offsets[i + 1]]``); nibabel's ``_offsets`` (F
+      entries, the first point of each fiber) is ``offsets[:-1]``.
+      ``lengths`` and ``_lengths`` are the same (F,) points per fiber.
+    - A step-1 slice ``s[a:b]`` is a view whose ``_data`` holds only the
+      sliced fibers' points, so its ``_offsets`` start at 0 (nibabel's keep
+      the parent's, with ``is_sliced_view`` True; here it is always False).
+    - Points are always float32 with 3 columns: appended elements are cast
+      to float32 (as nibabel casts into an existing float32 sequence), and
+      one of another shape raises ValueError. Appending copies the points
+      (the decoded arrays cannot grow in place): ``extend`` copies once, as
+      does a series of ``append(x, cache_build=True)`` ended by
+      ``finalize_append()``.
+    - No arithmetic or comparison operators, ``__setitem__``,
+      ``shrink_data``, ``save``/``load``: :meth:`to_array_sequence` gives a
+      real ArraySequence sharing the memory.
     """
 
-    __slots__ = ("points", "offsets", "fiber_ids", "_lengths")
+    __slots__ = ("points", "offsets", "fiber_ids", "_lengths_cache", "_pending")
 
     def __init__(self, points, offsets, fiber_ids=None):
         self.points = points
         self.offsets = offsets
         self.fiber_ids = _np.arange(len(offsets) - 1) if fiber_ids is None else fiber_ids
-        self._lengths = None
+        self._lengths_cache = None
+        self._pending = None  # elements of append(cache_build=True), until finalize_append()
 
     @property
     def lengths(self):
         """Points per fiber, (F,) int64."""
-        if self._lengths is None:
-            self._lengths = _np.diff(self.offsets)
-        return self._lengths
+        if self._lengths_cache is None:
+            self._lengths_cache = _np.diff(self.offsets)
+        return self._lengths_cache
+
+    # nibabel's ArraySequence fields.
+    @property
+    def _data(self):
+        """The (N, 3) points (nibabel's ``ArraySequence._data``)."""
+        return self.points
+
+    @property
+    def _offsets(self):
+        """(F,) first point of each fiber in ``_data``: ``offsets[:-1]``."""
+        return self.offsets[:-1]
+
+    @property
+    def _lengths(self):
+        """(F,) points per fiber: ``lengths``."""
+        return self.lengths
+
+    @property
+    def common_shape(self):
+        return self.points.shape[1:]
+
+    @property
+    def total_nb_rows(self):
+        """Points in all fibers (as nibabel: ``np.sum(_lengths)``)."""
+        return _np.sum(self.lengths)
+
+    @property
+    def is_sliced_view(self):
+        return self.lengths.sum() != self.points.shape[0]
+
+    @property
+    def is_array_sequence(self):
+        return True
+
+    def get_data(self):
+        """A copy of the points of all fibers, (total_nb_rows, 3) float32."""
+        return self.points[self.offsets[0]:self.offsets[-1]].copy()
+
+    def copy(self):
+        """A Streamlines with its own copy of the points, offsets and fiber_ids."""
+        return Streamlines(self.get_data(), self.offsets - self.offsets[0], self.fiber_ids.copy())
+
+    def append(self, element, cache_build=False):
+        """Adds one fiber, an (n, 3) array (cast to float32). As nibabel, an
+        empty element is not added; with ``cache_build=True`` the fibers are
+        added by :meth:`finalize_append`."""
+        element = _element(element)
+        if element is None:
+            return
+        if cache_build or self._pending is not None:
+            if self._pending is None:
+                self._pending = []
+            self._pending.append(element)
+            return
+        self._add([element])
+
+    def finalize_append(self):
+        """Adds the fibers of ``append(..., cache_build=True)``."""
+        pending, self._pending = self._pending, None
+        if pending:
+            self._add(pending)
+
+    def extend(self, elements):
+        """Adds every element of an iterable of (n, 3) arrays (a list, an
+        ArraySequence, a Streamlines, a generator); empty ones are skipped,
+        as nibabel does."""
+        self.finalize_append()
+        self._add([e for e in map(_element, elements) if e is not None])
+
+    def _add(self, elements):
+        if not elements:
+            return
+        lengths = _np.array([len(e) for e in elements], dtype=_np.int64)
+        first = self.offsets[0]
+        self.points = _np.concatenate([self.points[first:self.offsets[-1]]] + elements)
+        self.offsets = _np.concatenate([self.offsets - first, self.offsets[-1] - first + _np.cumsum(lengths)])
+        self.fiber_ids = _np.concatenate([self.fiber_ids, _np.full(len(elements), -1, dtype=_np.int64)])
+        self._lengths_cache = None
 
     def __len__(self):
         return len(self.offsets) - 1
@@ -107,6 +212,16 @@ class Streamlines:
         seq._offsets = self.offsets[:-1]
         seq._lengths = self.lengths
         return seq
+
+
+def _element(element):
+    """One fiber for append/extend: an (n, 3) float32 array, or None when empty."""
+    element = _np.asarray(element)
+    if element.size == 0:
+        return None
+    if element.ndim != 2 or element.shape[1] != 3:
+        raise ValueError(f"a fiber is an (n, 3) array of points, got shape {element.shape}")
+    return element.astype(_np.float32, copy=False)
 
 
 @_dataclass(frozen=True)
@@ -254,8 +369,9 @@ def _threads(threads):
 _MAX_THREADS = 1024  # as the CLI and the library (src/core/thread_count.hpp)
 
 
-def load(path, *, roi=None, fibers=None, threads=None, ignore_trailer=False):
-    """Decodes a .fft file into a :class:`Streamlines`.
+def load(path, *, roi=None, fibers=None, threads=None, ignore_trailer=False, data=False):
+    """Decodes a .fft or .fftz file into a :class:`Streamlines` (with
+    ``data=True``: ``(Streamlines, data)``).
 
     fibers: None (all), an int, a slice or range, a sequence/array of fiber
         indices (any order; negative indices count from the end, as in
@@ -272,12 +388,29 @@ def load(path, *, roi=None, fibers=None, threads=None, ignore_trailer=False):
     ignore_trailer: read only the header, LUT and blocks, not the trailer
         after them: salvages a file whose trailer is damaged (which otherwise
         raises a "checksum" FibletError); nothing is then verified.
+    data: also return the arrays the file keeps from a .trk or TRX source
+        (its DATA chunk, formats/fft-data.md) as a dict of numpy arrays in
+        their stored dtypes, each (rows, components): "dps/NAME" one row per
+        fiber, "dpv/NAME" one per point, "groups/NAME" (uint32 fiber
+        positions), "dpg/GROUP/NAME" (per group); {} for a file made from a
+        .tck. The rows follow the returned fibers, also with ``fibers=`` and
+        ``roi=``: "dps" rows are those of the returned fibers, in their order
+        (repeats repeated), "dpv" rows those of their points, a group lists
+        the positions in the returned Streamlines of its fibers that were
+        returned, "dpg" arrays are whole. A file whose input was resampled
+        (``info(path)["resampled"]``) keeps per-point arrays made for the
+        encoded points: float32, interpolated linearly between the input
+        points each new point lies between; the other arrays are the
+        source's. Refused (ValueError) with ``ignore_trailer=True``, which
+        skips the chunk.
 
     Raises FileNotFoundError, ValueError/IndexError/TypeError on bad
     arguments, and fiblet.FibletError (with ``.category``, e.g.
     "fft_format", "image_format") on bad files.
     """
     path = _existing(path)
+    if data and ignore_trailer:
+        raise ValueError("load: data=True reads the DATA chunk of the trailer, which ignore_trailer=True skips")
     regions = _regions(roi)
     begin, end, indices = 0, None, None
     if fibers is not None:
@@ -290,7 +423,39 @@ def load(path, *, roi=None, fibers=None, threads=None, ignore_trailer=False):
         else:
             indices = chosen.astype(_np.uint64)
     points, offsets, ids = _fiblet.decode(path, begin, end, indices, regions, _threads(threads), ignore_trailer)
-    return Streamlines(points, offsets, ids)
+    s = Streamlines(points, offsets, ids)
+    if not data:
+        return s
+    subset = fibers is not None or bool(regions)
+    d = _fiblet.data(path, subset)
+    if not subset:
+        return s, dict(d["fields"])
+    return s, _fields_of(d["fields"], s, d["fiber_points"])
+
+
+def _fields_of(fields, s, fiber_points):
+    """The rows of the file's arrays `fields` that belong to the fibers of
+    `s` (positions s.fiber_ids in the file, which has fiber_points[f] points
+    in fiber f)."""
+    ids = s.fiber_ids
+    if not _np.array_equal(fiber_points[ids], s.lengths):  # the index and the decoder disagree: never expected
+        raise RuntimeError("fiblet: the block index's point counts differ from the decoded fibers'")
+    first = _np.zeros(len(fiber_points) + 1, dtype=_np.int64)
+    _np.cumsum(fiber_points, out=first[1:])
+    # Point k of returned fiber i is row first[ids[i]] + k of a per-point array.
+    rows = _np.repeat(first[:-1][ids] - s.offsets[:-1], s.lengths) + _np.arange(s.offsets[-1], dtype=_np.int64)
+    out = {}
+    for name, a in fields.items():
+        scope = name.split("/", 1)[0]
+        if scope == "dps":
+            out[name] = a[ids]
+        elif scope == "dpv":
+            out[name] = a[rows]
+        elif scope == "groups":
+            out[name] = _np.flatnonzero(_np.isin(ids, a[:, 0])).astype(a.dtype).reshape(-1, 1)
+        else:  # dpg: one row per group element, not per fiber
+            out[name] = a
+    return out
 
 
 def load_array_sequence(path, **options):
@@ -306,19 +471,90 @@ def load_tractogram(path, **options):
     return Tractogram(load_array_sequence(path, **options), affine_to_rasmm=_np.eye(4))
 
 
-def load_sft(path, reference, **options):
-    """Decodes a .fft file into DIPY's StatefulTractogram (world millimetres,
-    ``Space.RASMM``), as ``dipy.io.streamline.load_tractogram`` gives for a
-    .tck file. reference: what DIPY accepts as one (a NIfTI path or image, a
-    .trk file, a header dict), giving the voxel grid of the tractogram.
-    options: those of :func:`load`. Needs DIPY (Debian: python3-dipy)."""
+def load_sft(path, reference, *, to_space=None, to_origin=None, bbox_valid_check=True, **options):
+    """Decodes a .fft file into DIPY's StatefulTractogram, as
+    ``dipy.io.streamline.load_tractogram`` loads a .trk or .tck.
+
+    reference: what DIPY accepts as one (a NIfTI path or image, a .trk
+        file, a header dict), or "same": the space the file keeps from its
+        .trk or TRX source (the PROP keys of formats/fft-data.md: the
+        voxel-to-RAS+ affine, dimensions, voxel sizes and order); ValueError
+        when the file keeps none (made from a .tck).
+    to_space, to_origin: DIPY's ``Space`` and ``Origin`` (or their names
+        or values: "rasmm", "vox", "voxmm"; "nifti"/"center",
+        "trackvis"/"corner"); default
+        ``Space.RASMM``, ``Origin.NIFTI``, as load_tractogram.
+    bbox_valid_check: as load_tractogram, raise ValueError when a point
+        lies outside the reference's voxel grid
+        (``sft.is_bbox_in_vox_valid()`` False); False skips the check.
+    options: those of :func:`load` (``fibers=``, ``roi=``, ...). The file's
+        per-streamline and per-point arrays (``load(data=True)``, aligned
+        with a subset) become ``data_per_streamline`` and ``data_per_point``
+        under their names without "dps/" or "dpv/"; groups have no place in
+        a StatefulTractogram (``load(data=True)`` gives them). With
+        ``ignore_trailer=True`` there are none (and no "same" space).
+    Needs DIPY (Debian: python3-dipy)."""
     try:
-        from dipy.io.stateful_tractogram import Space, StatefulTractogram
+        from dipy.io.stateful_tractogram import Origin, Space, StatefulTractogram
     except ImportError as e:
         raise ImportError("fiblet.load_sft needs DIPY (pip install dipy, or Debian's python3-dipy)") from e
+    from nibabel.streamlines import ArraySequence
+
+    path = _existing(path)
+    to_space = Space.RASMM if to_space is None else _dipy_enum(Space, to_space, "to_space")
+    to_origin = Origin.NIFTI if to_origin is None else _dipy_enum(Origin, to_origin, "to_origin")
+    with_data = not options.get("ignore_trailer", False)
     if isinstance(reference, _os.PathLike):
         reference = _os.fspath(reference)
-    return StatefulTractogram(load_array_sequence(path, **options), reference, Space.RASMM)
+    if isinstance(reference, str) and reference == "same":
+        if not with_data:
+            raise ValueError("load_sft: reference='same' reads the space from the file's trailer, "
+                             "which ignore_trailer=True skips")
+        reference = _trk_header(path, _fiblet.data(path, False)["space"])
+    if with_data:
+        s, data = load(path, data=True, **options)
+    else:
+        s, data = load(path, **options), {}
+    seq = s.to_array_sequence()
+    per_streamline = {name[4:]: a for name, a in data.items() if name.startswith("dps/")}
+    per_point = {}
+    for name, a in data.items():
+        if name.startswith("dpv/"):
+            values = ArraySequence()
+            values._data, values._offsets, values._lengths = a, seq._offsets, seq._lengths
+            per_point[name[4:]] = values
+    sft = StatefulTractogram(seq, reference, Space.RASMM, origin=Origin.NIFTI,
+                             data_per_point=per_point, data_per_streamline=per_streamline)
+    sft.to_space(to_space)
+    sft.to_origin(to_origin)
+    if bbox_valid_check and not sft.is_bbox_in_vox_valid():
+        raise ValueError(f"load_sft: {path}: the bounding box is not valid in voxel space of the reference "
+                         f"(points outside its grid), as dipy.io.streamline.load_tractogram refuses; pass "
+                         f"bbox_valid_check=False, then remove_invalid_streamlines() to discard them")
+    return sft
+
+
+def _dipy_enum(kind, value, what):
+    """A DIPY Space or Origin from itself, its name ("VOX", "trackvis") or its value ("vox", "corner")."""
+    if isinstance(value, kind):
+        return value
+    if isinstance(value, str):
+        if value.upper() in kind.__members__:
+            return kind[value.upper()]
+        if value in {m.value for m in kind}:
+            return kind(value)
+    raise ValueError(f"load_sft: {what} must be a dipy {kind.__name__} or one of "
+                     f"{', '.join(sorted({m.name.lower() for m in kind} | {m.value for m in kind}))}; got {value!r}")
+
+
+def _trk_header(path, space):
+    """The space a .fft keeps, as the TrackVis header dict DIPY takes as a reference."""
+    if space is None:
+        raise ValueError(f"load_sft: {path} keeps no reference space (it was made from a .tck, or points): "
+                         f"reference='same' needs a .fft made from a .trk or TRX; pass a reference image")
+    return {"magic_number": b"TRACK", "voxel_to_rasmm": space["voxel_to_rasmm"].astype(_np.float32),
+            "dimensions": space["dimensions"].astype(_np.int16), "voxel_sizes": space["voxel_sizes"].astype(_np.float32),
+            "voxel_order": space["voxel_order"]}
 
 
 def _flatten(streamlines):
@@ -370,11 +606,16 @@ def _flatten(streamlines):
 
 def read_streamlines(path):
     """Reads a .tck, .trk or TRX file through the readers ``fiblet compress``
-    uses; returns ``(Streamlines, data)``: points in world RAS+ mm (for a
-    .trk exactly as nibabel's ``load(path).streamlines``), and a dict of the
-    per-streamline ("dps/NAME"), per-point ("dpv/NAME") and group arrays,
-    each (rows, components)."""
-    r = _fiblet.read_streamlines(_existing(path))
+    uses, or decodes a .fft/.fftz; returns ``(Streamlines, data)``: points in
+    world RAS+ mm (for a .trk exactly as nibabel's ``load(path).streamlines``),
+    and a dict of the per-streamline ("dps/NAME"), per-point ("dpv/NAME") and
+    group arrays, each (rows, components). A .fft (recognised by its content)
+    gives ``load(path, data=True)``: the decoded points and the arrays it
+    keeps from its source (resampled per-point arrays as :func:`load` says)."""
+    path = _existing(path)
+    if _fiblet.container(path) != "other":
+        return load(path, data=True)
+    r = _fiblet.read_streamlines(path)
     return Streamlines(r["points"], r["offsets"]), r["data"]
 
 

@@ -33,7 +33,9 @@
 #include "fiblet/parallel.hpp"
 #include "fiblet/select.hpp"
 #include "fiblet/streamline_io.hpp"
+#include "fiblet/tractogram_format.hpp"
 #include "decode_range.hpp"
+#include "file_data.hpp"
 #include "owned_array.hpp"
 #include "gather_fibers.hpp"
 #include "write_streamlines.hpp"
@@ -423,13 +425,6 @@ py::dict convert(const std::string& input, const std::string& output, bool overw
     return d;
 }
 
-// numpy's dtype name for a field type ("float16", "uint32", ...: the same names).
-py::array field_array(const StreamlineField& f) {
-    py::array a(py::dtype(field_type_name(f.type)), std::vector<py::ssize_t>{py::ssize_t(f.rows()), py::ssize_t(f.components)});
-    std::memcpy(a.mutable_data(), f.bytes.data(), f.bytes.size());
-    return a;
-}
-
 // Reads a .tck, .trk or TRX file through the same readers as compress:
 // points (N, 3) float32 in RAS+ mm, offsets (F+1), fields {name: (rows,
 // components) array}, header properties, format name.
@@ -461,6 +456,25 @@ py::dict read_streamlines(const std::string& path) {
     d["properties"] = properties;
     d["format"] = format == TractogramFormat::tck ? "tck" : format == TractogramFormat::trk ? "trk" : "trx";
     return d;
+}
+
+// What a .fft carries besides its points (file_data.hpp); with fiber_points,
+// each fiber's point count, from the block index roi= uses (cached).
+py::dict data(const std::string& path, bool fiber_points) {
+    std::optional<FftFile> file;
+    std::shared_ptr<const BlockIndex> index;
+    {
+        py::gil_scoped_release release;
+        file.emplace(path);
+        if (fiber_points) index = block_index_of(*file);
+    }
+    return file_data(*file, index.get());
+}
+
+// "fft", "fftz" or "other": what fiblet.read_streamlines decodes itself.
+const char* container_of(const std::string& path) {
+    const TractogramFormat f = detect_tractogram_format(path);
+    return f == TractogramFormat::fft ? "fft" : f == TractogramFormat::fftz ? "fftz" : "other";
 }
 
 }  // namespace
@@ -497,6 +511,8 @@ PYBIND11_MODULE(_fiblet, m) {
     m.def("compress", &compress, py::arg("tck"), py::arg("fft"), py::arg("step_mm"), py::arg("overwrite"),
           py::arg("threads"), py::arg("zstd"));
     m.def("read_streamlines", &read_streamlines, py::arg("path"));
+    m.def("data", &data, py::arg("path"), py::arg("fiber_points"));
+    m.def("container", &container_of, py::arg("path"));
     m.def("write_streamlines", &write_streamlines_array, py::arg("path"), py::arg("points"), py::arg("offsets"),
           py::arg("properties"), py::arg("overwrite"));
     m.def("convert", &convert, py::arg("input"), py::arg("output"), py::arg("overwrite"));

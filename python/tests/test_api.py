@@ -48,6 +48,79 @@ def test_streamlines_index_like_array_sequence(dwi):
         full[[0.5]]
 
 
+def assert_same_members(got, ref):
+    """Every ArraySequence member of a fiblet.Streamlines against nibabel's."""
+    assert len(got) == len(ref)
+    for name in ("_data", "_offsets", "_lengths"):
+        a, b = getattr(got, name), getattr(ref, name)
+        assert a.dtype == b.dtype and a.shape == b.shape, name
+        np.testing.assert_array_equal(a, b, err_msg=name)
+    assert got.total_nb_rows == ref.total_nb_rows and type(got.total_nb_rows) is type(ref.total_nb_rows)
+    assert got.common_shape == ref.common_shape
+    assert got.is_sliced_view == ref.is_sliced_view and got.is_array_sequence
+    np.testing.assert_array_equal(got.get_data(), ref.get_data())
+    assert got.get_data().dtype == ref.get_data().dtype
+    for a, b in zip(got, ref):
+        np.testing.assert_array_equal(a, b)
+    # nibabel's own offsets/lengths relation holds: fiber i is _data[_offsets[i]:][:_lengths[i]].
+    for i in range(len(got)):
+        np.testing.assert_array_equal(got._data[got._offsets[i]:got._offsets[i] + got._lengths[i]], got[i])
+
+
+def test_streamlines_members_are_array_sequences(dwi):
+    from nibabel.streamlines import ArraySequence
+
+    _, _, full = dwi
+    part = full[:40]
+    ref = ArraySequence(list(part))  # nibabel's, built from the same fibers
+    got = part.copy()
+    assert_same_members(got, ref)
+    assert_same_members(full, full.to_array_sequence())
+    assert list(got.offsets) == list(ref._offsets) + [ref.total_nb_rows]  # ours: F + 1, the TRX layout
+    # get_data() and copy() are copies.
+    data = got.get_data()
+    data[0] = 1e6
+    assert got.points[0, 0] != 1e6
+    clone = got.copy()
+    clone.points[0] = -1e6
+    assert got.points[0, 0] != -1e6 and not np.shares_memory(clone.points, got.points)
+    assert list(clone.fiber_ids) == list(got.fiber_ids)
+    # append and extend, with nibabel's rules: empty elements are skipped,
+    # other shapes refused, float64 cast to float32, finalize_append after cache_build.
+    rng = np.random.default_rng(3)
+    new = [rng.normal(size=(n, 3)) for n in (4, 1, 9)]
+    for seq in (got, ref):
+        seq.append(new[0])
+        seq.append(np.zeros((0, 3)))
+        seq.extend([new[1], np.zeros((0, 3)), new[2]])
+        seq.extend(ArraySequence(new[:2]))
+        seq.extend(f for f in new[1:])
+        seq.append(new[2], cache_build=True)
+        seq.append(new[0], cache_build=True)
+        seq.finalize_append()
+        with pytest.raises(ValueError):
+            seq.append(np.zeros((2, 4)))
+    assert_same_members(got, ref)
+    assert len(got) == 40 + 9
+    assert list(got.fiber_ids[:40]) == list(range(40)) and set(got.fiber_ids[40:]) == {-1}
+    np.testing.assert_array_equal(got[-1], new[0].astype(np.float32))
+    # A sequence grown from nothing (of float32 fibers: nibabel's takes the
+    # first element's dtype, ours stays float32).
+    empty, nib_empty = fiblet.Streamlines(np.zeros((0, 3), np.float32), np.zeros(1, np.int64)), ArraySequence()
+    for seq in (empty, nib_empty):
+        seq.extend([f.astype(np.float32) for f in new])
+    assert_same_members(empty, nib_empty)
+    # A slice's _data holds only its fibers (nibabel's keeps the parent's,
+    # is_sliced_view True): the same fibers, get_data() and total_nb_rows.
+    seq = full.to_array_sequence()
+    sl, nib_sl = full[100:120], seq[100:120]
+    assert nib_sl.is_sliced_view and not sl.is_sliced_view and sl._offsets[0] == 0
+    np.testing.assert_array_equal(sl.get_data(), nib_sl.get_data())
+    assert sl.total_nb_rows == nib_sl.total_nb_rows
+    np.testing.assert_array_equal(sl._lengths, nib_sl._lengths)
+    assert_same_members(sl.copy(), nib_sl.copy())
+
+
 def test_fibers_accepts_boolean_masks(dwi):
     fft, _, full = dwi
     mask = full.lengths > 60
