@@ -1,16 +1,23 @@
 #!/usr/bin/env bash
-# Installs fiblet's build and test dependencies from Debian's packages.
-# Idempotent: quick when everything is already installed.
+# Installs fiblet's dependencies from Debian's packages. Idempotent: quick
+# when everything is already installed.
+#   scripts/setup.sh            everything the whole test suite needs
+#   scripts/setup.sh --minimal  the library, the CLI and the Python module
+#                               (pip install --no-build-isolation .) only
 set -euo pipefail
 
-PACKAGES=(
+MINIMAL=(
   build-essential cmake ninja-build pkg-config
   libcli11-dev libeigen3-dev libfmt-dev libzstd-dev libxxhash-dev
-  libzip-dev nlohmann-json3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libhwy-dev
+  libzip-dev nlohmann-json3-dev libhwy-dev
   libnifti2-dev  # NIfTI images (masks)
-  python3 python3-numpy python3-nibabel python3-matplotlib
-  python3-dev python3-pybind11 pybind11-dev python3-pytest snakemake
+  python3 python3-dev python3-numpy python3-pybind11 pybind11-dev
+  python3-pip python3-venv python3-setuptools python3-wheel  # pip install . / the wheel test
+)
+PACKAGES=(
+  "${MINIMAL[@]}"
+  libgtest-dev libgmock-dev libbenchmark-dev
+  python3-nibabel python3-matplotlib python3-pytest snakemake
   python3-dipy  # fiblet.load_sft() and its test
   mrtrix3 zstd time
   valgrind  # callgrind: the compress instruction budget (bench/instruction_budget.py)
@@ -19,6 +26,12 @@ PACKAGES=(
   libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libspng-dev
   libembree-dev  # test-only: the independent ray tracer the viewer's capsules are checked against
 )
+
+case "${1:-}" in
+  --minimal) PACKAGES=("${MINIMAL[@]}") ;;
+  "") ;;
+  *) echo "setup.sh: unknown argument $1 (--minimal or nothing)" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${PACKAGES[@]}"; do
