@@ -5,7 +5,9 @@
 #include <cmath>
 #include <random>
 
+#include "cli_runner.hpp"
 #include "fiber_picking.hpp"
+#include "fiber_selection.hpp"
 #include "gpu_scene.hpp"
 #include "orbit_camera.hpp"
 #include "render_target.hpp"
@@ -114,4 +116,88 @@ TEST(ViewerPicking, PickedFiberPassesThroughThePixel) {
         EXPECT_LT(best, 1.5) << "pixel " << x << "," << y << " fiber " << picked->index;
     }
     EXPECT_EQ(checked, 100);
+}
+
+// Highlighting (issue 30): with fibers picked, the others are drawn dimmed
+// in every technique, the picked ones exactly as before.
+TEST(ViewerPicking, HighlightDimsEveryOtherFiberInEveryTechnique) {
+    FIBLET_REQUIRE_GL();
+    std::vector<std::vector<Vec3f>> fibers;
+    for (int k = 0; k < 3; ++k) {
+        std::vector<Vec3f> f;
+        for (int i = 0; i < 200; ++i) f.push_back({-10 + 0.1f * float(i), -8 + 8 * float(k), 0.05f * float(i % 7)});
+        fibers.push_back(f);
+    }
+    const CompressedScene compressed(fibers);
+    const viewer::GpuScene& scene = compressed.scene;
+    viewer::Renderer renderer(*viewer_gl().programs);
+    viewer::RenderTarget target(160, 120);
+    const Camera cam = viewer::camera_from_spec("top", scene, 160.0f / 120.0f, 35, 1);
+    struct Case {
+        const char* name;
+        viewer::RenderOptions o;
+    };
+    std::vector<Case> cases(4);
+    cases[0].name = "lines";
+    cases[1].name = "tubes", cases[1].o.style = viewer::DrawStyle::tubes, cases[1].o.tube_radius_mm = 1;
+    cases[2].name = "capsules", cases[2].o.style = viewer::DrawStyle::capsules, cases[2].o.tube_radius_mm = 1;
+    cases[3].name = "voxel-rt", cases[3].o.engine = viewer::RenderEngine::voxel_rt, cases[3].o.tube_radius_mm = 1;
+    for (Case& c : cases) c.o.lighting = false;  // the base colour alone: pixel by pixel
+    for (Case& c : cases) {
+        renderer.render(scene, cam, c.o, target);
+        const auto plain = target.read_rgba();
+        const auto ids = target.read_fibers();  // fiber index + 1, 0 for none
+        c.o.highlighted_fibers = {1};
+        renderer.render(scene, cam, c.o, target);
+        const auto lit = target.read_rgba();
+        std::size_t kept = 0, dimmed = 0, others = 0;
+        for (std::size_t p = 0; p < ids.size(); ++p) {
+            int before = 0, after = 0;
+            for (int ch = 0; ch < 3; ++ch) before += plain[4 * p + ch], after += lit[4 * p + ch];
+            if (ids[p] == 2) {  // fiber 1: unchanged
+                kept += std::equal(&plain[4 * p], &plain[4 * p] + 4, &lit[4 * p]);
+            } else if (ids[p] != 0) {
+                ++others;
+                dimmed += after * 2 <= before + 6;  // at most about half as bright (30 % of the colour, greyed)
+            } else {
+                EXPECT_EQ(after, before) << c.name << ": background pixel " << p;
+            }
+        }
+        const auto count1 = std::size_t(std::count(ids.begin(), ids.end(), 2u));
+        EXPECT_GT(count1, 50u) << c.name;
+        EXPECT_EQ(kept, count1) << c.name;
+        EXPECT_GT(others, 100u) << c.name;
+        EXPECT_EQ(dimmed, others) << c.name;
+    }
+}
+
+// Click, shift-click, the list W saves, and that list read back by extract.
+TEST(ViewerPicking, SelectionUpdatesAndSavesAFiberList) {
+    std::vector<std::uint32_t> s;
+    EXPECT_TRUE(viewer::update_selection(s, 7, false));
+    EXPECT_EQ(s, (std::vector<std::uint32_t>{7}));
+    for (std::uint64_t f : {3u, 9u, 8u, 10u}) viewer::update_selection(s, f, true);
+    EXPECT_EQ(s, (std::vector<std::uint32_t>{3, 7, 8, 9, 10}));
+    viewer::update_selection(s, 8, true);  // a second shift-click takes it out
+    EXPECT_EQ(s, (std::vector<std::uint32_t>{3, 7, 9, 10}));
+    viewer::update_selection(s, std::nullopt, true);  // shift-click on the background keeps
+    EXPECT_EQ(s.size(), 4u);
+    EXPECT_EQ(viewer::fiber_list(s), "3,7,9-10\n");
+    viewer::update_selection(s, std::nullopt, false);  // a click on the background clears
+    EXPECT_TRUE(s.empty());
+    for (std::uint64_t f = 0; f < viewer::kMaxHighlightedFibers; ++f) EXPECT_TRUE(viewer::update_selection(s, 2 * f, true));
+    EXPECT_FALSE(viewer::update_selection(s, 1, true));
+    EXPECT_EQ(s.size(), viewer::kMaxHighlightedFibers);
+
+    if (!shared_data_available()) GTEST_SKIP() << "shared test data not found";
+    const TempDir dir;
+    const std::string fft = compress_into(dir, shared_data("bundles/CST_R.tck"), "cst.fft");
+    const std::vector<std::uint32_t> picked{2, 5, 6, 7, 30};
+    viewer::save_selection(dir.file("sel.txt"), picked);
+    const auto r = run_cli("extract -q " + fft + " -o " + dir.file("sel.tck") + " --fibers $(cat " + dir.file("sel.txt") + ")");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(read_tck_fibers(dir.file("sel.tck")).size(), picked.size());
+    const auto wide = run_cli("render " + fft + " --highlight 0-64 -o " + dir.file("x.png"));
+    EXPECT_EQ(wide.status, 2);
+    EXPECT_NE(wide.output.find("--highlight: at most 64 fibers"), std::string::npos) << wide.output;
 }

@@ -1,5 +1,7 @@
 #include "viewer_options.hpp"
 
+#include <algorithm>
+
 #include <cstdlib>
 #include <limits>
 
@@ -134,6 +136,9 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
     cmd->add_option("--lod-pixels", a.lod_pixels, "Blocks smaller than this on screen (diameter) are one segment")
         ->capture_default_str();
     cmd->add_option("--fibers", a.fibers, "Only fibers whose ID is in FIRST-LAST (inclusive, 0-based; FIRST:LAST too)");
+    cmd->add_option("--highlight", a.highlight,
+                    "Fiber IDs drawn as they are while every other fiber is dimmed (as picking does in the window; "
+                    "IDs and ranges as --fibers, at most " + std::to_string(viewer::kMaxHighlightedFibers) + ")");
     cmd->add_option("--min-length", a.min_length, "Only fibers at least this long (mm)");
     cmd->add_option("--max-length", a.max_length, "Only fibers at most this long (mm)");
     cmd->add_option("--decoder", a.decoder,
@@ -232,6 +237,17 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
         const std::vector<FiberRange> ranges = parse_fiber_ranges("--fibers", a.fibers);
         if (ranges.size() != 1) throw Error(Errc::invalid_argument, "--fibers: the viewer takes one range FIRST-LAST");
         o.id_min = fiber_id(ranges[0].first), o.id_max = fiber_id(ranges[0].last);
+    }
+    if (!a.highlight.empty()) {
+        for (const FiberRange& r : parse_fiber_ranges("--highlight", a.highlight))
+            for (std::uint64_t f = r.first; f <= r.last && o.highlighted_fibers.size() <= viewer::kMaxHighlightedFibers; ++f)
+                o.highlighted_fibers.push_back(fiber_id(f));
+        std::sort(o.highlighted_fibers.begin(), o.highlighted_fibers.end());
+        o.highlighted_fibers.erase(std::unique(o.highlighted_fibers.begin(), o.highlighted_fibers.end()),
+                                   o.highlighted_fibers.end());
+        if (o.highlighted_fibers.size() > viewer::kMaxHighlightedFibers)
+            throw Error(Errc::invalid_argument, "--highlight: at most " + std::to_string(viewer::kMaxHighlightedFibers) +
+                                                    " fibers (extract or --fibers draws larger subsets)");
     }
     if (a.min_length < 0 || a.max_length < 0) throw Error(Errc::invalid_argument, "fiber lengths must be positive");
     o.min_length_mm = a.min_length;

@@ -16,6 +16,7 @@ struct ViewerArgs {
     std::string camera = "oblique";
     float fov = 35, zoom = 1;
     std::string color = "direction", background = "black", fibers, decoder = "auto";
+    std::string highlight;  // fiber IDs drawn as they are, the others dimmed
     bool no_lighting = false, no_culling = false, no_lod = false;
     float lod_pixels = 4, line_width = 1;
     std::string style = "lines";

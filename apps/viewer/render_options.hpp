@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <vector>
 
 #include "decoder_kind.hpp"
 #include "draw_style.hpp"
@@ -13,6 +14,8 @@
 #include "transparency/transparency_mode.hpp"
 
 namespace fiblet::viewer {
+
+inline constexpr std::size_t kMaxHighlightedFibers = 64;  // fiber_colors.glsl's kMaxHighlighted
 
 struct RenderOptions {
     RenderEngine engine = RenderEngine::raster;
@@ -34,6 +37,9 @@ struct RenderOptions {
     bool color_by_direction = true;                    // |direction| as RGB, else fixed_color
     std::array<float, 3> fixed_color{0.95f, 0.85f, 0.6f};
     bool fiber_colors = false;                         // the scene's per-fiber colours (GpuScene::set_fiber_colors), when it has them
+    // Fibers drawn as they are while every other is dimmed (picking; at
+    // most kMaxHighlightedFibers, sorted, unique); empty: none dimmed.
+    std::vector<std::uint32_t> highlighted_fibers;
     bool lighting = true;                              // illuminated lines
     bool color_by_normal = false;                      // ray-cast styles: unit normal n as RGB (n + 1) / 2 (checks)
     float line_width = 1;                              // pixels

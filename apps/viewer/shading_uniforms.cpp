@@ -1,5 +1,7 @@
 #include "shading_uniforms.hpp"
 
+#include <algorithm>
+
 #include "shader_program.hpp"
 #include "vec_ops.hpp"
 
@@ -35,6 +37,10 @@ void set_shading_uniforms(const GlProgram& p, const Camera& camera, const Render
     glProgramUniform1f(id, uniform(p, "uSlabHalfWidth"), o.slab_half_width_mm);
     glProgramUniform1f(id, uniform(p, "uGlobalOpacity"), o.opacity);
     glProgramUniform1i(id, uniform(p, "uFiberOpacity"), o.fiber_opacity ? 1 : 0);
+    const auto& h = o.highlighted_fibers;
+    const GLsizei n = GLsizei(std::min(h.size(), kMaxHighlightedFibers));
+    glProgramUniform1i(id, uniform(p, "uHighlightedCount"), n);
+    if (n > 0) glProgramUniform1uiv(id, uniform(p, "uHighlighted"), n, h.data());
 }
 
 }  // namespace fiblet::viewer

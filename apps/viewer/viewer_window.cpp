@@ -14,6 +14,7 @@
 #include <optional>
 
 #include "fiber_picking.hpp"
+#include "fiber_selection.hpp"
 #include "fiblet/error.hpp"
 #include "gpu_programs.hpp"
 #include "gpu_scene.hpp"
@@ -32,7 +33,9 @@ namespace fiblet::viewer {
 
 const char* window_controls_help() {
     return "  left drag: orbit    right/middle drag or shift+left drag: pan    wheel: zoom\n"
-           "  click: print the fiber under the cursor (ID, points, length)\n"
+           "  click: highlight the fiber under the cursor and print it (ID, points, length); on the background: "
+           "clear\n"
+           "  shift+click: add the fiber to the highlighted ones (or take it out)    W: save them as a fiber list\n"
            "  R: reset view    S: screenshot (PNG)    C: culling on/off    L: level of detail on/off\n"
            "  D: colour by direction / fixed    I: lighting on/off    +/-: line width    T: lines / tubes / capsules\n"
            "  E: engine raster / voxel-rt    H: help    Q, Esc: quit\n";
@@ -70,6 +73,8 @@ struct Interaction {
     bool dragging = false, panning = false, moved = false;
     double press_x = 0, press_y = 0, last_x = 0, last_y = 0;
     std::optional<std::pair<double, double>> pick;  // window coordinates of a click
+    bool pick_adds = false;                          // a shift-click: add to the selection
+    bool save_selection = false;
 };
 
 Interaction& state_of(GLFWwindow* w) { return *static_cast<Interaction*>(glfwGetWindowUserPointer(w)); }
@@ -99,6 +104,7 @@ void on_key(GLFWwindow* w, int key, int, int action, int) {
             s.render.engine =
                 s.render.engine == RenderEngine::raster ? RenderEngine::voxel_rt : RenderEngine::raster;
             break;
+        case GLFW_KEY_W: s.save_selection = true; break;
         case GLFW_KEY_H: fmt::print("{}", window_controls_help()); break;
         default: return;
     }
@@ -112,6 +118,7 @@ void on_button(GLFWwindow* w, int button, int action, int mods) {
     if (action == GLFW_PRESS) {
         s.dragging = true, s.moved = false;
         s.panning = button != GLFW_MOUSE_BUTTON_LEFT || (mods & GLFW_MOD_SHIFT);
+        s.pick_adds = button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_SHIFT);
         s.press_x = s.last_x = x, s.press_y = s.last_y = y;
     } else if (action == GLFW_RELEASE) {
         if (s.dragging && !s.moved && button == GLFW_MOUSE_BUTTON_LEFT) s.pick = std::make_pair(x, y), s.dirty = true;
@@ -274,10 +281,26 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
             s.pick.reset();
             // A transparent frame is drawn again opaque to pick from: draw it again after.
             if (s.render.transparent()) s.dirty = true;
-            if (const auto f = pick_fiber_in_frame(renderer, scene, camera, s.render, target, px, py))
+            const auto f = pick_fiber_in_frame(renderer, scene, camera, s.render, target, px, py);
+            if (f)
                 fmt::print("fiber ID {} (index {}): {} points, {:.2f} mm\n", f->id, f->index, f->points, f->length_mm);
             else
                 fmt::print("no fiber at ({}, {})\n", px, py);
+            if (!update_selection(s.render.highlighted_fibers, f ? std::optional<std::uint64_t>(f->index) : std::nullopt,
+                                  s.pick_adds))
+                fmt::print("at most {} fibers are highlighted\n", kMaxHighlightedFibers);
+            s.dirty = true;
+            std::fflush(stdout);
+        }
+        if (s.save_selection) {
+            s.save_selection = false;
+            try {
+                save_selection(options.selection_path, s.render.highlighted_fibers);
+                fmt::print("{} highlighted fibers saved to {} (fiblet extract --fibers $(cat {}))\n",
+                           s.render.highlighted_fibers.size(), options.selection_path, options.selection_path);
+            } catch (const Error& e) {
+                fmt::print(stderr, "fiblet: error: {}\n", e.what());
+            }
             std::fflush(stdout);
         }
     }

@@ -17,6 +17,7 @@ struct WindowOptions {
     RenderOptions render;
     std::string screenshot_prefix = "fiblet-screenshot";  // + "-NNN.png" in the working directory
     int screenshot_supersample = 1;  // screenshots drawn again, supersampled (supersampling.hpp)
+    std::string selection_path = "fiblet-selection.txt";  // where W saves the highlighted fibers
     FiberColorSource fiber_colors;  // render.fiber_colors turns them on
     OverlaySources overlays;        // glyphs and slices over the fibers
     std::string fiber_radii_path;   // fiber_radii.hpp; render.fiber_radii turns them on

@@ -10,9 +10,31 @@ uniform vec3 uFixedColor;
 uniform float uGlobalOpacity = 1.0;  // RenderOptions::opacity
 uniform bool uFiberOpacity = false;  // RenderOptions::fiber_opacity
 
-vec3 baseColor(vec3 tangent, uint fiber) {
+// Highlighted fibers (picked; RenderOptions::highlighted_fibers, sorted):
+// when there are any, every other fiber is drawn dimmed and greyed.
+const int kMaxHighlighted = 64;  // kMaxHighlightedFibers
+uniform int uHighlightedCount = 0;
+uniform uint uHighlighted[kMaxHighlighted];
+
+bool highlighted(uint fiber) {
+    int lo = 0, hi = uHighlightedCount;  // binary search of [lo, hi)
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (uHighlighted[mid] < fiber) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < uHighlightedCount && uHighlighted[lo] == fiber;
+}
+
+vec3 ownColor(vec3 tangent, uint fiber) {
     if (uFiberColors) return fiberColors[fiber].rgb;
     return uColorByDirection && dot(tangent, tangent) > 0.0 ? abs(normalize(tangent)) : uFixedColor;
+}
+
+vec3 baseColor(vec3 tangent, uint fiber) {
+    vec3 c = ownColor(tangent, fiber);
+    if (uHighlightedCount == 0 || highlighted(fiber)) return c;
+    return 0.3 * mix(vec3(dot(c, vec3(0.299, 0.587, 0.114))), c, 0.25);
 }
 
 // What a fragment of the fiber blends with (blend_target.hpp): the global
