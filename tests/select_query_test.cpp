@@ -11,6 +11,7 @@
 #include "fiblet/compress.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/fft_subset.hpp"
+#include "fiblet/fiber_regions.hpp"
 #include "fiblet/select.hpp"
 #include "select_reference.hpp"
 #include "test_util.hpp"
@@ -222,6 +223,41 @@ TEST_P(SelectQuery, EndsInverseSkipAndNumberMatchBruteForce) {
         check(q, "ends/inverse/skip/number " + std::to_string(i));
     }
     EXPECT_GE(nonempty, 6);  // random regions rarely hold a fiber's end: half of the queries keep something
+}
+
+// The regions tested on decoded fibers (FiberRegionTest: only the points of
+// the blocks the index puts near a region) keep what the brute force keeps,
+// with the stored and the computed index; and the rule picks the full
+// decode for regions over the whole file, not for a small one.
+TEST_P(SelectQuery, FiberRegionTestOnDecodedFibersMatchesBruteForce) {
+    const Subject& s = subject();
+    QueryGenerator gen(s.decoded, 41);
+    int kept_some = 0;
+    for (int i = 0; i < 12; ++i) {
+        Query q;
+        for (int k = 0; k < 1 + i % 2; ++k) q.include.push_back(gen.region());
+        if (i % 3 == 1) q.exclude.push_back(gen.region());
+        if (i == 11) q.include.clear();
+        const ReferenceSelection ref = reference_select(*s.file, s.decoded, q);
+        std::vector<std::uint64_t> expected;
+        for (const SelectedRun& r : ref.runs) expected.push_back(r.fiber);
+        kept_some += !expected.empty();
+        for (const BlockIndex* index : {s.stored_or_loaded.get(), s.computed.get()}) {
+            const FiberRegionTest test(*s.file, *index, q);
+            std::vector<std::uint64_t> got;
+            const Streamlines& all = s.decoded.points;
+            for (std::uint64_t f = 0; f + 1 < all.offsets.size(); ++f)
+                if (test.keeps(f, all.xyz.data() + 3 * all.offsets[f], all.offsets[f + 1] - all.offsets[f]))
+                    got.push_back(f);
+            EXPECT_EQ(got, expected) << s.name << ": query " << i;
+        }
+    }
+    EXPECT_GT(kept_some, 4);
+    Query everything, tiny;
+    everything.include.push_back(Region::sphere({0, 0, 0}, 1e6f));
+    tiny.include.push_back(Region::sphere({1e4f, 1e4f, 1e4f}, 1));  // near no block
+    EXPECT_TRUE(full_decode_is_faster(*s.stored_or_loaded, everything));
+    EXPECT_FALSE(full_decode_is_faster(*s.stored_or_loaded, tiny));
 }
 
 TEST_P(SelectQuery, BlockRegionsMatchBruteForce) {

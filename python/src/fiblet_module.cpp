@@ -31,6 +31,7 @@
 #include "fiblet/fft_file.hpp"
 #include "fiblet/image_mask.hpp"
 #include "fiblet/parallel.hpp"
+#include "fiblet/fiber_regions.hpp"
 #include "fiblet/select.hpp"
 #include "fiblet/streamline_io.hpp"
 #include "fiblet/tractogram_format.hpp"
@@ -132,50 +133,22 @@ std::shared_ptr<const BlockIndex> block_index_of(const FftFile& file) {
     return index;
 }
 
-// Above this share of blocks near the include regions, roi= decodes
-// everything and tests points (measured on the medium tractogram, 2 cores:
-// docs/ecosystem.md).
-constexpr double kDecodeAllShare = 0.25;
-
-// Share of the file's blocks near the most selective include region (1
-// without one): what the index-driven selection would decode to test points.
-double share_near_regions(const BlockIndex& index, const Regions& regions) {
-    double share = 1.0;
-    for (const Region& r : regions.include) {
-        std::vector<std::uint64_t> bits;
-        if (r.shape == Region::Shape::sphere) index.blocks_near_sphere(r.center, r.radius, bits);
-        else if (r.shape == Region::Shape::box) index.blocks_near_box(r.box, bits);
-        else index.blocks_near_mask(*r.mask, bits);
-        std::uint64_t n = 0;
-        for (const std::uint64_t w : bits) n += std::uint64_t(std::popcount(w));
-        share = std::min(share, index.blocks() ? double(n) / double(index.blocks()) : 0.0);
-    }
-    return share;
-}
-
-// Positions (in `s`) of the fibers the regions keep, by testing every point
-// (Region::contains: the rules the library's selection applies), on
-// `threads` threads (0: all cores), each a contiguous share of the fibers.
-std::vector<std::uint64_t> kept_by_points(FibersView s, const Regions& regions, unsigned threads) {
-    auto meets = [&](const Region& r, std::uint64_t f) {
-        for (std::uint64_t p = s.offsets[f]; p < s.offsets[f + 1]; ++p)
-            if (r.contains({s.xyz[3 * p], s.xyz[3 * p + 1], s.xyz[3 * p + 2]})) return true;
-        return false;
-    };
+// Positions (in `s`) of the fibers the regions keep, by testing their
+// points (FiberRegionTest: only in the blocks the index puts near a region),
+// on `threads` threads (0: all cores), each a contiguous share of the
+// fibers; `fiber_of(k)` is the file's index of the k-th fiber of `s`.
+template <class FiberOf>
+std::vector<std::uint64_t> kept_by_points(const FiberRegionTest& test, FibersView s, FiberOf fiber_of, unsigned threads) {
     std::vector<std::uint8_t> kept(s.size(), 0);
-    auto test = [&](std::uint64_t first, std::uint64_t last) {
-        for (std::uint64_t f = first; f < last; ++f) {
-            bool k = s.offsets[f + 1] > s.offsets[f];  // as the selection: a fiber without points is never output
-            for (const Region& r : regions.include) k = k && meets(r, f);
-            for (const Region& r : regions.exclude) k = k && !meets(r, f);
-            kept[f] = k;
-        }
+    auto part = [&](std::uint64_t first, std::uint64_t last) {
+        for (std::uint64_t f = first; f < last; ++f)
+            kept[f] = test.keeps(fiber_of(f), s.xyz + 3 * s.offsets[f], s.offsets[f + 1] - s.offsets[f]);
     };
     // Parts of at least 256 fibers, up to 4 per thread, from the library's pool.
     if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
     const std::uint64_t n = s.size(),
                         parts = std::clamp<std::uint64_t>(n / 256, 1, std::uint64_t(4) * threads);
-    parallel_for(parts, threads, [&](std::size_t t) { test(n * t / parts, n * (t + 1) / parts); });
+    parallel_for(parts, threads, [&](std::size_t t) { part(n * t / parts, n * (t + 1) / parts); });
     std::vector<std::uint64_t> keep;
     for (std::uint64_t f = 0; f < n; ++f)
         if (kept[f]) keep.push_back(f);
@@ -218,14 +191,20 @@ void decode_with_regions(const FftFile& file, const Regions& regions, std::uint6
                          std::optional<DecodedRange>& range, Streamlines& s, std::vector<std::uint64_t>& ids) {
     ids.clear();
     if (indices ? indices->empty() : begin >= end) return;
-    // Regions near most of the file: decoding everything on all threads,
+    // Regions near much of the file: decoding everything on all threads,
     // then testing the points, beats the one-thread selection (which decodes
-    // the near blocks, then the kept fibers).
-    if (share_near_regions(*block_index_of(file), regions) > kDecodeAllShare) {
+    // the near blocks, then the kept fibers): the library's rule.
+    Query q;
+    q.include = regions.include, q.exclude = regions.exclude;
+    const std::shared_ptr<const BlockIndex> index = block_index_of(file);
+    if (full_decode_is_faster(*index, q)) {
         if (indices) s = decode_indices(file, *indices, decode_options<DecodeOptions>(threads));
         else range = decode_range(file, begin, end, threads);
         const FibersView view = range ? FibersView{range->xyz.as<const float>(), range->offsets} : view_of(s);
-        const std::vector<std::uint64_t> keep = kept_by_points(view, regions, threads);
+        const FiberRegionTest test(file, *index, q);
+        const std::vector<std::uint64_t> keep =
+            indices ? kept_by_points(test, view, [&](std::uint64_t k) { return (*indices)[k]; }, threads)
+                    : kept_by_points(test, view, [&](std::uint64_t k) { return begin + k; }, threads);
         for (const std::uint64_t k : keep) ids.push_back(indices ? (*indices)[k] : begin + k);
         if (range) keep_fibers(*range, keep);
         else s = gather_fibers(view, keep);
