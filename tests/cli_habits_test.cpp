@@ -256,6 +256,14 @@ TEST(CliHabits, BashCompletionOffersEachSubcommandsOptions) {
         EXPECT_NE(offered.find(option + "\n"), std::string::npos) << option << "\n" << offered;
     }
     EXPECT_GT(checked, 10);
+    // The values of options that take one of a fixed set, not file names.
+    EXPECT_EQ(complete("fiblet compress in.tck --bits \"\"", 4), "auto\n8\n16\n");
+    EXPECT_EQ(complete("fiblet extract in.fft --mode b", 4), "blocks\n");
+    if (test::run_cli("render --help").output.find("--style") != std::string::npos) {
+        EXPECT_EQ(complete("fiblet render in.fft --style t", 4), "tubes\n");
+        EXPECT_EQ(complete("fiblet render in.fft --transparency v", 4), "voxlines\n");
+    }
+    EXPECT_EQ(complete("fiblet compress " + fx.dir.file("in.t"), 2), fx.dir.file("in.tck") + "\n") << "files elsewhere";
 }
 
 TEST(CliHabits, ManPageRendersWithoutWarnings) {

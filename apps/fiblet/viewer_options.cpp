@@ -45,6 +45,19 @@ std::uint32_t fiber_id(std::uint64_t id) {
 
 // --opacity and --transparency: the default order is sorted; voxlines
 // draw lines only.
+// "lines, tubes, capsules" -> its words: the set a value must be one of
+// (CLI::IsMember), which the help and the bash completion then list.
+CLI::IsMember one_of(const std::string& names) {
+    std::vector<std::string> words;
+    for (std::size_t at = 0; at < names.size();) {
+        const std::size_t end = std::min(names.find(',', at), names.size());
+        words.push_back(names.substr(at, end - at));
+        at = names.find_first_not_of(", ", end);
+        if (at == std::string::npos) break;
+    }
+    return CLI::IsMember(words);
+}
+
 void set_transparency(const ViewerArgs& a, viewer::RenderOptions& o) {
     if (!(a.opacity > 0 && a.opacity <= 1)) throw Error(Errc::invalid_argument, "--opacity must be in (0, 1]");
     o.opacity = a.opacity;
@@ -94,6 +107,7 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
     cmd->add_option("--style", a.style, "How fibers are drawn: " + viewer::draw_style_names() +
                                             " (tubes: ray-cast spline tubes; capsules: a ray-cast capsule per "
                                             "segment; docs/viewer.md)")
+        ->check(one_of(viewer::draw_style_names()))
         ->capture_default_str();
     cmd->add_option("--radius", a.radius, "Tube and capsule radius in mm (--style tubes, capsules; --engine voxel-rt)")
         ->capture_default_str();
@@ -101,6 +115,7 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
                     "What draws: " + viewer::render_engine_names() +
                         " (raster: the --style techniques; voxel-rt: every segment a capsule of --radius, ray "
                         "traced through a voxel grid; docs/viewer.md)")
+        ->check(one_of(viewer::render_engine_names()))
         ->capture_default_str();
     cmd->add_option("--grid", a.grid, "Voxels per side of the voxel ray tracer's cubic grid, 4..512 (--engine voxel-rt)")
         ->capture_default_str();
@@ -126,7 +141,8 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
     cmd->add_option("--transparency", a.transparency,
                     "How streamlines blend when --opacity < 1 or with --fiber-opacity: sorted (~1 mm chunks sorted back to front on the "
                     "GPU; the default; lines, tubes, capsules), voxlines (10 mm voxels back to front, precomputed "
-                    "axis orders inside; lines), unsorted (plain blending)");
+                    "axis orders inside; lines), unsorted (plain blending)")
+        ->check(one_of(viewer::transparency_mode_names()));
     cmd->add_option("--supersample", a.supersample,
                     "Anti-aliasing of the PNG (render) or screenshots (view): draw N times larger per axis and "
                     "average, 1..8")
