@@ -137,12 +137,13 @@ TEST(ViewerPicking, HighlightDimsEveryOtherFiberInEveryTechnique) {
         const char* name;
         viewer::RenderOptions o;
     };
-    std::vector<Case> cases(4);
+    std::vector<Case> cases(5);
     cases[0].name = "lines";
     cases[1].name = "tubes", cases[1].o.style = viewer::DrawStyle::tubes, cases[1].o.tube_radius_mm = 1;
     cases[2].name = "capsules", cases[2].o.style = viewer::DrawStyle::capsules, cases[2].o.tube_radius_mm = 1;
     cases[3].name = "voxel-rt", cases[3].o.engine = viewer::RenderEngine::voxel_rt, cases[3].o.tube_radius_mm = 1;
     for (Case& c : cases) c.o.lighting = false;  // the base colour alone: pixel by pixel
+    cases[4].name = "tubes, lit", cases[4].o.style = viewer::DrawStyle::tubes, cases[4].o.tube_radius_mm = 1;
     for (Case& c : cases) {
         renderer.render(scene, cam, c.o, target);
         const auto plain = target.read_rgba();

@@ -31,10 +31,13 @@ vec3 ownColor(vec3 tangent, uint fiber) {
     return uColorByDirection && dot(tangent, tangent) > 0.0 ? abs(normalize(tangent)) : uFixedColor;
 }
 
+// How much of its light a fiber gets: all, or a dimmed fiber 30 %.
+float highlightShare(uint fiber) { return uHighlightedCount == 0 || highlighted(fiber) ? 1.0 : 0.3; }
+
 vec3 baseColor(vec3 tangent, uint fiber) {
     vec3 c = ownColor(tangent, fiber);
-    if (uHighlightedCount == 0 || highlighted(fiber)) return c;
-    return 0.3 * mix(vec3(dot(c, vec3(0.299, 0.587, 0.114))), c, 0.25);
+    float share = highlightShare(fiber);
+    return share == 1.0 ? c : share * mix(vec3(dot(c, vec3(0.299, 0.587, 0.114))), c, 0.25);
 }
 
 // What a fragment of the fiber blends with (blend_target.hpp): the global

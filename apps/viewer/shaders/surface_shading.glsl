@@ -27,5 +27,5 @@ vec3 shadeSurface(vec3 normal, vec3 tangent, vec3 toEye, uint fiber) {
     if (!uLighting) return base;
     float diffuse = max(dot(normal, uLightDirection), 0.0);
     float specular = pow(max(dot(normal, normalize(uLightDirection + toEye)), 0.0), uShininess);
-    return min(base * (uAmbient + uDiffuse * diffuse) + vec3(uSpecular * specular), vec3(1.0));
+    return min(base * (uAmbient + uDiffuse * diffuse) + vec3(uSpecular * specular * highlightShare(fiber)), vec3(1.0));
 }

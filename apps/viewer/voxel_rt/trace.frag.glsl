@@ -287,7 +287,7 @@ vec3 shadeHit(vec3 o, vec3 d, Hit h) {
     float diffuse = max(dot(h.normal, uLightDirection), 0.0) * lit;
     float specular = pow(max(dot(h.normal, normalize(uLightDirection - d)), 0.0), uShininess) * lit;
     // Ambient occlusion darkens the whole surface (the headlight is near the eye).
-    return min((base * (uAmbient + uDiffuse * diffuse) + vec3(uSpecular * specular)) * (1.0 - ao), vec3(1.0));
+    return min((base * (uAmbient + uDiffuse * diffuse) + vec3(uSpecular * specular * highlightShare(fiber))) * (1.0 - ao), vec3(1.0));
 }
 
 uint keyOf(float t, Walk w, uint local) {

@@ -21,5 +21,5 @@ vec3 lineColor(vec3 tangent, vec3 world, uint fiber) {
     float lt = dot(uLightDirection, tangent), vt = dot(view, tangent);
     float diffuse = sqrt(max(1.0 - lt * lt, 0.0));
     float specular = pow(max(diffuse * sqrt(max(1.0 - vt * vt, 0.0)) - lt * vt, 0.0), uShininess);
-    return min(base * (uAmbient + uDiffuse * diffuse) + vec3(uSpecular * specular), vec3(1.0));
+    return min(base * (uAmbient + uDiffuse * diffuse) + vec3(uSpecular * specular * highlightShare(fiber)), vec3(1.0));
 }
