@@ -8,6 +8,7 @@
 // the parameters header of that target; OUT_DIR/streamline_source_fuzz: the
 // shared .trk files and TRX zips written from them.
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -168,6 +169,51 @@ int trk_and_trx_seeds(const fs::path& shared, const fs::path& dir) {
     return n;
 }
 
+// image_fuzz seeds: the first byte picks the name (0 .nii, 1 .nii.gz,
+// 2 .mif), the rest is the file: a 2x2x2 float32 NIfTI-1 with an sform, a
+// 4-D one, and .mif files with the data inline.
+void image_seeds(const fs::path& dir) {
+    auto put = [](std::string& b, std::size_t at, const void* v, std::size_t n) { std::memcpy(&b[at], v, n); };
+    auto nifti = [&](std::vector<std::int16_t> dims) {
+        std::string h(352, '\0');
+        const std::int32_t size = 348;
+        put(h, 0, &size, 4);
+        std::int16_t dim[8] = {std::int16_t(dims.size()), 1, 1, 1, 1, 1, 1, 1};
+        std::size_t voxels = 1;
+        for (std::size_t i = 0; i < dims.size(); ++i) dim[i + 1] = dims[i], voxels *= std::size_t(dims[i]);
+        put(h, 40, dim, sizeof dim);
+        const std::int16_t datatype = 16, bitpix = 32, sform = 1;
+        put(h, 70, &datatype, 2), put(h, 72, &bitpix, 2), put(h, 254, &sform, 2);
+        const float pixdim[8] = {1, 1.5f, 1.5f, 2, 1, 1, 1, 1}, offset = 352, slope = 1;
+        put(h, 76, pixdim, sizeof pixdim), put(h, 108, &offset, 4), put(h, 112, &slope, 4);
+        const float srow[3][4] = {{1.5f, 0, 0, -10}, {0, 1.5f, 0, 5}, {0, 0, 2, 0}};
+        put(h, 280, srow, sizeof srow);
+        h.replace(344, 4, std::string("n+1\0", 4));
+        for (std::size_t i = 0; i < voxels; ++i) {
+            const float v = float(i % 3);
+            h.append(reinterpret_cast<const char*>(&v), 4);
+        }
+        return h;
+    };
+    auto mif = [](const std::string& dim, const std::string& vox, const std::string& layout, std::size_t voxels) {
+        std::string h = "mrtrix image\ndim: " + dim + "\nvox: " + vox + "\nlayout: " + layout +
+                        "\ndatatype: Float32LE\ntransform: 1,0,0,0\ntransform: 0,1,0,0\ntransform: 0,0,1,0\nfile: . 256\nEND\n";
+        h.resize(256, ' ');
+        for (std::size_t i = 0; i < voxels; ++i) {
+            const float v = float(i % 2);
+            h.append(reinterpret_cast<const char*>(&v), 4);
+        }
+        return h;
+    };
+    auto seed = [&](const std::string& name, char format, const std::string& bytes) {
+        std::ofstream(dir / name, std::ios::binary) << format << bytes;
+    };
+    seed("nifti-3d", '\0', nifti({2, 2, 2}));
+    seed("nifti-4d", '\0', nifti({2, 2, 2, 3}));
+    seed("mif-3d", '\2', mif("2,2,2", "1,1,1", "+0,+1,+2", 8));
+    seed("mif-4d-reversed", '\2', mif("2,3,2,2", "1,2,1,1", "-2,+0,+1,+3", 24));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -190,6 +236,8 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "fiblet_fuzz_seeds: no shared data at %s: hand-made seeds only\n", shared.c_str());
     }
     hand_made_tck(tck_dir);
+    fs::create_directories(out / "image_fuzz");
+    image_seeds(out / "image_fuzz");
 
     // .fft seeds: each .tck that compresses, with the default layout and
     // the extreme block sizes; the first also cut after its blocks (a file

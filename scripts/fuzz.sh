@@ -17,7 +17,7 @@ seconds="${1:-60}"
 shift || true
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(tck_reader_fuzz compress_fuzz fft_file_fuzz fft_trailer_fuzz decode_blocks_fuzz
-  streamline_source_fuzz)
+  streamline_source_fuzz image_fuzz)
 cxx="${FIBLET_FUZZ_CXX:-$(command -v clang++-14 || command -v clang++ || true)}"
 if [ -z "$cxx" ]; then
   echo "fuzz.sh: clang++ not found (scripts/setup.sh installs clang-14 and libclang-rt-14-dev)" >&2

@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "../fuzz/fuzz_targets.hpp"
+#include "../fuzz/image_target.hpp"
 #include "../fuzz/structure_mutator.hpp"
+#include "image_source.hpp"
 #include "test_util.hpp"
 
 using namespace fiblet;
@@ -141,4 +143,31 @@ TEST(FuzzRegression, FftTargets) {
         run(fuzz::blocks_target, in, "blocks");
     }
     RecordProperty("regressions", n);
+}
+
+// The image readers' target (fuzz/image_target.hpp) on a real .mif, .nii
+// and .nii.gz (mrconvert's), whole, cut anywhere and with bytes flipped.
+TEST(FuzzRegression, ImageTarget) {
+    const int n = replay_regressions("image_fuzz", fuzz::image_target);
+    const test::TempDir dir;
+    test::SourceImage img;
+    img.dims = {4, 3, 2, 2};
+    img.fill([](std::int64_t i, std::int64_t j, std::int64_t k, std::int64_t v) { return float(i + 2 * j - k + v); });
+    img.write_mif(dir.file("a.mif"));
+    std::vector<std::pair<char, std::string>> files{{'\2', dir.file("a.mif")}};
+    if (test::have_mrtrix() && test::mrconvert(dir.file("a.mif"), dir.file("a.nii")) &&
+        test::mrconvert(dir.file("a.mif"), dir.file("a.nii.gz")))
+        files.insert(files.end(), {{'\0', dir.file("a.nii")}, {'\1', dir.file("a.nii.gz")}});
+    for (const auto& [format, path] : files) {
+        const std::string good = format + test::read_file(path);
+        run(fuzz::image_target, good, path);
+        for (std::size_t cut = 1; cut < good.size(); cut += 7) run(fuzz::image_target, good.substr(0, cut), path + " (cut)");
+        for (std::size_t i = 1; i < good.size(); i += 11) {
+            std::string bad = good;
+            bad[i] = char(bad[i] ^ 0x5a);
+            run(fuzz::image_target, bad, path + " (flipped)");
+        }
+    }
+    RecordProperty("regressions", n);
+    if (files.size() < 3) GTEST_SKIP() << "no mrconvert (MRtrix3) to make the NIfTI cases; the .mif ran";
 }

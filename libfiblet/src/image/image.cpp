@@ -87,8 +87,17 @@ Affine3x4 centred_transform(const Image& image) {
 }
 
 void check_transform(const Image& image) {
+    // Every entry finite, both ways: a NaN or infinite offset (a header's
+    // qoffset or srow) would put every voxel nowhere.
+    auto finite = [](const Affine3x4& m) {
+        for (const auto& row : m)
+            for (const double v : row)
+                if (!std::isfinite(v)) return false;
+        return true;
+    };
     try {
-        inverse(image.voxel_to_world);
+        if (!finite(image.voxel_to_world) || !finite(inverse(image.voxel_to_world)))
+            throw Error(Errc::image_format, "the image's voxel-to-world transform is not finite");
     } catch (const Error& e) {
         throw Error(Errc::image_format, image.path + ": " + e.what());
     }
