@@ -9,6 +9,7 @@
 #include "stdio_files.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/fft_file.hpp"
+#include "fiblet/source_dtypes.hpp"
 #include "fiblet/streamline_io.hpp"
 #include "fiblet/tck.hpp"
 #include "fiblet/tractogram_space.hpp"
@@ -24,6 +25,19 @@ struct DecompressArgs {
     unsigned threads = 0;
     bool force = false, quiet = false, json = false, recursive = false;
 };
+
+// [{"array", "from", "to", "why"}, ...]: the arrays not written in their source dtype.
+std::string dtype_changes_json(const std::vector<DtypeChange>& changes) {
+    std::string out;
+    for (const DtypeChange& c : changes)
+        out += (out.empty() ? "" : ", ") + Json{}
+                                               .str("array", c.array)
+                                               .str("from", field_type_name(c.from))
+                                               .str("to", field_type_name(c.to))
+                                               .str("why", c.why)
+                                               .render();
+    return "[" + out + "]";
+}
 
 // Decodes one file through the spools of `-` (if any); returns its JSON
 // report (empty without --json).
@@ -58,6 +72,14 @@ std::string decompress_through(const DecompressArgs& a, const std::string& input
         fmt::print(stderr, "fiblet: note: {} data arrays of {} not written: a .tck holds points only (write a .trk or .trx)\n",
                    sink_header.fields.size(), input);
     if (points_only) sink_header.fields.clear();
+    // Arrays back in their source dtypes where the output holds them; the rest is said.
+    const std::vector<DtypeChange> changes = restore_source_dtypes(sink_header, out_format);
+    if (points_only)  // the recorded dtypes are no .tck header lines
+        std::erase_if(sink_header.properties, [](const auto& kv) { return is_source_dtype_property(kv.first); });
+    if (!a.quiet)
+        for (const DtypeChange& c : changes)
+            fmt::print(stderr, "fiblet: note: {}: {} was {} in the source, written as {} ({})\n", input, c.array,
+                       field_type_name(c.from), field_type_name(c.to), c.why);
     DecodeOptions options;
     options.decoder = parse_decoder(a.decoder);
     options.threads = a.threads;
@@ -84,6 +106,7 @@ std::string decompress_through(const DecompressArgs& a, const std::string& input
             .integer("fibers", h.fibers)
             .integer("points", h.points)
             .str("decoder", decoder)
+            .raw("dtype_changes", dtype_changes_json(changes))
             .num("seconds", s)
             .render();
     if (!a.quiet)

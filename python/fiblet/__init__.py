@@ -721,3 +721,13 @@ def info(path, *, ignore_trailer=False):
     """The header of a .fft file as a dict (fibers, points, step_mm,
     max_error_um recorded by the encoder, source .tck properties, ...)."""
     return _fiblet.info(_existing(path), ignore_trailer)
+
+
+# nibabel opens .fft/.fftz files through fiblet (nibabel_format.py), when
+# nibabel is installed; fiblet does not need it.
+try:
+    from . import nibabel_format as _nibabel_format
+except ImportError:
+    pass
+else:
+    _nibabel_format.register()

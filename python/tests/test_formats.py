@@ -77,9 +77,9 @@ def trx_read(path):
             stem, comps = stem.rsplit(".", 1)[0], int(stem.rsplit(".", 1)[1])
         a = np.frombuffer(read(n), dtype=np.dtype(dtype).newbyteorder("<")).reshape(-1, comps)
         if stem == "positions":
-            out["positions"] = a.astype(np.float64)
+            out["positions"], out["positions_dtype"] = a.astype(np.float64), a.dtype
         elif stem == "offsets":
-            out["offsets"] = a[:, 0].astype(np.int64)
+            out["offsets"], out["offsets_dtype"] = a[:, 0].astype(np.int64), a.dtype
         else:
             out["arrays"][stem] = a
     off = out["offsets"]
@@ -152,15 +152,16 @@ def round_trips(tmp_path_factory, cli):
     return make
 
 
-def check_decoded(original, decoded, info, report):
+def check_decoded(original, decoded, info, report, slack=0.0):
     """Fixed-step input: every decoded point within the error the .fft
     records of its input point. Resampled input (points on the cubic through
     the input's points): every decoded point as close to the input polyline
     as fiblet's own measure of it says (compress --json, decoded -> input),
-    read here through nibabel or the TRX oracle instead of fiblet."""
+    read here through nibabel or the TRX oracle instead of fiblet. `slack`:
+    what the output's dtype adds (half a float16 step)."""
     resampled = report["resampled"]
     recorded = report["geometry"]["decoded_to_input"]["max_um"] if resampled else info["max_error_um"]
-    bound = recorded * 1e-3 * (1 + 1e-3) + 1e-4  # + float32 voxmm rounding of a .trk
+    bound = recorded * 1e-3 * (1 + 1e-3) + 1e-4 + slack  # + float32 voxmm rounding of a .trk
     assert len(decoded) == len(original)
     worst = 0.0
     for a, b in zip(original, decoded):
@@ -283,10 +284,17 @@ def test_trx_written_by_spec_writer_round_trips(tmp_path, cli, positions, offset
     np.testing.assert_array_equal(t["header"]["VOXEL_TO_RASMM"], affine)
     assert t["header"]["DIMENSIONS"] == [121, 145, 121]
     decoded = trx_fibers(t)
-    check_decoded(fibers, decoded, fiblet.info(tmp_path / "x.fft"), report)
+    # Positions and offsets come back in the source's dtypes (formats/fft-data.md):
+    # float16 ones are the decoded points rounded to float16 (half a step of at most 2^-5 mm below 64 mm).
+    assert t["positions_dtype"] == np.dtype(positions) and t["offsets_dtype"] == np.dtype(offsets)
+    assert np.abs(t["positions"]).max() < 64
+    slack = 2.0 ** -6 * np.sqrt(3) if positions == "float16" else 0.0
+    check_decoded(fibers, decoded, fiblet.info(tmp_path / "x.fft"), report, slack)
     for name in ("dps/weight", "dps/label", "groups/CST", "dpg/CST/volume"):
         np.testing.assert_array_equal(t["arrays"][name].reshape(arrays[name].shape), arrays[name])
+        assert t["arrays"][name].dtype == arrays[name].dtype, name
     assert t["arrays"]["dpv/fa"].shape == (len(t["positions"]), 1)  # resampled with the points
+    assert t["arrays"]["dpv/fa"].dtype == np.float16  # interpolated, back in its dtype
     # A .trk cannot hold groups: a clear error, exit 6, no output.
     r = run(cli, "decompress", tmp_path / "x.fft", "-o", tmp_path / "out.trk", check=False)
     assert r.returncode == 6 and "groups" in r.stderr and not (tmp_path / "out.trk").exists()

@@ -29,6 +29,8 @@ std::size_t field_type_size(FieldType t) noexcept;
 // One little-endian value of type `t` at `p`, as a double (float16 included).
 double field_value(FieldType t, const std::uint8_t* p) noexcept;
 float half_to_float(std::uint16_t h) noexcept;
+// The nearest float16 (ties to even; beyond its range: ±infinity).
+std::uint16_t float_to_half(float f) noexcept;
 // A double as float32, out-of-range values to ±infinity (a plain cast of
 // them is undefined behaviour).
 inline float narrow_to_float(double v) noexcept {

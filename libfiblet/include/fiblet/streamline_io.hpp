@@ -66,6 +66,8 @@ struct SinkHeader {
     std::optional<TractogramSpace> space;     // .trk/TRX space (default: identity, RAS, 1 mm)
     std::vector<StreamlineField> fields;      // rows matching the streamlines written
     std::uint64_t fibers = 0, points = 0;     // what will be written (TRX header, field checks)
+    FieldType positions_type = FieldType::float32;  // TRX: positions.3.<dtype> (float16/32/64)
+    FieldType offsets_type = FieldType::uint64;     // TRX: offsets.<dtype> (uint32/64)
 };
 
 class StreamlineSink {

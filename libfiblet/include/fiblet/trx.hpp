@@ -39,8 +39,9 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
-// Writes a TRX zip (entries stored, uncompressed) with positions.3.float32
-// and offsets.uint64 (with the sentinel), and the fields as dps/, dpv/,
+// Writes a TRX zip (entries stored, uncompressed) with positions and
+// offsets (with the sentinel) in the header's positions_type and
+// offsets_type (float32 and uint64 by default), and the fields as dps/, dpv/,
 // groups/, dpg/ entries. Positions go to a temporary file until finish();
 // libzip writes the archive to a temporary and renames it over `path`.
 class TrxWriter final : public StreamlineSink {

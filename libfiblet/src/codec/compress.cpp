@@ -32,6 +32,7 @@
 #include "fiblet/fiber_ends.hpp"
 #include "fiblet/output_file.hpp"
 #include "fiblet/resample.hpp"
+#include "fiblet/source_dtypes.hpp"
 #include "fiblet/streamline_data_chunk.hpp"
 #include "fiblet/streamline_io.hpp"
 #include "fiblet/tractogram_format.hpp"
@@ -383,6 +384,10 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
         h.mean_error_mm = float(report.error.mean_mm());
         const auto final_head = serialize_fft_header(h);
         const std::uint64_t at = out->logical_size();
+        if (report.resampled)  // per-point arrays are interpolated, stored as float32: their source dtype in PROP
+            for (const StreamlineField& f : fields)
+                if (f.scope() == FieldScope::point && f.type != FieldType::float32)
+                    add_source_dtype_property(properties, f.name, f.type);
         std::vector<TrailerChunk> chunks{make_properties_chunk(properties)};
         if (!fields.empty()) {
             point_fields.finish();

@@ -80,6 +80,18 @@ float half_to_float(std::uint16_t h) noexcept {
     return std::bit_cast<float>(std::bit_cast<std::uint32_t>(v) | sign);
 }
 
+std::uint16_t float_to_half(float f) noexcept {
+    std::uint32_t x = std::bit_cast<std::uint32_t>(f);
+    const auto sign = std::uint16_t((x >> 16) & 0x8000);
+    x &= 0x7fffffff;
+    if (x > 0x7f800000) return sign | 0x7e00;                        // NaN
+    if (x >= 0x477ff000) return sign | 0x7c00;                       // ≥ 65520 (and inf): infinity
+    if (x < 0x38800000)                                              // below 2^-14: subnormal (exact scaling)
+        return sign | std::uint16_t(std::nearbyint(std::bit_cast<float>(x) * 16777216.0f));
+    x += 0xc8000fffu + ((x >> 13) & 1);                              // rebias, round to nearest even
+    return sign | std::uint16_t(x >> 13);
+}
+
 double field_value(FieldType t, const std::uint8_t* p) noexcept {
     switch (t) {
         case FieldType::int8: return load<std::int8_t>(p);

@@ -11,6 +11,7 @@
 #include "core/finite_points.hpp"
 #include "core/streamline_label.hpp"
 #include "fiblet/error.hpp"
+#include "fiblet/source_dtypes.hpp"
 #include "fiblet/tractogram_format.hpp"
 #include "fiblet/trx.hpp"
 #include "trx/trx_archive.hpp"
@@ -96,7 +97,7 @@ struct TrxReader::Impl {
     TrxHeaderJson header;
     TractogramSpace space;
     std::string positions_entry;
-    FieldType positions_type = FieldType::float32;
+    FieldType positions_type = FieldType::float32, offsets_type = FieldType::uint64;
     std::vector<std::uint64_t> offsets;  // NB_STREAMLINES + 1
     std::vector<StreamlineField> fields;
     std::unique_ptr<detail::TrxEntryStream> positions;
@@ -107,6 +108,7 @@ struct TrxReader::Impl {
         const FieldType t = dtype(n, entry, path);
         if ((t != FieldType::uint32 && t != FieldType::uint64) || n.components != 1)
             bad(path, entry + ": offsets must be uint32 or uint64");
+        offsets_type = t;
         const std::size_t size = field_type_size(t);
         const std::uint64_t stored = archive->size(entry);
         if (stored != header.streamlines * size && stored != (header.streamlines + 1) * size)
@@ -239,6 +241,7 @@ std::uint64_t TrxReader::point_count() const { return impl_->header.vertices; }
 Properties TrxReader::properties() const {
     Properties p;
     add_space_properties(p, impl_->space);
+    add_trx_dtype_properties(p, impl_->positions_type, impl_->offsets_type);  // what a .fft cannot keep otherwise
     return p;
 }
 

@@ -41,6 +41,7 @@ struct TrxWriter::Impl {
     SinkHeader header;
     std::FILE* positions = nullptr;  // owned until handed to libzip
     std::vector<std::uint64_t> offsets{0};
+    std::vector<std::uint8_t> converted;  // one streamline's positions as float16/float64
     bool finished = false;
 
     ~Impl() {
@@ -79,10 +80,18 @@ struct TrxWriter::Impl {
         const std::string json = header_json(header.space.value_or(TractogramSpace{}), fibers, points);
         add_buffer(z, "header.json", json.data(), json.size());
         std::rewind(positions);
-        zip_source_t* src = zip_source_filep(z, positions, 0, zip_int64_t(points * 12));
+        const std::size_t size = field_type_size(header.positions_type);
+        zip_source_t* src = zip_source_filep(z, positions, 0, zip_int64_t(points * 3 * size));
         if (src) positions = nullptr;  // libzip closes it
-        add(z, "positions.3.float32", src);
-        add_buffer(z, "offsets.uint64", offsets.data(), offsets.size() * 8);
+        add(z, std::string("positions.3.") + field_type_name(header.positions_type), src);
+        if (header.offsets_type == FieldType::uint32) {
+            std::vector<std::uint32_t> narrow(offsets.begin(), offsets.end());  // checked to fit at write()
+            converted.resize(narrow.size() * 4);
+            std::memcpy(converted.data(), narrow.data(), converted.size());
+            add_buffer(z, "offsets.uint32", converted.data(), converted.size());
+        } else {
+            add_buffer(z, "offsets.uint64", offsets.data(), offsets.size() * 8);
+        }
         for (const StreamlineField& f : header.fields) add_buffer(z, entry_name(f), f.bytes.data(), f.bytes.size());
         if (zip_close(z) != 0) zip_failed(z, "closing");
         finished = true;
@@ -99,6 +108,11 @@ TrxWriter::TrxWriter(const std::string& path, const SinkHeader& header, bool ove
         const std::string problem = check_streamline_field(f, header.fibers, header.points);
         if (!problem.empty()) throw Error(Errc::invalid_input, path + ": " + problem);
     }
+    const FieldType p = header.positions_type, o = header.offsets_type;
+    if ((p != FieldType::float16 && p != FieldType::float32 && p != FieldType::float64) ||
+        (o != FieldType::uint32 && o != FieldType::uint64))
+        throw Error(Errc::invalid_argument, path + ": TRX positions are float16/32/64 and offsets uint32/64, not " +
+                                                field_type_name(p) + "/" + field_type_name(o));
     m.header = header;
     m.positions = std::tmpfile();
     if (!m.positions) throw Error(Errc::io, path + ": cannot create a temporary file: " + std::strerror(errno));
@@ -109,9 +123,31 @@ TrxWriter::~TrxWriter() = default;
 void TrxWriter::write(const float* xyz, std::size_t n_points) {
     Impl& m = *impl_;
     if (m.finished) throw Error(Errc::invalid_argument, m.path + ": TrxWriter used after finish()");
-    if (n_points && std::fwrite(xyz, 12, n_points, m.positions) != n_points)
+    const std::uint64_t end = m.offsets.back() + n_points;
+    if (m.header.offsets_type == FieldType::uint32 && end > std::numeric_limits<std::uint32_t>::max())
+        throw Error(Errc::unsupported, m.path + ": more than 2^32 - 1 points: uint32 offsets cannot hold them");
+    const void* data = xyz;
+    std::size_t size = 4;
+    if (m.header.positions_type == FieldType::float64) {
+        size = 8;
+        m.converted.resize(n_points * 3 * 8);
+        for (std::size_t i = 0; i < 3 * n_points; ++i) {
+            const double d = xyz[i];
+            std::memcpy(&m.converted[i * 8], &d, 8);
+        }
+        data = m.converted.data();
+    } else if (m.header.positions_type == FieldType::float16) {
+        size = 2;
+        m.converted.resize(n_points * 3 * 2);
+        for (std::size_t i = 0; i < 3 * n_points; ++i) {
+            const std::uint16_t h = float_to_half(xyz[i]);
+            std::memcpy(&m.converted[i * 2], &h, 2);
+        }
+        data = m.converted.data();
+    }
+    if (n_points && std::fwrite(data, 3 * size, n_points, m.positions) != n_points)
         throw Error(Errc::io, m.path + ": writing positions: " + std::strerror(errno));
-    m.offsets.push_back(m.offsets.back() + n_points);
+    m.offsets.push_back(end);
 }
 
 void TrxWriter::finish() {
