@@ -470,6 +470,7 @@ struct DegenerateGlyph {
     int lmax;
     std::vector<std::pair<std::pair<int, int>, float>> terms;  // (l, m) -> coefficient
 };
+void PrintTo(const DegenerateGlyph& g, std::ostream* os) { *os << g.name; }  // stable test names
 class OdfGlyphsDegenerate : public ::testing::TestWithParam<DegenerateGlyph> {};
 
 TEST_P(OdfGlyphsDegenerate, DrawnAsTheCpuReferenceAndAMarchAlongTheRay) {
