@@ -13,6 +13,7 @@
 #include "fiblet/block_index.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/fft_subset.hpp"
+#include "fiblet/fiber_regions.hpp"
 #include "fiblet/image_mask.hpp"
 #include "fiblet/select.hpp"
 #include "fiblet/tck.hpp"
@@ -128,11 +129,7 @@ Query build_query(const ExtractArgs& a) {
 // coordinates in another space than the tractogram's (voxels, not mm).
 void warn_about_regions_missing(const ExtractArgs& a, const Query& q, const BlockIndex& index) {
     for (std::size_t i = 0; i < q.include.size(); ++i) {
-        const Region& r = q.include[i];
-        std::vector<std::uint64_t> near;
-        if (r.shape == Region::Shape::sphere) index.blocks_near_sphere(r.center, r.radius, near);
-        else if (r.shape == Region::Shape::box) index.blocks_near_box(r.box, near);
-        else index.blocks_near_mask(*r.mask, near);
+        const std::vector<std::uint64_t> near = blocks_near(index, q.include[i]);
         if (std::any_of(near.begin(), near.end(), [](std::uint64_t w) { return w != 0; })) continue;
         fmt::print(stderr,
                    "fiblet: warning: --include {} lies where {} has no point: no fiber can be kept{}\n", a.include[i],

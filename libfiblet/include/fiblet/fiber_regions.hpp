@@ -13,6 +13,12 @@
 
 namespace fiblet {
 
+// The blocks the index puts near region `r` (a bitmap of index.blocks()
+// bits; conservative: a block with a point in the region is always set),
+// and in `inside` those wholly in it (see BlockIndex::blocks_near_sphere).
+std::vector<std::uint64_t> blocks_near(const BlockIndex& index, const Region& r,
+                                       std::vector<std::uint64_t>* inside = nullptr);
+
 // The regions of `query` (include, exclude; its other criteria are not
 // looked at), with the blocks the index puts near each: a fiber's points
 // are tested only in those blocks (the index is conservative, so the

@@ -7,17 +7,6 @@ namespace fiblet {
 
 namespace {
 
-std::vector<std::uint64_t> blocks_near(const BlockIndex& index, const Region& r,
-                                       std::vector<std::uint64_t>* inside = nullptr) {
-    std::vector<std::uint64_t> bits;
-    if (r.shape == Region::Shape::sphere) index.blocks_near_sphere(r.center, r.radius, bits, inside);
-    else if (r.shape == Region::Shape::box) index.blocks_near_box(r.box, bits, inside);
-    else index.blocks_near_mask(*r.mask, bits, inside);
-    bits.resize((index.blocks() + 63) / 64, 0);
-    if (inside) inside->resize(bits.size(), 0);
-    return bits;
-}
-
 bool has_bit(const std::vector<std::uint64_t>& bits, std::uint64_t i) { return (bits[i >> 6] >> (i & 63)) & 1; }
 
 double share_of(const std::vector<std::uint64_t>& bits, std::uint64_t blocks) {
@@ -34,6 +23,16 @@ double share_of(const std::vector<std::uint64_t>& bits, std::uint64_t blocks) {
 constexpr double kFullDecodeShare = 0.25;
 
 }  // namespace
+
+std::vector<std::uint64_t> blocks_near(const BlockIndex& index, const Region& r, std::vector<std::uint64_t>* inside) {
+    std::vector<std::uint64_t> bits;
+    if (r.shape == Region::Shape::sphere) index.blocks_near_sphere(r.center, r.radius, bits, inside);
+    else if (r.shape == Region::Shape::box) index.blocks_near_box(r.box, bits, inside);
+    else index.blocks_near_mask(*r.mask, bits, inside);
+    bits.resize((index.blocks() + 63) / 64, 0);
+    if (inside) inside->resize(bits.size(), 0);
+    return bits;
+}
 
 FiberRegionTest::FiberRegionTest(const FftFile& file, const BlockIndex& index, const Query& q)
     : file_(file), include_(q.include), exclude_(q.exclude) {

@@ -16,6 +16,7 @@
 #include <cstring>
 
 #include "fiblet/error.hpp"
+#include "fiblet/fiber_regions.hpp"
 #include "fiblet/select.hpp"
 #include "select/block_batch_reader.hpp"
 #include "select/block_decoder.hpp"
@@ -371,15 +372,7 @@ public:
 private:
     // Blocks whose box meets a region (and, in `inside`, those wholly in it).
     Bits near(const Region& r, Bits* inside = nullptr) const {
-        Bits bits;
-        Bits* whole = trust_inside_ ? inside : nullptr;  // otherwise none: their points are tested
-        if (r.shape == Region::Shape::sphere)
-            index_.blocks_near_sphere(r.center, r.radius, bits, whole);
-        else if (r.shape == Region::Shape::mask)
-            index_.blocks_near_mask(*r.mask, bits, whole);
-        else
-            index_.blocks_near_box(r.box, bits, whole);
-        bits.resize((h_.blocks + 63) / 64, 0);
+        Bits bits = blocks_near(index_, r, trust_inside_ ? inside : nullptr);  // untrusted: their points are tested
         if (inside) inside->resize(bits.size(), 0);
         return bits;
     }
