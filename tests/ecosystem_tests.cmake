@@ -19,10 +19,8 @@ add_test(NAME ecosystem.cli_docs_up_to_date
 
 # The Snakemake cohort workflow on 3 generated subjects.
 if(DEFINED Python_EXECUTABLE)
-  add_test(NAME ecosystem.cohort_workflow
-    COMMAND ${Python_EXECUTABLE} ${FIBLET_PYTEST} ${PROJECT_SOURCE_DIR}/scripts/workflow/test_workflow.py)
-  set_tests_properties(ecosystem.cohort_workflow PROPERTIES TIMEOUT 300 SKIP_REGULAR_EXPRESSION "${FIBLET_PYTEST_SKIPPED}"
-    ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA};FIBLET_CLI=$<TARGET_FILE:fiblet_cli>;FIBLET_VERSION=${PROJECT_VERSION}")
+  fiblet_add_pytest(ecosystem.cohort_workflow ${PROJECT_SOURCE_DIR}/scripts/workflow/test_workflow.py 300
+    ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA}" "FIBLET_CLI=$<TARGET_FILE:fiblet_cli>" "FIBLET_VERSION=${PROJECT_VERSION}")
 endif()
 
 # The same Snakefile on a single-node SLURM (slurm-wlm, munge) started on
@@ -30,18 +28,14 @@ endif()
 # daemons itself (its workflow timeout is under CTest's) and they die with it
 # if it is killed.
 if(DEFINED Python_EXECUTABLE)
-  add_test(NAME ecosystem.cohort_workflow_slurm
-    COMMAND ${Python_EXECUTABLE} ${FIBLET_PYTEST} ${PROJECT_SOURCE_DIR}/scripts/workflow/test_workflow_slurm.py)
-  set_tests_properties(ecosystem.cohort_workflow_slurm PROPERTIES TIMEOUT 500 SKIP_REGULAR_EXPRESSION "${FIBLET_PYTEST_SKIPPED}"
-    ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA};FIBLET_CLI=$<TARGET_FILE:fiblet_cli>;FIBLET_SLURM_DIR=${PROJECT_BINARY_DIR}/slurm")
+  fiblet_add_pytest(ecosystem.cohort_workflow_slurm ${PROJECT_SOURCE_DIR}/scripts/workflow/test_workflow_slurm.py 500
+    ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA}" "FIBLET_CLI=$<TARGET_FILE:fiblet_cli>" "FIBLET_SLURM_DIR=${PROJECT_BINARY_DIR}/slurm")
 endif()
 
 # CLI conventions: help, --version, --json, documented exit codes.
 if(DEFINED Python_EXECUTABLE)
-  add_test(NAME ecosystem.cli_conventions
-    COMMAND ${Python_EXECUTABLE} ${FIBLET_PYTEST} ${PROJECT_SOURCE_DIR}/tests/test_cli_conventions.py)
-  set_tests_properties(ecosystem.cli_conventions PROPERTIES TIMEOUT 120 SKIP_REGULAR_EXPRESSION "${FIBLET_PYTEST_SKIPPED}"
-    ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA};FIBLET_CLI=$<TARGET_FILE:fiblet_cli>;FIBLET_VERSION=${PROJECT_VERSION}")
+  fiblet_add_pytest(ecosystem.cli_conventions ${PROJECT_SOURCE_DIR}/tests/test_cli_conventions.py 120
+    ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA}" "FIBLET_CLI=$<TARGET_FILE:fiblet_cli>" "FIBLET_VERSION=${PROJECT_VERSION}")
 endif()
 
 # The compress speed guard (bench/instruction_budget.py): callgrind's
@@ -56,24 +50,19 @@ endif()
 
 # The skip check scripts/test.sh runs after CTest (scripts/check_skips.py).
 if(DEFINED Python_EXECUTABLE)
-  add_test(NAME ecosystem.check_skips COMMAND ${Python_EXECUTABLE} ${FIBLET_PYTEST} ${PROJECT_SOURCE_DIR}/tests/test_check_skips.py)
-  set_tests_properties(ecosystem.check_skips PROPERTIES TIMEOUT 60 SKIP_REGULAR_EXPRESSION "${FIBLET_PYTEST_SKIPPED}")
+  fiblet_add_pytest(ecosystem.check_skips ${PROJECT_SOURCE_DIR}/tests/test_check_skips.py 60)
 endif()
 
 # The viewer benchmark's quick form on this machine's renderer, and the
 # build it carries to a GPU machine (scripts/bench_viewer.sh).
 if(DEFINED Python_EXECUTABLE AND FIBLET_BUILD_VIEWER)
-  add_test(NAME bench.viewer_quick
-    COMMAND ${Python_EXECUTABLE} ${FIBLET_PYTEST} ${PROJECT_SOURCE_DIR}/tests/test_bench_viewer.py)
-  set_tests_properties(bench.viewer_quick PROPERTIES TIMEOUT 600 SKIP_REGULAR_EXPRESSION "${FIBLET_PYTEST_SKIPPED}"
-    FIXTURES_REQUIRED phantom_fod
-    ENVIRONMENT "FIBLET_CLI=$<TARGET_FILE:fiblet_cli>;FIBLET_ODF=${PROJECT_BINARY_DIR}/tests/phantom-fod/phantom-fod-crop.nii")
+  fiblet_add_pytest(bench.viewer_quick ${PROJECT_SOURCE_DIR}/tests/test_bench_viewer.py 600
+    ENVIRONMENT "FIBLET_CLI=$<TARGET_FILE:fiblet_cli>" "FIBLET_ODF=${PROJECT_BINARY_DIR}/tests/phantom-fod/phantom-fod-crop.nii")
+  set_tests_properties(bench.viewer_quick PROPERTIES FIXTURES_REQUIRED phantom_fod)
 endif()
 
 # --reference IMAGE gives .tck sources a space, checked through nibabel.
 if(DEFINED Python_EXECUTABLE)
-  add_test(NAME ecosystem.reference_space
-    COMMAND ${Python_EXECUTABLE} ${FIBLET_PYTEST} ${PROJECT_SOURCE_DIR}/tests/test_reference_space.py)
-  set_tests_properties(ecosystem.reference_space PROPERTIES TIMEOUT 120 SKIP_REGULAR_EXPRESSION "${FIBLET_PYTEST_SKIPPED}"
-    ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA};FIBLET_CLI=$<TARGET_FILE:fiblet_cli>")
+  fiblet_add_pytest(ecosystem.reference_space ${PROJECT_SOURCE_DIR}/tests/test_reference_space.py 120
+    ENVIRONMENT "FIBLET_SHARED_DATA=${FIBLET_SHARED_DATA}" "FIBLET_CLI=$<TARGET_FILE:fiblet_cli>")
 endif()

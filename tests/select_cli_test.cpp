@@ -36,6 +36,13 @@ std::vector<std::vector<Vec3f>> as_fibers(const Streamlines& s) {
 
 bool have_tckedit() { return run("tckedit -version") == 0; }
 
+// A sphere as tckedit's -include/-exclude take it: x,y,z,radius.
+std::string sphere_spec(Vec3f c, float r) {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "%.6g,%.6g,%.6g,%.6g", c.x, c.y, c.z, r);
+    return buf;
+}
+
 class SelectCli : public ::testing::Test {
 protected:
     static void SetUpTestSuite() {
@@ -102,11 +109,6 @@ TEST_F(SelectCli, AgreesWithTckedit) {
     const FftFile file(fft());
     const DecodedFile d = decode_everything(file);
     QueryGenerator gen(d, 3);
-    auto spec = [](Vec3f c, float r) {
-        char buf[128];
-        std::snprintf(buf, sizeof buf, "%.6g,%.6g,%.6g,%.6g", c.x, c.y, c.z, r);
-        return std::string(buf);
-    };
     int nonempty = 0;
     for (int i = 0; i < 6; ++i) {
         // tckedit's options, and fiblet's spelling of them; fiblet also
@@ -116,8 +118,8 @@ TEST_F(SelectCli, AgreesWithTckedit) {
             args += " -" + flag + " " + value;
             ours += (i % 2 ? " -" + flag : " --" + fiblet_flag) + " " + value;
         };
-        for (int k = 0; k < 1 + i % 2; ++k) both("include", "include", spec(gen.some_point(), gen.uniform(3, 12)));
-        if (i % 3 == 2) both("exclude", "exclude", spec(gen.some_point(), gen.uniform(3, 10)));
+        for (int k = 0; k < 1 + i % 2; ++k) both("include", "include", sphere_spec(gen.some_point(), gen.uniform(3, 12)));
+        if (i % 3 == 2) both("exclude", "exclude", sphere_spec(gen.some_point(), gen.uniform(3, 10)));
         // Lengths are multiples of the 0.1 mm step: thresholds between them.
         if (i == 4) both("minlength", "min-length", "70.05"), both("maxlength", "max-length", "120.05");
         if (i == 5) both("minlength", "min-length", "90.05");
@@ -144,19 +146,14 @@ TEST_F(SelectCli, EndsOnlyInverseNumberAndSkipAgreeWithTckedit) {
     const FftFile file(fft());
     const DecodedFile d = decode_everything(file);
     QueryGenerator gen(d, 5);
-    auto spec = [](Vec3f c, float r) {
-        char buf[128];
-        std::snprintf(buf, sizeof buf, "%.6g,%.6g,%.6g,%.6g", c.x, c.y, c.z, r);
-        return std::string(buf);
-    };
     const std::vector<std::string> cases = {
-        " -include " + spec(gen.some_point(), 25) + " -ends_only",
-        " -exclude " + spec(gen.some_point(), 20) + " -ends_only",
-        " -include " + spec(gen.some_point(), 10) + " -inverse",
-        " -include " + spec(gen.some_point(), 10) + " -minlength 80.05 -inverse",
+        " -include " + sphere_spec(gen.some_point(), 25) + " -ends_only",
+        " -exclude " + sphere_spec(gen.some_point(), 20) + " -ends_only",
+        " -include " + sphere_spec(gen.some_point(), 10) + " -inverse",
+        " -include " + sphere_spec(gen.some_point(), 10) + " -minlength 80.05 -inverse",
         " -number 100 -skip 50",
-        " -include " + spec(gen.some_point(), 12) + " -number 7 -skip 3",
-        " -include " + spec(gen.some_point(), 30) + " -ends_only -inverse -number 20",
+        " -include " + sphere_spec(gen.some_point(), 12) + " -number 7 -skip 3",
+        " -include " + sphere_spec(gen.some_point(), 30) + " -ends_only -inverse -number 20",
     };
     int nonempty = 0;
     for (std::size_t i = 0; i < cases.size(); ++i) {
