@@ -256,8 +256,8 @@ TEST_P(SelectQuery, FiberRegionTestOnDecodedFibersMatchesBruteForce) {
     Query everything, tiny;
     everything.include.push_back(Region::sphere({0, 0, 0}, 1e6f));
     tiny.include.push_back(Region::sphere({1e4f, 1e4f, 1e4f}, 1));  // near no block
-    EXPECT_TRUE(full_decode_is_faster(*s.stored_or_loaded, everything));
-    EXPECT_FALSE(full_decode_is_faster(*s.stored_or_loaded, tiny));
+    EXPECT_TRUE(FiberRegionTest(*s.file, *s.stored_or_loaded, everything).full_decode_is_faster());
+    EXPECT_FALSE(FiberRegionTest(*s.file, *s.stored_or_loaded, tiny).full_decode_is_faster());
 }
 
 TEST_P(SelectQuery, BlockRegionsMatchBruteForce) {

@@ -196,12 +196,11 @@ void decode_with_regions(const FftFile& file, const Regions& regions, std::uint6
     // the near blocks, then the kept fibers): the library's rule.
     Query q;
     q.include = regions.include, q.exclude = regions.exclude;
-    const std::shared_ptr<const BlockIndex> index = block_index_of(file);
-    if (full_decode_is_faster(*index, q)) {
+    const FiberRegionTest test(file, *block_index_of(file), q);
+    if (test.full_decode_is_faster()) {
         if (indices) s = decode_indices(file, *indices, decode_options<DecodeOptions>(threads));
         else range = decode_range(file, begin, end, threads);
         const FibersView view = range ? FibersView{range->xyz.as<const float>(), range->offsets} : view_of(s);
-        const FiberRegionTest test(file, *index, q);
         const std::vector<std::uint64_t> keep =
             indices ? kept_by_points(test, view, [&](std::uint64_t k) { return (*indices)[k]; }, threads)
                     : kept_by_points(test, view, [&](std::uint64_t k) { return begin + k; }, threads);

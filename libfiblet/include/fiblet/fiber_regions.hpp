@@ -1,7 +1,7 @@
 // fiblet — fibers-mode regions (tckedit -include / -exclude) tested on
 // fibers already decoded, for callers that decode a whole range anyway (all
 // threads, the fast path) instead of select()'s index-driven passes; and
-// the rule that chooses between the two.
+// the rule that chooses between the two (FiberRegionTest::full_decode_is_faster).
 #pragma once
 
 #include <cstdint>
@@ -31,6 +31,14 @@ public:
     // without points: never).
     bool keeps(std::uint64_t fiber, const float* xyz, std::uint64_t points) const;
 
+    // Whether decoding every fiber (on all threads) and testing their points
+    // here beats select()'s passes, which decode the blocks near a region
+    // then the kept fibers on one thread: when the most selective include
+    // region (or, with none, the exclude regions) has blocks near it in more
+    // than a quarter of the file (measured on the medium tractogram:
+    // docs/ecosystem.md). From the bitmaps above: no second query of the index.
+    bool full_decode_is_faster() const;
+
 private:
     bool meets(const Region& r, const std::vector<std::uint64_t>& near, const std::vector<std::uint64_t>* inside,
                std::uint64_t fiber, const float* xyz, std::uint64_t points) const;
@@ -39,12 +47,5 @@ private:
     // Bitmaps of blocks: near each region, and wholly inside each include region.
     std::vector<std::vector<std::uint64_t>> near_include_, inside_include_, near_exclude_;
 };
-
-// Whether decoding every fiber (on all threads) and testing their points
-// beats select()'s passes, which decode the blocks near a region then the
-// kept fibers on one thread: when the most selective include region (or,
-// with none, the exclude regions) has blocks near it in more than a quarter
-// of the file (measured on the medium tractogram: docs/select.md).
-bool full_decode_is_faster(const BlockIndex& index, const Query& query);
 
 }  // namespace fiblet

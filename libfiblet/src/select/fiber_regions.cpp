@@ -19,7 +19,7 @@ double share_of(const std::vector<std::uint64_t>& bits, std::uint64_t blocks) {
 // (the selection's cost grows with the blocks near, the full decode's does
 // not): on the medium tractogram (index boxes of 8 blocks, 2 threads),
 // spheres whose blocks near are 22 % of the file select in 0.61x a full
-// load, 26 % in 0.99x, 38 % in 1.77x (docs/select.md).
+// load, 26 % in 0.99x, 38 % in 1.77x (docs/ecosystem.md).
 constexpr double kFullDecodeShare = 0.25;
 
 }  // namespace
@@ -74,11 +74,12 @@ bool FiberRegionTest::keeps(std::uint64_t fiber, const float* xyz, std::uint64_t
     return true;
 }
 
-bool full_decode_is_faster(const BlockIndex& index, const Query& q) {
-    double share = q.include.empty() ? 0.0 : 1.0;
-    for (const Region& r : q.include) share = std::min(share, share_of(blocks_near(index, r), index.blocks()));
-    if (q.include.empty())
-        for (const Region& r : q.exclude) share = std::max(share, share_of(blocks_near(index, r), index.blocks()));
+bool FiberRegionTest::full_decode_is_faster() const {
+    const std::uint64_t blocks = file_.header().blocks;
+    double share = include_.empty() ? 0.0 : 1.0;
+    for (const auto& near : near_include_) share = std::min(share, share_of(near, blocks));
+    if (include_.empty())
+        for (const auto& near : near_exclude_) share = std::max(share, share_of(near, blocks));
     return share > kFullDecodeShare;
 }
 
