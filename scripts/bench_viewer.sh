@@ -65,9 +65,9 @@ EOF
 fi
 table="${FIBLET_VIEWER_TABLE:-$table}"
 
+views="overview,close-up"  # the views timed (the full decodes once, with the first case)
 if [ "$quick" = 1 ]; then
   : "${size:=240x135}" "${frames:=1}" "${out:=$root/build/bench-viewer-quick}"
-  views="overview,close-up"
   mkdir -p "$out"
   if [ -z "$input" ]; then
     input="$out/cst.fft"
@@ -75,7 +75,6 @@ if [ "$quick" = 1 ]; then
   fi
 else
   : "${size:=1920x1080}" "${frames:=5}" "${out:=$root/bench}"
-  views="overview,close-up"
   if [ -z "$input" ]; then
     # shellcheck source=bench_env.sh
     source "$root/scripts/bench_env.sh"
