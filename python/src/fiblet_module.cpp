@@ -155,16 +155,14 @@ std::vector<std::uint64_t> kept_by_points(const FiberRegionTest& test, FibersVie
     return keep;
 }
 
-// The fibers among `candidates` that the regions keep, in file order, and
+// The fibers among `candidates` that the regions of `q` keep, in file order, and
 // their IDs: the library's selection decides through the block index (only
 // the blocks near a region are decoded to test their points), then decodes
 // the kept fibers with the fast block decoders.
-Streamlines select_by_regions(const FftFile& file, const Regions& regions, const std::vector<FiberRange>& candidates,
+Streamlines select_by_regions(const FftFile& file, Query q, const std::vector<FiberRange>& candidates,
                               std::vector<std::uint64_t>& ids) {
     const std::shared_ptr<const BlockIndex> index = block_index_of(file);
-    Query q;
     q.fibers = candidates;
-    q.include = regions.include, q.exclude = regions.exclude;
     std::vector<SelectedRun> runs;
     Streamlines s = select_streamlines(file, *index, q, &runs);
     ids.clear();
@@ -210,7 +208,7 @@ void decode_with_regions(const FftFile& file, const Regions& regions, std::uint6
         return;
     }
     const std::vector<FiberRange> candidates = indices ? ranges_of(*indices) : std::vector<FiberRange>{{begin, end - 1}};
-    s = select_by_regions(file, regions, candidates, ids);
+    s = select_by_regions(file, q, candidates, ids);
     if (!indices) return;
     // The kept fibers in the order (and with the repeats) asked for.
     std::vector<std::uint64_t> position(file.header().fibers, UINT64_MAX), want, order;
