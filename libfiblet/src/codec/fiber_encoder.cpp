@@ -7,6 +7,7 @@
 #include "codec/exact_model.hpp"
 #include "codec/greedy_blocks.hpp"
 #include "codec/length_feedback.hpp"
+#include "codec/lookahead_blocks.hpp"
 #include "codec/nearest_code_lut.hpp"
 #include "core/block_geometry.hpp"
 #include "core/vec_math.hpp"
@@ -303,43 +304,23 @@ void FiberEncoder::Encoding::write_block_heads() {
     }
 }
 
-// The first search of every block: lookahead, greedy (SIMD lanes) or beam.
+// The first search of every block: lookahead or greedy (SIMD lanes), or beam.
 void FiberEncoder::Encoding::search_blocks() {
     const SearchParams params{search().beam_width, search().radius};
     std::uint32_t b = 0;
-    if (params.beam <= 1 && !wide && search().lookahead > 0) {
-        // Lookahead: four blocks at a time, in lockstep, so that their
-        // independent dependency chains overlap in the CPU (the blocks'
-        // searches do not interact: the same codes as one at a time).
-        const Codebook8 cb = codebook8();
-        constexpr int kLanes = 4;
-        const std::size_t depth = search().lookahead;
-        LookaheadSearch<Codebook8> lanes[kLanes]{{cb, h.step, depth}, {cb, h.step, depth}, {cb, h.step, depth}, {cb, h.step, depth}};
-        auto start = [&](LookaheadSearch<Codebook8>& lane, std::uint32_t blk) {
-            const std::size_t i0 = std::size_t(blk) * ppb;
-            lane.start(s.frames[blk], s.points[i0 + 1], std::span<const Vec3f>(&s.targets[i0 + 2], block_points(blk) - 2),
-                       codes8_of(blk), &s.points[i0 + 2]);
-        };
-        for (; b + kLanes <= n_blocks && block_points(b + kLanes - 1) == ppb; b += kLanes) {
-            for (int i = 0; i < kLanes; ++i) start(lanes[i], b + i);
-            while (!lanes[0].done()) LookaheadSearch<Codebook8>::step_lanes<kLanes>(lanes);
-        }
-        for (; b < n_blocks; ++b)
-            if (block_points(b) > 2) {
-                start(lanes[0], b);
-                while (!lanes[0].done()) lanes[0].step();
-            }
-    } else if (params.beam <= 1 && !wide) {
-        // Greedy: the blocks one per SIMD lane (greedy_blocks.hpp; the same
-        // codes as search_codes), the last one too when it has codes.
-        // 16-bit codes gain nothing from lanes: their nearest-code search is
-        // branchy and dominates.
+    if (params.beam <= 1 && !wide) {
+        // Greedy or lookahead: many blocks at once (greedy_blocks.hpp,
+        // lookahead_blocks.hpp: one per SIMD lane; the same codes as one at
+        // a time), the last one too when it has codes. 16-bit codes gain
+        // nothing from lanes: their nearest-code search is branchy and dominates.
         const std::size_t full = n_points / ppb, rest = n_points % ppb;
         const std::size_t blocks = rest > 2 ? full + 1 : full;
-        if (blocks > 0 && ppb > 2)
-            greedy_blocks(codebook8(), h.step,
-                          GreedyBatch{&s.frames[0], &s.points[1], &s.targets[2], &s.points[2], ppb, codes8_of(0), bb, blocks,
-                                      ppb - 2, rest > 2 ? rest - 2 : ppb - 2});
+        const GreedyBatch batch{&s.frames[0], &s.points[1], &s.targets[2], &s.points[2], ppb, codes8_of(0), bb, blocks,
+                                ppb - 2, rest > 2 ? rest - 2 : ppb - 2};
+        if (blocks > 0 && ppb > 2) {
+            if (search().lookahead > 0) lookahead_blocks(codebook8(), h.step, search().lookahead, batch);
+            else greedy_blocks(codebook8(), h.step, batch);
+        }
         b = n_blocks;
     }
     for (; b < n_blocks; ++b)

@@ -4,7 +4,7 @@
 // scalar search's float operations in the same order (the library builds
 // with -ffp-contract=off; no fused multiply-add), and the nearest-code
 // lookup repeats NearestCodeLut::operator() step by step, so the codes and
-// decoded points are the same bits as search_codes' (tests/greedy_blocks_test.cpp).
+// decoded points are the same bits as search_codes' (tests/block_lanes_test.cpp).
 #pragma once
 
 #include <cstddef>
@@ -26,6 +26,8 @@ std::optional<SimdLevel> parse_simd_level(std::string_view name);
 // Compiled into this build and supported by this CPU.
 bool simd_level_supported(SimdLevel level);
 std::vector<SimdLevel> supported_simd_levels();
+// Throws Error(invalid_argument) unless simd_level_supported(level).
+void require_simd_level(SimdLevel level);
 // The level the search uses: force_simd_level's, else the environment's
 // FIBLET_SIMD, else the widest supported. Throws Error(invalid_argument)
 // when FIBLET_SIMD names no level or one this CPU (or build) lacks.

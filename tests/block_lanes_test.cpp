@@ -1,7 +1,8 @@
-// The encoder's greedy search with one block per SIMD lane
-// (codec/greedy_blocks.hpp): at every level this CPU supports, the same
-// codes and the same decoded points, bit for bit, as the scalar
-// search_codes, on random walks, on the shared tractogram and on the
+// The encoder's searches with one block per SIMD lane: greedy
+// (codec/greedy_blocks.hpp) and depth-1 lookahead (codec/lookahead_blocks.hpp).
+// At every level this CPU supports, the same codes and the same decoded
+// points, bit for bit, as the scalar searches (search_codes,
+// LookaheadSearch), on random walks, on the shared tractogram and on the
 // lookup's edge cases; the level choice and its errors.
 #include <gtest/gtest.h>
 
@@ -11,6 +12,7 @@
 #include <random>
 
 #include "codec/greedy_blocks.hpp"
+#include "codec/lookahead_blocks.hpp"
 #include "codec/nearest_code_lut.hpp"
 #include "core/vec_math.hpp"
 #include "fiblet/encode.hpp"
@@ -49,40 +51,49 @@ struct Result {
     std::vector<Vec3f> decoded;
 };
 
-Result run_level(const detail::Codebook8& cb, float step, const Blocks& in, SimdLevel level) {
+// Which search: greedy aiming or the depth-1 lookahead.
+enum class Search { greedy, lookahead };
+const char* name_of(Search s) { return s == Search::greedy ? "greedy" : "lookahead"; }
+
+Result run_level(const detail::Codebook8& cb, float step, const Blocks& in, SimdLevel level, Search search) {
     Result r;
     const std::size_t code_stride = in.m + 5;  // unlike the points' stride, as in the encoder
     r.codes.assign(in.count() * code_stride, 0xAA);
     r.decoded.assign(in.points.size(), Vec3f{-7, -7, -7});
     const detail::GreedyBatch batch{in.frames.data(), in.points.data(), in.points.data() + 1, r.decoded.data() + 1,
                                     in.stride, r.codes.data(), code_stride, in.count(), in.m, in.last_m()};
-    detail::greedy_blocks(cb, step, batch, level);
+    if (search == Search::greedy) detail::greedy_blocks(cb, step, batch, level);
+    else detail::lookahead_blocks(cb, step, 1, batch, level);
     return r;
 }
 
-// search_codes, block by block, into the same layout.
-Result run_reference(const detail::Codebook8& cb, float step, const Blocks& in) {
+// search_codes or LookaheadSearch, block by block, into the same layout.
+Result run_reference(const detail::Codebook8& cb, float step, const Blocks& in, Search search) {
     Result r;
     const std::size_t code_stride = in.m + 5;
     r.codes.assign(in.count() * code_stride, 0xAA);
     r.decoded.assign(in.points.size(), Vec3f{-7, -7, -7});
     for (std::size_t j = 0; j < in.count(); ++j) {
         const std::size_t at = j * in.stride;
-        detail::search_codes(cb, detail::SearchParams{1, 1}, in.frames[j], in.points[at], step,
-                             std::span<const Vec3f>(&in.points[at + 1], j + 1 == in.count() ? in.last_m() : in.m),
-                             &r.codes[j * code_stride],
-                             &r.decoded[at + 1]);
+        const std::span<const Vec3f> targets(&in.points[at + 1], j + 1 == in.count() ? in.last_m() : in.m);
+        if (search == Search::greedy)
+            detail::search_codes(cb, detail::SearchParams{1, 1}, in.frames[j], in.points[at], step, targets,
+                                 &r.codes[j * code_stride], &r.decoded[at + 1]);
+        else
+            detail::LookaheadSearch<detail::Codebook8>(cb, step, 1)
+                .run(in.frames[j], in.points[at], targets, &r.codes[j * code_stride], &r.decoded[at + 1]);
     }
     return r;
 }
 
 bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0 || (std::isnan(a) && std::isnan(b)); }
 
-// Every supported level against the reference; returns the number of mismatching codes and points.
-void expect_same_at_every_level(const detail::Codebook8& cb, float step, const Blocks& in, const std::string& what) {
-    const Result ref = run_reference(cb, step, in);
+// Every supported level against the reference: no code and no point differs.
+void expect_same_at_every_level(const detail::Codebook8& cb, float step, const Blocks& in, const std::string& what,
+                                Search search) {
+    const Result ref = run_reference(cb, step, in, search);
     for (SimdLevel level : detail::supported_simd_levels()) {
-        const Result got = run_level(cb, step, in, level);
+        const Result got = run_level(cb, step, in, level, search);
         std::size_t bad_codes = 0, bad_points = 0, first = SIZE_MAX;
         for (std::size_t i = 0; i < ref.codes.size(); ++i)
             if (ref.codes[i] != got.codes[i]) ++bad_codes, first = std::min(first, i);
@@ -90,9 +101,14 @@ void expect_same_at_every_level(const detail::Codebook8& cb, float step, const B
             const Vec3f a = ref.decoded[i], b = got.decoded[i];
             if (!same_bits(a.x, b.x) || !same_bits(a.y, b.y) || !same_bits(a.z, b.z)) ++bad_points;
         }
-        EXPECT_EQ(bad_codes, 0u) << what << ", level " << detail::simd_level_name(level) << ", first code " << first;
-        EXPECT_EQ(bad_points, 0u) << what << ", level " << detail::simd_level_name(level);
+        EXPECT_EQ(bad_codes, 0u) << name_of(search) << ", " << what << ", level " << detail::simd_level_name(level) << ", first code " << first;
+        EXPECT_EQ(bad_points, 0u) << name_of(search) << ", " << what << ", level " << detail::simd_level_name(level);
     }
+}
+
+// Both searches.
+void expect_same_at_every_level(const detail::Codebook8& cb, float step, const Blocks& in, const std::string& what) {
+    for (Search search : {Search::greedy, Search::lookahead}) expect_same_at_every_level(cb, step, in, what, search);
 }
 
 Vec3f unit(Vec3f v) { return detail::normalize(v); }
@@ -122,7 +138,7 @@ Blocks random_walks(std::size_t count, std::size_t m, float spacing, double turn
 
 }  // namespace
 
-TEST(GreedyBlocks, LevelNamesAndChoice) {
+TEST(BlockLanes, LevelNamesAndChoice) {
     for (SimdLevel l : {SimdLevel::scalar, SimdLevel::sse4, SimdLevel::avx2, SimdLevel::avx512})
         EXPECT_EQ(detail::parse_simd_level(detail::simd_level_name(l)), l);
     EXPECT_EQ(detail::parse_simd_level("avx"), std::nullopt);
@@ -145,7 +161,7 @@ TEST(GreedyBlocks, LevelNamesAndChoice) {
     std::cout << "[ levels   ]" << names << "\n";
 }
 
-TEST(GreedyBlocks, RandomWalksMatchTheScalarSearchAtEveryLevel) {
+TEST(BlockLanes, RandomWalksMatchTheScalarSearchAtEveryLevel) {
     // Ratios: narrow to wide caps, and 1.2 (no lookup table: the scalar path at every level).
     for (float ratio : {0.01f, 0.0968f, 0.3f, 0.95f, 1.2f}) {
         const DirectionTable table(ratio);
@@ -164,7 +180,7 @@ TEST(GreedyBlocks, RandomWalksMatchTheScalarSearchAtEveryLevel) {
     }
 }
 
-TEST(GreedyBlocks, AnyNumberOfBlocksAndAShorterLastBlock) {
+TEST(BlockLanes, AnyNumberOfBlocksAndAShorterLastBlock) {
     const DirectionTable table(0.0968f);
     const detail::NearestCodeLut lut(table);
     const detail::Codebook8 cb{table, lut};
@@ -180,7 +196,7 @@ TEST(GreedyBlocks, AnyNumberOfBlocksAndAShorterLastBlock) {
         }
 }
 
-TEST(GreedyBlocks, SharedTractogramBlocksMatchTheScalarSearchAtEveryLevel) {
+TEST(BlockLanes, SharedTractogramBlocksMatchTheScalarSearchAtEveryLevel) {
     const std::string path = test::shared_data("small-ifod1.tck");
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no shared data: " << path;
     const auto fibers = test::read_tck_fibers(path);
@@ -212,7 +228,7 @@ TEST(GreedyBlocks, SharedTractogramBlocksMatchTheScalarSearchAtEveryLevel) {
     }
 }
 
-TEST(GreedyBlocks, EncoderWritesTheSameBlocksAtEveryLevel) {
+TEST(BlockLanes, EncoderWritesTheSameBlocksAtEveryLevel) {
     const std::string path = test::shared_data("small-ifod1.tck");
     if (!std::filesystem::exists(path)) GTEST_SKIP() << "no shared data: " << path;
     auto fibers = test::read_tck_fibers(path);
@@ -222,26 +238,31 @@ TEST(GreedyBlocks, EncoderWritesTheSameBlocksAtEveryLevel) {
     h.offset = {0, 0, 0};
     h.ratio = 0.0968f;
     h.step = float(0.1 / 200);
-    const FiberEncoder greedy(h, search_for_effort(0));
-    auto encode_all = [&](SimdLevel level, std::vector<Vec3f>& decoded) {
-        ForcedLevel forced(level);
-        std::vector<std::uint8_t> out;
-        for (std::size_t i = 0; i < fibers.size(); ++i) greedy.encode(fibers[i], std::uint32_t(i), out, &decoded);
-        return out;
-    };
-    std::vector<Vec3f> ref_decoded;
-    const auto ref = encode_all(SimdLevel::scalar, ref_decoded);
-    for (SimdLevel level : detail::supported_simd_levels()) {
-        std::vector<Vec3f> decoded;
-        const auto got = encode_all(level, decoded);
-        EXPECT_TRUE(got == ref) << detail::simd_level_name(level);
-        ASSERT_EQ(decoded.size(), ref_decoded.size());
-        EXPECT_EQ(std::memcmp(decoded.data(), ref_decoded.data(), decoded.size() * sizeof(Vec3f)), 0)
-            << detail::simd_level_name(level);
+    // Greedy (effort 0) and the default's lookahead with its retry and length tails.
+    for (int effort : {0, kDefaultEffort}) {
+        SearchOptions search = search_for_effort(effort);
+        if (search.retry_beam_width > 0) search.retry_error_mm = 0.004;
+        const FiberEncoder encoder = FiberEncoder(h, search).with_length_feedback(1.0f, true);
+        auto encode_all = [&](SimdLevel level, std::vector<Vec3f>& decoded) {
+            ForcedLevel forced(level);
+            std::vector<std::uint8_t> out;
+            for (std::size_t i = 0; i < fibers.size(); ++i) encoder.encode(fibers[i], std::uint32_t(i), out, &decoded);
+            return out;
+        };
+        std::vector<Vec3f> ref_decoded;
+        const auto ref = encode_all(SimdLevel::scalar, ref_decoded);
+        for (SimdLevel level : detail::supported_simd_levels()) {
+            std::vector<Vec3f> decoded;
+            const auto got = encode_all(level, decoded);
+            EXPECT_TRUE(got == ref) << "effort " << effort << ", " << detail::simd_level_name(level);
+            ASSERT_EQ(decoded.size(), ref_decoded.size());
+            EXPECT_EQ(std::memcmp(decoded.data(), ref_decoded.data(), decoded.size() * sizeof(Vec3f)), 0)
+                << "effort " << effort << ", " << detail::simd_level_name(level);
+        }
     }
 }
 
-TEST(GreedyBlocks, EdgeCasesMatchTheScalarSearchAtEveryLevel) {
+TEST(BlockLanes, EdgeCasesMatchTheScalarSearchAtEveryLevel) {
     const DirectionTable table(0.0968f);
     const detail::NearestCodeLut lut(table);
     const detail::Codebook8 cb{table, lut};
@@ -302,26 +323,28 @@ TEST(GreedyBlocks, EdgeCasesMatchTheScalarSearchAtEveryLevel) {
 
 // compress says which level its search ran at (--json "simd"), writes the
 // same bytes at every level, and refuses an unknown FIBLET_SIMD before any work.
-TEST(GreedyBlocks, CompressReportsItsLevelAndTheSameBytesAtEach) {
+TEST(BlockLanes, CompressReportsItsLevelAndTheSameBytesAtEach) {
     test::TempDir dir;
     const std::string tck = test::shared_data("small-ifod1.tck");
     if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
     CompressOptions o;
     o.overwrite = true;
-    o.search = search_for_effort(0);
     o.threads = 1;
-    std::string first;
-    for (const SimdLevel level : detail::supported_simd_levels()) {
-        SCOPED_TRACE(detail::simd_level_name(level));
-        CompressReport r;
-        {
-            const ForcedLevel forced(level);
-            r = compress_tck(tck, dir.file("x.fft"), o);
+    for (int effort : {0, kDefaultEffort}) {
+        o.search = search_for_effort(effort);
+        std::string first;
+        for (const SimdLevel level : detail::supported_simd_levels()) {
+            SCOPED_TRACE(std::string("effort ") + std::to_string(effort) + ", " + detail::simd_level_name(level));
+            CompressReport r;
+            {
+                const ForcedLevel forced(level);
+                r = compress_tck(tck, dir.file("x.fft"), o);
+            }
+            EXPECT_EQ(r.simd, detail::simd_level_name(level));
+            const std::string bytes = test::read_file(dir.file("x.fft"));
+            if (first.empty()) first = bytes;
+            EXPECT_TRUE(bytes == first);
         }
-        EXPECT_EQ(r.simd, detail::simd_level_name(level));
-        const std::string bytes = test::read_file(dir.file("x.fft"));
-        if (first.empty()) first = bytes;
-        EXPECT_TRUE(bytes == first);
     }
     const auto json = test::run_cli("compress -q -f --json " + tck + " -o " + dir.file("y.fft"), "FIBLET_SIMD=scalar");
     EXPECT_NE(json.output.find("\"simd\": \"scalar\""), std::string::npos) << json.output;

@@ -1,0 +1,194 @@
+// The depth-1 lookahead search, one block per SIMD lane (lookahead_blocks.hpp).
+// Compiled per x86 target like greedy_blocks.cpp, whose level choice it uses.
+#if defined(FIBLET_HAVE_HWY) && defined(__x86_64__)
+#define FIBLET_LOOKAHEAD_HWY 1
+#define HWY_DISABLED_TARGETS (HWY_SSSE3 | HWY_AVX3_DL)
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "codec/lookahead_blocks.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+//
+#include <hwy/highway.h>
+#define FIBLET_LOOKAHEAD_ONCE HWY_ONCE
+#else
+#define FIBLET_LOOKAHEAD_HWY 0
+#define FIBLET_LOOKAHEAD_ONCE 1
+#endif
+
+#include <climits>
+#include <cmath>
+
+#include "codec/lookahead_blocks.hpp"
+
+#if FIBLET_LOOKAHEAD_HWY && (HWY_TARGET == HWY_SSE4 || HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3)
+#include "codec/code_lanes-inl.hpp"
+
+HWY_BEFORE_NAMESPACE();
+namespace fiblet::detail::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// A Neighbours record as floats: x[8], y[8], z[8], pad[8], then the eight
+// codes (two 32-bit words) and the count.
+static_assert(sizeof(NearestCodeLut::Neighbours) == 36 * sizeof(float), "Neighbours are gathered as 36 words");
+constexpr int kNbY = 8, kNbZ = 16, kNbCodes = 32, kNbCount = 34;
+
+// Blocks j0 .. j0 + active - 1 of the batch, one per lane of `d`.
+template <class D>
+void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batch, std::size_t j0, std::size_t active) {
+    using Lanes = CodeLanes<D>;
+    using VF = typename Lanes::VF;
+    using VI = typename Lanes::VI;
+    const Lanes code(cb);
+    BatchLanes<D> s(batch, j0, active);
+    const D d = s.d;
+    const auto di = code.di;
+    const VF stepv = hn::Set(d, step), step2 = hn::Set(d, step * step), two_step = hn::Set(d, 2.0f * step);
+    const VF zero = hn::Zero(d), inf = hn::Set(d, INFINITY);
+    const float* nb_floats = cb.lut.neighbours(0).x;
+    const auto* nb_words = reinterpret_cast<const std::int32_t*>(nb_floats);
+
+    // |local|^2 + step^2 (dot_self, then the sum).
+    auto base_of = [&](VF x, VF y, VF z) {
+        return hn::Add(hn::Add(hn::Add(hn::Mul(x, x), hn::Mul(y, y)), hn::Mul(z, z)), step2);
+    };
+    // A code's squared error: max0(base - 2 step ((d.x x + d.y y) + d.z z)).
+    auto error2 = [&](VF base, VF dx, VF dy, VF dz, VF x, VF y, VF z) {
+        const VF dot = hn::Add(hn::Add(hn::Mul(dx, x), hn::Mul(dy, y)), hn::Mul(dz, z));
+        return hn::Max(hn::Sub(base, hn::Mul(two_step, dot)), zero);
+    };
+
+    for (std::size_t k = 0; k < s.steps; ++k) {
+        // The aimed code at point k.
+        VF vx, vy, vz, x, y, z;
+        s.target_from(s.at, s.px, s.py, s.pz, vx, vy, vz);
+        Lanes::local(s.f, vx, vy, vz, x, y, z);
+        const VI aimed = code.nearest(x, y, z);
+        const VF base = base_of(x, y, z);
+        const VI next = s.next_at();
+        // Code c's state after point k (frame l of c given) into nf, q; returns
+        // the squared error of the greedy step at point k + 1 from there.
+        auto after = [&](const VF* l, VF* nf, VF& qx, VF& qy, VF& qz) {
+            Lanes::compose(s.f, l, nf);
+            qx = hn::Add(s.px, hn::Mul(stepv, nf[0]));
+            qy = hn::Add(s.py, hn::Mul(stepv, nf[1]));
+            qz = hn::Add(s.pz, hn::Mul(stepv, nf[2]));
+            VF wx, wy, wz, x1, y1, z1, bx, by, bz;
+            s.target_from(next, qx, qy, qz, wx, wy, wz);
+            Lanes::local(nf, wx, wy, wz, x1, y1, z1);
+            code.direction(code.nearest(x1, y1, z1), bx, by, bz);
+            return error2(base_of(x1, y1, z1), bx, by, bz, x1, y1, z1);
+        };
+        VF l[9], win_f[9], win_x, win_y, win_z;
+        code.frame(aimed, l);
+        const VF aimed_e0 = error2(base, l[0], l[1], l[2], x, y, z);
+        VF best = hn::Add(aimed_e0, after(l, win_f, win_x, win_y, win_z)), best_e0 = aimed_e0;
+        VI win_code = aimed;
+        // The rivals (the aimed code's neighbours), where a lane has a point
+        // after k. A rival replaces the winner with a smaller sum, or an equal
+        // sum and a smaller own error than a rival winner's (the scalar
+        // search's order of trial); rivals whose own error reaches the sum
+        // cannot win, and a rival no lane can take is skipped.
+        const auto more = s.more_after(k);
+        auto rival_won = hn::FirstN(d, 0);
+        const VI nb_at = hn::Mul(aimed, hn::Set(di, 36));
+        const VI words[2] = {hn::GatherIndex(di, nb_words + kNbCodes, nb_at),
+                             hn::GatherIndex(di, nb_words + kNbCodes + 1, nb_at)};
+        const VI count = hn::GatherIndex(di, nb_words + kNbCount, nb_at);
+        for (int r = 0; r < 8; ++r) {
+            const VF dx = hn::GatherIndex(d, nb_floats + r, nb_at), dy = hn::GatherIndex(d, nb_floats + kNbY + r, nb_at),
+                     dz = hn::GatherIndex(d, nb_floats + kNbZ + r, nb_at);
+            const auto listed = hn::RebindMask(d, hn::Lt(hn::Set(di, r), count));
+            const VF e0 = hn::IfThenElse(listed, error2(base, dx, dy, dz, x, y, z), inf);
+            const auto tries = hn::And(more, hn::Lt(e0, best));
+            if (hn::AllFalse(d, tries)) continue;
+            const VI c = hn::And(hn::ShiftRightSame(words[r / 4], 8 * (r % 4)), code.byte);
+            VF lr[9], rf[9], qx, qy, qz;
+            code.frame(c, lr);
+            const VF total = hn::Add(e0, after(lr, rf, qx, qy, qz));
+            const auto tie = hn::And(hn::Eq(total, best), hn::And(rival_won, hn::Lt(e0, best_e0)));
+            const auto wins = hn::And(tries, hn::Or(hn::Lt(total, best), tie));
+            best = hn::IfThenElse(wins, total, best);
+            best_e0 = hn::IfThenElse(wins, e0, best_e0);
+            rival_won = hn::Or(rival_won, wins);
+            win_code = hn::IfThenElse(hn::RebindMask(di, wins), c, win_code);
+            for (int j = 0; j < 9; ++j) win_f[j] = hn::IfThenElse(wins, rf[j], win_f[j]);
+            win_x = hn::IfThenElse(wins, qx, win_x), win_y = hn::IfThenElse(wins, qy, win_y);
+            win_z = hn::IfThenElse(wins, qz, win_z);
+        }
+        for (int j = 0; j < 9; ++j) s.f[j] = win_f[j];
+        s.px = win_x, s.py = win_y, s.pz = win_z;
+        s.store(k, win_code);
+    }
+}
+
+std::size_t LookaheadVectors(const Codebook8& cb, float step, const GreedyBatch& batch) {
+    return AllVectors(cb, step, batch, [](auto d, auto&&... args) { LookaheadVector(d, args...); });
+}
+
+}  // namespace fiblet::detail::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+#endif
+
+#if FIBLET_LOOKAHEAD_ONCE
+namespace fiblet::detail {
+namespace {
+
+using VectorSearch = std::size_t (*)(const Codebook8&, float, const GreedyBatch&);
+
+VectorSearch vector_search(SimdLevel level) {
+    switch (level) {
+#if FIBLET_LOOKAHEAD_HWY && (HWY_TARGETS & HWY_AVX3)
+        case SimdLevel::avx512: return &N_AVX3::LookaheadVectors;
+#endif
+#if FIBLET_LOOKAHEAD_HWY && (HWY_TARGETS & HWY_AVX2)
+        case SimdLevel::avx2: return &N_AVX2::LookaheadVectors;
+#endif
+#if FIBLET_LOOKAHEAD_HWY && (HWY_TARGETS & HWY_SSE4)
+        case SimdLevel::sse4: return &N_SSE4::LookaheadVectors;
+#endif
+        default: return nullptr;
+    }
+}
+
+// LookaheadSearch for blocks [first, batch.blocks): four in lockstep (their
+// dependency chains overlap in the CPU), then one at a time.
+void scalar_blocks(const Codebook8& cb, float step, std::size_t depth, const GreedyBatch& batch, std::size_t first) {
+    constexpr int kLanes = 4;
+    LookaheadSearch<Codebook8> lanes[kLanes]{{cb, step, depth}, {cb, step, depth}, {cb, step, depth}, {cb, step, depth}};
+    auto start = [&](LookaheadSearch<Codebook8>& lane, std::size_t j) {
+        const std::size_t at = j * batch.stride;
+        lane.start(batch.frames[j], batch.starts[at],
+                   std::span<const Vec3f>(batch.targets + at, j + 1 == batch.blocks ? batch.last_m : batch.m),
+                   batch.codes + j * batch.code_stride, batch.decoded + at);
+    };
+    const std::size_t same_length = batch.last_m == batch.m ? batch.blocks : batch.blocks - 1;
+    std::size_t j = first;
+    for (; j + kLanes <= same_length; j += kLanes) {
+        for (int i = 0; i < kLanes; ++i) start(lanes[i], j + i);
+        while (!lanes[0].done()) LookaheadSearch<Codebook8>::step_lanes<kLanes>(lanes);
+    }
+    for (; j < batch.blocks; ++j) {
+        start(lanes[0], j);
+        while (!lanes[0].done()) lanes[0].step();
+    }
+}
+
+}  // namespace
+
+void lookahead_blocks(const Codebook8& cb, float step, std::size_t depth, const GreedyBatch& batch) {
+    lookahead_blocks(cb, step, depth, batch, simd_level());
+}
+
+void lookahead_blocks(const Codebook8& cb, float step, std::size_t depth, const GreedyBatch& batch, SimdLevel level) {
+    require_simd_level(level);
+    if (batch.blocks == 0) return;
+    std::size_t done = 0;
+    // The lanes address a vector's points with 32-bit offsets (3 floats a point).
+    const bool offsets_fit = batch.stride <= std::size_t(INT_MAX) / 3 / 32 && batch.m <= batch.stride;
+    const bool lengths = batch.m > 0 && batch.last_m > 0 && batch.last_m <= batch.m;
+    if (const VectorSearch search = vector_search(level); depth == 1 && search && cb.lut.usable() && lengths && offsets_fit)
+        done = search(cb, step, batch);
+    scalar_blocks(cb, step, depth, batch, done);
+}
+
+}  // namespace fiblet::detail
+#endif
