@@ -5,7 +5,7 @@
 #   scripts/test.sh              Release build in build/
 #   FIBLET_SANITIZE=ON scripts/test.sh   ASan+UBSan build in build-sanitize/
 # Then, when clang is installed (scripts/setup.sh installs it), each libFuzzer
-# harness runs briefly: FIBLET_FUZZ_SECONDS per harness (default 30; 0 skips).
+# harness runs briefly: FIBLET_FUZZ_SECONDS per harness (default 20; 0 skips).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 "$root/scripts/setup.sh"
@@ -22,9 +22,9 @@ ctest --output-on-failure -j"$(nproc)" --output-junit ctest-junit.xml
 # (scripts/check_skips.py); ASan builds skip their RSS measurements.
 [ "${FIBLET_SANITIZE:-OFF}" != "ON" ] || export FIBLET_ALLOW_SKIPS="${FIBLET_ALLOW_SKIPS:+$FIBLET_ALLOW_SKIPS,}sanitizer"
 /usr/bin/python3 "$root/scripts/check_skips.py" ctest-junit.xml
-if [ "${FIBLET_SANITIZE:-OFF}" != "ON" ] && [ "${FIBLET_FUZZ_SECONDS:-30}" != "0" ]; then
+if [ "${FIBLET_SANITIZE:-OFF}" != "ON" ] && [ "${FIBLET_FUZZ_SECONDS:-20}" != "0" ]; then
   if command -v clang++-14 >/dev/null || command -v clang++ >/dev/null; then
-    "$root/scripts/fuzz.sh" "${FIBLET_FUZZ_SECONDS:-30}"
+    "$root/scripts/fuzz.sh" "${FIBLET_FUZZ_SECONDS:-20}"
   else
     echo "test.sh: clang not found: fuzzers skipped" >&2
   fi
