@@ -32,11 +32,15 @@ struct Frame3 {
     std::array<V3, 3> c;
 };
 
-// §4 "Local frames", with fiblet's fallback helper near ±C.
-inline Frame3 frame_of(V3 axis) {
+// Which frame rule: fiblet's, with the fallback helper near ±C, or the
+// original decoder's, which has none (formats/fft.md §4).
+enum class FrameRule { fiblet, original };
+
+// §4 "Local frames".
+inline Frame3 frame_of(V3 axis, FrameRule rule = FrameRule::fiblet) {
     const V3 helper{-0.703023156622, 0.039959276793, 0.71004344758};
     V3 c1 = cross(axis, helper);
-    if (dot(c1, c1) < 1e-6) c1 = cross(axis, cross(helper, V3{1, 0, 0}));
+    if (rule == FrameRule::fiblet && dot(c1, c1) < 1e-6) c1 = cross(axis, cross(helper, V3{1, 0, 0}));
     c1 = unit(c1);
     return {{axis, c1, unit(cross(axis, c1))}};
 }
@@ -104,7 +108,7 @@ inline std::array<double, 6> anchors(const unsigned char* blk) {
 
 // §5: one block's points, normalized coordinates.
 inline void decode_block(const unsigned char* blk, const std::array<Frame3, 256>& table, double step,
-                         std::vector<V3>& out) {
+                         std::vector<V3>& out, FrameRule rule) {
     const unsigned count = blk[16] & 63;
     const auto a = anchors(blk);
     const V3 a0{a[0], a[1], a[2]}, a1{a[3], a[4], a[5]};
@@ -112,7 +116,7 @@ inline void decode_block(const unsigned char* blk, const std::array<Frame3, 256>
     if (count < 2) return;
     out.push_back(a1);
     const V3 d = a1 - a0;
-    Frame3 f = frame_of(dot(d, d) > 0 ? unit(d) : V3{1, 0, 0});
+    Frame3 f = frame_of(dot(d, d) > 0 ? unit(d) : V3{1, 0, 0}, rule);
     V3 p = a1;
     for (unsigned k = 0; k + 2 < count; ++k) {
         f = compose(f, table[blk[18 + k]]);
@@ -165,8 +169,9 @@ inline std::size_t decode_packed_block(const unsigned char* blk, unsigned count,
     return 18 + (15 * (count - 2) + 7) / 8;  // count >= 2 here
 }
 
-// The whole file: fibers in LUT order, points mapped back to millimetres (§2).
-inline Decoded decode(const std::string& bytes) {
+// The whole file: fibers in LUT order, points mapped back to millimetres
+// (§2); version 2 with either frame rule.
+inline Decoded decode(const std::string& bytes, FrameRule rule = FrameRule::fiblet) {
     Decoded d;
     Header& h = d.header = read_header(bytes);
     if (h.version == 17) {
@@ -193,7 +198,7 @@ inline Decoded decode(const std::string& bytes) {
         return d;
     }
     std::array<Frame3, 256> table;
-    for (unsigned c = 0; c < 256; ++c) table[c] = frame_of(code_direction(c, h.ratio));
+    for (unsigned c = 0; c < 256; ++c) table[c] = frame_of(code_direction(c, h.ratio), rule);
     const std::size_t lut = 58 + 8 * h.buffer_ends.size(), blocks = lut + 8 * h.fibers;
     std::vector<V3> normalized;
     for (std::uint64_t i = 0; i < h.fibers; ++i) {
@@ -204,7 +209,8 @@ inline Decoded decode(const std::string& bytes) {
         for (unsigned b = 0; b < count; ++b) {
             const std::size_t at = blocks + (first + b) * h.block_bytes();
             if (at + h.block_bytes() > bytes.size()) throw std::runtime_error("exact decoder: block past the end");
-            decode_block(reinterpret_cast<const unsigned char*>(bytes.data()) + at, table, double(h.step), normalized);
+            decode_block(reinterpret_cast<const unsigned char*>(bytes.data()) + at, table, double(h.step), normalized,
+                         rule);
         }
         d.fibers.push_back(to_millimetres(normalized, h));
     }

@@ -30,6 +30,7 @@ struct ExactMeasurement {
     double header_max_mm = 0, header_mean_mm = 0;
     bool resampled = false;
     ErrorFigures exact;  // float64 reference decode vs target points
+    ErrorFigures original;  // the same with the original decoder's frame rule (no fallback near ±C; version 2)
     ErrorFigures fiblet; // one of the library's decoders (automatic by default) vs target points
     double exact_ratio() const { return exact.max_mm / header_max_mm; }
     double fiblet_ratio() const { return fiblet.max_mm / header_max_mm; }
@@ -56,6 +57,7 @@ inline ExactMeasurement measure_exact(const std::string& fft_path, const std::st
                                       const std::string& decoder = "auto") {
     const std::string bytes = read_file(fft_path);
     const exact::Decoded dec = exact::decode(bytes);
+    const exact::Decoded original = exact::decode(bytes, exact::FrameRule::original);
     ExactMeasurement m;
     m.header_max_mm = dec.header.max_error, m.header_mean_mm = dec.header.mean_error;
     // RSMP: f64 step, then (16-byte form) u32 curve; the 8-byte form is the polyline.
@@ -82,6 +84,7 @@ inline ExactMeasurement measure_exact(const std::string& fft_path, const std::st
             throw std::runtime_error(fft_path + ": fiber " + std::to_string(f) + " has fewer points than its targets");
         for (std::size_t k = 0; k < n; ++k) {
             m.exact.add(distance(exact_points[k], targets[k]));
+            m.original.add(distance(original.fibers[f][k], targets[k]));
             const float* q = &own.xyz[3 * (own.offsets[f] + k)];
             m.fiblet.add(distance(exact::V3{q[0], q[1], q[2]}, targets[k]));
         }

@@ -36,6 +36,16 @@ D3 tilted(D3 axis, double angle, std::mt19937& rng) {
     return std::cos(angle) * axis + std::sin(angle) * side;
 }
 
+// A straight fiber of `points` along unit `dir` at `step` mm from `start`.
+Fiber straight_fiber(D3 start, D3 dir, std::size_t points, double step) {
+    Fiber f;
+    for (std::size_t i = 0; i < points; ++i) {
+        const D3 p = start + (double(i) * step) * dir;
+        f.push_back({float(p.x), float(p.y), float(p.z)});
+    }
+    return f;
+}
+
 // A fiber from `start` whose first segment runs along `dir0`, then bends
 // on a circle of radius `radius` mm (in a random plane containing dir0):
 // the rest of the block strays from the first axis, which is where a turn
@@ -78,6 +88,7 @@ void expect_within_header(const Outcome& o, const char* what) {
     ASSERT_GT(o.m.header_max_mm, 0.0);
     EXPECT_LE(o.m.exact.max_mm, kDecoderSlack * o.m.header_max_mm) << what << ": float64 decode";
     EXPECT_LE(o.m.fiblet.max_mm, kDecoderSlack * o.m.header_max_mm) << what << ": fiblet's decoder";
+    EXPECT_LE(o.m.original.max_mm, kDecoderSlack * o.m.header_max_mm) << what << ": the original decoder's frames";
 }
 
 // The fiber turned rigidly about its first point so that its first
@@ -121,6 +132,28 @@ TEST(ExactStress, FirstSegmentsWithinOneDegreeOfTheHelper) {
     // Measured: 1.098x with greedy aiming, 1.105x with the default's lookahead
     // (which lowers both means, the control's by 1.5 %, these by 0.9 %).
     EXPECT_LT(o.m.exact.mean_mm(), 1.12 * c.m.exact.mean_mm());
+}
+
+// Fibers whose first segments run exactly along +C and -C (straight, and
+// bending away after the first segment), at 0.1 mm and 2 mm steps: where
+// fiblet's frame would take the fallback helper, which the original decoder
+// lacks (formats/fft.md §4), the encoder moves the second anchor off the
+// fallback's cone, so the original decoder's frames decode every block
+// within the recorded error too (before: 54 um off on the 2 mm lines).
+TEST(ExactStress, FirstSegmentsAlongTheHelper) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (double step : {0.1, 2.0}) {
+        std::vector<Fiber> fibers;
+        for (int i = 0; i < 40; ++i) {
+            const D3 axis = (i % 2 ? -1.0 : 1.0) * helper();
+            const D3 start{u(rng) * 100 - 50, u(rng) * 100 - 50, u(rng) * 100 - 50};
+            fibers.push_back(i % 4 < 2 ? straight_fiber(start, axis, 130, step)
+                                       : bending_fiber(start, axis, 40 * step * (1 + u(rng)), 130, step, rng));
+        }
+        const Outcome o = compress_and_measure(fibers, "along-helper");
+        expect_within_header(o, step < 1 ? "along ±C, 0.1 mm" : "along ±C, 2 mm");
+    }
 }
 
 // Tight loops (radius 1 to 3 mm, several turns), the longest block of a

@@ -29,6 +29,10 @@ struct Frame {
 // cross product vanishes) fiblet uses normalize(C x (1,0,0)) as the helper
 // instead, so the frame stays orthonormal (see formats/fft.md).
 Frame frame_from_axis(Vec3f unit_axis);
+// Whether frame_from_axis takes that fallback helper (|axis x C|^2 < 1e-6 in
+// float): the original decoder has none, so it turns such a frame about
+// its axis.
+bool frame_uses_fallback(Vec3f unit_axis);
 
 // Half sphere (x >= 0) <-> spherical cap (x >= 1 - ratio), unit vectors.
 Vec3f map_half_sphere_to_cap(Vec3f v, float ratio);

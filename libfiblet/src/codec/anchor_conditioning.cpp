@@ -27,6 +27,14 @@ Vec3d exact_anchor(const std::array<std::uint32_t, 3>& q) {
 // a whole quantum for little gain).
 constexpr double kDivergenceWeight = 0.1;
 
+// How many quanta the second anchor may move to leave the fallback's cone.
+constexpr int kFallbackQuanta = 4;
+
+// Whether fiblet's float decoders build this start's frame with the C'
+// fallback (formats/fft.md §4), which the original decoder lacks: it would
+// turn the whole block about its first axis. Version-2 blocks never start so.
+bool uses_fallback(const DecoderStarts& s) { return frame_uses_fallback(anchor_axis(s.a0, s.a1)); }
+
 double unorm16_value(double n) { return std::clamp(n, 0.0, 1.0) * 65535.0; }
 
 // The larger of the two anchors' distances to where they should be.
@@ -70,14 +78,27 @@ DecoderStarts condition_anchors(Vec3d n0, Vec3d n1, double reach, double thresho
     };
     DecoderStarts best = decoder_starts(words(0, true));
     best.divergence = start_divergence(best, reach);
-    if (!(best.divergence > threshold)) return best;
-    double best_cost = anchor_error(best.words, n0, n1) + kDivergenceWeight * best.divergence;
-    for (unsigned mask = 0; mask < 64; ++mask) {
-        DecoderStarts s = decoder_starts(words(mask, false));
+    bool fallback = uses_fallback(best);
+    if (!(best.divergence > threshold) && !fallback) return best;
+    double best_cost = fallback ? INFINITY : anchor_error(best.words, n0, n1) + kDivergenceWeight * best.divergence;
+    auto offer = [&](const AnchorWords& w) {
+        DecoderStarts s = decoder_starts(w);
+        if (uses_fallback(s)) return;
         s.divergence = start_divergence(s, reach);
         const double cost = anchor_error(s.words, n0, n1) + kDivergenceWeight * s.divergence;
-        if (cost < best_cost) best_cost = cost, best = s;
-    }
+        if (cost < best_cost) best_cost = cost, best = s, fallback = false;
+    };
+    for (unsigned mask = 0; mask < 64; ++mask) offer(words(mask, false));
+    // Anchors on the grid round one way only: the second one moved by a
+    // quantum on each axis turns the first axis away from C (a 0.1 mm step
+    // turns by 1.7 degrees a quantum of a 200 mm box, the fallback's cone is 0.06).
+    for (int q = 1; fallback && q <= kFallbackQuanta; ++q)
+        for (int i = 0; i < 27; ++i) {
+            AnchorWords w = words(0, true);
+            for (int a = 0, code = i; a < 3; ++a, code /= 3)
+                w.a1[a] = std::uint32_t(std::clamp<std::int64_t>(std::int64_t(w.a1[a]) + (code % 3 - 1) * q, 0, 65535));
+            offer(w);
+        }
     return best;
 }
 

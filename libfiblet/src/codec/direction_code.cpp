@@ -9,12 +9,20 @@
 namespace fiblet {
 using namespace detail;
 
+namespace {
+bool needs_fallback(Vec3f c1) { return dot(c1, c1) < 1e-6f; }
+}  // namespace
+
+bool frame_uses_fallback(Vec3f axis) {
+    return needs_fallback(cross(axis, Vec3f{kFrameHelper[0], kFrameHelper[1], kFrameHelper[2]}));
+}
+
 Frame frame_from_axis(Vec3f axis) {
     const Vec3f helper{kFrameHelper[0], kFrameHelper[1], kFrameHelper[2]};
     Vec3f c1 = cross(axis, helper);
     // |axis x C|^2 < 1e-6: the axis is within ~0.06 deg of C; C's own frame
     // would be ill-conditioned, so use the helper C x (1,0,0) (orthogonal to C).
-    if (dot(c1, c1) < 1e-6f) c1 = cross(axis, Vec3f{0.0f, helper.z, -helper.y});
+    if (needs_fallback(c1)) c1 = cross(axis, Vec3f{0.0f, helper.z, -helper.y});
     c1 = normalize(c1);
     const Vec3f c2 = normalize(cross(axis, c1));
     return {{axis, c1, c2}};
