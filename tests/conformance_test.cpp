@@ -17,22 +17,29 @@
 #include <string>
 #include <vector>
 
+#include "exact_decoder.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/fft_file.hpp"
+#include "test_util.hpp"
 
 using namespace fiblet;
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Expected {
+// A corpus text: per fiber its point count, then every coordinate (float32
+// values in NAME.txt, float64 in NAME.f64.txt; both read back exactly).
+template <class T>
+struct Points {
     std::vector<std::uint64_t> counts;
-    std::vector<float> xyz;
+    std::vector<T> xyz;
 };
+using Expected = Points<float>;
 
-Expected read_expected(const fs::path& path) {
+template <class T = float>
+Points<T> read_expected(const fs::path& path) {
     std::ifstream in(path);
-    Expected e;
+    Points<T> e;
     std::string line;
     while (std::getline(in, line)) {
         if (line.rfind("fiber ", 0) == 0) {
@@ -41,7 +48,7 @@ Expected read_expected(const fs::path& path) {
         }
         std::istringstream words(line);
         std::string w;
-        while (words >> w) e.xyz.push_back(std::strtof(w.c_str(), nullptr));
+        while (words >> w) e.xyz.push_back(T(std::strtod(w.c_str(), nullptr)));
     }
     return e;
 }
@@ -96,4 +103,43 @@ TEST(Conformance, EveryFileDecodesToItsCommittedPointsWithEveryDecoder) {
     versions.erase(std::unique(versions.begin(), versions.end()), versions.end());
     EXPECT_EQ(versions, (std::vector<int>{2, 16, 17})) << "every version in the corpus";
     EXPECT_GT(points, 5000u);
+}
+
+// The float64 points beside each .fft (NAME.f64.txt, the reference decoder
+// of tests/exact_decoder.hpp, written from formats/ alone): the reference
+// decoder reproduces them exactly, and every fiblet decoder comes within
+// 0.5 um of them (0.25 um at most on this corpus: float32 frames along the
+// fallback helper and 255-point fibers).
+TEST(Conformance, FloatDecodersStayNearTheFloat64Points) {
+    std::size_t files = 0;
+    for (const fs::path& path : corpus()) {
+        const fs::path f64 = path.string() + ".f64.txt";
+        if (path.extension() != ".fft") continue;
+        ASSERT_TRUE(fs::exists(f64)) << f64;
+        ++files;
+        const Points<double> e = read_expected<double>(f64);
+        const auto exact = test::exact::decode(test::read_file(path.string()));
+        ASSERT_EQ(exact.fibers.size(), e.counts.size()) << path;
+        std::size_t at = 0, differ = 0;
+        for (std::size_t f = 0; f < exact.fibers.size(); ++f) {
+            ASSERT_EQ(exact.fibers[f].size(), e.counts[f]) << path << " fiber " << f;
+            for (const auto& p : exact.fibers[f])
+                differ += (p.x != e.xyz[at]) + (p.y != e.xyz[at + 1]) + (p.z != e.xyz[at + 2]), at += 3;
+        }
+        EXPECT_EQ(differ, 0u) << path << ": the reference decoder no longer gives the committed float64 points";
+        const FftFile file(path.string());
+        for (const std::string& decoder : available_decoders()) {
+            DecodeOptions o;
+            o.decoder = parse_decoder(decoder);
+            const Streamlines got = decode_fibers(file, 0, file.header().fibers, o);
+            ASSERT_EQ(got.xyz.size(), e.xyz.size()) << path << " " << decoder;
+            double worst = 0;
+            for (std::size_t i = 0; i < e.xyz.size(); i += 3) {
+                const double dx = got.xyz[i] - e.xyz[i], dy = got.xyz[i + 1] - e.xyz[i + 1], dz = got.xyz[i + 2] - e.xyz[i + 2];
+                worst = std::max(worst, std::sqrt(dx * dx + dy * dy + dz * dz));
+            }
+            EXPECT_LE(worst, 5e-4) << path << " " << decoder;
+        }
+    }
+    EXPECT_GE(files, 10u);
 }

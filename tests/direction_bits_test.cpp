@@ -17,7 +17,6 @@
 #include "fiblet/compress.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/fft_file.hpp"
-#include "fiblet/fiber_ends.hpp"
 #include "fiblet/tck.hpp"
 #include "test_util.hpp"
 
@@ -118,28 +117,19 @@ struct LengthChanges {
 };
 
 // Every fiber's length change in `fft` against `tck`, by brute force (the
-// float64 decode with its ENDS fraction applied as formats/fft-ends.md says).
+// float64 decode, which applies the ENDS fraction as formats/fft-ends.md says).
 LengthChanges length_changes(const std::string& tck, const std::string& fft) {
     const FftFile file(fft);
     const Streamlines s = decode_fibers(file, 0, file.header().fibers);
     const std::string bytes = test::read_file(fft);
     const test::exact::Decoded exact = test::exact::decode(bytes);
-    const std::string ends = test::exact::trailer_chunk(bytes, "ENDS");
-    const std::uint32_t ppb = exact.header.points_per_block;
     TckReader in(tck);
     std::vector<Vec3f> f;
     LengthChanges out;
     for (std::size_t i = 0; in.next(f); ++i) {
         const double li = length_of(&f[0].x, f.size());
         out.fiblet = std::max(out.fiblet, std::fabs(length_of(&s.xyz[3 * s.offsets[i]], s.offsets[i + 1] - s.offsets[i]) - li));
-        std::vector<test::exact::V3> e = exact.fibers[i];
-        if (!ends.empty()) {
-            const auto q = std::uint16_t(std::uint8_t(ends[2 * i]) | std::uint8_t(ends[2 * i + 1]) << 8);
-            const std::size_t last_block = e.size() - ppb * ((e.size() - 1) / ppb);
-            if (q != kWholeLastStep && end_fraction_applies(std::uint32_t(last_block)))
-                e.back() = e[e.size() - 2] + (double(q) / 65535.0) * (e.back() - e[e.size() - 2]);
-        }
-        out.exact = std::max(out.exact, std::fabs(length_of(e) - li));
+        out.exact = std::max(out.exact, std::fabs(length_of(exact.fibers[i]) - li));
     }
     return out;
 }

@@ -169,11 +169,35 @@ inline std::size_t decode_packed_block(const unsigned char* blk, unsigned count,
     return 18 + (15 * (count - 2) + 7) / 8;  // count >= 2 here
 }
 
+// §6: the payload of trailer chunk `tag`, empty when the file has none.
+inline std::string trailer_chunk(const std::string& bytes, const char* tag) {
+    if (bytes.size() < 16 || bytes.compare(bytes.size() - 8, 8, "FIBLETX1") != 0) return {};
+    for (std::size_t at = le<std::uint64_t>(bytes, bytes.size() - 16); at + 16 <= bytes.size() - 16;) {
+        const std::uint64_t size = le<std::uint64_t>(bytes, at + 8);
+        if (bytes.compare(at, 4, tag) == 0) return bytes.substr(at + 16, size);
+        at += 16 + size;
+    }
+    return {};
+}
+
+
+// fft-ends.md: the fiber's last point moved to p_prev + f (p_last - p_prev),
+// f = q / 65535, where the chunk gives q < 65535 and the fiber's last block
+// holds three points or more.
+inline void apply_end(std::vector<V3>& fiber, const std::string& ends, std::uint64_t i, unsigned last_block_points) {
+    if (ends.size() < 2 * (i + 1) || last_block_points < 3 || fiber.size() < 2) return;
+    const unsigned q = unsigned((unsigned char)ends[2 * i]) | unsigned((unsigned char)ends[2 * i + 1]) << 8;
+    if (q == 65535) return;
+    const V3 prev = fiber[fiber.size() - 2], last = fiber.back();
+    fiber.back() = prev + (double(q) / 65535.0) * (last - prev);
+}
+
 // The whole file: fibers in LUT order, points mapped back to millimetres
 // (§2); version 2 with either frame rule.
 inline Decoded decode(const std::string& bytes, FrameRule rule = FrameRule::fiblet) {
     Decoded d;
     Header& h = d.header = read_header(bytes);
+    const std::string ends = trailer_chunk(bytes, "ENDS");
     if (h.version == 17) {
         // fft16.md: 181 levels; the LUT's second word is the fiber's point
         // count; packed blocks follow each other, fiber after fiber.
@@ -186,14 +210,16 @@ inline Decoded decode(const std::string& bytes, FrameRule rule = FrameRule::fibl
             const auto x = le<std::uint32_t>(bytes, lut + 8 * i), points = le<std::uint32_t>(bytes, lut + 8 * i + 4);
             const unsigned count = x & 0xffff;
             normalized.clear();
+            unsigned n = 0;
             for (unsigned b = 0; b < count; ++b) {
-                const unsigned n = b + 1 < count ? h.points_per_block : points - b * h.points_per_block;
+                n = b + 1 < count ? h.points_per_block : points - b * h.points_per_block;
                 if (at + 18 + (n > 2 ? (15 * (n - 2) + 7) / 8 : 0) > bytes.size())
                     throw std::runtime_error("exact decoder: block past the end");
                 at += decode_packed_block(reinterpret_cast<const unsigned char*>(bytes.data()) + at, n, table,
                                           double(h.step), normalized);
             }
             d.fibers.push_back(to_millimetres(normalized, h));
+            apply_end(d.fibers.back(), ends, i, n);
         }
         return d;
     }
@@ -213,19 +239,10 @@ inline Decoded decode(const std::string& bytes, FrameRule rule = FrameRule::fibl
                          rule);
         }
         d.fibers.push_back(to_millimetres(normalized, h));
+        if (count > 0) apply_end(d.fibers.back(), ends, i, bytes[blocks + (first + count - 1) * h.block_bytes() + 16] & 63);
     }
     return d;
 }
 
-// §6: the payload of trailer chunk `tag`, empty when the file has none.
-inline std::string trailer_chunk(const std::string& bytes, const char* tag) {
-    if (bytes.size() < 16 || bytes.compare(bytes.size() - 8, 8, "FIBLETX1") != 0) return {};
-    for (std::size_t at = le<std::uint64_t>(bytes, bytes.size() - 16); at + 16 <= bytes.size() - 16;) {
-        const std::uint64_t size = le<std::uint64_t>(bytes, at + 8);
-        if (bytes.compare(at, 4, tag) == 0) return bytes.substr(at + 16, size);
-        at += 16 + size;
-    }
-    return {};
-}
 
 }  // namespace fiblet::test::exact
