@@ -159,11 +159,10 @@ struct BatchLanes {
             decoded[i] = batch.decoded + (j0 + i) * batch.stride, codes[i] = batch.codes + (j0 + i) * batch.code_stride;
     }
 
-    // The lanes' targets at `where`, minus the point (x, y, z).
-    void target_from(VI where, VF x, VF y, VF z, VF& vx, VF& vy, VF& vz) const {
-        vx = hn::Sub(hn::GatherIndex(d, targets, where), x);
-        vy = hn::Sub(hn::GatherIndex(d, targets + 1, where), y);
-        vz = hn::Sub(hn::GatherIndex(d, targets + 2, where), z);
+    // The lanes' targets at `where`.
+    void target(VI where, VF& x, VF& y, VF& z) const {
+        x = hn::GatherIndex(d, targets, where), y = hn::GatherIndex(d, targets + 1, where);
+        z = hn::GatherIndex(d, targets + 2, where);
     }
     VI next_at() const { return hn::Min(hn::Add(at, hn::Set(hn::RebindToSigned<D>(), 3)), at_end); }
     // Lanes still having a target after step k.

@@ -44,9 +44,9 @@ void GreedyVector(D, const Codebook8& cb, float step, const GreedyBatch& batch, 
     BatchLanes<D> s(batch, j0, active);
     const VF stepv = hn::Set(s.d, step);
     for (std::size_t k = 0; k < s.steps; ++k) {
-        VF vx, vy, vz, x, y, z;
-        s.target_from(s.at, s.px, s.py, s.pz, vx, vy, vz);
-        Lanes::local(s.f, vx, vy, vz, x, y, z);
+        VF tx, ty, tz, x, y, z;
+        s.target(s.at, tx, ty, tz);
+        Lanes::local(s.f, hn::Sub(tx, s.px), hn::Sub(ty, s.py), hn::Sub(tz, s.pz), x, y, z);
         const auto code_k = code.nearest(x, y, z);
         VF l[9], nf[9];
         code.frame(code_k, l);

@@ -56,14 +56,16 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
         return hn::Max(hn::Sub(base, hn::Mul(two_step, dot)), zero);
     };
 
+    // The lanes' targets at point k and k + 1, each gathered once.
+    VF tx, ty, tz, nx, ny, nz;
+    s.target(s.at, tx, ty, tz);
     for (std::size_t k = 0; k < s.steps; ++k) {
         // The aimed code at point k.
-        VF vx, vy, vz, x, y, z;
-        s.target_from(s.at, s.px, s.py, s.pz, vx, vy, vz);
-        Lanes::local(s.f, vx, vy, vz, x, y, z);
+        VF x, y, z;
+        Lanes::local(s.f, hn::Sub(tx, s.px), hn::Sub(ty, s.py), hn::Sub(tz, s.pz), x, y, z);
         const VI aimed = code.nearest(x, y, z);
         const VF base = base_of(x, y, z);
-        const VI next = s.next_at();
+        s.target(s.next_at(), nx, ny, nz);
         // Code c's state after point k (frame l of c given) into nf, q; returns
         // the squared error of the greedy step at point k + 1 from there.
         auto after = [&](const VF* l, VF* nf, VF& qx, VF& qy, VF& qz) {
@@ -71,9 +73,8 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
             qx = hn::Add(s.px, hn::Mul(stepv, nf[0]));
             qy = hn::Add(s.py, hn::Mul(stepv, nf[1]));
             qz = hn::Add(s.pz, hn::Mul(stepv, nf[2]));
-            VF wx, wy, wz, x1, y1, z1, bx, by, bz;
-            s.target_from(next, qx, qy, qz, wx, wy, wz);
-            Lanes::local(nf, wx, wy, wz, x1, y1, z1);
+            VF x1, y1, z1, bx, by, bz;
+            Lanes::local(nf, hn::Sub(nx, qx), hn::Sub(ny, qy), hn::Sub(nz, qz), x1, y1, z1);
             code.direction(code.nearest(x1, y1, z1), bx, by, bz);
             return error2(base_of(x1, y1, z1), bx, by, bz, x1, y1, z1);
         };
@@ -101,7 +102,7 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
             const auto tries = hn::And(more, hn::Lt(e0, best));
             if (hn::AllFalse(d, tries)) continue;
             const VI c = hn::And(hn::ShiftRightSame(words[r / 4], 8 * (r % 4)), code.byte);
-            VF lr[9], rf[9], qx, qy, qz;
+            VF lr[9], rf[9], qx, qy, qz;  // the rival's frame, its state after point k
             code.frame(c, lr);
             const VF total = hn::Add(e0, after(lr, rf, qx, qy, qz));
             const auto tie = hn::And(hn::Eq(total, best), hn::And(rival_won, hn::Lt(e0, best_e0)));
@@ -110,13 +111,20 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
             best_e0 = hn::IfThenElse(wins, e0, best_e0);
             rival_won = hn::Or(rival_won, wins);
             win_code = hn::IfThenElse(hn::RebindMask(di, wins), c, win_code);
-            for (int j = 0; j < 9; ++j) win_f[j] = hn::IfThenElse(wins, rf[j], win_f[j]);
-            win_x = hn::IfThenElse(wins, qx, win_x), win_y = hn::IfThenElse(wins, qy, win_y);
-            win_z = hn::IfThenElse(wins, qz, win_z);
+        }
+        // A rival won in some lane: the winners' states again (the same
+        // operations give the same bits), rather than blending every rival's.
+        if (!hn::AllFalse(d, rival_won)) {
+            code.frame(win_code, l);
+            Lanes::compose(s.f, l, win_f);
+            win_x = hn::Add(s.px, hn::Mul(stepv, win_f[0]));
+            win_y = hn::Add(s.py, hn::Mul(stepv, win_f[1]));
+            win_z = hn::Add(s.pz, hn::Mul(stepv, win_f[2]));
         }
         for (int j = 0; j < 9; ++j) s.f[j] = win_f[j];
         s.px = win_x, s.py = win_y, s.pz = win_z;
         s.store(k, win_code);
+        tx = nx, ty = ny, tz = nz;
     }
 }
 
