@@ -83,6 +83,7 @@ private:
     float length_stretch_ = 0;
     bool length_tails_only_ = false;
     std::shared_ptr<const Tables> tables_;
+    static std::shared_ptr<const Tables> shared_tables(unsigned bits, float ratio, unsigned levels);
 };
 
 // Ratio of the direction code for a file: E = scaling / 2^16 (anchor

@@ -1,6 +1,8 @@
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <optional>
+#include <vector>
 
 #include "codec/anchor_conditioning.hpp"
 #include "codec/code_search.hpp"
@@ -168,16 +170,44 @@ FiberEncoder::FiberEncoder(const FftHeader& header, SearchOptions search) : head
     if (search_.retry_beam_width > 64 || search_.retry_radius < 1 || search_.retry_radius > 3 ||
         !(search_.retry_error_mm >= 0))
         throw Error(Errc::invalid_argument, "retry beam width must be in [0, 64], its radius in [1, 3]");
+    tables_ = shared_tables(header_.direction_bits(), header_.ratio, header_.code_levels());
+}
+
+// The tables of (bits, ratio, levels), shared by the encoders that use
+// them: tuning builds encoders of the same few caps again and again, and
+// the 8-bit lookup alone costs about 12 M instructions (small-ifod1's first
+// 600 fibers: 14 % of a compress). The last kKept 8-bit tables (about 0.2 MB
+// each) stay built; 16-bit ones (7 MB) only while an encoder holds them.
+std::shared_ptr<const FiberEncoder::Tables> FiberEncoder::shared_tables(unsigned bits, float ratio, unsigned levels) {
+    constexpr std::size_t kKept = 12;
+    struct Entry {
+        unsigned bits;
+        float ratio;
+        unsigned levels;
+        std::shared_ptr<const Tables> kept;  // 8-bit
+        std::weak_ptr<const Tables> tables;
+    };
+    static std::mutex mutex;
+    static std::vector<Entry> cache;  // oldest first
+    const std::lock_guard<std::mutex> lock(mutex);
+    std::erase_if(cache, [](const Entry& e) { return e.tables.expired(); });
+    for (const Entry& e : cache)
+        if (e.bits == bits && e.ratio == ratio && e.levels == levels)
+            if (auto t = e.tables.lock()) return t;
     auto t = std::make_shared<Tables>();
-    if (header_.direction_bits() == 16) {
-        t->table16.emplace(header_.ratio, header_.code_levels());
-        t->exact16.emplace(header_.ratio, header_.code_levels());
+    if (bits == 16) {
+        t->table16.emplace(ratio, levels);
+        t->exact16.emplace(ratio, levels);
     } else {
-        t->table8.emplace(header_.ratio);
+        t->table8.emplace(ratio);
         t->lut8.emplace(*t->table8);
-        t->exact8.emplace(header_.ratio);
+        t->exact8.emplace(ratio);
     }
-    tables_ = std::move(t);
+    const auto kept = std::count_if(cache.begin(), cache.end(), [](const Entry& e) { return e.kept != nullptr; });
+    if (bits != 16 && std::size_t(kept) >= kKept)
+        std::find_if(cache.begin(), cache.end(), [](const Entry& e) { return e.kept != nullptr; })->kept.reset();
+    cache.push_back({bits, ratio, levels, bits == 16 ? nullptr : t, t});
+    return t;
 }
 
 FiberEncoder FiberEncoder::with_step(float step) const {
