@@ -30,10 +30,13 @@ constexpr double kDivergenceWeight = 0.1;
 // How many quanta the second anchor may move to leave the fallback's cone.
 constexpr int kFallbackQuanta = 4;
 
-// Whether fiblet's float decoders build this start's frame with the C'
-// fallback (formats/fft.md §4), which the original decoder lacks: it would
-// turn the whole block about its first axis. Version-2 blocks never start so.
-bool uses_fallback(const DecoderStarts& s) { return frame_uses_fallback(anchor_axis(s.a0, s.a1)); }
+// Whether fiblet's float decoders or an exact one build this start's frame
+// with the C' fallback (formats/fft.md §4), which the original decoder
+// lacks: it would turn the whole block about its first axis. Version-2
+// blocks never start so.
+bool uses_fallback(const DecoderStarts& s) {
+    return frame_uses_fallback(anchor_axis(s.a0, s.a1)) || exact_frame_uses_fallback(exact_block_axis(s.exact0, s.exact1));
+}
 
 double unorm16_value(double n) { return std::clamp(n, 0.0, 1.0) * 65535.0; }
 

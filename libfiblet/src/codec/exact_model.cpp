@@ -11,18 +11,25 @@ Vec3d unit(Vec3d a) { return (1.0 / std::sqrt(dot(a, a))) * a; }
 
 }  // namespace
 
+bool exact_frame_uses_fallback(Vec3d axis) {
+    const Vec3d c1 = cross(axis, Vec3d{kFrameHelper[0], kFrameHelper[1], kFrameHelper[2]});
+    return dot(c1, c1) < 1e-6;
+}
+
 FrameD exact_frame_from_axis(Vec3d axis) {
     const Vec3d helper{kFrameHelper[0], kFrameHelper[1], kFrameHelper[2]};
     Vec3d c1 = cross(axis, helper);
-    if (dot(c1, c1) < 1e-6) c1 = cross(axis, Vec3d{0.0, helper.z, -helper.y});
+    if (exact_frame_uses_fallback(axis)) c1 = cross(axis, Vec3d{0.0, helper.z, -helper.y});
     c1 = unit(c1);
     return {{axis, c1, unit(cross(axis, c1))}};
 }
 
-FrameD exact_block_frame(Vec3d a0, Vec3d a1) {
+Vec3d exact_block_axis(Vec3d a0, Vec3d a1) {
     const Vec3d d = a1 - a0;
-    return exact_frame_from_axis(dot(d, d) > 0 ? unit(d) : Vec3d{1, 0, 0});
+    return dot(d, d) > 0 ? unit(d) : Vec3d{1, 0, 0};
 }
+
+FrameD exact_block_frame(Vec3d a0, Vec3d a1) { return exact_frame_from_axis(exact_block_axis(a0, a1)); }
 
 Vec3d apply(const FrameD& f, Vec3d v) { return v.x * f.c[0] + v.y * f.c[1] + v.z * f.c[2]; }
 Vec3d apply_transposed(const FrameD& f, Vec3d v) { return {dot(f.c[0], v), dot(f.c[1], v), dot(f.c[2], v)}; }

@@ -43,9 +43,13 @@ struct FrameD {
 
 // frame_from_axis (formats/fft.md §4) in double, with the same fallback helper.
 FrameD exact_frame_from_axis(Vec3d unit_axis);
+// Whether that takes the fallback helper (|axis x C|^2 < 1e-6 in double).
+bool exact_frame_uses_fallback(Vec3d unit_axis);
 // The first frame of a block from its anchors (normalized, exact unorm
 // values); coinciding anchors give the +x axis, as in every decoder.
 FrameD exact_block_frame(Vec3d anchor0, Vec3d anchor1);
+// Its axis: the unit first segment, (1, 0, 0) when the anchors coincide.
+Vec3d exact_block_axis(Vec3d anchor0, Vec3d anchor1);
 
 // F * v, F^T * v, F * L.
 Vec3d apply(const FrameD& f, Vec3d v);
