@@ -345,9 +345,9 @@ void FiberEncoder::Encoding::search_blocks() {
         // nothing from lanes: their nearest-code search is branchy and dominates.
         const std::size_t full = n_points / ppb, rest = n_points % ppb;
         const std::size_t blocks = rest > 2 ? full + 1 : full;
-        const GreedyBatch batch{&s.frames[0], &s.points[1], &s.targets[2], &s.points[2], ppb, codes8_of(0), bb, blocks,
-                                ppb - 2, rest > 2 ? rest - 2 : ppb - 2};
-        if (blocks > 0 && ppb > 2) {
+        if (blocks > 0 && ppb > 2) {  // then every pointer below is inside its vector
+            const GreedyBatch batch{&s.frames[0], &s.points[1], &s.targets[2], &s.points[2], ppb, codes8_of(0), bb,
+                                    blocks, ppb - 2, rest > 2 ? rest - 2 : ppb - 2};
             if (search().lookahead > 0) lookahead_blocks(codebook8(), h.step, search().lookahead, batch);
             else greedy_blocks(codebook8(), h.step, batch);
         }
