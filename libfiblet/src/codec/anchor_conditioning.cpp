@@ -30,14 +30,6 @@ constexpr double kDivergenceWeight = 0.1;
 // How many quanta the second anchor may move to leave the fallback's cone.
 constexpr int kFallbackQuanta = 4;
 
-// Whether fiblet's float decoders or an exact one build this start's frame
-// with the C' fallback (formats/fft.md §4), which the original decoder
-// lacks: it would turn the whole block about its first axis. Version-2
-// blocks never start so.
-bool uses_fallback(const DecoderStarts& s) {
-    return frame_uses_fallback(anchor_axis(s.a0, s.a1)) || exact_frame_uses_fallback(exact_block_axis(s.exact0, s.exact1));
-}
-
 double unorm16_value(double n) { return std::clamp(n, 0.0, 1.0) * 65535.0; }
 
 // The larger of the two anchors' distances to where they should be.
@@ -52,9 +44,12 @@ DecoderStarts decoder_starts(const AnchorWords& w) {
     DecoderStarts s;
     s.words = w;
     s.a0 = to_float(float_anchor(w.a0)), s.a1 = to_float(float_anchor(w.a1));
-    s.frame = frame_from_axis(anchor_axis(s.a0, s.a1));
+    const Vec3f axis = anchor_axis(s.a0, s.a1);
+    s.frame = frame_from_axis(axis);
     s.exact0 = exact_anchor(w.a0), s.exact1 = exact_anchor(w.a1);
-    s.exact_frame = exact_block_frame(s.exact0, s.exact1);
+    const Vec3d exact_axis = exact_block_axis(s.exact0, s.exact1);
+    s.exact_frame = exact_frame_from_axis(exact_axis);
+    s.fallback = frame_uses_fallback(axis) || exact_frame_uses_fallback(exact_axis);
     return s;
 }
 
@@ -81,12 +76,12 @@ DecoderStarts condition_anchors(Vec3d n0, Vec3d n1, double reach, double thresho
     };
     DecoderStarts best = decoder_starts(words(0, true));
     best.divergence = start_divergence(best, reach);
-    bool fallback = uses_fallback(best);
+    bool fallback = best.fallback;
     if (!(best.divergence > threshold) && !fallback) return best;
     double best_cost = fallback ? INFINITY : anchor_error(best.words, n0, n1) + kDivergenceWeight * best.divergence;
     auto offer = [&](const AnchorWords& w) {
         DecoderStarts s = decoder_starts(w);
-        if (uses_fallback(s)) return;
+        if (s.fallback) return;
         s.divergence = start_divergence(s, reach);
         const double cost = anchor_error(s.words, n0, n1) + kDivergenceWeight * s.divergence;
         if (cost < best_cost) best_cost = cost, best = s, fallback = false;
@@ -97,6 +92,7 @@ DecoderStarts condition_anchors(Vec3d n0, Vec3d n1, double reach, double thresho
     // turns by 1.7 degrees a quantum of a 200 mm box, the fallback's cone is 0.06).
     for (int q = 1; fallback && q <= kFallbackQuanta; ++q)
         for (int i = 0; i < 27; ++i) {
+            if (i == 13) continue;  // no move: the nearest rounding, refused above
             AnchorWords w = words(0, true);
             for (int a = 0, code = i; a < 3; ++a, code /= 3)
                 w.a1[a] = std::uint32_t(std::clamp<std::int64_t>(std::int64_t(w.a1[a]) + (code % 3 - 1) * q, 0, 65535));

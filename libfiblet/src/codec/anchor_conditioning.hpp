@@ -24,6 +24,9 @@ struct DecoderStarts {
     Vec3d exact0, exact1;  // an exact decoder
     FrameD exact_frame;
     double divergence = 0;  // start_divergence over the block's reach (condition_anchors)
+    // Either frame took the C' fallback (formats/fft.md §4), which the
+    // original decoder lacks: it would turn the whole block about its axis.
+    bool fallback = false;
 };
 DecoderStarts decoder_starts(const AnchorWords& w);
 
@@ -52,8 +55,8 @@ inline double walk_divergence(std::size_t m, double step) {
 // an anchor by less than one quantum turns the first axis away from C or
 // changes its float rounding; the robust code search (code_search.hpp)
 // then splits what divergence remains between the two decoders.
-// A start whose float frame would take the C' fallback (which the original
-// decoder lacks, formats/fft.md §4) is never kept: the second anchor moves
+// A start whose float or exact frame would take the C' fallback (which the
+// original decoder lacks, formats/fft.md §4) is never kept: the second anchor moves
 // by up to a few quanta until the first axis leaves the fallback's cone.
 // Returns the chosen words with both decoders' starts and their divergence.
 DecoderStarts condition_anchors(Vec3d n0, Vec3d n1, double reach, double threshold);

@@ -92,15 +92,18 @@ struct CodeLanes {
         return hn::IfThenElse(no_lateral, behind, looked_up);
     }
 
+    // Where the code's frame starts in the table, in floats: code * 9.
+    static VI frame_at(VI code) { return hn::Add(hn::ShiftLeft<3>(code), code); }
+
     // The code's frame (its first column is its direction).
     void frame(VI code, VF* l) const {
-        const VI at = hn::Add(hn::ShiftLeft<3>(code), code);  // code * 9
+        const VI at = frame_at(code);
         for (int j = 0; j < 9; ++j) l[j] = hn::GatherIndex(d, code_frames + j, at);
     }
 
     // The code's direction (its frame's first column).
     void direction(VI code, VF& x, VF& y, VF& z) const {
-        const VI at = hn::Add(hn::ShiftLeft<3>(code), code);
+        const VI at = frame_at(code);
         x = hn::GatherIndex(d, code_frames, at), y = hn::GatherIndex(d, code_frames + 1, at);
         z = hn::GatherIndex(d, code_frames + 2, at);
     }

@@ -9,17 +9,16 @@ namespace {
 Vec3d cross(Vec3d a, Vec3d b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 Vec3d unit(Vec3d a) { return (1.0 / std::sqrt(dot(a, a))) * a; }
 
+const Vec3d kHelper{kFrameHelper[0], kFrameHelper[1], kFrameHelper[2]};
+bool needs_fallback(Vec3d c1) { return dot(c1, c1) < 1e-6; }
+
 }  // namespace
 
-bool exact_frame_uses_fallback(Vec3d axis) {
-    const Vec3d c1 = cross(axis, Vec3d{kFrameHelper[0], kFrameHelper[1], kFrameHelper[2]});
-    return dot(c1, c1) < 1e-6;
-}
+bool exact_frame_uses_fallback(Vec3d axis) { return needs_fallback(cross(axis, kHelper)); }
 
 FrameD exact_frame_from_axis(Vec3d axis) {
-    const Vec3d helper{kFrameHelper[0], kFrameHelper[1], kFrameHelper[2]};
-    Vec3d c1 = cross(axis, helper);
-    if (exact_frame_uses_fallback(axis)) c1 = cross(axis, Vec3d{0.0, helper.z, -helper.y});
+    Vec3d c1 = cross(axis, kHelper);
+    if (needs_fallback(c1)) c1 = cross(axis, Vec3d{0.0, kHelper.z, -kHelper.y});
     c1 = unit(c1);
     return {{axis, c1, unit(cross(axis, c1))}};
 }

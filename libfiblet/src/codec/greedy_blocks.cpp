@@ -192,6 +192,13 @@ void scalar_blocks(const Codebook8& cb, float step, const GreedyBatch& batch, st
 
 }  // namespace
 
+bool lanes_can_take(const Codebook8& cb, const GreedyBatch& batch) {
+    // The lanes address a vector's points with 32-bit offsets (3 floats a point).
+    const bool offsets_fit = batch.stride <= std::size_t(INT_MAX) / 3 / 32 && batch.m <= batch.stride;
+    const bool lengths = batch.m > 0 && batch.last_m > 0 && batch.last_m <= batch.m;
+    return cb.lut.usable() && lengths && offsets_fit;
+}
+
 void require_simd_level(SimdLevel level) {
     if (!simd_level_supported(level))
         throw Error(Errc::invalid_argument, std::string("SIMD level ") + simd_level_name(level) +
@@ -247,11 +254,7 @@ void greedy_blocks(const Codebook8& cb, float step, const GreedyBatch& batch, Si
     require_simd_level(level);
     if (batch.blocks == 0) return;
     std::size_t done = 0;
-    // The lanes address a vector's points with 32-bit offsets (3 floats a point).
-    const bool offsets_fit = batch.stride <= std::size_t(INT_MAX) / 3 / 32 && batch.m <= batch.stride;
-    const bool lengths = batch.m > 0 && batch.last_m > 0 && batch.last_m <= batch.m;
-    if (const VectorSearch search = vector_search(level); search && cb.lut.usable() && lengths && offsets_fit)
-        done = search(cb, step, batch);
+    if (const VectorSearch search = vector_search(level); search && lanes_can_take(cb, batch)) done = search(cb, step, batch);
     scalar_blocks(cb, step, batch, done);
 }
 

@@ -55,6 +55,10 @@ struct GreedyBatch {
     std::size_t last_m;
 };
 
+// Whether the SIMD lanes can search this batch: the lookup table is usable,
+// the block lengths are as described above and the offsets fit 32 bits.
+bool lanes_can_take(const Codebook8& cb, const GreedyBatch& batch);
+
 // search_codes(cb, beam 1, ...) for every block of the batch, at simd_level()
 // (the scalar GreedyLanes where the lookup table is not usable).
 void greedy_blocks(const Codebook8& cb, float step, const GreedyBatch& batch);

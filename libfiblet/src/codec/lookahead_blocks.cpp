@@ -190,10 +190,7 @@ void lookahead_blocks(const Codebook8& cb, float step, std::size_t depth, const 
     require_simd_level(level);
     if (batch.blocks == 0) return;
     std::size_t done = 0;
-    // The lanes address a vector's points with 32-bit offsets (3 floats a point).
-    const bool offsets_fit = batch.stride <= std::size_t(INT_MAX) / 3 / 32 && batch.m <= batch.stride;
-    const bool lengths = batch.m > 0 && batch.last_m > 0 && batch.last_m <= batch.m;
-    if (const VectorSearch search = vector_search(level); depth == 1 && search && cb.lut.usable() && lengths && offsets_fit)
+    if (const VectorSearch search = vector_search(level); depth == 1 && search && lanes_can_take(cb, batch))
         done = search(cb, step, batch);
     scalar_blocks(cb, step, depth, batch, done);
 }
