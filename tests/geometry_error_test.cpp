@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "fiblet/geometry_error.hpp"
-#include "stats/geometry_shortcut.hpp"
+#include "stats/geometry_paths.hpp"
 
 namespace fiblet {
 namespace {
@@ -183,7 +183,7 @@ TEST(GeometryError, MergeEqualsOneAccumulator) {
 // evaluates a window ahead of the hint), from 1 to 400 points, with repeated
 // points (zero-length segments) and decoded points about 1 to 30 µm off (codec errors; the window is a
 // heuristic: decoded points half a step off can miss the nearest segment).
-TEST(GeometryError, MatchesBruteForceOnFixedStepPairs) {
+std::vector<std::pair<Line, Line>> fixed_step_pairs() {
     std::mt19937 rng(17);
     std::vector<std::pair<Line, Line>> pairs;
     for (int k = 0; k < 40; ++k) {
@@ -195,17 +195,12 @@ TEST(GeometryError, MatchesBruteForceOnFixedStepPairs) {
         for (Vec3f& p : dec) p = {float(p.x + e(rng)), float(p.y + e(rng)), float(p.z + e(rng))};
         pairs.emplace_back(in, dec);
     }
-    expect_matches_brute(pairs);
+    return pairs;
 }
 
-// Fixed-step pairs where a point's two own segments are not provably the
-// nearest (the shortcut of geometry_error.cpp): fibers that fold back by up
-// to 178 degrees, repeated points, decoded points up to 40 % of a step off.
-// The shortcut must give the full window's figures bit for bit (the window
-// itself is a heuristic: folded fibers can fool it, so brute force is not
-// the reference here), and must be taken on most points of well-behaved
-// fixed-step fibers, where both match brute force (previous test).
-TEST(GeometryError, ShortcutEqualsTheWindowOnFoldedFixedStepPairs) {
+TEST(GeometryError, MatchesBruteForceOnFixedStepPairs) { expect_matches_brute(fixed_step_pairs()); }
+
+std::vector<std::pair<Line, Line>> folded_pairs() {
     std::mt19937 rng(23);
     std::uniform_real_distribution<double> turn(100, 178);
     std::vector<std::pair<Line, Line>> pairs;
@@ -225,22 +220,67 @@ TEST(GeometryError, ShortcutEqualsTheWindowOnFoldedFixedStepPairs) {
         for (Vec3f& p : dec) p = {float(p.x + e(rng)), float(p.y + e(rng)), float(p.z + e(rng))};
         pairs.emplace_back(in, dec);
     }
-    auto measure = [&](bool shortcut) {
-        detail::geometry_shortcut_enabled() = shortcut;
-        GeometryError g;
-        for (std::size_t i = 0; i < pairs.size(); ++i) g.add_fiber(pairs[i].first, pairs[i].second, i);
-        detail::geometry_shortcut_enabled() = true;
-        return g;
-    };
-    const GeometryError with = measure(true), without = measure(false);
+    return pairs;
+}
+
+GeometryError measure_pairs(const std::vector<std::pair<Line, Line>>& pairs) {
+    GeometryError g;
+    for (std::size_t i = 0; i < pairs.size(); ++i) g.add_fiber(pairs[i].first, pairs[i].second, i);
+    return g;
+}
+
+void expect_same_bits(const GeometryError& a, const GeometryError& b) {
     for (auto pick : {&GeometryError::decoded_to_input, &GeometryError::input_to_decoded}) {
-        const ErrorStats &a = (with.*pick)(), &b = (without.*pick)();
-        EXPECT_EQ(a.max_mm(), b.max_mm());
-        EXPECT_EQ(a.mean_mm(), b.mean_mm());
-        EXPECT_EQ(a.rms_mm(), b.rms_mm());
-        EXPECT_EQ(a.percentile_mm(50), b.percentile_mm(50));
-        EXPECT_EQ(a.worst_fiber(), b.worst_fiber());
+        const ErrorStats &x = (a.*pick)(), &y = (b.*pick)();
+        EXPECT_EQ(x.count(), y.count());
+        EXPECT_EQ(x.max_mm(), y.max_mm());
+        EXPECT_EQ(x.mean_mm(), y.mean_mm());
+        EXPECT_EQ(x.rms_mm(), y.rms_mm());
+        EXPECT_EQ(x.percentile_mm(50), y.percentile_mm(50));
+        EXPECT_EQ(x.worst_fiber(), y.worst_fiber());
     }
+    EXPECT_EQ(a.endpoint_mm().max, b.endpoint_mm().max);
+    EXPECT_EQ(a.length_change_mm().sum, b.length_change_mm().sum);
+    EXPECT_EQ(a.mean_length_change_mm(), b.mean_length_change_mm());
+}
+
+// Fixed-step pairs where a point's two own segments are not provably the
+// nearest (the shortcut of geometry_error.cpp): fibers that fold back by up
+// to 178 degrees, repeated points, decoded points up to 40 % of a step off.
+// The shortcut must give the full window's figures bit for bit (the window
+// itself is a heuristic: folded fibers can fool it, so brute force is not
+// the reference here), and must be taken on most points of well-behaved
+// fixed-step fibers, where both match brute force (previous test).
+TEST(GeometryError, ShortcutEqualsTheWindowOnFoldedFixedStepPairs) {
+    const auto pairs = folded_pairs();
+    const GeometryError with = measure_pairs(pairs);
+    detail::geometry_shortcut_enabled() = false;
+    const GeometryError without = measure_pairs(pairs);
+    detail::geometry_shortcut_enabled() = true;
+    expect_same_bits(with, without);
+}
+
+// The AVX2 loops (columns, the fixed-step shortcut's proof, the windows,
+// square roots) give the scalar loops' figures bit for bit, on fixed-step
+// pairs (shortcut taken or not), folded ones and pairs of different point
+// counts; where the CPU has no AVX2 both runs take the scalar loops.
+TEST(GeometryError, VectorsEqualScalarLoops) {
+    std::mt19937 rng(31);
+    std::vector<std::pair<Line, Line>> pairs = fixed_step_pairs(), folded = folded_pairs();
+    pairs.insert(pairs.end(), folded.begin(), folded.end());
+    for (int k = 0; k < 10; ++k) {
+        const Line in = curve(30 + k * 7, 0.1 * (1 + k % 3), 0, rng, 0);
+        pairs.emplace_back(in, curve(int(in.size()) * (1 + k % 4), 0.1 * (1 + k % 3) / (1 + k % 4), 0, rng, 0.003));
+    }
+    for (const bool shortcut : {true, false}) {
+        detail::geometry_shortcut_enabled() = shortcut;
+        const GeometryError vectors = measure_pairs(pairs);
+        detail::geometry_vectors_enabled() = false;
+        const GeometryError scalar = measure_pairs(pairs);
+        detail::geometry_vectors_enabled() = true;
+        expect_same_bits(vectors, scalar);
+    }
+    detail::geometry_shortcut_enabled() = true;
 }
 
 }  // namespace

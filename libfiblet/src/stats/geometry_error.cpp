@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -13,7 +14,7 @@
 #endif
 
 #include "core/vec_math.hpp"
-#include "stats/geometry_shortcut.hpp"
+#include "stats/geometry_paths.hpp"
 
 namespace fiblet {
 
@@ -21,17 +22,43 @@ using detail::distance;
 
 namespace {
 
-// The segments of the polyline measured against, as columns (start,
-// direction, inverse squared length), computed once per fiber: the window
-// of segments a point is measured against is evaluated as one vectorizable
-// loop. The polyline's length comes with them (the same double arithmetic
-// and order as polyline_length).
+// The segments of a polyline as columns (start, direction, inverse squared
+// length, length), computed once per fiber: the window of segments a point
+// is measured against is evaluated as one vectorizable loop, and the points
+// of a fixed-step pair are read from their own polyline's columns. The
+// polyline's length comes with them (the same double arithmetic and order
+// as polyline_length).
 constexpr std::size_t kLanes = 8;
 
-// v[i] = sqrt(v[i]), two at a time where SSE2 is there (sqrtpd rounds
+#if defined(__GNUC__) && defined(__x86_64__)
+#define FIBLET_GEOMETRY_AVX2 1
+#define FIBLET_AVX2 __attribute__((target("avx2"))) inline
+#endif
+
+bool have_avx2() {
+#ifdef FIBLET_GEOMETRY_AVX2
+    static const bool yes = __builtin_cpu_supports("avx2");
+    return yes && detail::geometry_vectors_enabled();
+#else
+    return false;
+#endif
+}
+
+#ifdef FIBLET_GEOMETRY_AVX2
+__attribute__((target("avx2"))) std::size_t sqrt_avx2(double* v, std::size_t n) {
+    std::size_t i = 0;
+    for (; i + 4 <= n; i += 4) _mm256_storeu_pd(v + i, _mm256_sqrt_pd(_mm256_loadu_pd(v + i)));
+    return i;
+}
+#endif
+
+// v[i] = sqrt(v[i]), four or two at a time (vsqrtpd and sqrtpd round
 // correctly, as std::sqrt does).
 void sqrt_all(double* v, std::size_t n) {
     std::size_t i = 0;
+#ifdef FIBLET_GEOMETRY_AVX2
+    if (have_avx2()) i = sqrt_avx2(v, n);
+#endif
 #ifdef __SSE2__
     for (; i + 2 <= n; i += 2) _mm_storeu_pd(v + i, _mm_sqrt_pd(_mm_loadu_pd(v + i)));
 #endif
@@ -52,19 +79,6 @@ struct Segments {
     std::size_t count = 0;  // segments (the columns hold kLanes padding segments more)
     double length = 0;
 };
-
-#if defined(__GNUC__) && defined(__x86_64__)
-#define FIBLET_GEOMETRY_AVX2 1
-#endif
-
-bool have_avx2() {
-#ifdef FIBLET_GEOMETRY_AVX2
-    static const bool yes = __builtin_cpu_supports("avx2");
-    return yes;
-#else
-    return false;
-#endif
-}
 
 // From squared lengths uu (in len): inv[i] = uu > 0 ? 1 / uu : 0, then
 // len[i] = sqrt(uu), four at a time with AVX2 (vdivpd and vsqrtpd round
@@ -101,12 +115,22 @@ inline double segment_dist2(const Segments& g, double px, double py, double pz, 
 }
 
 #ifdef FIBLET_GEOMETRY_AVX2
-#define FIBLET_AVX2 __attribute__((target("avx2"))) inline
 FIBLET_AVX2 __m256d column(const std::vector<double>& c, std::size_t s) { return _mm256_loadu_pd(c.data() + s); }
 
-// Coordinate c (0, 1, 2) of points k .. k + 3, in double.
-FIBLET_AVX2 __m256d coordinate(std::span<const Vec3f> v, std::size_t k, int c) {
-    return _mm256_cvtps_pd(_mm_i32gather_ps(&v[k].x + c, _mm_setr_epi32(0, 3, 6, 9), 4));
+// Lanes idx of v, the low four.
+FIBLET_AVX2 __m128 pick(__m256 v, __m256i idx) { return _mm256_castps256_ps128(_mm256_permutevar8x32_ps(v, idx)); }
+
+// Points p .. p + 3 as columns of doubles (exact: float to double), from
+// two overlapping loads of their 12 floats instead of gathers.
+FIBLET_AVX2 void xyz4(const Vec3f* p, __m256d& x, __m256d& y, __m256d& z) {
+    const float* f = &p->x;
+    const __m256 lo = _mm256_loadu_ps(f), hi = _mm256_loadu_ps(f + 4);  // floats 0..7 and 4..11
+    x = _mm256_cvtps_pd(_mm_blend_ps(pick(lo, _mm256_setr_epi32(0, 3, 6, 0, 0, 0, 0, 0)),
+                                     pick(hi, _mm256_setr_epi32(0, 0, 0, 5, 0, 0, 0, 0)), 0b1000));
+    y = _mm256_cvtps_pd(_mm_blend_ps(pick(lo, _mm256_setr_epi32(1, 4, 7, 0, 0, 0, 0, 0)),
+                                     pick(hi, _mm256_setr_epi32(0, 0, 0, 6, 0, 0, 0, 0)), 0b1000));
+    z = _mm256_cvtps_pd(_mm_blend_ps(pick(lo, _mm256_setr_epi32(2, 5, 0, 0, 0, 0, 0, 0)),
+                                     pick(hi, _mm256_setr_epi32(0, 0, 4, 7, 0, 0, 0, 0)), 0b1100));
 }
 
 // segment_dist2 of the points (x, y, z) to segments s .. s + 3: the same
@@ -130,54 +154,68 @@ FIBLET_AVX2 void window_avx2(const Segments& g, double px, double py, double pz,
     for (std::size_t h = 0; h < kLanes; h += 4) _mm256_storeu_pd(d + h, segment_dist2_avx2(g, x, y, z, base + h));
 }
 
-// segments_of's columns for segments [0, s) four at a time (the same
-// double operations); returns s, the segments left to the scalar loop.
-__attribute__((target("avx2"))) std::size_t segment_columns_avx2(std::span<const Vec3f> line, std::size_t n,
-                                                                 Segments& out) {
+// Points [0, m) into the columns, four at a time; returns the points left
+// to the scalar loop.
+__attribute__((target("avx2"))) std::size_t point_columns_avx2(const Vec3f* p, std::size_t m, Segments& out) {
+    std::size_t i = 0;
+    for (; i + 4 <= m; i += 4) {
+        __m256d x, y, z;
+        xyz4(p + i, x, y, z);
+        _mm256_storeu_pd(out.ax.data() + i, x), _mm256_storeu_pd(out.ay.data() + i, y), _mm256_storeu_pd(out.az.data() + i, z);
+    }
+    return i;
+}
+
+// Directions and squared lengths of segments [0, s) from the point columns,
+// four at a time (the same double operations as the scalar loop); returns s.
+__attribute__((target("avx2"))) std::size_t directions_avx2(Segments& g, std::size_t n) {
     std::size_t s = 0;
-    for (; s + 4 <= n && s + 4 < line.size(); s += 4) {
-        for (int c = 0; c < 3; ++c) {
-            const __m256d a = coordinate(line, s, c), d = _mm256_sub_pd(coordinate(line, s + 1, c), a);
-            _mm256_storeu_pd((c == 0 ? out.ax : c == 1 ? out.ay : out.az).data() + s, a);
-            _mm256_storeu_pd((c == 0 ? out.ux : c == 1 ? out.uy : out.uz).data() + s, d);
-        }
-        const __m256d dx = column(out.ux, s), dy = column(out.uy, s), dz = column(out.uz, s);
-        _mm256_storeu_pd(out.len.data() + s, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)),
-                                                           _mm256_mul_pd(dz, dz)));
+    for (; s + 4 <= n; s += 4) {
+        const __m256d dx = _mm256_sub_pd(column(g.ax, s + 1), column(g.ax, s)),
+                      dy = _mm256_sub_pd(column(g.ay, s + 1), column(g.ay, s)),
+                      dz = _mm256_sub_pd(column(g.az, s + 1), column(g.az, s));
+        _mm256_storeu_pd(g.ux.data() + s, dx), _mm256_storeu_pd(g.uy.data() + s, dy), _mm256_storeu_pd(g.uz.data() + s, dz);
+        _mm256_storeu_pd(g.len.data() + s, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)),
+                                                         _mm256_mul_pd(dz, dz)));
     }
     return s;
 }
 #endif
 
+// A non-empty polyline's columns.
 void segments_of(std::span<const Vec3f> line, Segments& out) {
-    const std::size_t n = line.size() > 1 ? line.size() - 1 : 1;  // a single point: one degenerate segment
+    const std::size_t points = line.size(), n = points > 1 ? points - 1 : 1;  // a single point: one degenerate segment
     double *ax = at_least(out.ax, n + kLanes), *ay = at_least(out.ay, n + kLanes), *az = at_least(out.az, n + kLanes);
     double *ux = at_least(out.ux, n + kLanes), *uy = at_least(out.uy, n + kLanes), *uz = at_least(out.uz, n + kLanes);
     double *inv = at_least(out.inv_uu, n + kLanes), *len = at_least(out.len, n);
-    std::size_t s = 0;
+    // The points (segment s runs from point s to point s + 1).
+    std::size_t i = 0, s = 0;
 #ifdef FIBLET_GEOMETRY_AVX2
-    if (have_avx2()) s = segment_columns_avx2(line, n, out);
+    if (have_avx2()) i = point_columns_avx2(line.data(), points, out);
+#endif
+    for (; i < points; ++i) ax[i] = line[i].x, ay[i] = line[i].y, az[i] = line[i].z;
+#ifdef FIBLET_GEOMETRY_AVX2
+    if (have_avx2() && points > 1) s = directions_avx2(out, n);
 #endif
     for (; s < n; ++s) {
-        const Vec3f a = line[s], b = line[std::min(s + 1, line.size() - 1)];
-        const double dx = double(b.x) - a.x, dy = double(b.y) - a.y, dz = double(b.z) - a.z;
-        ax[s] = a.x, ay[s] = a.y, az[s] = a.z;
+        const std::size_t e = std::min(s + 1, points - 1);
+        const double dx = ax[e] - ax[s], dy = ay[e] - ay[s], dz = az[e] - az[s];
         ux[s] = dx, uy[s] = dy, uz[s] = dz;
         len[s] = dx * dx + dy * dy + dz * dz;
     }
     // kLanes padding segments far away (their squared distance is +inf,
     // never a nearest one), so a window of up to kLanes segments is always
     // evaluated whole.
-    for (std::size_t s = n; s < n + kLanes; ++s) {
-        ax[s] = ay[s] = az[s] = 1e300;
-        ux[s] = uy[s] = uz[s] = inv[s] = 0.0;
+    for (std::size_t p = n; p < n + kLanes; ++p) {
+        ax[p] = ay[p] = az[p] = 1e300;
+        ux[p] = uy[p] = uz[p] = inv[p] = 0.0;
     }
     // The inverse squared lengths, and the lengths (the same double
     // arithmetic and order as polyline_length).
     inverses_and_roots(len, inv, n);
     double length = 0;
-    if (line.size() > 1)
-        for (std::size_t s = 0; s < n; ++s) length += len[s];
+    if (points > 1)
+        for (std::size_t p = 0; p < n; ++p) length += len[p];
     out.count = n;
     out.length = length;
 }
@@ -198,14 +236,15 @@ void segments_of(std::span<const Vec3f> line, Segments& out) {
 // over three steps stay under 90 degrees is proven so: two segments instead
 // of the window, the same result bit for bit.
 struct OwnSegments {
-    std::vector<double> nearest;        // squared distance to the nearer of segments k - 1 and k (the first on a tie)
-    std::vector<std::uint8_t> later;    // 1 where that is segment k
+    std::vector<std::uint8_t> later;    // 1 where the nearer own segment is segment k (the first on a tie)
     std::vector<std::uint8_t> proven;   // it is the window's nearest
+    std::vector<double> forward[3];     // AVX2: all bits set where u_s . u_(s + d + 1) >= 0
 };
 
-// Point k of own_segments (any k; the edges of the fiber and machines without AVX2).
+// Point k of own_segments (any k; the edges of the fiber and machines
+// without AVX2): its squared distance into nearest[k].
 void own_segments_at(const Segments& g, std::span<const Vec3f> from, std::span<const Vec3f> to, std::size_t k,
-                     OwnSegments& out) {
+                     double* nearest, OwnSegments& out) {
     const std::size_t n = g.count;
     auto dot = [&](std::size_t a, std::size_t b) { return g.ux[a] * g.ux[b] + g.uy[a] * g.uy[b] + g.uz[a] * g.uz[b]; };
     const Vec3f p = from[k];
@@ -224,7 +263,7 @@ void own_segments_at(const Segments& g, std::span<const Vec3f> from, std::span<c
         for (std::size_t j = k + 1; j <= k + 3; ++j) proven = proven && dot(j, k) >= 0;
     }
     out.later[k] = after < before;
-    out.nearest[k] = after < before ? after : before;
+    nearest[k] = after < before ? after : before;
     out.proven[k] = proven;
 }
 
@@ -237,60 +276,92 @@ FIBLET_AVX2 __m256d not_against(const Segments& g, std::size_t a, std::size_t b)
     return _mm256_cmp_pd(d, _mm256_setzero_pd(), _CMP_GE_OQ);
 }
 
+// OwnSegments::forward of every segment: each pair of segments up to three
+// apart is tested once, not once for each point it proves.
+__attribute__((target("avx2"))) void forward_avx2(const Segments& g, OwnSegments& out) {
+    const std::size_t n = g.count;
+    for (std::size_t d = 0; d < 3; ++d) at_least(out.forward[d], n + 4);
+    for (std::size_t s = 0; s < n; s += 4)  // reads up to segment n + 5: padding
+        for (std::size_t d = 0; d < 3; ++d) _mm256_storeu_pd(out.forward[d].data() + s, not_against(g, s + d + 1, s));
+}
+
+FIBLET_AVX2 __m256d mask(const std::vector<double>& m, std::size_t s) { return _mm256_loadu_pd(m.data() + s); }
+
 // e4 < 0.98 len^2 for lengths len .. len + 3.
 FIBLET_AVX2 __m256d within_half_step(__m256d e4, const Segments& g, std::size_t s) {
     const __m256d len = column(g.len, s);
     return _mm256_cmp_pd(e4, _mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(0.98), len), len), _CMP_LT_OQ);
 }
 
-// own_segments_at for points [k0, k1) (4 <= k0, k1 <= n), four at a time:
-// the same distances bit for bit, the same proof.
-__attribute__((target("avx2"))) void own_segments_avx2(const Segments& g, std::span<const Vec3f> from,
-                                                       std::span<const Vec3f> to, std::size_t k0, std::size_t k1,
+// own_segments_at for points [k0, k1) (4 <= k0, k1 <= n), four at a time,
+// the points read from both polylines' columns: the same distances bit for
+// bit, the same proof.
+__attribute__((target("avx2"))) void own_segments_avx2(const Segments& g, const Segments& from_g,
+                                                       std::span<const Vec3f> from, std::span<const Vec3f> to,
+                                                       std::size_t k0, std::size_t k1, double* nearest,
                                                        OwnSegments& out) {
+    const std::vector<double>* f = out.forward;
     std::size_t k = k0;
     for (; k + 4 <= k1; k += 4) {
-        const __m256d x = coordinate(from, k, 0), y = coordinate(from, k, 1), z = coordinate(from, k, 2);
-        const __m256d ex = _mm256_sub_pd(x, coordinate(to, k, 0)), ey = _mm256_sub_pd(y, coordinate(to, k, 1)),
-                      ez = _mm256_sub_pd(z, coordinate(to, k, 2));
+        const __m256d x = column(from_g.ax, k), y = column(from_g.ay, k), z = column(from_g.az, k);
+        const __m256d ex = _mm256_sub_pd(x, column(g.ax, k)), ey = _mm256_sub_pd(y, column(g.ay, k)),
+                      ez = _mm256_sub_pd(z, column(g.az, k));
         const __m256d e4 = _mm256_mul_pd(
             _mm256_set1_pd(4.0),
             _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(ex, ex), _mm256_mul_pd(ey, ey)), _mm256_mul_pd(ez, ez)));
         const __m256d before = segment_dist2_avx2(g, x, y, z, k - 1), after = segment_dist2_avx2(g, x, y, z, k);
         const __m256d later = _mm256_cmp_pd(after, before, _CMP_LT_OQ);
-        _mm256_storeu_pd(&out.nearest[k], _mm256_blendv_pd(before, after, later));  // after < before ? after : before
+        _mm256_storeu_pd(nearest + k, _mm256_blendv_pd(before, after, later));  // after < before ? after : before
         const int later_mask = _mm256_movemask_pd(later);
-        __m256d ok = _mm256_and_pd(within_half_step(e4, g, k - 1), within_half_step(e4, g, k));
-        for (std::size_t d = 1; d <= 3; ++d)
-            ok = _mm256_and_pd(ok, _mm256_and_pd(not_against(g, k + d, k), not_against(g, k - 1 - d, k - 1)));
-        const int mask = _mm256_movemask_pd(ok);
-        for (int i = 0; i < 4; ++i) out.proven[k + i] = (mask >> i) & 1, out.later[k + i] = (later_mask >> i) & 1;
+        // Segments k + 1 .. k + 3 not against k, and k - 4 .. k - 2 not against k - 1.
+        const __m256d ahead = _mm256_and_pd(_mm256_and_pd(mask(f[0], k), mask(f[1], k)), mask(f[2], k));
+        const __m256d behind = _mm256_and_pd(_mm256_and_pd(mask(f[0], k - 2), mask(f[1], k - 3)), mask(f[2], k - 4));
+        const __m256d ok = _mm256_and_pd(_mm256_and_pd(within_half_step(e4, g, k - 1), within_half_step(e4, g, k)),
+                                         _mm256_and_pd(ahead, behind));
+        const int proven_mask = _mm256_movemask_pd(ok);
+        for (int i = 0; i < 4; ++i) out.proven[k + i] = (proven_mask >> i) & 1, out.later[k + i] = (later_mask >> i) & 1;
     }
-    for (; k < k1; ++k) own_segments_at(g, from, to, k, out);
+    for (; k < k1; ++k) own_segments_at(g, from, to, k, nearest, out);
 }
 #undef FIBLET_AVX2
 #endif
 
-// own_segments_at for every point of a fixed-step pair.
-void own_segments(const Segments& g, std::span<const Vec3f> from, std::span<const Vec3f> to, OwnSegments& out) {
+// own_segments_at for every point of a fixed-step pair (from_g: the
+// columns of `from`, g those of `to`).
+void own_segments(const Segments& g, const Segments& from_g, std::span<const Vec3f> from, std::span<const Vec3f> to,
+                  double* nearest, OwnSegments& out) {
     const std::size_t n = g.count, points = n + 1;  // to.size() == from.size() == n + 1
-    at_least(out.nearest, points), at_least(out.later, points), at_least(out.proven, points);
+    at_least(out.later, points), at_least(out.proven, points);
     std::size_t k = 0;
 #ifdef FIBLET_GEOMETRY_AVX2
-    // The vector loop reads segments k - 5 .. k + 6 and lengths to k + 3.
+    // The vector loop reads segments k - 4 .. k + 3 and lengths to k + 3.
     if (have_avx2() && n > 8) {
-        for (; k < 4; ++k) own_segments_at(g, from, to, k, out);
-        own_segments_avx2(g, from, to, 4, n, out);
+        forward_avx2(g, out);
+        for (; k < 4; ++k) own_segments_at(g, from, to, k, nearest, out);
+        own_segments_avx2(g, from_g, from, to, 4, n, nearest, out);
         k = n;
     }
 #endif
-    for (; k < points; ++k) own_segments_at(g, from, to, k, out);
+    for (; k < points; ++k) own_segments_at(g, from, to, k, nearest, out);
 }
 
-// Every point of `from` against the polyline `to`, in order along both, so
-// the nearest segment moves forward with the point: the segments within
-// reach of the last nearest one are searched (squared distances, one square
-// root per point; this runs on every point `compress` writes): two segments
+// The end of the run of proven points from k (bytes 0 or 1), eight at a
+// time while they all are.
+std::size_t proven_run_end(const std::uint8_t* proven, std::size_t k, std::size_t n) {
+    constexpr std::uint64_t kAllProven = 0x0101010101010101ull;
+    for (std::uint64_t w; k + 8 <= n; k += 8) {
+        std::memcpy(&w, proven + k, 8);
+        if (w != kAllProven) break;
+    }
+    while (k < n && proven[k]) ++k;
+    return k;
+}
+
+// Every point of `from` against the polyline `to` (its columns g; from_g:
+// those of `from`, for fixed-step pairs), in order along both, so the
+// nearest segment moves forward with the point: the segments within reach
+// of the last nearest one are searched (squared distances, one square root
+// per point; this runs on every point `compress` writes): two segments
 // back, and ahead the segments one step of `from` can cross plus two.
 // Returns the length of `to`.
 //
@@ -301,10 +372,9 @@ void own_segments(const Segments& g, std::span<const Vec3f> from, std::span<cons
 // segment); the nearest one is then chosen from the same window as always,
 // or evaluated directly where the window leaves those kLanes. The result is
 // the same, bit for bit.
-double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to, ErrorStats& out, std::uint64_t fiber) {
+double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, std::span<const Vec3f> to,
+                          const Segments& g, ErrorStats& out, std::uint64_t fiber) {
     if (to.empty()) return 0;
-    thread_local Segments g;
-    segments_of(to, g);
     if (from.empty()) return g.length;
     const std::size_t n = g.count;
     const std::size_t ahead = 2 + (to.size() + from.size() - 1) / from.size();
@@ -315,12 +385,11 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
     const bool same_count = from.size() == to.size() && to.size() > 1 && detail::geometry_shortcut_enabled();
     const bool paired = from.size() == to.size() && have_avx2();
     alignas(32) double lanes[kLanes];
-    thread_local OwnSegments own;
-    if (same_count) own_segments(g, from, to, own);
-    const std::uint8_t *proven = own.proven.data(), *later = own.later.data();
-    const double* own_nearest = own.nearest.data();
     thread_local std::vector<double> nearest_buffer;  // squared distances, then distances
     double* const nearest = at_least(nearest_buffer, from.size());
+    thread_local OwnSegments own;
+    if (same_count) own_segments(g, from_g, from, to, nearest, own);
+    const std::uint8_t *proven = own.proven.data(), *later = own.later.data();
     // Polylines of different point counts may be spaced unevenly (a sparse
     // input resampled: 0.2 mm segments, then 20 mm ones): the window reaches
     // ahead along `to` by at least the distance the nearest point can have
@@ -334,9 +403,12 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
     }
     for (std::size_t k = 0; k < from.size(); ++k) {
         if (same_count && proven[k] && hint <= k && hint + 2 >= k) {
-            // The window's nearest is k - 1 or k (the first on a tie, as below).
-            hint = k - 1 + later[k];
-            nearest[k] = own_nearest[k];
+            // The window's nearest is k - 1 or k (the first on a tie, as
+            // below), already in nearest[k]; so is every proven point's
+            // after it, whose hint is then within reach.
+            const std::size_t end = proven_run_end(proven, k + 1, from.size());
+            hint = end - 2 + later[end - 1];
+            k = end - 1;
             continue;
         }
         const Vec3f& p = from[k];
@@ -367,7 +439,7 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
             if (d[j] < best) best = d[j], hint = lo + j;
         nearest[k] = best;
     }
-    // Square roots two at a time (correctly rounded, as std::sqrt), then
+    // Square roots four at a time (correctly rounded, as std::sqrt), then
     // the statistics in order.
     sqrt_all(nearest, from.size());
     out.add_all(nearest, from.size(), fiber);
@@ -377,6 +449,11 @@ double points_to_polyline(std::span<const Vec3f> from, std::span<const Vec3f> to
 }  // namespace
 
 bool& detail::geometry_shortcut_enabled() {
+    thread_local bool enabled = true;
+    return enabled;
+}
+
+bool& detail::geometry_vectors_enabled() {
     thread_local bool enabled = true;
     return enabled;
 }
@@ -401,8 +478,11 @@ double polyline_length(std::span<const Vec3f> line) {
 }
 
 void GeometryError::add_fiber(std::span<const Vec3f> input, std::span<const Vec3f> decoded, std::uint64_t fiber) {
-    const double li = points_to_polyline(decoded, input, decoded_to_input_, fiber);
-    const double ld = points_to_polyline(input, decoded, input_to_decoded_, fiber);
+    thread_local Segments input_segments, decoded_segments;  // each polyline's columns, once
+    if (!input.empty()) segments_of(input, input_segments);
+    if (!decoded.empty()) segments_of(decoded, decoded_segments);
+    const double li = points_to_polyline(decoded, decoded_segments, input, input_segments, decoded_to_input_, fiber);
+    const double ld = points_to_polyline(input, input_segments, decoded, decoded_segments, input_to_decoded_, fiber);
     if (input.empty() || decoded.empty()) return;
     endpoint_.add(distance(input.front(), decoded.front()), fiber);
     endpoint_.add(distance(input.back(), decoded.back()), fiber);
