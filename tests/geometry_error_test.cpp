@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "fiblet/geometry_error.hpp"
+#include "core/points_avx2.hpp"
 #include "stats/geometry_paths.hpp"
 
 namespace fiblet {
@@ -275,9 +276,9 @@ TEST(GeometryError, VectorsEqualScalarLoops) {
     for (const bool shortcut : {true, false}) {
         detail::geometry_shortcut_enabled() = shortcut;
         const GeometryError vectors = measure_pairs(pairs);
-        detail::geometry_vectors_enabled() = false;
+        detail::avx2_loops_enabled() = false;
         const GeometryError scalar = measure_pairs(pairs);
-        detail::geometry_vectors_enabled() = true;
+        detail::avx2_loops_enabled() = true;
         expect_same_bits(vectors, scalar);
     }
     detail::geometry_shortcut_enabled() = true;

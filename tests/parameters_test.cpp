@@ -8,6 +8,7 @@
 
 #include "codec/compress_stages.hpp"
 #include "codec/parameters.hpp"
+#include "core/points_avx2.hpp"
 
 using namespace fiblet;
 using namespace fiblet::detail;
@@ -83,6 +84,47 @@ TEST(TurnStatistics, KeepsTheBlocksOfTheSharpestTurns) {
         const double kink = std::atan2(double(b.back().y), double(b.back().x) - 1.5) * 180 / M_PI;
         EXPECT_TRUE(std::fabs(kink - 40) < 0.1 || std::fabs(kink - 30) < 0.1) << kink;
     }
+}
+
+// The scan's AVX2 loops (segment lengths, the turns of fibers with no
+// zero-length segment) against the scalar ones, bit for bit: lengths
+// against |b - a| computed here, the statistics against the same fibers
+// with the AVX2 loops switched off and against add_fiber's own square roots.
+TEST(TurnStatistics, VectorLoopsEqualTheScalarLoops) {
+    std::vector<std::vector<Vec3f>> fibers;
+    for (int n = 1; n < 40; ++n) fibers.push_back(walk(n, 30, unsigned(n)));
+    for (unsigned s = 0; s < 10; ++s) fibers.push_back(walk(100 + 37 * int(s), 5 + 15 * s, s));
+    fibers[45][50] = fibers[45][49];  // a zero-length segment
+    std::vector<Vec3f> back{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {1, 0, 0}, {0, 0, 0}, {0, 1, 0}, {0, 2, 0}, {0, 3, 0}};
+    fibers.push_back(back);  // turns of 180 degrees: sin^2 clamped at 1
+    // Blocks of one point: the kept block is where the sharpest turn is.
+    TurnStatistics vectors(1, fibers.size()), scalar(1, fibers.size()), roots(1, fibers.size());
+    std::vector<double> lengths, scalar_lengths;
+    for (const auto& f : fibers) {
+        segment_lengths(f, lengths);
+        ASSERT_EQ(lengths.size(), f.size() - 1);
+        for (std::size_t s = 0; s + 1 < f.size(); ++s) {
+            const double dx = double(f[s + 1].x) - f[s].x, dy = double(f[s + 1].y) - f[s].y, dz = double(f[s + 1].z) - f[s].z;
+            ASSERT_EQ(lengths[s], std::sqrt(dx * dx + dy * dy + dz * dz)) << f.size() << " " << s;
+        }
+        TurnStatistics one_vectors(1, 1), one_scalar(1, 1);  // this fiber's sharpest turn, to the bit
+        vectors.add_fiber(f, lengths), one_vectors.add_fiber(f, lengths);
+        roots.add_fiber(f);
+        detail::avx2_loops_enabled() = false;
+        segment_lengths(f, scalar_lengths);
+        scalar.add_fiber(f, scalar_lengths), one_scalar.add_fiber(f, scalar_lengths);
+        detail::avx2_loops_enabled() = true;
+        ASSERT_EQ(lengths, scalar_lengths);
+        EXPECT_EQ(one_vectors.min_dot(), one_scalar.min_dot()) << f.size();
+        EXPECT_EQ(one_vectors.sharpest_blocks(), one_scalar.sharpest_blocks()) << f.size();
+    }
+    for (const TurnStatistics* other : {&scalar, &roots}) {
+        EXPECT_EQ(vectors.count(), other->count());
+        EXPECT_EQ(vectors.min_dot(), other->min_dot());
+        for (double p : {1.0, 50.0, 90.0, 99.0, 99.9}) EXPECT_EQ(vectors.dot_at_percentile(p), other->dot_at_percentile(p)) << p;
+        EXPECT_EQ(vectors.sharpest_blocks(), other->sharpest_blocks());
+    }
+    EXPECT_EQ(vectors.min_dot(), -1.0);
 }
 
 TEST(FiberSample, IsAnEveryKthSubsetWithinItsSize) {

@@ -63,11 +63,9 @@ void scan_task(const FiberBatch& b, std::size_t t, ScanSlot& s) {
     for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1]; ++i) {
         const std::vector<Vec3f>& fiber = b.fibers[i];
         add_bounds(fiber, s.min, s.max);
-        lengths.resize(fiber.empty() ? 0 : fiber.size() - 1);
+        segment_lengths(fiber, lengths);
         double fiber_length = 0;
-        for (std::size_t k = 1; k < fiber.size(); ++k) {
-            const double len = distance(fiber[k - 1], fiber[k]);
-            lengths[k - 1] = len;
+        for (const double len : lengths) {
             s.lengths.add(len);
             fiber_length += len;
             s.step_min = std::min(s.step_min, len);
@@ -92,16 +90,6 @@ struct ResampleSlot {
 };
 
 }  // namespace
-
-void LengthHistogram::add(double len) {
-    const float f = float(len);
-    ++count_;
-    if (!(f >= kMin)) return ++below_, void();
-    const std::uint32_t i = std::min<std::uint32_t>((std::bit_cast<std::uint32_t>(f) - kMinBits) >> kShift, kBins - 1);
-    auto& block = blocks_[i >> kMantissaBits];
-    if (!block) block = std::make_unique<std::uint64_t[]>(kBlock);  // zeroed
-    ++block[i & (kBlock - 1)];
-}
 
 void LengthHistogram::merge(const LengthHistogram& o) {
     count_ += o.count_, below_ += o.below_;

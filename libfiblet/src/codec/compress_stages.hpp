@@ -9,6 +9,7 @@
 //                                 the pool encodes this one.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <chrono>
@@ -70,7 +71,15 @@ bool read_fiber_batch(StreamlineSource& reader, FiberBatch& b, std::uint32_t fir
 // allocated when a length first falls in it: constant, small memory.
 class LengthHistogram {
 public:
-    void add(double len);
+    void add(double len) {  // inline: once per segment of the input
+        const float f = float(len);
+        ++count_;
+        if (!(f >= kMin)) return ++below_, void();
+        const std::uint32_t i = std::min<std::uint32_t>((std::bit_cast<std::uint32_t>(f) - kMinBits) >> kShift, kBins - 1);
+        auto& block = blocks_[i >> kMantissaBits];
+        if (!block) block = std::make_unique<std::uint64_t[]>(kBlock);  // zeroed
+        ++block[i & (kBlock - 1)];
+    }
     void merge(const LengthHistogram& other);
     double median() const;
 

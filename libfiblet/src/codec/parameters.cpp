@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/points_avx2.hpp"
 #include "core/vec_math.hpp"
 #include "fiblet/resample.hpp"
 
@@ -19,7 +20,91 @@ TurnStatistics::TurnStatistics(std::uint32_t points_per_block, std::size_t kept_
 
 void TurnStatistics::add_fiber(std::span<const Vec3f> f) { add_turns(f, [](double n2, std::size_t) { return std::sqrt(n2); }); }
 
+#ifdef FIBLET_POINTS_AVX2
+namespace {
+
+// segment_lengths' first segments, four at a time; returns how many.
+__attribute__((target("avx2"))) std::size_t segment_lengths_avx2(const Vec3f* f, std::size_t segments, double* out) {
+    std::size_t s = 0;
+    for (; s + 4 <= segments; s += 4) {  // reads points s .. s + 4
+        __m256d dx, dy, dz;
+        deltas4(f + s, dx, dy, dz);
+        _mm256_storeu_pd(out + s, _mm256_sqrt_pd(norm2(dx, dy, dz)));
+    }
+    return s;
+}
+
+// add_turns' turns of a fiber none of whose segments has length 0 (those
+// are skipped there), four at a time: the segments' unit directions, then
+// s2[t] = sin^2 of the turn between segments t and t + 1 (at point t + 1),
+// with the same double operations. Returns the turns (segments - 1).
+__attribute__((target("avx2"))) std::size_t turn_sizes_avx2(std::span<const Vec3f> f, const double* lengths,
+                                                            std::vector<double>& columns, std::vector<double>& s2) {
+    const std::size_t n = f.size() - 1;
+    columns.resize(3 * n), s2.resize(n - 1);
+    double *ux = columns.data(), *uy = ux + n, *uz = uy + n;
+    const __m256d one = _mm256_set1_pd(1.0), quarter = _mm256_set1_pd(0.25);
+    std::size_t s = 0;
+    for (; s + 4 <= n; s += 4) {
+        __m256d dx, dy, dz;
+        deltas4(&f[s], dx, dy, dz);
+        const __m256d inv = _mm256_div_pd(one, _mm256_loadu_pd(lengths + s));
+        _mm256_storeu_pd(ux + s, _mm256_mul_pd(dx, inv));
+        _mm256_storeu_pd(uy + s, _mm256_mul_pd(dy, inv));
+        _mm256_storeu_pd(uz + s, _mm256_mul_pd(dz, inv));
+    }
+    for (; s < n; ++s) {
+        const double inv = 1.0 / lengths[s];
+        ux[s] = (double(f[s + 1].x) - f[s].x) * inv, uy[s] = (double(f[s + 1].y) - f[s].y) * inv;
+        uz[s] = (double(f[s + 1].z) - f[s].z) * inv;
+    }
+    std::size_t t = 0;
+    for (; t + 5 <= n; t += 4) {  // std::min(v, 1.0) is (1.0 < v) ? 1.0 : v, as minpd(1.0, v)
+        const __m256d ex = _mm256_sub_pd(_mm256_loadu_pd(ux + t + 1), _mm256_loadu_pd(ux + t)),
+                      ey = _mm256_sub_pd(_mm256_loadu_pd(uy + t + 1), _mm256_loadu_pd(uy + t)),
+                      ez = _mm256_sub_pd(_mm256_loadu_pd(uz + t + 1), _mm256_loadu_pd(uz + t));
+        _mm256_storeu_pd(s2.data() + t, _mm256_min_pd(one, _mm256_mul_pd(quarter, norm2(ex, ey, ez))));
+    }
+    for (; t + 1 < n; ++t) {
+        const double ex = ux[t + 1] - ux[t], ey = uy[t + 1] - uy[t], ez = uz[t + 1] - uz[t];
+        s2[t] = std::min(0.25 * (ex * ex + ey * ey + ez * ez), 1.0);
+    }
+    return n - 1;
+}
+
+}  // namespace
+#endif
+
+// The same double operations as distance() (a difference's square is its
+// negation's; vsqrtpd rounds correctly).
+void segment_lengths(std::span<const Vec3f> f, std::vector<double>& lengths) {
+    const std::size_t n = f.empty() ? 0 : f.size() - 1;
+    lengths.resize(n);
+    std::size_t s = 0;
+#ifdef FIBLET_POINTS_AVX2
+    if (use_avx2_loops()) s = segment_lengths_avx2(f.data(), n, lengths.data());
+#endif
+    for (; s < n; ++s) lengths[s] = distance(f[s], f[s + 1]);
+}
+
 void TurnStatistics::add_fiber(std::span<const Vec3f> f, std::span<const double> segment_lengths) {
+#ifdef FIBLET_POINTS_AVX2
+    // The common case in vectors: no segment of length 0 (or NaN).
+    bool positive = f.size() >= 6;
+    for (const double len : segment_lengths) positive = positive && len > 0;
+    if (positive && use_avx2_loops()) {
+        thread_local std::vector<double> columns, s2;
+        const std::size_t turns = turn_sizes_avx2(f, segment_lengths.data(), columns, s2);
+        double fiber_max = -1;
+        std::size_t at = 0;
+        for (std::size_t t = 0; t < turns; ++t) {
+            if (s2[t] > fiber_max) fiber_max = s2[t], at = t + 1;
+            ++bins_[std::size_t(s2[t] * float(kTurnBins))];
+        }
+        count_ += turns;
+        return keep_sharpest(f, fiber_max, at);
+    }
+#endif
     add_turns(f, [&](double, std::size_t i) { return segment_lengths[i - 1]; });
 }
 
@@ -47,6 +132,12 @@ void TurnStatistics::add_turns(std::span<const Vec3f> f, SegmentLength segment_l
         }
         px = dx, py = dy, pz = dz, have = true;
     }
+    keep_sharpest(f, fiber_max, at);
+}
+
+// The fiber's sharpest turn (sin^2 fiber_max, at point `at`; -1: none)
+// into the smallest dot, and its block into the sharpest blocks if it is one.
+void TurnStatistics::keep_sharpest(std::span<const Vec3f> f, double fiber_max, std::size_t at) {
     if (fiber_max < 0) return;
     const double fiber_min = 1.0 - 2.0 * fiber_max;  // the dot of the sharpest turn
     min_dot_ = std::min(min_dot_, fiber_min);

@@ -31,6 +31,10 @@ inline double tension_of(std::uint16_t code) { return code * kTensionQuantum; }
 // of sin^2(angle / 2) in 2^15 bins (0.013 degree resolution at 15
 // degrees), the sharpest turn, and copies of the blocks holding the sharpest turns (where
 // a small cap costs the most error, and which a sample would miss).
+// lengths[s] = |f[s + 1] - f[s]| in double, as distance() computes it
+// (bit for bit; four at a time with AVX2).
+void segment_lengths(std::span<const Vec3f> f, std::vector<double>& lengths);
+
 class TurnStatistics {
 public:
     TurnStatistics(std::uint32_t points_per_block, std::size_t kept_blocks);
@@ -61,6 +65,7 @@ private:
     bool wants(double dot) const;
     template <class SegmentLength>
     void add_turns(std::span<const Vec3f> fiber, SegmentLength segment_length);
+    void keep_sharpest(std::span<const Vec3f> fiber, double fiber_max, std::size_t at);
     void keep(double dot, std::vector<Vec3f> block);
 };
 

@@ -6,13 +6,11 @@
 #include <limits>
 #include <vector>
 
-#if defined(__GNUC__) && defined(__x86_64__)
-#include <immintrin.h>
-#endif
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
 
+#include "core/points_avx2.hpp"
 #include "core/vec_math.hpp"
 #include "stats/geometry_paths.hpp"
 
@@ -30,19 +28,12 @@ namespace {
 // as polyline_length).
 constexpr std::size_t kLanes = 8;
 
-#if defined(__GNUC__) && defined(__x86_64__)
+#ifdef FIBLET_POINTS_AVX2
 #define FIBLET_GEOMETRY_AVX2 1
 #define FIBLET_AVX2 __attribute__((target("avx2"))) inline
 #endif
 
-bool have_avx2() {
-#ifdef FIBLET_GEOMETRY_AVX2
-    static const bool yes = __builtin_cpu_supports("avx2");
-    return yes && detail::geometry_vectors_enabled();
-#else
-    return false;
-#endif
-}
+using detail::use_avx2_loops;
 
 #ifdef FIBLET_GEOMETRY_AVX2
 __attribute__((target("avx2"))) std::size_t sqrt_avx2(double* v, std::size_t n) {
@@ -57,7 +48,7 @@ __attribute__((target("avx2"))) std::size_t sqrt_avx2(double* v, std::size_t n) 
 void sqrt_all(double* v, std::size_t n) {
     std::size_t i = 0;
 #ifdef FIBLET_GEOMETRY_AVX2
-    if (have_avx2()) i = sqrt_avx2(v, n);
+    if (use_avx2_loops()) i = sqrt_avx2(v, n);
 #endif
 #ifdef __SSE2__
     for (; i + 2 <= n; i += 2) _mm_storeu_pd(v + i, _mm_sqrt_pd(_mm_loadu_pd(v + i)));
@@ -98,7 +89,7 @@ __attribute__((target("avx2"))) void inverses_and_roots_avx2(double* len, double
 
 void inverses_and_roots(double* len, double* inv, std::size_t n) {
 #ifdef FIBLET_GEOMETRY_AVX2
-    if (have_avx2()) return inverses_and_roots_avx2(len, inv, n);
+    if (use_avx2_loops()) return inverses_and_roots_avx2(len, inv, n);
 #endif
     for (std::size_t i = 0; i < n; ++i) inv[i] = len[i] > 0 ? 1.0 / len[i] : 0.0;
     sqrt_all(len, n);
@@ -116,22 +107,6 @@ inline double segment_dist2(const Segments& g, double px, double py, double pz, 
 
 #ifdef FIBLET_GEOMETRY_AVX2
 FIBLET_AVX2 __m256d column(const std::vector<double>& c, std::size_t s) { return _mm256_loadu_pd(c.data() + s); }
-
-// Lanes idx of v, the low four.
-FIBLET_AVX2 __m128 pick(__m256 v, __m256i idx) { return _mm256_castps256_ps128(_mm256_permutevar8x32_ps(v, idx)); }
-
-// Points p .. p + 3 as columns of doubles (exact: float to double), from
-// two overlapping loads of their 12 floats instead of gathers.
-FIBLET_AVX2 void xyz4(const Vec3f* p, __m256d& x, __m256d& y, __m256d& z) {
-    const float* f = &p->x;
-    const __m256 lo = _mm256_loadu_ps(f), hi = _mm256_loadu_ps(f + 4);  // floats 0..7 and 4..11
-    x = _mm256_cvtps_pd(_mm_blend_ps(pick(lo, _mm256_setr_epi32(0, 3, 6, 0, 0, 0, 0, 0)),
-                                     pick(hi, _mm256_setr_epi32(0, 0, 0, 5, 0, 0, 0, 0)), 0b1000));
-    y = _mm256_cvtps_pd(_mm_blend_ps(pick(lo, _mm256_setr_epi32(1, 4, 7, 0, 0, 0, 0, 0)),
-                                     pick(hi, _mm256_setr_epi32(0, 0, 0, 6, 0, 0, 0, 0)), 0b1000));
-    z = _mm256_cvtps_pd(_mm_blend_ps(pick(lo, _mm256_setr_epi32(2, 5, 0, 0, 0, 0, 0, 0)),
-                                     pick(hi, _mm256_setr_epi32(0, 0, 4, 7, 0, 0, 0, 0)), 0b1100));
-}
 
 // segment_dist2 of the points (x, y, z) to segments s .. s + 3: the same
 // double operations in the same order (max(0, t) and min(1, t) return t
@@ -160,7 +135,7 @@ __attribute__((target("avx2"))) std::size_t point_columns_avx2(const Vec3f* p, s
     std::size_t i = 0;
     for (; i + 4 <= m; i += 4) {
         __m256d x, y, z;
-        xyz4(p + i, x, y, z);
+        detail::xyz4(p + i, x, y, z);
         _mm256_storeu_pd(out.ax.data() + i, x), _mm256_storeu_pd(out.ay.data() + i, y), _mm256_storeu_pd(out.az.data() + i, z);
     }
     return i;
@@ -191,11 +166,11 @@ void segments_of(std::span<const Vec3f> line, Segments& out) {
     // The points (segment s runs from point s to point s + 1).
     std::size_t i = 0, s = 0;
 #ifdef FIBLET_GEOMETRY_AVX2
-    if (have_avx2()) i = point_columns_avx2(line.data(), points, out);
+    if (use_avx2_loops()) i = point_columns_avx2(line.data(), points, out);
 #endif
     for (; i < points; ++i) ax[i] = line[i].x, ay[i] = line[i].y, az[i] = line[i].z;
 #ifdef FIBLET_GEOMETRY_AVX2
-    if (have_avx2() && points > 1) s = directions_avx2(out, n);
+    if (use_avx2_loops() && points > 1) s = directions_avx2(out, n);
 #endif
     for (; s < n; ++s) {
         const std::size_t e = std::min(s + 1, points - 1);
@@ -335,7 +310,7 @@ void own_segments(const Segments& g, const Segments& from_g, std::span<const Vec
     std::size_t k = 0;
 #ifdef FIBLET_GEOMETRY_AVX2
     // The vector loop reads segments k - 4 .. k + 3 and lengths to k + 3.
-    if (have_avx2() && n > 8) {
+    if (use_avx2_loops() && n > 8) {
         forward_avx2(g, out);
         for (; k < 4; ++k) own_segments_at(g, from, to, k, nearest, out);
         own_segments_avx2(g, from_g, from, to, 4, n, nearest, out);
@@ -383,7 +358,7 @@ double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, s
     double* d = d2.data();
     std::size_t hint = 0;
     const bool same_count = from.size() == to.size() && to.size() > 1 && detail::geometry_shortcut_enabled();
-    const bool paired = from.size() == to.size() && have_avx2();
+    const bool paired = from.size() == to.size() && use_avx2_loops();
     alignas(32) double lanes[kLanes];
     thread_local std::vector<double> nearest_buffer;  // squared distances, then distances
     double* const nearest = at_least(nearest_buffer, from.size());
@@ -453,10 +428,6 @@ bool& detail::geometry_shortcut_enabled() {
     return enabled;
 }
 
-bool& detail::geometry_vectors_enabled() {
-    thread_local bool enabled = true;
-    return enabled;
-}
 
 void FiberMax::add(double v, std::uint64_t fiber) {
     if (count == 0 || v > max) max = v, worst_fiber = fiber;
