@@ -242,6 +242,7 @@ struct FiberEncoder::Encoding {
         std::vector<std::uint16_t> codes16, retry_codes16;
         std::vector<std::uint8_t> retry_codes8;
         std::vector<Vec3d> walked;
+        std::vector<double> block_errors;  // append_exact8: each block's largest point error
     };
 
     const FiberEncoder& enc;
@@ -306,7 +307,7 @@ struct FiberEncoder::Encoding {
     void store_codes16();
     void append_decoded(std::vector<Vec3f>& decoded) const;
     void append_exact16(std::vector<Vec3f>& decoded_exact);
-    void append_exact8(std::vector<Vec3f>& decoded_exact);
+    void append_exact8(std::vector<Vec3f>& decoded_exact, const Vec3f* decoded);
 };
 
 // Anchors: the block's first two points; a one-point block stores the point
@@ -521,24 +522,31 @@ void FiberEncoder::Encoding::append_exact16(std::vector<Vec3f>& decoded_exact) {
 // bound on the two decoders' divergence stay below the fiber's largest
 // float error cannot raise the max error: it gets the float points (most
 // blocks), which keeps the cost of this pass small.
-void FiberEncoder::Encoding::append_exact8(std::vector<Vec3f>& decoded_exact) {
+void FiberEncoder::Encoding::append_exact8(std::vector<Vec3f>& decoded_exact, const Vec3f* decoded) {
     s.walked.resize(ppb);
+    s.block_errors.resize(n_blocks);
     const double out_slack =
         4 * 0x1p-24 * (1 + std::max({std::fabs(h.offset[0]), std::fabs(h.offset[1]), std::fabs(h.offset[2])}) / h.scaling);
-    auto block_error = [&](std::uint32_t blk) {
-        const std::size_t i0 = std::size_t(blk) * ppb;
-        return std::sqrt(double(max_distance2(&s.points[i0], &s.targets[i0], block_points(blk))));
-    };
     double fiber_max = 0;
-    for (std::uint32_t b = 0; b < n_blocks; ++b) fiber_max = std::max(fiber_max, block_error(b));
+    for (std::uint32_t b = 0; b < n_blocks; ++b) {
+        const std::size_t i0 = std::size_t(b) * ppb;
+        s.block_errors[b] = std::sqrt(double(max_distance2(&s.points[i0], &s.targets[i0], block_points(b))));
+        fiber_max = std::max(fiber_max, s.block_errors[b]);
+    }
     decoded_exact.reserve(decoded_exact.size() + n_points);
     for (std::uint32_t b = 0; b < n_blocks; ++b) {
         const DecoderStarts& e = s.starts[b];
         const std::size_t i0 = std::size_t(b) * ppb, n = block_points(b), m = n > 2 ? n - 2 : 0;
         const double bound = e.divergence + walk_divergence(m, double(h.step)) + out_slack;
-        if (block_error(b) + bound <= fiber_max) {
-            for (std::size_t k = 0; k < n; ++k)
-                decoded_exact.push_back(h.to_world(s.points[i0 + k].x, s.points[i0 + k].y, s.points[i0 + k].z));
+        if (s.block_errors[b] + bound <= fiber_max) {
+            // Not the fiber's worst even if the exact decode is off by the
+            // bound: the float decode's points stand for it.
+            if (decoded) {
+                decoded_exact.insert(decoded_exact.end(), decoded + i0, decoded + i0 + n);
+            } else {
+                for (std::size_t k = 0; k < n; ++k)
+                    decoded_exact.push_back(h.to_world(s.points[i0 + k].x, s.points[i0 + k].y, s.points[i0 + k].z));
+            }
             continue;
         }
         exact_walk(*enc.tables_->exact8, e.exact_frame, e.exact1, double(h.step), codes8_of(b), m, s.walked.data());
@@ -563,7 +571,8 @@ void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, 
     e.keep_lengths();
     if (e.wide) e.store_codes16();
     if (decoded) e.append_decoded(*decoded);
-    if (decoded_exact) e.wide ? e.append_exact16(*decoded_exact) : e.append_exact8(*decoded_exact);
+    const Vec3f* fiber_decoded = decoded ? decoded->data() + (decoded->size() - fiber.size()) : nullptr;
+    if (decoded_exact) e.wide ? e.append_exact16(*decoded_exact) : e.append_exact8(*decoded_exact, fiber_decoded);
 }
 
 }  // namespace fiblet
