@@ -131,9 +131,11 @@ void feed_back_length(std::span<const Vec3f> targets, std::span<Vec3f> points, s
 // cannot change its length) is taken back, where it exceeds `act_share`
 // of the fiber's largest point error, by moving the targets of the block's
 // last `tail` points along the track (linearly more towards the end, by at
-// most that point error, in shares 1, 1/2, 1/4) and searching those points
-// again; in the fiber's last adjustable block, all its points when the tail
-// left more than `act`. Callbacks:
+// most that point error, in shares 1, 1/2, 1/4: the first candidate that
+// keeps the point error and shortens the lag is kept, as a smaller share
+// moves the end less) and searching those points again; in the fiber's last
+// adjustable block, all its points when the tail left more than `act`.
+// Callbacks:
 //   adjustable(b)                 whether block b's codes may be searched again
 //   search(b, j0, t, decoded)     searches block b's codes j0.. (its points
 //                                 j0 + 2..) for targets t into a candidate
@@ -187,7 +189,7 @@ void feed_back_length_tails(std::span<const Vec3f> targets, std::span<Vec3f> poi
                 best = std::fabs(now);
                 std::copy(candidate.begin(), candidate.end(), points.begin() + std::ptrdiff_t(first + j0));
                 keep(b, j0);
-                if (best <= act) break;  // close enough: the next blocks carry the rest
+                break;  // the largest share the point error allows: smaller ones take back less
             }
         }
     }
