@@ -6,7 +6,8 @@ Usage: scripts/encode_table.py [--fiblet build/bin/fiblet] [--data ../shared/dat
 For every file and mode it runs `fiblet compress -j 1` (speed: points per
 second of CPU time, user + system, i.e. per core), then `fiblet stats`
 against the source .tck (errors as any reader decodes them). Prints a
-Markdown table (docs/encode.md holds one). --quick skips efforts 3 and 4.
+Markdown table (docs/notes/encode-history.md, "Measured", holds one).
+--quick skips efforts 3 and 4.
 """
 import argparse
 import json

@@ -284,8 +284,9 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
 //   (a chain of depth + 1 steps, shifted by one when the aimed code wins,
 //   replaced by the winner's own continuation otherwise), so the aimed
 //   path costs one new greedy step per point.
-// Measured on small-ifod1 (docs/encode.md): 0.85 rivals tried and 0.55
-// followed a second step per point; a rival wins at 16 % of the points.
+// Measured on small-ifod1 at depth 2 (docs/notes/encode-history.md): 0.85
+// rivals tried and 0.55 followed a second step per point; a rival wins at
+// 16 % of the points.
 inline constexpr std::size_t kMaxLookahead = 6;
 
 template <class Codebook>
