@@ -29,13 +29,12 @@ namespace {
 constexpr std::size_t kLanes = 8;
 
 #ifdef FIBLET_POINTS_AVX2
-#define FIBLET_GEOMETRY_AVX2 1
 #define FIBLET_AVX2 __attribute__((target("avx2"))) inline
 #endif
 
 using detail::use_avx2_loops;
 
-#ifdef FIBLET_GEOMETRY_AVX2
+#ifdef FIBLET_POINTS_AVX2
 __attribute__((target("avx2"))) std::size_t sqrt_avx2(double* v, std::size_t n) {
     std::size_t i = 0;
     for (; i + 4 <= n; i += 4) _mm256_storeu_pd(v + i, _mm256_sqrt_pd(_mm256_loadu_pd(v + i)));
@@ -47,7 +46,7 @@ __attribute__((target("avx2"))) std::size_t sqrt_avx2(double* v, std::size_t n) 
 // correctly, as std::sqrt does).
 void sqrt_all(double* v, std::size_t n) {
     std::size_t i = 0;
-#ifdef FIBLET_GEOMETRY_AVX2
+#ifdef FIBLET_POINTS_AVX2
     if (use_avx2_loops()) i = sqrt_avx2(v, n);
 #endif
 #ifdef __SSE2__
@@ -74,7 +73,7 @@ struct Segments {
 // From squared lengths uu (in len): inv[i] = uu > 0 ? 1 / uu : 0, then
 // len[i] = sqrt(uu), four at a time with AVX2 (vdivpd and vsqrtpd round
 // correctly, as / and std::sqrt do; the mask keeps +0, as the ternary).
-#ifdef FIBLET_GEOMETRY_AVX2
+#ifdef FIBLET_POINTS_AVX2
 __attribute__((target("avx2"))) void inverses_and_roots_avx2(double* len, double* inv, std::size_t n) {
     const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
     std::size_t i = 0;
@@ -88,7 +87,7 @@ __attribute__((target("avx2"))) void inverses_and_roots_avx2(double* len, double
 #endif
 
 void inverses_and_roots(double* len, double* inv, std::size_t n) {
-#ifdef FIBLET_GEOMETRY_AVX2
+#ifdef FIBLET_POINTS_AVX2
     if (use_avx2_loops()) return inverses_and_roots_avx2(len, inv, n);
 #endif
     for (std::size_t i = 0; i < n; ++i) inv[i] = len[i] > 0 ? 1.0 / len[i] : 0.0;
@@ -105,7 +104,7 @@ inline double segment_dist2(const Segments& g, double px, double py, double pz, 
     return dx * dx + dy * dy + dz * dz;
 }
 
-#ifdef FIBLET_GEOMETRY_AVX2
+#ifdef FIBLET_POINTS_AVX2
 FIBLET_AVX2 __m256d column(const std::vector<double>& c, std::size_t s) { return _mm256_loadu_pd(c.data() + s); }
 
 // segment_dist2 of the points (x, y, z) to segments s .. s + 3: the same
@@ -165,11 +164,11 @@ void segments_of(std::span<const Vec3f> line, Segments& out) {
     double *inv = at_least(out.inv_uu, n + kLanes), *len = at_least(out.len, n);
     // The points (segment s runs from point s to point s + 1).
     std::size_t i = 0, s = 0;
-#ifdef FIBLET_GEOMETRY_AVX2
+#ifdef FIBLET_POINTS_AVX2
     if (use_avx2_loops()) i = point_columns_avx2(line.data(), points, out);
 #endif
     for (; i < points; ++i) ax[i] = line[i].x, ay[i] = line[i].y, az[i] = line[i].z;
-#ifdef FIBLET_GEOMETRY_AVX2
+#ifdef FIBLET_POINTS_AVX2
     if (use_avx2_loops() && points > 1) s = directions_avx2(out, n);
 #endif
     for (; s < n; ++s) {
@@ -242,7 +241,7 @@ void own_segments_at(const Segments& g, std::span<const Vec3f> from, std::span<c
     out.proven[k] = proven;
 }
 
-#ifdef FIBLET_GEOMETRY_AVX2
+#ifdef FIBLET_POINTS_AVX2
 // Whether the directions of segments a .. a + 3 and b .. b + 3 are not against each other.
 FIBLET_AVX2 __m256d not_against(const Segments& g, std::size_t a, std::size_t b) {
     const __m256d d = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(column(g.ux, a), column(g.ux, b)),
@@ -308,7 +307,7 @@ void own_segments(const Segments& g, const Segments& from_g, std::span<const Vec
     const std::size_t n = g.count, points = n + 1;  // to.size() == from.size() == n + 1
     at_least(out.later, points), at_least(out.proven, points);
     std::size_t k = 0;
-#ifdef FIBLET_GEOMETRY_AVX2
+#ifdef FIBLET_POINTS_AVX2
     // The vector loop reads segments k - 4 .. k + 3 and lengths to k + 3.
     if (use_avx2_loops() && n > 8) {
         forward_avx2(g, out);
@@ -397,7 +396,7 @@ double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, s
         const std::size_t lo = hint > 2 ? hint - 2 : 0, w = hi - lo;
         const double px = p.x, py = p.y, pz = p.z;
         double best = std::numeric_limits<double>::infinity();
-#ifdef FIBLET_GEOMETRY_AVX2
+#ifdef FIBLET_POINTS_AVX2
         if (paired) {
             const std::size_t base = k >= 4 ? k - 4 : 0;
             window_avx2(g, px, py, pz, base, lanes);
