@@ -53,11 +53,10 @@ std::string work_dir() {
 
 class SharedTractograms : public ::testing::TestWithParam<std::string> {};
 
-// Every shared tractogram, compressed with the default settings at 8 bits
-// (every decoder below is the 8-bit layout's). The default writes each
-// shared file as `--bits 8` or, for smooth fibers, `--bits 16` does, byte
-// for byte (docs/encode.md, "Why smooth fibers need 16 bits"): this test
-// and the next cover both.
+// Every shared tractogram, compressed with the default settings (8 bits:
+// every decoder below is the 8-bit layout's); the next test covers the
+// 16-bit layout that `--bits auto` chooses for smooth fibers (docs/encode.md,
+// "Why smooth fibers need 16 bits").
 TEST_P(SharedTractograms, DecodeWithinTheHeaderErrorInFloat64AndFloat32) {
     if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
     const std::string tck = test::shared_data(GetParam());
