@@ -415,7 +415,6 @@ inline void fft_target(const std::uint8_t* data, std::size_t size) {
         }
         check(chunked.s.offsets == ref.s.offsets, "decode_file offsets differ from the reference");
         check(same_points(chunked.s.xyz, ref.s.xyz, 0), "decode_file points differ from the reference");
-#if FIBLET_HAS_DECODER_CHOICE
         // Every decoder this CPU runs (SIMD kinds and levels), with one
         // thread and with several: the same fibers; lanes bit-identical,
         // warp within a few float roundings of the file's scale.
@@ -433,7 +432,6 @@ inline void fft_target(const std::uint8_t* data, std::size_t size) {
                       "a decoder's points differ from the reference");
             }
         }
-#endif
         select_target(f, ref.s);
         // A sub-range decodes to the same slice.
         const std::uint64_t b = h.fibers / 3, e = h.fibers - h.fibers / 4;
@@ -519,7 +517,6 @@ inline void blocks_target(const std::uint8_t* data, std::size_t size) {
     for (std::size_t b = 0, at = 0; b < count; ++b)
         at += 3 * scalar_reference(ctx, blocks.data() + b * bb, 1, one.data() + at);
     check(same_points(one, ref, 0), "a block decoded alone differs");
-#if FIBLET_HAS_DECODER_CHOICE
     for (const std::string& name : available_decoders()) {
         const Decoder d = parse_decoder(name);
         const bool exact = name.rfind("warp", 0) != 0 || wide;  // 16-bit: scalar only
@@ -531,7 +528,6 @@ inline void blocks_target(const std::uint8_t* data, std::size_t size) {
             check(same_points(got, ref, exact ? 0.0f : warp_tolerance(h, ref)), "a decoder differs from the reference");
         }
     }
-#endif
 }
 
 }  // namespace fiblet::fuzz

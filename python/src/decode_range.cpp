@@ -15,20 +15,6 @@
 namespace fiblet::python {
 namespace {
 
-// The block decoder: the library's fastest (decode_blocks, with the SIMD
-// decoders) where this build has it, else the scalar reference. Found by
-// argument-dependent lookup, so this file builds before and after it lands.
-template <typename Context>
-concept has_fast_decoder = requires(const Context& c, const std::uint8_t* b, std::size_t n, float* xyz) {
-    decode_blocks(c, b, n, xyz, {}, 1u);
-};
-
-template <typename Context>
-void decode_run(const Context& ctx, const std::uint8_t* blocks, std::size_t count, float* xyz) {
-    if constexpr (has_fast_decoder<Context>) decode_blocks(ctx, blocks, count, xyz, {}, 1u);
-    else decode_blocks_scalar(ctx, blocks, count, xyz);
-}
-
 // The output's pages: FIBLET_PY_BUFFER=populate|huge picks one for
 // measuring (scripts/bench_python.sh); the default is the faster on the
 // medium tractogram (bench/results.md).
@@ -40,13 +26,11 @@ PageMode output_page_mode() {
 
 }  // namespace
 
-bool fast_block_decoder_available() { return has_fast_decoder<DecodeContext>; }
-
 DecodedRange decode_range(const FftFile& file, std::uint64_t begin, std::uint64_t end, unsigned threads) {
     if (begin > end || end > file.header().fibers)
         throw Error(Errc::invalid_argument, file.path() + ": fiber range past the end");
-    // The fast path reads fixed-size 8-bit blocks; 16-bit files (formats/fft16.md,
-    // which compress writes by default for smooth fibers) take the library's path.
+    // The fast path reads fixed-size 8-bit blocks; 16-bit files (formats/fft16.md)
+    // take the library's path.
     if (file.header().direction_bits() != 8) {
         DecodeOptions o;
         o.threads = threads;
@@ -84,7 +68,7 @@ DecodedRange decode_range(const FftFile& file, std::uint64_t begin, std::uint64_
     out.xyz = PopulatedBuffer(out.points * 3 * sizeof(float), output_page_mode());
     float* xyz = out.xyz.as<float>();
     parallel_for(runs, threads, [&](std::size_t r) {
-        decode_run(ctx, data + run_block[r] * bb, run_block[r + 1] - run_block[r], xyz + 3 * run_point[r]);
+        decode_blocks(ctx, data + run_block[r] * bb, run_block[r + 1] - run_block[r], xyz + 3 * run_point[r], {}, 1u);
     });
 
     // Per-fiber offsets from the blocks' point counts.

@@ -25,8 +25,5 @@ DecodedRange decode_range(const FftFile& file, std::uint64_t begin, std::uint64_
 // the front of the same buffer and giving the rest of it back.
 void keep_fibers(DecodedRange& range, const std::vector<std::uint64_t>& keep);
 
-// Whether the library's fast block decoders were found at build time (else
-// the scalar reference decodes).
-bool fast_block_decoder_available();
 
 }  // namespace fiblet::python

@@ -46,17 +46,10 @@ namespace py = pybind11;
 namespace fiblet::python {
 namespace {
 
-// DecodeOptions gains a thread count with the multithreaded decoders; until
-// then decoding runs on one thread and `threads` is accepted and ignored.
-template <typename Options>
-constexpr bool has_decode_threads = requires(Options o) { o.threads; };
-
-template <typename Options>
-Options decode_options(unsigned threads) {
-    Options o;
-    if constexpr (has_decode_threads<Options>) {
-        if (threads) o.threads = static_cast<decltype(o.threads)>(threads);
-    }
+// Decode options for `threads` (0: the library's default).
+DecodeOptions decode_options(unsigned threads) {
+    DecodeOptions o;
+    if (threads) o.threads = threads;
     return o;
 }
 
@@ -196,7 +189,7 @@ void decode_with_regions(const FftFile& file, const Regions& regions, std::uint6
     q.include = regions.include, q.exclude = regions.exclude;
     const FiberRegionTest test(file, *block_index_of(file), q);
     if (test.full_decode_is_faster()) {
-        if (indices) s = decode_indices(file, *indices, decode_options<DecodeOptions>(threads));
+        if (indices) s = decode_indices(file, *indices, decode_options(threads));
         else range = decode_range(file, begin, end, threads);
         const FibersView view = range ? FibersView{range->xyz.as<const float>(), range->offsets} : view_of(s);
         const std::vector<std::uint64_t> keep =
@@ -250,7 +243,7 @@ py::tuple decode(const std::string& path, std::uint64_t begin, std::optional<std
         if (!regions.empty()) {
             decode_with_regions(file, regions, begin, e, indices, threads, range, s, ids);
         } else if (indices) {
-            s = decode_indices(file, *indices, decode_options<DecodeOptions>(threads));
+            s = decode_indices(file, *indices, decode_options(threads));
             ids = std::move(*indices);
         } else {
             range = decode_range(file, begin, e, threads);
@@ -461,7 +454,6 @@ PYBIND11_MODULE(_fiblet, m) {
     m.doc() = "fiblet's compiled core; use the `fiblet` package instead.";
     m.attr("version") = FIBLET_VERSION;
     // Which block decoder fiblet.load() runs on (decode_range.hpp).
-    m.attr("block_decoder") = fast_block_decoder_available() ? "library (fastest available)" : "scalar reference";
 
     // fiblet::Error -> fiblet.FibletError, with the stable category name
     // (errc_name: "io", "fft_format", ...) as its `category` attribute.
