@@ -189,231 +189,287 @@ std::vector<FiberLutEntry> plan_blocks(FftHeader& h, const std::vector<std::uint
     return lut;
 }
 
+// One compress run, stage by stage: compress_tck calls them in order. The
+// state passes from stage to stage in these members; each stage says what
+// it reads and what it sets.
+class CompressJob {
+public:
+    CompressJob(const std::string& input, const std::string& output, const CompressOptions& options);
+    void scan();           // pass 1 (compress_scan.cpp), the data fields' checks
+    void choose_step();    // the step (and whether to resample), the header's normalisation
+    void resample_scan();  // pass 1b, resampled input only: tensions, counts, turns
+    void tune();           // cap, decoder step, encoder; the bits where they are to choose
+    void encode();         // pass 2 (compress_encode.cpp): header, fiber table, blocks, errors
+    void finish();         // block index, trailer chunks, the header's errors, commit
+    CompressReport report;
+
+private:
+    static constexpr std::size_t kSharpBlocks = 32;  // blocks of the sharpest turns kept for tuning
+    FiberEncoder tuned_encoder();
+
+    const std::string& input_;
+    const std::string& output_;
+    const CompressOptions& options_;
+    const bool choose_bits_;        // unset bits: 8 unless the sample says otherwise after tuning
+    const bool wide_blocks_asked_;  // ... or the block size asks for 16-bit blocks
+    BlockLayout layout_;
+    unsigned threads_ = 1;
+    std::size_t max_fiber_points_ = 0;
+    std::unique_ptr<StreamlineSource> source_;
+    std::vector<std::pair<std::string, std::string>> properties_;
+    std::optional<detail::ScanStageResult> scanned_;
+    std::vector<StreamlineField> fields_;
+    double step_ = 0;
+    std::optional<detail::PointFieldResampler> point_fields_;
+    std::vector<std::uint16_t> tensions_;
+    std::optional<double> step_scale_;
+    double stretch_ = 1;
+    std::optional<float> fixed_ratio_;
+    std::optional<detail::TuningSet> tuning_set_;
+    std::optional<FiberEncoder> encoder_;
+    std::unique_ptr<detail::FftSink> out_;
+    std::optional<FftChecksumBuilder> checksum_;
+    FiberEndFractions end_fractions_;
+    std::optional<IndexBuilder> index_;
+};
+
+// The options' checks, before any work; the source opened.
+CompressJob::CompressJob(const std::string& input, const std::string& output, const CompressOptions& options)
+    : input_(input), output_(output), options_(options), choose_bits_(!options.direction_bits),
+      wide_blocks_asked_(choose_bits_ && options.points_per_block > kMaxPointsPerBlock),
+      layout_(block_layout(options.direction_bits.value_or(wide_blocks_asked_ ? 16 : 8), options)) {
+    if (options.step_mm && !(std::isfinite(*options.step_mm) && *options.step_mm > 0))
+        throw Error(Errc::invalid_argument, "the step must be a positive number of millimetres");
+    threads_ = detail::resolve_threads(options.threads);
+    report.simd = detail::simd_level_name(detail::simd_level());  // a bad FIBLET_SIMD: refused before any work
+    // The longest streamline a file can hold bounds the one in memory too
+    // (either layout's while the bits are still to choose).
+    max_fiber_points_ = std::size_t{0xffff} * (choose_bits_ ? std::max(layout_.points_per_block,
+                                                                         block_layout(16, options).points_per_block)
+                                                            : layout_.points_per_block);
+    source_ = open_streamline_source(input, {.allow_count_mismatch = options.allow_count_mismatch,
+                                             .max_points = max_fiber_points_});
+    properties_ = source_->properties();
+    if (options.reference_space) {
+        if (space_from_properties(properties_, input))
+            throw Error(Errc::invalid_argument, input + " carries its own space (a .trk or TRX header): a reference "
+                                                        "image is for sources without one (.tck)");
+        add_space_properties(properties_, *options.reference_space);
+    }
+    report.scan.header_step = source_->step_size();
+    AtomicOutputFile::check_destination(output, options.overwrite);  // before the passes, not after
+}
+
+// Pass 1: counts, bounding box, spacing, turning angles, the tuning and
+// bits samples (the bits on a larger sample than the tuning's:
+// direction_bits.hpp); then the data fields against the counts.
+void CompressJob::scan() {
+    TckScan& scan = report.scan;
+    const std::size_t bits_sample_points =
+        choose_bits_ && !wide_blocks_asked_ ? std::max(options_.tuning_points, detail::kBitsSamplePoints) : 0;
+    scanned_.emplace(detail::scan_stage(*source_, scan, layout_.points_per_block, kSharpBlocks, options_.tuning_points,
+                                        bits_sample_points, threads_, options_, report.timings));
+    fields_ = source_->take_fields();
+    for (const StreamlineField& f : fields_)
+        if (const std::string problem = check_streamline_field(f, scan.fibers, scan.points); !problem.empty())
+            throw Error(Errc::invalid_input, input_ + ": " + problem);
+    if (scan.points == 0) scan.min = scan.max = {0, 0, 0};
+    if (scan.segments == 0) scan.step_min = 0;
+    scan.step_mean = scan.segments ? scanned_->length_sum / double(scan.segments) : 0.0;
+    scan.step_median = scanned_->lengths.median();
+}
+
+void CompressJob::choose_step() {
+    step_ = fiblet::choose_step(report.scan, scanned_->fiber_lengths, options_, layout_.points_per_block, report.resampled);
+    std::vector<float>().swap(scanned_->fiber_lengths);
+    if (report.resampled && !(step_ > 0))
+        throw Error(Errc::invalid_input, input_ + ": cannot resample: the measured step is zero");
+    FftHeader& h = report.header;
+    set_layout(h, layout_);
+    h.fibers = report.scan.fibers;
+    step_ = normalize(h, report.scan, step_, input_);
+    report.step_mm = step_;
+}
+
+// Pass 1b (resampled input): each fiber's fitted tension (formats/fft.md
+// §5) in kTensionQuantum units, fitted once and reused by pass 2 (2 bytes a
+// fiber), and the resampled counts and turns. The fit needs the decoder's
+// stretch of each step: resampled input has its step scale tuned on the
+// sample first (with the input's own turns; the cap is tuned again after
+// pass 1b, at that scale).
+void CompressJob::resample_scan() {
+    point_fields_.emplace(report.resampled ? &fields_ : nullptr, scanned_->fiber_points);
+    tensions_.assign(report.resampled ? report.scan.fibers : 0, 0);
+    if (options_.step_scale && !(*options_.step_scale > 0.5 && *options_.step_scale < 2))
+        throw Error(Errc::invalid_argument, "the step scale must be in (0.5, 2)");
+    step_scale_ = options_.step_scale;
+    FftHeader& h = report.header;
+    if (report.resampled && !step_scale_) {
+        const detail::StageClock clock(report.timings.tune);
+        step_scale_ = detail::tune_parameters({scanned_->sample.fibers(), {}, step_}, scanned_->turns, h, options_.search,
+                                              step_, std::nullopt, std::nullopt)
+                          .step_scale;
+    }
+    stretch_ = step_scale_ ? decoder_stretch(float(step_ * *step_scale_ / h.scaling), h.scaling, step_) : 1.0;
+    if (report.resampled)
+        detail::resample_scan_stage(*source_, {step_, stretch_}, options_.step_tolerance, max_fiber_points_, report.scan,
+                                    scanned_->fiber_points, tensions_, scanned_->turns, layout_.points_per_block,
+                                    kSharpBlocks, threads_, options_, report.timings);
+    point_fields_->set_resampled_points(scanned_->fiber_points);
+}
+
+// The cap, the decoder step and the encoder for the header's bits
+// (parameters.cpp). Resampled fibers keep their length across blocks
+// (length_feedback.hpp); fixed-step fibers where the sampling step and the
+// tail feedback do it (parameters.hpp, keep_fixed_step_lengths), their
+// block tails only.
+FiberEncoder CompressJob::tuned_encoder() {
+    FftHeader& h = report.header;
+    const detail::StageClock clock(report.timings.tune);
+    detail::TunedParameters tuned =
+        detail::tune_parameters(*tuning_set_, scanned_->turns, h, options_.search, step_, fixed_ratio_, step_scale_);
+    const bool keep_lengths = !report.resampled && detail::keep_fixed_step_lengths(*tuning_set_, scanned_->turns, tuned, h,
+                                                                                  step_, fixed_ratio_, step_scale_);
+    h.ratio = tuned.ratio;
+    report.step_scale = tuned.step_scale;
+    h.step = float(step_ * report.step_scale / h.scaling);
+    return (tuned.encoder ? std::move(*tuned.encoder) : FiberEncoder(h, tuned.search))
+        .with_length_feedback(report.resampled ? float(decoder_stretch(h.step, h.scaling, step_))
+                              : keep_lengths   ? 1.0f
+                                               : 0.0f,
+                              !report.resampled);
+}
+
+// Bits to choose: what 8-bit codes do to the sample's lengths; 16 bits when
+// they would not keep them (direction_bits.hpp), or when a fiber needs more
+// 8-bit blocks than a file holds. The 16-bit encoder is tuned as for
+// --bits 16 on the same sample (fixed-step input: the same bytes);
+// resampled input keeps the step and the decoder step pass 1b fitted its
+// tensions to.
+void CompressJob::tune() {
+    FftHeader& h = report.header;
+    report.scan.min_dot = scanned_->turns.min_dot();
+    if (options_.cap_ratio && !(*options_.cap_ratio > 0 && *options_.cap_ratio <= 2))
+        throw Error(Errc::invalid_argument, "the cap ratio must be in (0, 2]");
+    if (options_.cap_ratio) fixed_ratio_ = float(*options_.cap_ratio);
+    else if (options_.turn_percentile)
+        fixed_ratio_ = compute_ratio(h.scaling, step_, scanned_->turns.dot_at_percentile(*options_.turn_percentile));
+    tuning_set_.emplace(
+        detail::TuningSet{scanned_->sample.fibers(), scanned_->turns.sharpest_blocks(), report.resampled ? step_ : 0.0});
+    encoder_.emplace(tuned_encoder());
+    std::optional<std::uint32_t> too_long;  // points of a fiber 8-bit blocks cannot hold
+    if (choose_bits_ && h.direction_bits() == 8) {
+        {
+            const detail::StageClock clock(report.timings.tune);
+            report.bits = detail::measure_sample_lengths(scanned_->bits_sample.fibers(), *encoder_,
+                                                          {report.resampled ? step_ : 0.0, stretch_}, threads_);
+        }
+        const std::vector<std::uint32_t>& points = scanned_->fiber_points;
+        const std::uint32_t longest = points.empty() ? 0 : *std::max_element(points.begin(), points.end());
+        if (encoder_->block_count(longest) > 0xffff) too_long = longest;
+        if (too_long || !detail::eight_bits_keep_lengths(report.bits)) {
+            layout_ = block_layout(16, options_);
+            set_layout(h, layout_);
+            encoder_.emplace(tuned_encoder());
+        }
+    }
+    report.bits.automatic = choose_bits_;
+    report.bits.reason = too_long ? "16 bits: a fiber of " + std::to_string(*too_long) +
+                                        " points needs more than 65535 blocks of 8-bit codes"
+                                  : bits_reason(report.bits, h.direction_bits(), wide_blocks_asked_, layout_.points_per_block);
+    report.search = encoder_->search();
+}
+
+// Pass 2: the header and the fiber table, then the blocks, encoded and
+// measured (compress_encode.cpp).
+void CompressJob::encode() {
+    FftHeader& h = report.header;  // plan_blocks sets the block count
+    std::vector<FiberLutEntry> lut = plan_blocks(h, scanned_->fiber_points, *encoder_, layout_, input_);
+    out_ = detail::open_fft_sink(output_, options_.overwrite, options_.zstd, h.direction_bits(), h.block_bytes(), threads_);
+    checksum_.emplace(h.block_bytes());  // the CSUM trailer chunk (formats/fft-checksum.md)
+    const std::span<const std::uint8_t> lut_bytes{reinterpret_cast<const std::uint8_t*>(lut.data()),
+                                                  lut.size() * sizeof(FiberLutEntry)};
+    out_->begin(serialize_fft_header(h), lut_bytes);
+    checksum_->add_lut(lut_bytes.data(), lut_bytes.size());
+    // The per-fiber tables are written: free them (12 bytes per fiber, 62 MB
+    // for 5 M fibers) before the block index grows.
+    std::vector<FiberLutEntry>().swap(lut);
+    std::vector<std::uint32_t>().swap(scanned_->fiber_points);
+    // Resampled fibers keep their true end points: one last-step fraction
+    // per fiber (the ENDS chunk, formats/fft-ends.md), 2 bytes a fiber.
+    end_fractions_ = FiberEndFractions(report.resampled ? report.scan.fibers : 0, kWholeLastStep);
+    index_.emplace(h);
+    const detail::EncodeStageInputs in{.encoder = *encoder_,
+                                       .step = report.resampled ? step_ : 0.0,
+                                       .point_fields = &*point_fields_,
+                                       .end_fractions = &end_fractions_,
+                                       .tensions = &tensions_,
+                                       .block_index = options_.block_index,
+                                       .threads = threads_};
+    detail::EncodeStageResult r = detail::encode_stage(*source_, in, *out_, *checksum_, *index_, options_);
+    report.error = std::move(r.error);
+    report.geometry = std::move(r.geometry);
+    report.timings += r.timings;
+}
+
+void CompressJob::finish() {
+    FftHeader& h = report.header;
+    // The block index's chunk first: its builder's codes are larger than the chunk.
+    std::optional<TrailerChunk> index_chunk;
+    if (options_.block_index) {
+        const detail::StageClock clock(report.timings.index);
+        index_chunk = std::exchange(*index_, IndexBuilder(h)).finish();
+    }
+    const detail::StageClock clock(report.timings.write);  // the trailer and the commit
+    if (report.resampled) report.error_vs_original = report.geometry.decoded_to_input();
+    h.max_error_mm = float(report.error.max_mm());
+    h.mean_error_mm = float(report.error.mean_mm());
+    const auto final_head = serialize_fft_header(h);
+    const std::uint64_t at = out_->logical_size();
+    if (report.resampled)  // per-point arrays are interpolated, stored as float32: their source dtype in PROP
+        for (const StreamlineField& f : fields_)
+            if (f.scope() == FieldScope::point && f.type != FieldType::float32)
+                add_source_dtype_property(properties_, f.name, f.type);
+    std::vector<TrailerChunk> chunks{make_properties_chunk(properties_)};
+    if (!fields_.empty()) {
+        point_fields_->finish();
+        chunks.push_back(make_streamline_data_chunk(fields_));
+        std::vector<StreamlineField>().swap(fields_);
+    }
+    if (report.resampled) {
+        TrailerChunk c{kResampledTag, std::vector<std::uint8_t>(16)};  // step, curve, 0
+        const auto curve = std::uint32_t(detail::kWrittenCurve);
+        std::memcpy(c.payload.data(), &step_, 8);
+        std::memcpy(c.payload.data() + 8, &curve, 4);
+        chunks.push_back(std::move(c));
+        chunks.push_back(make_fiber_ends_chunk(end_fractions_));
+        FiberEndFractions().swap(end_fractions_);
+    }
+    if (index_chunk) chunks.push_back(std::move(*index_chunk));
+    chunks.push_back(checksum_->finish(final_head, chunks));  // last: it covers the chunks before it
+    out_->finish(serialize_trailer(chunks, at), final_head);
+    report.output_bytes = out_->stored_size();
+    out_->commit();
+}
+
 }  // namespace
 
 CompressReport compress_tck(const std::string& tck_path, const std::string& fft_path, const CompressOptions& options) {
     const Timer timer;
     if (options.direction_bits && *options.direction_bits != 8 && *options.direction_bits != 16)
         throw Error(Errc::invalid_argument, "direction bits must be 8 or 16");
-    // Unset bits: 8 unless the sample says otherwise after tuning (or the
-    // block size asks for 16-bit blocks).
-    const bool choose_bits = !options.direction_bits;
-    const bool wide_blocks_asked = choose_bits && options.points_per_block > kMaxPointsPerBlock;
-    BlockLayout layout = block_layout(options.direction_bits.value_or(wide_blocks_asked ? 16 : 8), options);
-    std::uint32_t points_per_block = layout.points_per_block;
-    if (options.step_mm && !(std::isfinite(*options.step_mm) && *options.step_mm > 0))
-        throw Error(Errc::invalid_argument, "the step must be a positive number of millimetres");
-    const unsigned threads = detail::resolve_threads(options.threads);  // checked before any work
-    CompressReport report;
-    report.simd = detail::simd_level_name(detail::simd_level());  // a bad FIBLET_SIMD: refused before any work
-
-    TckScan& scan = report.scan;
-    // The longest streamline a file can hold bounds the one in memory too
-    // (either layout's while the bits are still to choose).
-    const std::size_t max_fiber_points =
-        std::size_t{0xffff} *
-        (choose_bits ? std::max(points_per_block, block_layout(16, options).points_per_block) : points_per_block);
-    const auto source = open_streamline_source(
-        tck_path, {.allow_count_mismatch = options.allow_count_mismatch, .max_points = max_fiber_points});
-    StreamlineSource& reader = *source;
-    std::vector<std::pair<std::string, std::string>> properties = reader.properties();
-    if (options.reference_space) {
-        if (space_from_properties(properties, tck_path))
-            throw Error(Errc::invalid_argument, tck_path + " carries its own space (a .trk or TRX header): a reference "
-                                                           "image is for sources without one (.tck)");
-        add_space_properties(properties, *options.reference_space);
-    }
-    scan.header_step = reader.step_size();
-    AtomicOutputFile::check_destination(fft_path, options.overwrite);  // before the passes, not after
-
-    // Pass 1: counts, bounding box, spacing, turning angles (compress_scan.cpp).
-    // Turning angles and a sample of fibers, for the encoder's choices (parameters.cpp).
-    constexpr std::size_t kSharpBlocks = 32;
-    // The bits are measured on a larger sample than the tuning's (direction_bits.hpp).
-    const std::size_t bits_sample_points =
-        choose_bits && !wide_blocks_asked ? std::max(options.tuning_points, detail::kBitsSamplePoints) : 0;
-    CompressTimings& timings = report.timings;
-    detail::ScanStageResult scanned = detail::scan_stage(reader, scan, points_per_block, kSharpBlocks, options.tuning_points,
-                                                         bits_sample_points, threads, options, timings);
-    std::vector<std::uint32_t>& fiber_points = scanned.fiber_points;
-    detail::TurnStatistics& turns = scanned.turns;
-    detail::FiberSample& sample = scanned.sample;
-    const double length_sum = scanned.length_sum;
-    std::vector<StreamlineField> fields = reader.take_fields();
-    for (const StreamlineField& f : fields)
-        if (const std::string problem = check_streamline_field(f, scan.fibers, scan.points); !problem.empty())
-            throw Error(Errc::invalid_input, tck_path + ": " + problem);
-    if (scan.points == 0) scan.min = scan.max = {0, 0, 0};
-    if (scan.segments == 0) scan.step_min = 0;
-    scan.step_mean = scan.segments ? length_sum / double(scan.segments) : 0.0;
-    scan.step_median = scanned.lengths.median();
-
-    const double tol = options.step_tolerance;
-    double step = choose_step(scan, scanned.fiber_lengths, options, points_per_block, report.resampled);
-    std::vector<float>().swap(scanned.fiber_lengths);
-    if (report.resampled && !(step > 0))
-        throw Error(Errc::invalid_input, tck_path + ": cannot resample: the measured step is zero");
-    FftHeader& h = report.header;
-    set_layout(h, layout);
-    h.fibers = scan.fibers;
-    step = normalize(h, scan, step, tck_path);
-    report.step_mm = step;
-
-    // Pass 1b (resampling only): the counts and turning angles change.
-    detail::PointFieldResampler point_fields(report.resampled ? &fields : nullptr, fiber_points);
-    // Each fiber's fitted tension (formats/fft.md §5), in kTensionQuantum
-    // units: fitted once in pass 1b, reused by pass 2 (2 bytes a fiber). The
-    // fit needs the decoder's stretch of each step: resampled input has its
-    // step scale tuned on the sample first (with the input's own turns; the
-    // cap is tuned again after pass 1b, at that scale).
-    std::vector<std::uint16_t> tensions(report.resampled ? scan.fibers : 0);
-    if (options.step_scale && !(*options.step_scale > 0.5 && *options.step_scale < 2))
-        throw Error(Errc::invalid_argument, "the step scale must be in (0.5, 2)");
-    std::optional<double> step_scale = options.step_scale;
-    if (report.resampled && !step_scale) {
-        const detail::StageClock clock(timings.tune);
-        step_scale = detail::tune_parameters({sample.fibers(), {}, step}, turns, h, options.search, step, std::nullopt,
-                                             std::nullopt)
-                         .step_scale;
-    }
-    const double stretch = step_scale ? decoder_stretch(float(step * *step_scale / h.scaling), h.scaling, step) : 1.0;
-    if (report.resampled)
-        detail::resample_scan_stage(reader, {step, stretch}, tol, max_fiber_points, scan, fiber_points, tensions, turns,
-                                    points_per_block, kSharpBlocks, threads, options, timings);
-
-    point_fields.set_resampled_points(fiber_points);
-    // Header: the encoder's choices (parameters.cpp), block layout and buffer table.
-    scan.min_dot = turns.min_dot();
-    if (options.cap_ratio && !(*options.cap_ratio > 0 && *options.cap_ratio <= 2))
-        throw Error(Errc::invalid_argument, "the cap ratio must be in (0, 2]");
-    std::optional<float> fixed_ratio;
-    if (options.cap_ratio) fixed_ratio = float(*options.cap_ratio);
-    else if (options.turn_percentile) fixed_ratio = compute_ratio(h.scaling, step, turns.dot_at_percentile(*options.turn_percentile));
-    const detail::TuningSet tuning_set{sample.fibers(), turns.sharpest_blocks(), report.resampled ? step : 0.0};
-    // The cap, the decoder step and the encoder for the header's bits.
-    auto tuned_encoder = [&] {
-        const detail::StageClock clock(timings.tune);
-        detail::TunedParameters tuned =
-            detail::tune_parameters(tuning_set, turns, h, options.search, step, fixed_ratio, step_scale);
-        // Fixed-step input keeps its lengths where the sampling step and the
-        // tail feedback do it (parameters.hpp, keep_fixed_step_lengths).
-        const bool keep_lengths =
-            !report.resampled &&
-            detail::keep_fixed_step_lengths(tuning_set, turns, tuned, h, step, fixed_ratio, step_scale);
-        h.ratio = tuned.ratio;
-        report.step_scale = tuned.step_scale;
-        h.step = float(step * report.step_scale / h.scaling);
-        // Resampled fibers keep their length across blocks (length_feedback.hpp);
-        // fixed-step fibers where keep_lengths (their block tails only).
-        return (tuned.encoder ? std::move(*tuned.encoder) : FiberEncoder(h, tuned.search))
-            .with_length_feedback(report.resampled ? float(decoder_stretch(h.step, h.scaling, step))
-                                  : keep_lengths   ? 1.0f
-                                                   : 0.0f,
-                                  !report.resampled);
-    };
-    FiberEncoder encoder = tuned_encoder();
-    // Bits to choose: what 8-bit codes do to the sample's lengths; 16 bits when they would
-    // not keep them (direction_bits.hpp), or when a fiber needs more 8-bit
-    // blocks than a file holds. The 16-bit encoder is tuned as for --bits 16
-    // on the same sample (fixed-step input: the same bytes); resampled input
-    // keeps the step and the decoder step pass 1b fitted its tensions to.
-    std::optional<std::uint32_t> too_long;  // points of a fiber 8-bit blocks cannot hold
-    if (choose_bits && h.direction_bits() == 8) {
-        {
-            const detail::StageClock clock(timings.tune);
-            report.bits = detail::measure_sample_lengths(scanned.bits_sample.fibers(), encoder,
-                                                          {report.resampled ? step : 0.0, stretch}, threads);
-        }
-        const std::uint32_t longest = fiber_points.empty() ? 0 : *std::max_element(fiber_points.begin(), fiber_points.end());
-        if (encoder.block_count(longest) > 0xffff) too_long = longest;
-        if (too_long || !detail::eight_bits_keep_lengths(report.bits)) {
-            layout = block_layout(16, options);
-            points_per_block = layout.points_per_block;
-            set_layout(h, layout);
-            encoder = tuned_encoder();
-        }
-    }
-    report.bits.automatic = choose_bits;
-    report.bits.reason = too_long ? "16 bits: a fiber of " + std::to_string(*too_long) +
-                                        " points needs more than 65535 blocks of 8-bit codes"
-                                  : bits_reason(report.bits, h.direction_bits(), wide_blocks_asked, points_per_block);
-    report.search = encoder.search();
-    std::vector<FiberLutEntry> lut = plan_blocks(h, fiber_points, encoder, layout, tck_path);
-
-    // Pass 2: encode, measure, write.
-    const auto out = detail::open_fft_sink(fft_path, options.overwrite, options.zstd, h.direction_bits(),
-                                           h.block_bytes(), threads);
-    FftChecksumBuilder checksum(h.block_bytes());  // the CSUM trailer chunk (formats/fft-checksum.md)
-    {
-        const std::span<const std::uint8_t> lut_bytes{reinterpret_cast<const std::uint8_t*>(lut.data()),
-                                                      lut.size() * sizeof(FiberLutEntry)};
-        out->begin(serialize_fft_header(h), lut_bytes);
-        checksum.add_lut(lut_bytes.data(), lut_bytes.size());
-    }
-    // The per-fiber tables are written: free them (12 bytes per fiber, 62 MB
-    // for 5 M fibers) before the block index grows.
-    std::vector<FiberLutEntry>().swap(lut);
-    std::vector<std::uint32_t>().swap(fiber_points);
-    // Resampled fibers keep their true end points: one last-step fraction
-    // per fiber (the ENDS chunk, formats/fft-ends.md), 2 bytes a fiber.
-    FiberEndFractions end_fractions(report.resampled ? scan.fibers : 0, kWholeLastStep);
-    IndexBuilder index(h);
-    {
-        const detail::EncodeStageInputs in{.encoder = encoder,
-                                           .step = report.resampled ? step : 0.0,
-                                           .point_fields = &point_fields,
-                                           .end_fractions = &end_fractions,
-                                           .tensions = &tensions,
-                                           .block_index = options.block_index,
-                                           .threads = threads};
-        detail::EncodeStageResult r = detail::encode_stage(reader, in, *out, checksum, index, options);
-        report.error = std::move(r.error);
-        report.geometry = std::move(r.geometry);
-        timings += r.timings;
-    }
-    // The block index's chunk first: its builder's codes are larger than the chunk.
-    std::optional<TrailerChunk> index_chunk;
-    if (options.block_index) {
-        const detail::StageClock clock(timings.index);
-        index_chunk = std::exchange(index, IndexBuilder(h)).finish();
-    }
-    {
-        const detail::StageClock clock(timings.write);  // the trailer and the commit
-        if (report.resampled) report.error_vs_original = report.geometry.decoded_to_input();
-        h.max_error_mm = float(report.error.max_mm());
-        h.mean_error_mm = float(report.error.mean_mm());
-        const auto final_head = serialize_fft_header(h);
-        const std::uint64_t at = out->logical_size();
-        if (report.resampled)  // per-point arrays are interpolated, stored as float32: their source dtype in PROP
-            for (const StreamlineField& f : fields)
-                if (f.scope() == FieldScope::point && f.type != FieldType::float32)
-                    add_source_dtype_property(properties, f.name, f.type);
-        std::vector<TrailerChunk> chunks{make_properties_chunk(properties)};
-        if (!fields.empty()) {
-            point_fields.finish();
-            chunks.push_back(make_streamline_data_chunk(fields));
-            std::vector<StreamlineField>().swap(fields);
-        }
-        if (report.resampled) {
-            TrailerChunk c{kResampledTag, std::vector<std::uint8_t>(16)};  // step, curve, 0
-            const auto curve = std::uint32_t(detail::kWrittenCurve);
-            std::memcpy(c.payload.data(), &step, 8);
-            std::memcpy(c.payload.data() + 8, &curve, 4);
-            chunks.push_back(std::move(c));
-            chunks.push_back(make_fiber_ends_chunk(end_fractions));
-            FiberEndFractions().swap(end_fractions);
-        }
-        if (index_chunk) chunks.push_back(std::move(*index_chunk));
-        chunks.push_back(checksum.finish(final_head, chunks));  // last: it covers the chunks before it
-        out->finish(serialize_trailer(chunks, at), final_head);
-        report.output_bytes = out->stored_size();
-        out->commit();
-    }
+    CompressJob job(tck_path, fft_path, options);
+    job.scan();
+    job.choose_step();
+    job.resample_scan();
+    job.tune();
+    job.encode();
+    job.finish();
     if (options.progress) options.progress("encode", 1.0);
-
+    CompressReport& report = job.report;
     report.input_bytes = tractogram_bytes(tck_path);  // a TRX directory: its files
     report.seconds = timer.seconds();
-    return report;
+    return std::move(report);
 }
 
 }  // namespace fiblet
