@@ -26,15 +26,15 @@ inline constexpr ResampleCurve kWrittenCurve = ResampleCurve::rounded_keeping_le
 inline std::uint16_t tension_code(double tension) { return std::uint16_t(std::lround(tension / kTensionQuantum)); }
 inline double tension_of(std::uint16_t code) { return code * kTensionQuantum; }
 
+// lengths[s] = |f[s + 1] - f[s]| in double, as distance() computes it
+// (bit for bit; four at a time with AVX2).
+void segment_lengths(std::span<const Vec3f> f, std::vector<double>& lengths);
+
 // The turning angles between consecutive unit segment directions
 // (zero-length segments carry no direction and are skipped): a histogram
 // of sin^2(angle / 2) in 2^15 bins (0.013 degree resolution at 15
 // degrees), the sharpest turn, and copies of the blocks holding the sharpest turns (where
 // a small cap costs the most error, and which a sample would miss).
-// lengths[s] = |f[s + 1] - f[s]| in double, as distance() computes it
-// (bit for bit; four at a time with AVX2).
-void segment_lengths(std::span<const Vec3f> f, std::vector<double>& lengths);
-
 class TurnStatistics {
 public:
     TurnStatistics(std::uint32_t points_per_block, std::size_t kept_blocks);

@@ -119,7 +119,7 @@ FIBLET_AVX2 __m256d segment_dist2_avx2(const Segments& g, __m256d x, __m256d y, 
     t = _mm256_min_pd(_mm256_set1_pd(1.0), _mm256_max_pd(_mm256_setzero_pd(), _mm256_mul_pd(t, column(g.inv_uu, s))));
     const __m256d dx = _mm256_sub_pd(wx, _mm256_mul_pd(t, ux)), dy = _mm256_sub_pd(wy, _mm256_mul_pd(t, uy)),
                   dz = _mm256_sub_pd(wz, _mm256_mul_pd(t, uz));
-    return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)), _mm256_mul_pd(dz, dz));
+    return detail::norm2(dx, dy, dz);
 }
 
 // Squared distances of p to the kLanes segments from `base` into d.
@@ -149,8 +149,7 @@ __attribute__((target("avx2"))) std::size_t directions_avx2(Segments& g, std::si
                       dy = _mm256_sub_pd(column(g.ay, s + 1), column(g.ay, s)),
                       dz = _mm256_sub_pd(column(g.az, s + 1), column(g.az, s));
         _mm256_storeu_pd(g.ux.data() + s, dx), _mm256_storeu_pd(g.uy.data() + s, dy), _mm256_storeu_pd(g.uz.data() + s, dz);
-        _mm256_storeu_pd(g.len.data() + s, _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)),
-                                                         _mm256_mul_pd(dz, dz)));
+        _mm256_storeu_pd(g.len.data() + s, detail::norm2(dx, dy, dz));
     }
     return s;
 }
@@ -280,9 +279,7 @@ __attribute__((target("avx2"))) void own_segments_avx2(const Segments& g, const 
         const __m256d x = column(from_g.ax, k), y = column(from_g.ay, k), z = column(from_g.az, k);
         const __m256d ex = _mm256_sub_pd(x, column(g.ax, k)), ey = _mm256_sub_pd(y, column(g.ay, k)),
                       ez = _mm256_sub_pd(z, column(g.az, k));
-        const __m256d e4 = _mm256_mul_pd(
-            _mm256_set1_pd(4.0),
-            _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(ex, ex), _mm256_mul_pd(ey, ey)), _mm256_mul_pd(ez, ez)));
+        const __m256d e4 = _mm256_mul_pd(_mm256_set1_pd(4.0), detail::norm2(ex, ey, ez));
         const __m256d before = segment_dist2_avx2(g, x, y, z, k - 1), after = segment_dist2_avx2(g, x, y, z, k);
         const __m256d later = _mm256_cmp_pd(after, before, _CMP_LT_OQ);
         _mm256_storeu_pd(nearest + k, _mm256_blendv_pd(before, after, later));  // after < before ? after : before
