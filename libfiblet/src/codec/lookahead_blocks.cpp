@@ -81,45 +81,50 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
         VF l[9], win_f[9], win_x, win_y, win_z;
         code.frame(aimed, l);
         const VF aimed_e0 = error2(base, l[0], l[1], l[2], x, y, z);
-        VF best = hn::Add(aimed_e0, after(l, win_f, win_x, win_y, win_z)), best_e0 = aimed_e0;
+        VF best = hn::Add(aimed_e0, after(l, win_f, win_x, win_y, win_z));
         VI win_code = aimed;
         // The rivals (the aimed code's neighbours), where a lane has a point
-        // after k. A rival replaces the winner with a smaller sum, or an equal
-        // sum and a smaller own error than a rival winner's (the scalar
-        // search's order of trial); rivals whose own error reaches the sum
-        // cannot win, and a rival no lane can take is skipped.
+        // after k, in the scalar search's order: each round takes every
+        // lane's cheapest untried rival by own error (the first on a tie),
+        // tried while that error is below the lane's best; a rival wins with
+        // a smaller sum. Rounds end when no lane has a rival left to try
+        // (most lanes try none or one: about two rounds a point, not eight).
         const auto more = s.more_after(k);
-        auto rival_won = hn::FirstN(d, 0);
         const VI nb_at = hn::Mul(aimed, hn::Set(di, 36));
         const VI words[2] = {hn::GatherIndex(di, nb_words + kNbCodes, nb_at),
                              hn::GatherIndex(di, nb_words + kNbCodes + 1, nb_at)};
         const VI count = hn::GatherIndex(di, nb_words + kNbCount, nb_at);
+        VF rival_e0[8];
         for (int r = 0; r < 8; ++r) {
             const VF dx = hn::GatherIndex(d, nb_floats + r, nb_at), dy = hn::GatherIndex(d, nb_floats + kNbY + r, nb_at),
                      dz = hn::GatherIndex(d, nb_floats + kNbZ + r, nb_at);
-            const auto listed = hn::RebindMask(d, hn::Lt(hn::Set(di, r), count));
-            const VF e0 = hn::IfThenElse(listed, error2(base, dx, dy, dz, x, y, z), inf);
-            const auto tries = hn::And(more, hn::Lt(e0, best));
-            if (hn::AllFalse(d, tries)) continue;
-            const VI c = hn::And(hn::ShiftRightSame(words[r / 4], 8 * (r % 4)), code.byte);
+            const auto listed = hn::And(more, hn::RebindMask(d, hn::Lt(hn::Set(di, r), count)));
+            rival_e0[r] = hn::IfThenElse(listed, error2(base, dx, dy, dz, x, y, z), inf);
+        }
+        for (int round = 0; round < 8; ++round) {
+            VF e0 = rival_e0[0];
+            VI which = hn::Zero(di);
+            for (int r = 1; r < 8; ++r) {
+                const auto lower = hn::Lt(rival_e0[r], e0);
+                e0 = hn::IfThenElse(lower, rival_e0[r], e0);
+                which = hn::IfThenElse(hn::RebindMask(di, lower), hn::Set(di, r), which);
+            }
+            const auto tries = hn::Lt(e0, best);
+            if (hn::AllFalse(d, tries)) break;
+            for (int r = 0; r < 8; ++r)
+                rival_e0[r] = hn::IfThenElse(hn::RebindMask(d, hn::Eq(which, hn::Set(di, r))), inf, rival_e0[r]);
+            // Rival `which`'s code: byte (which % 4) of its word.
+            const VI word = hn::IfThenElse(hn::RebindMask(di, hn::Lt(which, hn::Set(di, 4))), words[0], words[1]);
+            const VI c = hn::And(word >> hn::ShiftLeft<3>(hn::And(which, hn::Set(di, 3))), code.byte);
             VF lr[9], rf[9], qx, qy, qz;  // the rival's frame, its state after point k
             code.frame(c, lr);
             const VF total = hn::Add(e0, after(lr, rf, qx, qy, qz));
-            const auto tie = hn::And(hn::Eq(total, best), hn::And(rival_won, hn::Lt(e0, best_e0)));
-            const auto wins = hn::And(tries, hn::Or(hn::Lt(total, best), tie));
+            const auto wins = hn::And(tries, hn::Lt(total, best));
             best = hn::IfThenElse(wins, total, best);
-            best_e0 = hn::IfThenElse(wins, e0, best_e0);
-            rival_won = hn::Or(rival_won, wins);
             win_code = hn::IfThenElse(hn::RebindMask(di, wins), c, win_code);
-        }
-        // A rival won in some lane: the winners' states again (the same
-        // operations give the same bits), rather than blending every rival's.
-        if (!hn::AllFalse(d, rival_won)) {
-            code.frame(win_code, l);
-            Lanes::compose(s.f, l, win_f);
-            win_x = hn::Add(s.px, hn::Mul(stepv, win_f[0]));
-            win_y = hn::Add(s.py, hn::Mul(stepv, win_f[1]));
-            win_z = hn::Add(s.pz, hn::Mul(stepv, win_f[2]));
+            for (int j = 0; j < 9; ++j) win_f[j] = hn::IfThenElse(wins, rf[j], win_f[j]);
+            win_x = hn::IfThenElse(wins, qx, win_x), win_y = hn::IfThenElse(wins, qy, win_y);
+            win_z = hn::IfThenElse(wins, qz, win_z);
         }
         for (int j = 0; j < 9; ++j) s.f[j] = win_f[j];
         s.px = win_x, s.py = win_y, s.pz = win_z;
