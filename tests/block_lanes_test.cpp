@@ -1,5 +1,6 @@
 // The encoder's searches with one block per SIMD lane: greedy
-// (codec/greedy_blocks.hpp) and depth-1 lookahead (codec/lookahead_blocks.hpp).
+// (codec/greedy_blocks.hpp) and lookahead at depths 1 and 2
+// (codec/lookahead_blocks.hpp: the first search and the length tails).
 // At every level this CPU supports, the same codes and the same decoded
 // points, bit for bit, as the scalar searches (search_codes,
 // LookaheadSearch), on random walks, on the shared tractogram and on the
@@ -51,9 +52,12 @@ struct Result {
     std::vector<Vec3f> decoded;
 };
 
-// Which search: greedy aiming or the depth-1 lookahead.
-enum class Search { greedy, lookahead };
-const char* name_of(Search s) { return s == Search::greedy ? "greedy" : "lookahead"; }
+// Which search: greedy aiming or the lookahead of depth 1 or 2.
+enum class Search { greedy, lookahead, lookahead2 };
+const char* name_of(Search s) {
+    return s == Search::greedy ? "greedy" : s == Search::lookahead ? "lookahead" : "lookahead depth 2";
+}
+std::size_t depth_of(Search s) { return s == Search::lookahead2 ? 2 : 1; }
 
 Result run_level(const detail::Codebook8& cb, float step, const Blocks& in, SimdLevel level, Search search) {
     Result r;
@@ -63,7 +67,7 @@ Result run_level(const detail::Codebook8& cb, float step, const Blocks& in, Simd
     const detail::GreedyBatch batch{in.frames.data(), in.points.data(), in.points.data() + 1, r.decoded.data() + 1,
                                     in.stride, r.codes.data(), code_stride, in.count(), in.m, in.last_m()};
     if (search == Search::greedy) detail::greedy_blocks(cb, step, batch, level);
-    else detail::lookahead_blocks(cb, step, 1, batch, level);
+    else detail::lookahead_blocks(cb, step, depth_of(search), batch, level);
     return r;
 }
 
@@ -80,7 +84,7 @@ Result run_reference(const detail::Codebook8& cb, float step, const Blocks& in, 
             detail::search_codes(cb, detail::SearchParams{1, 1}, in.frames[j], in.points[at], step, targets,
                                  &r.codes[j * code_stride], &r.decoded[at + 1]);
         else
-            detail::LookaheadSearch<detail::Codebook8>(cb, step, 1)
+            detail::LookaheadSearch<detail::Codebook8>(cb, step, depth_of(search))
                 .run(in.frames[j], in.points[at], targets, &r.codes[j * code_stride], &r.decoded[at + 1]);
     }
     return r;
@@ -106,9 +110,10 @@ void expect_same_at_every_level(const detail::Codebook8& cb, float step, const B
     }
 }
 
-// Both searches.
+// Every search.
 void expect_same_at_every_level(const detail::Codebook8& cb, float step, const Blocks& in, const std::string& what) {
-    for (Search search : {Search::greedy, Search::lookahead}) expect_same_at_every_level(cb, step, in, what, search);
+    for (Search search : {Search::greedy, Search::lookahead, Search::lookahead2})
+        expect_same_at_every_level(cb, step, in, what, search);
 }
 
 Vec3f unit(Vec3f v) { return detail::normalize(v); }
@@ -243,17 +248,22 @@ TEST(BlockLanes, EncoderWritesTheSameBlocksAtEveryLevel) {
         SearchOptions search = search_for_effort(effort);
         if (search.retry_beam_width > 0) search.retry_error_mm = 0.004;
         const FiberEncoder encoder = FiberEncoder(h, search).with_length_feedback(1.0f, true);
-        auto encode_all = [&](SimdLevel level, std::vector<Vec3f>& decoded) {
+        // One fiber at a time, or 13 together (encode_fibers: the length
+        // tails' searches of many fibers in SIMD lanes).
+        auto encode_all = [&](SimdLevel level, std::vector<Vec3f>& decoded, std::size_t together) {
             ForcedLevel forced(level);
             std::vector<std::uint8_t> out;
-            for (std::size_t i = 0; i < fibers.size(); ++i) encoder.encode(fibers[i], std::uint32_t(i), out, &decoded);
+            const std::vector<std::span<const Vec3f>> spans(fibers.begin(), fibers.end());
+            for (std::size_t i = 0; i < fibers.size(); i += together)
+                encoder.encode_fibers(std::span(spans).subspan(i, std::min(together, fibers.size() - i)), std::uint32_t(i),
+                                      out, &decoded);
             return out;
         };
         std::vector<Vec3f> ref_decoded;
-        const auto ref = encode_all(SimdLevel::scalar, ref_decoded);
+        const auto ref = encode_all(SimdLevel::scalar, ref_decoded, 1);
         for (SimdLevel level : detail::supported_simd_levels()) {
             std::vector<Vec3f> decoded;
-            const auto got = encode_all(level, decoded);
+            const auto got = encode_all(level, decoded, 13);
             EXPECT_TRUE(got == ref) << "effort " << effort << ", " << detail::simd_level_name(level);
             ASSERT_EQ(decoded.size(), ref_decoded.size());
             EXPECT_EQ(std::memcmp(decoded.data(), ref_decoded.data(), decoded.size() * sizeof(Vec3f)), 0)

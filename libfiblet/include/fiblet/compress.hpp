@@ -112,6 +112,7 @@ struct CompressReport {
     double step_scale = 1;           // decoder step / sampling step (header step = step_mm * step_scale)
     SearchOptions search;            // the search used (with the retry threshold chosen)
     bool resampled = false;          // the input was resampled to the fixed step
+    bool lengths_kept = false;       // fixed-step input: block tails searched again to keep lengths
     ErrorStats error;                // decoded vs the encoded points (resampled ones if resampled)
     ErrorStats error_vs_original;    // decoded vs the original polyline (only if resampled)
     GeometryError geometry;          // decoded vs input polylines, both ways; endpoints, lengths

@@ -150,7 +150,7 @@ struct BatchLanes {
             for (int c = 0; c < 3; ++c)
                 start[3 * c][i] = fr.c[c].x, start[3 * c + 1][i] = fr.c[c].y, start[3 * c + 2][i] = fr.c[c].z;
             start[9][i] = p.x, start[10][i] = p.y, start[11][i] = p.z;
-            m_of[i] = j + 1 == batch.blocks ? batch.last_m : batch.m;
+            m_of[i] = batch.length(j);
             steps = std::max(steps, m_of[i]);
             first_at[i] = std::int32_t(3 * (j - j0) * batch.stride);
             last_at[i] = std::int32_t(3 * ((j - j0) * batch.stride + m_of[i] - 1));
@@ -167,7 +167,9 @@ struct BatchLanes {
         x = hn::GatherIndex(d, targets, where), y = hn::GatherIndex(d, targets + 1, where);
         z = hn::GatherIndex(d, targets + 2, where);
     }
-    VI next_at() const { return hn::Min(hn::Add(at, hn::Set(hn::RebindToSigned<D>(), 3)), at_end); }
+    VI next_at() const { return ahead_at(1); }
+    // Where the targets n points ahead are (the last target past a lane's end).
+    VI ahead_at(int n) const { return hn::Min(hn::Add(at, hn::Set(hn::RebindToSigned<D>(), 3 * n)), at_end); }
     // Lanes still having a target after step k.
     hn::Mask<D> more_after(std::size_t k) const {
         alignas(64) float more[kMaxLanes];

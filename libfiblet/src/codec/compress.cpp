@@ -332,6 +332,7 @@ FiberEncoder CompressJob::tuned_encoder() {
                                                                                   step_, fixed_ratio_, step_scale_);
     h.ratio = tuned.ratio;
     report.step_scale = tuned.step_scale;
+    report.lengths_kept = keep_lengths;
     h.step = float(step_ * report.step_scale / h.scaling);
     return (tuned.encoder ? std::move(*tuned.encoder) : FiberEncoder(h, tuned.search))
         .with_length_feedback(report.resampled ? float(decoder_stretch(h.step, h.scaling, step_))

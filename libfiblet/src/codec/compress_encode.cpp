@@ -32,6 +32,10 @@ namespace fiblet::detail {
 
 namespace {
 
+// Fixed-step fibers encoded together: enough that four of them usually
+// have a length tail to search at once.
+constexpr std::size_t kFibersTogether = 16;
+
 // The header's error of each point: the worse of fiblet's float decode and
 // the exact decode (when given), so it holds for every decoder. One square
 // root per point (of the larger square: the same double as the larger of
@@ -138,48 +142,73 @@ void pack_task(const EncodeStageInputs& in, Slot& w) {
     if (h.packed()) pack_blocks16(h, w.blocks, w.packed, &w.packed_sizes);
 }
 
+// Fixed-step fibers [i, end) of the batch, encoded together (their length
+// tails' searches run in lockstep: FiberEncoder::encode_fibers).
+void encode_fixed_step(const EncodeStageInputs& in, const FiberBatch& b, std::size_t i, std::size_t end, Slot& w) {
+    const StageClock clock(w.timings.encode);
+    std::span<const Vec3f> fibers[kFibersTogether];
+    for (std::size_t j = i; j < end; ++j) fibers[j - i] = b.fibers[j];
+    std::size_t blocks_end = w.blocks.size();
+    in.encoder.encode_fibers(std::span<const std::span<const Vec3f>>(fibers, end - i), std::uint32_t(b.first_fiber + i),
+                             w.blocks, &w.decoded, &w.decoded_exact);
+    for (std::size_t j = i; j < end; ++j) {
+        blocks_end += std::size_t(in.encoder.block_count(b.fibers[j].size())) * in.encoder.header().block_bytes();
+        w.starts.push_back(w.starts.back() + b.fibers[j].size());
+        w.block_ends.push_back(blocks_end);
+    }
+}
+
+// Resampled fiber i of the batch, its end placed; its largest error that
+// no later end placement moves (8-bit) into the task's budget.
+void encode_resampled(const EncodeStageInputs& in, const FiberBatch& b, std::size_t i, Slot& w) {
+    const std::vector<Vec3f>& original = b.fibers[i];
+    const auto f = std::uint32_t(b.first_fiber + i);
+    {
+        const StageClock clock(w.timings.encode);
+        const bool fields = in.point_fields && in.point_fields->active();
+        const std::size_t at = w.targets.size();
+        const bool short_tail = resample_cubic_keeping_end(original, in.step, tension_of((*in.tensions)[f]), w.resampled,
+                                                           fields ? &w.positions : nullptr, kWrittenCurve);
+        if (fields) in.point_fields->resample(f, w.positions);
+        w.targets.insert(w.targets.end(), w.resampled.begin(), w.resampled.end());
+        const std::span<const Vec3f> points(w.targets.data() + at, w.targets.size() - at);
+        w.lengths.push_back(polyline_length(original));
+        w.ends.push_back(encode_keeping_end(in.encoder, points, short_tail, in.step, f, w.blocks, w.decoded,
+                                            &w.decoded_exact, w.scratch, w.lengths.back()));
+        (*in.end_fractions)[f] = w.ends.back().fraction;
+    }
+    const std::size_t s = w.starts.back();
+    w.starts.push_back(w.decoded.size());
+    w.block_ends.push_back(w.blocks.size());
+    if (in.encoder.header().direction_bits() != 8) return;
+    const StageClock clock(w.timings.metrics);
+    const bool missing = misses_its_length(w.ends.back());
+    w.ends_missing = w.ends_missing || missing;
+    const std::size_t n = w.decoded.size() - s;
+    const std::size_t kept = missing ? n - std::min(n, movable_end_points(w.ends.back())) : n;
+    auto fiber = [&](const std::vector<Vec3f>& v) { return v.empty() ? std::span<const Vec3f>() : std::span<const Vec3f>(v).subspan(s); };
+    w.kept_max = std::max(w.kept_max, largest_error(fiber(w.targets), fiber(w.decoded), fiber(w.decoded_exact), kept));
+}
+
 // Stage 2, one task: fibers [cuts[t], cuts[t + 1]) of the batch into the
-// slot, each measured as soon as it is encoded — but from the first that
-// misses its length on, they wait for the batch's budget (finish_batch).
+// slot, measured as soon as they are encoded — but from the first
+// resampled fiber that misses its length on, they wait for the batch's
+// budget (finish_batch).
 void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t, Slot& w) {
     w.blocks.clear();
     w.index.clear();
     w.targets.clear(), w.decoded.clear(), w.decoded_exact.clear();
     w.starts.assign(1, 0), w.block_ends.clear(), w.ends.clear(), w.lengths.clear();
     w.kept_max = 0, w.ends_missing = false;
-    const bool budgeted = in.step > 0 && in.encoder.header().direction_bits() == 8;
-    for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1]; ++i) {
-        const std::vector<Vec3f>& original = b.fibers[i];
-        const auto f = std::uint32_t(b.first_fiber + i);
+    for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1];) {
         if (w.starts.size() == 1) w.first_pending = i;
-        std::optional<StageClock> encoding(std::in_place, w.timings.encode);
         if (in.step > 0) {
-            const bool fields = in.point_fields && in.point_fields->active();
-            const std::size_t at = w.targets.size();
-            const bool short_tail = resample_cubic_keeping_end(original, in.step, tension_of((*in.tensions)[f]),
-                                                               w.resampled, fields ? &w.positions : nullptr, kWrittenCurve);
-            if (fields) in.point_fields->resample(f, w.positions);
-            w.targets.insert(w.targets.end(), w.resampled.begin(), w.resampled.end());
-            const std::span<const Vec3f> points(w.targets.data() + at, w.targets.size() - at);
-            w.lengths.push_back(polyline_length(original));
-            w.ends.push_back(encode_keeping_end(in.encoder, points, short_tail, in.step, f, w.blocks, w.decoded,
-                                                &w.decoded_exact, w.scratch, w.lengths.back()));
-            (*in.end_fractions)[f] = w.ends.back().fraction;
+            encode_resampled(in, b, i, w);
+            ++i;
         } else {
-            in.encoder.encode(original, f, w.blocks, &w.decoded, &w.decoded_exact);
-        }
-        encoding.reset();
-        const std::size_t s = w.starts.back();
-        w.starts.push_back(w.decoded.size());
-        w.block_ends.push_back(w.blocks.size());
-        if (budgeted) {
-            const StageClock clock(w.timings.metrics);
-            const bool missing = misses_its_length(w.ends.back());
-            w.ends_missing = w.ends_missing || missing;
-            const std::size_t n = w.decoded.size() - s;
-            const std::size_t kept = missing ? n - std::min(n, movable_end_points(w.ends.back())) : n;
-            auto fiber = [&](const std::vector<Vec3f>& v) { return v.empty() ? std::span<const Vec3f>() : std::span<const Vec3f>(v).subspan(s); };
-            w.kept_max = std::max(w.kept_max, largest_error(fiber(w.targets), fiber(w.decoded), fiber(w.decoded_exact), kept));
+            const std::size_t end = std::min(b.cuts[t + 1], i + kFibersTogether);
+            encode_fixed_step(in, b, i, end, w);
+            i = end;
         }
         if (!w.ends_missing) measure_pending(in, b, w);
     }

@@ -2,6 +2,7 @@
 #include <cmath>
 #include <mutex>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "codec/anchor_conditioning.hpp"
@@ -106,15 +107,33 @@ void exact_decoder_targets(const DecoderStarts& s, std::span<const Vec3f> target
 }
 
 
-// Largest squared distance of a[k] to b[k].
-float max_distance2(const Vec3f* a, const Vec3f* b, std::size_t m) {
-    float worst = 0;
-    for (std::size_t k = 0; k < m; ++k) {
-        const Vec3f d = a[k] - b[k];
-        worst = std::max(worst, dot(d, d));
+// Blocks gathered from several fibers into one batch for the SIMD lanes
+// (greedy_blocks.hpp's layout: block j's start point, then its targets, at
+// points[j * stride]; its codes at codes[j * m]), and their results.
+struct BlockBatch {
+    std::size_t m = 0, stride = 0;
+    std::vector<Frame> frames;
+    std::vector<Vec3f> points, decoded;
+    std::vector<std::uint8_t> codes;
+    std::vector<std::uint32_t> lengths;
+
+    // Room for `count` blocks of at most m codes.
+    void reset(std::size_t longest, std::size_t count) {
+        m = longest, stride = m + 1;
+        frames.resize(count), points.resize(count * stride), decoded.resize(count * stride);
+        codes.resize(count * m), lengths.resize(count);
     }
-    return worst;
-}
+    void set(std::size_t j, const Frame& f, Vec3f start, std::span<const Vec3f> targets) {
+        frames[j] = f, points[j * stride] = start, lengths[j] = std::uint32_t(targets.size());
+        std::copy(targets.begin(), targets.end(), &points[j * stride + 1]);
+    }
+    GreedyBatch batch() {
+        return {frames.data(), points.data(), points.data() + 1, decoded.data() + 1, stride, codes.data(), m,
+                frames.size(), m, m, lengths.data()};
+    }
+    const Vec3f* decoded_of(std::size_t j) const { return &decoded[j * stride + 1]; }
+    const std::uint8_t* codes_of(std::size_t j) const { return &codes[j * m]; }
+};
 
 // Largest squared distance of decoded[k] to targets[k] or alt[k].
 float worst_error2(const Vec3f* decoded, const Vec3f* targets, const Vec3f* alt, std::size_t m) {
@@ -243,6 +262,7 @@ struct FiberEncoder::Encoding {
         std::vector<std::uint8_t> retry_codes8;
         std::vector<Vec3d> walked;
         std::vector<double> block_errors;  // append_exact8: each block's largest point error
+        std::optional<LengthTails> tails;  // keep_length_tails
     };
 
     const FiberEncoder& enc;
@@ -301,9 +321,13 @@ struct FiberEncoder::Encoding {
 
     void write_block_heads();
     void search_blocks();
+    static void search_blocks_together(std::span<Encoding> fibers);
     void retry_worst_blocks();
     void search_robust_blocks();
     void keep_lengths();
+    static void keep_length_tails(std::span<Encoding> fibers);
+    bool tails_only() const { return enc.length_stretch_ > 0 && enc.length_tails_only_ && !wide; }
+    std::pair<Frame, Vec3f> tail_start(const LengthTails::Search& t);
     void store_codes16();
     void append_decoded(std::vector<Vec3f>& decoded) const;
     void append_exact16(std::vector<Vec3f>& decoded_exact);
@@ -335,29 +359,52 @@ void FiberEncoder::Encoding::write_block_heads() {
     }
 }
 
-// The first search of every block: lookahead or greedy (SIMD lanes), or beam.
+// The first search of every block with the beam, or (16-bit codes) greedy
+// a block at a time: 16-bit codes gain nothing from lanes, their
+// nearest-code search is branchy and dominates.
 void FiberEncoder::Encoding::search_blocks() {
     const SearchParams params{search().beam_width, search().radius};
-    std::uint32_t b = 0;
-    if (params.beam <= 1 && !wide) {
-        // Greedy or lookahead: many blocks at once (greedy_blocks.hpp,
-        // lookahead_blocks.hpp: one per SIMD lane; the same codes as one at
-        // a time), the last one too when it has codes. 16-bit codes gain
-        // nothing from lanes: their nearest-code search is branchy and dominates.
-        const std::size_t full = n_points / ppb, rest = n_points % ppb;
-        const std::size_t blocks = rest > 2 ? full + 1 : full;
-        if (blocks > 0 && ppb > 2) {  // then every pointer below is inside its vector
-            const GreedyBatch batch{&s.frames[0], &s.points[1], &s.targets[2], &s.points[2], ppb, codes8_of(0), bb,
-                                    blocks, ppb - 2, rest > 2 ? rest - 2 : ppb - 2};
-            if (search().lookahead > 0) lookahead_blocks(codebook8(), h.step, search().lookahead, batch);
-            else greedy_blocks(codebook8(), h.step, batch);
-        }
-        b = n_blocks;
-    }
-    for (; b < n_blocks; ++b)
+    for (std::uint32_t b = 0; b < n_blocks; ++b)
         if (block_points(b) > 2)
             search_block(b, params, wide ? nullptr : codes8_of(b), wide ? s.codes16.data() + std::size_t(b) * ppb : nullptr,
                          &s.points[std::size_t(b) * ppb + 2]);
+}
+
+// The first search of several fibers' blocks: 8-bit greedy or lookahead
+// (greedy_blocks.hpp, lookahead_blocks.hpp) has the blocks of all the
+// fibers searched together, one per SIMD lane, the longest first (lanes
+// of one vector then end together); the same codes as one at a time.
+void FiberEncoder::Encoding::search_blocks_together(std::span<Encoding> fibers) {
+    if (fibers.empty()) return;
+    const Encoding& first = fibers.front();
+    if (first.wide || first.search().beam_width > 1 || first.ppb <= 2) {
+        for (Encoding& e : fibers) e.search_blocks();
+        return;
+    }
+    struct Block {
+        Encoding* e;
+        std::uint32_t b, m;
+    };
+    thread_local std::vector<Block> blocks;
+    blocks.clear();
+    for (Encoding& e : fibers)
+        for (std::uint32_t b = 0; b < e.n_blocks; ++b)
+            if (e.block_points(b) > 2) blocks.push_back({&e, b, e.block_points(b) - 2});
+    std::stable_sort(blocks.begin(), blocks.end(), [](const Block& x, const Block& y) { return x.m > y.m; });
+    thread_local BlockBatch batch;
+    batch.reset(first.ppb - 2, blocks.size());
+    for (std::size_t j = 0; j < blocks.size(); ++j) {
+        const Encoding& e = *blocks[j].e;
+        const std::size_t i0 = std::size_t(blocks[j].b) * e.ppb;
+        batch.set(j, e.s.frames[blocks[j].b], e.s.points[i0 + 1], std::span<const Vec3f>(&e.s.targets[i0 + 2], blocks[j].m));
+    }
+    if (first.search().lookahead > 0) lookahead_blocks(first.codebook8(), first.h.step, first.search().lookahead, batch.batch());
+    else greedy_blocks(first.codebook8(), first.h.step, batch.batch());
+    for (std::size_t j = 0; j < blocks.size(); ++j) {
+        Encoding& e = *blocks[j].e;
+        std::copy_n(batch.decoded_of(j), blocks[j].m, &e.s.points[std::size_t(blocks[j].b) * e.ppb + 2]);
+        std::copy_n(batch.codes_of(j), blocks[j].m, e.codes8_of(blocks[j].b));
+    }
 }
 
 // Blocks whose largest error exceeds the retry threshold are searched
@@ -437,31 +484,6 @@ void FiberEncoder::Encoding::search_robust_blocks() {
 void FiberEncoder::Encoding::keep_lengths() {
     const float stretch = enc.length_stretch_;
     if (!(stretch > 0)) return;
-    const SearchParams params{search().beam_width, search().radius};
-    if (enc.length_tails_only_ && !wide) {
-        const Codebook8 cb = codebook8();
-        s.retry_codes8.resize(ppb);
-        feed_back_length_tails(
-            std::span<const Vec3f>(s.targets), std::span<Vec3f>(s.points), ppb, kLengthFeedbackTail, kLengthFeedbackActShare,
-            [&](std::uint32_t blk) { return !robust(blk); },
-            [&](std::uint32_t blk, std::size_t j0, std::span<const Vec3f> t, Vec3f* dec) {
-                // The decoder's state before code j0, replayed from the block's start.
-                const std::size_t i0 = std::size_t(blk) * ppb;
-                Frame f = s.frames[blk];
-                const std::uint8_t* codes = codes8_of(blk);
-                for (std::size_t k = 0; k < j0; ++k) f = compose(f, cb.frame(codes[k]));
-                const Vec3f p = s.points[i0 + 1 + j0];
-                if (search().beam_width <= 1 && search().lookahead > 0)
-                    LookaheadSearch<Codebook8>(cb, h.step, std::max(search().lookahead, kLengthFeedbackLookahead))
-                        .run(f, p, t, s.retry_codes8.data(), dec);
-                else
-                    search_codes(cb, params, f, p, h.step, t, s.retry_codes8.data(), dec);
-            },
-            [&](std::uint32_t blk, std::size_t j0) {
-                std::copy_n(s.retry_codes8.begin(), block_points(blk) - 2 - j0, codes8_of(blk) + j0);
-            });
-        return;
-    }
     const SearchParams feedback_params{std::max({8u, search().beam_width, search().retry_beam_width}), 1};
     s.retry_codes8.resize(ppb);
     s.retry_codes16.resize(ppb);
@@ -482,6 +504,72 @@ void FiberEncoder::Encoding::keep_lengths() {
             if (wide) std::copy_n(s.retry_codes16.begin(), m, s.codes16.begin() + std::ptrdiff_t(i0));
             else std::copy_n(s.retry_codes8.begin(), m, codes8_of(blk));
         });
+}
+
+// The decoder's state before code t.j0 of a tail search's block, replayed
+// from the block's start.
+std::pair<Frame, Vec3f> FiberEncoder::Encoding::tail_start(const LengthTails::Search& t) {
+    const Codebook8 cb = codebook8();
+    Frame f = s.frames[t.block];
+    const std::uint8_t* codes = codes8_of(t.block);
+    for (std::size_t k = 0; k < t.j0; ++k) f = compose(f, cb.frame(codes[k]));
+    return {f, s.points[std::size_t(t.block) * ppb + 1 + t.j0]};
+}
+
+// The fixed-step length tails (length_feedback.hpp) of several fibers,
+// with the block's own search. Each fiber's tails depend on its earlier
+// blocks' outcome, so a fiber has one search at a time, but the fibers'
+// searches are independent: lookahead searches of the same length run
+// together, one per SIMD lane (lookahead_blocks.hpp).
+void FiberEncoder::Encoding::keep_length_tails(std::span<Encoding> fibers) {
+    struct Pending {
+        Encoding* e;
+        LengthTails::Search search;
+    };
+    std::vector<Pending> waiting, group;
+    auto next = [&](Encoding& e) {
+        Pending p{&e, {}};
+        if (e.s.tails->next([&](std::uint32_t b) { return !e.robust(b); }, p.search)) waiting.push_back(p);
+    };
+    for (Encoding& e : fibers) {
+        e.s.tails.emplace(std::span<const Vec3f>(e.s.targets), std::span<Vec3f>(e.s.points), e.ppb, kLengthFeedbackTail,
+                          kLengthFeedbackActShare);
+        next(e);
+    }
+    if (fibers.empty()) return;
+    const Encoding& first = fibers.front();
+    const Codebook8 cb = first.codebook8();
+    const SearchOptions& search = first.search();
+    const bool lookahead = search.beam_width <= 1 && search.lookahead > 0;
+    const std::size_t depth = std::max(search.lookahead, kLengthFeedbackLookahead);
+    thread_local BlockBatch batch;
+    while (!waiting.empty()) {
+        // Every waiting search of the first one's length (lookahead), or the first.
+        group.clear();
+        const std::size_t m = waiting.front().search.targets.size();
+        std::size_t kept = 0;
+        for (const Pending& p : waiting) {
+            if ((lookahead || group.empty()) && p.search.targets.size() == m) group.push_back(p);
+            else waiting[kept++] = p;
+        }
+        waiting.resize(kept);
+        batch.reset(m, group.size());
+        for (std::size_t i = 0; i < group.size(); ++i) {
+            const auto [f, p] = group[i].e->tail_start(group[i].search);
+            batch.set(i, f, p, group[i].search.targets);
+        }
+        if (lookahead)
+            lookahead_blocks(cb, first.h.step, depth, batch.batch());
+        else
+            search_codes(cb, SearchParams{search.beam_width, search.radius}, batch.frames[0], batch.points[0], first.h.step,
+                         group[0].search.targets, batch.codes.data(), batch.decoded.data() + 1);
+        for (std::size_t i = 0; i < group.size(); ++i) {
+            Encoding& e = *group[i].e;
+            std::copy_n(batch.decoded_of(i), m, e.s.tails->candidate());
+            if (e.s.tails->judge()) std::copy_n(batch.codes_of(i), m, e.codes8_of(group[i].search.block) + group[i].search.j0);
+            next(e);
+        }
+    }
 }
 
 void FiberEncoder::Encoding::store_codes16() {
@@ -556,23 +644,40 @@ void FiberEncoder::Encoding::append_exact8(std::vector<Vec3f>& decoded_exact, co
     }
 }
 
-// The passes over one fiber, in order (each one's comment says what it does).
+// The passes over each fiber, in order (each one's comment says what it
+// does); the first search and the length tails of all the fibers together,
+// their blocks in SIMD lanes.
+void FiberEncoder::encode_fibers(std::span<const std::span<const Vec3f>> fibers, std::uint32_t first_id,
+                                 std::vector<std::uint8_t>& out, std::vector<Vec3f>* decoded,
+                                 std::vector<Vec3f>* decoded_exact) const {
+    for (std::size_t i = 0; i < fibers.size(); ++i)
+        if (block_count(fibers[i].size()) > 0xffff)
+            throw Error(Errc::unsupported, "fiber " + std::to_string(first_id + i) + " has " +
+                                               std::to_string(fibers[i].size()) + " points: more than 65535 blocks");
+    thread_local std::vector<Encoding::Scratch> scratch;
+    if (scratch.size() < fibers.size()) scratch.resize(fibers.size());
+    std::vector<Encoding> es;
+    es.reserve(fibers.size());
+    for (std::size_t i = 0; i < fibers.size(); ++i) es.emplace_back(*this, fibers[i], std::uint32_t(first_id + i), out, scratch[i]);
+    for (Encoding& e : es) e.write_block_heads();
+    Encoding::search_blocks_together(es);
+    for (Encoding& e : es) {
+        e.retry_worst_blocks();
+        if (!e.wide) e.search_robust_blocks();
+    }
+    if (!es.empty() && es.front().tails_only()) Encoding::keep_length_tails(es);
+    else for (Encoding& e : es) e.keep_lengths();
+    for (Encoding& e : es) {
+        if (e.wide) e.store_codes16();
+        if (decoded) e.append_decoded(*decoded);
+        const Vec3f* fiber_decoded = decoded ? decoded->data() + (decoded->size() - e.n_points) : nullptr;
+        if (decoded_exact) e.wide ? e.append_exact16(*decoded_exact) : e.append_exact8(*decoded_exact, fiber_decoded);
+    }
+}
+
 void FiberEncoder::encode(std::span<const Vec3f> fiber, std::uint32_t fiber_id, std::vector<std::uint8_t>& out,
                           std::vector<Vec3f>* decoded, std::vector<Vec3f>* decoded_exact) const {
-    if (block_count(fiber.size()) > 0xffff)
-        throw Error(Errc::unsupported, "fiber " + std::to_string(fiber_id) + " has " + std::to_string(fiber.size()) +
-                                           " points: more than 65535 blocks");
-    thread_local Encoding::Scratch scratch;
-    Encoding e(*this, fiber, fiber_id, out, scratch);
-    e.write_block_heads();
-    e.search_blocks();
-    e.retry_worst_blocks();
-    if (!e.wide) e.search_robust_blocks();
-    e.keep_lengths();
-    if (e.wide) e.store_codes16();
-    if (decoded) e.append_decoded(*decoded);
-    const Vec3f* fiber_decoded = decoded ? decoded->data() + (decoded->size() - fiber.size()) : nullptr;
-    if (decoded_exact) e.wide ? e.append_exact16(*decoded_exact) : e.append_exact8(*decoded_exact, fiber_decoded);
+    encode_fibers(std::span<const std::span<const Vec3f>>(&fiber, 1), fiber_id, out, decoded, decoded_exact);
 }
 
 }  // namespace fiblet

@@ -165,28 +165,30 @@ const EnvironmentChoice& environment_choice() {
 
 std::atomic<int> forced_level{-1};
 
-// search_codes' greedy for blocks [first, batch.blocks): four in lockstep, then one at a time.
+// search_codes' greedy for blocks [first, batch.blocks): four of the same
+// length in lockstep, the others one at a time.
 void scalar_blocks(const Codebook8& cb, float step, const GreedyBatch& batch, std::size_t first) {
     constexpr int kLanes = 4;
-    const std::size_t same_length = batch.last_m == batch.m ? batch.blocks : batch.blocks - 1;
-    std::size_t j = first;
-    for (; j + kLanes <= same_length; j += kLanes) {
-        GreedyLanes<Codebook8, kLanes> lanes;
-        for (int i = 0; i < kLanes; ++i) {
-            const std::size_t at = (j + i) * batch.stride;
-            lanes.f[i] = batch.frames[j + i];
-            lanes.p[i] = batch.starts[at];
-            lanes.targets[i] = batch.targets + at;
-            lanes.codes[i] = batch.codes + (j + i) * batch.code_stride;
-            lanes.decoded[i] = batch.decoded + at;
+    for (std::size_t j = first; j < batch.blocks;) {
+        const std::size_t m = batch.length(j);
+        if (j + kLanes <= batch.blocks && batch.length(j + 1) == m && batch.length(j + 2) == m && batch.length(j + 3) == m) {
+            GreedyLanes<Codebook8, kLanes> lanes;
+            for (int i = 0; i < kLanes; ++i) {
+                const std::size_t at = (j + i) * batch.stride;
+                lanes.f[i] = batch.frames[j + i];
+                lanes.p[i] = batch.starts[at];
+                lanes.targets[i] = batch.targets + at;
+                lanes.codes[i] = batch.codes + (j + i) * batch.code_stride;
+                lanes.decoded[i] = batch.decoded + at;
+            }
+            lanes.run(cb, step, m);
+            j += kLanes;
+            continue;
         }
-        lanes.run(cb, step, batch.m);
-    }
-    for (; j < batch.blocks; ++j) {
         const std::size_t at = j * batch.stride;
         search_codes(cb, SearchParams{1, 1}, batch.frames[j], batch.starts[at], step,
-                     std::span<const Vec3f>(batch.targets + at, j + 1 == batch.blocks ? batch.last_m : batch.m),
-                     batch.codes + j * batch.code_stride, batch.decoded + at);
+                     std::span<const Vec3f>(batch.targets + at, m), batch.codes + j * batch.code_stride, batch.decoded + at);
+        ++j;
     }
 }
 
@@ -195,7 +197,8 @@ void scalar_blocks(const Codebook8& cb, float step, const GreedyBatch& batch, st
 bool lanes_can_take(const Codebook8& cb, const GreedyBatch& batch) {
     // The lanes address a vector's points with 32-bit offsets (3 floats a point).
     const bool offsets_fit = batch.stride <= std::size_t(INT_MAX) / 3 / 32 && batch.m <= batch.stride;
-    const bool lengths = batch.m > 0 && batch.last_m > 0 && batch.last_m <= batch.m;
+    bool lengths = batch.m > 0 && batch.last_m > 0 && batch.last_m <= batch.m;
+    for (std::size_t j = 0; batch.lengths && j < batch.blocks; ++j) lengths = lengths && batch.lengths[j] > 0 && batch.lengths[j] <= batch.m;
     return cb.lut.usable() && lengths && offsets_fit;
 }
 

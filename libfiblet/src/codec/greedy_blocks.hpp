@@ -37,11 +37,13 @@ SimdLevel simd_level();
 void force_simd_level(std::optional<SimdLevel> level);
 
 // `blocks` blocks of `m` codes each but the last, which has `last_m`
-// (1 <= last_m <= m: a fiber's last block may be shorter), block j's data
-// at a fixed stride (the encoder's layout: one fiber's points, ppb per block):
+// (1 <= last_m <= m: a fiber's last block may be shorter), or, where
+// `lengths` is given, lengths[j] codes (1 <= lengths[j] <= m; blocks of
+// several fibers), block j's data at a fixed stride (the encoder's layout:
+// one fiber's points, ppb per block):
 //   start frame frames[j], start point starts[j * stride],
 //   targets targets[j * stride + k], decoded points decoded[j * stride + k],
-//   codes codes[j * code_stride + k], for k in [0, m).
+//   codes codes[j * code_stride + k], for k in [0, length(j)).
 struct GreedyBatch {
     const Frame* frames;
     const Vec3f* starts;
@@ -53,6 +55,9 @@ struct GreedyBatch {
     std::size_t blocks;
     std::size_t m;
     std::size_t last_m;
+    const std::uint32_t* lengths = nullptr;
+
+    std::size_t length(std::size_t j) const { return lengths ? lengths[j] : j + 1 == blocks ? last_m : m; }
 };
 
 // Whether the SIMD lanes can search this batch: the lookup table is usable,

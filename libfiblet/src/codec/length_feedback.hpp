@@ -14,7 +14,7 @@
 // fraction (fiber_end_encoder.hpp), which places the end point.
 //
 // Fixed-step input (no end fraction) takes a cheaper form,
-// feed_back_length_tails: only a block's last codes are searched again,
+// LengthTails: only a block's last codes are searched again,
 // with the block's own search, and only where the fiber's running length
 // error exceeds a share of its point error; the fiber's last block, which
 // no code can change, is paid for by the bridge before it (whose whole
@@ -52,14 +52,21 @@ inline constexpr unsigned kLengthFeedbackLookahead = 2;
 inline constexpr float kLengthRescueOverRetry = 1.4f;
 inline constexpr unsigned kLengthRescueBeam = 32;
 
-// The largest squared distance of decoded[0, m) from targets[first, first + m).
-inline float max_distance2(std::span<const Vec3f> targets, const Vec3f* decoded, std::size_t first, std::size_t m) {
-    float worst = 0;
-    for (std::size_t k = 0; k < m; ++k) {
-        const Vec3f d = decoded[k] - targets[first + k];
-        worst = std::max(worst, dot(d, d));
+// The largest squared distance of a[k] from b[k], k < m (four running
+// maxima: one would wait on the last at every point; the points are finite).
+inline float max_distance2(const Vec3f* a, const Vec3f* b, std::size_t m) {
+    float worst[4] = {0, 0, 0, 0};
+    std::size_t k = 0;
+    for (; k + 4 <= m; k += 4)
+        for (std::size_t i = 0; i < 4; ++i) {
+            const Vec3f d = a[k + i] - b[k + i];
+            worst[i] = std::max(worst[i], dot(d, d));
+        }
+    for (; k < m; ++k) {
+        const Vec3f d = a[k] - b[k];
+        worst[0] = std::max(worst[0], dot(d, d));
     }
-    return worst;
+    return std::max(std::max(worst[0], worst[1]), std::max(worst[2], worst[3]));
 }
 
 // targets[from, last] into `moved`, the last `count` of them moved along the
@@ -92,7 +99,7 @@ void feed_back_length(std::span<const Vec3f> targets, std::span<Vec3f> points, s
     thread_local std::vector<Vec3f> moved, candidate;
     auto error_of = [&](std::size_t k) { return norm(points[k] - points[k - 1]) - stretch * norm(targets[k] - targets[k - 1]); };
     auto max_error2 = [&](const Vec3f* decoded, std::size_t first, std::size_t m) {
-        return max_distance2(targets, decoded, first, m);
+        return max_distance2(decoded, targets.data() + first, m);
     };
     // The point error the fiber has anyway: a block may go up to it.
     const float fiber_max2 = max_error2(points.data(), 0, n_points);
@@ -135,64 +142,120 @@ void feed_back_length(std::span<const Vec3f> targets, std::span<Vec3f> points, s
 // keeps the point error and shortens the lag is kept, as a smaller share
 // moves the end less) and searching those points again; in the fiber's last
 // adjustable block, all its points when the tail left more than `act`.
-// Callbacks:
-//   adjustable(b)                 whether block b's codes may be searched again
-//   search(b, j0, t, decoded)     searches block b's codes j0.. (its points
-//                                 j0 + 2..) for targets t into a candidate
-//   keep(b, j0)                   the candidate becomes those codes
-template <class Adjustable, class Search, class Keep>
-void feed_back_length_tails(std::span<const Vec3f> targets, std::span<Vec3f> points, std::uint32_t ppb,
-                            std::uint32_t tail, float act_share, Adjustable&& adjustable, Search&& search,
-                            Keep&& keep) {
-    const std::size_t n_points = points.size();
-    if (n_points <= ppb) return;  // one block: its length is the anchors' and the steps'
-    thread_local std::vector<Vec3f> moved, candidate;
-    auto error_of = [&](std::size_t k) { return norm(points[k] - points[k - 1]) - norm(targets[k] - targets[k - 1]); };
-    auto max_error2 = [&](const Vec3f* decoded, std::size_t first, std::size_t m) {
-        return max_distance2(targets, decoded, first, m);
+//
+// Written as a sequence of searches the caller runs, so that the searches
+// of several fibers can run in lockstep (their dependency chains overlap):
+//   while (tails.next(adjustable, search)) {
+//       run search: block search.block's codes search.j0.. (its points
+//       j0 + 2..) for search.targets, decoded into tails.candidate();
+//       if (tails.judge()) the candidate's codes become the block's;
+//   }
+class LengthTails {
+public:
+    struct Search {
+        std::uint32_t block = 0;
+        std::size_t j0 = 0;                // the first code searched again
+        std::span<const Vec3f> targets;    // its targets, moved
     };
-    const float fiber_max2 = max_error2(points.data(), 0, n_points);
-    const double act = act_share * std::sqrt(double(fiber_max2));
-    // The fiber's last block: its segments are the anchors' and whole
-    // steps whatever its codes; the block before it takes its error.
-    const std::size_t last_b0 = (n_points - 1) / ppb * ppb;
-    double last_block_error = 0;
-    for (std::size_t k = last_b0 + 1; k < n_points; ++k) last_block_error += error_of(k);
-    double error = 0;  // decoded minus target length, up to the current point
-    for (std::size_t b0 = 0; b0 < last_b0; b0 += ppb) {
-        const std::size_t n = std::min<std::size_t>(ppb, n_points - b0), last = b0 + n - 1;
-        for (std::size_t k = std::max<std::size_t>(b0, 1); k <= last; ++k) error += error_of(k);
-        if (n <= 2) continue;
-        const auto b = std::uint32_t(b0 / ppb);
-        double lag = error + error_of(last + 1);
-        if (last + 1 == last_b0) lag += last_block_error;
-        if (!(std::fabs(lag) > act) || !adjustable(b)) continue;
-        const std::size_t m = n - 2, first = b0 + 2, tail_codes = std::min<std::size_t>(tail, m);
-        const float allowed2 = fiber_max2;
-        double best = std::fabs(lag);
-        const float reach = std::sqrt(allowed2), move = std::clamp(float(lag), -reach, reach);
-        // The block's tail, and where that leaves more than `act` in the
-        // fiber's last adjustable block (no later block takes the rest),
-        // the whole block.
-        const bool last_chance = last + 1 == last_b0;
-        for (const std::size_t codes : {tail_codes, m}) {
-            if (codes != tail_codes && !(last_chance && best > act)) break;
-            const std::size_t j0 = m - codes;
-            for (const float share : kLengthFeedbackShares) {
-                move_tail_along_track(targets, first + j0, last, codes, share, move, moved);
-                candidate.resize(codes);
-                search(b, j0, std::span<const Vec3f>(moved), candidate.data());
-                if (max_error2(candidate.data(), first + j0, codes) > allowed2) continue;
-                const double now =
-                    lag + (norm(points[last + 1] - candidate[codes - 1]) - norm(points[last + 1] - points[last]));
-                if (!(std::fabs(now) < best)) continue;
-                best = std::fabs(now);
-                std::copy(candidate.begin(), candidate.end(), points.begin() + std::ptrdiff_t(first + j0));
-                keep(b, j0);
-                break;  // the largest share the point error allows: smaller ones take back less
-            }
+
+    LengthTails(std::span<const Vec3f> targets, std::span<Vec3f> points, std::uint32_t ppb, std::uint32_t tail,
+                float act_share)
+        : targets_(targets), points_(points), ppb_(ppb), tail_(tail) {
+        const std::size_t n_points = points.size();
+        if (n_points <= ppb) {  // one block: its length is the anchors' and the steps'
+            b0_ = last_b0_ = 0;
+            return;
+        }
+        fiber_max2_ = max_distance2(points.data(), targets.data(), n_points);
+        act_ = act_share * std::sqrt(double(fiber_max2_));
+        last_b0_ = (n_points - 1) / ppb * ppb;
+        for (std::size_t k = last_b0_ + 1; k < n_points; ++k) last_block_error_ += error_of(k);
+    }
+
+    // The next search to run, false once the fiber is done. adjustable(b):
+    // whether block b's codes may be searched again.
+    template <class Adjustable>
+    bool next(Adjustable&& adjustable, Search& out) {
+        for (;;) {
+            if (in_block_ && next_try(out)) return true;
+            in_block_ = false;
+            if (b0_ >= last_b0_) return false;
+            start_block(adjustable);
         }
     }
-}
+    // Where the search writes its decoded points (as many as its targets).
+    Vec3f* candidate() { return candidate_.data(); }
+    // Judges the search's candidate: true when it is kept (its points are
+    // then the fiber's, and the caller makes its codes the block's).
+    bool judge() {
+        const std::size_t j0 = m_ - codes_;
+        ++share_;
+        if (max_distance2(candidate_.data(), targets_.data() + first_ + j0, codes_) > fiber_max2_) return false;
+        const double now = lag_ + (norm(points_[last_ + 1] - candidate_[codes_ - 1]) - norm(points_[last_ + 1] - points_[last_]));
+        if (!(std::fabs(now) < best_)) return false;
+        best_ = std::fabs(now);
+        std::copy(candidate_.begin(), candidate_.end(), points_.begin() + std::ptrdiff_t(first_ + j0));
+        share_ = std::size(kLengthFeedbackShares);  // the largest share the point error allows: smaller ones take back less
+        return true;
+    }
+
+private:
+    double error_of(std::size_t k) const {
+        return norm(points_[k] - points_[k - 1]) - norm(targets_[k] - targets_[k - 1]);
+    }
+    // Block b0_'s length error; whether its tail is searched again.
+    template <class Adjustable>
+    void start_block(Adjustable&& adjustable) {
+        const std::size_t b0 = b0_;
+        b0_ += ppb_;
+        const std::size_t n = std::min<std::size_t>(ppb_, points_.size() - b0);
+        last_ = b0 + n - 1;
+        double error = error_;  // a local: the member would be stored at every point
+        for (std::size_t k = std::max<std::size_t>(b0, 1); k <= last_; ++k) error += error_of(k);
+        error_ = error;
+        if (n <= 2) return;
+        block_ = std::uint32_t(b0 / ppb_);
+        lag_ = error_ + error_of(last_ + 1);
+        last_chance_ = last_ + 1 == last_b0_;
+        if (last_chance_) lag_ += last_block_error_;
+        if (!(std::fabs(lag_) > act_) || !adjustable(block_)) return;
+        m_ = n - 2, first_ = b0 + 2, codes_ = std::min<std::size_t>(tail_, m_);
+        best_ = std::fabs(lag_);
+        const float reach = std::sqrt(fiber_max2_);
+        move_ = std::clamp(float(lag_), -reach, reach);
+        share_ = 0, whole_ = false, in_block_ = true;
+    }
+    // The block's next try: its tail at the next share, then (in the
+    // fiber's last adjustable block, where the tail left more than `act`)
+    // the whole block.
+    bool next_try(Search& out) {
+        if (share_ == std::size(kLengthFeedbackShares)) {
+            // (A block no longer than the tail is tried twice: the second
+            // time against the points the first kept.)
+            if (whole_ || !(codes_ == m_ || (last_chance_ && best_ > act_))) return false;
+            whole_ = true, codes_ = m_, share_ = 0;
+        }
+        const std::size_t j0 = m_ - codes_;
+        move_tail_along_track(targets_, first_ + j0, last_, codes_, kLengthFeedbackShares[share_], move_, moved_);
+        candidate_.resize(codes_);
+        out = {block_, j0, std::span<const Vec3f>(moved_)};
+        return true;
+    }
+
+    std::span<const Vec3f> targets_;
+    std::span<Vec3f> points_;
+    std::size_t ppb_, tail_;
+    float fiber_max2_ = 0;
+    double act_ = 0, last_block_error_ = 0;
+    std::size_t b0_ = 0, last_b0_ = 0;  // the next block's first point; the fiber's last block's
+    double error_ = 0;                  // decoded minus target length, up to the current point
+    // The block being tried.
+    bool in_block_ = false, last_chance_ = false, whole_ = false;
+    std::uint32_t block_ = 0;
+    std::size_t last_ = 0, first_ = 0, m_ = 0, codes_ = 0, share_ = 0;
+    double lag_ = 0, best_ = 0;
+    float move_ = 0;
+    std::vector<Vec3f> moved_, candidate_;
+};
 
 }  // namespace fiblet::detail

@@ -31,9 +31,11 @@ namespace hn = hwy::HWY_NAMESPACE;
 static_assert(sizeof(NearestCodeLut::Neighbours) == 36 * sizeof(float), "Neighbours are gathered as 36 words");
 constexpr int kNbY = 8, kNbZ = 16, kNbCodes = 32, kNbCount = 34;
 
-// Blocks j0 .. j0 + active - 1 of the batch, one per lane of `d`.
-template <class D>
+// Blocks j0 .. j0 + active - 1 of the batch, one per lane of `d`, with
+// kDepth (1 or 2) points of lookahead.
+template <int kDepth, class D>
 void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batch, std::size_t j0, std::size_t active) {
+    static_assert(kDepth == 1 || kDepth == 2, "lanes look one or two points ahead");
     using Lanes = CodeLanes<D>;
     using VF = typename Lanes::VF;
     using VI = typename Lanes::VI;
@@ -55,41 +57,63 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
         const VF dot = hn::Add(hn::Add(hn::Mul(dx, x), hn::Mul(dy, y)), hn::Mul(dz, z));
         return hn::Max(hn::Sub(base, hn::Mul(two_step, dot)), zero);
     };
+    // The state after taking the code of frame l from (f, p): nf, q.
+    auto take = [&](const VF* f, VF px, VF py, VF pz, const VF* l, VF* nf, VF& qx, VF& qy, VF& qz) {
+        Lanes::compose(f, l, nf);
+        qx = hn::Add(px, hn::Mul(stepv, nf[0]));
+        qy = hn::Add(py, hn::Mul(stepv, nf[1]));
+        qz = hn::Add(pz, hn::Mul(stepv, nf[2]));
+    };
 
-    // The lanes' targets at point k and k + 1, each gathered once.
-    VF tx, ty, tz, nx, ny, nz;
+    // The lanes' targets at points k, k + 1 and (depth 2) k + 2, each gathered once.
+    VF tx, ty, tz, nx, ny, nz, ox, oy, oz;
     s.target(s.at, tx, ty, tz);
+    if (kDepth == 2) s.target(s.next_at(), nx, ny, nz);
     for (std::size_t k = 0; k < s.steps; ++k) {
         // The aimed code at point k.
         VF x, y, z;
         Lanes::local(s.f, hn::Sub(tx, s.px), hn::Sub(ty, s.py), hn::Sub(tz, s.pz), x, y, z);
         const VI aimed = code.nearest(x, y, z);
         const VF base = base_of(x, y, z);
-        s.target(s.next_at(), nx, ny, nz);
+        if (kDepth == 1) s.target(s.next_at(), nx, ny, nz);
+        else s.target(s.ahead_at(2), ox, oy, oz);
+        const auto more = s.more_after(k);                            // lanes with a point k + 1
+        const auto more2 = kDepth == 2 ? s.more_after(k + 1) : more;  // and k + 2
+        const bool any2 = kDepth == 2 && !hn::AllFalse(d, more2);
         // Code c's state after point k (frame l of c given) into nf, q; returns
-        // the squared error of the greedy step at point k + 1 from there.
-        auto after = [&](const VF* l, VF* nf, VF& qx, VF& qy, VF& qz) {
-            Lanes::compose(s.f, l, nf);
-            qx = hn::Add(s.px, hn::Mul(stepv, nf[0]));
-            qy = hn::Add(s.py, hn::Mul(stepv, nf[1]));
-            qz = hn::Add(s.pz, hn::Mul(stepv, nf[2]));
-            VF x1, y1, z1, bx, by, bz;
+        // the path's sum of squared errors, e0 (c's own) plus greedy aiming's
+        // at the points after it (added in the scalar search's order).
+        auto path = [&](const VF* l, VF e0, VF* nf, VF& qx, VF& qy, VF& qz) {
+            take(s.f, s.px, s.py, s.pz, l, nf, qx, qy, qz);
+            VF x1, y1, z1;
             Lanes::local(nf, hn::Sub(nx, qx), hn::Sub(ny, qy), hn::Sub(nz, qz), x1, y1, z1);
-            code.direction(code.nearest(x1, y1, z1), bx, by, bz);
-            return error2(base_of(x1, y1, z1), bx, by, bz, x1, y1, z1);
+            const VI c1 = code.nearest(x1, y1, z1);
+            if (!any2) {
+                VF bx, by, bz;
+                code.direction(c1, bx, by, bz);
+                return hn::Add(e0, error2(base_of(x1, y1, z1), bx, by, bz, x1, y1, z1));
+            }
+            VF l1[9], f2[9], rx, ry, rz, x2, y2, z2, bx, by, bz;
+            code.frame(c1, l1);
+            const VF sum1 = hn::Add(e0, error2(base_of(x1, y1, z1), l1[0], l1[1], l1[2], x1, y1, z1));
+            take(nf, qx, qy, qz, l1, f2, rx, ry, rz);
+            Lanes::local(f2, hn::Sub(ox, rx), hn::Sub(oy, ry), hn::Sub(oz, rz), x2, y2, z2);
+            code.direction(code.nearest(x2, y2, z2), bx, by, bz);
+            return hn::IfThenElse(more2, hn::Add(sum1, error2(base_of(x2, y2, z2), bx, by, bz, x2, y2, z2)), sum1);
         };
         VF l[9], win_f[9], win_x, win_y, win_z;
         code.frame(aimed, l);
         const VF aimed_e0 = error2(base, l[0], l[1], l[2], x, y, z);
-        VF best = hn::Add(aimed_e0, after(l, win_f, win_x, win_y, win_z));
+        VF best = path(l, aimed_e0, win_f, win_x, win_y, win_z);
         VI win_code = aimed;
         // The rivals (the aimed code's neighbours), where a lane has a point
         // after k, in the scalar search's order: each round takes every
         // lane's cheapest untried rival by own error (the first on a tie),
         // tried while that error is below the lane's best; a rival wins with
-        // a smaller sum. Rounds end when no lane has a rival left to try
-        // (most lanes try none or one: about two rounds a point, not eight).
-        const auto more = s.more_after(k);
+        // a smaller sum (the scalar search's branch and bound drops a path
+        // once its partial sum reaches the best: errors are at least 0, so
+        // such a path's whole sum does not win either). Rounds end when no
+        // lane has a rival left to try (about two a point, not eight).
         const VI nb_at = hn::Mul(aimed, hn::Set(di, 36));
         const VI words[2] = {hn::GatherIndex(di, nb_words + kNbCodes, nb_at),
                              hn::GatherIndex(di, nb_words + kNbCodes + 1, nb_at)};
@@ -118,7 +142,7 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
             const VI c = hn::And(word >> hn::ShiftLeft<3>(hn::And(which, hn::Set(di, 3))), code.byte);
             VF lr[9], rf[9], qx, qy, qz;  // the rival's frame, its state after point k
             code.frame(c, lr);
-            const VF total = hn::Add(e0, after(lr, rf, qx, qy, qz));
+            const VF total = path(lr, e0, rf, qx, qy, qz);
             const auto wins = hn::And(tries, hn::Lt(total, best));
             best = hn::IfThenElse(wins, total, best);
             win_code = hn::IfThenElse(hn::RebindMask(di, wins), c, win_code);
@@ -130,11 +154,15 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
         s.px = win_x, s.py = win_y, s.pz = win_z;
         s.store(k, win_code);
         tx = nx, ty = ny, tz = nz;
+        if (kDepth == 2) nx = ox, ny = oy, nz = oz;
     }
 }
 
-std::size_t LookaheadVectors(const Codebook8& cb, float step, const GreedyBatch& batch) {
-    return AllVectors(cb, step, batch, [](auto d, auto&&... args) { LookaheadVector(d, args...); });
+std::size_t LookaheadVectors1(const Codebook8& cb, float step, const GreedyBatch& batch) {
+    return AllVectors(cb, step, batch, [](auto d, auto&&... args) { LookaheadVector<1>(d, args...); });
+}
+std::size_t LookaheadVectors2(const Codebook8& cb, float step, const GreedyBatch& batch) {
+    return AllVectors(cb, step, batch, [](auto d, auto&&... args) { LookaheadVector<2>(d, args...); });
 }
 
 }  // namespace fiblet::detail::HWY_NAMESPACE
@@ -147,41 +175,46 @@ namespace {
 
 using VectorSearch = std::size_t (*)(const Codebook8&, float, const GreedyBatch&);
 
-VectorSearch vector_search(SimdLevel level) {
+// The lanes' search for this depth and level, if there is one.
+VectorSearch vector_search(SimdLevel level, std::size_t depth) {
+    if (depth != 1 && depth != 2) return nullptr;
+    const bool one = depth == 1;
     switch (level) {
 #if FIBLET_LOOKAHEAD_HWY && (HWY_TARGETS & HWY_AVX3)
-        case SimdLevel::avx512: return &N_AVX3::LookaheadVectors;
+        case SimdLevel::avx512: return one ? &N_AVX3::LookaheadVectors1 : &N_AVX3::LookaheadVectors2;
 #endif
 #if FIBLET_LOOKAHEAD_HWY && (HWY_TARGETS & HWY_AVX2)
-        case SimdLevel::avx2: return &N_AVX2::LookaheadVectors;
+        case SimdLevel::avx2: return one ? &N_AVX2::LookaheadVectors1 : &N_AVX2::LookaheadVectors2;
 #endif
 #if FIBLET_LOOKAHEAD_HWY && (HWY_TARGETS & HWY_SSE4)
-        case SimdLevel::sse4: return &N_SSE4::LookaheadVectors;
+        case SimdLevel::sse4: return one ? &N_SSE4::LookaheadVectors1 : &N_SSE4::LookaheadVectors2;
 #endif
         default: return nullptr;
     }
 }
 
-// LookaheadSearch for blocks [first, batch.blocks): four in lockstep (their
-// dependency chains overlap in the CPU), then one at a time.
+// LookaheadSearch for blocks [first, batch.blocks): four of the same length
+// in lockstep (their dependency chains overlap in the CPU), the others one
+// at a time.
 void scalar_blocks(const Codebook8& cb, float step, std::size_t depth, const GreedyBatch& batch, std::size_t first) {
     constexpr int kLanes = 4;
     LookaheadSearch<Codebook8> lanes[kLanes]{{cb, step, depth}, {cb, step, depth}, {cb, step, depth}, {cb, step, depth}};
     auto start = [&](LookaheadSearch<Codebook8>& lane, std::size_t j) {
         const std::size_t at = j * batch.stride;
-        lane.start(batch.frames[j], batch.starts[at],
-                   std::span<const Vec3f>(batch.targets + at, j + 1 == batch.blocks ? batch.last_m : batch.m),
+        lane.start(batch.frames[j], batch.starts[at], std::span<const Vec3f>(batch.targets + at, batch.length(j)),
                    batch.codes + j * batch.code_stride, batch.decoded + at);
     };
-    const std::size_t same_length = batch.last_m == batch.m ? batch.blocks : batch.blocks - 1;
-    std::size_t j = first;
-    for (; j + kLanes <= same_length; j += kLanes) {
-        for (int i = 0; i < kLanes; ++i) start(lanes[i], j + i);
-        while (!lanes[0].done()) LookaheadSearch<Codebook8>::step_lanes<kLanes>(lanes);
-    }
-    for (; j < batch.blocks; ++j) {
+    for (std::size_t j = first; j < batch.blocks;) {
+        const std::size_t m = batch.length(j);
+        if (j + kLanes <= batch.blocks && batch.length(j + 1) == m && batch.length(j + 2) == m && batch.length(j + 3) == m) {
+            for (int i = 0; i < kLanes; ++i) start(lanes[i], j + i);
+            while (!lanes[0].done()) LookaheadSearch<Codebook8>::step_lanes<kLanes>(lanes);
+            j += kLanes;
+            continue;
+        }
         start(lanes[0], j);
         while (!lanes[0].done()) lanes[0].step();
+        ++j;
     }
 }
 
@@ -195,7 +228,7 @@ void lookahead_blocks(const Codebook8& cb, float step, std::size_t depth, const 
     require_simd_level(level);
     if (batch.blocks == 0) return;
     std::size_t done = 0;
-    if (const VectorSearch search = vector_search(level); depth == 1 && search && lanes_can_take(cb, batch))
+    if (const VectorSearch search = vector_search(level, depth); search && lanes_can_take(cb, batch))
         done = search(cb, step, batch);
     scalar_blocks(cb, step, depth, batch, done);
 }
