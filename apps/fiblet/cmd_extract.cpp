@@ -147,8 +147,8 @@ void run(const ExtractArgs& a) {
         usage("--lod produces segments that a .fft file cannot hold: write a .tck");
     const FftFile file = open_fft_input(a.input, a.ignore_trailer);
     const FftHeader& h = file.header();
-    if (!file.streamline_fields().empty() && !a.quiet)  // formats/fft-data.md: not subset yet
-        fmt::print(stderr, "fiblet: note: the {} data arrays of {} (DATA chunk) are not carried into extracted files\n",
+    if (ext == ".tck" && !file.streamline_fields().empty() && !a.quiet)  // a .fft output carries them (write_fft_subset)
+        fmt::print(stderr, "fiblet: note: the {} data arrays of {} (DATA chunk) have no place in a .tck: extract to a .fft to keep them\n",
                    file.streamline_fields().size(), a.input);
     const auto t_open = std::chrono::steady_clock::now();
     const BlockIndex index = a.compute_index ? BlockIndex::compute(file) : BlockIndex::load(file);

@@ -20,7 +20,10 @@ struct SubsetReport {
 // exactly as in the source. The header keeps the source's normalization,
 // step and direction code, and its recorded errors (the maximum remains an
 // upper bound; the mean is the source's). The trailer keeps the source's
-// PROP and RSMP chunks and gets a fresh BIDX index and CSUM checksums. Runs with coarse blocks
+// PROP and RSMP chunks, the ENDS fractions and DATA arrays of the kept
+// runs (a per-streamline row per run, the run's per-point rows, groups
+// listing the runs of their fibers), and gets a fresh BIDX index and CSUM
+// checksums. Runs with coarse blocks
 // (a level of detail) cannot be stored: Error{invalid_argument}.
 SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedRun>& runs, const std::string& path,
                               bool overwrite);

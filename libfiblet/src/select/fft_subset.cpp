@@ -1,13 +1,16 @@
 #include "fiblet/fft_subset.hpp"
 
+#include <algorithm>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "fiblet/block_index.hpp"
 #include "fiblet/checksum.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/output_file.hpp"
+#include "fiblet/streamline_data_chunk.hpp"
 #include "format/packed_blocks16.hpp"
 #include "select/block_decoder.hpp"
 
@@ -52,6 +55,79 @@ TrailerChunk subset_end_fractions(const FftFile& source, const std::vector<Selec
             kept[i] = src[r.fiber];
     }
     return make_fiber_ends_chunk(kept);
+}
+
+// Where each fiber's points start among the file's points (fibers + 1
+// entries): a fiber's blocks hold points_per_block points each but the last
+// (FftFile checks it), whose count is read.
+std::vector<std::uint64_t> fiber_point_starts(const FftFile& source) {
+    const FftHeader& h = source.header();
+    std::vector<std::uint64_t> starts(h.fibers + 1, 0);
+    std::vector<std::uint8_t> last(h.block_bytes());
+    for (std::uint64_t f = 0; f < h.fibers; ++f) {
+        const std::uint32_t count = source.block_count(f);
+        std::uint64_t n = 0;
+        if (count > 0) {
+            source.read_blocks(source.first_block(f) + count - 1, 1, last.data());
+            n = std::uint64_t(count - 1) * h.points_per_block + block_flags(h, last.data()).point_count;
+        }
+        starts[f + 1] = starts[f] + n;
+    }
+    return starts;
+}
+
+// The source's DATA arrays for the runs (formats/fft-data.md): each run gets
+// its fiber's per-streamline row and its own points' per-point rows; a
+// group lists the runs of its fibers; per-group rows stay as they are.
+// run_points[i]: the points of run i.
+TrailerChunk subset_streamline_data(const FftFile& source, const std::vector<SelectedRun>& runs,
+                                    const std::vector<std::uint32_t>& run_points) {
+    const FftHeader& h = source.header();
+    const std::vector<StreamlineField>& fields = source.streamline_fields();
+    const bool per_point = std::any_of(fields.begin(), fields.end(),
+                                       [](const StreamlineField& f) { return f.scope() == FieldScope::point; });
+    const std::vector<std::uint64_t> starts = per_point ? fiber_point_starts(source) : std::vector<std::uint64_t>{};
+    // (fiber, run) in fiber order: a group's fibers' runs.
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> by_fiber;
+    std::vector<StreamlineField> kept;
+    for (const StreamlineField& f : fields) {
+        StreamlineField out{f.name, f.type, f.components, {}};
+        const std::size_t row = std::size_t(f.components) * f.value_size();
+        auto copy_rows = [&](std::uint64_t first, std::uint64_t count) {
+            out.bytes.insert(out.bytes.end(), f.bytes.begin() + std::ptrdiff_t(first * row),
+                             f.bytes.begin() + std::ptrdiff_t((first + count) * row));
+        };
+        switch (*f.scope()) {
+            case FieldScope::streamline:
+                for (const SelectedRun& r : runs) copy_rows(r.fiber, 1);
+                break;
+            case FieldScope::point:
+                for (std::size_t i = 0; i < runs.size(); ++i) {
+                    const std::uint64_t in_fiber = (runs[i].first_block - source.first_block(runs[i].fiber)) * h.points_per_block;
+                    copy_rows(starts[runs[i].fiber] + in_fiber, run_points[i]);
+                }
+                break;
+            case FieldScope::group: {
+                if (by_fiber.empty()) {
+                    for (std::size_t i = 0; i < runs.size(); ++i) by_fiber.emplace_back(runs[i].fiber, std::uint32_t(i));
+                    std::sort(by_fiber.begin(), by_fiber.end());
+                }
+                std::vector<std::uint32_t> members;
+                for (std::uint64_t v = 0; v < f.rows(); ++v) {
+                    const auto fiber = std::uint64_t(f.at(v, 0));
+                    auto at = std::lower_bound(by_fiber.begin(), by_fiber.end(), std::make_pair(fiber, std::uint32_t(0)));
+                    for (; at != by_fiber.end() && at->first == fiber; ++at) members.push_back(at->second);
+                }
+                std::sort(members.begin(), members.end());
+                for (const std::uint32_t i : members)
+                    for (int b = 0; b < 4; ++b) out.bytes.push_back(std::uint8_t(i >> (8 * b)));
+                break;
+            }
+            case FieldScope::group_data: out.bytes = f.bytes; break;
+        }
+        kept.push_back(std::move(out));
+    }
+    return make_streamline_data_chunk(kept);
 }
 
 }  // namespace
@@ -103,6 +179,7 @@ SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedR
     std::vector<std::uint8_t> raw, packed;
     std::vector<std::uint32_t> packed_sizes;
     std::vector<float> xyz;
+    std::vector<std::uint32_t> run_points(runs.size(), 0);
     for (std::size_t i = 0; i < runs.size(); ++i) {
         const SelectedRun& r = runs[i];
         raw.resize(std::size_t(r.block_count) * bb);
@@ -118,6 +195,7 @@ SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedR
             index.add_block(p, n, k + 1 == r.block_count);
             p += 3 * n;
             h.points += n;
+            run_points[i] += n;
         }
         if (h.packed()) {  // checksums cover the bytes as stored
             packed.clear();
@@ -138,6 +216,7 @@ SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedR
         for (const auto tag : {kPropertiesTag, kResampledTag})
             if (const TrailerChunk* c = source.find_chunk(tag)) chunks.push_back(*c);
         if (source.end_fractions()) chunks.push_back(subset_end_fractions(source, runs));
+        if (!source.streamline_fields().empty()) chunks.push_back(subset_streamline_data(source, runs, run_points));
         if (auto bidx = index.finish()) chunks.push_back(std::move(*bidx));
         chunks.push_back(checksum.finish(head, chunks));  // last: it covers the chunks before it
         const auto trailer = serialize_trailer(chunks, at);
