@@ -180,10 +180,11 @@ TEST(TrxThroughFft, DirectoryArraysComeBackInTheirDtypes) {
     EXPECT_GT(worst, 0);  // the points went through the lossy codec
 }
 
-// Resampled input: per-point values are interpolated. float64 ones come back
-// as float64 (the interpolated values), uint8 ones stay float32 and are
-// listed in --json; float16 positions are the decoded points rounded to float16.
-TEST(TrxThroughFft, ResampledZipKeepsFloatDtypesAndListsTheRest) {
+// Resampled input: float per-point values are interpolated, float64 ones
+// come back as float64 (the interpolated values); integer ones (labels)
+// take the nearer input point's value and keep their dtype; float16
+// positions are the decoded points rounded to float16.
+TEST(TrxThroughFft, ResampledZipKeepsEveryDtype) {
     TempDir dir;
     const std::size_t fibers = 4, n = 50, points = fibers * n;
     const std::vector<double> pos = helices(fibers, n, false);
@@ -206,17 +207,14 @@ TEST(TrxThroughFft, ResampledZipKeepsFloatDtypesAndListsTheRest) {
     ASSERT_EQ(run_cli("compress -q " + dir.file("in.trx") + " -o " + dir.file("a.fft")).status, 0);
     const auto r = run_cli("decompress -q --json " + dir.file("a.fft") + " -o " + dir.file("out.trx"));
     ASSERT_EQ(r.status, 0) << r.output;
-    EXPECT_NE(r.output.find(R"("dtype_changes": [{"array": "dpv/idx", "from": "uint8", "to": "float32")"),
-              std::string::npos)
-        << r.output;
-    EXPECT_EQ(r.output.find(R"("array": "dpv/fa")"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(R"("dtype_changes": [])"), std::string::npos) << r.output;
     ASSERT_EQ(run_cli("decompress -q " + dir.file("a.fft") + " -o " + dir.file("out.tck")).status, 0);
 
     const FftFile file(dir.file("a.fft"));
     const std::uint64_t resampled = file.header().points;
     EXPECT_NE(resampled, points);
     const Entries out = read_trx(dir.file("out.trx"));
-    EXPECT_EQ(names(out), (std::vector<std::string>{"dps/w.float32", "dpv/fa.float64", "dpv/idx.float32", "header.json",
+    EXPECT_EQ(names(out), (std::vector<std::string>{"dps/w.float32", "dpv/fa.float64", "dpv/idx.uint8", "header.json",
                                                     "offsets.uint64", "positions.3.float16"}));
     EXPECT_EQ(out.at("dps/w.float32"), in.at("dps/w.float32"));
     // The per-point values: the file's interpolated float32 values, as float64.
@@ -228,7 +226,20 @@ TEST(TrxThroughFft, ResampledZipKeepsFloatDtypesAndListsTheRest) {
     const std::vector<double> out_fa = values_of<double>(out.at("dpv/fa.float64"));
     ASSERT_EQ(out_fa.size(), resampled);
     for (std::uint64_t i = 0; i < resampled; ++i) ASSERT_EQ(out_fa[i], stored_fa->at(i, 0)) << i;
-    EXPECT_EQ(values_of<float>(out.at("dpv/idx.float32")).size(), resampled);
+    // The labels: each input point's index along its fiber, so at the
+    // resampled points they start at 0, end at n - 1 (the ends are kept)
+    // and never go back; never a value between two labels.
+    const std::vector<std::uint8_t> out_idx = values_of<std::uint8_t>(out.at("dpv/idx.uint8"));
+    ASSERT_EQ(out_idx.size(), resampled);
+    const std::vector<std::uint64_t> out_offsets = values_of<std::uint64_t>(out.at("offsets.uint64"));
+    ASSERT_EQ(out_offsets.size(), fibers + 1);
+    for (std::size_t f = 0; f < fibers; ++f) {
+        const std::uint64_t a = out_offsets[f], b = out_offsets[f + 1];
+        ASSERT_GT(b, a + 1);
+        EXPECT_EQ(out_idx[a], 0) << f;
+        EXPECT_EQ(out_idx[b - 1], n - 1) << f;
+        for (std::uint64_t i = a + 1; i < b; ++i) EXPECT_LE(out_idx[i - 1], out_idx[i]) << f << " " << i;
+    }
     // Positions: the decoded points (the .tck's), each rounded to float16.
     TckReader tck(dir.file("out.tck"));
     std::vector<Vec3f> fiber;

@@ -399,8 +399,9 @@ def load(path, *, roi=None, fibers=None, threads=None, ignore_trailer=False, dat
         the positions in the returned Streamlines of its fibers that were
         returned, "dpg" arrays are whole. A file whose input was resampled
         (``info(path)["resampled"]``) keeps per-point arrays made for the
-        encoded points: float32, interpolated linearly between the input
-        points each new point lies between; the other arrays are the
+        encoded points: float ones float32, interpolated linearly between
+        the input points each new point lies between, integer ones the
+        nearer input point's in their dtype; the other arrays are the
         source's. Refused (ValueError) with ``ignore_trailer=True``, which
         skips the chunk.
 

@@ -427,9 +427,9 @@ void CompressJob::finish() {
     h.mean_error_mm = float(report.error.mean_mm());
     const auto final_head = serialize_fft_header(h);
     const std::uint64_t at = out_->logical_size();
-    if (report.resampled)  // per-point arrays are interpolated, stored as float32: their source dtype in PROP
+    if (report.resampled)  // float per-point arrays are interpolated, stored as float32: their source dtype in PROP
         for (const StreamlineField& f : fields_)
-            if (f.scope() == FieldScope::point && f.type != FieldType::float32)
+            if (f.scope() == FieldScope::point && (f.type == FieldType::float16 || f.type == FieldType::float64))
                 add_source_dtype_property(properties_, f.name, f.type);
     std::vector<TrailerChunk> chunks{make_properties_chunk(properties_)};
     if (!fields_.empty()) {

@@ -258,39 +258,57 @@ void write_batch(const FiberBatch& b, std::vector<Slot>& slots, FftSink& out, Ff
 PointFieldResampler::PointFieldResampler(std::vector<StreamlineField>* fields,
                                          const std::vector<std::uint32_t>& original_points) {
     if (!fields) return;
-    for (StreamlineField& f : *fields)
-        if (f.scope() == FieldScope::point) point_fields_.push_back(&f);
-    if (point_fields_.empty()) return;
+    for (StreamlineField& f : *fields) {
+        if (f.scope() != FieldScope::point) continue;
+        Column c{&f, f.type != FieldType::float16 && f.type != FieldType::float32 && f.type != FieldType::float64, {}, {}, {}};
+        if (c.nearest) {
+            c.raw = std::move(f.bytes);
+        } else {
+            c.input.resize(std::size_t(f.values()));
+            for (std::uint64_t k = 0; k < c.input.size(); ++k)
+                c.input[k] = narrow_to_float(field_value(f.type, &f.bytes[k * f.value_size()]));
+        }
+        columns_.push_back(std::move(c));
+    }
+    if (columns_.empty()) return;
     original_offsets_.resize(original_points.size() + 1);
     for (std::size_t i = 0; i < original_points.size(); ++i)
         original_offsets_[i + 1] = original_offsets_[i] + original_points[i];
-    for (StreamlineField* f : point_fields_) {
-        std::vector<float> v(std::size_t(f->values()));
-        for (std::uint64_t k = 0; k < v.size(); ++k) v[k] = narrow_to_float(field_value(f->type, &f->bytes[k * f->value_size()]));
-        input_.push_back(std::move(v));
-    }
 }
 
 void PointFieldResampler::set_resampled_points(const std::vector<std::uint32_t>& points) {
     if (!active()) return;
     offsets_.assign(points.size() + 1, 0);
     for (std::size_t i = 0; i < points.size(); ++i) offsets_[i + 1] = offsets_[i] + points[i];
-    for (StreamlineField* f : point_fields_) output_.emplace_back(std::size_t(offsets_.back()) * f->components);
+    for (Column& c : columns_) {
+        const std::size_t values = std::size_t(offsets_.back()) * c.field->components;
+        if (c.nearest) c.field->bytes.assign(values * c.field->value_size(), 0);
+        else c.output.resize(values);
+    }
 }
 
 void PointFieldResampler::resample(std::uint32_t f, std::span<const PolylinePosition> positions) {
-    for (std::size_t i = 0; i < point_fields_.size(); ++i) {
-        const std::size_t c = point_fields_[i]->components;
-        interpolate_point_values(positions, &input_[i][original_offsets_[f] * c], c, &output_[i][offsets_[f] * c]);
+    for (Column& c : columns_) {
+        const std::size_t n = c.field->components;
+        if (!c.nearest) {
+            interpolate_point_values(positions, &c.input[original_offsets_[f] * n], n, &c.output[offsets_[f] * n]);
+            continue;
+        }
+        const std::size_t row = n * c.field->value_size();
+        for (std::size_t k = 0; k < positions.size(); ++k) {
+            const std::size_t nearer = positions[k].segment + (positions[k].t > 0.5 ? 1 : 0);
+            std::memcpy(&c.field->bytes[(offsets_[f] + k) * row], &c.raw[(original_offsets_[f] + nearer) * row], row);
+        }
     }
 }
 
 void PointFieldResampler::finish() {
-    for (std::size_t i = 0; i < point_fields_.size(); ++i) {
-        StreamlineField& f = *point_fields_[i];
+    for (Column& c : columns_) {
+        if (c.nearest) continue;
+        StreamlineField& f = *c.field;
         f.type = FieldType::float32;
-        f.bytes.resize(output_[i].size() * 4);
-        std::memcpy(f.bytes.data(), output_[i].data(), f.bytes.size());
+        f.bytes.resize(c.output.size() * 4);
+        std::memcpy(f.bytes.data(), c.output.data(), f.bytes.size());
     }
 }
 

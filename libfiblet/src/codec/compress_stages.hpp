@@ -141,16 +141,17 @@ void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double
                          std::size_t sharp_blocks, unsigned threads, const CompressOptions& options,
                          CompressTimings& timings);
 
-// Per-point fields of resampled input, re-made at the resampled points
-// (float32, linear between the two input points of the piece each lies on:
-// interpolate_point_values);
-// the other fields are kept as read.
+// Per-point fields of resampled input, re-made at the resampled points:
+// float values as float32, linear between the two input points of the
+// piece each lies on (interpolate_point_values); integer values (labels)
+// the nearer input point's, in their own type. The other fields are kept
+// as read.
 class PointFieldResampler {
 public:
     // `fields`: null when the input is not resampled; `original_points`:
     // each fiber's input point count.
     PointFieldResampler(std::vector<StreamlineField>* fields, const std::vector<std::uint32_t>& original_points);
-    bool active() const { return !point_fields_.empty(); }
+    bool active() const { return !columns_.empty(); }
     // The resampled point counts are known: size the outputs.
     void set_resampled_points(const std::vector<std::uint32_t>& points);
     // Fiber f was resampled at `positions` (threads write disjoint fibers).
@@ -158,9 +159,14 @@ public:
     void finish();
 
 private:
-    std::vector<StreamlineField*> point_fields_;
+    struct Column {
+        StreamlineField* field;
+        bool nearest;                       // integer values: the nearer input point's
+        std::vector<float> input, output;   // float values, as float32
+        std::vector<std::uint8_t> raw;      // integer values, as read
+    };
+    std::vector<Column> columns_;
     std::vector<std::uint64_t> original_offsets_, offsets_;
-    std::vector<std::vector<float>> input_, output_;
 };
 
 // What the encode stage needs besides the input: the encoder, the
