@@ -19,6 +19,7 @@
 
 #include "cli_runner.hpp"
 #include "fiblet/error.hpp"
+#include "fiblet/fft_file.hpp"
 #include "fiblet/streamline_io.hpp"
 #include "fiblet/trk.hpp"
 #include "test_util.hpp"
@@ -227,6 +228,53 @@ TEST(ReaderRefusals, SmallFilesClaimingGigabytesStayWithinAFewMegabytes) {
         {"extract", "-q", fft, "--include", dir.file("mask.nii.gz"), "-o", dir.file("o.tck")});
     EXPECT_EQ(mask_status, 4);
     EXPECT_LT(mask_mb, bound_mb);
+}
+
+// An honest mask: 400^3 uint8 voxels (64 MB), a cube of ones, gzipped to a
+// few hundred kB, with a second volume. Read as a mask it costs a byte a
+// voxel of its first volume (was: every volume widened to float32 after
+// its raw bytes, 330 MB), and it selects what it should.
+TEST(ReaderRefusals, MasksAreReadAsBytesNotFloats) {
+    TempDir dir;
+    const std::int16_t n = 400;
+    std::string nii(352, '\0');
+    auto put16 = [&](std::size_t at, std::int16_t v) { std::memcpy(&nii[at], &v, 2); };
+    auto putf = [&](std::size_t at, float v) { std::memcpy(&nii[at], &v, 4); };
+    const std::int32_t header = 348;
+    std::memcpy(&nii[0], &header, 4);
+    const std::int16_t dims[5] = {4, n, n, n, 2};
+    for (int i = 0; i < 5; ++i) put16(40 + 2 * std::size_t(i), dims[i]);
+    for (int i = 5; i < 8; ++i) put16(40 + 2 * std::size_t(i), 1);
+    put16(70, 2), put16(72, 8);  // uint8
+    for (int i = 0; i < 8; ++i) putf(76 + 4 * std::size_t(i), 1.0f);  // 1 mm voxels, identity axes
+    putf(108, 352.0f);
+    std::memcpy(&nii[344], "n+1", 4);
+    const std::size_t volume = std::size_t(n) * n * n;
+    std::string voxels(2 * volume, '\0');
+    for (std::size_t k = 190; k < 210; ++k)  // the first volume's cube: voxels 190..209 on each axis
+        for (std::size_t j = 190; j < 210; ++j) std::memset(&voxels[190 + n * (j + n * k)], 1, 20);
+    test::write_file(dir.file("mask.nii"), nii + voxels);
+    voxels.clear(), voxels.shrink_to_fit();
+    ASSERT_EQ(test::run_command("gzip -1 " + dir.file("mask.nii")).status, 0);
+    // MRtrix's default transform centres the grid on the origin: the cube
+    // spans world -10.5 .. 9.5 mm on each axis. Two fibers: one through it.
+    const std::string tck = dir.file("t.tck"), fft = dir.file("t.fft");
+    std::string data = "mrtrix tracks\ndatatype: Float32LE\nfile: . 64\nEND\n";
+    data.resize(64, '\0');
+    std::vector<float> pts;
+    for (int f = 0; f < 2; ++f) {
+        for (int k = 0; k < 100; ++k) pts.insert(pts.end(), {-50.0f + float(k), f ? 40.0f : 0.0f, 0.0f});
+        pts.insert(pts.end(), {NAN, NAN, NAN});
+    }
+    pts.insert(pts.end(), {INFINITY, INFINITY, INFINITY});
+    data.append(reinterpret_cast<const char*>(pts.data()), pts.size() * sizeof(float));
+    test::write_file(tck, data);
+    ASSERT_EQ(test::run_cli("compress -q " + tck + " -o " + fft).status, 0);
+    const auto [status, mb] = status_and_peak_rss_mb(
+        {"extract", "-q", fft, "--include", dir.file("mask.nii.gz"), "-o", dir.file("o.fft")});
+    ASSERT_EQ(status, 0);
+    EXPECT_LT(mb, test::kSanitized ? 1024 : 200);
+    EXPECT_EQ(FftFile(dir.file("o.fft")).header().fibers, 1u);
 }
 
 // 2^21 empty streamlines (an 8 MiB offsets array, 131 kB zipped at 2^24):

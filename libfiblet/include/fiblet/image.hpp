@@ -41,6 +41,17 @@ struct Image {
     }
 };
 
+// An image read as a mask, as MRtrix3 reads a bool image: voxel (i, j, k) of
+// the first volume counts when its value (scaled as read_image scales it)
+// rounds to non-zero; NaN and infinity do not. One byte a voxel, the voxels
+// never widened to float; a NIfTI file's later volumes are not read.
+struct MaskImage {
+    Image geometry;                    // path, dims, spacing, voxel_to_world; no values
+    std::vector<std::uint8_t> counts;  // 0 or 1 per voxel of the first volume, x fastest
+    bool at(std::int64_t i, std::int64_t j, std::int64_t k) const { return counts[geometry.offset(i, j, k)]; }
+};
+MaskImage read_mask_image(const std::string& path);
+
 // Reads an image by its name: .nii / .nii.gz (NIfTI-1 or NIfTI-2), .mif
 // (MRtrix3, data in the same file or, for .mih, in the file it names).
 // Throws Error{io} when it cannot be read, Error{image_format} when it is

@@ -26,8 +26,8 @@ namespace fiblet {
 class ImageMask {
 public:
     // Throws Error{invalid_argument} when no voxel is inside (tckedit: "image is empty").
-    explicit ImageMask(const Image& image);
-    // read_image(path) made into a mask.
+    explicit ImageMask(const MaskImage& mask);
+    // read_mask_image(path) made into a mask.
     static std::shared_ptr<const ImageMask> read(const std::string& path);
 
     const std::string& path() const { return path_; }

@@ -23,10 +23,10 @@ std::int64_t Image::volumes() const {
 }
 
 namespace {
-Image read_any(const std::string& path, bool values) {
+Image read_any(const std::string& path, detail::VoxelOutput out) {
     detail::require_regular_input(path);
-    if (ends_with(path, ".nii") || ends_with(path, ".nii.gz")) return detail::read_nifti(path, values);
-    if (ends_with(path, ".mif") || ends_with(path, ".mih")) return detail::read_mif(path, values);
+    if (ends_with(path, ".nii") || ends_with(path, ".nii.gz")) return detail::read_nifti(path, out);
+    if (ends_with(path, ".mif") || ends_with(path, ".mih")) return detail::read_mif(path, out);
     if (ends_with(path, ".mif.gz"))
         throw Error(Errc::unsupported, path + ": compressed .mif.gz images are not supported: "
                                               "mrconvert it to .mif or .nii.gz");
@@ -34,8 +34,18 @@ Image read_any(const std::string& path, bool values) {
 }
 }  // namespace
 
-Image read_image(const std::string& path) { return read_any(path, true); }
-Image read_image_header(const std::string& path) { return read_any(path, false); }
+Image read_image(const std::string& path) {
+    std::vector<float> values;
+    Image image = read_any(path, {&values, nullptr});
+    image.values = std::move(values);
+    return image;
+}
+Image read_image_header(const std::string& path) { return read_any(path, {}); }
+MaskImage read_mask_image(const std::string& path) {
+    MaskImage mask;
+    mask.geometry = read_any(path, {nullptr, &mask.counts});
+    return mask;
+}
 
 std::array<double, 3> transform_point(const Affine3x4& m, const std::array<double, 3>& v) {
     std::array<double, 3> out{};

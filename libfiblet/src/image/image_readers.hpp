@@ -2,15 +2,35 @@
 // geometry rules they share (MRtrix3's, see fiblet/image.hpp).
 #pragma once
 
+#include <cmath>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "fiblet/image.hpp"
 
 namespace fiblet::detail {
 
-// `values`: false reads the header alone (dims, spacing, voxel_to_world).
-Image read_nifti(const std::string& path, bool values = true);
-Image read_mif(const std::string& path, bool values = true);
+// What a reader does with the voxels: nothing (the header alone: dims,
+// spacing, voxel_to_world), every volume as float (Image::values), or the
+// first volume as mask counts (MaskImage::counts, whose rule voxel_counts is).
+struct VoxelOutput {
+    std::vector<float>* values = nullptr;
+    std::vector<std::uint8_t>* counts = nullptr;
+    void put(std::size_t at, float v) const {
+        if (values) (*values)[at] = v;
+        else (*counts)[at] = voxel_counts(v);
+    }
+    // Sized for `voxels` more (grown as data arrives, never to a header's claim).
+    void grow_to(std::size_t voxels) const {
+        if (values) values->resize(voxels);
+        else counts->resize(voxels);
+    }
+    static bool voxel_counts(float v) { return std::isfinite(v) && std::round(v) != 0; }
+};
+
+Image read_nifti(const std::string& path, VoxelOutput out = {});
+Image read_mif(const std::string& path, VoxelOutput out = {});
 
 // Axes in `rotation` (3x3 part; translation in column 3) scaled by the voxel
 // sizes: the voxel -> world map. Cosine vectors that are not unit length are

@@ -155,7 +155,7 @@ std::vector<std::uint8_t> read_bytes(const std::string& path, std::uint64_t offs
 
 }  // namespace
 
-Image read_mif(const std::string& path, bool values) {
+Image read_mif(const std::string& path, VoxelOutput out) {
     const KeyValueHeader kv = read_key_value_header(path, "mrtrix image", Errc::image_format, ".mif");
     Image img;
     img.path = path;
@@ -195,7 +195,7 @@ Image read_mif(const std::string& path, bool values) {
     }
     img.voxel_to_world = voxel_to_world(m, img.spacing);
     check_transform(img);
-    if (!values) return img;
+    if (!out.values && !out.counts) return img;
 
     // "scaling: offset,scale" applies to integer data only, as MRtrix 3.0
     // reads it (float data is used as stored; tests/image_test.cpp).
@@ -221,13 +221,15 @@ Image read_mif(const std::string& path, bool values) {
     const auto [file, data_offset] = data_file(path, kv.one("file"));
     const std::vector<std::uint8_t> bytes = read_bytes(file, data_offset, data_bytes);
 
-    img.values.resize(n);
+    // Output order (x fastest, the volumes last): a mask stops after the first volume.
+    const std::size_t wanted = out.values ? n : std::size_t(img.dims[0] * img.dims[1] * img.dims[2]);
+    out.grow_to(wanted);
     std::vector<std::int64_t> idx(ndim, 0);
-    for (std::size_t out = 0; out < n; ++out) {
+    for (std::size_t voxel = 0; voxel < wanted; ++voxel) {
         std::size_t at = 0;
         for (std::size_t a = 0; a < ndim; ++a)
             at += stride[a] * std::size_t(layout[a] < 0 ? img.dims[a] - 1 - idx[a] : idx[a]);
-        img.values[out] = float(offset + scale * value_at(bytes, at, dtype));
+        out.put(voxel, float(offset + scale * value_at(bytes, at, dtype)));
         for (std::size_t a = 0; a < ndim && ++idx[a] == img.dims[a]; ++a) idx[a] = 0;
     }
     return img;

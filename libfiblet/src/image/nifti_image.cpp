@@ -71,69 +71,70 @@ NiftiPtr read_header_only(const std::string& path) {
     return NiftiPtr();
 }
 
-// The voxel bytes of `path` itself, read through znzlib (gzip or not).
-// libnifti's own loader is not used: with both X.nii and X.nii.gz present it
-// reads the data of X.nii for X.nii.gz (libnifti 3.0.1).
-std::vector<std::uint8_t> read_voxel_bytes(const std::string& path, const nifti_image& h, std::size_t n, bool gz) {
+// The first `n` voxels of `path` itself, read through znzlib (gzip or not)
+// 16 MiB at a time, each chunk converted into `out` as it arrives: a gzip
+// header may claim up to 1032x its file (deflate's best ratio) and be a
+// lie, so memory follows the bytes that exist, not the claim, and the
+// voxels' own bytes are never held whole. libnifti's own loader is not
+// used: with both X.nii and X.nii.gz present it reads the data of X.nii for
+// X.nii.gz (libnifti 3.0.1).
+void read_voxels(const std::string& path, const nifti_image& h, std::size_t n, bool gz, const VoxelOutput& out) {
+    // scl_slope / scl_inter, when the slope is finite and non-zero, scale
+    // integer data only: MRtrix 3.0 (and so tckedit) reads float data as
+    // stored (checked in tests/image_test.cpp).
+    double slope = 1, inter = 0;
+    const bool integer = h.datatype != DT_FLOAT32 && h.datatype != DT_FLOAT64;
+    if (integer && std::isfinite(h.scl_slope) && h.scl_slope != 0) {
+        slope = h.scl_slope;
+        inter = std::isfinite(h.scl_inter) ? h.scl_inter : 0.0;
+    }
+    auto convert = [&]<class T>(const std::uint8_t* data, std::size_t first, std::size_t count) {
+        for (std::size_t i = 0; i < count; ++i) {
+            T v;
+            std::memcpy(&v, data + i * sizeof(T), sizeof(T));
+            out.put(first + i, float(inter + slope * double(v)));
+        }
+    };
+    auto convert_chunk = [&](const std::uint8_t* data, std::size_t first, std::size_t count) {
+        switch (h.datatype) {
+            case DT_UINT8: return convert.operator()<std::uint8_t>(data, first, count);
+            case DT_INT8: return convert.operator()<std::int8_t>(data, first, count);
+            case DT_INT16: return convert.operator()<std::int16_t>(data, first, count);
+            case DT_UINT16: return convert.operator()<std::uint16_t>(data, first, count);
+            case DT_INT32: return convert.operator()<std::int32_t>(data, first, count);
+            case DT_UINT32: return convert.operator()<std::uint32_t>(data, first, count);
+            case DT_INT64: return convert.operator()<std::int64_t>(data, first, count);
+            case DT_UINT64: return convert.operator()<std::uint64_t>(data, first, count);
+            case DT_FLOAT32: return convert.operator()<float>(data, first, count);
+            case DT_FLOAT64: return convert.operator()<double>(data, first, count);
+            default:
+                throw Error(Errc::unsupported, path + ": NIfTI datatype " + std::string(nifti_datatype_string(h.datatype)) +
+                                                   " is not supported (real-valued voxels only)");
+        }
+    };
+    convert_chunk(nullptr, 0, 0);  // an unsupported datatype fails before any read
     znzFile f = znzopen(path.c_str(), "rb", gz ? 1 : 0);
     if (znz_isnull(f)) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
-    const std::size_t bytes = n * std::size_t(h.nbyper);
-    // Grown as the data arrives (64 MiB at a time): a gzip header may claim up
-    // to 1032x its file (deflate's best ratio) and be a lie; memory then
-    // follows the bytes that exist, not the claim.
-    constexpr std::size_t kChunk = std::size_t(64) << 20;
-    std::vector<std::uint8_t> data;
+    const std::size_t width = std::size_t(h.nbyper), chunk_voxels = (std::size_t(16) << 20) / width;
+    const bool swap = h.byteorder != nifti_short_order() && h.swapsize > 1;
+    std::vector<std::uint8_t> chunk;
     std::size_t got = 0;
     if (znzseek(f, znz_off_t(h.iname_offset), SEEK_SET) >= 0) {
-        while (got < bytes) {
-            const std::size_t want = std::min(kChunk, bytes - got);
-            data.resize(got + want);
-            const std::size_t n_read = znzread(data.data() + got, 1, want, f);
+        while (got < n) {
+            const std::size_t want = std::min(chunk_voxels, n - got);
+            chunk.resize(want * width);
+            const std::size_t n_read = znzread(chunk.data(), 1, chunk.size(), f) / width;
+            if (swap) nifti_swap_Nbytes(std::int64_t(n_read), h.swapsize, chunk.data());
+            out.grow_to(got + n_read);
+            convert_chunk(chunk.data(), got, n_read);
             got += n_read;
             if (n_read < want) break;
         }
     }
     znzclose(f);
-    if (got != bytes)
-        throw Error(Errc::image_format, path + ": voxel data truncated (" + std::to_string(bytes) +
+    if (got != n)
+        throw Error(Errc::image_format, path + ": voxel data truncated (" + std::to_string(n * width) +
                                             " bytes expected at offset " + std::to_string(h.iname_offset) + ")");
-    if (h.byteorder != nifti_short_order() && h.swapsize > 1) nifti_swap_Nbytes(std::int64_t(n), h.swapsize, data.data());
-    return data;
-}
-
-template <class T>
-void convert(const void* data, std::size_t n, double slope, double inter, std::vector<float>& out) {
-    const T* v = static_cast<const T*>(data);
-    out.resize(n);
-    for (std::size_t i = 0; i < n; ++i) out[i] = float(inter + slope * double(v[i]));
-}
-
-void convert_values(const std::string& path, const nifti_image& nim, const void* data, std::size_t n,
-                    std::vector<float>& out) {
-    // scl_slope / scl_inter, when the slope is finite and non-zero, scale
-    // integer data only: MRtrix 3.0 (and so tckedit) reads float data as
-    // stored (checked in tests/image_test.cpp).
-    double slope = 1, inter = 0;
-    const bool integer = nim.datatype != DT_FLOAT32 && nim.datatype != DT_FLOAT64;
-    if (integer && std::isfinite(nim.scl_slope) && nim.scl_slope != 0) {
-        slope = nim.scl_slope;
-        inter = std::isfinite(nim.scl_inter) ? nim.scl_inter : 0.0;
-    }
-    switch (nim.datatype) {
-        case DT_UINT8: return convert<std::uint8_t>(data, n, slope, inter, out);
-        case DT_INT8: return convert<std::int8_t>(data, n, slope, inter, out);
-        case DT_INT16: return convert<std::int16_t>(data, n, slope, inter, out);
-        case DT_UINT16: return convert<std::uint16_t>(data, n, slope, inter, out);
-        case DT_INT32: return convert<std::int32_t>(data, n, slope, inter, out);
-        case DT_UINT32: return convert<std::uint32_t>(data, n, slope, inter, out);
-        case DT_INT64: return convert<std::int64_t>(data, n, slope, inter, out);
-        case DT_UINT64: return convert<std::uint64_t>(data, n, slope, inter, out);
-        case DT_FLOAT32: return convert<float>(data, n, slope, inter, out);
-        case DT_FLOAT64: return convert<double>(data, n, slope, inter, out);
-        default:
-            throw Error(Errc::unsupported, path + ": NIfTI datatype " + std::string(nifti_datatype_string(nim.datatype)) +
-                                               " is not supported (real-valued voxels only)");
-    }
 }
 
 // MRtrix's rules (core/file/nifti_utils.cpp): the sform when sform_code is
@@ -181,7 +182,7 @@ Affine3x4 rotation_and_spacing(const nifti_image& nim, std::array<double, 3>& sp
 
 }  // namespace
 
-Image read_nifti(const std::string& path, bool values) {
+Image read_nifti(const std::string& path, VoxelOutput out) {
     struct stat st {};
     if (::stat(path.c_str(), &st) != 0) throw Error(Errc::io, path + ": cannot open: " + std::strerror(errno));
     const bool gz = path.size() > 3 && path.compare(path.size() - 3, 3, ".gz") == 0;
@@ -203,10 +204,9 @@ Image read_nifti(const std::string& path, bool values) {
         throw Error(Errc::image_format, path + ": the header describes " + std::to_string(n) +
                                             " voxels, more than the file holds (truncated or malformed image)");
     if (h.iname_offset < 0) throw Error(Errc::image_format, path + ": negative data offset");
-    if (values) {
-        const std::vector<std::uint8_t> bytes = read_voxel_bytes(path, h, n, gz);
-        convert_values(path, h, bytes.data(), n, img.values);
-    }
+    // Voxels are stored x fastest, the volumes last: a mask reads the first.
+    if (out.values) read_voxels(path, h, n, gz, out);
+    else if (out.counts) read_voxels(path, h, std::size_t(img.dims[0] * img.dims[1] * img.dims[2]), gz, out);
 
     for (int c = 0; c < 3; ++c) img.spacing[c] = c < ndim ? std::abs(h.pixdim[c + 1]) : 1.0;
     for (double& s : img.spacing)

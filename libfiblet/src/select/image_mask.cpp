@@ -9,14 +9,8 @@
 #include "fiblet/error.hpp"
 
 namespace fiblet {
-namespace {
-
-// MRtrix reads a mask as bool: round(value) != 0, NaN and Inf as 0.
-bool counts(float v) { return std::isfinite(v) && std::round(v) != 0; }
-
-}  // namespace
-
-ImageMask::ImageMask(const Image& image) : path_(image.path) {
+ImageMask::ImageMask(const MaskImage& mask) : path_(mask.geometry.path) {
+    const Image& image = mask.geometry;
     std::array<std::int64_t, 3> lo{std::numeric_limits<std::int64_t>::max(), std::numeric_limits<std::int64_t>::max(),
                                    std::numeric_limits<std::int64_t>::max()},
         hi{-1, -1, -1};
@@ -24,7 +18,7 @@ ImageMask::ImageMask(const Image& image) : path_(image.path) {
     for (std::int64_t k = 0; k < nz; ++k)
         for (std::int64_t j = 0; j < ny; ++j)
             for (std::int64_t i = 0; i < nx; ++i)
-                if (counts(image.at(i, j, k))) {
+                if (mask.at(i, j, k)) {
                     const std::array<std::int64_t, 3> v{i, j, k};
                     for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], v[a]), hi[a] = std::max(hi[a], v[a]);
                 }
@@ -46,7 +40,7 @@ ImageMask::ImageMask(const Image& image) : path_(image.path) {
     for (std::int64_t k = 0; k < size_[2]; ++k)
         for (std::int64_t j = 0; j < size_[1]; ++j)
             for (std::int64_t i = 0; i < size_[0]; ++i) {
-                const bool in = counts(image.at(i + bottom[0], j + bottom[1], k + bottom[2]));
+                const bool in = mask.at(i + bottom[0], j + bottom[1], k + bottom[2]);
                 inside_[std::size_t(i + size_[0] * (j + size_[1] * k))] = in;
                 inside_count_ += in;
                 sat(i + 1, j + 1, k + 1) = std::uint32_t(in) + sat(i, j + 1, k + 1) + sat(i + 1, j, k + 1) +
@@ -82,7 +76,7 @@ ImageMask::ImageMask(const Image& image) : path_(image.path) {
 }
 
 std::shared_ptr<const ImageMask> ImageMask::read(const std::string& path) {
-    return std::make_shared<const ImageMask>(read_image(path));
+    return std::make_shared<const ImageMask>(read_mask_image(path));
 }
 
 std::int64_t ImageMask::occupied(const std::array<std::int64_t, 3>& lo, const std::array<std::int64_t, 3>& hi) const {
