@@ -277,6 +277,41 @@ TEST(ReaderRefusals, MasksAreReadAsBytesNotFloats) {
     EXPECT_EQ(FftFile(dir.file("o.fft")).header().fibers, 1u);
 }
 
+// A TRX directory of a three-point streamline reaching `length` mm (its
+// uneven spacing resampled to ~1 mm: thousands of points) and a one-point
+// one, with `components` uint8 values a point (dpv/x).
+std::string long_resampled_trx(const TempDir& dir, const std::string& name, float length, std::size_t components) {
+    const std::string root = trx_dir(dir, name, trx_header("1", "2", "4"), {0, 0, 0, 1, 0, 0, length, 0, 0, 5, 5, 5});
+    const std::uint32_t offsets[2] = {0, 3};
+    test::write_file(root + "/offsets.uint32", std::string(reinterpret_cast<const char*>(offsets), sizeof offsets));
+    std::filesystem::create_directories(root + "/dpv");
+    test::write_file(root + "/dpv/x." + std::to_string(components) + ".uint8", std::string(4 * components, '\x07'));
+    return root;
+}
+
+// Per-point data x resampling: 400 kB of values on a 20 m segment would
+// take 1.9 GB once resampled (was: allocated until bad_alloc, exit 1). It
+// is sized against the memory budget before anything is allocated.
+TEST(ReaderRefusals, ResampledPerPointDataIsSizedAgainstTheMemoryBudget) {
+    TempDir dir;
+    const std::string big = long_resampled_trx(dir, "big.trx", 20000, 100000);
+    const auto [status, mb] = status_and_peak_rss_mb({"compress", "-q", big, "-o", dir.file("big.fft"), "--max-memory", "1G"});
+    EXPECT_EQ(status, 6);
+    EXPECT_LT(mb, test::kSanitized ? 1024 : 200);
+    EXPECT_FALSE(std::filesystem::exists(dir.file("big.fft")));
+    const auto r = test::run_cli("compress -q " + big + " -o " + dir.file("big.fft") + " --max-memory 1G");
+    EXPECT_NE(r.output.find("more than the memory budget of 1024 MiB; --max-memory"), std::string::npos) << r.output;
+    // Within the budget: written, the labels in their dtype, a row a point.
+    const std::string small = long_resampled_trx(dir, "small.trx", 2000, 50);
+    ASSERT_EQ(test::run_cli("compress -q " + small + " -o " + dir.file("small.fft") + " --max-memory 64M").status, 0);
+    const FftFile f(dir.file("small.fft"));
+    ASSERT_EQ(f.streamline_fields().size(), 1u);
+    EXPECT_EQ(f.streamline_fields()[0].type, FieldType::uint8);
+    EXPECT_GT(f.header().points, 1000u);
+    EXPECT_EQ(f.streamline_fields()[0].rows(), f.header().points);
+    EXPECT_EQ(f.streamline_fields()[0].bytes, std::vector<std::uint8_t>(50 * f.header().points, 7));
+}
+
 // 2^21 empty streamlines (an 8 MiB offsets array, 131 kB zipped at 2^24):
 // compress's memory follows the per-fiber tables of its output, no longer
 // one batch of them all and a tuning sample of every one (2^21: 297 MB

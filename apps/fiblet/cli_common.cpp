@@ -20,6 +20,7 @@ std::string cli_message(const Error& e) {
         case Remedy::overwrite: return std::string(e.what()) + " (use --force to overwrite)";
         case Remedy::ignore_trailer: return std::string(e.what()) + "; --ignore-trailer reads the blocks without it";
         case Remedy::allow_count_mismatch: return std::string(e.what()) + "; --allow-count-mismatch reads it anyway";
+        case Remedy::max_memory: return std::string(e.what()) + "; --max-memory SIZE raises the budget";
         case Remedy::none: break;
     }
     return e.what();

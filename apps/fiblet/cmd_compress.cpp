@@ -37,6 +37,7 @@ struct CompressArgs {
     std::uint32_t zstd_group = ZstdOptions{}.group_blocks;
     bool force = false, quiet = false, json = false, allow_count_mismatch = false, recursive = false;
     std::optional<double> max_error_um;
+    std::uint64_t max_memory = 0;  // 0: the library's default
 };
 
 std::string describe_errors(const ErrorStats& e) {
@@ -154,6 +155,7 @@ void run(const CompressArgs& args) {
         o.overwrite = a.force;
         o.threads = a.threads;
         o.allow_count_mismatch = a.allow_count_mismatch;
+        o.max_memory = a.max_memory;
         o.reference_space = reference_space;
         o.direction_bits = a.bits == "auto" ? std::nullopt : std::optional<unsigned>(unsigned(std::stoul(a.bits)));
         o.points_per_block = a.block_points;
@@ -285,6 +287,11 @@ void add_compress(CLI::App& app) {
     cmd->add_flag("--json", args->json, "Print the report as JSON");
     cmd->add_flag("--allow-count-mismatch", args->allow_count_mismatch,
                   "Accept a .tck whose count: (a .trk whose n_count) disagrees with its data");
+    cmd->add_option("--max-memory", args->max_memory,
+                    "Memory the per-point arrays of resampled streamlines may take, e.g. 8G or 512M "
+                    "(default: half the physical memory); beyond it compress stops before writing")
+        ->transform(CLI::AsSizeValue(false))
+        ->check(CLI::PositiveNumber);
     cmd->callback([args] { run(*args); });
 }
 

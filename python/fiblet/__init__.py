@@ -635,7 +635,16 @@ def _output_kind(path):
     return ext
 
 
-def save(path, streamlines, step=None, *, overwrite=False, threads=None):
+def _memory_budget(max_memory):
+    """CompressOptions::max_memory: 0 (the library's default) for None."""
+    if max_memory is None:
+        return 0
+    if isinstance(max_memory, bool) or not isinstance(max_memory, int) or not 0 < max_memory < 2**63:
+        raise ValueError(f"max_memory must be a positive number of bytes, got {max_memory!r}")
+    return max_memory
+
+
+def save(path, streamlines, step=None, *, overwrite=False, threads=None, max_memory=None):
     """Writes streamlines to ``path`` in the format its extension names.
 
     - ``.fft``: compressed, as ``fiblet compress``; ``.fftz``: compressed
@@ -658,6 +667,9 @@ def save(path, streamlines, step=None, *, overwrite=False, threads=None):
         variable spacing is resampled to it); refused for other outputs.
     overwrite: replace an existing file (else FileExistsError).
     threads: compression threads (None: all cores).
+    max_memory: bytes compression may give the per-point arrays of resampled
+        streamlines (None: half the physical memory); beyond it nothing is
+        written and an error says how much was needed.
 
     Points for a .fft/.fftz go through a temporary .tck file (in the default
     temporary directory, see ``tempfile``), which is removed afterwards.
@@ -676,7 +688,7 @@ def save(path, streamlines, step=None, *, overwrite=False, threads=None):
         source = _existing(streamlines)
         if ext in _COMPRESSED:
             return _fiblet.compress(source, path, None if step is None else float(step), bool(overwrite),
-                                    nthreads, zstd)
+                                    nthreads, zstd, _memory_budget(max_memory))
         written = _fiblet.convert(source, path, bool(overwrite))
         if written.pop("fields_dropped"):
             import warnings
@@ -698,7 +710,7 @@ def save(path, streamlines, step=None, *, overwrite=False, threads=None):
         tck = _os.path.join(tmp, "streamlines.tck")
         _fiblet.write_streamlines(tck, points, offsets, properties, False)
         report = _fiblet.compress(tck, path, None if step is None else float(step), bool(overwrite),
-                                  nthreads, zstd)
+                                  nthreads, zstd, _memory_budget(max_memory))
     report["input"] = None  # the temporary .tck is gone
     return report
 

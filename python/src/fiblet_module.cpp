@@ -332,9 +332,9 @@ py::dict stats(const std::string& fft_path, const std::string& reference) {
 // Same keys as `fiblet compress --json`.
 // zstd: the seekable zstd container (.fftz) with the defaults of `fiblet compress --zstd`.
 py::dict compress(const std::string& tck_path, const std::string& fft_path, std::optional<double> step_mm,
-                  bool overwrite, unsigned threads, bool zstd) {
+                  bool overwrite, unsigned threads, bool zstd, std::uint64_t max_memory) {
     CompressOptions o;
-    o.step_mm = step_mm, o.overwrite = overwrite, o.threads = threads;
+    o.step_mm = step_mm, o.overwrite = overwrite, o.threads = threads, o.max_memory = max_memory;
     if (zstd) o.zstd = ZstdOptions{};
     CompressReport r;
     {
@@ -466,6 +466,7 @@ PYBIND11_MODULE(_fiblet, m) {
             std::string message = e.what();
             if (e.remedy() == fiblet::Remedy::overwrite) message += " (overwrite=True replaces it)";
             if (e.remedy() == fiblet::Remedy::ignore_trailer) message += "; ignore_trailer=True reads the blocks without it";
+            if (e.remedy() == fiblet::Remedy::max_memory) message += "; max_memory= (bytes) raises the budget";
             py::object instance = py::reinterpret_borrow<py::object>(error_type.ptr())(message);
             instance.attr("category") = fiblet::errc_name(e.code());
             PyErr_SetObject(error_type.ptr(), instance.ptr());
@@ -477,7 +478,7 @@ PYBIND11_MODULE(_fiblet, m) {
     m.def("info", &info, py::arg("path"), py::arg("ignore_trailer"));
     m.def("stats", &stats, py::arg("fft"), py::arg("reference"));
     m.def("compress", &compress, py::arg("tck"), py::arg("fft"), py::arg("step_mm"), py::arg("overwrite"),
-          py::arg("threads"), py::arg("zstd"));
+          py::arg("threads"), py::arg("zstd"), py::arg("max_memory"));
     m.def("read_streamlines", &read_streamlines, py::arg("path"));
     m.def("data", &data, py::arg("path"), py::arg("fiber_points"));
     m.def("container", &container_of, py::arg("path"));

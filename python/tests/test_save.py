@@ -238,3 +238,31 @@ def test_save_of_a_file_converts_it_keeping_its_data(tmp_path, shared):
         fiblet.save(tmp_path / "c.tck", src)
     np.testing.assert_allclose(nib.streamlines.load(str(tmp_path / "c.tck")).streamlines.get_data(),
                                a.streamlines.get_data(), rtol=0, atol=1e-4)
+
+
+def test_save_sizes_resampled_point_data_against_max_memory(tmp_path):
+    """A TRX whose 400 kB of per-point values would take 1.9 GB once its
+    20 m segment is resampled: refused before anything is allocated or
+    written, with the budget in the message; within the budget it is saved."""
+    def trx(name, length, components):
+        root = tmp_path / name
+        (root / "dpv").mkdir(parents=True)
+        (root / "header.json").write_text(json.dumps({
+            "VOXEL_TO_RASMM": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], "DIMENSIONS": [10, 10, 10],
+            "NB_STREAMLINES": 2, "NB_VERTICES": 4}))
+        np.array([[0, 0, 0], [1, 0, 0], [length, 0, 0], [5, 5, 5]], np.float32).tofile(root / "positions.3.float32")
+        np.array([0, 3], np.uint32).tofile(root / "offsets.uint32")
+        np.full((4, components), 7, np.uint8).tofile(root / "dpv" / f"x.{components}.uint8")
+        return str(root)
+
+    out = tmp_path / "big.fft"
+    with pytest.raises(fiblet.FibletError, match=r"memory budget of 1024 MiB; max_memory="):
+        fiblet.save(out, trx("big.trx", 20000, 100000), max_memory=1 << 30)
+    assert not out.exists()
+    with pytest.raises(ValueError):
+        fiblet.save(out, trx("bad.trx", 20, 2), max_memory=-1)
+    report = fiblet.save(tmp_path / "small.fft", trx("small.trx", 2000, 50), max_memory=64 << 20)
+    assert report["points"] > 1000
+    streamlines, data = fiblet.load(tmp_path / "small.fft", data=True)
+    assert data["dpv/x"].dtype == np.uint8 and data["dpv/x"].shape == (len(streamlines._data), 50)
+    assert (data["dpv/x"] == 7).all()

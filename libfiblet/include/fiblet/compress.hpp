@@ -56,6 +56,11 @@ struct CompressOptions {
     unsigned threads = 0;                     // encoding threads; 0 = all cores
     bool overwrite = false;
     bool allow_count_mismatch = false;
+    // Bytes the run's data may take where a small input can ask for much
+    // (the per-point arrays of resampled streamlines); beyond it compress
+    // stops before allocating (Error{unsupported}, Remedy::max_memory).
+    // 0: default_memory_budget().
+    std::uint64_t max_memory = 0;
     // The reference space of a source that carries none (a .tck: tckconvert's
     // and DIPY's reference image, space_of_image), stored in the PROP chunk
     // as a .trk's or TRX's is. Error{invalid_argument} for a source with its own.
@@ -121,6 +126,9 @@ struct CompressReport {
     CompressTimings timings;
     std::string simd;  // the code search's SIMD level: avx512, avx2, sse4 or scalar (FIBLET_SIMD forces one)
 };
+
+// Half of this machine's physical memory (4 GiB where it cannot be told).
+std::uint64_t default_memory_budget();
 
 // Compresses `tck_path` (a .tck, .trk or TRX: open_streamline_source) into
 // `fft_path` (atomically; see AtomicOutputFile). Per-streamline and per-point

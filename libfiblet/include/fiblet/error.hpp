@@ -31,10 +31,11 @@ const char* errc_name(Errc c) noexcept;
 
 // The caller's option that would have allowed what failed, named by the
 // library option it is (CompressOptions::overwrite, FftOpenOptions::
-// ignore_trailer, TckReadOptions::allow_count_mismatch). The message says
+// ignore_trailer, TckReadOptions::allow_count_mismatch, CompressOptions::
+// max_memory). The message says
 // nothing of it: each front end names it in its own terms (the CLI's
 // --force, Python's overwrite=True).
-enum class Remedy : int { none, overwrite, ignore_trailer, allow_count_mismatch };
+enum class Remedy : int { none, overwrite, ignore_trailer, allow_count_mismatch, max_memory };
 
 class Error : public std::runtime_error {
 public:

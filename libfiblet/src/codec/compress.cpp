@@ -6,6 +6,8 @@
 // (compress_stages.hpp).
 #include "fiblet/compress.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <bit>
 #include <chrono>
@@ -315,6 +317,16 @@ void CompressJob::resample_scan() {
         detail::resample_scan_stage(*source_, {step_, stretch_}, options_.step_tolerance, max_fiber_points_, report.scan,
                                     scanned_->fiber_points, tensions_, scanned_->turns, layout_.points_per_block,
                                     kSharpBlocks, threads_, options_, report.timings);
+    // A few input points can resample to millions, each with its values:
+    // their arrays, and the DATA chunk made of them at the end, are sized
+    // against the budget before they exist.
+    const std::uint64_t budget = options_.max_memory ? options_.max_memory : default_memory_budget();
+    if (const std::uint64_t need = std::min(point_fields_->bytes_for(scanned_->fiber_points), ~std::uint64_t(0) / 4) * 2;
+        need > budget)
+        throw Error(Errc::unsupported,
+                    input_ + ": the per-point arrays of the resampled streamlines would take " +
+                        std::to_string(need >> 20) + " MiB, more than the memory budget of " + std::to_string(budget >> 20) + " MiB",
+                    Remedy::max_memory);
     point_fields_->set_resampled_points(scanned_->fiber_points);
 }
 
@@ -454,6 +466,12 @@ void CompressJob::finish() {
 }
 
 }  // namespace
+
+std::uint64_t default_memory_budget() {
+    const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
+    if (pages <= 0 || page <= 0) return std::uint64_t(4) << 30;
+    return std::uint64_t(pages) * std::uint64_t(page) / 2;
+}
 
 CompressReport compress_tck(const std::string& tck_path, const std::string& fft_path, const CompressOptions& options) {
     const Timer timer;

@@ -276,6 +276,19 @@ PointFieldResampler::PointFieldResampler(std::vector<StreamlineField>* fields,
         original_offsets_[i + 1] = original_offsets_[i] + original_points[i];
 }
 
+std::uint64_t PointFieldResampler::bytes_for(const std::vector<std::uint32_t>& points) const {
+    std::uint64_t total = 0, rows = 0;
+    for (const std::uint32_t n : points) rows += n;
+    for (const Column& c : columns_) {
+        const std::uint64_t value = c.nearest ? c.field->value_size() : sizeof(float);
+        const std::uint64_t per_row = std::uint64_t(c.field->components) * value;
+        if (per_row && rows > std::numeric_limits<std::uint64_t>::max() / 2 / per_row) return std::numeric_limits<std::uint64_t>::max();
+        total += rows * per_row;
+        if (total > std::numeric_limits<std::uint64_t>::max() / 2) return std::numeric_limits<std::uint64_t>::max();
+    }
+    return total;
+}
+
 void PointFieldResampler::set_resampled_points(const std::vector<std::uint32_t>& points) {
     if (!active()) return;
     offsets_.assign(points.size() + 1, 0);
