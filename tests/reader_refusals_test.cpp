@@ -312,6 +312,25 @@ TEST(ReaderRefusals, ResampledPerPointDataIsSizedAgainstTheMemoryBudget) {
     EXPECT_EQ(f.streamline_fields()[0].bytes, std::vector<std::uint8_t>(50 * f.header().points, 7));
 }
 
+// A TRX's data arrays count against the memory budget before each is read
+// (a 1.3 MB zip of twenty 64 MiB dpg arrays took 1.29 GB): here four
+// 400 kB dpg arrays, against budgets of 1 MiB and 8 MiB.
+TEST(ReaderRefusals, TrxDataArraysDrawFromTheMemoryBudget) {
+    TempDir dir;
+    const std::string root = trx_dir(dir, "dpg.trx", trx_header("1", "2", "3"));
+    for (int g = 0; g < 4; ++g) {
+        const std::string group = "G" + std::to_string(g);
+        std::filesystem::create_directories(root + "/dpg/" + group);
+        test::write_file(root + "/dpg/" + group + "/v.uint8", std::string(400000, '\x01'));
+    }
+    const auto r = test::run_cli("compress -q " + root + " -o " + dir.file("a.fft") + " --max-memory 1M");
+    EXPECT_EQ(r.status, 6) << r.output;
+    EXPECT_NE(r.output.find("more than the memory budget of 1 MiB; --max-memory"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("a.fft")));
+    ASSERT_EQ(test::run_cli("compress -q " + root + " -o " + dir.file("a.fft") + " --max-memory 8M").status, 0);
+    EXPECT_EQ(FftFile(dir.file("a.fft")).streamline_fields().size(), 4u);
+}
+
 // 2^21 empty streamlines (an 8 MiB offsets array, 131 kB zipped at 2^24):
 // compress's memory follows the per-fiber tables of its output, no longer
 // one batch of them all and a tuning sample of every one (2^21: 297 MB

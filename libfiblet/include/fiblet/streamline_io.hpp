@@ -50,6 +50,10 @@ public:
 struct SourceOptions {
     bool allow_count_mismatch = false;  // a count field that disagrees with the data
     std::size_t max_points = 0;         // longest streamline accepted (0: no limit)
+    // Bytes the source's data arrays (TRX dps/dpv/groups/dpg, decompressed)
+    // may take in all, checked before each is read: Error{unsupported},
+    // Remedy::max_memory (0: no limit).
+    std::uint64_t max_memory = 0;
 };
 
 // Opens `path` as the format its content says (content of no known kind:

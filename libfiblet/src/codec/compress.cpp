@@ -250,7 +250,8 @@ CompressJob::CompressJob(const std::string& input, const std::string& output, co
                                                                          block_layout(16, options).points_per_block)
                                                             : layout_.points_per_block);
     source_ = open_streamline_source(input, {.allow_count_mismatch = options.allow_count_mismatch,
-                                             .max_points = max_fiber_points_});
+                                             .max_points = max_fiber_points_,
+                                             .max_memory = options.max_memory ? options.max_memory : default_memory_budget()});
     properties_ = source_->properties();
     if (options.reference_space) {
         if (space_from_properties(properties_, input))

@@ -93,6 +93,7 @@ FieldType dtype(const TrxEntryName& n, const std::string& entry, const std::stri
 struct TrxReader::Impl {
     std::string path;
     SourceOptions options;
+    std::uint64_t fields_bytes = 0;  // the data arrays read so far
     std::unique_ptr<detail::TrxArchive> archive;
     TrxHeaderJson header;
     TractogramSpace space;
@@ -173,6 +174,13 @@ struct TrxReader::Impl {
                 for (const StreamlineField& earlier : fields)
                     if (earlier.name == f.name) bad(path, "more than one array named " + f.name + " (" + entry + ")");
                 check_plausible_size(f, entry);
+                fields_bytes += archive->size(entry);
+                if (options.max_memory && fields_bytes > options.max_memory)
+                    throw Error(Errc::unsupported,
+                                path + ": its data arrays take " + std::to_string(fields_bytes >> 20) + " MiB and more (" +
+                                    entry + " included), more than the memory budget of " +
+                                    std::to_string(options.max_memory >> 20) + " MiB",
+                                Remedy::max_memory);
                 f.bytes = archive->read_all(entry);
                 const std::string problem = check_streamline_field(f, header.streamlines, header.vertices);
                 if (!problem.empty()) bad(path, problem);
