@@ -89,16 +89,24 @@ void make_source(const std::string& trx, const std::string& fft, std::vector<std
     ASSERT_EQ(r.header.points, points);
 }
 
+// The source (s.fft) and what `query` keeps of it (sub.fft), in `dir`.
+std::vector<SelectedRun> write_subset(const test::TempDir& dir, const Query& query, std::vector<std::uint64_t>& starts) {
+    make_source(dir.path() + "/s.trx", dir.path() + "/s.fft", starts);
+    const FftFile source(dir.path() + "/s.fft");
+    const auto runs = select_runs(source, BlockIndex::load(source), query);
+    write_fft_subset(source, runs, dir.path() + "/sub.fft", false);
+    return runs;
+}
+
 TEST(FftSubsetData, WholeFibersKeepTheirRows) {
     test::TempDir dir;
     std::vector<std::uint64_t> starts;
-    ASSERT_NO_FATAL_FAILURE(make_source(dir.path() + "/s.trx", dir.path() + "/s.fft", starts));
-    const FftFile source(dir.path() + "/s.fft");
     Query q;
     q.fibers = {{3, 3}, {5, 5}, {20, 20}};
-    const auto runs = select_runs(source, BlockIndex::load(source), q);
+    std::vector<SelectedRun> runs;
+    ASSERT_NO_FATAL_FAILURE(runs = write_subset(dir, q, starts));
     ASSERT_EQ(runs.size(), 3u);
-    write_fft_subset(source, runs, dir.path() + "/sub.fft", false);
+    const FftFile source(dir.path() + "/s.fft");
     const FftFile sub(dir.path() + "/sub.fft");
     EXPECT_EQ(uint32_values(field(sub, "dps/id")), (std::vector<std::uint32_t>{3, 5, 20}));
     std::vector<std::uint32_t> at;
@@ -122,14 +130,13 @@ TEST(FftSubsetData, WholeFibersKeepTheirRows) {
 TEST(FftSubsetData, PiecesOfFibersKeepTheirPointsRows) {
     test::TempDir dir;
     std::vector<std::uint64_t> starts;
-    ASSERT_NO_FATAL_FAILURE(make_source(dir.path() + "/s.trx", dir.path() + "/s.fft", starts));
-    const FftFile source(dir.path() + "/s.fft");
     Query q;
     q.roi_mode = RoiMode::blocks;
     q.include = {Region::box_between({40, -1, -1}, {70, 100, 100}), Region::box_between({-60, -1, -1}, {-30, 200, 100})};
-    const auto runs = select_runs(source, BlockIndex::load(source), q);
+    std::vector<SelectedRun> runs;
+    ASSERT_NO_FATAL_FAILURE(runs = write_subset(dir, q, starts));
     ASSERT_GT(runs.size(), 10u);
-    write_fft_subset(source, runs, dir.path() + "/sub.fft", false);
+    const FftFile source(dir.path() + "/s.fft");
     const FftFile sub(dir.path() + "/sub.fft");
     const Streamlines got = decode_fibers(sub, 0, sub.header().fibers);
     const Streamlines all = decode_fibers(source, 0, source.header().fibers);
