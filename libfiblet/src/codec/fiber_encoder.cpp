@@ -389,6 +389,7 @@ void FiberEncoder::Encoding::search_blocks_together(std::span<Encoding> fibers) 
     for (Encoding& e : fibers)
         for (std::uint32_t b = 0; b < e.n_blocks; ++b)
             if (e.block_points(b) > 2) blocks.push_back({&e, b, e.block_points(b) - 2});
+    if (blocks.empty()) return;  // fibers of at most two points a block: no codes
     std::stable_sort(blocks.begin(), blocks.end(), [](const Block& x, const Block& y) { return x.m > y.m; });
     thread_local BlockBatch batch;
     batch.reset(first.ppb - 2, blocks.size());

@@ -144,7 +144,8 @@ void feed_back_length(std::span<const Vec3f> targets, std::span<Vec3f> points, s
 // adjustable block, all its points when the tail left more than `act`.
 //
 // Written as a sequence of searches the caller runs, so that the searches
-// of several fibers can run in lockstep (their dependency chains overlap):
+// of several fibers can run together, one per SIMD lane (fiber_encoder.cpp,
+// keep_length_tails):
 //   while (tails.next(adjustable, search)) {
 //       run search: block search.block's codes search.j0.. (its points
 //       j0 + 2..) for search.targets, decoded into tails.candidate();
