@@ -26,6 +26,10 @@ enum class FieldType : std::uint8_t {
 std::optional<FieldType> field_type_from_name(std::string_view name);  // "float32" -> float32
 const char* field_type_name(FieldType t) noexcept;
 std::size_t field_type_size(FieldType t) noexcept;
+// float16, float32 or float64.
+inline bool is_float_type(FieldType t) noexcept {
+    return t == FieldType::float16 || t == FieldType::float32 || t == FieldType::float64;
+}
 // One little-endian value of type `t` at `p`, as a double (float16 included).
 double field_value(FieldType t, const std::uint8_t* p) noexcept;
 float half_to_float(std::uint16_t h) noexcept;

@@ -322,11 +322,11 @@ void CompressJob::resample_scan() {
     // their arrays, and the DATA chunk made of them at the end, are sized
     // against the budget before they exist.
     const std::uint64_t budget = options_.max_memory ? options_.max_memory : default_memory_budget();
-    if (const std::uint64_t need = std::min(point_fields_->bytes_for(scanned_->fiber_points), ~std::uint64_t(0) / 4) * 2;
-        need > budget)
+    if (const double need = 2 * point_fields_->bytes_for(scanned_->fiber_points); need > double(budget))
         throw Error(Errc::unsupported,
                     input_ + ": the per-point arrays of the resampled streamlines would take " +
-                        std::to_string(need >> 20) + " MiB, more than the memory budget of " + std::to_string(budget >> 20) + " MiB",
+                        std::to_string(std::uint64_t(std::min(need / 1048576, 1e18))) + " MiB, more than the memory budget of " +
+                        std::to_string(budget >> 20) + " MiB",
                     Remedy::max_memory);
     point_fields_->set_resampled_points(scanned_->fiber_points);
 }
@@ -442,7 +442,7 @@ void CompressJob::finish() {
     const std::uint64_t at = out_->logical_size();
     if (report.resampled)  // float per-point arrays are interpolated, stored as float32: their source dtype in PROP
         for (const StreamlineField& f : fields_)
-            if (f.scope() == FieldScope::point && (f.type == FieldType::float16 || f.type == FieldType::float64))
+            if (f.scope() == FieldScope::point && is_float_type(f.type) && f.type != FieldType::float32)
                 add_source_dtype_property(properties_, f.name, f.type);
     std::vector<TrailerChunk> chunks{make_properties_chunk(properties_)};
     if (!fields_.empty()) {

@@ -32,8 +32,8 @@ namespace fiblet::detail {
 
 namespace {
 
-// Fixed-step fibers encoded together: enough that four of them usually
-// have a length tail to search at once.
+// Fixed-step fibers encoded together: enough that their next length tail
+// searches usually fill a vector's lanes.
 constexpr std::size_t kFibersTogether = 16;
 
 // The header's error of each point: the worse of fiblet's float decode and
@@ -142,8 +142,8 @@ void pack_task(const EncodeStageInputs& in, Slot& w) {
     if (h.packed()) pack_blocks16(h, w.blocks, w.packed, &w.packed_sizes);
 }
 
-// Fixed-step fibers [i, end) of the batch, encoded together (their length
-// tails' searches run in lockstep: FiberEncoder::encode_fibers).
+// Fixed-step fibers [i, end) of the batch, encoded together (their blocks
+// and length tails searched in SIMD lanes: FiberEncoder::encode_fibers).
 void encode_fixed_step(const EncodeStageInputs& in, const FiberBatch& b, std::size_t i, std::size_t end, Slot& w) {
     const StageClock clock(w.timings.encode);
     std::span<const Vec3f> fibers[kFibersTogether];
@@ -260,7 +260,7 @@ PointFieldResampler::PointFieldResampler(std::vector<StreamlineField>* fields,
     if (!fields) return;
     for (StreamlineField& f : *fields) {
         if (f.scope() != FieldScope::point) continue;
-        Column c{&f, f.type != FieldType::float16 && f.type != FieldType::float32 && f.type != FieldType::float64, {}, {}, {}};
+        Column c{&f, !is_float_type(f.type), {}, {}, {}};
         if (c.nearest) {
             c.raw = std::move(f.bytes);
         } else {
@@ -276,16 +276,11 @@ PointFieldResampler::PointFieldResampler(std::vector<StreamlineField>* fields,
         original_offsets_[i + 1] = original_offsets_[i] + original_points[i];
 }
 
-std::uint64_t PointFieldResampler::bytes_for(const std::vector<std::uint32_t>& points) const {
-    std::uint64_t total = 0, rows = 0;
+double PointFieldResampler::bytes_for(const std::vector<std::uint32_t>& points) const {
+    double rows = 0, total = 0;  // doubles: no product can overflow
     for (const std::uint32_t n : points) rows += n;
-    for (const Column& c : columns_) {
-        const std::uint64_t value = c.nearest ? c.field->value_size() : sizeof(float);
-        const std::uint64_t per_row = std::uint64_t(c.field->components) * value;
-        if (per_row && rows > std::numeric_limits<std::uint64_t>::max() / 2 / per_row) return std::numeric_limits<std::uint64_t>::max();
-        total += rows * per_row;
-        if (total > std::numeric_limits<std::uint64_t>::max() / 2) return std::numeric_limits<std::uint64_t>::max();
-    }
+    for (const Column& c : columns_)
+        total += rows * double(c.field->components) * double(c.nearest ? c.field->value_size() : sizeof(float));
     return total;
 }
 

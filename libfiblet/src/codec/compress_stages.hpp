@@ -153,7 +153,7 @@ public:
     PointFieldResampler(std::vector<StreamlineField>* fields, const std::vector<std::uint32_t>& original_points);
     bool active() const { return !columns_.empty(); }
     // Bytes the outputs will take for these resampled point counts.
-    std::uint64_t bytes_for(const std::vector<std::uint32_t>& points) const;
+    double bytes_for(const std::vector<std::uint32_t>& points) const;
     // The resampled point counts are known: size the outputs.
     void set_resampled_points(const std::vector<std::uint32_t>& points);
     // Fiber f was resampled at `positions` (threads write disjoint fibers).

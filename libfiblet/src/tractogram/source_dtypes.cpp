@@ -13,8 +13,6 @@ constexpr const char* kPositions = "trx_positions_dtype";
 constexpr const char* kOffsets = "trx_offsets_dtype";
 constexpr const char* kSource = "source_dtype";
 
-bool is_float(FieldType t) { return t == FieldType::float16 || t == FieldType::float32 || t == FieldType::float64; }
-
 // A float32 array as `to` (float16 or float64), values as they are.
 void convert_floats(StreamlineField& f, FieldType to) {
     std::vector<std::uint8_t> out(std::size_t(f.values()) * field_type_size(to));
@@ -54,7 +52,7 @@ std::vector<DtypeChange> restore_source_dtypes(SinkHeader& header, TractogramFor
     for (const auto& [key, value] : header.properties) {
         if (key == kPositions) {
             const auto t = field_type_from_name(value);
-            if (t && is_float(*t)) positions = t;
+            if (t && is_float_type(*t)) positions = t;
         } else if (key == kOffsets) {
             const auto t = field_type_from_name(value);
             if (t == FieldType::uint32 || t == FieldType::uint64) offsets = t;
@@ -88,7 +86,7 @@ std::vector<DtypeChange> restore_source_dtypes(SinkHeader& header, TractogramFor
             if (source != FieldType::float32 && (scope == FieldScope::streamline || scope == FieldScope::point))
                 changes.push_back({f.name, source, FieldType::float32, "a .trk holds float32 values"});
         } else if (source != f.type) {
-            if (is_float(source)) convert_floats(f, source);
+            if (is_float_type(source)) convert_floats(f, source);
             else
                 changes.push_back({f.name, source, f.type, "interpolated on the resampled points, kept as float32"});
         }

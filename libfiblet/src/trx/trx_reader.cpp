@@ -161,8 +161,7 @@ struct TrxReader::Impl {
                 if (!positions_entry.empty()) bad(path, "more than one positions array");
                 positions_entry = entry;
                 positions_type = dtype(*n, entry, path);
-                if (n->components != 3 || (positions_type != FieldType::float16 && positions_type != FieldType::float32 &&
-                                           positions_type != FieldType::float64))
+                if (n->components != 3 || !is_float_type(positions_type))
                     bad(path, entry + ": positions must be 3 float16/32/64 components");
             } else if (n->name == "offsets") {
                 if (!offsets_entry.empty()) bad(path, "more than one offsets array");

@@ -109,7 +109,7 @@ TrxWriter::TrxWriter(const std::string& path, const SinkHeader& header, bool ove
         if (!problem.empty()) throw Error(Errc::invalid_input, path + ": " + problem);
     }
     const FieldType p = header.positions_type, o = header.offsets_type;
-    if ((p != FieldType::float16 && p != FieldType::float32 && p != FieldType::float64) ||
+    if (!is_float_type(p) ||
         (o != FieldType::uint32 && o != FieldType::uint64))
         throw Error(Errc::invalid_argument, path + ": TRX positions are float16/32/64 and offsets uint32/64, not " +
                                                 field_type_name(p) + "/" + field_type_name(o));
