@@ -17,13 +17,10 @@
 #include <cstring>
 #include <optional>
 #include <utility>
-#ifdef __SSE2__
-#include <emmintrin.h>
-#endif
-
 #include "codec/batch_pipeline.hpp"
 #include "codec/compress_stages.hpp"
 #include "codec/fiber_end_encoder.hpp"
+#include "core/points_avx2.hpp"
 #include "core/vec_math.hpp"
 #include "fiblet/parallel.hpp"
 #include "format/packed_blocks16.hpp"
@@ -40,20 +37,44 @@ constexpr std::size_t kFibersTogether = 16;
 // the exact decode (when given), so it holds for every decoder. One square
 // root per point (of the larger square: the same double as the larger of
 // the two roots), taken in a loop of its own that vectorizes.
+#ifdef FIBLET_POINTS_AVX2
+// The loop of add_point_errors four points at a time: the same double
+// operations (distance2's, std::max of non-NaN squares, a correctly rounded
+// square root); returns the points left to the scalar loop.
+__attribute__((target("avx2"))) std::size_t point_errors_avx2(const Vec3f* targets, const Vec3f* decoded,
+                                                              const Vec3f* decoded_exact, std::size_t n, double* e) {
+    std::size_t k = 0;
+    for (; k + 4 <= n; k += 4) {
+        __m256d tx, ty, tz, x, y, z;
+        xyz4(targets + k, tx, ty, tz);
+        xyz4(decoded + k, x, y, z);
+        __m256d worst = norm2(_mm256_sub_pd(tx, x), _mm256_sub_pd(ty, y), _mm256_sub_pd(tz, z));
+        if (decoded_exact) {
+            xyz4(decoded_exact + k, x, y, z);
+            worst = _mm256_max_pd(norm2(_mm256_sub_pd(tx, x), _mm256_sub_pd(ty, y), _mm256_sub_pd(tz, z)), worst);
+        }
+        _mm256_storeu_pd(e + k, _mm256_sqrt_pd(worst));
+    }
+    return k;
+}
+#endif
+
 void add_point_errors(std::span<const Vec3f> targets, std::span<const Vec3f> decoded,
                       std::span<const Vec3f> decoded_exact, std::uint32_t fiber, std::vector<double>& scratch,
                       ErrorStats& out) {
     const std::size_t n = targets.size();
     scratch.resize(n);
     double* e = scratch.data();
-    for (std::size_t k = 0; k < n; ++k) e[k] = distance2(targets[k], decoded[k]);
-    if (!decoded_exact.empty())
-        for (std::size_t k = 0; k < n; ++k) e[k] = std::max(e[k], distance2(targets[k], decoded_exact[k]));
     std::size_t k = 0;
-#ifdef __SSE2__
-    for (; k + 2 <= n; k += 2) _mm_storeu_pd(e + k, _mm_sqrt_pd(_mm_loadu_pd(e + k)));  // correctly rounded, as std::sqrt
+#ifdef FIBLET_POINTS_AVX2
+    if (use_avx2_loops())
+        k = point_errors_avx2(targets.data(), decoded.data(), decoded_exact.empty() ? nullptr : decoded_exact.data(), n, e);
 #endif
-    for (; k < n; ++k) e[k] = std::sqrt(e[k]);
+    for (; k < n; ++k) {
+        e[k] = distance2(targets[k], decoded[k]);
+        if (!decoded_exact.empty()) e[k] = std::max(e[k], distance2(targets[k], decoded_exact[k]));
+        e[k] = std::sqrt(e[k]);
+    }
     out.add_all(e, n, fiber);
 }
 

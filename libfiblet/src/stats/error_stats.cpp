@@ -21,6 +21,11 @@ void ErrorStats::add_all(const double* errors, std::size_t n, std::uint64_t fibe
     std::uint64_t count = count_;
     double sum = sum_, sum_sq = sum_sq_, max = max_;
     std::uint64_t worst = worst_fiber_;
+    // The page in locals too: the counts are 64-bit words, which the
+    // compiler must otherwise assume may be page_index_ and reload it after
+    // every count.
+    std::uint64_t* page = page_;
+    std::size_t page_index = page_index_;
     for (std::size_t k = 0; k < n; ++k) {
         const double e = errors[k];
         ++count;
@@ -29,8 +34,11 @@ void ErrorStats::add_all(const double* errors, std::size_t n, std::uint64_t fibe
         if (count == 1 || e > max) max = e, worst = fiber;
         const double bin = e * kBinsPerMm;
         const std::size_t i = bin < double(kBins) ? std::size_t(bin) : kBins;
-        if (i / kPageBins != page_index_) [[unlikely]] select_page(i / kPageBins);
-        ++page_[i % kPageBins];
+        if (i / kPageBins != page_index) [[unlikely]] {
+            select_page(i / kPageBins);
+            page = page_, page_index = page_index_;
+        }
+        ++page[i % kPageBins];
     }
     count_ = count, sum_ = sum, sum_sq_ = sum_sq, max_ = max, worst_fiber_ = worst;
 }
