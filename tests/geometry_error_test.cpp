@@ -8,9 +8,11 @@
 #include <random>
 #include <vector>
 
+#include "fiblet/compress.hpp"
 #include "fiblet/geometry_error.hpp"
 #include "core/points_avx2.hpp"
 #include "stats/geometry_paths.hpp"
+#include "test_util.hpp"
 
 namespace fiblet {
 namespace {
@@ -282,6 +284,42 @@ TEST(GeometryError, VectorsEqualScalarLoops) {
         expect_same_bits(vectors, scalar);
     }
     detail::geometry_shortcut_enabled() = true;
+}
+
+// The same end to end: compress's every AVX2 loop over points (the
+// reader's finiteness check, the scan's turns, the header's point errors,
+// the symmetric metrics) switched off gives the same file and the same
+// report, bit for bit; fixed-step input and resampled input (its uneven
+// windows). One thread: the switch is per thread, and one thread runs every
+// task on the caller.
+TEST(GeometryError, CompressReportsTheSameBitsWithoutAvx2Loops) {
+    if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
+    test::TempDir dir;
+    CompressOptions o;
+    o.overwrite = true;
+    o.threads = 1;
+    for (const double step : {0.0, 0.5}) {
+        SCOPED_TRACE(step);
+        o.step_mm = step > 0 ? std::optional<double>(step) : std::nullopt;
+        const std::string tck = test::shared_data(step > 0 ? "small-sdstream.tck" : "small-ifod1.tck");
+        const CompressReport vectors = compress_tck(tck, dir.file("v.fft"), o);
+        detail::avx2_loops_enabled() = false;
+        const CompressReport scalar = compress_tck(tck, dir.file("s.fft"), o);
+        detail::avx2_loops_enabled() = true;
+        EXPECT_TRUE(test::read_file(dir.file("v.fft")) == test::read_file(dir.file("s.fft")));
+        expect_same_bits(vectors.geometry, scalar.geometry);
+        for (auto pick : {&CompressReport::error, &CompressReport::error_vs_original}) {
+            const ErrorStats &x = vectors.*pick, &y = scalar.*pick;
+            EXPECT_EQ(x.count(), y.count());
+            EXPECT_EQ(x.max_mm(), y.max_mm());
+            EXPECT_EQ(x.mean_mm(), y.mean_mm());
+            EXPECT_EQ(x.rms_mm(), y.rms_mm());
+            EXPECT_EQ(x.percentile_mm(99), y.percentile_mm(99));
+            EXPECT_EQ(x.worst_fiber(), y.worst_fiber());
+        }
+        EXPECT_EQ(vectors.scan.min_dot, scalar.scan.min_dot);
+        EXPECT_EQ(vectors.scan.step_mean, scalar.scan.step_mean);
+    }
 }
 
 }  // namespace
