@@ -190,7 +190,7 @@ std::vector<std::pair<Line, Line>> fixed_step_pairs() {
     std::mt19937 rng(17);
     std::vector<std::pair<Line, Line>> pairs;
     for (int k = 0; k < 40; ++k) {
-        const int n = k < 8 ? k + 1 : 30 + 9 * k;
+        const int n = k < 14 ? k + 1 : 30 + 9 * k;  // 1 .. 14 points: every vector loop's edges
         Line in = curve(n, 0.1, k % 5 == 0 ? 2.0 : 0, rng, 0);
         if (n > 6) in[n / 2] = in[n / 2 - 1];  // a zero-length segment
         std::normal_distribution<double> e(0, k % 3 == 0 ? 0.01 : 0.002);

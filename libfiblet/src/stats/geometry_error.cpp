@@ -71,25 +71,8 @@ struct Segments {
 };
 
 // From squared lengths uu (in len): inv[i] = uu > 0 ? 1 / uu : 0, then
-// len[i] = sqrt(uu), four at a time with AVX2 (vdivpd and vsqrtpd round
-// correctly, as / and std::sqrt do; the mask keeps +0, as the ternary).
-#ifdef FIBLET_POINTS_AVX2
-__attribute__((target("avx2"))) void inverses_and_roots_avx2(double* len, double* inv, std::size_t n) {
-    const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
-    std::size_t i = 0;
-    for (; i + 4 <= n; i += 4) {
-        const __m256d uu = _mm256_loadu_pd(len + i);
-        _mm256_storeu_pd(inv + i, _mm256_and_pd(_mm256_cmp_pd(uu, zero, _CMP_GT_OQ), _mm256_div_pd(one, uu)));
-        _mm256_storeu_pd(len + i, _mm256_sqrt_pd(uu));
-    }
-    for (; i < n; ++i) inv[i] = len[i] > 0 ? 1.0 / len[i] : 0.0, len[i] = std::sqrt(len[i]);
-}
-#endif
-
+// len[i] = sqrt(uu).
 void inverses_and_roots(double* len, double* inv, std::size_t n) {
-#ifdef FIBLET_POINTS_AVX2
-    if (use_avx2_loops()) return inverses_and_roots_avx2(len, inv, n);
-#endif
     for (std::size_t i = 0; i < n; ++i) inv[i] = len[i] > 0 ? 1.0 / len[i] : 0.0;
     sqrt_all(len, n);
 }
@@ -128,28 +111,35 @@ FIBLET_AVX2 void window_avx2(const Segments& g, double px, double py, double pz,
     for (std::size_t h = 0; h < kLanes; h += 4) _mm256_storeu_pd(d + h, segment_dist2_avx2(g, x, y, z, base + h));
 }
 
-// Points [0, m) into the columns, four at a time; returns the points left
-// to the scalar loop.
-__attribute__((target("avx2"))) std::size_t point_columns_avx2(const Vec3f* p, std::size_t m, Segments& out) {
-    std::size_t i = 0;
-    for (; i + 4 <= m; i += 4) {
-        __m256d x, y, z;
-        detail::xyz4(p + i, x, y, z);
-        _mm256_storeu_pd(out.ax.data() + i, x), _mm256_storeu_pd(out.ay.data() + i, y), _mm256_storeu_pd(out.az.data() + i, z);
-    }
-    return i;
+// Lanes 1 2 3 of a and lane 0 of b: the next point of each lane.
+FIBLET_AVX2 __m256d next_points(__m256d a, __m256d b) {
+    return _mm256_shuffle_pd(a, _mm256_permute2f128_pd(a, b, 0x21), 0b0101);
 }
 
-// Directions and squared lengths of segments [0, s) from the point columns,
-// four at a time (the same double operations as the scalar loop); returns s.
-__attribute__((target("avx2"))) std::size_t directions_avx2(Segments& g, std::size_t n) {
+// The columns of segments [0, s) in one pass, four at a time (each point
+// converted once): starts, directions, inv_uu = uu > 0 ? 1 / uu : 0 and
+// len = sqrt(uu), the scalar loops' double operations (vdivpd and vsqrtpd
+// round correctly, as / and std::sqrt do; the mask keeps +0, as the
+// ternary). Reads points up to s + 4; returns s.
+__attribute__((target("avx2"))) std::size_t columns_avx2(const Vec3f* p, std::size_t points, Segments& g) {
+    double *ax = g.ax.data(), *ay = g.ay.data(), *az = g.az.data(), *ux = g.ux.data(), *uy = g.uy.data(),
+           *uz = g.uz.data(), *inv = g.inv_uu.data(), *len = g.len.data();
+    const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0);
     std::size_t s = 0;
-    for (; s + 4 <= n; s += 4) {
-        const __m256d dx = _mm256_sub_pd(column(g.ax, s + 1), column(g.ax, s)),
-                      dy = _mm256_sub_pd(column(g.ay, s + 1), column(g.ay, s)),
-                      dz = _mm256_sub_pd(column(g.az, s + 1), column(g.az, s));
-        _mm256_storeu_pd(g.ux.data() + s, dx), _mm256_storeu_pd(g.uy.data() + s, dy), _mm256_storeu_pd(g.uz.data() + s, dz);
-        _mm256_storeu_pd(g.len.data() + s, detail::norm2(dx, dy, dz));
+    if (points < 8) return 0;
+    __m256d x, y, z;
+    detail::xyz4(p, x, y, z);
+    for (; s + 8 <= points; s += 4) {
+        __m256d nx, ny, nz;
+        detail::xyz4(p + s + 4, nx, ny, nz);
+        const __m256d dx = _mm256_sub_pd(next_points(x, nx), x), dy = _mm256_sub_pd(next_points(y, ny), y),
+                      dz = _mm256_sub_pd(next_points(z, nz), z);
+        const __m256d uu = detail::norm2(dx, dy, dz);
+        _mm256_storeu_pd(ax + s, x), _mm256_storeu_pd(ay + s, y), _mm256_storeu_pd(az + s, z);
+        _mm256_storeu_pd(ux + s, dx), _mm256_storeu_pd(uy + s, dy), _mm256_storeu_pd(uz + s, dz);
+        _mm256_storeu_pd(inv + s, _mm256_and_pd(_mm256_cmp_pd(uu, zero, _CMP_GT_OQ), _mm256_div_pd(one, uu)));
+        _mm256_storeu_pd(len + s, _mm256_sqrt_pd(uu));
+        x = nx, y = ny, z = nz;
     }
     return s;
 }
@@ -161,16 +151,14 @@ void segments_of(std::span<const Vec3f> line, Segments& out) {
     double *ax = at_least(out.ax, n + kLanes), *ay = at_least(out.ay, n + kLanes), *az = at_least(out.az, n + kLanes);
     double *ux = at_least(out.ux, n + kLanes), *uy = at_least(out.uy, n + kLanes), *uz = at_least(out.uz, n + kLanes);
     double *inv = at_least(out.inv_uu, n + kLanes), *len = at_least(out.len, n);
-    // The points (segment s runs from point s to point s + 1).
-    std::size_t i = 0, s = 0;
+    // The points (segment s runs from point s to point s + 1); segments
+    // [0, done) complete from the vector loop.
+    std::size_t done = 0;
 #ifdef FIBLET_POINTS_AVX2
-    if (use_avx2_loops()) i = point_columns_avx2(line.data(), points, out);
+    if (use_avx2_loops()) done = columns_avx2(line.data(), points, out);
 #endif
-    for (; i < points; ++i) ax[i] = line[i].x, ay[i] = line[i].y, az[i] = line[i].z;
-#ifdef FIBLET_POINTS_AVX2
-    if (use_avx2_loops() && points > 1) s = directions_avx2(out, n);
-#endif
-    for (; s < n; ++s) {
+    for (std::size_t i = done; i < points; ++i) ax[i] = line[i].x, ay[i] = line[i].y, az[i] = line[i].z;
+    for (std::size_t s = done; s < n; ++s) {
         const std::size_t e = std::min(s + 1, points - 1);
         const double dx = ax[e] - ax[s], dy = ay[e] - ay[s], dz = az[e] - az[s];
         ux[s] = dx, uy[s] = dy, uz[s] = dz;
@@ -185,7 +173,7 @@ void segments_of(std::span<const Vec3f> line, Segments& out) {
     }
     // The inverse squared lengths, and the lengths (the same double
     // arithmetic and order as polyline_length).
-    inverses_and_roots(len, inv, n);
+    inverses_and_roots(len + done, inv + done, n - done);
     double length = 0;
     if (points > 1)
         for (std::size_t p = 0; p < n; ++p) length += len[p];
