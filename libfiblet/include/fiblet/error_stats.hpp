@@ -36,8 +36,9 @@ public:
         if (i / kPageBins != page_index_) [[unlikely]] select_page(i / kPageBins);
         ++page_[i % kPageBins];
     }
-    // The same as add() of each error in turn (bit for bit), with the
-    // running sums kept in registers.
+    // The same as add() of each error in turn, but for the sums' rounding:
+    // the errors of one call are summed in four lanes (error k in lane k % 4,
+    // the same bits with or without SIMD), then added to the totals.
     void add_all(const double* errors_mm, std::size_t n, std::uint64_t fiber);
     void merge(const ErrorStats& other);
 

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/points_avx2.hpp"
+
 namespace fiblet {
 
 namespace {
@@ -17,30 +19,84 @@ void ErrorStats::select_page(std::size_t p) {
     page_ = page.data(), page_index_ = p;
 }
 
+namespace {
+
+// Four running sums of errors and of squares, error k into lane k % 4:
+// the same bits whichever loop fills them.
+struct LaneSums {
+    double sum[4] = {0, 0, 0, 0}, sum_sq[4] = {0, 0, 0, 0};
+    double total() const { return (sum[0] + sum[1]) + (sum[2] + sum[3]); }
+    double total_sq() const { return (sum_sq[0] + sum_sq[1]) + (sum_sq[2] + sum_sq[3]); }
+};
+
+std::size_t bin_of(double e, double bins_per_mm, std::size_t bins) {
+    const double bin = e * bins_per_mm;  // a multiply, no division
+    return bin < double(bins) ? std::size_t(bin) : bins;
+}
+
+#ifdef FIBLET_POINTS_AVX2
+// Errors [0, n / 4 * 4): the lane sums, the largest error and each error's
+// bin (as bin_of), four at a time; returns the errors done.
+__attribute__((target("avx2"))) std::size_t sums_and_bins_avx2(const double* errors, std::size_t n, double bins_per_mm,
+                                                               std::size_t bins, LaneSums& lanes, double& max,
+                                                               std::int32_t* bin) {
+    __m256d sum = _mm256_setzero_pd(), sum_sq = sum, largest = _mm256_set1_pd(max);
+    const __m256d per_mm = _mm256_set1_pd(bins_per_mm), last = _mm256_set1_pd(double(bins));
+    std::size_t k = 0;
+    for (; k + 4 <= n; k += 4) {
+        const __m256d e = _mm256_loadu_pd(errors + k);
+        sum = _mm256_add_pd(sum, e);
+        sum_sq = _mm256_add_pd(sum_sq, _mm256_mul_pd(e, e));
+        largest = _mm256_max_pd(e, largest);
+        const __m256d b = _mm256_mul_pd(e, per_mm);
+        // b < bins ? b : bins, truncated (bins fits 32 bits)
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(bin + k),
+                         _mm256_cvttpd_epi32(_mm256_blendv_pd(last, b, _mm256_cmp_pd(b, last, _CMP_LT_OQ))));
+    }
+    _mm256_storeu_pd(lanes.sum, sum), _mm256_storeu_pd(lanes.sum_sq, sum_sq);
+    alignas(32) double l[4];
+    _mm256_store_pd(l, largest);
+    max = std::max(std::max(l[0], l[1]), std::max(l[2], l[3]));
+    return k;
+}
+#endif
+
+}  // namespace
+
 void ErrorStats::add_all(const double* errors, std::size_t n, std::uint64_t fiber) {
-    std::uint64_t count = count_;
-    double sum = sum_, sum_sq = sum_sq_, max = max_;
-    std::uint64_t worst = worst_fiber_;
-    // The page in locals too: the counts are 64-bit words, which the
-    // compiler must otherwise assume may be page_index_ and reload it after
-    // every count.
+    if (n == 0) return;
+    thread_local std::vector<std::int32_t> bins;
+    if (bins.size() < n) bins.resize(n);
+    LaneSums lanes;
+    double max = errors[0];
+    std::size_t k = 0;
+#ifdef FIBLET_POINTS_AVX2
+    if (detail::use_avx2_loops()) k = sums_and_bins_avx2(errors, n, kBinsPerMm, kBins, lanes, max, bins.data());
+#endif
+    for (; k < n; ++k) {
+        const double e = errors[k];
+        lanes.sum[k % 4] += e;
+        lanes.sum_sq[k % 4] += e * e;
+        max = std::max(max, e);
+        bins[k] = std::int32_t(bin_of(e, kBinsPerMm, kBins));
+    }
+    // The fiber holds the largest error if any of its errors is above the max so far.
+    if (count_ == 0 || max > max_) max_ = max, worst_fiber_ = fiber;
+    count_ += n;
+    sum_ += lanes.total();
+    sum_sq_ += lanes.total_sq();
+    // The page in locals: the counts are 64-bit words, which the compiler
+    // must otherwise assume may be page_index_ and reload it after every count.
     std::uint64_t* page = page_;
     std::size_t page_index = page_index_;
-    for (std::size_t k = 0; k < n; ++k) {
-        const double e = errors[k];
-        ++count;
-        sum += e;
-        sum_sq += e * e;
-        if (count == 1 || e > max) max = e, worst = fiber;
-        const double bin = e * kBinsPerMm;
-        const std::size_t i = bin < double(kBins) ? std::size_t(bin) : kBins;
+    for (std::size_t j = 0; j < n; ++j) {
+        const std::size_t i = std::size_t(bins[j]);
         if (i / kPageBins != page_index) [[unlikely]] {
             select_page(i / kPageBins);
             page = page_, page_index = page_index_;
         }
         ++page[i % kPageBins];
     }
-    count_ = count, sum_ = sum, sum_sq_ = sum_sq, max_ = max, worst_fiber_ = worst;
 }
 
 void ErrorStats::merge(const ErrorStats& o) {
