@@ -263,10 +263,11 @@ TEST(GeometryError, ShortcutEqualsTheWindowOnFoldedFixedStepPairs) {
     expect_same_bits(with, without);
 }
 
-// The AVX2 loops (columns, the fixed-step shortcut's proof, the windows,
-// square roots) give the scalar loops' figures bit for bit, on fixed-step
-// pairs (shortcut taken or not), folded ones and pairs of different point
-// counts; where the CPU has no AVX2 both runs take the scalar loops.
+// The AVX-512 loops (the fixed-step shortcut's proof) and the AVX2 loops
+// (columns, the proof, the windows, square roots) give the scalar loops'
+// figures bit for bit, on fixed-step pairs (shortcut taken or not), folded
+// ones and pairs of different point counts; where the CPU lacks AVX-512 or
+// AVX2 those runs take the narrower loops.
 TEST(GeometryError, VectorsEqualScalarLoops) {
     std::mt19937 rng(31);
     std::vector<std::pair<Line, Line>> pairs = fixed_step_pairs(), folded = folded_pairs();
@@ -277,21 +278,24 @@ TEST(GeometryError, VectorsEqualScalarLoops) {
     }
     for (const bool shortcut : {true, false}) {
         detail::geometry_shortcut_enabled() = shortcut;
-        const GeometryError vectors = measure_pairs(pairs);
+        const GeometryError widest = measure_pairs(pairs);
+        detail::avx512_loops_enabled() = false;
+        const GeometryError avx2 = measure_pairs(pairs);
         detail::avx2_loops_enabled() = false;
         const GeometryError scalar = measure_pairs(pairs);
-        detail::avx2_loops_enabled() = true;
-        expect_same_bits(vectors, scalar);
+        detail::avx2_loops_enabled() = true, detail::avx512_loops_enabled() = true;
+        expect_same_bits(widest, scalar);
+        expect_same_bits(avx2, scalar);
     }
     detail::geometry_shortcut_enabled() = true;
 }
 
-// The same end to end: compress's every AVX2 loop over points (the
-// reader's finiteness check, the scan's turns, the header's point errors,
-// the symmetric metrics) switched off gives the same file and the same
-// report, bit for bit; fixed-step input and resampled input (its uneven
-// windows). One thread: the switch is per thread, and one thread runs every
-// task on the caller.
+// The same end to end: compress's every AVX-512 and AVX2 loop over points
+// (the reader's finiteness check, the scan's turns, the header's point
+// errors, the symmetric metrics) switched off gives the same file and the
+// same report, bit for bit; fixed-step input and resampled input (its
+// uneven windows). One thread: the switches are per thread, and one thread
+// runs every task on the caller.
 TEST(GeometryError, CompressReportsTheSameBitsWithoutAvx2Loops) {
     if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
     test::TempDir dir;
@@ -303,10 +307,14 @@ TEST(GeometryError, CompressReportsTheSameBitsWithoutAvx2Loops) {
         o.step_mm = step > 0 ? std::optional<double>(step) : std::nullopt;
         const std::string tck = test::shared_data(step > 0 ? "small-sdstream.tck" : "small-ifod1.tck");
         const CompressReport vectors = compress_tck(tck, dir.file("v.fft"), o);
+        detail::avx512_loops_enabled() = false;
+        const CompressReport avx2 = compress_tck(tck, dir.file("a.fft"), o);
         detail::avx2_loops_enabled() = false;
         const CompressReport scalar = compress_tck(tck, dir.file("s.fft"), o);
-        detail::avx2_loops_enabled() = true;
+        detail::avx2_loops_enabled() = true, detail::avx512_loops_enabled() = true;
         EXPECT_TRUE(test::read_file(dir.file("v.fft")) == test::read_file(dir.file("s.fft")));
+        EXPECT_TRUE(test::read_file(dir.file("a.fft")) == test::read_file(dir.file("s.fft")));
+        expect_same_bits(avx2.geometry, scalar.geometry);
         expect_same_bits(vectors.geometry, scalar.geometry);
         for (auto pick : {&CompressReport::error, &CompressReport::error_vs_original}) {
             const ErrorStats &x = vectors.*pick, &y = scalar.*pick;

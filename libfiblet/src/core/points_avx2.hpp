@@ -1,8 +1,9 @@
-// Internal: hand-written AVX2 loops over arrays of Vec3f (x86-64, GCC and
-// Clang), and the switch that sends them to their scalar twins. Every loop
-// using these repeats its scalar loop's double operations in the same order
-// (the library builds with -ffp-contract=off), so both give the same bits;
-// tests switch the AVX2 loops off to check that (per thread).
+// Internal: hand-written AVX2 (and a few AVX-512) loops over arrays of
+// Vec3f (x86-64, GCC and Clang), and the switches that send them to their
+// narrower or scalar twins. Every loop using these repeats its scalar
+// loop's double operations in the same order (the library builds with
+// -ffp-contract=off), so all give the same bits; tests switch the AVX-512
+// and AVX2 loops off to check that (per thread).
 #pragma once
 
 #include "fiblet/geometry.hpp"
@@ -25,6 +26,25 @@ inline bool use_avx2_loops() {
 #ifdef FIBLET_POINTS_AVX2
     static const bool cpu = __builtin_cpu_supports("avx2");
     return cpu && avx2_loops_enabled();
+#else
+    return false;
+#endif
+}
+
+// On by default; tests switch it off to run the AVX2 loops where the
+// AVX-512 ones would run.
+inline bool& avx512_loops_enabled() {
+    thread_local bool enabled = true;
+    return enabled;
+}
+
+// Whether the AVX-512 loops (eight doubles a vector) run: the CPU has
+// AVX-512 F, DQ, BW and VL, and they and the AVX2 loops are switched on.
+inline bool use_avx512_loops() {
+#ifdef FIBLET_POINTS_AVX2
+    static const bool cpu = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+                            __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
+    return cpu && avx512_loops_enabled() && use_avx2_loops();
 #else
     return false;
 #endif

@@ -27,12 +27,15 @@ namespace {
 // polyline's length comes with them (the same double arithmetic and order
 // as polyline_length).
 constexpr std::size_t kLanes = 8;
+// Padding segments after the last (the vector loops read up to 11 past it).
+constexpr std::size_t kPadding = 16;
 
 #ifdef FIBLET_POINTS_AVX2
 #define FIBLET_AVX2 __attribute__((target("avx2"))) inline
 #endif
 
 using detail::use_avx2_loops;
+using detail::use_avx512_loops;
 
 #ifdef FIBLET_POINTS_AVX2
 __attribute__((target("avx2"))) std::size_t sqrt_avx2(double* v, std::size_t n) {
@@ -148,9 +151,9 @@ __attribute__((target("avx2"))) std::size_t columns_avx2(const Vec3f* p, std::si
 // A non-empty polyline's columns.
 void segments_of(std::span<const Vec3f> line, Segments& out) {
     const std::size_t points = line.size(), n = points > 1 ? points - 1 : 1;  // a single point: one degenerate segment
-    double *ax = at_least(out.ax, n + kLanes), *ay = at_least(out.ay, n + kLanes), *az = at_least(out.az, n + kLanes);
-    double *ux = at_least(out.ux, n + kLanes), *uy = at_least(out.uy, n + kLanes), *uz = at_least(out.uz, n + kLanes);
-    double *inv = at_least(out.inv_uu, n + kLanes), *len = at_least(out.len, n);
+    double *ax = at_least(out.ax, n + kPadding), *ay = at_least(out.ay, n + kPadding), *az = at_least(out.az, n + kPadding);
+    double *ux = at_least(out.ux, n + kPadding), *uy = at_least(out.uy, n + kPadding), *uz = at_least(out.uz, n + kPadding);
+    double *inv = at_least(out.inv_uu, n + kPadding), *len = at_least(out.len, n);
     // The points (segment s runs from point s to point s + 1); segments
     // [0, done) complete from the vector loop.
     std::size_t done = 0;
@@ -164,10 +167,10 @@ void segments_of(std::span<const Vec3f> line, Segments& out) {
         ux[s] = dx, uy[s] = dy, uz[s] = dz;
         len[s] = dx * dx + dy * dy + dz * dz;
     }
-    // kLanes padding segments far away (their squared distance is +inf,
-    // never a nearest one), so a window of up to kLanes segments is always
+    // Padding segments far away (their squared distance is +inf, never a
+    // nearest one), so a window of up to kLanes segments is always
     // evaluated whole.
-    for (std::size_t p = n; p < n + kLanes; ++p) {
+    for (std::size_t p = n; p < n + kPadding; ++p) {
         ax[p] = ay[p] = az[p] = 1e300;
         ux[p] = uy[p] = uz[p] = inv[p] = 0.0;
     }
@@ -199,7 +202,7 @@ void segments_of(std::span<const Vec3f> line, Segments& out) {
 struct OwnSegments {
     std::vector<std::uint8_t> later;    // 1 where the nearer own segment is segment k (the first on a tie)
     std::vector<std::uint8_t> proven;   // it is the window's nearest
-    std::vector<double> forward[3];     // AVX2: all bits set where u_s . u_(s + d + 1) >= 0
+    std::vector<double> forward[3];     // vector loops: all bits set where u_s . u_(s + d + 1) >= 0
 };
 
 // Point k of own_segments (any k; the edges of the fiber and machines
@@ -241,7 +244,7 @@ FIBLET_AVX2 __m256d not_against(const Segments& g, std::size_t a, std::size_t b)
 // apart is tested once, not once for each point it proves.
 __attribute__((target("avx2"))) void forward_avx2(const Segments& g, OwnSegments& out) {
     const std::size_t n = g.count;
-    for (std::size_t d = 0; d < 3; ++d) at_least(out.forward[d], n + 4);
+    for (std::size_t d = 0; d < 3; ++d) at_least(out.forward[d], n + 8);
     for (std::size_t s = 0; s < n; s += 4)  // reads up to segment n + 5: padding
         for (std::size_t d = 0; d < 3; ++d) _mm256_storeu_pd(out.forward[d].data() + s, not_against(g, s + d + 1, s));
 }
@@ -283,6 +286,78 @@ __attribute__((target("avx2"))) void own_segments_avx2(const Segments& g, const 
     for (; k < k1; ++k) own_segments_at(g, from, to, k, nearest, out);
 }
 #undef FIBLET_AVX2
+
+// The AVX-512 twins of forward_avx2 and own_segments_avx2: eight lanes,
+// the same double operations.
+#define FIBLET_AVX512 __attribute__((target("avx512f,avx512dq,avx512bw,avx512vl"))) inline
+FIBLET_AVX512 __m512d column8(const std::vector<double>& c, std::size_t s) { return _mm512_loadu_pd(c.data() + s); }
+
+FIBLET_AVX512 __m512d norm2_8(__m512d dx, __m512d dy, __m512d dz) {
+    return _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)), _mm512_mul_pd(dz, dz));
+}
+
+// segment_dist2_avx2 for segments s .. s + 7 (vmaxpd and vminpd return
+// their second operand for a NaN, as the 256-bit ones).
+FIBLET_AVX512 __m512d segment_dist2_avx512(const Segments& g, __m512d x, __m512d y, __m512d z, std::size_t s) {
+    const __m512d ux = column8(g.ux, s), uy = column8(g.uy, s), uz = column8(g.uz, s);
+    const __m512d wx = _mm512_sub_pd(x, column8(g.ax, s)), wy = _mm512_sub_pd(y, column8(g.ay, s)),
+                  wz = _mm512_sub_pd(z, column8(g.az, s));
+    __m512d t = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(wx, ux), _mm512_mul_pd(wy, uy)), _mm512_mul_pd(wz, uz));
+    t = _mm512_min_pd(_mm512_set1_pd(1.0), _mm512_max_pd(_mm512_setzero_pd(), _mm512_mul_pd(t, column8(g.inv_uu, s))));
+    const __m512d dx = _mm512_sub_pd(wx, _mm512_mul_pd(t, ux)), dy = _mm512_sub_pd(wy, _mm512_mul_pd(t, uy)),
+                  dz = _mm512_sub_pd(wz, _mm512_mul_pd(t, uz));
+    return norm2_8(dx, dy, dz);
+}
+
+__attribute__((target("avx512f,avx512dq,avx512bw,avx512vl"))) void forward_avx512(const Segments& g, OwnSegments& out) {
+    const std::size_t n = g.count;
+    for (std::size_t d = 0; d < 3; ++d) at_least(out.forward[d], n + 8);
+    for (std::size_t s = 0; s < n; s += 8)  // reads up to segment n + 10: padding
+        for (std::size_t d = 0; d < 3; ++d) {
+            const std::size_t a = s + d + 1;
+            const __m512d dot = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(column8(g.ux, a), column8(g.ux, s)),
+                                                            _mm512_mul_pd(column8(g.uy, a), column8(g.uy, s))),
+                                              _mm512_mul_pd(column8(g.uz, a), column8(g.uz, s)));
+            const __mmask8 ok = _mm512_cmp_pd_mask(dot, _mm512_setzero_pd(), _CMP_GE_OQ);
+            _mm512_storeu_pd(out.forward[d].data() + s, _mm512_castsi512_pd(_mm512_movm_epi64(ok)));
+        }
+}
+
+// Lanes of a forward mask that are set.
+FIBLET_AVX512 __mmask8 set_lanes(const std::vector<double>& m, std::size_t s) {
+    const __m512i v = _mm512_castpd_si512(column8(m, s));
+    return _mm512_test_epi64_mask(v, v);
+}
+
+FIBLET_AVX512 __mmask8 within_half_step8(__m512d e4, const Segments& g, std::size_t s) {
+    const __m512d len = column8(g.len, s);
+    return _mm512_cmp_pd_mask(e4, _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(0.98), len), len), _CMP_LT_OQ);
+}
+
+// own_segments_avx2's loop eight points at a time from k0 (>= 4) while
+// eight fit before k1; returns where it stopped.
+__attribute__((target("avx512f,avx512dq,avx512bw,avx512vl"))) std::size_t own_segments_avx512(
+    const Segments& g, const Segments& from_g, std::size_t k0, std::size_t k1, double* nearest, OwnSegments& out) {
+    const std::vector<double>* f = out.forward;
+    const __m128i ones = _mm_set1_epi8(1);
+    std::size_t k = k0;
+    for (; k + 8 <= k1; k += 8) {
+        const __m512d x = column8(from_g.ax, k), y = column8(from_g.ay, k), z = column8(from_g.az, k);
+        const __m512d e4 = _mm512_mul_pd(_mm512_set1_pd(4.0), norm2_8(_mm512_sub_pd(x, column8(g.ax, k)),
+                                                                      _mm512_sub_pd(y, column8(g.ay, k)),
+                                                                      _mm512_sub_pd(z, column8(g.az, k))));
+        const __m512d before = segment_dist2_avx512(g, x, y, z, k - 1), after = segment_dist2_avx512(g, x, y, z, k);
+        const __mmask8 later = _mm512_cmp_pd_mask(after, before, _CMP_LT_OQ);
+        _mm512_storeu_pd(nearest + k, _mm512_mask_blend_pd(later, before, after));
+        const __mmask8 ahead = set_lanes(f[0], k) & set_lanes(f[1], k) & set_lanes(f[2], k);
+        const __mmask8 behind = set_lanes(f[0], k - 2) & set_lanes(f[1], k - 3) & set_lanes(f[2], k - 4);
+        const __mmask8 ok = within_half_step8(e4, g, k - 1) & within_half_step8(e4, g, k) & ahead & behind;
+        _mm_storel_epi64(reinterpret_cast<__m128i*>(out.proven.data() + k), _mm_maskz_mov_epi8(ok, ones));
+        _mm_storel_epi64(reinterpret_cast<__m128i*>(out.later.data() + k), _mm_maskz_mov_epi8(later, ones));
+    }
+    return k;
+}
+#undef FIBLET_AVX512
 #endif
 
 // own_segments_at for every point of a fixed-step pair (from_g: the
@@ -295,9 +370,11 @@ void own_segments(const Segments& g, const Segments& from_g, std::span<const Vec
 #ifdef FIBLET_POINTS_AVX2
     // The vector loop reads segments k - 4 .. k + 3 and lengths to k + 3.
     if (use_avx2_loops() && n > 8) {
-        forward_avx2(g, out);
+        const bool avx512 = use_avx512_loops();
+        avx512 ? forward_avx512(g, out) : forward_avx2(g, out);
         for (; k < 4; ++k) own_segments_at(g, from, to, k, nearest, out);
-        own_segments_avx2(g, from_g, from, to, 4, n, nearest, out);
+        own_segments_avx2(g, from_g, from, to, avx512 ? own_segments_avx512(g, from_g, 4, n, nearest, out) : 4, n,
+                          nearest, out);
         k = n;
     }
 #endif
