@@ -30,10 +30,6 @@ Vec3d exact_block_axis(Vec3d a0, Vec3d a1) {
 
 FrameD exact_block_frame(Vec3d a0, Vec3d a1) { return exact_frame_from_axis(exact_block_axis(a0, a1)); }
 
-Vec3d apply(const FrameD& f, Vec3d v) { return v.x * f.c[0] + v.y * f.c[1] + v.z * f.c[2]; }
-Vec3d apply_transposed(const FrameD& f, Vec3d v) { return {dot(f.c[0], v), dot(f.c[1], v), dot(f.c[2], v)}; }
-FrameD compose(const FrameD& f, const FrameD& l) { return {{apply(f, l.c[0]), apply(f, l.c[1]), apply(f, l.c[2])}}; }
-
 // formats/fft.md §4, decoding side; fft16.md for 256 levels.
 Vec3d exact_code_direction(unsigned code, unsigned levels, double ratio) {
     const double half = 0.5 * double(levels - 1);

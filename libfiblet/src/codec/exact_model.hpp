@@ -51,10 +51,10 @@ FrameD exact_block_frame(Vec3d anchor0, Vec3d anchor1);
 // Its axis: the unit first segment, (1, 0, 0) when the anchors coincide.
 Vec3d exact_block_axis(Vec3d anchor0, Vec3d anchor1);
 
-// F * v, F^T * v, F * L.
-Vec3d apply(const FrameD& f, Vec3d v);
-Vec3d apply_transposed(const FrameD& f, Vec3d v);
-FrameD compose(const FrameD& f, const FrameD& l);
+// F * v, F^T * v, F * L (inline: the exact walk composes a frame a point).
+inline Vec3d apply(const FrameD& f, Vec3d v) { return v.x * f.c[0] + v.y * f.c[1] + v.z * f.c[2]; }
+inline Vec3d apply_transposed(const FrameD& f, Vec3d v) { return {dot(f.c[0], v), dot(f.c[1], v), dot(f.c[2], v)}; }
+inline FrameD compose(const FrameD& f, const FrameD& l) { return {{apply(f, l.c[0]), apply(f, l.c[1]), apply(f, l.c[2])}}; }
 
 // The direction of a code with `levels` levels per diagonal axis (16 for
 // 8-bit codes, 256 for 16-bit ones) in the cap of `ratio`, from the
