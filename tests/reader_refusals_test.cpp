@@ -334,7 +334,9 @@ TEST(ReaderRefusals, TrxDataArraysDrawFromTheMemoryBudget) {
 // 2^21 empty streamlines (an 8 MiB offsets array, 131 kB zipped at 2^24):
 // compress's memory follows the per-fiber tables of its output, no longer
 // one batch of them all and a tuning sample of every one (2^21: 297 MB
-// before, 90 MB now; 2^24: 1.84 GB before, 486 MB for a 151 MB output).
+// before, 90 MB now; 2^24: 1.84 GB before, 486 MB for a 151 MB output);
+// those tables draw from the memory budget as the scan counts them (2^21
+// of ~32 bytes: 64 MiB, refused under a 32 MiB budget, before pass 2).
 TEST(ReaderRefusals, EmptyStreamlinesCostTheirTablesOnly) {
     TempDir dir;
     const std::uint32_t n = 1u << 21;
@@ -348,6 +350,13 @@ TEST(ReaderRefusals, EmptyStreamlinesCostTheirTablesOnly) {
     EXPECT_LT(mb, test::kSanitized ? 2048 : 160);
     const auto info = test::run_cli("info --json " + dir.file("e.fft"));
     EXPECT_NE(info.output.find("\"fibers\": " + std::to_string(n)), std::string::npos) << info.output.substr(0, 300);
+    const auto refused = test::run_cli("compress -q " + root + " -o " + dir.file("f.fft") + " --max-memory 32M");
+    EXPECT_EQ(refused.status, 6) << refused.output;
+    EXPECT_NE(refused.output.find("streamlines and counting: their tables (about 32 bytes each) would take more than "
+                                  "the memory budget of 32 MiB; --max-memory"),
+              std::string::npos)
+        << refused.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("f.fft")));
 }
 
 }  // namespace

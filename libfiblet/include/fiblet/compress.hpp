@@ -58,8 +58,9 @@ struct CompressOptions {
     bool allow_count_mismatch = false;
     // Bytes the run's data may take where a small input can ask for much
     // (a TRX's decompressed data arrays: SourceOptions::max_memory; the
-    // per-point arrays of resampled streamlines); beyond it compress stops
-    // before allocating (Error{unsupported}, Remedy::max_memory).
+    // per-point arrays of resampled streamlines; the per-streamline tables,
+    // ~32 bytes a streamline however few its points); beyond it compress
+    // stops before allocating (Error{unsupported}, Remedy::max_memory).
     // 0: default_memory_budget().
     std::uint64_t max_memory = 0;
     // The reference space of a source that carries none (a .tck: tckconvert's
