@@ -7,7 +7,7 @@
 
 #include "fiber_ranges.hpp"
 #include "fiblet/error.hpp"
-#include "supersampling.hpp"
+#include "render/supersampling.hpp"
 
 namespace fiblet::cli {
 

@@ -4,9 +4,9 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "fiber_colors.hpp"
+#include "scene/fiber_colors.hpp"
 #include "overlays/overlay_sources.hpp"
-#include "render_options.hpp"
+#include "render/render_options.hpp"
 
 namespace fiblet::cli {
 

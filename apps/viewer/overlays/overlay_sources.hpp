@@ -10,7 +10,7 @@
 #include "overlays/image_slice_spec.hpp"
 #include "overlays/overlay.hpp"
 #include "overlays/sh_basis/sh_basis.hpp"
-#include "render_options.hpp"
+#include "render/render_options.hpp"
 
 namespace fiblet::viewer {
 
