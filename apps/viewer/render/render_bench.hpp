@@ -10,17 +10,11 @@
 #include "fiblet/view.hpp"
 #include "scene/block_decoder.hpp"
 #include "scene/gpu_scene.hpp"
-#include "render/render_options.hpp"
+#include "fiblet_viewer/headless_render.hpp"
+#include "fiblet_viewer/render_options.hpp"
 #include "render/renderer.hpp"
 
 namespace fiblet::viewer {
-
-struct BenchCase {
-    std::string view;   // "overview", "close-up", "far"
-    bool selection;     // frustum culling + level of detail on
-    FrameStats median;  // stage times: medians over the frames; counts of the last frame
-    double frame_ms;    // median wall time of a whole frame, glFinish included
-};
 
 // The benchmark's views, nearest last but one: the whole scene; a close-up
 // where about a third of the blocks are off-screen; far away.
@@ -35,10 +29,6 @@ std::vector<BenchCase> run_render_bench(const GpuScene& scene, Renderer& rendere
 
 // A transparent frame against the opaque one (the overview, culling on):
 // median wall times of both, and the GPU memory transparency added.
-struct TransparencyBench {
-    double opaque_ms = 0, transparent_ms = 0;
-    std::uint64_t extra_bytes = 0;
-};
 TransparencyBench run_transparency_bench(const GpuScene& scene, Renderer& renderer, RenderTarget& target,
                                          const Camera& camera, const RenderOptions& transparent, int frames);
 

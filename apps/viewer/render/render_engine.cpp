@@ -1,4 +1,4 @@
-#include "render/render_engine.hpp"
+#include "fiblet_viewer/render_engine.hpp"
 
 #include <array>
 #include <utility>

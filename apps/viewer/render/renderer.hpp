@@ -20,7 +20,7 @@
 #include "scene/gpu_scene.hpp"
 #include "overlays/overlay.hpp"
 #include "gl/gpu_timer.hpp"
-#include "render/render_options.hpp"
+#include "fiblet_viewer/render_options.hpp"
 #include "render/render_target.hpp"
 #include "techniques/draw_technique.hpp"
 #include "transparency/blend_target.hpp"

@@ -7,7 +7,7 @@
 
 #include "fiblet/view.hpp"
 #include "gl/gl_objects.hpp"
-#include "render/render_options.hpp"
+#include "fiblet_viewer/render_options.hpp"
 
 namespace fiblet::viewer {
 

@@ -9,8 +9,6 @@
 
 namespace fiblet::viewer {
 
-inline constexpr int kMaxSupersample = 8;
-
 // The mean of each factor × factor block (width and height multiples of factor).
 RgbaImage downsample_box(const RgbaImage& image, int factor);
 

@@ -6,12 +6,15 @@
 #include <cstdint>
 #include <vector>
 
-#include "scene/decoder_kind.hpp"
+#include "fiblet_viewer/decoder_kind.hpp"
 #include "gl/gl_objects.hpp"
 #include "scene/gpu_programs.hpp"
 #include "scene/gpu_scene.hpp"
 
 namespace fiblet::viewer {
+
+// scan, or sequential on a software renderer (current context).
+DecoderKind default_decoder();
 
 // One decode pass over `count` blocks: list[first + i] of the list bound at
 // binding::kFineList when `use_list`, else blocks first + i. With

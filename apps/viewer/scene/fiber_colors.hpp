@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "fiblet_viewer/scene_sources.hpp"
+
 namespace fiblet {
 class FftFile;
 }
@@ -30,9 +32,6 @@ std::vector<float> read_fiber_values(const std::string& path, std::uint64_t fibe
 // value finite. Throws Error{invalid_argument} naming the file's dps fields
 // when there is no such field, {invalid_input} for a bad one.
 std::vector<float> fiber_values_from_data(const FftFile& file, const std::string& name);
-// Whether a values source is such a name ("dps/" and more); a file of that
-// name, when one exists, is read instead.
-bool is_data_field_name(const std::string& values);
 // One finite number per streamline of `file` from `source`: a text file
 // (read_fiber_values) or "dps/NAME" (fiber_values_from_data) as above. What
 // --fiber-values and --fiber-opacity read.
@@ -41,14 +40,6 @@ std::vector<float> read_fiber_value_source(const std::string& source, const FftF
 // Values mapped through viridis over [low, high] (default: the values'
 // range), clamped.
 std::vector<Rgb> colors_from_values(const std::vector<float>& values, std::optional<std::array<float, 2>> range = {});
-
-// Where a scene's per-fiber colours come from (at most one source): a text
-// file, or for values "dps/NAME", the file's own per-streamline data.
-struct FiberColorSource {
-    std::string colors_path, values_path;
-    std::optional<std::array<float, 2>> value_range;
-    bool empty() const { return colors_path.empty() && values_path.empty(); }
-};
 
 class GpuScene;
 // Reads the source for `scene` (made from `file`) and sets its colours

@@ -2,7 +2,7 @@
 // context (the drawing styles compile their own: techniques/).
 #pragma once
 
-#include "scene/decoder_kind.hpp"
+#include "fiblet_viewer/decoder_kind.hpp"
 #include "gl/gl_objects.hpp"
 
 namespace fiblet::viewer {

@@ -12,7 +12,7 @@
 #include <optional>
 #include <vector>
 
-#include "scene/decoder_kind.hpp"
+#include "fiblet_viewer/decoder_kind.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/geometry.hpp"
 #include "gl/gl_objects.hpp"

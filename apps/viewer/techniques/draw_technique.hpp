@@ -11,7 +11,7 @@
 #include "fiblet/view.hpp"
 #include "gl/gl_objects.hpp"
 #include "scene/gpu_scene.hpp"
-#include "render/render_options.hpp"
+#include "fiblet_viewer/render_options.hpp"
 
 namespace fiblet::viewer {
 

@@ -11,7 +11,7 @@
 
 #include "scene/gpu_programs.hpp"
 #include "scene/gpu_scene.hpp"
-#include "render/render_options.hpp"
+#include "fiblet_viewer/render_options.hpp"
 #include "render/render_target.hpp"
 #include "voxel_rt/chord_occlusion.hpp"
 #include "voxel_rt/resident_segments.hpp"

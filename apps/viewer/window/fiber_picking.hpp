@@ -7,7 +7,7 @@
 #include <optional>
 
 #include "scene/gpu_scene.hpp"
-#include "render/render_options.hpp"
+#include "fiblet_viewer/render_options.hpp"
 #include "render/render_target.hpp"
 
 namespace fiblet::viewer {

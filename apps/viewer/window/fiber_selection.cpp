@@ -3,7 +3,7 @@
 #include <algorithm>
 
 #include "fiblet/output_file.hpp"
-#include "render/render_options.hpp"
+#include "fiblet_viewer/render_options.hpp"
 
 namespace fiblet::viewer {
 

@@ -1,4 +1,4 @@
-#include "window/viewer_window.hpp"
+#include "fiblet_viewer/viewer_window.hpp"
 
 #include <fmt/core.h>
 #include <epoxy/gl.h>
@@ -13,6 +13,8 @@
 #include <memory>
 #include <optional>
 
+#include "overlays/overlay_sources.hpp"
+#include "scene/fiber_colors.hpp"
 #include "window/fiber_picking.hpp"
 #include "window/fiber_selection.hpp"
 #include "fiblet/error.hpp"

@@ -17,7 +17,7 @@
 #include <cstdint>
 
 #include "scene/gpu_scene.hpp"
-#include "render/render_options.hpp"
+#include "fiblet_viewer/render_options.hpp"
 
 namespace fiblet::viewer {
 

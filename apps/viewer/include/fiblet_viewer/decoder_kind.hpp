@@ -17,7 +17,4 @@ enum class DecoderKind { scan, sequential };
 const char* decoder_name(DecoderKind k);
 std::optional<DecoderKind> parse_decoder(const std::string& name);
 
-// scan, or sequential on a software renderer (current context).
-DecoderKind default_decoder();
-
 }  // namespace fiblet::viewer

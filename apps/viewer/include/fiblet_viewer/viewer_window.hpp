@@ -4,9 +4,8 @@
 
 #include <string>
 
-#include "scene/fiber_colors.hpp"
-#include "overlays/overlay_sources.hpp"
-#include "render/render_options.hpp"
+#include "fiblet_viewer/render_options.hpp"
+#include "fiblet_viewer/scene_sources.hpp"
 
 namespace fiblet::viewer {
 

@@ -7,15 +7,16 @@
 #include <optional>
 #include <vector>
 
-#include "scene/decoder_kind.hpp"
-#include "render/draw_style.hpp"
-#include "render/render_engine.hpp"
+#include "fiblet_viewer/decoder_kind.hpp"
+#include "fiblet_viewer/draw_style.hpp"
+#include "fiblet_viewer/render_engine.hpp"
 #include "fiblet/view.hpp"
-#include "transparency/transparency_mode.hpp"
+#include "fiblet_viewer/transparency_mode.hpp"
 
 namespace fiblet::viewer {
 
 inline constexpr std::size_t kMaxHighlightedFibers = 64;  // fiber_colors.glsl's kMaxHighlighted
+inline constexpr int kMaxSupersample = 8;  // render_supersampled's largest factor (render/supersampling.hpp)
 
 struct RenderOptions {
     RenderEngine engine = RenderEngine::raster;
