@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "cli_runner.hpp"
-#include "png_file.hpp"
+#include "gl/png_file.hpp"
 #include "viewer_test_util.hpp"
 
 using namespace fiblet;

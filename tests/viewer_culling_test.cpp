@@ -7,8 +7,8 @@
 #include <cmath>
 #include <random>
 
-#include "gpu_scene.hpp"
-#include "renderer.hpp"
+#include "scene/gpu_scene.hpp"
+#include "render/renderer.hpp"
 #include "viewer_test_util.hpp"
 
 using namespace fiblet;

@@ -8,13 +8,13 @@
 #include <cstdlib>
 
 #include "cli_runner.hpp"
-#include "fiber_colors.hpp"
+#include "scene/fiber_colors.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/streamline_field.hpp"
-#include "gpu_scene.hpp"
-#include "orbit_camera.hpp"
-#include "render_target.hpp"
-#include "renderer.hpp"
+#include "scene/gpu_scene.hpp"
+#include "window/orbit_camera.hpp"
+#include "render/render_target.hpp"
+#include "render/renderer.hpp"
 #include "viewer_test_util.hpp"
 
 using namespace fiblet;

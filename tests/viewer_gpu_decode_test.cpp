@@ -6,8 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "block_decoder.hpp"
-#include "gpu_scene.hpp"
+#include "scene/block_decoder.hpp"
+#include "scene/gpu_scene.hpp"
 #include "viewer_test_util.hpp"
 
 using namespace fiblet;

@@ -19,7 +19,7 @@
 #include <random>
 
 #include "fiblet/image.hpp"
-#include "gpu_bindings.hpp"
+#include "gl/gpu_bindings.hpp"
 #include "overlays/image_slice/image_slice_overlay.hpp"
 #include "overlays/odf_glyphs/glyph_ray.hpp"
 #include "overlays/odf_glyphs/glyph_set.hpp"
@@ -27,10 +27,10 @@
 #include "overlays/sh_basis/sh_basis.hpp"
 #include "cli_runner.hpp"
 #include "image_source.hpp"
-#include "png_file.hpp"
-#include "render_target.hpp"
-#include "renderer.hpp"
-#include "shader_program.hpp"
+#include "gl/png_file.hpp"
+#include "render/render_target.hpp"
+#include "render/renderer.hpp"
+#include "gl/shader_program.hpp"
 #include "viewer_test_util.hpp"
 
 using namespace fiblet;

@@ -6,8 +6,8 @@
 #include <filesystem>
 
 #include "cli_runner.hpp"
-#include "orbit_camera.hpp"
-#include "png_file.hpp"
+#include "window/orbit_camera.hpp"
+#include "gl/png_file.hpp"
 #include "viewer_test_util.hpp"
 
 using namespace fiblet;

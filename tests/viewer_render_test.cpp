@@ -5,11 +5,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include "gpu_scene.hpp"
-#include "orbit_camera.hpp"
-#include "png_file.hpp"
-#include "render_target.hpp"
-#include "renderer.hpp"
+#include "scene/gpu_scene.hpp"
+#include "window/orbit_camera.hpp"
+#include "gl/png_file.hpp"
+#include "render/render_target.hpp"
+#include "render/renderer.hpp"
 #include "viewer_test_util.hpp"
 
 using namespace fiblet;

@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "gpu_scene.hpp"
-#include "orbit_camera.hpp"
-#include "render_target.hpp"
-#include "renderer.hpp"
+#include "scene/gpu_scene.hpp"
+#include "window/orbit_camera.hpp"
+#include "render/render_target.hpp"
+#include "render/renderer.hpp"
 #include "techniques/tubes/tubes_technique.hpp"
 #include "viewer_test_util.hpp"
 

@@ -3,9 +3,9 @@
 // plain render.
 #include <gtest/gtest.h>
 
-#include "gpu_scene.hpp"
-#include "orbit_camera.hpp"
-#include "supersampling.hpp"
+#include "scene/gpu_scene.hpp"
+#include "window/orbit_camera.hpp"
+#include "render/supersampling.hpp"
 #include "viewer_test_util.hpp"
 
 using namespace fiblet;

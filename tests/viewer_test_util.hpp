@@ -18,9 +18,9 @@
 #include "fiblet/fft_file.hpp"
 #include "fiblet/tck.hpp"
 #include "fiblet/view.hpp"
-#include "gpu_programs.hpp"
-#include "gpu_scene.hpp"
-#include "headless_context.hpp"
+#include "scene/gpu_programs.hpp"
+#include "scene/gpu_scene.hpp"
+#include "gl/headless_context.hpp"
 #include "test_util.hpp"
 
 namespace fiblet::test {

@@ -14,10 +14,10 @@
 #include <random>
 
 #include "cli_runner.hpp"
-#include "gpu_scene.hpp"
-#include "orbit_camera.hpp"
-#include "render_target.hpp"
-#include "renderer.hpp"
+#include "scene/gpu_scene.hpp"
+#include "window/orbit_camera.hpp"
+#include "render/render_target.hpp"
+#include "render/renderer.hpp"
 #include "viewer_test_util.hpp"
 
 using namespace fiblet;

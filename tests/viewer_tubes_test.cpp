@@ -8,11 +8,11 @@
 #include <cmath>
 #include <random>
 
-#include "block_decoder.hpp"
-#include "gpu_bindings.hpp"
-#include "gpu_scene.hpp"
-#include "render_target.hpp"
-#include "renderer.hpp"
+#include "scene/block_decoder.hpp"
+#include "gl/gpu_bindings.hpp"
+#include "scene/gpu_scene.hpp"
+#include "render/render_target.hpp"
+#include "render/renderer.hpp"
 #include "techniques/tubes/tubes_technique.hpp"
 #include "viewer_test_util.hpp"
 

@@ -17,11 +17,11 @@
 #include <unordered_set>
 
 #include "cli_runner.hpp"
-#include "gpu_scene.hpp"
-#include "png_file.hpp"
-#include "orbit_camera.hpp"
-#include "render_target.hpp"
-#include "renderer.hpp"
+#include "scene/gpu_scene.hpp"
+#include "gl/png_file.hpp"
+#include "window/orbit_camera.hpp"
+#include "render/render_target.hpp"
+#include "render/renderer.hpp"
 #include "viewer_test_util.hpp"
 #include "voxel_rt/capsule_voxelization.hpp"
 #include "voxel_rt/voxel_structure.hpp"

@@ -11,19 +11,7 @@
 
 #include "cli_common.hpp"
 #include "fiblet/error.hpp"
-#include "gpu_programs.hpp"
-#include "gpu_scene.hpp"
-#include "gpu_timer.hpp"
-#include "headless_context.hpp"
-#include "orbit_camera.hpp"
-#include "png_file.hpp"
-#include "render_bench.hpp"
-#include "render_target.hpp"
-#include "renderer.hpp"
-#include "scene_file.hpp"
-#include "fiber_opacity.hpp"
-#include "fiber_radii.hpp"
-#include "supersampling.hpp"
+#include "fiblet_viewer/headless_render.hpp"
 #include "viewer_options.hpp"
 
 namespace fiblet::cli {
@@ -86,20 +74,15 @@ std::string transparency_json(const viewer::TransparencyBench& t, const viewer::
         .render();
 }
 
-// The full decodes' median times, when the benchmark ran them.
-struct FullDecodeTimes {
-    double scan_ms = 0, sequential_ms = 0;
-};
-
-void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::string& device, int width, int height,
-                 const std::vector<viewer::BenchCase>& cases, const std::optional<FullDecodeTimes>& full,
-                 viewer::DecoderKind decoder, viewer::DrawStyle style,
-                 const std::optional<viewer::TransparencyBench>& transparency, const viewer::RenderOptions& options,
-                 const viewer::Renderer& renderer) {
+void print_bench(const RenderArgs& a, const viewer::HeadlessScene& scene, int width, int height,
+                 const viewer::RenderBench& bench, const viewer::RenderOptions& options) {
+    const std::vector<viewer::BenchCase>& cases = bench.cases;
+    const std::optional<viewer::FullDecodeTimes>& full = bench.full_decode;
+    const std::optional<viewer::TransparencyBench>& transparency = bench.transparency;
+    const viewer::DecoderKind decoder = bench.decoder;
+    const viewer::DrawStyle style = options.style;
     // The voxel ray tracer's one-off preprocessing (the warm-up frame's).
-    const viewer::voxel_rt::VoxelRayTracer* rt = a.view.engine == "voxel-rt" ? renderer.voxel_ray_tracer_if_made() : nullptr;
-    const viewer::voxel_rt::VoxelStructure* vs = rt ? rt->structure() : nullptr;
-    const viewer::voxel_rt::BuildTimes bt = vs ? vs->times() : viewer::voxel_rt::BuildTimes{};
+    const std::optional<viewer::VoxelRtPreprocessing>& vs = bench.voxel_rt;
     if (a.json) {
         std::string list = "[";
         for (std::size_t i = 0; i < cases.size(); ++i) {
@@ -113,25 +96,25 @@ void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::
         }
         fmt::print("{}\n", Json{}
                                .str("file", a.view.input)
-                               .str("device", device)
-                               .str("timing", viewer::timing_method_name(viewer::default_timing_method()))
+                               .str("device", scene.device)
+                               .str("timing", bench.timing)
                                .integer("width", std::uint64_t(width))
                                .integer("height", std::uint64_t(height))
                                .integer("frames", std::uint64_t(a.frames))
-                               .integer("fibers", scene.fiber_count())
-                               .integer("blocks", scene.block_count())
+                               .integer("fibers", scene.fibers)
+                               .integer("blocks", scene.blocks)
                                .str("decoder", viewer::decoder_name(decoder))
                                .str("style", viewer::draw_style_name(style))
                                .str("engine", a.view.engine)
                                .raw("voxel_rt", vs ? Json{}
-                                                         .integer("grid", std::uint64_t(vs->grid().n))
-                                                         .num("decode_ms", rt->last_decode_ms())
-                                                         .num("count_ms", bt.count_ms)
-                                                         .num("scan_ms", bt.scan_ms)
-                                                         .num("fill_ms", bt.fill_ms)
-                                                         .num("occupancy_ms", bt.occupancy_ms)
-                                                         .num("ambient_occlusion_ms", bt.ambient_occlusion_ms)
-                                                         .integer("fragments", vs->fragment_count())
+                                                         .integer("grid", std::uint64_t(vs->grid))
+                                                         .num("decode_ms", vs->decode_ms)
+                                                         .num("count_ms", vs->count_ms)
+                                                         .num("scan_ms", vs->scan_ms)
+                                                         .num("fill_ms", vs->fill_ms)
+                                                         .num("occupancy_ms", vs->occupancy_ms)
+                                                         .num("ambient_occlusion_ms", vs->ambient_occlusion_ms)
+                                                         .integer("fragments", vs->fragments)
                                                          .render()
                                                    : "null")
                                .num("radius_mm", a.view.radius)
@@ -143,22 +126,22 @@ void print_bench(const RenderArgs& a, const viewer::GpuScene& scene, const std::
         return;
     }
     fmt::print("{}: {} fibers, {} blocks, {} segments; {}x{}, median of {} frames\n", a.view.input,
-               scene.fiber_count(), scene.block_count(), scene.segment_count(), width, height, a.frames);
-    fmt::print("device: {}; stage times by {}\n", device, viewer::timing_method_name(viewer::default_timing_method()));
+               scene.fibers, scene.blocks, scene.segments, width, height, a.frames);
+    fmt::print("device: {}; stage times by {}\n", scene.device, bench.timing);
     fmt::print("style: {}{}\n", viewer::draw_style_name(style),
                style == viewer::DrawStyle::tubes ? fmt::format(", radius {} mm", a.view.radius) : "");
     if (vs)
         fmt::print("engine: voxel-rt, {}³ grid, capsule radius {} mm{}{}{}: preprocessing once (first frame) {:.1f} ms: "
                    "decode {:.1f}, voxelize (counts + occupancy) {:.1f}, prefix sum {:.1f}, fragment lists {:.1f}, "
                    "occupancy pyramid {:.1f}, ambient occlusion {:.1f}; {} fragments ({:.1f} MiB)\n",
-                   vs->grid().n, a.view.radius, a.view.ao ? ", --ao" : "", a.view.shadows ? ", --shadows" : "",
+                   vs->grid, a.view.radius, a.view.ao ? ", --ao" : "", a.view.shadows ? ", --shadows" : "",
                    a.view.opacity < 1 ? fmt::format(", --opacity {}", a.view.opacity) : "",
-                   rt->last_decode_ms() + bt.total_ms(), rt->last_decode_ms(), bt.count_ms, bt.scan_ms, bt.fill_ms,
-                   bt.occupancy_ms, bt.ambient_occlusion_ms, vs->fragment_count(),
-                   double(vs->fragment_count()) * 4 / (1 << 20));
+                   vs->total_ms, vs->decode_ms, vs->count_ms, vs->scan_ms, vs->fill_ms,
+                   vs->occupancy_ms, vs->ambient_occlusion_ms, vs->fragments,
+                   double(vs->fragments) * 4 / (1 << 20));
     if (full)
         fmt::print("decoding all {} blocks: scan {:.2f} ms, sequential {:.2f} ms; frames below use the {} decoder\n",
-                   scene.block_count(), full->scan_ms, full->sequential_ms, viewer::decoder_name(decoder));
+                   scene.blocks, full->scan_ms, full->sequential_ms, viewer::decoder_name(decoder));
     fmt::print("{:<9} {:<12} {:>10} {:>10} {:>11} {:>9} {:>10} {:>9} {:>10} {:>9}\n", "view", "culling+LoD",
                "full blks", "coarse", "segments", "cull ms", "decode ms", "draw ms", "GPU ms", "frame ms");
     for (const auto& c : cases) {
@@ -201,57 +184,27 @@ void run(const RenderArgs& a) {
         if (!a.force && std::filesystem::exists(out)) throw Error(Errc::exists, out + ": output exists", Remedy::overwrite);
     if (a.frames < 1) throw Error(Errc::invalid_argument, "--frames must be at least 1");
 
-    const viewer::HeadlessContext context;
-    const viewer::GpuPrograms programs;
-    const FftFile file = viewer::open_scene_file(a.view.input);
-    viewer::GpuScene scene(file, programs);
-    viewer::load_fiber_colors(fiber_color_source(a.view), file, scene);
-    if (!a.view.fiber_radii.empty()) viewer::load_fiber_radii(a.view.fiber_radii, scene);
-    if (!a.view.fiber_opacity.empty()) viewer::load_fiber_opacities(a.view.fiber_opacity, file, scene);
-    viewer::RenderTarget target(width, height);
-    viewer::Renderer renderer(programs);
-    renderer.set_overlays(viewer::make_overlays(overlay_sources, options));
-    const float aspect = float(width) / float(height);
-    auto camera_for = [&](float zoom) {
-        return viewer::camera_from_spec(a.view.camera, scene, aspect, a.view.fov, a.view.zoom * zoom);
-    };
-
-    if (a.bench) {
-        const auto cases = viewer::run_render_bench(scene, renderer, target, camera_for, options, a.frames, a.bench_views);
-        std::optional<FullDecodeTimes> full;
-        if (std::find(a.bench_views.begin(), a.bench_views.end(), "decode") != a.bench_views.end())
-            full = FullDecodeTimes{viewer::time_full_decode(scene, programs, viewer::DecoderKind::scan, a.frames),
-                                   viewer::time_full_decode(scene, programs, viewer::DecoderKind::sequential, a.frames)};
-        std::optional<viewer::TransparencyBench> transparency;
-        if (options.transparent())
-            transparency = viewer::run_transparency_bench(scene, renderer, target, camera_for(1), options, a.frames);
-        print_bench(a, scene, context.description(), width, height, cases, full,
-                    options.decoder.value_or(viewer::default_decoder()), options.style, transparency, options,
-                    renderer);
-    }
-    if (a.output.empty()) return;
-    // One image; a turntable (frame i turned 360 i / n degrees about the
-    // camera's up axis); or the cameras of a path file. Every camera is
-    // made (and checked) before the first frame is written.
-    std::vector<Camera> cameras;
-    for (const std::string& spec : path_specs)
-        cameras.push_back(viewer::camera_from_spec(spec, scene, aspect, a.view.fov, a.view.zoom));
-    if (cameras.empty()) {
-        const Camera start = camera_for(1.0f);
-        for (std::size_t i = 0; i < outputs.size(); ++i)
-            cameras.push_back(viewer::turned_about_up(start, 360.0f * float(i) / float(outputs.size()), scene.bounds()));
-    }
-    viewer::FrameStats stats;
+    viewer::HeadlessRenderJob job;
+    job.input = a.view.input, job.width = width, job.height = height;
+    job.render = options;
+    job.fiber_colors = fiber_color_source(a.view);
+    job.fiber_radii_path = a.view.fiber_radii, job.fiber_opacity_source = a.view.fiber_opacity;
+    job.overlays = overlay_sources;
+    job.camera = a.view.camera, job.fov_y_deg = a.view.fov, job.zoom = a.view.zoom;
+    job.bench = a.bench, job.frames = a.frames, job.bench_views = a.bench_views;
+    job.outputs = outputs, job.camera_path = path_specs;
+    job.supersample = a.view.supersample, job.overwrite = a.force;
     // --json reports the frame's stage times (cull, decode, draw; voxel-rt:
     // preprocessing and trace), so that one frame of a big file is measured
     // without the benchmark's many.
-    if (a.json) options.time_stages = true;
-    for (std::size_t i = 0; i < outputs.size(); ++i) {
-        const viewer::SupersampledFrame frame =
-            viewer::render_supersampled(renderer, scene, cameras[i], options, width, height, a.view.supersample);
-        if (i == 0) stats = frame.stats;
-        viewer::write_png(outputs[i], frame.image, a.force);
-    }
+    job.time_stages = a.json;
+    const viewer::HeadlessRenderResult result =
+        viewer::render_headless(job, [&](const viewer::HeadlessScene& scene, const viewer::RenderBench& bench) {
+            print_bench(a, scene, width, height, bench, options);
+        });
+    if (a.output.empty()) return;
+    const viewer::HeadlessScene& scene = result.scene;
+    const viewer::FrameStats& stats = result.first_image;
     if (movie > 0) {
         if (!a.quiet)
             fmt::print("{} -> {} .. {} ({} frames, {}x{})\n", a.view.input, outputs.front(), outputs.back(),
@@ -262,13 +215,13 @@ void run(const RenderArgs& a) {
         fmt::print("{}\n", Json{}
                                .str("input", a.view.input)
                                .str("output", a.output)
-                               .str("device", context.description())
+                               .str("device", scene.device)
                                .raw("frame", stats_json(stats))
                                .render());
     } else if (!a.quiet && !a.bench) {
         fmt::print("{} -> {} ({}x{})\n", a.view.input, a.output, width, height);
         fmt::print("  drew {} of {} blocks ({} full, {} as one segment), {} segments\n", stats.drawn_blocks(),
-                   scene.block_count(), stats.fine_blocks, stats.coarse_blocks, stats.drawn_segments());
+                   scene.blocks, stats.fine_blocks, stats.coarse_blocks, stats.drawn_segments());
     }
 }
 

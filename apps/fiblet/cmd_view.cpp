@@ -1,7 +1,7 @@
 // fiblet view IN — the interactive viewer (needs a display).
 #include "cli_common.hpp"
 #include "viewer_options.hpp"
-#include "viewer_window.hpp"
+#include "fiblet_viewer/viewer_window.hpp"
 
 namespace fiblet::cli {
 namespace {

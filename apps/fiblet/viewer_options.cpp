@@ -7,7 +7,6 @@
 
 #include "fiber_ranges.hpp"
 #include "fiblet/error.hpp"
-#include "supersampling.hpp"
 
 namespace fiblet::cli {
 
@@ -28,7 +27,7 @@ std::array<float, 3> parse_color(std::string text, const char* option) {
 }
 
 // A per-streamline value source (--fiber-values, --fiber-opacity): an
-// existing file or dps/NAME (fiber_colors.hpp).
+// existing file or dps/NAME (fiblet_viewer/scene_sources.hpp).
 CLI::Validator fiber_values_check() {
     return CLI::ExistingFile | CLI::Validator(
                                    [](const std::string& v) {

@@ -4,9 +4,8 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "fiber_colors.hpp"
-#include "overlays/overlay_sources.hpp"
-#include "render_options.hpp"
+#include "fiblet_viewer/render_options.hpp"
+#include "fiblet_viewer/scene_sources.hpp"
 
 namespace fiblet::cli {
 

@@ -7,17 +7,9 @@
 #include <string>
 
 #include "fiblet/image.hpp"
+#include "fiblet_viewer/scene_sources.hpp"
 
 namespace fiblet::viewer {
-
-struct SliceSpec {
-    int axis = 2;             // voxel axis across the slice
-    std::int64_t index = -1;  // voxel index along it; -1: the middle
-};
-
-// Parses "axis:index" (or "axis" alone: the middle slice); throws
-// fiblet::Error{invalid_argument} naming `option`.
-SliceSpec parse_slice_spec(const std::string& text, const char* option);
 
 // The index the slice has in `image` (the middle when unset); throws
 // fiblet::Error{invalid_argument} when it lies outside the grid.

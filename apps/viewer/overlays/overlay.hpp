@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "fiblet/view.hpp"
-#include "render_options.hpp"
+#include "fiblet_viewer/render_options.hpp"
 
 namespace fiblet::viewer {
 

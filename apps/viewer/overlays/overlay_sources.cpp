@@ -6,7 +6,7 @@
 #include "overlays/image_slice/image_slice_overlay.hpp"
 #include "overlays/odf_glyphs/glyph_set.hpp"
 #include "overlays/odf_glyphs/odf_glyphs_overlay.hpp"
-#include "vec_ops.hpp"
+#include "render/vec_ops.hpp"
 
 namespace fiblet::viewer {
 

@@ -9,9 +9,9 @@
 #include <memory>
 
 #include "fiblet/view.hpp"
-#include "gl_objects.hpp"
-#include "gpu_scene.hpp"
-#include "render_options.hpp"
+#include "gl/gl_objects.hpp"
+#include "scene/gpu_scene.hpp"
+#include "fiblet_viewer/render_options.hpp"
 
 namespace fiblet::viewer {
 

@@ -3,7 +3,7 @@
 
 #include <memory>
 
-#include "draw_style.hpp"
+#include "fiblet_viewer/draw_style.hpp"
 #include "techniques/draw_technique.hpp"
 
 namespace fiblet::viewer {

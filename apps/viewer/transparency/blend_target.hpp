@@ -8,8 +8,8 @@
 #include <array>
 #include <cstdint>
 
-#include "gl_objects.hpp"
-#include "render_target.hpp"
+#include "gl/gl_objects.hpp"
+#include "render/render_target.hpp"
 
 namespace fiblet::viewer {
 

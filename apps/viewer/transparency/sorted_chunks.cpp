@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "gpu_bindings.hpp"
-#include "shader_program.hpp"
-#include "vec_ops.hpp"
+#include "gl/gpu_bindings.hpp"
+#include "gl/shader_program.hpp"
+#include "render/vec_ops.hpp"
 
 namespace fiblet::viewer {
 

@@ -13,7 +13,7 @@
 
 #include <cstdint>
 
-#include "block_decoder.hpp"
+#include "scene/block_decoder.hpp"
 #include "techniques/draw_technique.hpp"
 
 namespace fiblet::viewer {

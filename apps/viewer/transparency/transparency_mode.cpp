@@ -1,4 +1,4 @@
-#include "transparency/transparency_mode.hpp"
+#include "fiblet_viewer/transparency_mode.hpp"
 
 #include <array>
 #include <utility>

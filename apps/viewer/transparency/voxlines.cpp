@@ -5,11 +5,11 @@
 #include <cstring>
 #include <numeric>
 
-#include "block_decoder.hpp"
-#include "gpu_bindings.hpp"
-#include "shader_program.hpp"
+#include "scene/block_decoder.hpp"
+#include "gl/gpu_bindings.hpp"
+#include "gl/shader_program.hpp"
 #include "transparency/transparent_lines.hpp"
-#include "vec_ops.hpp"
+#include "render/vec_ops.hpp"
 
 namespace fiblet::viewer {
 

@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "gpu_programs.hpp"
+#include "scene/gpu_programs.hpp"
 #include "techniques/draw_technique.hpp"
 
 namespace fiblet::viewer {

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 
-#include "gpu_bindings.hpp"
-#include "shader_program.hpp"
+#include "gl/gpu_bindings.hpp"
+#include "gl/shader_program.hpp"
 #include "voxel_rt/voxel_rt_bindings.hpp"
 
 namespace fiblet::viewer {

@@ -7,8 +7,8 @@
 
 #include <memory>
 
-#include "gl_objects.hpp"
-#include "gpu_scene.hpp"
+#include "gl/gl_objects.hpp"
+#include "scene/gpu_scene.hpp"
 #include "voxel_rt/voxel_rt_programs.hpp"
 #include "voxel_rt/voxel_structure.hpp"
 

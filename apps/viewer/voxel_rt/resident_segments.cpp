@@ -4,7 +4,7 @@
 #include <chrono>
 #include <string>
 
-#include "block_decoder.hpp"
+#include "scene/block_decoder.hpp"
 #include "fiblet/error.hpp"
 #include "voxel_rt/voxel_rt_bindings.hpp"
 

@@ -14,9 +14,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "gl_objects.hpp"
-#include "gpu_programs.hpp"
-#include "gpu_scene.hpp"
+#include "gl/gl_objects.hpp"
+#include "scene/gpu_programs.hpp"
+#include "scene/gpu_scene.hpp"
 #include "voxel_rt/voxel_structure.hpp"
 
 namespace fiblet::viewer::voxel_rt {

@@ -2,7 +2,7 @@
 
 #include <chrono>
 
-#include "shader_program.hpp"
+#include "gl/shader_program.hpp"
 #include "voxel_rt/voxel_rt_bindings.hpp"
 
 namespace fiblet::viewer::voxel_rt {

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "fiblet/view.hpp"
-#include "gl_objects.hpp"
+#include "gl/gl_objects.hpp"
 #include "voxel_rt/voxel_pyramid.hpp"
 #include "voxel_rt/voxel_rt_programs.hpp"
 #include "voxel_rt/voxel_structure.hpp"

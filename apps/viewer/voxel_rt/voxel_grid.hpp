@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <array>
 
-#include "gpu_scene.hpp"
+#include "scene/gpu_scene.hpp"
 
 namespace fiblet::viewer::voxel_rt {
 

@@ -3,8 +3,8 @@
 #include <chrono>
 #include <cmath>
 
-#include "shader_program.hpp"
-#include "shading_uniforms.hpp"
+#include "gl/shader_program.hpp"
+#include "render/shading_uniforms.hpp"
 #include "voxel_rt/voxel_rt_bindings.hpp"
 
 namespace fiblet::viewer::voxel_rt {

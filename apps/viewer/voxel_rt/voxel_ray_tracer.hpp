@@ -9,10 +9,10 @@
 
 #include <memory>
 
-#include "gpu_programs.hpp"
-#include "gpu_scene.hpp"
-#include "render_options.hpp"
-#include "render_target.hpp"
+#include "scene/gpu_programs.hpp"
+#include "scene/gpu_scene.hpp"
+#include "fiblet_viewer/render_options.hpp"
+#include "render/render_target.hpp"
 #include "voxel_rt/chord_occlusion.hpp"
 #include "voxel_rt/resident_segments.hpp"
 #include "voxel_rt/voxel_culling.hpp"

@@ -2,7 +2,7 @@
 
 #include <fmt/core.h>
 
-#include "gpu_bindings.hpp"
+#include "gl/gpu_bindings.hpp"
 #include "voxel_rt/voxel_pyramid.hpp"
 
 namespace fiblet::viewer::voxel_rt {

@@ -1,7 +1,7 @@
 // The voxel ray tracer's GL programs, compiled once per engine.
 #pragma once
 
-#include "gl_objects.hpp"
+#include "gl/gl_objects.hpp"
 
 namespace fiblet::viewer::voxel_rt {
 

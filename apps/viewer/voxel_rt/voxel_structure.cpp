@@ -6,7 +6,7 @@
 #include <string>
 
 #include "fiblet/error.hpp"
-#include "shader_program.hpp"
+#include "gl/shader_program.hpp"
 #include "voxel_rt/voxel_rt_bindings.hpp"
 
 namespace fiblet::viewer::voxel_rt {

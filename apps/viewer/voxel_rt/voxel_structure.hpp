@@ -9,8 +9,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "gl_objects.hpp"
-#include "gpu_scene.hpp"
+#include "gl/gl_objects.hpp"
+#include "scene/gpu_scene.hpp"
 #include "voxel_rt/voxel_grid.hpp"
 #include "voxel_rt/voxel_pyramid.hpp"
 #include "voxel_rt/voxel_rt_programs.hpp"

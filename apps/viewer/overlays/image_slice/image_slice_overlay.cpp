@@ -2,8 +2,8 @@
 
 #include <algorithm>
 
-#include "shader_program.hpp"
-#include "shading_uniforms.hpp"
+#include "gl/shader_program.hpp"
+#include "render/shading_uniforms.hpp"
 
 namespace fiblet::viewer {
 

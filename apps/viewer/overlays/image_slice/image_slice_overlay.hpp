@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "fiblet/image.hpp"
-#include "gl_objects.hpp"
+#include "gl/gl_objects.hpp"
 #include "overlays/overlay.hpp"
 
 namespace fiblet::viewer {

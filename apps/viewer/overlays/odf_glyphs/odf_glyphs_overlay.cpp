@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <vector>
 
-#include "gpu_bindings.hpp"
+#include "gl/gpu_bindings.hpp"
 #include "overlays/odf_glyphs/glyph_ray.hpp"
-#include "shader_program.hpp"
-#include "vec_ops.hpp"
-#include "shading_uniforms.hpp"
+#include "gl/shader_program.hpp"
+#include "render/vec_ops.hpp"
+#include "render/shading_uniforms.hpp"
 #include "techniques/draw_technique.hpp"
 
 namespace fiblet::viewer {

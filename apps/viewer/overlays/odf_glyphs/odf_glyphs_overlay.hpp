@@ -2,7 +2,7 @@
 // an overlay of the fibers' frame.
 #pragma once
 
-#include "gl_objects.hpp"
+#include "gl/gl_objects.hpp"
 #include "overlays/odf_glyphs/glyph_set.hpp"
 #include "overlays/overlay.hpp"
 

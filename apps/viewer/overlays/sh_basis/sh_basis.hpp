@@ -17,12 +17,10 @@
 #include <string>
 #include <vector>
 
+#include "fiblet_viewer/scene_sources.hpp"
+
 namespace fiblet::viewer {
 
-enum class ShBasis { mrtrix, descoteaux07 };
-std::optional<ShBasis> parse_sh_basis(const std::string& name);  // "mrtrix" (or "tournier"), "descoteaux07"
-
-inline constexpr int kMaxShLmax = 12;
 inline constexpr int sh_coefficient_count(int lmax) { return (lmax + 1) * (lmax + 2) / 2; }
 inline constexpr int sh_index(int l, int m) { return l * (l + 1) / 2 + m; }
 // The lmax of an image with `count` coefficients, or -1 when no even lmax <= 12 has that many.

@@ -1,8 +1,8 @@
 #include "techniques/lines/lines_technique.hpp"
 
-#include "gpu_bindings.hpp"
-#include "shader_program.hpp"
-#include "shading_uniforms.hpp"
+#include "gl/gpu_bindings.hpp"
+#include "gl/shader_program.hpp"
+#include "render/shading_uniforms.hpp"
 #include "voxel_rt/chord_occlusion.hpp"
 
 namespace fiblet::viewer {

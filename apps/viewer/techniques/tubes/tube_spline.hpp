@@ -16,8 +16,8 @@
 #include <cmath>
 #include <cstdint>
 
-#include "gpu_scene.hpp"
-#include "render_options.hpp"
+#include "scene/gpu_scene.hpp"
+#include "fiblet_viewer/render_options.hpp"
 
 namespace fiblet::viewer {
 

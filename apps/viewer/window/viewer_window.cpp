@@ -1,0 +1,311 @@
+#include "fiblet_viewer/viewer_window.hpp"
+
+#include <fmt/core.h>
+#include <epoxy/gl.h>
+// GLFW after epoxy: epoxy provides the GL declarations.
+#include <GLFW/glfw3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include "overlays/overlay_sources.hpp"
+#include "scene/fiber_colors.hpp"
+#include "window/fiber_picking.hpp"
+#include "window/fiber_selection.hpp"
+#include "fiblet/error.hpp"
+#include "scene/gpu_programs.hpp"
+#include "scene/gpu_scene.hpp"
+#include "gl/gl_info.hpp"
+#include "window/orbit_camera.hpp"
+#include "gl/png_file.hpp"
+#include "render/render_target.hpp"
+#include "render/renderer.hpp"
+#include "scene/fiber_opacity.hpp"
+#include "scene/fiber_radii.hpp"
+#include "render/supersampling.hpp"
+#include "scene/scene_file.hpp"
+#include "render/vec_ops.hpp"
+
+namespace fiblet::viewer {
+
+const char* window_controls_help() {
+    return "  left drag: orbit    right/middle drag or shift+left drag: pan    wheel: zoom\n"
+           "  click: highlight the fiber under the cursor and print it (ID, points, length); on the background: "
+           "clear\n"
+           "  shift+click: add the fiber to the highlighted ones (or take it out)    W: save them as a fiber list\n"
+           "  R: reset view    S: screenshot (PNG)    C: culling on/off    L: level of detail on/off\n"
+           "  D: colour by direction / fixed    I: lighting on/off    +/-: line width    T: lines / tubes / capsules\n"
+           "  E: engine raster / voxel-rt    H: help    Q, Esc: quit\n";
+}
+
+namespace {
+
+std::string glfw_error;  // the last GLFW error message (GLFW reports through a callback)
+
+struct GlfwSession {
+    GlfwSession() {
+        glfwSetErrorCallback([](int, const char* message) { glfw_error = message ? message : "unknown error"; });
+        if (!glfwInit())
+            throw Error(Errc::unsupported,
+                        "cannot open a window: " + glfw_error +
+                            (std::getenv("DISPLAY") || std::getenv("WAYLAND_DISPLAY")
+                                 ? std::string()
+                                 : std::string(" (no display: DISPLAY and WAYLAND_DISPLAY are unset)")) +
+                            "; `fiblet render` draws to a PNG without a display");
+    }
+    ~GlfwSession() { glfwTerminate(); }
+    GlfwSession(const GlfwSession&) = delete;
+    GlfwSession& operator=(const GlfwSession&) = delete;
+};
+
+struct WindowDeleter {
+    void operator()(GLFWwindow* w) const { glfwDestroyWindow(w); }
+};
+
+// The state the GLFW callbacks change.
+struct Interaction {
+    OrbitCamera orbit, home;
+    RenderOptions render;
+    bool dirty = true, screenshot = false, quit = false;
+    bool dragging = false, panning = false, moved = false;
+    double press_x = 0, press_y = 0, last_x = 0, last_y = 0;
+    std::optional<std::pair<double, double>> pick;  // window coordinates of a click
+    bool pick_adds = false;                          // a shift-click: add to the selection
+    bool save_selection = false;
+};
+
+Interaction& state_of(GLFWwindow* w) { return *static_cast<Interaction*>(glfwGetWindowUserPointer(w)); }
+
+void on_key(GLFWwindow* w, int key, int, int action, int) {
+    if (action != GLFW_PRESS && action != GLFW_REPEAT) return;
+    Interaction& s = state_of(w);
+    switch (key) {
+        case GLFW_KEY_ESCAPE:
+        case GLFW_KEY_Q: s.quit = true; break;
+        case GLFW_KEY_R: s.orbit = s.home; break;
+        case GLFW_KEY_S: s.screenshot = true; break;
+        case GLFW_KEY_C: s.render.frustum_culling = !s.render.frustum_culling; break;
+        case GLFW_KEY_L: s.render.level_of_detail = !s.render.level_of_detail; break;
+        case GLFW_KEY_D: s.render.color_by_direction = !s.render.color_by_direction; break;
+        case GLFW_KEY_I: s.render.lighting = !s.render.lighting; break;
+        case GLFW_KEY_EQUAL:
+        case GLFW_KEY_KP_ADD: s.render.line_width = std::min(s.render.line_width + 1, 16.0f); break;
+        case GLFW_KEY_MINUS:
+        case GLFW_KEY_KP_SUBTRACT: s.render.line_width = std::max(s.render.line_width - 1, 1.0f); break;
+        case GLFW_KEY_T:
+            s.render.style = s.render.style == DrawStyle::lines   ? DrawStyle::tubes
+                             : s.render.style == DrawStyle::tubes ? DrawStyle::capsules
+                                                                  : DrawStyle::lines;
+            break;
+        case GLFW_KEY_E:
+            s.render.engine =
+                s.render.engine == RenderEngine::raster ? RenderEngine::voxel_rt : RenderEngine::raster;
+            break;
+        case GLFW_KEY_W: s.save_selection = true; break;
+        case GLFW_KEY_H: fmt::print("{}", window_controls_help()); break;
+        default: return;
+    }
+    s.dirty = true;
+}
+
+void on_button(GLFWwindow* w, int button, int action, int mods) {
+    Interaction& s = state_of(w);
+    double x = 0, y = 0;
+    glfwGetCursorPos(w, &x, &y);
+    if (action == GLFW_PRESS) {
+        s.dragging = true, s.moved = false;
+        s.panning = button != GLFW_MOUSE_BUTTON_LEFT || (mods & GLFW_MOD_SHIFT);
+        s.pick_adds = button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_SHIFT);
+        s.press_x = s.last_x = x, s.press_y = s.last_y = y;
+    } else if (action == GLFW_RELEASE) {
+        if (s.dragging && !s.moved && button == GLFW_MOUSE_BUTTON_LEFT) s.pick = std::make_pair(x, y), s.dirty = true;
+        s.dragging = false;
+    }
+}
+
+void on_cursor(GLFWwindow* w, double x, double y) {
+    Interaction& s = state_of(w);
+    if (!s.dragging) return;
+    if (std::abs(x - s.press_x) + std::abs(y - s.press_y) > 3) s.moved = true;
+    const double dx = x - s.last_x, dy = y - s.last_y;
+    s.last_x = x, s.last_y = y;
+    if (!s.moved) return;
+    int height = 1;
+    glfwGetWindowSize(w, nullptr, &height);
+    if (s.panning)
+        s.orbit.pan(float(dx), float(dy), height);
+    else
+        s.orbit.orbit(float(-dx) * 0.3f, float(dy) * 0.3f);
+    s.dirty = true;
+}
+
+void on_scroll(GLFWwindow* w, double, double dy) {
+    Interaction& s = state_of(w);
+    s.orbit.zoom(std::pow(1.15f, float(dy)));
+    s.dirty = true;
+}
+
+// The orbit for a --camera spec: named views are fitted; explicit eyes keep
+// their eye and target (the up vector follows the orbit).
+OrbitCamera initial_orbit(const WindowOptions& o, const GpuScene& scene, float aspect) {
+    const SceneBounds& bounds = scene.bounds();
+    float az = 0, el = 0;
+    if (named_view(o.camera, az, el)) {
+        OrbitCamera orbit = fit_orbit(bounds, scene.sample_points(), az, el, o.fov_y_deg, aspect);
+        orbit.distance /= o.zoom;
+        return orbit;
+    }
+    const Camera c = camera_from_spec(o.camera, scene, aspect, o.fov_y_deg, o.zoom);
+    OrbitCamera orbit = fit_orbit(bounds, scene.sample_points(), 0, 0, o.fov_y_deg, aspect);
+    const Vec3f d = sub(c.position, c.target);
+    orbit.target = c.target;
+    orbit.distance = length(d);
+    orbit.azimuth_deg = std::atan2(d.y, d.x) * 180.0f / float(M_PI);
+    orbit.elevation_deg = std::clamp(std::asin(d.z / orbit.distance) * 180.0f / float(M_PI), -89.9f, 89.9f);
+    return orbit;
+}
+
+std::string next_screenshot_name(const std::string& prefix) {
+    for (int i = 1;; ++i) {
+        const std::string name = fmt::format("{}-{:03}.png", prefix, i);
+        if (!std::filesystem::exists(name)) return name;
+    }
+}
+
+}  // namespace
+
+void run_viewer_window(const std::string& path, const WindowOptions& options) {
+    const GlfwSession glfw;
+    const std::string title = std::filesystem::path(path).filename().string();
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_FALSE);  // wide lines stay available
+    std::unique_ptr<GLFWwindow, WindowDeleter> window(
+        glfwCreateWindow(options.width, options.height, title.c_str(), nullptr, nullptr));
+    if (!window) throw Error(Errc::unsupported, "cannot open an OpenGL 4.5 window: " + glfw_error);
+    GLFWwindow* w = window.get();
+    glfwMakeContextCurrent(w);
+    glfwSwapInterval(1);
+    require_gl45();
+
+    const GpuPrograms programs;
+    const FftFile file = open_scene_file(path);
+    GpuScene scene(file, programs);
+    load_fiber_colors(options.fiber_colors, file, scene);
+    if (!options.fiber_radii_path.empty()) load_fiber_radii(options.fiber_radii_path, scene);
+    if (!options.fiber_opacity_source.empty()) load_fiber_opacities(options.fiber_opacity_source, file, scene);
+    Renderer renderer(programs);
+    int fb_width = 0, fb_height = 0;
+    glfwGetFramebufferSize(w, &fb_width, &fb_height);
+    RenderTarget target(std::max(fb_width, 1), std::max(fb_height, 1));
+
+    Interaction s;
+    s.render = options.render;
+    s.render.time_stages = true;
+    renderer.set_overlays(make_overlays(options.overlays, s.render));
+    s.home = s.orbit = initial_orbit(options, scene, float(target.width()) / float(target.height()));
+    glfwSetWindowUserPointer(w, &s);
+    glfwSetKeyCallback(w, on_key);
+    glfwSetMouseButtonCallback(w, on_button);
+    glfwSetCursorPosCallback(w, on_cursor);
+    glfwSetScrollCallback(w, on_scroll);
+    glfwSetFramebufferSizeCallback(w, [](GLFWwindow* win, int, int) { state_of(win).dirty = true; });
+    fmt::print("{}: {} fibers, {} blocks on {}\n{}", title, scene.fiber_count(), scene.block_count(),
+               current_gl_description(), window_controls_help());
+    std::fflush(stdout);
+
+    while (!glfwWindowShouldClose(w) && !s.quit) {
+        // Sleep until something happens; redraw only when the view changed.
+        if (!s.dirty) glfwWaitEventsTimeout(0.5);
+        glfwPollEvents();
+        if (!s.dirty) continue;
+        s.dirty = false;
+        glfwGetFramebufferSize(w, &fb_width, &fb_height);
+        if (fb_width < 1 || fb_height < 1) continue;  // minimized
+        target.resize(fb_width, fb_height);
+        const Camera camera = s.orbit.camera(float(fb_width) / float(fb_height));
+        const auto t0 = std::chrono::steady_clock::now();
+        FrameStats st;
+        try {
+            st = renderer.render(scene, camera, s.render, target);
+        } catch (const Error& e) {
+            // E on a scene the voxel ray tracer refuses (its buffers): say
+            // why and keep drawing with the rasterizer.
+            if (s.render.engine != RenderEngine::voxel_rt || e.code() != Errc::unsupported) throw;
+            fmt::print(stderr, "{}; back to --engine raster\n", e.what());
+            s.render.engine = RenderEngine::raster;
+            s.dirty = true;
+            continue;
+        }
+        const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+
+        glNamedFramebufferReadBuffer(target.framebuffer(), GL_COLOR_ATTACHMENT0);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glBlitNamedFramebuffer(target.framebuffer(), 0, 0, 0, fb_width, fb_height, 0, 0, fb_width, fb_height,
+                               GL_COLOR_BUFFER_BIT, GL_NEAREST);
+        glfwSwapBuffers(w);
+        glfwSetWindowTitle(
+            w, fmt::format("{} | {:.1f} ms (GPU cull {:.1f} decode {:.1f} draw {:.1f}) | {} blocks ({} coarse), {} "
+                           "segments | {} | culling {} LoD {}",
+                           title, frame_ms, st.cull_ms, st.decode_ms, st.draw_ms, st.drawn_blocks(), st.coarse_blocks,
+                           st.drawn_segments(),
+                           s.render.engine == RenderEngine::voxel_rt ? "voxel-rt" : draw_style_name(s.render.style),
+                           s.render.frustum_culling ? "on" : "off",
+                           s.render.level_of_detail ? "on" : "off")
+                   .c_str());
+
+        // Screenshots first: picking a transparent frame draws over the target.
+        if (s.screenshot) {
+            s.screenshot = false;
+            const std::string name = next_screenshot_name(options.screenshot_prefix);
+            if (options.screenshot_supersample > 1)
+                write_png(name,
+                          render_supersampled(renderer, scene, camera, s.render, target.width(), target.height(),
+                                              options.screenshot_supersample)
+                              .image,
+                          false);
+            else
+                write_png(name, {target.width(), target.height(), target.read_rgba()}, false);
+            fmt::print("screenshot: {}\n", name);
+            std::fflush(stdout);
+        }
+        if (s.pick) {
+            int win_width = 1, win_height = 1;
+            glfwGetWindowSize(w, &win_width, &win_height);
+            const int px = int(s.pick->first * fb_width / std::max(win_width, 1));
+            const int py = int(s.pick->second * fb_height / std::max(win_height, 1));
+            s.pick.reset();
+            // A transparent frame is drawn again opaque to pick from: draw it again after.
+            if (s.render.transparent()) s.dirty = true;
+            const auto f = pick_fiber_in_frame(renderer, scene, camera, s.render, target, px, py);
+            if (f)
+                fmt::print("fiber ID {} (index {}): {} points, {:.2f} mm\n", f->id, f->index, f->points, f->length_mm);
+            else
+                fmt::print("no fiber at ({}, {})\n", px, py);
+            if (!update_selection(s.render.highlighted_fibers, f ? std::optional<std::uint64_t>(f->index) : std::nullopt,
+                                  s.pick_adds))
+                fmt::print("at most {} fibers are highlighted\n", kMaxHighlightedFibers);
+            s.dirty = true;
+            std::fflush(stdout);
+        }
+        if (s.save_selection) {
+            s.save_selection = false;
+            try {
+                save_selection(options.selection_path, s.render.highlighted_fibers);
+                fmt::print("{} highlighted fibers saved to {} (fiblet extract --fibers $(cat {}))\n",
+                           s.render.highlighted_fibers.size(), options.selection_path, options.selection_path);
+            } catch (const Error& e) {
+                fmt::print(stderr, "fiblet: error: {}\n", e.what());
+            }
+            std::fflush(stdout);
+        }
+    }
+}
+
+}  // namespace fiblet::viewer
