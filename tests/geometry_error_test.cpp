@@ -232,16 +232,18 @@ GeometryError measure_pairs(const std::vector<std::pair<Line, Line>>& pairs) {
     return g;
 }
 
+void expect_same_bits(const ErrorStats& x, const ErrorStats& y) {
+    EXPECT_EQ(x.count(), y.count());
+    EXPECT_EQ(x.max_mm(), y.max_mm());
+    EXPECT_EQ(x.mean_mm(), y.mean_mm());
+    EXPECT_EQ(x.rms_mm(), y.rms_mm());
+    for (double p : {50.0, 99.0}) EXPECT_EQ(x.percentile_mm(p), y.percentile_mm(p)) << p;
+    EXPECT_EQ(x.worst_fiber(), y.worst_fiber());
+}
+
 void expect_same_bits(const GeometryError& a, const GeometryError& b) {
-    for (auto pick : {&GeometryError::decoded_to_input, &GeometryError::input_to_decoded}) {
-        const ErrorStats &x = (a.*pick)(), &y = (b.*pick)();
-        EXPECT_EQ(x.count(), y.count());
-        EXPECT_EQ(x.max_mm(), y.max_mm());
-        EXPECT_EQ(x.mean_mm(), y.mean_mm());
-        EXPECT_EQ(x.rms_mm(), y.rms_mm());
-        EXPECT_EQ(x.percentile_mm(50), y.percentile_mm(50));
-        EXPECT_EQ(x.worst_fiber(), y.worst_fiber());
-    }
+    for (auto pick : {&GeometryError::decoded_to_input, &GeometryError::input_to_decoded})
+        expect_same_bits((a.*pick)(), (b.*pick)());
     EXPECT_EQ(a.endpoint_mm().max, b.endpoint_mm().max);
     EXPECT_EQ(a.length_change_mm().sum, b.length_change_mm().sum);
     EXPECT_EQ(a.mean_length_change_mm(), b.mean_length_change_mm());
@@ -316,15 +318,8 @@ TEST(GeometryError, CompressReportsTheSameBitsWithoutAvx2Loops) {
         EXPECT_TRUE(test::read_file(dir.file("a.fft")) == test::read_file(dir.file("s.fft")));
         expect_same_bits(avx2.geometry, scalar.geometry);
         expect_same_bits(vectors.geometry, scalar.geometry);
-        for (auto pick : {&CompressReport::error, &CompressReport::error_vs_original}) {
-            const ErrorStats &x = vectors.*pick, &y = scalar.*pick;
-            EXPECT_EQ(x.count(), y.count());
-            EXPECT_EQ(x.max_mm(), y.max_mm());
-            EXPECT_EQ(x.mean_mm(), y.mean_mm());
-            EXPECT_EQ(x.rms_mm(), y.rms_mm());
-            EXPECT_EQ(x.percentile_mm(99), y.percentile_mm(99));
-            EXPECT_EQ(x.worst_fiber(), y.worst_fiber());
-        }
+        for (auto pick : {&CompressReport::error, &CompressReport::error_vs_original})
+            expect_same_bits(vectors.*pick, scalar.*pick);
         EXPECT_EQ(vectors.scan.min_dot, scalar.scan.min_dot);
         EXPECT_EQ(vectors.scan.step_mean, scalar.scan.step_mean);
     }
