@@ -8,7 +8,9 @@
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -18,6 +20,7 @@
 #include <vector>
 
 #include "cli_runner.hpp"
+#include "fiblet/compress.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/streamline_io.hpp"
@@ -107,6 +110,15 @@ TEST(ReaderRefusals, TrkNonFiniteCoordinatesNameTheirStreamlineAndPoint) {
         const std::string path = patched(dir, good, kTrkSecondY, f32(bad), "bad.trk");
         expect_refused(dir, path, Errc::trk_format, "streamline 1 (0-based) point 0 (0-based) is not finite");
     }
+}
+
+// A point count beyond the file is damage in every command (compress said
+// "unsupported", exit 6, where info said malformed, exit 4).
+TEST(ReaderRefusals, TrkCountBeyondTheFileIsMalformedEverywhere) {
+    TempDir dir;
+    const std::string path = patched(dir, trk_file(dir, "good.trk"), 1000, le32(0x7fffffff), "count.trk");
+    expect_refused(dir, path, Errc::trk_format, "streamline 0 (0-based) claims 2147483647 points, more than the file holds");
+    EXPECT_EQ(test::run_cli("info " + path).status, 4);
 }
 
 TEST(ReaderRefusals, TrkVersionThreeAndNegativeDimensions) {
@@ -280,12 +292,14 @@ TEST(ReaderRefusals, MasksAreReadAsBytesNotFloats) {
 // A TRX directory of a three-point streamline reaching `length` mm (its
 // uneven spacing resampled to ~1 mm: thousands of points) and a one-point
 // one, with `components` uint8 values a point (dpv/x).
-std::string long_resampled_trx(const TempDir& dir, const std::string& name, float length, std::size_t components) {
+std::string long_resampled_trx(const TempDir& dir, const std::string& name, float length, std::size_t components,
+                               const std::string& dtype = "uint8", std::size_t value_size = 1) {
     const std::string root = trx_dir(dir, name, trx_header("1", "2", "4"), {0, 0, 0, 1, 0, 0, length, 0, 0, 5, 5, 5});
     const std::uint32_t offsets[2] = {0, 3};
     test::write_file(root + "/offsets.uint32", std::string(reinterpret_cast<const char*>(offsets), sizeof offsets));
     std::filesystem::create_directories(root + "/dpv");
-    test::write_file(root + "/dpv/x." + std::to_string(components) + ".uint8", std::string(4 * components, '\x07'));
+    test::write_file(root + "/dpv/x." + std::to_string(components) + "." + dtype,
+                     std::string(4 * components * value_size, '\x07'));
     return root;
 }
 
@@ -310,6 +324,54 @@ TEST(ReaderRefusals, ResampledPerPointDataIsSizedAgainstTheMemoryBudget) {
     EXPECT_GT(f.header().points, 1000u);
     EXPECT_EQ(f.streamline_fields()[0].rows(), f.header().points);
     EXPECT_EQ(f.streamline_fields()[0].bytes, std::vector<std::uint8_t>(50 * f.header().points, 7));
+}
+
+// The budget counts two copies of the resampled per-point arrays (the values
+// and the DATA chunk made of them), and the peak holds to it: the resampler's
+// columns are released as the fields take them, the checksum hashes the
+// trailer chunk by chunk, a large write goes straight to the file. Before,
+// a 320 MB array peaked at 1.25 GB (four copies).
+TEST(ReaderRefusals, ResampledPerPointDataPeaksAtTwoCopies) {
+    TempDir dir;
+    // ~20,000 resampled points x 1250 float32: 100 MB of values.
+    const std::string trx = long_resampled_trx(dir, "float.trx", 20000, 1250, "float32", 4);
+    const auto [status, mb] = status_and_peak_rss_mb({"compress", "-q", "-j", "1", trx, "-o", dir.file("f.fft")});
+    ASSERT_EQ(status, 0);
+    const FftFile f(dir.file("f.fft"));
+    ASSERT_EQ(f.streamline_fields().size(), 1u);
+    const double values_mb = double(f.streamline_fields()[0].bytes.size()) / (1 << 20);
+    EXPECT_GT(values_mb, 80);
+    if (!test::kSanitized) EXPECT_LT(mb, 2.4 * values_mb + 40) << values_mb << " MB of values";
+}
+
+// Without --max-memory the budget is half of what the process may use: under
+// `ulimit -v` that limit, not the machine's memory, so a file whose arrays
+// would not fit is refused (exit 6) instead of failing in the allocator
+// (bad_alloc, exit 1, as before).
+TEST(ReaderRefusals, DefaultBudgetFollowsTheProcessLimits) {
+    const std::uint64_t unlimited = default_memory_budget();
+    int fds[2];
+    ASSERT_EQ(::pipe(fds), 0);
+    const std::uint64_t limit = std::uint64_t(1) << 30;
+    if (const pid_t pid = ::fork(); pid == 0) {
+        const rlimit r{limit, limit};
+        std::uint64_t budget = ::setrlimit(RLIMIT_DATA, &r) == 0 ? default_memory_budget() : 0;
+        ::write(fds[1], &budget, sizeof budget);
+        ::_exit(0);
+    } else {
+        std::uint64_t budget = 0;
+        EXPECT_EQ(::read(fds[0], &budget, sizeof budget), ssize_t(sizeof budget));
+        ::waitpid(pid, nullptr, 0);
+        ::close(fds[0]), ::close(fds[1]);
+        EXPECT_EQ(budget, std::min(unlimited, limit / 2));
+    }
+    if (test::kSanitized) return;  // ASan reserves its shadow memory beyond any such ulimit -v
+    TempDir dir;
+    const std::string big = long_resampled_trx(dir, "big.trx", 20000, 100000);  // 1.9 GB once resampled
+    const auto r = test::run_cli("compress -q " + big + " -o " + dir.file("big.fft"), "ulimit -v 2000000;");
+    EXPECT_EQ(r.status, 6) << r.output;
+    EXPECT_NE(r.output.find("more than the memory budget of"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("big.fft")));
 }
 
 // A TRX's data arrays count against the memory budget before each is read
@@ -357,6 +419,14 @@ TEST(ReaderRefusals, EmptyStreamlinesCostTheirTablesOnly) {
               std::string::npos)
         << refused.output;
     EXPECT_FALSE(std::filesystem::exists(dir.file("f.fft")));
+    // The offsets array and its 64-bit table (8 + 16 MiB) count before they are read.
+    const auto [offsets_status, offsets_mb] =
+        status_and_peak_rss_mb({"compress", "-q", root, "-o", dir.file("g.fft"), "--max-memory", "16M"});
+    EXPECT_EQ(offsets_status, 6);
+    EXPECT_LT(offsets_mb, test::kSanitized ? 2048 : 24);
+    const auto offsets = test::run_cli("compress -q " + root + " -o " + dir.file("g.fft") + " --max-memory 16M");
+    EXPECT_NE(offsets.output.find("its arrays take 24 MiB and more (offsets.uint32 included)"), std::string::npos)
+        << offsets.output;
 }
 
 }  // namespace

@@ -129,7 +129,8 @@ struct CompressReport {
     std::string simd;  // the code search's SIMD level: avx512, avx2, sse4 or scalar (FIBLET_SIMD forces one)
 };
 
-// Half of this machine's physical memory (4 GiB where it cannot be told).
+// Half of the memory this process may use: the physical memory, or less
+// under `ulimit -v`/`-d` or a cgroup v2 memory.max (src/core/memory_budget.cpp).
 std::uint64_t default_memory_budget();
 
 // Compresses `tck_path` (a .tck, .trk or TRX: open_streamline_source) into

@@ -154,8 +154,9 @@ struct TrailerChunk {
     std::array<char, 4> tag{};
     std::vector<std::uint8_t> payload;
 };
-// Appends one chunk (16-byte head, then the payload) to `out`.
+// Appends one chunk (16-byte head, then the payload) to `out`; or its head alone.
 void append_trailer_chunk(std::vector<std::uint8_t>& out, const TrailerChunk& chunk);
+void append_trailer_chunk_head(std::vector<std::uint8_t>& out, const TrailerChunk& chunk);
 // Serializes chunks + footer; `trailer_offset` is where the first chunk starts.
 std::vector<std::uint8_t> serialize_trailer(const std::vector<TrailerChunk>& chunks, std::uint64_t trailer_offset);
 

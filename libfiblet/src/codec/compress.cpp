@@ -6,8 +6,6 @@
 // (compress_stages.hpp).
 #include "fiblet/compress.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <bit>
 #include <chrono>
@@ -467,12 +465,6 @@ void CompressJob::finish() {
 }
 
 }  // namespace
-
-std::uint64_t default_memory_budget() {
-    const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGE_SIZE);
-    if (pages <= 0 || page <= 0) return std::uint64_t(4) << 30;
-    return std::uint64_t(pages) * std::uint64_t(page) / 2;
-}
 
 CompressReport compress_tck(const std::string& tck_path, const std::string& fft_path, const CompressOptions& options) {
     const Timer timer;

@@ -331,13 +331,21 @@ void PointFieldResampler::resample(std::uint32_t f, std::span<const PolylinePosi
     }
 }
 
+// Each column's arrays are released as soon as its field holds the values:
+// the peak stays within the budget's two copies (compress.cpp), the values
+// and the DATA chunk made of them.
 void PointFieldResampler::finish() {
     for (Column& c : columns_) {
-        if (c.nearest) continue;
+        if (c.nearest) {
+            std::vector<std::uint8_t>().swap(c.raw);
+            continue;
+        }
+        std::vector<float>().swap(c.input);
         StreamlineField& f = *c.field;
         f.type = FieldType::float32;
         f.bytes.resize(c.output.size() * 4);
         std::memcpy(f.bytes.data(), c.output.data(), f.bytes.size());
+        std::vector<float>().swap(c.output);
     }
 }
 

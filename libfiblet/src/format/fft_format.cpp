@@ -32,15 +32,22 @@ std::vector<std::uint8_t> serialize_fft_header(const FftHeader& h) {
     return out;
 }
 
-void append_trailer_chunk(std::vector<std::uint8_t>& out, const TrailerChunk& c) {
+void append_trailer_chunk_head(std::vector<std::uint8_t>& out, const TrailerChunk& c) {
     out.insert(out.end(), c.tag.begin(), c.tag.end());
     put_le(out, std::uint32_t{0});
     put_le(out, std::uint64_t{c.payload.size()});
+}
+
+void append_trailer_chunk(std::vector<std::uint8_t>& out, const TrailerChunk& c) {
+    append_trailer_chunk_head(out, c);
     out.insert(out.end(), c.payload.begin(), c.payload.end());
 }
 
 std::vector<std::uint8_t> serialize_trailer(const std::vector<TrailerChunk>& chunks, std::uint64_t trailer_offset) {
     std::vector<std::uint8_t> out;
+    std::size_t size = kTrailerFooterBytes;  // reserved whole, as the DATA chunk may be large
+    for (const TrailerChunk& c : chunks) size += 16 + c.payload.size();
+    out.reserve(size);
     for (const TrailerChunk& c : chunks) append_trailer_chunk(out, c);
     put_le(out, trailer_offset);
     out.insert(out.end(), std::begin(kTrailerMagic), std::end(kTrailerMagic));

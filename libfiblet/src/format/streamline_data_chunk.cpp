@@ -13,6 +13,9 @@ using detail::put_le;
 
 TrailerChunk make_streamline_data_chunk(const std::vector<StreamlineField>& fields) {
     TrailerChunk c{kStreamlineDataTag, {}};
+    std::size_t size = 4;  // reserved whole: growing by doubling would hold two payloads at once
+    for (const StreamlineField& f : fields) size += 4 + f.name.size() + 4 + 4 + 8 + f.bytes.size();
+    c.payload.reserve(size);
     put_le<std::uint32_t>(c.payload, std::uint32_t(fields.size()));
     for (const StreamlineField& f : fields) {
         put_le<std::uint32_t>(c.payload, std::uint32_t(f.name.size()));

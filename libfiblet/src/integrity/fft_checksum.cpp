@@ -86,9 +86,14 @@ TrailerChunk FftChecksumBuilder::finish(std::span<const std::uint8_t> header,
     }
     sums_.header_hash = xxh64(header.data(), header.size());
     sums_.lut_hash = lut_.digest();
-    std::vector<std::uint8_t> before;
-    for (const TrailerChunk& c : chunks_before) append_trailer_chunk(before, c);
-    sums_.trailer_hash = xxh64(before.data(), before.size());
+    Xxh64Stream before;  // the chunks as serialized, hashed piece by piece: a DATA chunk may be large
+    for (const TrailerChunk& c : chunks_before) {
+        std::vector<std::uint8_t> head;
+        append_trailer_chunk_head(head, c);
+        before.update(head.data(), head.size());
+        before.update(c.payload.data(), c.payload.size());
+    }
+    sums_.trailer_hash = before.digest();
     return sums_.serialize();
 }
 

@@ -154,12 +154,11 @@ void AtomicOutputFile::flush_buffer() {
 
 void AtomicOutputFile::write(const void* data, std::size_t size) {
     if (buffer_.size() + size > buffer_.capacity()) flush_buffer();
-    if (size >= buffer_.capacity()) {
-        buffer_.assign(static_cast<const char*>(data), size);
-        flush_buffer();
-    } else {
-        buffer_.append(static_cast<const char*>(data), size);
+    if (size >= buffer_.capacity()) {  // straight to the file: a copy would double a large trailer
+        write_pieces(&data, &size, 1);
+        return;
     }
+    buffer_.append(static_cast<const char*>(data), size);
     written_ += size;
 }
 

@@ -95,14 +95,16 @@ struct TrkReader::Impl {
         if (header.big_endian) raw = __builtin_bswap32(raw);
         const auto n = std::int32_t(raw);
         if (n < 0) bad(detail::streamline_label(streamlines) + " has a negative point count (" + std::to_string(n) + ")");
+        const std::size_t stride = 3 + std::size_t(header.n_scalars);
+        const std::size_t total = std::size_t(n) * stride + std::size_t(header.n_properties);
+        // A count larger than the rest of the file is damage (exit 4 in every
+        // command), not a reason to allocate nor a size fiblet lacks.
+        if (header.file_bytes && 4 * std::uint64_t(total) > header.file_bytes)
+            bad(detail::streamline_label(streamlines) + " claims " + std::to_string(n) + " points, more than the file holds");
         if (options.max_points && std::size_t(n) > options.max_points)
             throw Error(Errc::unsupported, path + ": " + detail::streamline_label(streamlines) + " has " +
                                                std::to_string(n) + " points (at most " +
                                                std::to_string(options.max_points) + " supported)");
-        const std::size_t stride = 3 + std::size_t(header.n_scalars);
-        const std::size_t total = std::size_t(n) * stride + std::size_t(header.n_properties);
-        // A count larger than the rest of the file is damage, not a reason to allocate.
-        if (header.file_bytes && 4 * std::uint64_t(total) > header.file_bytes) bad(detail::streamline_label(streamlines) + " claims " + std::to_string(n) + " points, more than the file holds");
         values.resize(total);
         if (total > 0) read(values.data(), 4 * total, false, "points");
         swap_floats(values.data(), total);

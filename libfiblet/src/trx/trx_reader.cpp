@@ -93,7 +93,7 @@ FieldType dtype(const TrxEntryName& n, const std::string& entry, const std::stri
 struct TrxReader::Impl {
     std::string path;
     SourceOptions options;
-    std::uint64_t fields_bytes = 0;  // the data arrays read so far
+    std::uint64_t budget_used = 0;  // the arrays read so far and the offsets table
     std::unique_ptr<detail::TrxArchive> archive;
     TrxHeaderJson header;
     TractogramSpace space;
@@ -115,6 +115,7 @@ struct TrxReader::Impl {
         if (stored != header.streamlines * size && stored != (header.streamlines + 1) * size)
             bad(path, entry + " holds " + std::to_string(stored) + " bytes for NB_STREAMLINES = " +
                           std::to_string(header.streamlines));
+        draw_from_budget(stored + 8 * (header.streamlines + 1), entry);  // the entry, then its 64-bit table
         const auto bytes = archive->read_all(entry);
         const std::uint64_t count = bytes.size() / size;
         if (bytes.size() % size || (count != header.streamlines && count != header.streamlines + 1))
@@ -134,6 +135,18 @@ struct TrxReader::Impl {
         for (std::size_t i = 1; i < offsets.size(); ++i)
             if (offsets[i] < offsets[i - 1])
                 bad(path, entry + ": offsets decrease at " + detail::streamline_label(i - 1));
+    }
+
+    // Every array is counted (decompressed size) before it is read: a small
+    // zip can hold gigabytes of zeros.
+    void draw_from_budget(std::uint64_t bytes, const std::string& entry) {
+        budget_used += bytes;
+        if (options.max_memory && budget_used > options.max_memory)
+            throw Error(Errc::unsupported,
+                        path + ": its arrays take " + std::to_string(budget_used >> 20) + " MiB and more (" + entry +
+                            " included), more than the memory budget of " + std::to_string(options.max_memory >> 20) +
+                            " MiB",
+                        Remedy::max_memory);
     }
 
     // Before reading an array: the size its rows must have (dps, dpv), or a
@@ -173,13 +186,7 @@ struct TrxReader::Impl {
                 for (const StreamlineField& earlier : fields)
                     if (earlier.name == f.name) bad(path, "more than one array named " + f.name + " (" + entry + ")");
                 check_plausible_size(f, entry);
-                fields_bytes += archive->size(entry);
-                if (options.max_memory && fields_bytes > options.max_memory)
-                    throw Error(Errc::unsupported,
-                                path + ": its data arrays take " + std::to_string(fields_bytes >> 20) + " MiB and more (" +
-                                    entry + " included), more than the memory budget of " +
-                                    std::to_string(options.max_memory >> 20) + " MiB",
-                                Remedy::max_memory);
+                draw_from_budget(archive->size(entry), entry);
                 f.bytes = archive->read_all(entry);
                 const std::string problem = check_streamline_field(f, header.streamlines, header.vertices);
                 if (!problem.empty()) bad(path, problem);
