@@ -288,9 +288,10 @@ void add_compress(CLI::App& app) {
     cmd->add_flag("--allow-count-mismatch", args->allow_count_mismatch,
                   "Accept a .tck whose count: (a .trk whose n_count) disagrees with its data");
     cmd->add_option("--max-memory", args->max_memory,
-                    "Memory a source's data arrays (TRX dps/dpv/groups/dpg), the per-point arrays of resampled "
+                    "Memory a source's arrays (TRX offsets, dps/dpv/groups/dpg), the per-point arrays of resampled "
                     "streamlines and the per-streamline tables (~32 bytes each) may take, e.g. 8G or 512M (default: "
-                    "half the physical memory); beyond it compress stops before allocating them, exit 6")
+                    "half the memory the process may use: physical, ulimit -v/-d or the cgroup's limit); beyond it "
+                    "compress stops before allocating them, exit 6")
         ->transform(CLI::AsSizeValue(false))
         ->check(CLI::PositiveNumber);
     cmd->callback([args] { run(*args); });

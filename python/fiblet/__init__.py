@@ -668,7 +668,8 @@ def save(path, streamlines, step=None, *, overwrite=False, threads=None, max_mem
     overwrite: replace an existing file (else FileExistsError).
     threads: compression threads (None: all cores).
     max_memory: bytes compression may give the per-point arrays of resampled
-        streamlines (None: half the physical memory); beyond it nothing is
+        streamlines (None: half the memory the process may use, as the CLI's
+        --max-memory); beyond it nothing is
         written and an error says how much was needed.
 
     Points for a .fft/.fftz go through a temporary .tck file (in the default
