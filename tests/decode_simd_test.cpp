@@ -183,6 +183,59 @@ TEST(DecodeSimd, RandomBlocksMatchTheReference) {
     }
 }
 
+namespace {
+
+// 16-bit blocks (BlockView16) as an encoder could write them: any unorm24
+// anchors (sometimes equal), any point count, any first/last flags and u16
+// codes (for version 17 mostly below 181^2, some beyond: the table maps every u16).
+std::vector<std::uint8_t> random_blocks16(std::mt19937& rng, const FftHeader& h, std::size_t count) {
+    const std::uint32_t bb = h.block_bytes();
+    std::vector<std::uint8_t> data(count * bb, 0);
+    std::uniform_int_distribution<int> byte(0, 255);
+    std::uniform_int_distribution<std::uint32_t> points(1, h.points_per_block), code(0, 65535),
+        valid(0, h.code_levels() * h.code_levels() - 1);
+    for (std::size_t b = 0; b < count; ++b) {
+        std::uint8_t* block = &data[b * bb];
+        for (std::size_t i = 0; i < kBlock16FlagsOffset; ++i) block[i] = std::uint8_t(byte(rng));
+        if (byte(rng) < 16) std::memcpy(block + 9, block, 9);  // coinciding anchors: the first axis falls back to +x
+        const std::uint32_t n = byte(rng) < 192 ? h.points_per_block : points(rng);
+        const std::uint16_t flags = std::uint16_t(n | (byte(rng) & 0xc0) << 8);
+        block[kBlock16FlagsOffset] = std::uint8_t(flags), block[kBlock16FlagsOffset + 1] = std::uint8_t(flags >> 8);
+        for (std::uint32_t k = 0; k + 2 < n; ++k) {
+            const std::uint32_t c = byte(rng) < 4 ? code(rng) : valid(rng);
+            block[kBlock16DirectionsOffset + 2 * k] = std::uint8_t(c), block[kBlock16DirectionsOffset + 2 * k + 1] = std::uint8_t(c >> 8);
+        }
+    }
+    return data;
+}
+
+}  // namespace
+
+// Every SIMD decoder of 16-bit blocks (lanes; warp runs as lanes) gives the
+// scalar16 reference's points bit for bit, for versions 16 and 17 (whose
+// first axis comes from the anchors' integers).
+TEST(DecodeSimd, RandomBlocks16MatchTheReference) {
+    std::mt19937 rng(16);
+    for (const std::uint8_t version : {kFft16Version, kFft16PackedVersion}) {
+        for (std::uint32_t ppb : {254u, 126u, 2u, 3u, 17u, 33u}) {
+            for (std::size_t count : {std::size_t(1), std::size_t(15), std::size_t(16), std::size_t(300)}) {
+                FftHeader h = random_header(rng, ppb);
+                h.version = version;
+                const DecodeContext ctx(h);
+                const std::vector<std::uint8_t> blocks = random_blocks16(rng, h, count);
+                const std::size_t points = count_block_points(ctx, blocks.data(), count);
+                std::vector<float> reference(3 * points);
+                ASSERT_EQ(decode_blocks_scalar16(ctx, blocks.data(), count, reference.data()), points);
+                for (const std::string& name : simd_decoders()) {
+                    const std::vector<float> got = decode_guarded(ctx, blocks, name, points);
+                    EXPECT_TRUE(compare_points(got.data(), reference.data(), points).identical)
+                        << name << ", version " << int(version) << ", " << ppb << " points a block, " << count << " blocks";
+                }
+            }
+        }
+    }
+}
+
 TEST(DecodeSimd, InvalidPointCountsAreRejectedByEveryDecoder) {
     std::mt19937 rng(5);
     const FftHeader h = random_header(rng, 60);
@@ -215,9 +268,15 @@ void expect_file_matches_reference(const std::string& path) {
     const std::size_t points = count_block_points(ctx, blocks.data(), h.blocks);
     ASSERT_EQ(points, h.points) << path;
     std::vector<float> reference(3 * points);
-    decode_blocks_scalar(ctx, blocks.data(), h.blocks, reference.data());
+    const bool wide = h.direction_bits() == 16;
+    if (wide) decode_blocks_scalar16(ctx, blocks.data(), h.blocks, reference.data());
+    else decode_blocks_scalar(ctx, blocks.data(), h.blocks, reference.data());
     for (const std::string& name : simd_decoders()) {
         const std::vector<float> got = decode_guarded(ctx, blocks, name, points);
+        if (wide) {  // every SIMD decoder of 16-bit blocks is the lanes one
+            EXPECT_TRUE(compare_points(got.data(), reference.data(), points).identical) << path << ", " << name;
+            continue;
+        }
         double of_bound = 0;
         const double steps = expect_equivalent(ctx, blocks, name, got.data(), reference.data(), points, &of_bound);
         std::printf("  %-28s %-16s max deviation %.3g x step, %.2f of the bound\n",
@@ -256,6 +315,16 @@ TEST(DecodeSimd, SharedTractogramsMatchTheReferenceDecoder) {
         CompressOptions o;
         o.direction_bits = 8;
         compress_tck(tck.string(), fft, o);
+        expect_file_matches_reference(fft);
+    }
+    // And 16-bit files (version 17) of a smooth and of a folded tractogram.
+    for (const char* name : {"small-ifod1-step0.05.tck", "conformance/standard.tck"}) {
+        const std::string fft = dir.file("wide.fft");
+        CompressOptions o;
+        o.direction_bits = 16;
+        o.overwrite = true;
+        compress_tck(test::shared_data(name), fft, o);
+        ASSERT_EQ(FftFile(fft).header().direction_bits(), 16u);
         expect_file_matches_reference(fft);
     }
 }

@@ -51,6 +51,11 @@ struct DecodeContext {
     // component 3 col + row of code k at [16 k + 3 col + row], zero padded.
     // What the SIMD decoders load.
     alignas(64) std::array<float, 256 * 16> frame_rows{};
+    // The same for a 16-bit file's table (every u16 code, 4 MiB), null for version 2.
+    struct FrameRows16 {
+        alignas(64) std::array<float, 65536 * 16> rows;
+    };
+    std::shared_ptr<const FrameRows16> frame_rows16;
     // Last-step fractions per fiber; null: fibers end where their blocks do.
     // decode_blocks (and everything built on it) applies them; the raw
     // kernels (decode_blocks_scalar, ...) do not.

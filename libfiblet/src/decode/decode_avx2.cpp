@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <vector>
 
 #include "core/block_geometry.hpp"
@@ -27,7 +28,7 @@ namespace fiblet::detail::avx2 {
 #include "decode/decode_lanes.inl"
 #include "decode/decode_warp.inl"
 
-const KernelSet kKernels{decode_lanes, decode_warp};
+const KernelSet kKernels{decode_lanes, decode_warp, decode_lanes16};
 
 }  // namespace fiblet::detail::avx2
 

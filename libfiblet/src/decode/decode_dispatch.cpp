@@ -97,7 +97,9 @@ namespace {
 
 std::size_t decode_kernel(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count, float* xyz,
                           Decoder d) {
-    if (ctx.header.direction_bits() == 16) return decode_blocks_scalar16(ctx, blocks, count, xyz);
+    if (ctx.header.direction_bits() == 16)  // one SIMD decoder for 16-bit blocks: warp runs as lanes
+        return d.kind == DecoderKind::scalar ? decode_blocks_scalar16(ctx, blocks, count, xyz)
+                                             : kernels(d.simd).lanes16(ctx, blocks, count, xyz);
     switch (d.kind) {
         case DecoderKind::lanes: return kernels(d.simd).lanes(ctx, blocks, count, xyz);
         case DecoderKind::warp: return kernels(d.simd).warp(ctx, blocks, count, xyz);
@@ -137,22 +139,21 @@ void stream_copy(float* dst, const float* src, std::size_t n) {
 
 std::size_t detail::decode_resolved(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count,
                                     float* xyz, Decoder d) {
-    // 16-bit files (formats/fft16.md) have only the scalar decoder.
-    if (ctx.header.direction_bits() == 16) return decode_direct(ctx, blocks, count, xyz, d);
 #ifdef __SSE2__
     // Output far larger than the caches: written straight to memory, each
     // cache line is first read (write-allocate), doubling the traffic of a
     // memory-bound decoder. Decode batches into a buffer that stays in L2
     // and stream them out instead (bench: DecodeBlocksToMemory).
-    constexpr std::size_t kBatchBlocks = 256, kStreamBytes = 4u << 20;
+    constexpr std::size_t kBatchPoints = 256 * 60, kStreamBytes = 4u << 20;  // 180 kB of points a batch
     const std::size_t most = 12 * count * ctx.header.points_per_block;
     if (d.kind != DecoderKind::scalar && most >= kStreamBytes) {
+        const std::size_t batch_blocks = std::max<std::size_t>(1, kBatchPoints / ctx.header.points_per_block);
         thread_local std::vector<float> staging;
-        staging.resize(3 * kBatchBlocks * ctx.header.points_per_block);
+        staging.resize(3 * batch_blocks * ctx.header.points_per_block);
         const std::size_t bb = ctx.header.block_bytes();
         std::size_t points = 0;
-        for (std::size_t b = 0; b < count; b += kBatchBlocks) {
-            const std::size_t n = decode_direct(ctx, blocks + b * bb, std::min(kBatchBlocks, count - b), staging.data(), d);
+        for (std::size_t b = 0; b < count; b += batch_blocks) {
+            const std::size_t n = decode_direct(ctx, blocks + b * bb, std::min(batch_blocks, count - b), staging.data(), d);
             stream_copy(xyz + 3 * points, staging.data(), 3 * n);
             points += n;
         }

@@ -29,6 +29,16 @@ using BlockKernel = std::size_t (*)(const DecodeContext&, const std::uint8_t* bl
 struct KernelSet {
     BlockKernel lanes;
     BlockKernel warp;
+    BlockKernel lanes16;  // the lanes decoder for 16-bit blocks (formats/fft16.md)
+};
+
+// How V::lookup reads a block's direction code: a byte (version 2) or a
+// little-endian u16 (16-bit blocks, in memory as BlockView16 reads them).
+struct Code8 {
+    static unsigned at(const std::uint8_t* p) { return *p; }
+};
+struct Code16 {
+    static unsigned at(const std::uint8_t* p) { return unsigned(p[0]) | unsigned(p[1]) << 8; }
 };
 
 namespace portable {

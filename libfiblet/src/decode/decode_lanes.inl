@@ -29,17 +29,21 @@ inline Vec select(V::M m, const Vec& a, const Vec& b) {
     return {V::select(m, a.x, b.x), V::select(m, a.y, b.y), V::select(m, a.z, b.z)};
 }
 
-// block_start() for W blocks at once: the anchors from their unorm16 words
-// (`words[k][lane]`, as floats) and the first frame. Operation for operation
-// the scalar anchor_axis() (core/block_geometry.hpp) and frame_from_axis()
-// (codec/direction_code.cpp), so the frames are bit-identical (the lanes
-// equivalence test fails if they part).
-inline void block_starts(const float (&words)[6][V::W], Vec& a0, Vec& a1, V::F (&frame)[9]) {
-    const V::F unorm = V::set1(65535.0f);
+// block_start() for W blocks at once: the anchors from their unorm words
+// (`words[k][lane]`, as floats, exact) and the first frame. Operation for
+// operation the scalar anchor_axis() (core/block_geometry.hpp), or for
+// packed 16-bit blocks packed16_anchor_axis() (the words' difference), and
+// frame_from_axis() (codec/direction_code.cpp), so the frames are
+// bit-identical (the lanes equivalence tests fail if they part).
+inline void block_starts(const float (&words)[6][V::W], float unorm_max, bool axis_from_words, Vec& a0, Vec& a1,
+                         V::F (&frame)[9]) {
+    const V::F unorm = V::set1(unorm_max);
     a0 = {V::div(V::load(words[0]), unorm), V::div(V::load(words[1]), unorm), V::div(V::load(words[2]), unorm)};
     a1 = {V::div(V::load(words[3]), unorm), V::div(V::load(words[4]), unorm), V::div(V::load(words[5]), unorm)};
     const V::F zero = V::set1(0.0f), one = V::set1(1.0f);
-    const Vec d{V::sub(a1.x, a0.x), V::sub(a1.y, a0.y), V::sub(a1.z, a0.z)};
+    const Vec d = axis_from_words ? Vec{V::sub(V::load(words[3]), V::load(words[0])), V::sub(V::load(words[4]), V::load(words[1])),
+                                        V::sub(V::load(words[5]), V::load(words[2]))}
+                                  : Vec{V::sub(a1.x, a0.x), V::sub(a1.y, a0.y), V::sub(a1.z, a0.z)};
     const V::F n2 = dot(d, d);
     const Vec axis = select(V::less(zero, n2), scale(V::div(one, V::sqrt(n2)), d), Vec{one, zero, zero});
     const Vec helper{V::set1(kFrameHelper[0]), V::set1(kFrameHelper[1]), V::set1(kFrameHelper[2])};
@@ -52,14 +56,34 @@ inline void block_starts(const float (&words)[6][V::W], Vec& a0, Vec& a1, V::F (
     for (int c = 0; c < 9; ++c) frame[c] = f[c];
 }
 
+// The two block layouts: where the anchors, point count and codes are.
+struct Blocks8 {
+    using Code = Code8;
+    static constexpr int kCodesOffset = kBlockDirectionsOffset, kCodeBytes = 1;
+    static int points(const std::uint8_t* b) { return int(BlockView{b}.point_count()); }
+    static void anchor_words(const std::uint8_t* b, float* w) {
+        const auto q = BlockView{b}.anchor_words();
+        for (int k = 0; k < 6; ++k) w[k] = float(q[k]);
+    }
+};
+struct Blocks16 {
+    using Code = Code16;
+    static constexpr int kCodesOffset = kBlock16DirectionsOffset, kCodeBytes = 2;
+    static int points(const std::uint8_t* b) { return int(BlockView16{b}.point_count()); }
+    static void anchor_words(const std::uint8_t* b, float* w) {
+        for (int k = 0; k < 6; ++k) w[k] = float(BlockView16{b}.anchor_word(k));  // < 2^24: exact
+    }
+};
+
 }  // namespace lanes
 
-inline std::size_t decode_lanes(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count, float* xyz) {
+template <class Blocks>
+std::size_t decode_lanes_of(const DecodeContext& ctx, const float* rows_table, float unorm_max, bool axis_from_words,
+                            const std::uint8_t* blocks, std::size_t count, float* xyz) {
     using F = V::F;
     constexpr int W = V::W;
     const FftHeader& h = ctx.header;
     const int bb = int(h.block_bytes());
-    const float* rows_table = ctx.frame_rows.data();
     const F step = V::set1(h.step), half = V::set1(0.5f), scaling = V::set1(h.scaling);
     const F offset[3] = {V::set1(h.offset[0]), V::set1(h.offset[1]), V::set1(h.offset[2])};
 
@@ -82,12 +106,13 @@ inline std::size_t decode_lanes(const DecodeContext& ctx, const std::uint8_t* bl
             for (int l = m; l < W; ++l) std::memcpy(&padded[std::size_t(l) * bb], base + std::size_t(m - 1) * bb, bb);
             base = padded.data();
         }
-        int max_points = 0, min_floats = 3 * 64;
+        int max_points = 0, min_floats = std::numeric_limits<int>::max();
         for (int l = 0; l < W; ++l) {
-            const BlockView block{base + std::size_t(l) * std::size_t(bb)};
-            const auto q = block.anchor_words();
-            for (int k = 0; k < 6; ++k) words[k][l] = float(q[k]);
-            const int n = l < m ? int(block.point_count()) : 0;
+            const std::uint8_t* block = base + std::size_t(l) * std::size_t(bb);
+            float w[6];
+            Blocks::anchor_words(block, w);
+            for (int k = 0; k < 6; ++k) words[k][l] = w[k];
+            const int n = l < m ? Blocks::points(block) : 0;
             dst[l] = out;
             lane_floats[l] = 3 * n;
             out += 3 * n;
@@ -96,7 +121,7 @@ inline std::size_t decode_lanes(const DecodeContext& ctx, const std::uint8_t* bl
         }
         lanes::Vec a0, a1;
         F frame[9];  // component 3 col + row
-        lanes::block_starts(words, a0, a1, frame);
+        lanes::block_starts(words, unorm_max, axis_from_words, a0, a1, frame);
 
         // Rows 3(i % W) + c hold component c of point i. After point
         // `first + W - 1` (or the last point), rows q W .. q W + W - 1
@@ -129,10 +154,10 @@ inline std::size_t decode_lanes(const DecodeContext& ctx, const std::uint8_t* bl
         F p[3] = {a1.x, a1.y, a1.z};
         if (max_points >= 2) emit(1, p[0], p[1], p[2]);
 
-        const std::uint8_t* codes = base + kBlockDirectionsOffset;
+        const std::uint8_t* codes = base + Blocks::kCodesOffset;
         for (int k = 0; k + 2 < max_points; ++k) {
             F local[9];
-            V::lookup(rows_table, codes + k, bb, local);
+            V::template lookup<typename Blocks::Code>(rows_table, codes + Blocks::kCodeBytes * k, bb, local);
             // frame = frame * local, as compose(): column j = F * local.c[j],
             // summed left to right.
             F next[9];
@@ -146,4 +171,15 @@ inline std::size_t decode_lanes(const DecodeContext& ctx, const std::uint8_t* bl
         }
     }
     return std::size_t(out - xyz) / 3;
+}
+
+inline std::size_t decode_lanes(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count, float* xyz) {
+    return decode_lanes_of<lanes::Blocks8>(ctx, ctx.frame_rows.data(), 65535.0f, false, blocks, count, xyz);
+}
+
+// 16-bit blocks (formats/fft16.md): unorm24 anchors, u16 codes; version 17
+// (packed) takes its first axis from the anchors' integers.
+inline std::size_t decode_lanes16(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count, float* xyz) {
+    return decode_lanes_of<lanes::Blocks16>(ctx, ctx.frame_rows16->rows.data(), float(kUnorm24Max), ctx.header.packed(),
+                                            blocks, count, xyz);
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -18,6 +19,6 @@ namespace fiblet::detail::portable {
 #include "decode/decode_lanes.inl"
 #include "decode/decode_warp.inl"
 
-const KernelSet kKernels{decode_lanes, decode_warp};
+const KernelSet kKernels{decode_lanes, decode_warp, decode_lanes16};
 
 }  // namespace fiblet::detail::portable

@@ -11,14 +11,25 @@
 namespace fiblet {
 using namespace detail;
 
+namespace {
+
+// Component 3 col + row of `f` at row[3 col + row]; row[9..16) stay zero.
+void put_frame_row(const Frame& f, float* row) {
+    for (int col = 0; col < 3; ++col) {
+        row[3 * col + 0] = f.c[col].x;
+        row[3 * col + 1] = f.c[col].y;
+        row[3 * col + 2] = f.c[col].z;
+    }
+}
+
+}  // namespace
+
 DecodeContext::DecodeContext(const FftHeader& h) : header(h), table(h.ratio) {
-    for (int k = 0; k < 256; ++k) {
-        const Frame& f = table.frame(std::uint8_t(k));
-        for (int col = 0; col < 3; ++col) {
-            frame_rows[16 * k + 3 * col + 0] = f.c[col].x;
-            frame_rows[16 * k + 3 * col + 1] = f.c[col].y;
-            frame_rows[16 * k + 3 * col + 2] = f.c[col].z;
-        }
+    for (int k = 0; k < 256; ++k) put_frame_row(table.frame(std::uint8_t(k)), &frame_rows[16 * k]);
+    if (table16) {
+        auto rows = std::unique_ptr<FrameRows16>(new FrameRows16{});  // over-aligned: not make_shared
+        for (unsigned k = 0; k < 65536; ++k) put_frame_row(table16->frame(std::uint16_t(k)), &rows->rows[16 * k]);
+        frame_rows16 = std::move(rows);
     }
 }
 
