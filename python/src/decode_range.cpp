@@ -29,19 +29,8 @@ PageMode output_page_mode() {
 DecodedRange decode_range(const FftFile& file, std::uint64_t begin, std::uint64_t end, unsigned threads) {
     if (begin > end || end > file.header().fibers)
         throw Error(Errc::invalid_argument, file.path() + ": fiber range past the end");
-    // The fast path reads fixed-size 8-bit blocks; 16-bit files (formats/fft16.md)
-    // take the library's path.
-    if (file.header().direction_bits() != 8) {
-        DecodeOptions o;
-        o.threads = threads;
-        const Streamlines s = decode_fibers(file, begin, end, o);
-        DecodedRange out;
-        out.points = s.point_count();
-        out.xyz = PopulatedBuffer(out.points * 3 * sizeof(float), output_page_mode());
-        if (out.points) std::memcpy(out.xyz.as<float>(), s.xyz.data(), out.points * 3 * sizeof(float));
-        out.offsets.assign(s.offsets.begin(), s.offsets.end());
-        return out;
-    }
+    // Blocks in their in-memory layout (read_blocks expands version 17's
+    // packed ones), 8- or 16-bit alike.
     const DecodeContext ctx(file);
     const std::uint32_t bb = ctx.header.block_bytes();
     const std::uint64_t b0 = file.block_end(begin), nblocks = file.block_end(end) - b0;
@@ -75,7 +64,7 @@ DecodedRange decode_range(const FftFile& file, std::uint64_t begin, std::uint64_
     out.offsets.reserve(end - begin + 1);
     std::uint64_t b = 0, acc = 0;
     for (std::uint64_t f = begin; f < end; ++f) {
-        for (std::uint32_t k = 0; k < file.block_count(f); ++k, ++b) acc += BlockView{data + b * bb}.point_count();
+        for (std::uint32_t k = 0; k < file.block_count(f); ++k, ++b) acc += block_flags(ctx.header, data + b * bb).point_count;
         out.offsets.push_back(acc);
     }
     return out;

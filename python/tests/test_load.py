@@ -1,5 +1,7 @@
 """fiblet.load and its nibabel helpers, against nibabel's own reading of the
 source .tck files."""
+import subprocess
+
 import numpy as np
 import pytest
 
@@ -180,6 +182,21 @@ def test_threads_and_decode_paths_give_the_same_points(compressed):
     listed = fiblet.load(fft, fibers=np.arange(len(one)))
     np.testing.assert_array_equal(one.points, listed.points)
     np.testing.assert_array_equal(one.offsets, listed.offsets)
+
+
+def test_sixteen_bit_files_load_the_reference_decoders_points(tmp_path, shared, cli):
+    # A 16-bit file (version 17, packed blocks) goes through the same range
+    # decoder as an 8-bit one: its points are the scalar reference decoder's,
+    # as the CLI writes them, for one thread and several.
+    fft, ref = tmp_path / "wide.fft", tmp_path / "ref.tck"
+    subprocess.run([cli, "compress", "-q", "--bits", "16", str(shared / "small-sdstream.tck"), "-o", str(fft)], check=True)
+    subprocess.run([cli, "decompress", "-q", "--decoder", "scalar", str(fft), "-o", str(ref)], check=True)
+    assert fiblet.info(fft)["block_bytes"] > 76
+    reference = nib.streamlines.load(str(ref)).streamlines
+    for threads in (1, 2):
+        s = fiblet.load(fft, threads=threads)
+        np.testing.assert_array_equal(s.points, reference.get_data())
+        np.testing.assert_array_equal(s.offsets[1:] - s.offsets[:-1], reference._lengths)
 
 
 def test_damaged_trailer_is_an_integrity_error_unless_ignored(tmp_path, compressed):
