@@ -483,6 +483,23 @@ TEST(CliHabits, CompressWritesTheContainerItsOutputNames) {
     EXPECT_EQ(run_in(fx.dir, "compress -q -z in.tck -o /dev/null").status, 0);
 }
 
+// decompress too: a .fft/.fftz name or an unknown extension would have got
+// a .tck's bytes; refused before anything is written (exit 2), .fft
+// pointing at extract, which writes .fft files.
+TEST(CliHabits, DecompressWritesOnlyWhatItsOutputNames) {
+    Fixture fx;
+    for (const std::string& name : {std::string("out.fft"), std::string("out.fftz"), std::string("out.xyz"), std::string("out")}) {
+        const auto bad = run_in(fx.dir, "decompress -q in.fft -o " + name);
+        EXPECT_EQ(bad.status, 2) << name << ": " << bad.output;
+        EXPECT_TRUE(mentions(bad, ".tck, .trk or .trx")) << bad.output;
+        EXPECT_EQ(mentions(bad, "fiblet extract"), name.find(".fft") != std::string::npos) << bad.output;
+        EXPECT_FALSE(fs::exists(fx.dir.file(name))) << name;
+    }
+    ASSERT_EQ(run_in(fx.dir, "extract -q in.fft -o copy.fft").status, 0);
+    EXPECT_EQ(detect_tractogram_format(fx.dir.file("copy.fft")), TractogramFormat::fft);
+    EXPECT_EQ(run_in(fx.dir, "decompress -q in.fft -o /dev/null").status, 0);
+}
+
 // The man page's and docs/cli.md's examples use only options their
 // subcommand has (each --option and -x in it appears in that help).
 TEST(CliHabits, ExamplesUseOnlyRealOptions) {

@@ -2,6 +2,7 @@
 #include <fmt/core.h>
 
 #include <chrono>
+#include <filesystem>
 #include <optional>
 
 #include "cli_common.hpp"
@@ -124,10 +125,27 @@ std::string decompress_one(const DecompressArgs& a, const std::string& input, co
     }
 }
 
+// An output writes what it names (out.fft would otherwise get a .tck's
+// bytes): a .fft/.fftz or a file of unknown extension is refused before any work;
+// other tractogram formats are the sink's to refuse.
+void check_output_name(const std::string& output) {
+    if (output.empty() || output == "-") return;
+    const TractogramFormat f = format_from_extension(output);
+    if (f == TractogramFormat::fft || f == TractogramFormat::fftz)
+        throw Error(Errc::invalid_argument, output + ": decompress writes .tck, .trk or .trx files; fiblet extract IN -o " +
+                                           "OUT.fft writes a .fft (of a .fft or .fftz)");
+    std::error_code ec;
+    const bool device = std::filesystem::exists(output, ec) && !std::filesystem::is_regular_file(output, ec);
+    if (f == TractogramFormat::unknown && !device)  // /dev/null and pipes take the .tck stream as before
+        throw Error(Errc::invalid_argument,
+                    output + ": decompress writes .tck, .trk or .trx files, named by their extension");
+}
+
 // Every input is tried; with several, a failed one is reported and the
 // first failure's code is the exit status (as compress does).
 void run(const DecompressArgs& args) {
     DecompressArgs a = args;
+    check_output_name(a.output);
     if (!a.reference.empty()) a.reference_space = space_of_image(a.reference);
     const auto jobs = plan_file_jobs(a.inputs, {{".fft", ".fftz"}, {}, "", ".tck", a.output, a.output_dir, a.recursive});
     std::vector<std::string> json;
