@@ -124,9 +124,10 @@ TEST(OutputTarget, TheCliRefusesInputAsOutputWithForce) {
     const std::string tck = test::read_file(dir.file("in.tck")), fft = test::read_file(dir.file("in.fft"));
     fs::create_symlink("in.fft", dir.file("link.fft"));
     fs::create_symlink("in.tck", dir.file("tck-link.fft"));  // a .fft name (compress refuses others) on the input
+    fs::create_symlink("in.fft", dir.file("fft-link.tck"));  // and a .tck name (decompress refuses others)
     for (const std::string& args :
-         {"decompress -q -f " + dir.file("in.fft") + " -o " + dir.file("link.fft"),
-          "decompress -q -f " + dir.file("link.fft") + " -o " + dir.file("in.fft"),
+         {"decompress -q -f " + dir.file("in.fft") + " -o " + dir.file("fft-link.tck"),
+          "decompress -q -f " + dir.file("link.fft") + " -o " + dir.file("fft-link.tck"),
           "extract -q -f " + dir.file("in.fft") + " -o " + dir.file("link.fft"),
           "compress -q -f " + dir.file("in.tck") + " -o " + dir.file("tck-link.fft")}) {
         const auto r = test::run_cli(args);

@@ -145,9 +145,9 @@ void check_output_name(const std::string& output) {
 // first failure's code is the exit status (as compress does).
 void run(const DecompressArgs& args) {
     DecompressArgs a = args;
-    check_output_name(a.output);
     if (!a.reference.empty()) a.reference_space = space_of_image(a.reference);
     const auto jobs = plan_file_jobs(a.inputs, {{".fft", ".fftz"}, {}, "", ".tck", a.output, a.output_dir, a.recursive});
+    check_output_name(a.output);  // after the plan, which names an output that is an input
     std::vector<std::string> json;
     std::optional<Error> first_failure;
     for (const auto& [in, out] : jobs) {
