@@ -2,7 +2,8 @@
 // decoded sequentially. Every lane performs the reference decoder's float
 // operations in the reference's order (separate multiplies and adds, never
 // fused: the library is built with -ffp-contract=off), so the points are
-// bit-identical to decode_blocks_scalar's.
+// bit-identical to decode_blocks_scalar's (decode_blocks_scalar16's for
+// 16-bit blocks: one kernel, templated on the block layout).
 //
 // Per step the W lanes look their local frame up (V::lookup: W row loads
 // and a transpose), compose it into their frame, advance and convert to
