@@ -6,6 +6,7 @@
 
 #include "fiblet/block_index.hpp"
 #include "fiblet/error.hpp"
+#include "select/box_stream.hpp"
 #include "select/index_chunk.hpp"
 
 namespace fiblet {
@@ -24,13 +25,37 @@ Aabb bounds_of(const float* xyz, std::uint32_t n) {
 
 }  // namespace
 
-IndexBuilder::IndexBuilder(const FftHeader& header, unsigned bits_per_box, std::uint32_t group_blocks)
-    : header_(header), bits_(bits_per_box), group_blocks_(group_blocks) {
-    if (bits_per_box < 8 || bits_per_box > 32) throw Error(Errc::invalid_argument, "index bits per box must be in [8, 32]");
-    if (group_blocks == 0) throw Error(Errc::invalid_argument, "index groups must hold at least one block");
-    const auto g = detail::IndexGrid::for_header(header, bits_per_box, group_blocks);
-    grid_ = {g.origin, g.cell, g.min_levels, g.extent_levels};
+struct IndexBuilder::Coder {
+    explicit Coder(const FftHeader& h) : grid(detail::IndexGrid::for_blocks(h)), stream(grid.min_levels) {}
+    // Codes the pending boxes after those coded already.
+    void code_pending() {
+        for (const Pending& p : pending) stream.add(p.box, p.first_of_fiber);
+        pending.clear();
+    }
+    struct Pending {
+        std::optional<detail::GridBox> box;
+        bool first_of_fiber;
+    };
+    detail::IndexGrid grid;
+    std::vector<Pending> pending;
+    detail::BoxStreamEncoder stream;
+    bool coded = false;  // the stream holds boxes
+};
+
+IndexBuilder::IndexBuilder() = default;
+IndexBuilder::IndexBuilder(const FftHeader& header) : header_(header), coder_(std::make_unique<Coder>(header)) {}
+IndexBuilder::IndexBuilder(const IndexBuilder& o)
+    : header_(o.header_), coder_(o.coder_ ? std::make_unique<Coder>(*o.coder_) : nullptr), blocks_(o.blocks_),
+      last_points_(o.last_points_), open_fiber_blocks_(o.open_fiber_blocks_), layout_ok_(o.layout_ok_),
+      unbounded_(o.unbounded_), max_sphere_radius_(o.max_sphere_radius_), max_join_(o.max_join_),
+      last_point_(o.last_point_) {}
+IndexBuilder& IndexBuilder::operator=(const IndexBuilder& o) {
+    if (this != &o) *this = IndexBuilder(o);
+    return *this;
 }
+IndexBuilder::IndexBuilder(IndexBuilder&&) noexcept = default;
+IndexBuilder& IndexBuilder::operator=(IndexBuilder&&) noexcept = default;
+IndexBuilder::~IndexBuilder() = default;
 
 void IndexBuilder::add_fiber(std::span<const Vec3f> decoded) {
     static_assert(sizeof(Vec3f) == 3 * sizeof(float));
@@ -54,41 +79,26 @@ void IndexBuilder::add_block(const float* xyz, std::uint32_t n, bool last_of_fib
     }
     last_point_ = {xyz[3 * (n - 1)], xyz[3 * (n - 1) + 1], xyz[3 * (n - 1) + 2]};
     const Vec3f p1 = n >= 2 ? Vec3f{xyz[3], xyz[4], xyz[5]} : p0;
-    add_box(bounds_of(xyz, n), n, last_of_fiber, block_bounding_sphere(header_, p0, p1, n).radius);
-}
-
-void IndexBuilder::add_box(const Aabb& box, std::uint32_t n, bool last_of_fiber, float sphere_radius) {
-    if (group_fill_ == 0) {
-        group_box_ = box;
-    } else {
-        const Aabb& b = box;
-        Aabb& g = group_box_;
-        g.min = {std::min(g.min.x, b.min.x), std::min(g.min.y, b.min.y), std::min(g.min.z, b.min.z)};
-        g.max = {std::max(g.max.x, b.max.x), std::max(g.max.y, b.max.y), std::max(g.max.z, b.max.z)};
-    }
-    ++group_fill_, ++blocks_;
-    max_sphere_radius_ = std::max(max_sphere_radius_, sphere_radius);
-    ++open_fiber_blocks_;
+    max_sphere_radius_ = std::max(max_sphere_radius_, block_bounding_sphere(header_, p0, p1, n).radius);
+    const auto box = coder_->grid.quantize(bounds_of(xyz, n));
+    unbounded_ += !box;
+    coder_->pending.push_back({box, open_fiber_blocks_ == 0});
+    ++blocks_, ++open_fiber_blocks_;
     if (last_of_fiber) {
         last_points_.push_back(std::uint16_t(n));
         open_fiber_blocks_ = 0;
     } else if (n != header_.points_per_block) {
         layout_ok_ = false;  // only a fiber's last block may be partial
     }
-    if (last_of_fiber || group_fill_ == group_blocks_) close_group();
-}
-
-void IndexBuilder::close_group() {
-    const detail::IndexGrid g{grid_.origin, grid_.cell, grid_.min_levels, grid_.extent_levels, bits_};
-    const std::uint32_t code = g.encode(group_box_);
-    unbounded_ += code == g.unbounded_code();
-    codes_.push_back(code);
-    group_fill_ = 0;
 }
 
 void IndexBuilder::append(const IndexBuilder& later) {
-    layout_ok_ = layout_ok_ && open_fiber_blocks_ == 0;  // groups never span two fibers
-    codes_.insert(codes_.end(), later.codes_.begin(), later.codes_.end());
+    if (later.coder_->coded) throw Error(Errc::invalid_argument, "IndexBuilder::append: the later part has coded boxes");
+    layout_ok_ = layout_ok_ && open_fiber_blocks_ == 0;  // blocks of a fiber are added to one builder
+    coder_->code_pending();
+    coder_->pending = later.coder_->pending;
+    coder_->code_pending();
+    coder_->coded = coder_->coded || !later.coder_->pending.empty();
     blocks_ += later.blocks_;
     last_points_.insert(last_points_.end(), later.last_points_.begin(), later.last_points_.end());
     layout_ok_ = layout_ok_ && later.layout_ok_ && later.open_fiber_blocks_ == 0;
@@ -99,9 +109,9 @@ void IndexBuilder::append(const IndexBuilder& later) {
 }
 
 void IndexBuilder::clear() {
-    codes_.clear();
+    coder_ = std::make_unique<Coder>(header_);
     last_points_.clear();
-    group_fill_ = 0, blocks_ = 0;
+    blocks_ = 0;
     open_fiber_blocks_ = 0;
     layout_ok_ = true;
     unbounded_ = 0;
@@ -111,18 +121,17 @@ void IndexBuilder::clear() {
 
 std::optional<TrailerChunk> IndexBuilder::finish() const {
     if (!layout_ok_ || open_fiber_blocks_ != 0) return std::nullopt;
+    Coder all = *coder_;
+    all.code_pending();
     detail::IndexChunk c;
-    c.grid = {grid_.origin, grid_.cell, grid_.min_levels, grid_.extent_levels, bits_};
-    c.group_blocks = group_blocks_;
+    c.grid = all.grid;
     c.fibers = last_points_.size();
     c.blocks = blocks_;
-    c.groups = codes_.size();
     c.max_sphere_radius = max_sphere_radius_;
     // Rounded up, with room for the float rounding of the readers' tests.
     c.max_join = std::nextafter(float(max_join_ * (1 + 1e-6)), std::numeric_limits<float>::infinity());
     c.last_block_points = last_points_;
-    c.codes = codes_;
-    return TrailerChunk{kBlockIndexTag, detail::serialize_index_chunk(c, header_)};
+    return TrailerChunk{kBlockIndexTag, detail::serialize_index_chunk(c, header_, all.stream.finish())};
 }
 
 }  // namespace fiblet
