@@ -184,7 +184,7 @@ void run(const ExtractArgs& a) {
         j.str("input", a.input).str("output", a.output).str("index", source);
         j.integer("fibers", stats.fibers).integer("streamlines", stats.runs).integer("blocks", stats.blocks);
         j.integer("coarse_blocks", stats.coarse_blocks).integer("points", stats.points);
-        j.integer("source_blocks", h.blocks).integer("blocks_read", stats.blocks_read);
+        j.integer("source_blocks", h.blocks).integer("blocks_tested", stats.blocks_tested).integer("blocks_read", stats.blocks_read);
         j.integer("blocks_decoded", stats.blocks_decoded).integer("output_bytes", bytes);
         j.num("index_seconds", secs(t_open, t_index)).num("select_seconds", secs(t_index, t1));
         j.num("seconds", secs(t0, t1));

@@ -350,8 +350,9 @@ public:
           // block lies wholly inside a region only when the checksums tie it
           // to the blocks read (a damaged block read unverified may be elsewhere).
           trust_inside_(index.source() == BlockIndex::Source::decoded || file.verifies_checksums()),
-          // Boxes of groups of blocks: narrowed down to single blocks from their headers.
-          coarse_index_(index.groups() < index.blocks()) {
+          // Stored boxes (of groups of blocks, or of blocks on a grid of half a
+          // block's path) are narrowed down from each block's header.
+          coarse_index_(index.max_join() >= 0) {
         if (index.blocks() != h_.blocks || index.fibers() != h_.fibers)
             throw Error(Errc::invalid_argument, file.path() + ": the block index belongs to another file");
         detail::check_query(q);
@@ -447,16 +448,17 @@ private:
         const std::uint32_t bb = h_.block_bytes();
         std::vector<std::size_t> tested, first_point;
         while (candidates.next(batch_blocks(h_), blocks, fibers)) {
+            stats_.blocks_tested += blocks.size();
             reader_.read(blocks);
             if (coarse_index_) spheres_of_read(blocks.size());
             // Decoded: the blocks whose bound from headers (block_bound)
             // meets a region they are tested against; the index's boxes
-            // bound groups of blocks, block_bound each block.
+            // are coarser (quantized, or of groups of blocks).
             tested.clear();
             for (std::size_t i = 0; i < blocks.size(); ++i) {
                 const std::uint64_t f = fibers[i], b = blocks[i];
                 if (excluded[f]) continue;
-                if (!coarse_index_) {  // the index's boxes bound single blocks already
+                if (!coarse_index_) {  // exact boxes (computed) or no join bound (version 1)
                     tested.push_back(i);
                     continue;
                 }
@@ -508,6 +510,7 @@ private:
         std::vector<std::size_t> all;
         const std::uint32_t bb = h_.block_bytes();
         while (candidates.next(batch_blocks(h_), blocks, fibers)) {
+            stats_.blocks_tested += blocks.size();
             reader_.read(blocks);
             all.resize(blocks.size());
             for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
@@ -594,14 +597,17 @@ private:
             if (include_test(i) && !any_point_in(q_.include, p, n)) return false;
             return !(exclude_test(i) && any_point_in(q_.exclude, p, n));
         };
+        const bool include_tests = coarse_index_ && blocks_mode && !q_.include.empty();
         while (candidates.next(batch_blocks(h_), blocks, fibers)) {
-            // With a level of detail, the next block's first point may end a segment.
+            stats_.blocks_tested += blocks.size();
+            // With a level of detail, the next block's first point may end a
+            // segment; with include tests, it narrows the block's bound.
             need.clear(), at_need.assign(blocks.size(), 0), next_at_need.assign(blocks.size(), SIZE_MAX);
             for (std::size_t i = 0; i < blocks.size(); ++i) {
                 if (need.empty() || need.back() != blocks[i]) need.push_back(blocks[i]);
                 at_need[i] = need.size() - 1;
                 const std::uint64_t next = std::uint64_t(blocks[i]) + 1;
-                if (lod && next < file_.block_end(fibers[i] + 1)) {
+                if ((lod || include_tests) && next < file_.block_end(fibers[i] + 1)) {
                     need.push_back(std::uint32_t(next));  // the next candidate, if it is that block, reuses it
                     next_at_need[i] = need.size() - 1;
                 }
@@ -610,9 +616,8 @@ private:
 
             // Header tests: the block's sphere against the frustum, the level
             // of detail and, where its points would be tested, the include
-            // regions (the index bounds groups of blocks, the sphere each block).
+            // regions (the index's boxes are coarser than the block's bound).
             kind.assign(blocks.size(), fine);
-            const bool include_tests = coarse_index_ && blocks_mode && !q_.include.empty();
             // Every header tested below, in one call (a call per block cost more than its arithmetic).
             if (q_.view || include_tests) spheres_of_read(need.size());
             if (q_.view || include_tests)
