@@ -148,7 +148,8 @@ private:
     std::vector<std::uint32_t> order_;           // Morton position -> group
     std::vector<std::uint32_t> rank_;            // group -> Morton position
     std::vector<std::vector<Aabb>> levels_;      // levels_[k][j]: node j of level k (k = 0: leaves)
-    std::vector<Aabb> block_boxes_;              // per block in file order (version 3), else empty
+    std::vector<Aabb> block_boxes_;              // version 3: per block, leaf after leaf in Morton order
+    std::vector<std::uint32_t> leaf_first_box_;  // Morton position -> its first block box; one more: blocks_
 };
 
 }  // namespace fiblet

@@ -97,12 +97,20 @@ BlockIndex BlockIndex::load(const FftFile& file) {
     if (total != h.points)
         bad("its fibers hold " + std::to_string(total) + " points, the header says " + std::to_string(h.points));
     if (per_block) {
-        index.block_boxes_ = detail::index_block_boxes(c, chunk->payload, file);
+        const std::vector<Aabb> boxes = detail::index_block_boxes(c, chunk->payload, file);
         std::vector<Aabb> leaves(index.group_first_.size() - 1, empty_box());
-        for (std::size_t g = 0; g + 1 < index.group_first_.size(); ++g)
-            for (std::uint32_t b = index.group_first_[g]; b < index.group_first_[g + 1]; ++b)
-                grow(leaves[g], index.block_boxes_[b]);
+        for (std::size_t g = 0; g < leaves.size(); ++g)
+            for (std::uint32_t b = index.group_first_[g]; b < index.group_first_[g + 1]; ++b) grow(leaves[g], boxes[b]);
         index.set_groups(leaves);
+        // Block boxes in the leaves' Morton order, as a query walks them.
+        index.block_boxes_.reserve(boxes.size());
+        index.leaf_first_box_.reserve(leaves.size() + 1);
+        for (const std::uint32_t g : index.order_) {
+            index.leaf_first_box_.push_back(std::uint32_t(index.block_boxes_.size()));
+            index.block_boxes_.insert(index.block_boxes_.end(), boxes.begin() + index.group_first_[g],
+                                      boxes.begin() + index.group_first_[g + 1]);
+        }
+        index.leaf_first_box_.push_back(std::uint32_t(index.block_boxes_.size()));
         return index;
     }
     // Morton keys straight from the codes' cells, then boxes decoded in that order.
@@ -124,9 +132,9 @@ BlockIndex BlockIndex::load(const FftFile& file) {
 }
 
 Aabb BlockIndex::block_box(std::uint64_t block) const {
-    if (!block_boxes_.empty()) return block_boxes_[block];
     const auto g = std::size_t(std::upper_bound(group_first_.begin(), group_first_.end() - 1, std::uint32_t(block)) -
                                group_first_.begin()) - 1;
+    if (!block_boxes_.empty()) return block_boxes_[leaf_first_box_[rank_[g]] + (block - group_first_[g])];
     return sorted_boxes_[rank_[g]];
 }
 
@@ -245,8 +253,9 @@ void BlockIndex::collect(const Classify& classify, std::vector<std::uint64_t>& b
     // Those of its blocks whose own box meets the region.
     auto mark_blocks = [&](std::size_t pos) {
         const std::uint32_t g = order_[pos];
-        for (std::uint32_t b = group_first_[g]; b < group_first_[g + 1]; ++b) {
-            const Overlap o = classify(block_boxes_[b]);
+        const Aabb* box = &block_boxes_[leaf_first_box_[pos]];
+        for (std::uint32_t b = group_first_[g]; b < group_first_[g + 1]; ++b, ++box) {
+            const Overlap o = classify(*box);
             if (o != Overlap::outside) set_bit(bits, b);
             if (o == Overlap::inside && inside) set_bit(*inside, b);
         }
