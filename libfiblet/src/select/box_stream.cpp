@@ -27,8 +27,8 @@ std::uint32_t sign_of(std::int64_t d) { return d < 0 ? 0 : (d == 0 ? 1 : 2); }
 BoxModel::BoxModel(std::uint32_t levels)
     : bounded_(kHalf), levels_(levels), level_bits_(unsigned(std::bit_width(levels > 1 ? levels - 1 : 1u))) {
     for (Axis& a : axes_) {
-        for (auto& t : a.extent_tree) t.fill(kHalf);
-        for (auto& t : a.delta_tree) t.fill(kHalf);
+        for (auto& t : a.extent_steps) t.fill(kHalf);
+        for (auto& t : a.delta_steps) t.fill(kHalf);
     }
 }
 
@@ -54,11 +54,10 @@ void BoxStreamEncoder::bit(std::uint16_t& p, unsigned b) {
     while (range_ < kTop) range_ <<= 8, shift_low();
 }
 
-void BoxStreamEncoder::tree(std::uint16_t* p, unsigned bits, std::uint32_t v) {
-    for (std::uint32_t m = 1, i = bits; i-- > 0;) {
-        const unsigned b = (v >> i) & 1;
-        bit(p[m], b);
-        m = 2 * m + b;
+void BoxStreamEncoder::unary(std::uint16_t* p, std::uint32_t max, std::uint32_t v) {
+    for (std::uint32_t i = 0; i < max; ++i) {
+        bit(p[i], v > i);
+        if (v == i) return;
     }
 }
 
@@ -78,10 +77,10 @@ void BoxStreamEncoder::add(const std::optional<GridBox>& box, bool first_of_fibe
     for (int k = 0; k < 3; ++k) {
         Axis& a = axes_[k];
         const std::uint32_t e = box->extent[k];
-        tree(a.extent_context(), kBoxExtentBits, e);
+        unary(a.extent_context(), kMaxBoxExtent, e);
         const std::int64_t d = std::int64_t(box->lo[k]) - std::int64_t(a.lo);
         const std::uint32_t z = first_of_fiber ? kEscape : std::min(zigzag(d), kEscape);
-        if (!first_of_fiber) tree(a.delta_context(e), kDeltaBits, z);
+        if (!first_of_fiber) unary(a.delta_context(e), kEscape, z);
         if (z == kEscape) direct(level_bits_, box->lo[k]);
         a.sign = z == kEscape ? 3 : sign_of(d);
         a.lo = box->lo[k], a.extent = e;
@@ -112,8 +111,8 @@ public:
         GridBox b;
         for (int k = 0; k < 3; ++k) {
             Axis& a = axes_[k];
-            const std::uint32_t e = tree(a.extent_context(), kBoxExtentBits);
-            const std::uint32_t z = first_of_fiber ? kEscape : tree(a.delta_context(e), kDeltaBits);
+            const std::uint32_t e = unary(a.extent_context(), kMaxBoxExtent);
+            const std::uint32_t z = first_of_fiber ? kEscape : unary(a.delta_context(e), kEscape);
             const std::int64_t lo = z == kEscape ? std::int64_t(direct(level_bits_)) : std::int64_t(a.lo) + unzigzag(z);
             if (lo < 0 || lo >= std::int64_t(levels_)) {
                 error = "a box lies off the grid";
@@ -143,10 +142,10 @@ private:
         normalize();
         return b;
     }
-    std::uint32_t tree(std::uint16_t* p, unsigned bits) {
-        std::uint32_t m = 1;
-        for (unsigned i = 0; i < bits; ++i) m = 2 * m + bit(p[m]);
-        return m - (1u << bits);
+    std::uint32_t unary(std::uint16_t* p, std::uint32_t max) {
+        std::uint32_t v = 0;
+        while (v < max && bit(p[v])) ++v;
+        return v;
     }
     std::uint32_t direct(unsigned bits) {
         std::uint32_t v = 0;

@@ -19,8 +19,7 @@ struct GridBox {
     bool operator==(const GridBox&) const = default;
 };
 
-inline constexpr unsigned kBoxExtentBits = 4;  // extents 0..15 cells
-inline constexpr std::uint32_t kMaxBoxExtent = (1u << kBoxExtentBits) - 1;
+inline constexpr std::uint32_t kMaxBoxExtent = 15;  // extents 0..15 cells
 // lo < levels <= 1024: a cell stays above 1/1024 of the range, so that the
 // 0.001-cell slack of quantized boxes exceeds the float rounding of
 // coordinates (2^-24 of their magnitude).
@@ -35,18 +34,20 @@ public:
     unsigned level_bits() const { return level_bits_; }
 
 protected:
-    static constexpr unsigned kDeltaBits = 5;  // zigzag deltas 0..30; 31: lo follows in level_bits bits
-    static constexpr std::uint32_t kEscape = (1u << kDeltaBits) - 1;
+    // Values are coded in unary (a bit "more" per step, with its own
+    // probability): the common small values take few of the coder's serial
+    // steps, which bound the load time.
+    static constexpr std::uint32_t kEscape = 31;  // zigzag deltas 0..30; 31: lo follows in level_bits bits
     static constexpr std::uint32_t kContextExtents = 8;  // extents above 7 share a context
     struct Axis {
         std::uint32_t lo = 0, extent = 0;
         std::uint32_t sign = 3;  // of the last delta: 0 negative, 1 zero, 2 positive, 3 coded whole
         // Contexts: the last delta's sign and extent (and, for deltas, the box's extent).
-        std::array<std::array<std::uint16_t, 1u << kBoxExtentBits>, 4 * kContextExtents> extent_tree;
-        std::array<std::array<std::uint16_t, 1u << kDeltaBits>, 4 * kContextExtents * kContextExtents> delta_tree;
-        std::uint16_t* extent_context() { return extent_tree[sign * kContextExtents + capped(extent)].data(); }
+        std::array<std::array<std::uint16_t, kMaxBoxExtent>, 4 * kContextExtents> extent_steps;
+        std::array<std::array<std::uint16_t, kEscape>, 4 * kContextExtents * kContextExtents> delta_steps;
+        std::uint16_t* extent_context() { return extent_steps[sign * kContextExtents + capped(extent)].data(); }
         std::uint16_t* delta_context(std::uint32_t e) {
-            return delta_tree[(sign * kContextExtents + capped(extent)) * kContextExtents + capped(e)].data();
+            return delta_steps[(sign * kContextExtents + capped(extent)) * kContextExtents + capped(e)].data();
         }
         static std::uint32_t capped(std::uint32_t e) { return e < kContextExtents ? e : kContextExtents - 1; }
     };
@@ -66,7 +67,7 @@ public:
 
 private:
     void bit(std::uint16_t& p, unsigned b);
-    void tree(std::uint16_t* p, unsigned bits, std::uint32_t v);
+    void unary(std::uint16_t* p, std::uint32_t max, std::uint32_t v);
     void direct(unsigned bits, std::uint32_t v);
     void shift_low();
     std::uint64_t low_ = 0;
