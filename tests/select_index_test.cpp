@@ -29,9 +29,12 @@ protected:
     void SetUp() override {
         if (!shared_data_available()) GTEST_SKIP() << "shared test data not found";
     }
-    static std::string compressed(const std::string& tck, const std::string& name, CompressOptions o = {}) {
+    static std::string work_file(const std::string& name) {
         if (!dir_) dir_ = std::make_unique<TempDir>();
-        const std::string out = dir_->file(name);
+        return dir_->file(name);
+    }
+    static std::string compressed(const std::string& tck, const std::string& name, CompressOptions o = {}) {
+        const std::string out = work_file(name);
         if (!std::filesystem::exists(out)) {
             o.threads = 2;
             // The 8-bit layout unless a test asks for 16 (the default gives small-sdstream 16 bits).
@@ -310,7 +313,7 @@ TEST_F(SelectIndex, MalformedChunksAreRejected) {
     const FftFile good(fiblet_file());
     const std::vector<std::uint8_t> payload = good.find_chunk(kBlockIndexTag)->payload;
     auto bad = [&](const std::vector<std::uint8_t>& p, const std::string& name) {
-        return rejected(good, p, dir_->file(name));
+        return rejected(good, p, work_file(name));
     };
     EXPECT_FALSE(bad(payload, "same.fft"));
     auto p = payload;
@@ -361,7 +364,7 @@ TEST_F(SelectIndex, MalformedChunksAreRejected) {
     EXPECT_TRUE(bad(p, "offgrid.fft"));
     // Through the CLI: exit 4, the chunk named.
     const CommandResult r =
-        run_cli("extract " + dir_->file("offgrid.fft") + " -o " + dir_->file("offgrid.tck") + " --include 0,0,0,5");
+        run_cli("extract " + work_file("offgrid.fft") + " -o " + work_file("offgrid.tck") + " --include 0,0,0,5");
     EXPECT_EQ(r.status, 4) << r.output;
     EXPECT_NE(r.output.find("BIDX"), std::string::npos) << r.output;
 }
@@ -376,7 +379,7 @@ TEST_F(SelectIndex, DamagedBoxStreamsAreRefusedOrStillHoldOnlyBoxes) {
     for (int i = 0; i < 16; ++i) {
         auto p = payload;
         p[stream + 5 + (p.size() - stream - 5) * std::size_t(i) / 16] ^= std::uint8_t(0x5a);
-        refused += rejected(good, p, dir_->file("flip" + std::to_string(i) + ".fft"));
+        refused += rejected(good, p, work_file("flip" + std::to_string(i) + ".fft"));
     }
     EXPECT_GT(refused, 8u);
 }
@@ -385,7 +388,7 @@ TEST_F(SelectIndex, MalformedVersionTwoChunksAreRejected) {
     const FftFile good(v2_file());
     const std::vector<std::uint8_t> payload = good.find_chunk(kBlockIndexTag)->payload;
     auto bad = [&](const std::vector<std::uint8_t>& p, const std::string& name) {
-        return rejected(good, p, dir_->file("v2-" + name));
+        return rejected(good, p, work_file("v2-" + name));
     };
     EXPECT_FALSE(bad(payload, "same.fft"));
     auto p = payload;
@@ -445,7 +448,7 @@ TEST_F(SelectIndex, VersionOneChunksOfOneBoxPerBlockAreStillRead) {
     v1.insert(v1.end(), 4, 0);  // reserved
     v1.insert(v1.end(), v2.begin() + 72, v2.begin() + 72 + std::ptrdiff_t(counts));
     pack_codes(block_codes, 28, v1);
-    const FftFile old(with_index_payload(file, v1, dir_->file("v1.fft")));
+    const FftFile old(with_index_payload(file, v1, work_file("v1.fft")));
     const BlockIndex index = BlockIndex::load(old);
     EXPECT_EQ(index.source(), BlockIndex::Source::chunk);
     EXPECT_EQ(index.groups(), index.blocks());
@@ -484,7 +487,7 @@ TEST_F(SelectIndex, VerifyCatchesAJoinBoundBelowARealJump) {
     std::vector<std::uint8_t> p = good.find_chunk(kBlockIndexTag)->payload;
     const float small = 0.25f * BlockIndex::load(good).max_join();
     std::memcpy(&p[48], &small, 4);
-    const std::string bad = with_index_payload(good, p, dir_->file("join.fft"));
+    const std::string bad = with_index_payload(good, p, work_file("join.fft"));
     EXPECT_NO_THROW(FftFile{bad});
     expect_verify_fails_on_index(bad);
 }
@@ -502,7 +505,7 @@ TEST_F(SelectIndex, VerifyCatchesABlockBoxThatMissesAPoint) {
             for (std::size_t k = 0; k < pts.size(); k += 3) pts[k] += 20;
         builder.add_block(pts.data(), d.blocks[b].points, d.blocks[b].last_of_fiber);
     }
-    const std::string bad = with_index_payload(file, builder.finish()->payload, dir_->file("box.fft"));
+    const std::string bad = with_index_payload(file, builder.finish()->payload, work_file("box.fft"));
     EXPECT_NO_THROW(BlockIndex::load(FftFile{bad}));
     expect_verify_fails_on_index(bad);
 }
@@ -522,7 +525,7 @@ TEST_F(SelectIndex, BlocksOffTheGridAreNeverCulled) {
     EXPECT_EQ(builder.unbounded_blocks(), 1u);
     const auto chunk = builder.finish();
     ASSERT_TRUE(chunk);
-    const FftFile patched(with_index_payload(file, chunk->payload, dir_->file("unbounded.fft")));
+    const FftFile patched(with_index_payload(file, chunk->payload, work_file("unbounded.fft")));
     const BlockIndex index = BlockIndex::load(patched);
     EXPECT_GT(index.block_box(0).max.x, 1e20f);
     EXPECT_LT(index.block_box(1).max.x, 1e3f);
