@@ -33,7 +33,15 @@ protected:
         if (!dir_) dir_ = std::make_unique<TempDir>();
         return dir_->file(name);
     }
-    static std::string compressed(const std::string& tck, const std::string& name, CompressOptions o = {}) {
+    // The finer index (version 3) unless a test asks otherwise: most tests
+    // here check its boxes; the default version 2 is checked by
+    // CompressWritesVersionTwoByDefaultAndThreeWithTheFineIndex and v2_file().
+    static CompressOptions fine_index() {
+        CompressOptions o;
+        o.index_format = BlockIndexFormat::block_boxes;
+        return o;
+    }
+    static std::string compressed(const std::string& tck, const std::string& name, CompressOptions o = fine_index()) {
         const std::string out = work_file(name);
         if (!std::filesystem::exists(out)) {
             o.threads = 2;
@@ -175,6 +183,33 @@ TEST_F(SelectIndex, VersionTwoIndexesAreStillRead) {
     }
 }
 
+// compress writes version 2 (quick to load) unless asked for the finer
+// version 3; both select exactly what brute force keeps.
+TEST_F(SelectIndex, CompressWritesVersionTwoByDefaultAndThreeWithTheFineIndex) {
+    const std::string coarse = compressed("dwi-small64d-ifod1.tck", "dwi-default.fft", CompressOptions{});
+    for (const auto& [path, version] : {std::pair{coarse, 2u}, std::pair{dwi_file(), 3u}}) {
+        const FftFile file(path);
+        const BlockIndex index = BlockIndex::load(file);
+        ASSERT_EQ(index.source(), BlockIndex::Source::chunk) << path;
+        EXPECT_EQ(index.chunk_version(), version) << path;
+        if (version == 2) EXPECT_EQ(index.groups(), index_groups(file, 8).size()) << path;
+        const DecodedFile d = decode_everything(file);
+        expect_boxes_hold_points(file, index, d);
+        EXPECT_NO_THROW(verify_fft_file(file.path()));
+        QueryGenerator gen(d, 6);
+        for (int i = 0; i < 12; ++i) {
+            Query q;
+            q.include.push_back(gen.region());
+            if (i % 2) q.roi_mode = RoiMode::blocks;
+            if (i % 3 == 0) q.view = ViewSelection{gen.camera(), true, std::nullopt, 4.0f};
+            std::vector<SelectedRun> runs;
+            const Streamlines got = select_streamlines(file, index, q, &runs);
+            expect_same_selection(reference_select(file, d, q), got, runs,
+                                  path + " query " + std::to_string(i));
+        }
+    }
+}
+
 TEST_F(SelectIndex, EveryPointLiesInItsBlocksViewSphere) {
     // Selections narrow an index group down to its blocks with this sphere
     // (from the block's header): it must hold every decoded point.
@@ -216,7 +251,7 @@ TEST_F(SelectIndex, StoredJoinBoundsTheJumpBetweenBlocksOfAFiber) {
 }
 
 TEST_F(SelectIndex, ChunkHasTheDocumentedSizeWithinOnePercentOfTheFile) {
-    CompressOptions wide;
+    CompressOptions wide = fine_index();
     wide.direction_bits = 16, wide.points_per_block = 300;
     const std::string wide_file = compressed("bundles/CST_R-step0.1.tck", "cst16.fft", wide);
     for (const std::string& path : {fiblet_file(), dwi_file(), wide_file}) {
@@ -497,7 +532,7 @@ TEST_F(SelectIndex, VerifyCatchesABlockBoxThatMissesAPoint) {
     // box for block 5 misses the block.
     const FftFile file(dwi_file());
     const DecodedFile d = decode_everything(file);
-    IndexBuilder builder(file.header());
+    IndexBuilder builder(file.header(), BlockIndexFormat::block_boxes);
     for (std::size_t b = 0; b < d.blocks.size(); ++b) {
         std::vector<float> pts(&d.points.xyz[3 * d.blocks[b].first_point],
                                &d.points.xyz[3 * (d.blocks[b].first_point + d.blocks[b].points)]);
@@ -515,7 +550,7 @@ TEST_F(SelectIndex, BlocksOffTheGridAreNeverCulled) {
     // builder stores it as unbounded, and every query returns it.
     const FftFile file(dwi_file());
     const DecodedFile d = decode_everything(file);
-    IndexBuilder builder(file.header());
+    IndexBuilder builder(file.header(), BlockIndexFormat::block_boxes);
     for (std::size_t b = 0; b < d.blocks.size(); ++b) {
         std::vector<float> pts(&d.points.xyz[3 * d.blocks[b].first_point],
                                &d.points.xyz[3 * (d.blocks[b].first_point + d.blocks[b].points)]);
@@ -547,18 +582,27 @@ TEST_F(SelectIndex, BuilderRefusesLayoutsItCannotDescribe) {
 }
 
 TEST_F(SelectIndex, ParallelPartsJoinToTheSameChunk) {
-    const FftFile file(fiblet_file());
-    const DecodedFile d = decode_everything(file);
-    IndexBuilder whole(file.header()), first(file.header()), second(file.header());
-    for (std::size_t b = 0; b < d.blocks.size(); ++b) {
-        const float* p = &d.points.xyz[3 * d.blocks[b].first_point];
-        whole.add_block(p, d.blocks[b].points, d.blocks[b].last_of_fiber);
-        (d.blocks[b].fiber < 400 ? first : second).add_block(p, d.blocks[b].points, d.blocks[b].last_of_fiber);
+    const std::string coarse = compressed("small-sdstream.tck", "sdstream-default.fft", CompressOptions{});
+    for (const auto& [path, format] :
+         {std::pair{fiblet_file(), BlockIndexFormat::block_boxes}, std::pair{coarse, BlockIndexFormat::group_boxes}}) {
+        const FftFile file(path);
+        const DecodedFile d = decode_everything(file);
+        IndexBuilder whole(file.header(), format), first(file.header(), format), second(file.header(), format);
+        EXPECT_EQ(whole.format(), format);
+        for (std::size_t b = 0; b < d.blocks.size(); ++b) {
+            const float* p = &d.points.xyz[3 * d.blocks[b].first_point];
+            whole.add_block(p, d.blocks[b].points, d.blocks[b].last_of_fiber);
+            (d.blocks[b].fiber < 400 ? first : second).add_block(p, d.blocks[b].points, d.blocks[b].last_of_fiber);
+        }
+        first.append(second);
+        EXPECT_EQ(first.finish()->payload, whole.finish()->payload) << path;
+        // ... and to what compress stored.
+        EXPECT_EQ(whole.finish()->payload, file.find_chunk(kBlockIndexTag)->payload) << path;
     }
-    first.append(second);
-    EXPECT_EQ(first.finish()->payload, whole.finish()->payload);
-    // ... and to what compress stored.
-    EXPECT_EQ(whole.finish()->payload, file.find_chunk(kBlockIndexTag)->payload);
+    // Parts of different formats do not join.
+    const FftHeader& h = FftFile(coarse).header();
+    IndexBuilder v2(h, BlockIndexFormat::group_boxes);
+    EXPECT_THROW(v2.append(IndexBuilder(h, BlockIndexFormat::block_boxes)), Error);
 }
 
 }  // namespace

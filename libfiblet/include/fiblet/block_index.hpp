@@ -2,12 +2,15 @@
 // volume hierarchy over them, so that a query finds the blocks near a region
 // without reading (let alone decoding) the others.
 //
-// On disk it is the optional "BIDX" trailer chunk (formats/fft-index.md):
-// version 3 stores a box per block on a grid of half a block's path,
-// range-coded against the previous block's box (about 5 bits a block), plus
-// one byte per fiber (two when blocks hold more than 255 points): under 1 %
-// of a file. Version 2 (a box per group of 8 blocks) and version 1 (a box
-// per block, 28 bits) are still read. Files without it (e.g. from the
+// On disk it is the optional "BIDX" trailer chunk (formats/fft-index.md),
+// in one of two versions a writer chooses (BlockIndexFormat): version 2
+// (the default) stores a quantized box per group of up to 8 consecutive
+// blocks of a fiber in 28 bits; version 3 stores a box per block on a grid
+// of half a block's path, range-coded against the previous block's box
+// (about 5 bits a block): fewer candidate blocks for a selection, but about
+// 20x slower to load (a serial decoder). Both add one byte per fiber (two
+// when blocks hold more than 255 points): under 1 % of a file. Version 1 (a
+// box per block, 28 bits) is still read. Files without it (e.g. from the
 // official encoder) get an index of exact per-block boxes computed on load
 // by decoding every block once. The hierarchy is never stored: it is
 // rebuilt in memory on load.
@@ -23,6 +26,7 @@
 #include "fiblet/fft_file.hpp"
 #include "fiblet/fft_format.hpp"
 #include "fiblet/image_mask.hpp"
+#include "fiblet/index_format.hpp"
 #include "fiblet/view.hpp"
 
 namespace fiblet {
@@ -33,16 +37,17 @@ inline constexpr std::array<char, 4> kBlockIndexTag = {'B', 'I', 'D', 'X'};
 inline constexpr std::uint32_t kIndexLeafBlocks = 8;
 
 // Accumulates the bounds of blocks as they are written (compress, extract)
-// and serializes them as a BIDX chunk of version 3: a box per block.
-// Blocks come in file order, a fiber at a time; builders filled in parallel
-// on consecutive fibers are joined in order with append(), which codes the
-// later builder's boxes (a builder keeps its boxes, 20 bytes a block, until
-// they are appended or finished; a builder that has codes takes appends,
-// never is appended).
+// and serializes them as a BIDX chunk of the chosen format: version 2, a
+// box per group of 8 consecutive blocks of a fiber (4 bytes a group), or
+// version 3, a box per block (kept, 20 bytes a block, until appended or
+// finished, then range-coded; a version-3 builder that has codes takes
+// appends, never is appended). Blocks come in file order, a fiber at a
+// time; builders filled in parallel on consecutive fibers are joined in
+// order with append() (builders of one format).
 class IndexBuilder {
 public:
     IndexBuilder();  // unusable until assigned from a header-built one
-    explicit IndexBuilder(const FftHeader& header);
+    explicit IndexBuilder(const FftHeader& header, BlockIndexFormat format = kDefaultBlockIndexFormat);
     IndexBuilder(const IndexBuilder&);
     IndexBuilder& operator=(const IndexBuilder&);
     IndexBuilder(IndexBuilder&&) noexcept;
@@ -60,8 +65,10 @@ public:
 
     std::uint64_t blocks() const { return blocks_; }
     std::uint64_t fibers() const { return last_points_.size(); }
-    // Blocks too large for the grid, stored as "unbounded" (never culled).
-    std::uint64_t unbounded_blocks() const { return unbounded_; }
+    BlockIndexFormat format() const;
+    // Boxes too large for the grid (groups in version 2, blocks in version
+    // 3), stored as "unbounded" (never culled).
+    std::uint64_t unbounded_blocks() const;
 
     // The BIDX chunk, or nullopt when the layout cannot be described: a
     // block other than the last of its fiber holds fewer than
@@ -69,7 +76,9 @@ public:
     std::optional<TrailerChunk> finish() const;
 
 private:
-    struct Coder;  // the grid, the boxes not yet coded, the box stream's encoder
+    struct Coder;  // the boxes as the chosen format stores them (index_builder.cpp)
+    struct GroupCoder;
+    struct BlockCoder;
 
     FftHeader header_;
     std::unique_ptr<Coder> coder_;
@@ -77,7 +86,6 @@ private:
     std::vector<std::uint16_t> last_points_;
     std::uint32_t open_fiber_blocks_ = 0;  // blocks of the fiber being added
     bool layout_ok_ = true;
-    std::uint64_t unbounded_ = 0;
     float max_sphere_radius_ = 0;
     double max_join_ = 0;     // largest |last point of a block - first point of the next| in a fiber
     Vec3f last_point_{};      // of the last block added
@@ -100,6 +108,9 @@ public:
     static BlockIndex compute(const FftFile& file);
 
     Source source() const { return source_; }
+    // The stored chunk's version (1, 2 or 3; BlockIndexFormat's values for
+    // those fiblet writes); 0 when computed.
+    std::uint32_t chunk_version() const { return chunk_version_; }
     std::uint64_t blocks() const { return blocks_; }
     // Leaf boxes of the hierarchy: groups of consecutive blocks of a fiber
     // (one block each when computed).
@@ -139,6 +150,7 @@ private:
     void collect(const Classify& classify, std::vector<std::uint64_t>& bits, std::vector<std::uint64_t>* inside) const;
 
     Source source_ = Source::decoded;
+    std::uint32_t chunk_version_ = 0;
     std::vector<std::uint64_t> fiber_points_;
     float max_sphere_radius_ = 0;
     float max_join_ = -1;

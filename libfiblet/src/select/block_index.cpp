@@ -67,6 +67,7 @@ BlockIndex BlockIndex::load(const FftFile& file) {
     };
     BlockIndex index;
     index.source_ = Source::chunk;
+    index.chunk_version_ = c.version;
     index.blocks_ = h.blocks;
     index.max_sphere_radius_ = c.max_sphere_radius;
     index.max_join_ = c.max_join;

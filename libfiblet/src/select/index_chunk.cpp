@@ -25,6 +25,14 @@ constexpr double kCubeMargin = 1.0 / 1024;
 // boxes cost about 5 bits a block (formats/fft-index.md §3).
 constexpr double kCellsPerBlockPath = 2;
 
+// Largest v with v^3 < 2^bits - 1 (so that the all-ones code stays free).
+std::uint32_t max_axis_levels(unsigned bits) {
+    const std::uint64_t limit = (std::uint64_t{1} << bits) - 1;
+    std::uint64_t v = std::uint64_t(std::cbrt(double(limit))) + 2;
+    while (v * v * v >= limit) --v;
+    return std::uint32_t(v);
+}
+
 }  // namespace
 
 IndexGrid IndexGrid::for_blocks(const FftHeader& h) {
@@ -42,6 +50,56 @@ IndexGrid IndexGrid::for_blocks(const FftHeader& h) {
     g.min_levels = std::uint32_t(std::min<double>(kMaxGridLevels, std::ceil(range / double(g.cell)) + 1));
     g.extent_levels = kMaxBoxExtent + 1;
     return g;
+}
+
+IndexGrid IndexGrid::for_groups(const FftHeader& h, unsigned bits, std::uint32_t group_blocks) {
+    IndexGrid g;
+    g.bits = bits;
+    const float lo = float(-kCubeMargin);
+    g.origin = h.to_world(lo, lo, lo);
+    const double range = double(h.scaling) * (1 + 2 * kCubeMargin);
+    // A group of G blocks spans at most G*n-1 steps plus the quantization of
+    // its first block's second anchor; one more step of room keeps every
+    // group fiblet writes on the grid (larger ones are stored as unbounded,
+    // never wrongly culled).
+    const double extent = double(group_blocks) * double(h.points_per_block) * double(h.step) * double(h.scaling);
+    const std::uint32_t v = max_axis_levels(bits);
+    // A box of extent x spans i..j with j - i < x / cell + 2 + 2 * slack
+    // (floor below, ceil above), so e < extent_levels needs
+    // extent <= (extent_levels - 2 - 2 * slack) * cell.
+    auto smallest_cell = [&](double box_extent) {
+        double best = std::numeric_limits<double>::infinity();
+        for (std::uint32_t e = 3; e <= v / 2; ++e) {
+            const std::uint32_t n = v / e;
+            const double cell = std::max(box_extent / (double(e) - 2 - 2 * kSlackCells), range / double(n - 1));
+            if (cell < best) best = cell, g.extent_levels = e, g.min_levels = n;
+        }
+        return best;
+    };
+    double best = smallest_cell(extent);
+    // Coordinates near the float range (a step of 1e38 mm): that cell is no
+    // float. No box spans more than the range, so size the cell for that.
+    if (!(float(best) < std::numeric_limits<float>::infinity())) best = smallest_cell(std::min(extent, range));
+    // Round the cell up to a float, then make sure the grid still covers the range.
+    g.cell = std::nextafter(float(best), std::numeric_limits<float>::infinity());
+    return g;
+}
+
+std::uint32_t IndexGrid::encode(const Aabb& box) const {
+    std::uint32_t code = 0, scale = 1;
+    const float lo[3] = {box.min.x, box.min.y, box.min.z}, hi[3] = {box.max.x, box.max.y, box.max.z};
+    const float o[3] = {origin.x, origin.y, origin.z};
+    for (int a = 0; a < 3; ++a) {
+        const double b = (double(lo[a]) - o[a]) / cell - kSlackCells;
+        const double t = (double(hi[a]) - o[a]) / cell + kSlackCells;
+        if (!(b >= 0 && t >= b && t < double(min_levels + extent_levels))) return unbounded_code();
+        const auto i = std::uint32_t(std::floor(b));
+        const auto j = std::uint32_t(std::ceil(t));
+        if (i >= min_levels || j - i >= extent_levels) return unbounded_code();
+        code += (i * extent_levels + (j - i)) * scale;
+        scale *= axis_levels();
+    }
+    return code;
 }
 
 std::optional<GridBox> IndexGrid::quantize(const Aabb& box) const {
@@ -103,6 +161,42 @@ std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c, const FftHe
         if (count_bytes == 2) out[kIndexChunkHeaderBytes + 2 * f + 1] = std::uint8_t(n >> 8);
     }
     out.insert(out.end(), box_stream.begin(), box_stream.end());
+    return out;
+}
+
+std::vector<std::uint8_t> serialize_index_chunk_v2(const IndexChunk& c, const FftHeader& h) {
+    const unsigned bits = c.grid.bits;
+    // Fixed header, at the offsets parse_v1_v2 reads.
+    std::vector<std::uint8_t> out(kIndexChunkV2HeaderBytes, 0);
+    auto put = [&](std::size_t at, auto v) { std::memcpy(&out[at], &v, sizeof v); };
+    put(0, kIndexChunkV2Version);
+    put(4, std::uint32_t(bits));
+    put(8, c.fibers);
+    put(16, c.blocks);
+    put(24, c.grid.origin.x), put(28, c.grid.origin.y), put(32, c.grid.origin.z);
+    put(36, c.grid.cell);
+    put(40, c.grid.min_levels);
+    put(44, c.grid.extent_levels);
+    put(48, c.max_sphere_radius);
+    put(52, c.group_blocks);
+    put(56, c.groups);
+    put(64, c.max_join);
+    const unsigned count_bytes = index_count_bytes(h);
+    out.resize(kIndexChunkV2HeaderBytes + count_bytes * c.last_block_points.size());
+    for (std::size_t f = 0; f < c.last_block_points.size(); ++f) {
+        const std::uint16_t n = c.last_block_points[f];
+        out[kIndexChunkV2HeaderBytes + count_bytes * f] = std::uint8_t(n);
+        if (count_bytes == 2) out[kIndexChunkV2HeaderBytes + 2 * f + 1] = std::uint8_t(n >> 8);
+    }
+    // Codes as one little-endian bit stream, least significant bit first.
+    std::uint64_t acc = 0;
+    unsigned filled = 0;
+    for (std::uint32_t code : c.codes) {
+        acc |= std::uint64_t(code) << filled;
+        filled += bits;
+        while (filled >= 8) out.push_back(std::uint8_t(acc)), acc >>= 8, filled -= 8;
+    }
+    if (filled > 0) out.push_back(std::uint8_t(acc));
     return out;
 }
 

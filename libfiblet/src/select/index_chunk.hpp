@@ -13,10 +13,14 @@
 
 namespace fiblet::detail {
 
-// Version 3 (written) bounds every block, its boxes range-coded
-// (box_stream.hpp); versions 2 (a box per group of blocks) and 1 (a box per
-// block, fixed width) are still read.
+// Version 3 (written on request) bounds every block, its boxes range-coded
+// (box_stream.hpp); version 2 (written by default) bounds groups of
+// consecutive blocks of a fiber, a fixed-width code each; version 1 (a box
+// per block, fixed width) is still read.
 inline constexpr std::uint32_t kIndexChunkVersion = 3;
+inline constexpr std::uint32_t kIndexChunkV2Version = 2;
+inline constexpr unsigned kIndexV2BitsPerBox = 28;  // bits per group box code
+inline constexpr std::uint32_t kIndexV2GroupBlocks = 8;
 inline constexpr std::size_t kIndexChunkHeaderBytes = 64, kIndexChunkV2HeaderBytes = 72,
                              kIndexChunkV1HeaderBytes = 56;
 
@@ -38,10 +42,17 @@ struct IndexGrid {
     // The version-3 grid of a file: covers the normalized cube (with a
     // margin) in cells of half a block's path.
     static IndexGrid for_blocks(const FftHeader& h);
+    // The version-2 grid of a file: covers the normalized cube (with a
+    // margin) and makes the cells as small as `bits` allow for groups of
+    // `group_blocks` blocks, up to group_blocks * points_per_block steps across.
+    static IndexGrid for_groups(const FftHeader& h, unsigned bits, std::uint32_t group_blocks);
     // Conservative grid box of a box (its bounds contain it, with a small
     // slack for float rounding), or nullopt when it does not fit the grid.
     std::optional<GridBox> quantize(const Aabb& box) const;
     Aabb bounds(const GridBox& b) const;
+    // Version 2: the conservative code of a box (the decoded box contains
+    // it, with the same slack), or unbounded_code().
+    std::uint32_t encode(const Aabb& box) const;
 };
 
 inline constexpr float kUnboundedExtentMm = 1e30f;
@@ -108,6 +119,8 @@ struct IndexChunk {
 // A version-3 chunk: its fields, the per-fiber counts and the coded boxes.
 std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c, const FftHeader& h,
                                                 const std::vector<std::uint8_t>& box_stream);
+// A version-2 chunk: its fields, the per-fiber counts and c.codes.
+std::vector<std::uint8_t> serialize_index_chunk_v2(const IndexChunk& c, const FftHeader& h);
 // Parses and validates a chunk against its file's header (counts, levels,
 // sizes). Throws Error{fft_format} naming `file`. What needs the fiber LUT
 // (the group count, point totals, version 3's boxes) is checked by its users.
