@@ -210,6 +210,28 @@ TEST_F(SelectIndex, CompressWritesVersionTwoByDefaultAndThreeWithTheFineIndex) {
     }
 }
 
+// The CLI: --fine-index asks compress and extract -o x.fft for version 3;
+// without it they write version 2.
+TEST_F(SelectIndex, FineIndexFlagChoosesTheVersionCompressAndExtractWrite) {
+    const std::string tck = shared_data("dwi-small64d-ifod1.tck");
+    auto version_of = [](const std::string& path) { return BlockIndex::load(FftFile(path)).chunk_version(); };
+    const std::string plain = work_file("cli-plain.fft"), fine = work_file("cli-fine.fft");
+    ASSERT_EQ(test::run_cli("compress -q -f " + tck + " -o " + plain).status, 0);
+    ASSERT_EQ(test::run_cli("compress -q -f --fine-index " + tck + " -o " + fine).status, 0);
+    EXPECT_EQ(version_of(plain), 2u);
+    EXPECT_EQ(version_of(fine), 3u);
+    for (const std::string& from : {plain, fine}) {
+        const std::string sub = work_file("cli-sub.fft"), sub_fine = work_file("cli-sub-fine.fft");
+        const std::string region = " --include 0,0,0,30";
+        ASSERT_EQ(test::run_cli("extract -q -f " + from + " -o " + sub + region).status, 0);
+        ASSERT_EQ(test::run_cli("extract -q -f --fine-index " + from + " -o " + sub_fine + region).status, 0);
+        EXPECT_EQ(version_of(sub), 2u) << from;
+        EXPECT_EQ(version_of(sub_fine), 3u) << from;
+        EXPECT_EQ(FftFile(sub).header().blocks, FftFile(sub_fine).header().blocks) << from;
+        EXPECT_GT(FftFile(sub).header().blocks, 0u) << from;
+    }
+}
+
 TEST_F(SelectIndex, EveryPointLiesInItsBlocksViewSphere) {
     // Selections narrow an index group down to its blocks with this sphere
     // (from the block's header): it must hold every decoded point.
