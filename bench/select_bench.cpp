@@ -133,6 +133,7 @@ void report(benchmark::State& state, const SelectionStats& s) {
     state.counters["kept_pct"] = 100.0 * double(s.blocks) / blocks;
     state.counters["read_pct"] = 100.0 * double(s.blocks_read) / blocks;
     state.counters["decoded_pct"] = 100.0 * double(s.blocks_decoded) / blocks;
+    state.counters["tested_pct"] = 100.0 * double(s.blocks_tested) / blocks;
     state.counters["coarse_pct"] = 100.0 * double(s.coarse_blocks) / blocks;
     state.SetLabel(bench_file().label);
 }

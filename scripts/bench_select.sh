@@ -28,20 +28,20 @@ full = min(fulls, key=lambda b: b["cpu_time"])
 label = next(b.get("label", "") for b in fulls if b["run_name"].startswith("BM_SelectFullDecode/"))
 print(f"file, decoder: {label}; one thread; median of repetitions; CPU time (real time in brackets); "
       f"ratios against the fastest full decode ({full['run_name']})\n")
-print("| query | blocks kept | read | decoded | time | vs full decode |")
-print("|---|---|---|---|---|---|")
+print("| query | blocks kept | candidates (tested) | read | decoded | time | vs full decode |")
+print("|---|---|---|---|---|---|---|")
 for b in fulls:
     name = b["run_name"].replace("BM_SelectFullDecode/", "full decode, decode_file, chunks of ").replace(
         "BM_SelectEverything", "full decode, select() with an empty query").replace(
         "chunks of 0", "default chunks (4096 blocks)")
-    print(f"| {name} | 100 % | 100 % | 100 % | {b['cpu_time']:.1f} ms ({b['real_time']:.1f}) | "
+    print(f"| {name} | 100 % | | 100 % | 100 % | {b['cpu_time']:.1f} ms ({b['real_time']:.1f}) | "
           f"{100 * b['cpu_time'] / full['cpu_time']:.1f} % |")
 for b in runs:
     name = b["run_name"]
     if not name.startswith("BM_SelectQuery"):
         continue
     q = name.replace("BM_SelectQuery/", "")
-    print(f"| {q} | {b['kept_pct']:.2f} % | {b['read_pct']:.2f} % | {b['decoded_pct']:.2f} % | "
+    print(f"| {q} | {b['kept_pct']:.2f} % | {b['tested_pct']:.2f} % | {b['read_pct']:.2f} % | {b['decoded_pct']:.2f} % | "
           f"{b['cpu_time']:.2f} ms ({b['real_time']:.2f}) | {100 * b['cpu_time'] / full['cpu_time']:.1f} % |")
 load, comp = by["BM_SelectIndexLoad"], by.get("BM_SelectIndexCompute")
 print(f"\nindex: {load['index_bytes'] / 1e6:.3f} MB = {load['index_pct_of_file']:.2f} % of the file without it, "

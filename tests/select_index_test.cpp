@@ -1,7 +1,8 @@
 // The block index: every stored or computed box contains every point its
 // block decodes to, candidate sets never miss a block with a point in the
-// region, the stored chunk has the documented size, and malformed chunks
-// are rejected with a clear error.
+// region, the stored chunk has the documented size within 1 % of the file,
+// older versions (1, 2) are still read, and malformed chunks are rejected
+// with a clear error.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,6 +13,7 @@
 #include "fiblet/checksum.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/error.hpp"
+#include "cli_runner.hpp"
 #include "select_reference.hpp"
 #include "test_util.hpp"
 
@@ -27,9 +29,20 @@ protected:
     void SetUp() override {
         if (!shared_data_available()) GTEST_SKIP() << "shared test data not found";
     }
-    static std::string compressed(const std::string& tck, const std::string& name, CompressOptions o = {}) {
+    static std::string work_file(const std::string& name) {
         if (!dir_) dir_ = std::make_unique<TempDir>();
-        const std::string out = dir_->file(name);
+        return dir_->file(name);
+    }
+    // The finer index (version 3) unless a test asks otherwise: most tests
+    // here check its boxes; the default version 2 is checked by
+    // CompressWritesVersionTwoByDefaultAndThreeWithTheFineIndex and v2_file().
+    static CompressOptions fine_index() {
+        CompressOptions o;
+        o.index_format = BlockIndexFormat::block_boxes;
+        return o;
+    }
+    static std::string compressed(const std::string& tck, const std::string& name, CompressOptions o = fine_index()) {
+        const std::string out = work_file(name);
         if (!std::filesystem::exists(out)) {
             o.threads = 2;
             // The 8-bit layout unless a test asks for 16 (the default gives small-sdstream 16 bits).
@@ -40,6 +53,9 @@ protected:
     }
     static std::string fiblet_file() { return compressed("small-sdstream.tck", "sdstream.fft"); }
     static std::string dwi_file() { return compressed("dwi-small64d-ifod1.tck", "dwi.fft"); }
+    // dwi-small64d-ifod1.tck as fiblet wrote it before version 3: a version-2
+    // index, groups of 8 blocks (tests/index-v2/README.md).
+    static std::string v2_file() { return std::string(FIBLET_TESTS_DIR) + "/index-v2/dwi-small64d-ifod1.fft"; }
     static inline std::unique_ptr<TempDir> dir_;
 };
 
@@ -101,8 +117,8 @@ TEST_F(SelectIndex, ComputedIndexOfOfficialEncoderFilesHoldsEveryPoint) {
     }
 }
 
-// The groups of the stored index: kDefaultIndexGroupBlocks blocks at a time
-// from each fiber's first block, as the format says.
+// The groups of a version-2 index: 8 blocks at a time from each fiber's
+// first block, as the format says.
 std::vector<std::pair<std::uint64_t, std::uint64_t>> index_groups(const FftFile& file, std::uint32_t g) {
     std::vector<std::pair<std::uint64_t, std::uint64_t>> groups;  // first block, end
     for (std::uint64_t f = 0; f < file.header().fibers; ++f)
@@ -111,38 +127,109 @@ std::vector<std::pair<std::uint64_t, std::uint64_t>> index_groups(const FftFile&
     return groups;
 }
 
-TEST_F(SelectIndex, StoredBoxesBoundGroupsWithinACellOfTheirExactBoxes) {
+// The payload's box stream bytes (version 3, formats/fft-index.md §1).
+std::uint64_t stream_bytes(const std::vector<std::uint8_t>& p) {
+    std::uint64_t n;
+    std::memcpy(&n, &p[56], 8);
+    return n;
+}
+
+TEST_F(SelectIndex, StoredBoxesBoundBlocksWithinACellOfTheirExactBoxes) {
     const FftFile file(fiblet_file());
     const BlockIndex stored = BlockIndex::load(file), exact = BlockIndex::compute(file);
-    const auto groups = index_groups(file, kDefaultIndexGroupBlocks);
-    EXPECT_EQ(stored.groups(), groups.size());
     EXPECT_EQ(exact.groups(), exact.blocks());
-    // The grid for groups of 8 blocks (8 x 6 mm of fiber, 87 mm of range)
-    // has a cell of about 3 mm: every side of a group's box lies within a
-    // cell of the union of its blocks' exact boxes, and the same box is
-    // given for each of its blocks.
+    // The grid's cell is half a block's path (60 points at 0.1 mm: 3 mm):
+    // every side of a block's stored box lies within a cell of its exact box.
+    const FftHeader& h = file.header();
+    const double cell = double(h.points_per_block) * double(h.step) * double(h.scaling) / 2;
+    ASSERT_GT(cell, 2.9);
+    ASSERT_LT(cell, 3.1);
     double grow = 0;
-    float cell = 0;
-    for (const auto& [b0, b1] : groups) {
-        Aabb u = exact.block_box(b0);
-        for (std::uint64_t b = b0 + 1; b < b1; ++b) {
-            const Aabb e = exact.block_box(b);
-            u.min = {std::min(u.min.x, e.min.x), std::min(u.min.y, e.min.y), std::min(u.min.z, e.min.z)};
-            u.max = {std::max(u.max.x, e.max.x), std::max(u.max.y, e.max.y), std::max(u.max.z, e.max.z)};
-        }
-        const Aabb s = stored.block_box(b0);
-        for (std::uint64_t b = b0 + 1; b < b1; ++b) {
-            const Aabb o = stored.block_box(b);
-            ASSERT_TRUE(o.min.x == s.min.x && o.max.z == s.max.z) << "block " << b;
-        }
+    for (std::uint64_t b = 0; b < stored.blocks(); ++b) {
+        const Aabb u = exact.block_box(b), s = stored.block_box(b);
         for (float d : {u.min.x - s.min.x, u.min.y - s.min.y, u.min.z - s.min.z, s.max.x - u.max.x, s.max.y - u.max.y,
                         s.max.z - u.max.z}) {
-            ASSERT_GE(d, 0.0f);
-            ASSERT_LT(d, 3.5f) << "group at block " << b0;
-            grow += d, cell = std::max(cell, d);
+            ASSERT_GE(d, 0.0f) << "block " << b;
+            ASSERT_LT(d, cell * 1.01) << "block " << b;
+            grow += d;
         }
     }
-    EXPECT_LT(grow / double(6 * groups.size()), 0.6 * cell);  // about half a cell on average
+    EXPECT_LT(grow / double(6 * stored.blocks()), 0.6 * cell);  // about half a cell on average
+}
+
+TEST_F(SelectIndex, VersionTwoIndexesAreStillRead) {
+    const FftFile file(v2_file());
+    const TrailerChunk* c = file.find_chunk(kBlockIndexTag);
+    ASSERT_NE(c, nullptr);
+    ASSERT_EQ(c->payload[0], 2);
+    const BlockIndex index = BlockIndex::load(file);
+    EXPECT_EQ(index.source(), BlockIndex::Source::chunk);
+    EXPECT_EQ(index.groups(), index_groups(file, 8).size());
+    const DecodedFile d = decode_everything(file);
+    expect_boxes_hold_points(file, index, d);
+    // A group's box is given for each of its blocks.
+    for (const auto& [b0, b1] : index_groups(file, 8))
+        for (std::uint64_t b = b0 + 1; b < b1; ++b) ASSERT_EQ(index.block_box(b).min.x, index.block_box(b0).min.x);
+    EXPECT_NO_THROW(verify_fft_file(file.path()));
+    QueryGenerator gen(d, 4);
+    for (int i = 0; i < 12; ++i) {
+        Query q;
+        q.include.push_back(gen.region());
+        if (i % 2) q.roi_mode = RoiMode::blocks;
+        if (i % 3 == 0) q.view = ViewSelection{gen.camera(), true, std::nullopt, 4.0f};
+        std::vector<SelectedRun> runs;
+        const Streamlines got = select_streamlines(file, index, q, &runs);
+        expect_same_selection(reference_select(file, d, q), got, runs, "query " + std::to_string(i));
+    }
+}
+
+// compress writes version 2 (quick to load) unless asked for the finer
+// version 3; both select exactly what brute force keeps.
+TEST_F(SelectIndex, CompressWritesVersionTwoByDefaultAndThreeWithTheFineIndex) {
+    const std::string coarse = compressed("dwi-small64d-ifod1.tck", "dwi-default.fft", CompressOptions{});
+    for (const auto& [path, version] : {std::pair{coarse, 2u}, std::pair{dwi_file(), 3u}}) {
+        const FftFile file(path);
+        const BlockIndex index = BlockIndex::load(file);
+        ASSERT_EQ(index.source(), BlockIndex::Source::chunk) << path;
+        EXPECT_EQ(index.chunk_version(), version) << path;
+        if (version == 2) EXPECT_EQ(index.groups(), index_groups(file, 8).size()) << path;
+        const DecodedFile d = decode_everything(file);
+        expect_boxes_hold_points(file, index, d);
+        EXPECT_NO_THROW(verify_fft_file(file.path()));
+        QueryGenerator gen(d, 6);
+        for (int i = 0; i < 12; ++i) {
+            Query q;
+            q.include.push_back(gen.region());
+            if (i % 2) q.roi_mode = RoiMode::blocks;
+            if (i % 3 == 0) q.view = ViewSelection{gen.camera(), true, std::nullopt, 4.0f};
+            std::vector<SelectedRun> runs;
+            const Streamlines got = select_streamlines(file, index, q, &runs);
+            expect_same_selection(reference_select(file, d, q), got, runs,
+                                  path + " query " + std::to_string(i));
+        }
+    }
+}
+
+// The CLI: --fine-index asks compress and extract -o x.fft for version 3;
+// without it they write version 2.
+TEST_F(SelectIndex, FineIndexFlagChoosesTheVersionCompressAndExtractWrite) {
+    const std::string tck = shared_data("dwi-small64d-ifod1.tck");
+    auto version_of = [](const std::string& path) { return BlockIndex::load(FftFile(path)).chunk_version(); };
+    const std::string plain = work_file("cli-plain.fft"), fine = work_file("cli-fine.fft");
+    ASSERT_EQ(test::run_cli("compress -q -f " + tck + " -o " + plain).status, 0);
+    ASSERT_EQ(test::run_cli("compress -q -f --fine-index " + tck + " -o " + fine).status, 0);
+    EXPECT_EQ(version_of(plain), 2u);
+    EXPECT_EQ(version_of(fine), 3u);
+    for (const std::string& from : {plain, fine}) {
+        const std::string sub = work_file("cli-sub.fft"), sub_fine = work_file("cli-sub-fine.fft");
+        const std::string region = " --include 0,0,0,30";
+        ASSERT_EQ(test::run_cli("extract -q -f " + from + " -o " + sub + region).status, 0);
+        ASSERT_EQ(test::run_cli("extract -q -f --fine-index " + from + " -o " + sub_fine + region).status, 0);
+        EXPECT_EQ(version_of(sub), 2u) << from;
+        EXPECT_EQ(version_of(sub_fine), 3u) << from;
+        EXPECT_EQ(FftFile(sub).header().blocks, FftFile(sub_fine).header().blocks) << from;
+        EXPECT_GT(FftFile(sub).header().blocks, 0u) << from;
+    }
 }
 
 TEST_F(SelectIndex, EveryPointLiesInItsBlocksViewSphere) {
@@ -185,8 +272,8 @@ TEST_F(SelectIndex, StoredJoinBoundsTheJumpBetweenBlocksOfAFiber) {
     }
 }
 
-TEST_F(SelectIndex, ChunkHasTheDocumentedSize) {
-    CompressOptions wide;
+TEST_F(SelectIndex, ChunkHasTheDocumentedSizeWithinOnePercentOfTheFile) {
+    CompressOptions wide = fine_index();
     wide.direction_bits = 16, wide.points_per_block = 300;
     const std::string wide_file = compressed("bundles/CST_R-step0.1.tck", "cst16.fft", wide);
     for (const std::string& path : {fiblet_file(), dwi_file(), wide_file}) {
@@ -195,25 +282,24 @@ TEST_F(SelectIndex, ChunkHasTheDocumentedSize) {
         ASSERT_NE(c, nullptr);
         const FftHeader& h = file.header();
         const std::uint64_t count_bytes = h.points_per_block > 255 ? 2 : 1;
-        const std::uint64_t groups = index_groups(file, kDefaultIndexGroupBlocks).size();
-        EXPECT_EQ(c->payload.size(), 72 + count_bytes * h.fibers + (groups * 28 + 7) / 8) << path;
+        EXPECT_EQ(c->payload[0], 3) << path;
+        EXPECT_EQ(c->payload.size(), 64 + count_bytes * h.fibers + stream_bytes(c->payload)) << path;
+        // The budget: 1 % of a file of long fibers (the per-fiber counts
+        // make more of a file of short ones): about 6 bits a block.
+        if (path == fiblet_file()) EXPECT_LT(double(c->payload.size() + 16), 0.01 * double(file.file_size()));
         const BlockIndex index = BlockIndex::load(file);
         EXPECT_EQ(index.source(), BlockIndex::Source::chunk);
-        EXPECT_EQ(index.groups(), groups);
         expect_boxes_hold_points(file, index, decode_everything(file));
     }
 }
 
 TEST_F(SelectIndex, CandidatesNeverMissABlockWithAPointInTheRegion) {
-    for (const std::string& path : {fiblet_file(), shared_data("reference/small-ifod1.fft")}) {
+    for (const std::string& path : {fiblet_file(), shared_data("reference/small-ifod1.fft"), v2_file()}) {
         const FftFile file(path);
         const DecodedFile d = decode_everything(file);
         const BlockIndex index = BlockIndex::load(file);
-        // Boxes bound groups of blocks (stored chunk) or single blocks (computed).
-        const auto groups = index_groups(file, index.groups() == index.blocks() ? 1 : kDefaultIndexGroupBlocks);
-        ASSERT_EQ(groups.size(), index.groups());
         QueryGenerator gen(d, 5);
-        std::size_t candidates = 0, hits = 0, candidate_groups = 0, hit_groups = 0;
+        std::size_t candidates = 0, hits = 0;
         for (int i = 0; i < 40; ++i) {
             const Region r = gen.region();
             std::vector<std::uint64_t> bits;
@@ -228,20 +314,13 @@ TEST_F(SelectIndex, CandidatesNeverMissABlockWithAPointInTheRegion) {
                     ASSERT_TRUE(bit(bits, b)) << path << ": region " << i << " misses block " << b;
                 }
             }
-            for (const auto& [b0, b1] : groups) {
-                bool hit = false;
-                for (std::uint64_t b = b0; b < b1; ++b) {
-                    ASSERT_EQ(bit(bits, b), bit(bits, b0)) << "a group's blocks are candidates together";
-                    hit = hit || any_inside(d, d.blocks[b].first_point, d.blocks[b].points, r);
-                }
-                candidate_groups += bit(bits, b0), hit_groups += hit;
-            }
         }
-        // Pruning works: small regions leave most blocks out, and the
-        // candidate boxes are not many more than the boxes really hit.
-        EXPECT_LT(candidates, 40 * d.blocks.size() / 4);
-        EXPECT_LT(candidate_groups, 3 * hit_groups);
-        EXPECT_GE(candidates, hits);
+        // Pruning works: a box per block (version 3, computed) leaves most
+        // blocks out and lets through few more than are hit.
+        EXPECT_GE(candidates, hits) << path;
+        if (path == v2_file()) continue;
+        EXPECT_LT(candidates, 40 * d.blocks.size() / 4) << path;
+        EXPECT_LT(candidates, 2 * hits) << path;
     }
 }
 
@@ -273,82 +352,166 @@ std::string with_index_payload(const FftFile& from, const std::vector<std::uint8
     return to;
 }
 
+// Whether `p` as the BIDX payload of a copy of `good` is refused with a
+// clear error when the file opens or its index loads.
+bool rejected(const FftFile& good, const std::vector<std::uint8_t>& p, const std::string& to) {
+    try {
+        const FftFile bad(with_index_payload(good, p, to));
+        BlockIndex::load(bad);
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), Errc::fft_format);
+        EXPECT_NE(std::string(e.what()).find("BIDX"), std::string::npos) << e.what();
+        return true;
+    }
+    return false;
+}
+
 TEST_F(SelectIndex, MalformedChunksAreRejected) {
     const FftFile good(fiblet_file());
     const std::vector<std::uint8_t> payload = good.find_chunk(kBlockIndexTag)->payload;
-    auto rejected = [&](std::vector<std::uint8_t> p, const std::string& name) {
-        try {  // the chunk is validated when the file opens, and again when the index loads
-            const FftFile bad(with_index_payload(good, p, dir_->file(name)));
-            BlockIndex::load(bad);
-        } catch (const Error& e) {
-            EXPECT_EQ(e.code(), Errc::fft_format);
-            EXPECT_NE(std::string(e.what()).find("BIDX"), std::string::npos) << e.what();
-            return true;
-        }
-        return false;
+    auto bad = [&](const std::vector<std::uint8_t>& p, const std::string& name) {
+        return rejected(good, p, work_file(name));
     };
-    EXPECT_FALSE(rejected(payload, "same.fft"));
+    EXPECT_FALSE(bad(payload, "same.fft"));
     auto p = payload;
     p.resize(30);
-    EXPECT_TRUE(rejected(p, "truncated.fft"));
+    EXPECT_TRUE(bad(p, "truncated.fft"));
     p = payload, p.pop_back();
-    EXPECT_TRUE(rejected(p, "short.fft"));
+    EXPECT_TRUE(bad(p, "short.fft"));
+    p = payload, p.push_back(0);
+    EXPECT_TRUE(bad(p, "long.fft"));
     p = payload, p[0] = 9;
-    EXPECT_TRUE(rejected(p, "version.fft"));
+    EXPECT_TRUE(bad(p, "version.fft"));
     p = payload, p[8] ^= 1;  // fiber count
-    EXPECT_TRUE(rejected(p, "fibers.fft"));
-    p = payload, p[4] = 40;  // bits per block
-    EXPECT_TRUE(rejected(p, "bits.fft"));
+    EXPECT_TRUE(bad(p, "fibers.fft"));
+    p = payload, p[4] = 1;  // reserved
+    EXPECT_TRUE(bad(p, "reserved.fft"));
     p = payload, std::memset(&p[36], 0, 4);  // cell 0
-    EXPECT_TRUE(rejected(p, "cell.fft"));
-    p = payload, p[72] = std::uint8_t(p[72] == 1 ? 2 : 1);  // first fiber's point count no longer adds up
-    EXPECT_TRUE(rejected(p, "points.fft"));
-    p = payload, p[72] = 64;
-    EXPECT_TRUE(rejected(p, "toomany.fft"));
-    p = payload, std::memset(&p[40], 0xff, 4);  // levels overflow the code
-    EXPECT_TRUE(rejected(p, "levels.fft"));
+    EXPECT_TRUE(bad(p, "cell.fft"));
+    p = payload, std::memset(&p[40], 0, 4);  // no grid levels
+    EXPECT_TRUE(bad(p, "levels0.fft"));
+    p = payload, std::memset(&p[40], 0xff, 4);  // more levels than 1024
+    EXPECT_TRUE(bad(p, "levels.fft"));
+    p = payload, p[64] = std::uint8_t(p[64] == 1 ? 2 : 1);  // first fiber's point count no longer adds up
+    EXPECT_TRUE(bad(p, "points.fft"));
+    p = payload, p[64] = 64;
+    EXPECT_TRUE(bad(p, "toomany.fft"));
     const float nan = std::nanf(""), negative = -1;
-    p = payload, std::memcpy(&p[64], &nan, 4);  // join distance
-    EXPECT_TRUE(rejected(p, "join-nan.fft"));
-    p = payload, std::memcpy(&p[64], &negative, 4);
-    EXPECT_TRUE(rejected(p, "join-negative.fft"));
+    p = payload, std::memcpy(&p[48], &nan, 4);  // join distance
+    EXPECT_TRUE(bad(p, "join-nan.fft"));
+    p = payload, std::memcpy(&p[48], &negative, 4);
+    EXPECT_TRUE(bad(p, "join-negative.fft"));
+    p = payload, p[56] ^= 1;  // stream bytes: the payload size no longer matches
+    EXPECT_TRUE(bad(p, "stream-size.fft"));
+    // A stream cut short (its stated size with it): fewer boxes than blocks.
+    p = payload, p.resize(p.size() - 8);
+    const std::uint64_t shorter = stream_bytes(payload) - 8;
+    std::memcpy(&p[56], &shorter, 8);
+    EXPECT_TRUE(bad(p, "stream-short.fft"));
+    // ... or with bytes after its boxes.
+    p = payload, p.insert(p.end(), 8, 0x55);
+    const std::uint64_t longer = stream_bytes(payload) + 8;
+    std::memcpy(&p[56], &longer, 8);
+    EXPECT_TRUE(bad(p, "stream-long.fft"));
+    // The first fiber's first box, coded whole, at the last grid level:
+    // later boxes, coded against it, fall off the grid.
+    p = payload;
+    const std::uint32_t one = 1;
+    std::memcpy(&p[40], &one, 4);
+    EXPECT_TRUE(bad(p, "offgrid.fft"));
+    // Through the CLI: exit 4, the chunk named.
+    const CommandResult r =
+        run_cli("extract " + work_file("offgrid.fft") + " -o " + work_file("offgrid.tck") + " --include 0,0,0,5");
+    EXPECT_EQ(r.status, 4) << r.output;
+    EXPECT_NE(r.output.find("BIDX"), std::string::npos) << r.output;
+}
+
+TEST_F(SelectIndex, DamagedBoxStreamsAreRefusedOrStillHoldOnlyBoxes) {
+    // Any bytes decode to some boxes: a damaged stream is refused (boxes off
+    // the grid, a length that does not match) or loads; never a crash.
+    const FftFile good(fiblet_file());
+    const std::vector<std::uint8_t> payload = good.find_chunk(kBlockIndexTag)->payload;
+    const std::size_t stream = payload.size() - stream_bytes(payload);
+    std::size_t refused = 0;
+    for (int i = 0; i < 16; ++i) {
+        auto p = payload;
+        p[stream + 5 + (p.size() - stream - 5) * std::size_t(i) / 16] ^= std::uint8_t(0x5a);
+        refused += rejected(good, p, work_file("flip" + std::to_string(i) + ".fft"));
+    }
+    EXPECT_GT(refused, 8u);
+}
+
+TEST_F(SelectIndex, MalformedVersionTwoChunksAreRejected) {
+    const FftFile good(v2_file());
+    const std::vector<std::uint8_t> payload = good.find_chunk(kBlockIndexTag)->payload;
+    auto bad = [&](const std::vector<std::uint8_t>& p, const std::string& name) {
+        return rejected(good, p, work_file("v2-" + name));
+    };
+    EXPECT_FALSE(bad(payload, "same.fft"));
+    auto p = payload;
+    p = payload, p.pop_back();
+    EXPECT_TRUE(bad(p, "short.fft"));
+    p = payload, p[4] = 40;  // bits per box
+    EXPECT_TRUE(bad(p, "bits.fft"));
+    p = payload, std::memset(&p[40], 0xff, 4);  // levels overflow the code
+    EXPECT_TRUE(bad(p, "levels.fft"));
     p = payload, std::memset(&p[52], 0, 4);  // 0 blocks per group
-    EXPECT_TRUE(rejected(p, "group0.fft"));
+    EXPECT_TRUE(bad(p, "group0.fft"));
     p = payload, p[56] ^= 1;  // group count: the payload size no longer matches
-    EXPECT_TRUE(rejected(p, "groups.fft"));
-    // Groups of 7 blocks with the same number of groups: well-formed on its
+    EXPECT_TRUE(bad(p, "groups.fft"));
+    // Groups of 2 blocks with the same number of groups: well-formed on its
     // own, but the fibers' blocks make another number of groups.
-    p = payload, p[52] = 7;
-    EXPECT_TRUE(rejected(p, "group7.fft"));
+    p = payload, p[52] = 2;
+    EXPECT_TRUE(bad(p, "group2.fft"));
+    p = payload, p[72] = std::uint8_t(p[72] == 1 ? 2 : 1);  // point counts
+    EXPECT_TRUE(bad(p, "points.fft"));
     // Version 1's size rule (56-byte header, a box per block) applied to a
     // version-2 payload.
     p = payload, p[0] = 1;
-    EXPECT_TRUE(rejected(p, "v1.fft"));
+    EXPECT_TRUE(bad(p, "v1.fft"));
+}
+
+// Codes of `bits` bits, least significant bit first, from byte `at`.
+std::vector<std::uint32_t> unpack_codes(const std::vector<std::uint8_t>& p, std::size_t at, std::size_t n,
+                                        unsigned bits) {
+    std::vector<std::uint32_t> codes(n, 0);
+    for (std::size_t k = 0; k < n * bits; ++k)
+        codes[k / bits] |= std::uint32_t((p[at + k / 8] >> (k % 8)) & 1) << (k % bits);
+    return codes;
+}
+
+void pack_codes(const std::vector<std::uint32_t>& codes, unsigned bits, std::vector<std::uint8_t>& out) {
+    const std::size_t at = out.size();
+    out.resize(at + (codes.size() * bits + 7) / 8, 0);
+    for (std::size_t k = 0; k < codes.size() * bits; ++k)
+        out[at + k / 8] |= std::uint8_t(((codes[k / bits] >> (k % bits)) & 1) << (k % 8));
 }
 
 TEST_F(SelectIndex, VersionOneChunksOfOneBoxPerBlockAreStillRead) {
     // Version 1 (fiblet before groups): the 56-byte header and a box per
-    // block. Made from a version-2 chunk of one-block groups, which has the
-    // same grid and codes.
-    const FftFile file(fiblet_file());
+    // block. Made from the version-2 chunk, each group's code given to each
+    // of its blocks (same grid).
+    const FftFile file(v2_file());
     const DecodedFile d = decode_everything(file);
-    IndexBuilder builder(file.header(), kDefaultIndexBitsPerBlock, 1);
-    for (std::size_t b = 0; b < d.blocks.size(); ++b)
-        builder.add_block(&d.points.xyz[3 * d.blocks[b].first_point], d.blocks[b].points, d.blocks[b].last_of_fiber);
-    std::vector<std::uint8_t> v1 = builder.finish()->payload;
-    ASSERT_EQ(v1[52], 1);  // one block per group
-    v1.erase(v1.begin() + 52, v1.begin() + 72);  // group size and count, join, reserved
-    v1.insert(v1.begin() + 52, 4, 0);             // reserved
+    const std::vector<std::uint8_t> v2 = file.find_chunk(kBlockIndexTag)->payload;
+    const auto groups = index_groups(file, 8);
+    const std::size_t counts = file.header().fibers;  // one byte a fiber
+    const std::vector<std::uint32_t> group_codes = unpack_codes(v2, 72 + counts, groups.size(), 28);
+    std::vector<std::uint32_t> block_codes;
+    for (std::size_t g = 0; g < groups.size(); ++g)
+        block_codes.insert(block_codes.end(), groups[g].second - groups[g].first, group_codes[g]);
+    std::vector<std::uint8_t> v1(v2.begin(), v2.begin() + 52);
     v1[0] = 1;
-    const FftFile old(with_index_payload(file, v1, dir_->file("v1.fft")));
+    v1.insert(v1.end(), 4, 0);  // reserved
+    v1.insert(v1.end(), v2.begin() + 72, v2.begin() + 72 + std::ptrdiff_t(counts));
+    pack_codes(block_codes, 28, v1);
+    const FftFile old(with_index_payload(file, v1, work_file("v1.fft")));
     const BlockIndex index = BlockIndex::load(old);
     EXPECT_EQ(index.source(), BlockIndex::Source::chunk);
     EXPECT_EQ(index.groups(), index.blocks());
+    EXPECT_LT(index.max_join(), 0.0f);  // unknown in version 1
     expect_boxes_hold_points(old, index, d);
-    // Its boxes are the per-block boxes of version 1: within a 1.1 mm cell.
-    const BlockIndex exact = BlockIndex::compute(file);
-    for (std::uint64_t b = 0; b < index.blocks(); b += 7)
-        ASSERT_LT(exact.block_box(b).min.x - index.block_box(b).min.x, 1.15f) << "block " << b;
+    EXPECT_NO_THROW(verify_fft_file(old.path()));
     // Selections through it are the decode-everything reference's.
     QueryGenerator gen(d, 3);
     for (int i = 0; i < 10; ++i) {
@@ -361,6 +524,18 @@ TEST_F(SelectIndex, VersionOneChunksOfOneBoxPerBlockAreStillRead) {
     }
 }
 
+// verify's verdict on a file, as the CLI gives it.
+void expect_verify_fails_on_index(const std::string& path) {
+    try {
+        verify_fft_file(path);
+        ADD_FAILURE() << "verify passed " << path;
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), Errc::fft_format);
+        EXPECT_NE(std::string(e.what()).find("BIDX"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(run_cli("verify " + path).status, 4);
+}
+
 TEST_F(SelectIndex, VerifyCatchesAJoinBoundBelowARealJump) {
     // A writer that understated maxJoin: the file opens (well-formed), but a
     // selection could lose blocks; verify decodes them and says so.
@@ -368,16 +543,28 @@ TEST_F(SelectIndex, VerifyCatchesAJoinBoundBelowARealJump) {
     EXPECT_NO_THROW(verify_fft_file(good.path()));
     std::vector<std::uint8_t> p = good.find_chunk(kBlockIndexTag)->payload;
     const float small = 0.25f * BlockIndex::load(good).max_join();
-    std::memcpy(&p[64], &small, 4);
-    const std::string bad = with_index_payload(good, p, dir_->file("join.fft"));
+    std::memcpy(&p[48], &small, 4);
+    const std::string bad = with_index_payload(good, p, work_file("join.fft"));
     EXPECT_NO_THROW(FftFile{bad});
-    try {
-        verify_fft_file(bad);
-        ADD_FAILURE() << "verify passed a join bound below a real jump";
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), Errc::fft_format);
-        EXPECT_NE(std::string(e.what()).find("BIDX"), std::string::npos) << e.what();
+    expect_verify_fails_on_index(bad);
+}
+
+TEST_F(SelectIndex, VerifyCatchesABlockBoxThatMissesAPoint) {
+    // A builder given block 5's points 20 mm away: a well-formed chunk whose
+    // box for block 5 misses the block.
+    const FftFile file(dwi_file());
+    const DecodedFile d = decode_everything(file);
+    IndexBuilder builder(file.header(), BlockIndexFormat::block_boxes);
+    for (std::size_t b = 0; b < d.blocks.size(); ++b) {
+        std::vector<float> pts(&d.points.xyz[3 * d.blocks[b].first_point],
+                               &d.points.xyz[3 * (d.blocks[b].first_point + d.blocks[b].points)]);
+        if (b == 5)
+            for (std::size_t k = 0; k < pts.size(); k += 3) pts[k] += 20;
+        builder.add_block(pts.data(), d.blocks[b].points, d.blocks[b].last_of_fiber);
     }
+    const std::string bad = with_index_payload(file, builder.finish()->payload, work_file("box.fft"));
+    EXPECT_NO_THROW(BlockIndex::load(FftFile{bad}));
+    expect_verify_fails_on_index(bad);
 }
 
 TEST_F(SelectIndex, BlocksOffTheGridAreNeverCulled) {
@@ -385,25 +572,23 @@ TEST_F(SelectIndex, BlocksOffTheGridAreNeverCulled) {
     // builder stores it as unbounded, and every query returns it.
     const FftFile file(dwi_file());
     const DecodedFile d = decode_everything(file);
-    IndexBuilder builder(file.header());
+    IndexBuilder builder(file.header(), BlockIndexFormat::block_boxes);
     for (std::size_t b = 0; b < d.blocks.size(); ++b) {
         std::vector<float> pts(&d.points.xyz[3 * d.blocks[b].first_point],
                                &d.points.xyz[3 * (d.blocks[b].first_point + d.blocks[b].points)]);
         if (b == 0) pts[0] += 1000;
         builder.add_block(pts.data(), d.blocks[b].points, d.blocks[b].last_of_fiber);
     }
-    EXPECT_EQ(builder.unbounded_blocks(), 1u);  // block 0's group
+    EXPECT_EQ(builder.unbounded_blocks(), 1u);
     const auto chunk = builder.finish();
     ASSERT_TRUE(chunk);
-    const FftFile patched(with_index_payload(file, chunk->payload, dir_->file("unbounded.fft")));
+    const FftFile patched(with_index_payload(file, chunk->payload, work_file("unbounded.fft")));
     const BlockIndex index = BlockIndex::load(patched);
     EXPECT_GT(index.block_box(0).max.x, 1e20f);
+    EXPECT_LT(index.block_box(1).max.x, 1e3f);
     std::vector<std::uint64_t> bits;
     index.blocks_near_sphere({-5000, 0, 0}, 1, bits);
-    // Block 0 and the other blocks of its group, none else.
-    const std::uint64_t group_end =
-        std::min<std::uint64_t>(kDefaultIndexGroupBlocks, patched.block_count(0));
-    for (std::size_t b = 0; b < d.blocks.size(); ++b) EXPECT_EQ(bit(bits, b), b < group_end) << "block " << b;
+    for (std::size_t b = 0; b < d.blocks.size(); ++b) EXPECT_EQ(bit(bits, b), b == 0) << "block " << b;
 }
 
 TEST_F(SelectIndex, BuilderRefusesLayoutsItCannotDescribe) {
@@ -419,18 +604,27 @@ TEST_F(SelectIndex, BuilderRefusesLayoutsItCannotDescribe) {
 }
 
 TEST_F(SelectIndex, ParallelPartsJoinToTheSameChunk) {
-    const FftFile file(fiblet_file());
-    const DecodedFile d = decode_everything(file);
-    IndexBuilder whole(file.header()), first(file.header()), second(file.header());
-    for (std::size_t b = 0; b < d.blocks.size(); ++b) {
-        const float* p = &d.points.xyz[3 * d.blocks[b].first_point];
-        whole.add_block(p, d.blocks[b].points, d.blocks[b].last_of_fiber);
-        (d.blocks[b].fiber < 400 ? first : second).add_block(p, d.blocks[b].points, d.blocks[b].last_of_fiber);
+    const std::string coarse = compressed("small-sdstream.tck", "sdstream-default.fft", CompressOptions{});
+    for (const auto& [path, format] :
+         {std::pair{fiblet_file(), BlockIndexFormat::block_boxes}, std::pair{coarse, BlockIndexFormat::group_boxes}}) {
+        const FftFile file(path);
+        const DecodedFile d = decode_everything(file);
+        IndexBuilder whole(file.header(), format), first(file.header(), format), second(file.header(), format);
+        EXPECT_EQ(whole.format(), format);
+        for (std::size_t b = 0; b < d.blocks.size(); ++b) {
+            const float* p = &d.points.xyz[3 * d.blocks[b].first_point];
+            whole.add_block(p, d.blocks[b].points, d.blocks[b].last_of_fiber);
+            (d.blocks[b].fiber < 400 ? first : second).add_block(p, d.blocks[b].points, d.blocks[b].last_of_fiber);
+        }
+        first.append(second);
+        EXPECT_EQ(first.finish()->payload, whole.finish()->payload) << path;
+        // ... and to what compress stored.
+        EXPECT_EQ(whole.finish()->payload, file.find_chunk(kBlockIndexTag)->payload) << path;
     }
-    first.append(second);
-    EXPECT_EQ(first.finish()->payload, whole.finish()->payload);
-    // ... and to what compress stored.
-    EXPECT_EQ(whole.finish()->payload, file.find_chunk(kBlockIndexTag)->payload);
+    // Parts of different formats do not join.
+    const FftHeader& h = FftFile(coarse).header();
+    IndexBuilder v2(h, BlockIndexFormat::group_boxes);
+    EXPECT_THROW(v2.append(IndexBuilder(h, BlockIndexFormat::block_boxes)), Error);
 }
 
 }  // namespace

@@ -83,6 +83,10 @@ protected:
                 o.direction_bits = 16;
                 compress_tck(shared_data("dwi-small64d-ifod1.tck"), fft, o);
                 break;
+            case 5:  // a version-2 index (a box per 8 blocks), as fiblet wrote it before version 3
+                s->name = "fiblet dwi-small64d, version-2 index";
+                fft = std::string(FIBLET_TESTS_DIR) + "/index-v2/dwi-small64d-ifod1.fft";
+                break;
             default:  // 16-bit directions, 400 points a block (2-byte counts in the index)
                 s->name = "fiblet 16-bit CST_R, 400 points a block";
                 fft = dir_->file("cst16.fft");
@@ -404,7 +408,7 @@ TEST_P(SelectQuery, SubsetFileDecodesToTheSelection) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Files, SelectQuery, ::testing::Values(0, 1, 2, 3, 4));
+INSTANTIATE_TEST_SUITE_P(Files, SelectQuery, ::testing::Values(0, 1, 2, 3, 4, 5));
 
 TEST(SelectQueryErrors, BadQueriesAreRejectedBeforeReading) {
     if (!shared_data_available()) GTEST_SKIP() << "no shared data";

@@ -10,6 +10,7 @@
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
+#include "fiblet/index_format.hpp"
 #include "fiblet/streamline_io.hpp"
 #include "fiblet/tck.hpp"
 
@@ -38,6 +39,13 @@ struct ExitCodeInfo {
     const char* meaning;
 };
 const std::vector<ExitCodeInfo>& exit_code_table();
+
+// --fine-index (compress, extract -o x.fft): the flag that writes the
+// block index's version 3 (a box per block) instead of the default version 2.
+void add_fine_index_flag(CLI::App* cmd, bool& fine_index);
+inline BlockIndexFormat index_format_for(bool fine_index) {
+    return fine_index ? BlockIndexFormat::block_boxes : kDefaultBlockIndexFormat;
+}
 
 // Progress on stderr, only when stderr is a terminal and not --quiet.
 class Progress {

@@ -32,7 +32,7 @@ struct CompressArgs {
     std::optional<std::size_t> tuning_points;
     // The seekable zstd container.
     bool zstd = false, no_transpose = false;
-    bool no_index = false;
+    bool no_index = false, fine_index = false;
     int zstd_level = ZstdOptions{}.level;
     std::uint32_t zstd_group = ZstdOptions{}.group_blocks;
     bool force = false, quiet = false, json = false, allow_count_mismatch = false, recursive = false;
@@ -170,6 +170,7 @@ void run(const CompressArgs& args) {
         if (a.tuning_points) o.tuning_points = *a.tuning_points;
         if (a.zstd) o.zstd = ZstdOptions{a.zstd_level, a.zstd_group, !a.no_transpose};
         o.block_index = !a.no_index;
+        o.index_format = index_format_for(a.fine_index);
         const std::string name = std::filesystem::path(in).filename().string();
         o.progress = [&](const char* phase, double f) { progress.update(name + ": " + phase, f); };
         try {
@@ -270,6 +271,7 @@ void add_compress(CLI::App& app) {
     cmd->add_option("--step-scale", args->step_scale, "Decoder step / sampling step (default: tuned on a sample)");
     cmd->add_flag("--no-index", args->no_index,
                   "Leave out the block index (BIDX chunk, under 1 % of the file; extract and render compute it on load)");
+    add_fine_index_flag(cmd, args->fine_index);
     cmd->add_flag("-z,--zstd", args->zstd,
                   "Write the seekable zstd container (.fftz, formats/fftz.md): smaller, still random access "
                   "(-o x.fftz implies it)");

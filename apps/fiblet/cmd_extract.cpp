@@ -36,6 +36,7 @@ struct ExtractArgs {
     std::string camera_position, camera_target, camera_up = "0,1,0", lod;
     float fov = 45, aspect = 16.0f / 9.0f, near_mm = 1, far_mm = 2000, lod_pixels = kDefaultLodPixels;
     bool no_cull = false, compute_index = false, force = false, quiet = false, json = false;
+    bool fine_index = false;  // a .fft output's block index: version 3
 };
 
 [[noreturn]] void usage(const std::string& what) { throw Error(Errc::invalid_argument, what); }
@@ -174,7 +175,7 @@ void run(const ExtractArgs& a) {
         bytes = std::filesystem::file_size(a.output);
     } else {
         const auto runs = select_runs(file, index, query, &stats);
-        bytes = write_fft_subset(file, runs, a.output, a.force).bytes;
+        bytes = write_fft_subset(file, runs, a.output, a.force, index_format_for(a.fine_index)).bytes;
     }
     const auto t1 = std::chrono::steady_clock::now();
     auto secs = [](auto from, auto to) { return std::chrono::duration<double>(to - from).count(); };
@@ -184,7 +185,7 @@ void run(const ExtractArgs& a) {
         j.str("input", a.input).str("output", a.output).str("index", source);
         j.integer("fibers", stats.fibers).integer("streamlines", stats.runs).integer("blocks", stats.blocks);
         j.integer("coarse_blocks", stats.coarse_blocks).integer("points", stats.points);
-        j.integer("source_blocks", h.blocks).integer("blocks_read", stats.blocks_read);
+        j.integer("source_blocks", h.blocks).integer("blocks_tested", stats.blocks_tested).integer("blocks_read", stats.blocks_read);
         j.integer("blocks_decoded", stats.blocks_decoded).integer("output_bytes", bytes);
         j.num("index_seconds", secs(t_open, t_index)).num("select_seconds", secs(t_index, t1));
         j.num("seconds", secs(t0, t1));
@@ -241,6 +242,7 @@ void add_extract(CLI::App& app) {
     cmd->add_option("--lod", args->lod, "Level of detail for a viewport WIDTHxHEIGHT (pixels): .tck output only");
     cmd->add_option("--lod-pixels", args->lod_pixels, "Blocks under this many pixels become one segment (default 4)");
     cmd->add_flag("--compute-index", args->compute_index, "Compute the block index by decoding, ignoring a stored one");
+    add_fine_index_flag(cmd, args->fine_index);
     cmd->add_flag("-f,--force", args->force, "Overwrite an existing output");
     cmd->add_flag("-q,--quiet", args->quiet, "Print nothing but errors");
     cmd->add_flag("--json", args->json, "Print the summary as JSON");

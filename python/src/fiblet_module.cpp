@@ -332,9 +332,10 @@ py::dict stats(const std::string& fft_path, const std::string& reference) {
 // Same keys as `fiblet compress --json`.
 // zstd: the seekable zstd container (.fftz) with the defaults of `fiblet compress --zstd`.
 py::dict compress(const std::string& tck_path, const std::string& fft_path, std::optional<double> step_mm,
-                  bool overwrite, unsigned threads, bool zstd, std::uint64_t max_memory) {
+                  bool overwrite, unsigned threads, bool zstd, std::uint64_t max_memory, bool fine_index) {
     CompressOptions o;
     o.step_mm = step_mm, o.overwrite = overwrite, o.threads = threads, o.max_memory = max_memory;
+    o.index_format = fine_index ? BlockIndexFormat::block_boxes : kDefaultBlockIndexFormat;
     if (zstd) o.zstd = ZstdOptions{};
     CompressReport r;
     {
@@ -478,7 +479,7 @@ PYBIND11_MODULE(_fiblet, m) {
     m.def("info", &info, py::arg("path"), py::arg("ignore_trailer"));
     m.def("stats", &stats, py::arg("fft"), py::arg("reference"));
     m.def("compress", &compress, py::arg("tck"), py::arg("fft"), py::arg("step_mm"), py::arg("overwrite"),
-          py::arg("threads"), py::arg("zstd"), py::arg("max_memory"));
+          py::arg("threads"), py::arg("zstd"), py::arg("max_memory"), py::arg("fine_index"));
     m.def("read_streamlines", &read_streamlines, py::arg("path"));
     m.def("data", &data, py::arg("path"), py::arg("fiber_points"));
     m.def("container", &container_of, py::arg("path"));

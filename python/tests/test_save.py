@@ -184,6 +184,22 @@ def test_save_fft_and_fftz_compress_as_the_cli_does(tmp_path, shared, cli, dwi_s
     assert (tmp_path / f"py{ext}").read_bytes() == (tmp_path / f"cli{ext}").read_bytes()
 
 
+def test_save_fine_index_writes_what_compress_fine_index_does(tmp_path, shared, cli):
+    # fine_index=True: the block index's version 3, byte for byte as `fiblet
+    # compress --fine-index`; the default stays `fiblet compress`'s version 2.
+    tck = shared / "dwi-small64d-ifod1.tck"
+    fiblet.save(tmp_path / "py.fft", tck, fine_index=True)
+    fiblet.save(tmp_path / "py-default.fft", tck)
+    subprocess.run([cli, "compress", "-q", "--fine-index", str(tck), "-o", str(tmp_path / "cli.fft")], check=True)
+    subprocess.run([cli, "compress", "-q", str(tck), "-o", str(tmp_path / "cli-default.fft")], check=True)
+    assert (tmp_path / "py.fft").read_bytes() == (tmp_path / "cli.fft").read_bytes()
+    assert (tmp_path / "py-default.fft").read_bytes() == (tmp_path / "cli-default.fft").read_bytes()
+    assert (tmp_path / "py.fft").read_bytes() != (tmp_path / "py-default.fft").read_bytes()
+    with pytest.raises(ValueError, match="fine_index"):
+        fiblet.save(tmp_path / "out.tck", tck, fine_index=True)
+    assert not (tmp_path / "out.tck").exists()
+
+
 @pytest.mark.parametrize("name", ["out.vtk", "out.txt", "out", "out.fft.gz", "out.tck.bak", "out.nii"])
 def test_save_refuses_other_extensions_and_writes_nothing(tmp_path, shared, name):
     fibers = [np.array([[0, 0, 0], [0.1, 0, 0], [0.2, 0, 0]], np.float32)]

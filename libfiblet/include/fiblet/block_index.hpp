@@ -2,18 +2,23 @@
 // volume hierarchy over them, so that a query finds the blocks near a region
 // without reading (let alone decoding) the others.
 //
-// On disk it is the optional "BIDX" trailer chunk (formats/fft-index.md):
-// one quantized box per group of up to 8 consecutive blocks of a fiber in 28
-// bits, plus one byte per fiber (two when blocks hold more than 255
-// points): under 1 % of a file. A selection narrows a group down to its
-// blocks with each block's own view sphere (from its header, no decoding).
-// Files without it (e.g. from the official encoder) get an index of exact
-// per-block boxes computed on load by decoding every block once. The
-// hierarchy is never stored: it is rebuilt in memory on load.
+// On disk it is the optional "BIDX" trailer chunk (formats/fft-index.md),
+// in one of two versions a writer chooses (BlockIndexFormat): version 2
+// (the default) stores a quantized box per group of up to 8 consecutive
+// blocks of a fiber in 28 bits; version 3 stores a box per block on a grid
+// of half a block's path, range-coded against the previous block's box
+// (about 5 bits a block): fewer candidate blocks for a selection, but about
+// 20x slower to load (a serial decoder). Both add one byte per fiber (two
+// when blocks hold more than 255 points): under 1 % of a file. Version 1 (a
+// box per block, 28 bits) is still read. Files without it (e.g. from the
+// official encoder) get an index of exact per-block boxes computed on load
+// by decoding every block once. The hierarchy is never stored: it is
+// rebuilt in memory on load.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -21,24 +26,33 @@
 #include "fiblet/fft_file.hpp"
 #include "fiblet/fft_format.hpp"
 #include "fiblet/image_mask.hpp"
+#include "fiblet/index_format.hpp"
 #include "fiblet/view.hpp"
 
 namespace fiblet {
 
 inline constexpr std::array<char, 4> kBlockIndexTag = {'B', 'I', 'D', 'X'};
-inline constexpr unsigned kDefaultIndexBitsPerBlock = 28;  // bits per box code
-inline constexpr std::uint32_t kDefaultIndexGroupBlocks = 8;
+// Blocks under one leaf box of the in-memory hierarchy over a version-3
+// index (the leaf's blocks' boxes are tested one by one).
+inline constexpr std::uint32_t kIndexLeafBlocks = 8;
 
 // Accumulates the bounds of blocks as they are written (compress, extract)
-// and serializes them as a BIDX chunk: one box per group of group_blocks
-// consecutive blocks of a fiber. Blocks come in file order, a fiber at a
+// and serializes them as a BIDX chunk of the chosen format: version 2, a
+// box per group of 8 consecutive blocks of a fiber (4 bytes a group), or
+// version 3, a box per block (kept, 20 bytes a block, until appended or
+// finished, then range-coded; a version-3 builder that has codes takes
+// appends, never is appended). Blocks come in file order, a fiber at a
 // time; builders filled in parallel on consecutive fibers are joined in
-// order with append(). Memory: 4 bytes per group.
+// order with append() (builders of one format).
 class IndexBuilder {
 public:
-    IndexBuilder() = default;  // unusable until assigned from a header-built one
-    explicit IndexBuilder(const FftHeader& header, unsigned bits_per_box = kDefaultIndexBitsPerBlock,
-                          std::uint32_t group_blocks = kDefaultIndexGroupBlocks);
+    IndexBuilder();  // unusable until assigned from a header-built one
+    explicit IndexBuilder(const FftHeader& header, BlockIndexFormat format = kDefaultBlockIndexFormat);
+    IndexBuilder(const IndexBuilder&);
+    IndexBuilder& operator=(const IndexBuilder&);
+    IndexBuilder(IndexBuilder&&) noexcept;
+    IndexBuilder& operator=(IndexBuilder&&) noexcept;
+    ~IndexBuilder();
 
     // The decoded points (world mm) of one whole fiber laid out as the
     // encoder does: blocks of points_per_block points, the last one the rest.
@@ -51,9 +65,10 @@ public:
 
     std::uint64_t blocks() const { return blocks_; }
     std::uint64_t fibers() const { return last_points_.size(); }
-    std::uint64_t groups() const { return codes_.size(); }
-    // Groups too large for the grid, stored as "unbounded" (never culled).
-    std::uint64_t unbounded_blocks() const { return unbounded_; }
+    BlockIndexFormat format() const;
+    // Boxes too large for the grid (groups in version 2, blocks in version
+    // 3), stored as "unbounded" (never culled).
+    std::uint64_t unbounded_blocks() const;
 
     // The BIDX chunk, or nullopt when the layout cannot be described: a
     // block other than the last of its fiber holds fewer than
@@ -61,35 +76,27 @@ public:
     std::optional<TrailerChunk> finish() const;
 
 private:
-    struct Grid {
-        Vec3f origin{};
-        float cell = 1;
-        std::uint32_t min_levels = 1, extent_levels = 1;
-    };
-    void add_box(const Aabb& box, std::uint32_t n, bool last_of_fiber, float sphere_radius);
-    void close_group();
+    struct Coder;  // the boxes as the chosen format stores them (index_builder.cpp)
+    struct GroupCoder;
+    struct BlockCoder;
 
     FftHeader header_;
-    unsigned bits_ = kDefaultIndexBitsPerBlock;
-    std::uint32_t group_blocks_ = kDefaultIndexGroupBlocks;
-    Grid grid_;
-    std::vector<std::uint32_t> codes_;  // per closed group
-    Aabb group_box_{};                  // the open group's bounds
-    std::uint32_t group_fill_ = 0;      // blocks in the open group
+    std::unique_ptr<Coder> coder_;
     std::uint64_t blocks_ = 0;
     std::vector<std::uint16_t> last_points_;
     std::uint32_t open_fiber_blocks_ = 0;  // blocks of the fiber being added
     bool layout_ok_ = true;
-    std::uint64_t unbounded_ = 0;
     float max_sphere_radius_ = 0;
     double max_join_ = 0;     // largest |last point of a block - first point of the next| in a fiber
     Vec3f last_point_{};      // of the last block added
 };
 
 // The index of one file, in memory: boxes of groups of consecutive blocks
-// (a stored chunk's groups, or one exact box per block when computed),
-// per-fiber point counts, and a bounding volume hierarchy (8-wide, over the
-// groups sorted along a Morton curve) to find the blocks that meet a region.
+// (a version-2 chunk's groups; one box per block from a version-1 chunk or
+// computed exactly; for a version-3 chunk, groups of kIndexLeafBlocks
+// bounding their blocks' own boxes), per-fiber point counts, and a bounding
+// volume hierarchy (8-wide, over the groups sorted along a Morton curve) to
+// find the blocks that meet a region.
 class BlockIndex {
 public:
     enum class Source { chunk, decoded };
@@ -101,20 +108,23 @@ public:
     static BlockIndex compute(const FftFile& file);
 
     Source source() const { return source_; }
+    // The stored chunk's version (1, 2 or 3; BlockIndexFormat's values for
+    // those fiblet writes); 0 when computed.
+    std::uint32_t chunk_version() const { return chunk_version_; }
     std::uint64_t blocks() const { return blocks_; }
-    // Boxes: groups of consecutive blocks of a fiber (one block each when
-    // computed).
+    // Leaf boxes of the hierarchy: groups of consecutive blocks of a fiber
+    // (one block each when computed).
     std::uint64_t groups() const { return order_.size(); }
     std::uint64_t fibers() const { return fiber_points_.size(); }
     std::uint64_t fiber_points(std::uint64_t fiber) const { return fiber_points_[fiber]; }
-    // Bounds of every point a block decodes to: its group's box
-    // (conservative; escaped groups have an unbounded box).
+    // Bounds of every point a block decodes to: its own box, or its group's
+    // (version 2) (conservative; escaped ones are unbounded).
     Aabb block_box(std::uint64_t block) const;
     // Every block's view sphere (view.hpp) has a radius at most this.
     float max_sphere_radius() const { return max_sphere_radius_; }
     // A block's last point lies at most this far (mm) from the next block's
     // first point of its fiber; negative when unknown (version-1 chunks,
-    // computed indexes, whose boxes bound single blocks).
+    // computed indexes).
     float max_join() const { return max_join_; }
 
     // Blocks whose box may meet a sphere / a box / the frustum grown by
@@ -133,12 +143,14 @@ public:
 private:
     BlockIndex() = default;
     void set_blocks(std::vector<Aabb> boxes);  // one group per block; sorts and builds the hierarchy
+    void set_groups(const std::vector<Aabb>& boxes);  // of group_first_'s groups; sorts and builds it
     template <class BoxOf>
     void build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of);  // (Morton key << 32 | group)
     template <class Classify>
     void collect(const Classify& classify, std::vector<std::uint64_t>& bits, std::vector<std::uint64_t>* inside) const;
 
     Source source_ = Source::decoded;
+    std::uint32_t chunk_version_ = 0;
     std::vector<std::uint64_t> fiber_points_;
     float max_sphere_radius_ = 0;
     float max_join_ = -1;
@@ -148,6 +160,8 @@ private:
     std::vector<std::uint32_t> order_;           // Morton position -> group
     std::vector<std::uint32_t> rank_;            // group -> Morton position
     std::vector<std::vector<Aabb>> levels_;      // levels_[k][j]: node j of level k (k = 0: leaves)
+    std::vector<Aabb> block_boxes_;              // version 3: per block, leaf after leaf in Morton order
+    std::vector<std::uint32_t> leaf_first_box_;  // Morton position -> its first block box; one more: blocks_
 };
 
 }  // namespace fiblet

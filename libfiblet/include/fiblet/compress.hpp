@@ -12,6 +12,7 @@
 #include "fiblet/error_stats.hpp"
 #include "fiblet/fft_format.hpp"
 #include "fiblet/geometry_error.hpp"
+#include "fiblet/index_format.hpp"
 #include "fiblet/tractogram_space.hpp"
 
 namespace fiblet {
@@ -51,7 +52,10 @@ struct CompressOptions {
     std::optional<double> step_scale;         // decoder step / sampling step; default: tuned on a sample
     std::size_t tuning_points = 1u << 14;     // points in the tuning sample (8k to 32k choose alike)
     std::optional<ZstdOptions> zstd;          // write the seekable zstd container instead of a plain file
-    bool block_index = true;                  // write the BIDX chunk (formats/fft-index.md; ~5 % of the file)
+    bool block_index = true;                  // write the BIDX chunk (formats/fft-index.md; under 1 % of the file)
+    // Its version: a box per 8 blocks (default: loads in a few ms) or a box
+    // per block (fewer candidate blocks for selections, ~20x slower to load).
+    BlockIndexFormat index_format = kDefaultBlockIndexFormat;
     double step_tolerance = 0.01;             // relative spacing deviation that triggers resampling
     unsigned threads = 0;                     // encoding threads; 0 = all cores
     bool overwrite = false;

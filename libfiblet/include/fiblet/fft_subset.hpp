@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fiblet/fft_file.hpp"
+#include "fiblet/index_format.hpp"
 #include "fiblet/select.hpp"
 
 namespace fiblet {
@@ -23,9 +24,9 @@ struct SubsetReport {
 // PROP and RSMP chunks, the ENDS fractions and DATA arrays of the kept
 // runs (a per-streamline row per run, the run's per-point rows, groups
 // listing the runs of their fibers), and gets a fresh BIDX index and CSUM
-// checksums. Runs with coarse blocks
-// (a level of detail) cannot be stored: Error{invalid_argument}.
+// checksums (the index in `index_format`, index_format.hpp). Runs with
+// coarse blocks (a level of detail) cannot be stored: Error{invalid_argument}.
 SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedRun>& runs, const std::string& path,
-                              bool overwrite);
+                              bool overwrite, BlockIndexFormat index_format = kDefaultBlockIndexFormat);
 
 }  // namespace fiblet

@@ -127,6 +127,7 @@ struct SelectionStats {
     std::uint64_t blocks = 0;          // blocks kept (fine + coarse)
     std::uint64_t coarse_blocks = 0;
     std::uint64_t points = 0;          // points output
+    std::uint64_t blocks_tested = 0;   // candidates the index let through, tested by header or points (all passes)
     std::uint64_t blocks_read = 0;     // blocks read or accessed in the mapping (all passes)
     std::uint64_t blocks_decoded = 0;  // blocks decoded (all passes)
 };

@@ -410,7 +410,7 @@ void CompressJob::encode() {
     // Resampled fibers keep their true end points: one last-step fraction
     // per fiber (the ENDS chunk, formats/fft-ends.md), 2 bytes a fiber.
     end_fractions_ = FiberEndFractions(report.resampled ? report.scan.fibers : 0, kWholeLastStep);
-    index_.emplace(h);
+    index_.emplace(h, options_.index_format);
     const detail::EncodeStageInputs in{.encoder = *encoder_,
                                        .step = report.resampled ? step_ : 0.0,
                                        .point_fields = &*point_fields_,
@@ -430,7 +430,7 @@ void CompressJob::finish() {
     std::optional<TrailerChunk> index_chunk;
     if (options_.block_index) {
         const detail::StageClock clock(report.timings.index);
-        index_chunk = std::exchange(*index_, IndexBuilder(h)).finish();
+        index_chunk = std::exchange(*index_, IndexBuilder()).finish();
     }
     const detail::StageClock clock(report.timings.write);  // the trailer and the commit
     if (report.resampled) report.error_vs_original = report.geometry.decoded_to_input();

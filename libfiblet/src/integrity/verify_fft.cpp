@@ -20,15 +20,16 @@ namespace {
 // checksum can (a file may have none, or a writer may have been wrong): the
 // header's point count, the BIDX chunk's per-fiber counts and boxes, and
 // that every decoded point is finite. The chunk is read as parsed (2 bytes a
-// fiber, 4 a group of blocks), not as a BlockIndex, so verify's memory stays near the
-// open file's 12 bytes a fiber.
+// fiber, 4 a group of blocks; version 3: 24 bytes a block), not as a
+// BlockIndex with its hierarchy.
 class BlockCrossCheck {
 public:
     // Decoded as every reader decodes them: with the file's kept fiber ends.
     explicit BlockCrossCheck(const FftFile& file) : file_(file), ctx_(file) {
         if (const TrailerChunk* c = file.find_chunk(kBlockIndexTag)) {
             index_.emplace(detail::parse_index_chunk(c->payload, file.header(), file.path()));
-            boxes_.emplace(index_->grid);
+            if (index_->version == 3) block_boxes_ = detail::index_block_boxes(*index_, c->payload, file);
+            else boxes_.emplace(index_->grid);  // versions 1 and 2: codes
         }
     }
     bool checks_index() const { return index_.has_value(); }
@@ -66,15 +67,16 @@ private:
     }
 
     void check_points(std::uint64_t block, const float* p, std::uint32_t n) const {
-        // The block's box is its group's: G blocks at a time from its fiber's first.
+        // The block's box is its group's: G blocks at a time from its fiber's
+        // first (version 3: G = 1, its own box).
         const std::uint64_t group = index_ ? group_base_ + (block_in_fiber_ - 1) / index_->group_blocks : 0;
         if (index_ && group >= index_->groups)
             fail("the fibers have more groups than the BIDX chunk stores (" + std::to_string(index_->groups) + ")");
-        const Aabb box = boxes_ ? boxes_->box(index_->codes[group]) : Aabb{};
+        const Aabb box = !index_ ? Aabb{} : boxes_ ? boxes_->box(index_->codes[group]) : block_boxes_[group];
         for (std::uint32_t i = 0; i < n; ++i, p += 3) {
             if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])))
                 fail("block " + std::to_string(block) + " decodes to a non-finite point");
-            if (boxes_ && !(p[0] >= box.min.x && p[0] <= box.max.x && p[1] >= box.min.y && p[1] <= box.max.y &&
+            if (index_ && !(p[0] >= box.min.x && p[0] <= box.max.x && p[1] >= box.min.y && p[1] <= box.max.y &&
                             p[2] >= box.min.z && p[2] <= box.max.z))
                 fail("block " + std::to_string(block) +
                      " decodes to points outside its box in the BIDX chunk (a selection would lose them)");
@@ -120,7 +122,8 @@ private:
     const FftFile& file_;
     DecodeContext ctx_;
     std::optional<detail::IndexChunk> index_;
-    std::optional<detail::IndexBoxDecoder> boxes_;
+    std::optional<detail::IndexBoxDecoder> boxes_;  // versions 1 and 2
+    std::vector<Aabb> block_boxes_;                 // version 3
     std::vector<float> xyz_;
     std::uint64_t fiber_ = 0, block_in_fiber_ = 0, fiber_points_ = 0, points_ = 0, group_base_ = 0;
     bool started_ = false;

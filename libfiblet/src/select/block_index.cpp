@@ -1,5 +1,5 @@
-// BlockIndex: per-block boxes (from the BIDX chunk or computed by decoding)
-// and an 8-wide bounding volume hierarchy over them, built in memory.
+// BlockIndex: block or group boxes (from the BIDX chunk or computed by
+// decoding) and an 8-wide bounding volume hierarchy over them, built in memory.
 #include "fiblet/block_index.hpp"
 
 #include <algorithm>
@@ -67,14 +67,18 @@ BlockIndex BlockIndex::load(const FftFile& file) {
     };
     BlockIndex index;
     index.source_ = Source::chunk;
+    index.chunk_version_ = c.version;
     index.blocks_ = h.blocks;
     index.max_sphere_radius_ = c.max_sphere_radius;
     index.max_join_ = c.max_join;
     // Fiber point counts: full blocks but the last (checked against the
-    // header's total); groups: G blocks at a time from each fiber's first.
+    // header's total); groups: G blocks at a time from each fiber's first
+    // (version 3: the hierarchy's leaves, over the blocks' own boxes).
+    const bool per_block = c.version == 3;
+    const std::uint32_t group_blocks = per_block ? kIndexLeafBlocks : c.group_blocks;
     index.fiber_points_.resize(h.fibers);
     index.group_first_.clear();
-    index.group_first_.reserve(c.groups + 1);
+    index.group_first_.reserve((per_block ? h.blocks / group_blocks + h.fibers : c.groups) + 1);
     std::uint64_t total = 0;
     for (std::uint64_t f = 0; f < h.fibers; ++f) {
         const std::uint32_t nb = file.block_count(f);
@@ -82,17 +86,34 @@ BlockIndex BlockIndex::load(const FftFile& file) {
         if ((nb == 0) != (last == 0)) bad("fiber " + std::to_string(f) + " point count disagrees with its blocks");
         index.fiber_points_[f] = nb == 0 ? 0 : std::uint64_t(nb - 1) * h.points_per_block + last;
         total += index.fiber_points_[f];
-        if (index.group_first_.size() + detail::index_groups_of_fiber(nb, c.group_blocks) > c.groups)
-            bad("its fibers have more groups of " + std::to_string(c.group_blocks) + " blocks than it stores");
-        for (std::uint32_t k = 0; k < nb; k += c.group_blocks)
+        if (!per_block && index.group_first_.size() + detail::index_groups_of_fiber(nb, group_blocks) > c.groups)
+            bad("its fibers have more groups of " + std::to_string(group_blocks) + " blocks than it stores");
+        for (std::uint32_t k = 0; k < nb; k += group_blocks)
             index.group_first_.push_back(std::uint32_t(file.first_block(f) + k));
     }
-    if (index.group_first_.size() != c.groups)
+    if (!per_block && index.group_first_.size() != c.groups)
         bad("it stores " + std::to_string(c.groups) + " groups, its fibers have " +
             std::to_string(index.group_first_.size()));
     index.group_first_.push_back(std::uint32_t(h.blocks));
     if (total != h.points)
         bad("its fibers hold " + std::to_string(total) + " points, the header says " + std::to_string(h.points));
+    if (per_block) {
+        const std::vector<Aabb> boxes = detail::index_block_boxes(c, chunk->payload, file);
+        std::vector<Aabb> leaves(index.group_first_.size() - 1, empty_box());
+        for (std::size_t g = 0; g < leaves.size(); ++g)
+            for (std::uint32_t b = index.group_first_[g]; b < index.group_first_[g + 1]; ++b) grow(leaves[g], boxes[b]);
+        index.set_groups(leaves);
+        // Block boxes in the leaves' Morton order, as a query walks them.
+        index.block_boxes_.reserve(boxes.size());
+        index.leaf_first_box_.reserve(leaves.size() + 1);
+        for (const std::uint32_t g : index.order_) {
+            index.leaf_first_box_.push_back(std::uint32_t(index.block_boxes_.size()));
+            index.block_boxes_.insert(index.block_boxes_.end(), boxes.begin() + index.group_first_[g],
+                                      boxes.begin() + index.group_first_[g + 1]);
+        }
+        index.leaf_first_box_.push_back(std::uint32_t(index.block_boxes_.size()));
+        return index;
+    }
     // Morton keys straight from the codes' cells, then boxes decoded in that order.
     const detail::IndexBoxDecoder decoder(c.grid);
     unsigned shift = 0;
@@ -114,6 +135,7 @@ BlockIndex BlockIndex::load(const FftFile& file) {
 Aabb BlockIndex::block_box(std::uint64_t block) const {
     const auto g = std::size_t(std::upper_bound(group_first_.begin(), group_first_.end() - 1, std::uint32_t(block)) -
                                group_first_.begin()) - 1;
+    if (!block_boxes_.empty()) return block_boxes_[leaf_first_box_[rank_[g]] + (block - group_first_[g])];
     return sorted_boxes_[rank_[g]];
 }
 
@@ -159,9 +181,13 @@ BlockIndex BlockIndex::compute(const FftFile& file) {
 }
 
 void BlockIndex::set_blocks(std::vector<Aabb> boxes) {
+    group_first_.resize(boxes.size() + 1);
+    for (std::size_t b = 0; b < group_first_.size(); ++b) group_first_[b] = std::uint32_t(b);
+    set_groups(boxes);
+}
+
+void BlockIndex::set_groups(const std::vector<Aabb>& boxes) {
     const std::size_t n = boxes.size();
-    group_first_.resize(n + 1);
-    for (std::size_t b = 0; b <= n; ++b) group_first_[b] = std::uint32_t(b);
     // Morton order of the box centres over the bounds of the bounded ones;
     // unbounded boxes go last, so that they spoil one path of the tree only.
     Aabb all = empty_box();
@@ -225,6 +251,16 @@ void BlockIndex::collect(const Classify& classify, std::vector<std::uint64_t>& b
         const std::uint32_t g = order_[pos];
         for (std::uint32_t b = group_first_[g]; b < group_first_[g + 1]; ++b) set_bit(to, b);
     };
+    // Those of its blocks whose own box meets the region.
+    auto mark_blocks = [&](std::size_t pos) {
+        const std::uint32_t g = order_[pos];
+        const Aabb* box = &block_boxes_[leaf_first_box_[pos]];
+        for (std::uint32_t b = group_first_[g]; b < group_first_[g + 1]; ++b, ++box) {
+            const Overlap o = classify(*box);
+            if (o != Overlap::outside) set_bit(bits, b);
+            if (o == Overlap::inside && inside) set_bit(*inside, b);
+        }
+    };
     // Positions covered by node j of level k: [j * span, (j + 1) * span), span = 8^(k+1).
     auto mark_all = [&](std::size_t first, std::size_t last) {
         for (std::size_t pos = first; pos < std::min(last, n); ++pos) {
@@ -239,6 +275,10 @@ void BlockIndex::collect(const Classify& classify, std::vector<std::uint64_t>& b
         if (k == 0) {
             for (std::size_t pos = j * kFanout; pos < std::min(n, (j + 1) * kFanout); ++pos) {
                 const Overlap b = classify(sorted_boxes_[pos]);
+                if (b == Overlap::partial && !block_boxes_.empty()) {
+                    mark_blocks(pos);
+                    continue;
+                }
                 if (b != Overlap::outside) mark(bits, pos);
                 if (b == Overlap::inside && inside) mark(*inside, pos);
             }

@@ -133,7 +133,7 @@ TrailerChunk subset_streamline_data(const FftFile& source, const std::vector<Sel
 }  // namespace
 
 SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedRun>& runs, const std::string& path,
-                              bool overwrite) {
+                              bool overwrite, BlockIndexFormat index_format) {
     const FftHeader& src = source.header();
     if (runs.size() > std::numeric_limits<std::uint32_t>::max())
         throw Error(Errc::unsupported, path + ": more than 2^32 - 1 fibers (fiber IDs are 32-bit)");
@@ -175,7 +175,7 @@ SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedR
     }
     const DecodeContext ctx(source);
     const std::uint32_t bb = h.block_bytes();
-    IndexBuilder index(h);
+    IndexBuilder index(h, index_format);
     std::vector<std::uint8_t> raw, packed;
     std::vector<std::uint32_t> packed_sizes;
     std::vector<float> xyz;

@@ -1,45 +1,65 @@
 // Internal: the BIDX chunk's layout (formats/fft-index.md): the grid that
-// quantizes block boxes, the packing of the per-block codes, and parsing
-// with validation.
+// quantizes boxes, the fields of the chunk, and parsing with validation.
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
+#include "fiblet/fft_file.hpp"
 #include "fiblet/fft_format.hpp"
 #include "fiblet/view.hpp"
+#include "select/box_stream.hpp"
 
 namespace fiblet::detail {
 
-// Version 2 bounds groups of consecutive blocks of a fiber (64-byte
-// header); version 1, one box per block (56-byte header), is still read.
-inline constexpr std::uint32_t kIndexChunkVersion = 2;
-inline constexpr std::size_t kIndexChunkHeaderBytes = 72, kIndexChunkV1HeaderBytes = 56;
+// Version 3 (written on request) bounds every block, its boxes range-coded
+// (box_stream.hpp); version 2 (written by default) bounds groups of
+// consecutive blocks of a fiber, a fixed-width code each; version 1 (a box
+// per block, fixed width) is still read.
+inline constexpr std::uint32_t kIndexChunkVersion = 3;
+inline constexpr std::uint32_t kIndexChunkV2Version = 2;
+inline constexpr unsigned kIndexV2BitsPerBox = 28;  // bits per group box code
+inline constexpr std::uint32_t kIndexV2GroupBlocks = 8;
+inline constexpr std::size_t kIndexChunkHeaderBytes = 64, kIndexChunkV2HeaderBytes = 72,
+                             kIndexChunkV1HeaderBytes = 56;
 
 // Boxes are stored on a cubic grid: on each axis a box is [origin + i*cell,
-// origin + (i+e)*cell] with i < min_levels and e < extent_levels, the axis
-// code is i*extent_levels + e, and the block code is the three axis codes in
-// mixed radix (x fastest). The all-ones code of `bits` bits means
-// "unbounded" (a block that does not fit the grid).
+// origin + (i+e)*cell] with i < min_levels and e < extent_levels. Versions
+// 1 and 2 store a box as one code: the three axis codes i*extent_levels + e
+// in mixed radix (x fastest), the all-ones code of `bits` bits meaning
+// "unbounded" (a group that does not fit the grid). Version 3 codes i and e
+// themselves (GridBox).
 struct IndexGrid {
     Vec3f origin{};
     float cell = 1;
     std::uint32_t min_levels = 1, extent_levels = 1;
-    unsigned bits = 28;
+    unsigned bits = 28;  // versions 1 and 2
 
     std::uint32_t axis_levels() const { return min_levels * extent_levels; }
     std::uint32_t unbounded_code() const { return bits >= 32 ? 0xffffffffu : (1u << bits) - 1; }
 
-    // The grid for a file: covers the normalized cube (with a margin) and
-    // makes the cells as small as `bits` allow for groups of `group_blocks`
-    // blocks, up to group_blocks * points_per_block steps across.
-    static IndexGrid for_header(const FftHeader& h, unsigned bits, std::uint32_t group_blocks);
-    // Conservative code of a box (the decoded box contains it, with a small
-    // slack for float rounding), or unbounded_code().
+    // The version-3 grid of a file: covers the normalized cube (with a
+    // margin) in cells of half a block's path.
+    static IndexGrid for_blocks(const FftHeader& h);
+    // The version-2 grid of a file: covers the normalized cube (with a
+    // margin) and makes the cells as small as `bits` allow for groups of
+    // `group_blocks` blocks, up to group_blocks * points_per_block steps across.
+    static IndexGrid for_groups(const FftHeader& h, unsigned bits, std::uint32_t group_blocks);
+    // Conservative grid box of a box (its bounds contain it, with a small
+    // slack for float rounding), or nullopt when it does not fit the grid.
+    std::optional<GridBox> quantize(const Aabb& box) const;
+    Aabb bounds(const GridBox& b) const;
+    // Version 2: the conservative code of a box (the decoded box contains
+    // it, with the same slack), or unbounded_code().
     std::uint32_t encode(const Aabb& box) const;
 };
 
 inline constexpr float kUnboundedExtentMm = 1e30f;
+inline Aabb unbounded_box() {
+    return {{-kUnboundedExtentMm, -kUnboundedExtentMm, -kUnboundedExtentMm},
+            {kUnboundedExtentMm, kUnboundedExtentMm, kUnboundedExtentMm}};
+}
 
 // Decodes codes into boxes (unbounded ones span +-1e30 mm) with per-axis
 // tables: no integer division per block.
@@ -48,9 +68,7 @@ public:
     explicit IndexBoxDecoder(const IndexGrid& g);
     bool unbounded(std::uint32_t code) const { return code == unbounded_; }
     Aabb box(std::uint32_t code) const {
-        if (unbounded(code))
-            return {{-kUnboundedExtentMm, -kUnboundedExtentMm, -kUnboundedExtentMm},
-                    {kUnboundedExtentMm, kUnboundedExtentMm, kUnboundedExtentMm}};
+        if (unbounded(code)) return unbounded_box();
         std::uint32_t c[3];
         split(code, c);
         return {{lo_[0][c[0]], lo_[1][c[1]], lo_[2][c[2]]}, {hi_[0][c[0]], hi_[1][c[1]], hi_[2][c[2]]}};
@@ -85,21 +103,31 @@ inline std::uint64_t index_groups_of_fiber(std::uint64_t blocks, std::uint32_t g
 }
 
 struct IndexChunk {
+    std::uint32_t version = kIndexChunkVersion;
     IndexGrid grid;
-    std::uint32_t group_blocks = 1;  // 1 in version 1
+    std::uint32_t group_blocks = 1;  // 1 in versions 1 and 3
     std::uint64_t fibers = 0, blocks = 0, groups = 0;
     float max_sphere_radius = 0;
     // Largest distance from a block's last point to the next block's first
     // (same fiber), mm; negative: unknown (version 1).
     float max_join = -1;
     std::vector<std::uint16_t> last_block_points;  // per fiber (stored in 1 byte, or 2 beyond 255 points a block)
-    std::vector<std::uint32_t> codes;             // per group
+    std::vector<std::uint32_t> codes;             // per group (versions 1 and 2)
+    std::size_t box_stream_offset = 0, box_stream_bytes = 0;  // in the payload (version 3)
 };
 
-std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c, const FftHeader& h);
+// A version-3 chunk: its fields, the per-fiber counts and the coded boxes.
+std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c, const FftHeader& h,
+                                                const std::vector<std::uint8_t>& box_stream);
+// A version-2 chunk: its fields, the per-fiber counts and c.codes.
+std::vector<std::uint8_t> serialize_index_chunk_v2(const IndexChunk& c, const FftHeader& h);
 // Parses and validates a chunk against its file's header (counts, levels,
 // sizes). Throws Error{fft_format} naming `file`. What needs the fiber LUT
-// (the group count, point totals) is checked by its users.
+// (the group count, point totals, version 3's boxes) is checked by its users.
 IndexChunk parse_index_chunk(const std::vector<std::uint8_t>& payload, const FftHeader& h, const std::string& file);
+// Version 3: every block's box (unbounded ones span +-1e30 mm), decoded
+// with the file's fibers. Throws Error{fft_format} on a malformed stream.
+std::vector<Aabb> index_block_boxes(const IndexChunk& c, const std::vector<std::uint8_t>& payload,
+                                    const FftFile& file);
 
 }  // namespace fiblet::detail

@@ -350,8 +350,9 @@ public:
           // block lies wholly inside a region only when the checksums tie it
           // to the blocks read (a damaged block read unverified may be elsewhere).
           trust_inside_(index.source() == BlockIndex::Source::decoded || file.verifies_checksums()),
-          // Boxes of groups of blocks: narrowed down to single blocks from their headers.
-          coarse_index_(index.groups() < index.blocks()) {
+          // Stored boxes (of groups of blocks, or of blocks on a grid of half a
+          // block's path) are narrowed down from each block's header.
+          coarse_index_(index.max_join() >= 0) {
         if (index.blocks() != h_.blocks || index.fibers() != h_.fibers)
             throw Error(Errc::invalid_argument, file.path() + ": the block index belongs to another file");
         detail::check_query(q);
@@ -447,21 +448,23 @@ private:
         const std::uint32_t bb = h_.block_bytes();
         std::vector<std::size_t> tested, first_point;
         while (candidates.next(batch_blocks(h_), blocks, fibers)) {
-            reader_.read(blocks);
-            if (coarse_index_) spheres_of_read(blocks.size());
+            stats_.blocks_tested += blocks.size();
+            read_with_next(blocks, fibers, coarse_index_);  // the next block's first point narrows a bound
+            if (coarse_index_) spheres_of_read(need_.size());
             // Decoded: the blocks whose bound from headers (block_bound)
             // meets a region they are tested against; the index's boxes
-            // bound groups of blocks, block_bound each block.
+            // are coarser (quantized, or of groups of blocks).
             tested.clear();
             for (std::size_t i = 0; i < blocks.size(); ++i) {
                 const std::uint64_t f = fibers[i], b = blocks[i];
                 if (excluded[f]) continue;
-                if (!coarse_index_) {  // the index's boxes bound single blocks already
+                if (!coarse_index_) {  // exact boxes (computed) or no join bound (version 1)
                     tested.push_back(i);
                     continue;
                 }
-                const bool has_next = i + 1 < blocks.size() && blocks[i + 1] == b + 1 && fibers[i + 1] == f;
-                const BlockBound c = block_bound(spheres_[i], has_next ? &spheres_[i + 1] : nullptr, index_.max_join());
+                const std::size_t next = next_at_need_[i];
+                const BlockBound c =
+                    block_bound(spheres_[at_need_[i]], next != SIZE_MAX ? &spheres_[next] : nullptr, index_.max_join());
                 bool test = !q_.exclude.empty() && has_bit(exc, b) && bound_may_meet(q_.exclude, c);
                 for (std::size_t k = 0; k < k_inc && !test; ++k)
                     test = !(met[f] >> k & 1) && has_bit(inc[k], b) && bound_may_meet(q_.include[k], c);
@@ -469,7 +472,8 @@ private:
             }
             if (tested.empty()) continue;
             // One decode call for the whole batch (SIMD decoders fill their lanes).
-            const std::uint8_t* bytes = contiguous(blocks, tested, [&](std::size_t i) { return reader_.block(i); });
+            const std::uint8_t* bytes =
+                contiguous(blocks, tested, [&](std::size_t i) { return reader_.block(at_need_[i]); });
             decode_into(ctx_, bytes, tested.size(), scratch_, 0);
             first_point.assign(tested.size() + 1, 0);
             for (std::size_t t = 0; t < tested.size(); ++t)
@@ -508,6 +512,7 @@ private:
         std::vector<std::size_t> all;
         const std::uint32_t bb = h_.block_bytes();
         while (candidates.next(batch_blocks(h_), blocks, fibers)) {
+            stats_.blocks_tested += blocks.size();
             reader_.read(blocks);
             all.resize(blocks.size());
             for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
@@ -577,9 +582,8 @@ private:
 
         RunWriter out(options_, sink, stats_, batch_blocks(h_) * h_.points_per_block);
         CandidateBlocks candidates(file_, keep_, only ? &*only : nullptr);
-        std::vector<std::uint32_t> blocks, need;
+        std::vector<std::uint32_t> blocks;
         std::vector<std::uint64_t> fibers;
-        std::vector<std::size_t> at_need, next_at_need;
         enum Kind : std::uint8_t { dropped, fine, coarse };
         std::vector<Kind> kind;
         const std::uint32_t bb = h_.block_bytes();
@@ -594,42 +598,32 @@ private:
             if (include_test(i) && !any_point_in(q_.include, p, n)) return false;
             return !(exclude_test(i) && any_point_in(q_.exclude, p, n));
         };
+        const bool include_tests = coarse_index_ && blocks_mode && !q_.include.empty();
         while (candidates.next(batch_blocks(h_), blocks, fibers)) {
-            // With a level of detail, the next block's first point may end a segment.
-            need.clear(), at_need.assign(blocks.size(), 0), next_at_need.assign(blocks.size(), SIZE_MAX);
-            for (std::size_t i = 0; i < blocks.size(); ++i) {
-                if (need.empty() || need.back() != blocks[i]) need.push_back(blocks[i]);
-                at_need[i] = need.size() - 1;
-                const std::uint64_t next = std::uint64_t(blocks[i]) + 1;
-                if (lod && next < file_.block_end(fibers[i] + 1)) {
-                    need.push_back(std::uint32_t(next));  // the next candidate, if it is that block, reuses it
-                    next_at_need[i] = need.size() - 1;
-                }
-            }
-            reader_.read(need);
+            stats_.blocks_tested += blocks.size();
+            // With a level of detail, the next block's first point may end a
+            // segment; with include tests, it narrows the block's bound.
+            read_with_next(blocks, fibers, lod || include_tests);
 
             // Header tests: the block's sphere against the frustum, the level
             // of detail and, where its points would be tested, the include
-            // regions (the index bounds groups of blocks, the sphere each block).
+            // regions (the index's boxes are coarser than the block's bound).
             kind.assign(blocks.size(), fine);
-            const bool include_tests = coarse_index_ && blocks_mode && !q_.include.empty();
             // Every header tested below, in one call (a call per block cost more than its arithmetic).
-            if (q_.view || include_tests) spheres_of_read(need.size());
+            if (q_.view || include_tests) spheres_of_read(need_.size());
             if (q_.view || include_tests)
                 for (std::size_t i = 0; i < blocks.size(); ++i) {
                     const bool bound_test = include_tests && include_test(i);
                     if (!q_.view && !bound_test) continue;
-                    const Sphere& s = spheres_[at_need[i]];
+                    const Sphere& s = spheres_[at_need_[i]];
                     if (cull && !sphere_intersects_frustum(frustum, s.center, s.radius)) {
                         kind[i] = dropped;
                         continue;
                     }
                     if (bound_test) {
-                        const std::size_t k = at_need[i] + 1;
-                        const bool has_next = k < need.size() && need[k] == blocks[i] + 1 &&
-                                              std::uint64_t(blocks[i]) + 1 < file_.block_end(fibers[i] + 1);
+                        const std::size_t k = next_at_need_[i];
                         if (!bound_may_meet(q_.include,
-                                            block_bound(s, has_next ? &spheres_[k] : nullptr, index_.max_join()))) {
+                                            block_bound(s, k != SIZE_MAX ? &spheres_[k] : nullptr, index_.max_join()))) {
                             kind[i] = dropped;
                             continue;
                         }
@@ -640,18 +634,18 @@ private:
             for (std::size_t i = 0, j; i < blocks.size(); i = j) {
                 j = i + 1;
                 if (kind[i] == dropped) continue;
-                const std::uint8_t* block = reader_.block(at_need[i]);
+                const std::uint8_t* block = reader_.block(at_need_[i]);
                 if (kind[i] == coarse) {
                     // First point, then the next block's first point or the fiber's last point.
                     const std::uint32_t n = block_flags(h_, block).point_count;
-                    const bool last = next_at_need[i] == SIZE_MAX;
+                    const bool last = next_at_need_[i] == SIZE_MAX;
                     if (region_test(i) || (last && n > 1)) {
                         decode_into(ctx_, block, 1, scratch_, 0);
                         ++stats_.blocks_decoded;
                         if (!passes_regions(i, scratch_.data(), n)) continue;
                     }
                     Vec3f end{};
-                    if (!last) end = first_point(h_, reader_.block(next_at_need[i]));
+                    if (!last) end = first_point(h_, reader_.block(next_at_need_[i]));
                     else if (n > 1) end = {scratch_[3 * (n - 1)], scratch_[3 * (n - 1) + 1], scratch_[3 * (n - 1) + 2]};
                     out.coarse(fibers[i], blocks[i], first_point(h_, block), last && n < 2 ? nullptr : &end);
                     out.maybe_flush();
@@ -666,12 +660,12 @@ private:
                     if (kind[j] == fine) segment_.push_back(j), test |= region_test(j);
                 if (!options_.points && !test) {
                     for (std::size_t k : segment_)
-                        out.fine(fibers[k], blocks[k], 0, block_flags(h_, reader_.block(at_need[k])).point_count);
+                        out.fine(fibers[k], blocks[k], 0, block_flags(h_, reader_.block(at_need_[k])).point_count);
                     out.maybe_flush();
                     continue;
                 }
                 const std::uint8_t* bytes =
-                    contiguous(blocks, segment_, [&](std::size_t k) { return reader_.block(at_need[k]); });
+                    contiguous(blocks, segment_, [&](std::size_t k) { return reader_.block(at_need_[k]); });
                 out.break_unless_continues(fibers[i], blocks[i]);
                 const std::size_t base = out.frontier();
                 const std::size_t decoded = decode_into(ctx_, bytes, segment_.size(), out.buffer(), base);
@@ -688,6 +682,24 @@ private:
             }
         }
         out.finish();
+    }
+
+    // Reads `blocks` and, with `with_next`, the next block of each in its
+    // fiber: at_need_[i] is block i's place among the reader's blocks,
+    // next_at_need_[i] its successor's (SIZE_MAX: not read).
+    void read_with_next(const std::vector<std::uint32_t>& blocks, const std::vector<std::uint64_t>& fibers,
+                        bool with_next) {
+        need_.clear(), at_need_.assign(blocks.size(), 0), next_at_need_.assign(blocks.size(), SIZE_MAX);
+        for (std::size_t i = 0; i < blocks.size(); ++i) {
+            if (need_.empty() || need_.back() != blocks[i]) need_.push_back(blocks[i]);
+            at_need_[i] = need_.size() - 1;
+            const std::uint64_t next = std::uint64_t(blocks[i]) + 1;
+            if (with_next && next < file_.block_end(fibers[i] + 1)) {
+                need_.push_back(std::uint32_t(next));  // the next candidate, if it is that block, reuses it
+                next_at_need_[i] = need_.size() - 1;
+            }
+        }
+        reader_.read(need_);
     }
 
     // spheres_[k]: the view sphere of the reader's block k, for k < count.
@@ -729,6 +741,8 @@ private:
     std::vector<std::size_t> segment_;
     std::vector<const std::uint8_t*> block_pointers_;
     std::vector<Sphere> spheres_;  // of the blocks read, in reading order
+    std::vector<std::uint32_t> need_;                   // blocks read (read_with_next)
+    std::vector<std::size_t> at_need_, next_at_need_;   // a candidate's place among them, its successor's
     SelectionStats stats_;
 };
 

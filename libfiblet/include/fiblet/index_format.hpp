@@ -1,0 +1,19 @@
+// fiblet — which version of the block index (BIDX chunk,
+// formats/fft-index.md) a writer produces: compress (CompressOptions) and
+// extract's subset files (write_fft_subset). Every version is read.
+#pragma once
+
+#include <cstdint>
+
+namespace fiblet {
+
+// The value is the chunk's version number.
+// group_boxes (2, the default): a box per group of up to 8 blocks of a
+// fiber, loaded in a few ms (the medium file: 4 ms). block_boxes (3): a box
+// per block, range-coded: about 3x fewer candidate blocks for a small
+// region, but about 20x slower to load (89 ms, a serial decoder): for
+// viewers and long-lived sessions that load once and query often.
+enum class BlockIndexFormat : std::uint32_t { group_boxes = 2, block_boxes = 3 };
+inline constexpr BlockIndexFormat kDefaultBlockIndexFormat = BlockIndexFormat::group_boxes;
+
+}  // namespace fiblet
