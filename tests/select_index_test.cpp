@@ -549,19 +549,27 @@ TEST_F(SelectIndex, VerifyCatchesAJoinBoundBelowARealJump) {
     expect_verify_fails_on_index(bad);
 }
 
+// A version-3 builder given `file`'s decoded blocks, block `moved`'s points
+// shifted by `dx` mm along x (`first_only`: its first point alone).
+IndexBuilder block_boxes_with_one_moved(const FftFile& file, const DecodedFile& d, std::size_t moved, float dx,
+                                        bool first_only) {
+    IndexBuilder builder(file.header(), BlockIndexFormat::block_boxes);
+    for (std::size_t b = 0; b < d.blocks.size(); ++b) {
+        std::vector<float> pts(&d.points.xyz[3 * d.blocks[b].first_point],
+                               &d.points.xyz[3 * (d.blocks[b].first_point + d.blocks[b].points)]);
+        if (b == moved)
+            for (std::size_t k = 0; k < (first_only ? 1 : pts.size()); k += 3) pts[k] += dx;
+        builder.add_block(pts.data(), d.blocks[b].points, d.blocks[b].last_of_fiber);
+    }
+    return builder;
+}
+
 TEST_F(SelectIndex, VerifyCatchesABlockBoxThatMissesAPoint) {
     // A builder given block 5's points 20 mm away: a well-formed chunk whose
     // box for block 5 misses the block.
     const FftFile file(dwi_file());
     const DecodedFile d = decode_everything(file);
-    IndexBuilder builder(file.header(), BlockIndexFormat::block_boxes);
-    for (std::size_t b = 0; b < d.blocks.size(); ++b) {
-        std::vector<float> pts(&d.points.xyz[3 * d.blocks[b].first_point],
-                               &d.points.xyz[3 * (d.blocks[b].first_point + d.blocks[b].points)]);
-        if (b == 5)
-            for (std::size_t k = 0; k < pts.size(); k += 3) pts[k] += 20;
-        builder.add_block(pts.data(), d.blocks[b].points, d.blocks[b].last_of_fiber);
-    }
+    IndexBuilder builder = block_boxes_with_one_moved(file, d, 5, 20, false);
     const std::string bad = with_index_payload(file, builder.finish()->payload, work_file("box.fft"));
     EXPECT_NO_THROW(BlockIndex::load(FftFile{bad}));
     expect_verify_fails_on_index(bad);
@@ -572,13 +580,7 @@ TEST_F(SelectIndex, BlocksOffTheGridAreNeverCulled) {
     // builder stores it as unbounded, and every query returns it.
     const FftFile file(dwi_file());
     const DecodedFile d = decode_everything(file);
-    IndexBuilder builder(file.header(), BlockIndexFormat::block_boxes);
-    for (std::size_t b = 0; b < d.blocks.size(); ++b) {
-        std::vector<float> pts(&d.points.xyz[3 * d.blocks[b].first_point],
-                               &d.points.xyz[3 * (d.blocks[b].first_point + d.blocks[b].points)]);
-        if (b == 0) pts[0] += 1000;
-        builder.add_block(pts.data(), d.blocks[b].points, d.blocks[b].last_of_fiber);
-    }
+    IndexBuilder builder = block_boxes_with_one_moved(file, d, 0, 1000, true);
     EXPECT_EQ(builder.unbounded_blocks(), 1u);
     const auto chunk = builder.finish();
     ASSERT_TRUE(chunk);
