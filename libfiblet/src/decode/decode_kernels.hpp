@@ -19,6 +19,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 
 #include "fiblet/decode.hpp"
 
@@ -53,6 +54,11 @@ namespace avx512 {
 extern const KernelSet kKernels;
 }
 #endif
+
+// Component 3 col + row of `f` at row[3 col + row] (DecodeContext::frame_rows).
+void put_frame_row(const Frame& f, float* row);
+// A 16-bit header's rows, shared by every context of the same table (null for version 2).
+std::shared_ptr<const DecodeContext::FrameRows16> frame_rows16_of(const FftHeader& header);
 
 // Decodes validated blocks on the calling thread with a decoder already
 // resolved by resolve_decoder().

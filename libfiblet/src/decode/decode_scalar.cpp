@@ -5,16 +5,14 @@
 
 #include "core/block_geometry.hpp"
 #include "core/vec_math.hpp"
+#include "decode/decode_kernels.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 
 namespace fiblet {
 using namespace detail;
 
-namespace {
-
-// Component 3 col + row of `f` at row[3 col + row]; row[9..16) stay zero.
-void put_frame_row(const Frame& f, float* row) {
+void detail::put_frame_row(const Frame& f, float* row) {
     for (int col = 0; col < 3; ++col) {
         row[3 * col + 0] = f.c[col].x;
         row[3 * col + 1] = f.c[col].y;
@@ -22,15 +20,8 @@ void put_frame_row(const Frame& f, float* row) {
     }
 }
 
-}  // namespace
-
-DecodeContext::DecodeContext(const FftHeader& h) : header(h), table(h.ratio) {
+DecodeContext::DecodeContext(const FftHeader& h) : header(h), table(h.ratio), frame_rows16(frame_rows16_of(h)) {
     for (int k = 0; k < 256; ++k) put_frame_row(table.frame(std::uint8_t(k)), &frame_rows[16 * k]);
-    if (table16) {
-        auto rows = std::unique_ptr<FrameRows16>(new FrameRows16{});  // over-aligned: not make_shared
-        for (unsigned k = 0; k < 65536; ++k) put_frame_row(table16->frame(std::uint16_t(k)), &rows->rows[16 * k]);
-        frame_rows16 = std::move(rows);
-    }
 }
 
 DecodeContext::DecodeContext(const FftFile& file) : DecodeContext(file.header()) {

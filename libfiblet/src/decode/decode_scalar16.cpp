@@ -2,20 +2,60 @@
 // walk as decode_scalar.cpp with unorm24 anchors and 16-bit codes.
 #include "fiblet/decode.hpp"
 
+#include <bit>
 #include <cmath>
+#include <map>
+#include <mutex>
 #include <string>
+#include <utility>
 
 #include "core/block_geometry.hpp"
 #include "core/vec_math.hpp"
+#include "decode/decode_kernels.hpp"
 #include "fiblet/error.hpp"
 #include "format/packed_blocks16.hpp"
 
 namespace fiblet {
 using namespace detail;
 
+namespace {
+
+// A 16-bit file's table and its SIMD rows, shared by every DecodeContext of
+// the same ratio and levels: they take milliseconds and 6 MiB to make, and
+// a decode makes a context per thread and chunk. Held while some context
+// holds them.
+struct Tables16 {
+    Tables16(float ratio, unsigned levels) : table(ratio, levels) {
+        for (unsigned k = 0; k < 65536; ++k) put_frame_row(table.frame(std::uint16_t(k)), &rows.rows[16 * k]);
+    }
+    DirectionTable16 table;
+    DecodeContext::FrameRows16 rows{};  // padding zero, as the 8-bit rows
+};
+
+std::shared_ptr<const Tables16> tables16(const FftHeader& header) {
+    static std::mutex mutex;
+    static std::map<std::pair<std::uint32_t, unsigned>, std::weak_ptr<const Tables16>> made;
+    const std::pair key{std::bit_cast<std::uint32_t>(header.ratio), header.code_levels()};
+    const std::lock_guard lock(mutex);
+    if (auto t = made[key].lock()) return t;
+    std::erase_if(made, [](const auto& entry) { return entry.second.expired(); });
+    auto t = std::shared_ptr<const Tables16>(new Tables16(header.ratio, header.code_levels()));  // over-aligned
+    made[key] = t;
+    return t;
+}
+
+}  // namespace
+
 std::shared_ptr<const DirectionTable16> make_direction_table16(const FftHeader& header) {
     if (header.direction_bits() != 16) return nullptr;
-    return std::make_shared<const DirectionTable16>(header.ratio, header.code_levels());
+    auto t = tables16(header);
+    return {t, &t->table};
+}
+
+std::shared_ptr<const DecodeContext::FrameRows16> detail::frame_rows16_of(const FftHeader& header) {
+    if (header.direction_bits() != 16) return nullptr;
+    auto t = tables16(header);
+    return {t, &t->rows};
 }
 
 std::size_t decode_blocks_scalar16(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count,
