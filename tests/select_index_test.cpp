@@ -61,6 +61,23 @@ protected:
 
 bool bit(const std::vector<std::uint64_t>& bits, std::size_t b) { return (bits[b >> 6] >> (b & 63)) & 1; }
 
+// `count` random region queries (seeded), every other one in blocks mode and
+// (`with_views`) every third one with a camera, select through `index`
+// exactly what the decode-everything reference keeps.
+void expect_selections_match_brute_force(const FftFile& file, const BlockIndex& index, const DecodedFile& d,
+                                         std::uint32_t seed, int count, bool with_views, const std::string& label) {
+    QueryGenerator gen(d, seed);
+    for (int i = 0; i < count; ++i) {
+        Query q;
+        q.include.push_back(gen.region());
+        if (i % 2) q.roi_mode = RoiMode::blocks;
+        if (with_views && i % 3 == 0) q.view = ViewSelection{gen.camera(), true, std::nullopt, 4.0f};
+        std::vector<SelectedRun> runs;
+        const Streamlines got = select_streamlines(file, index, q, &runs);
+        expect_same_selection(reference_select(file, d, q), got, runs, label + " query " + std::to_string(i));
+    }
+}
+
 void expect_boxes_hold_points(const FftFile& file, const BlockIndex& index, const DecodedFile& d) {
     ASSERT_EQ(index.blocks(), file.header().blocks);
     ASSERT_EQ(index.fibers(), file.header().fibers);
@@ -171,16 +188,7 @@ TEST_F(SelectIndex, VersionTwoIndexesAreStillRead) {
     for (const auto& [b0, b1] : index_groups(file, 8))
         for (std::uint64_t b = b0 + 1; b < b1; ++b) ASSERT_EQ(index.block_box(b).min.x, index.block_box(b0).min.x);
     EXPECT_NO_THROW(verify_fft_file(file.path()));
-    QueryGenerator gen(d, 4);
-    for (int i = 0; i < 12; ++i) {
-        Query q;
-        q.include.push_back(gen.region());
-        if (i % 2) q.roi_mode = RoiMode::blocks;
-        if (i % 3 == 0) q.view = ViewSelection{gen.camera(), true, std::nullopt, 4.0f};
-        std::vector<SelectedRun> runs;
-        const Streamlines got = select_streamlines(file, index, q, &runs);
-        expect_same_selection(reference_select(file, d, q), got, runs, "query " + std::to_string(i));
-    }
+    expect_selections_match_brute_force(file, index, d, 4, 12, true, file.path());
 }
 
 // compress writes version 2 (quick to load) unless asked for the finer
@@ -196,17 +204,7 @@ TEST_F(SelectIndex, CompressWritesVersionTwoByDefaultAndThreeWithTheFineIndex) {
         const DecodedFile d = decode_everything(file);
         expect_boxes_hold_points(file, index, d);
         EXPECT_NO_THROW(verify_fft_file(file.path()));
-        QueryGenerator gen(d, 6);
-        for (int i = 0; i < 12; ++i) {
-            Query q;
-            q.include.push_back(gen.region());
-            if (i % 2) q.roi_mode = RoiMode::blocks;
-            if (i % 3 == 0) q.view = ViewSelection{gen.camera(), true, std::nullopt, 4.0f};
-            std::vector<SelectedRun> runs;
-            const Streamlines got = select_streamlines(file, index, q, &runs);
-            expect_same_selection(reference_select(file, d, q), got, runs,
-                                  path + " query " + std::to_string(i));
-        }
+        expect_selections_match_brute_force(file, index, d, 6, 12, true, path);
     }
 }
 
@@ -513,15 +511,7 @@ TEST_F(SelectIndex, VersionOneChunksOfOneBoxPerBlockAreStillRead) {
     expect_boxes_hold_points(old, index, d);
     EXPECT_NO_THROW(verify_fft_file(old.path()));
     // Selections through it are the decode-everything reference's.
-    QueryGenerator gen(d, 3);
-    for (int i = 0; i < 10; ++i) {
-        Query q;
-        q.include.push_back(gen.region());
-        if (i % 2) q.roi_mode = RoiMode::blocks;
-        std::vector<SelectedRun> runs;
-        const Streamlines got = select_streamlines(old, index, q, &runs);
-        expect_same_selection(reference_select(old, d, q), got, runs, "query " + std::to_string(i));
-    }
+    expect_selections_match_brute_force(old, index, d, 3, 10, false, old.path());
 }
 
 // verify's verdict on a file, as the CLI gives it.
