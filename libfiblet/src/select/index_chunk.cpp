@@ -139,6 +139,20 @@ IndexBoxDecoder::IndexBoxDecoder(const IndexGrid& g)
     }
 }
 
+namespace {
+
+// Per-fiber point counts of the last blocks, appended: 1 or 2 bytes a fiber
+// (parse_last_points reads them).
+void append_last_points(const IndexChunk& c, const FftHeader& h, std::vector<std::uint8_t>& out) {
+    const unsigned count_bytes = index_count_bytes(h);
+    for (const std::uint16_t n : c.last_block_points) {
+        out.push_back(std::uint8_t(n));
+        if (count_bytes == 2) out.push_back(std::uint8_t(n >> 8));
+    }
+}
+
+}  // namespace
+
 std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c, const FftHeader& h,
                                                 const std::vector<std::uint8_t>& box_stream) {
     // Fixed header, at the offsets parse_index_chunk reads.
@@ -153,13 +167,7 @@ std::vector<std::uint8_t> serialize_index_chunk(const IndexChunk& c, const FftHe
     put(44, c.max_sphere_radius);
     put(48, c.max_join);
     put(56, std::uint64_t(box_stream.size()));
-    const unsigned count_bytes = index_count_bytes(h);
-    out.resize(kIndexChunkHeaderBytes + count_bytes * c.last_block_points.size());
-    for (std::size_t f = 0; f < c.last_block_points.size(); ++f) {
-        const std::uint16_t n = c.last_block_points[f];
-        out[kIndexChunkHeaderBytes + count_bytes * f] = std::uint8_t(n);
-        if (count_bytes == 2) out[kIndexChunkHeaderBytes + 2 * f + 1] = std::uint8_t(n >> 8);
-    }
+    append_last_points(c, h, out);
     out.insert(out.end(), box_stream.begin(), box_stream.end());
     return out;
 }
@@ -181,13 +189,7 @@ std::vector<std::uint8_t> serialize_index_chunk_v2(const IndexChunk& c, const Ff
     put(52, c.group_blocks);
     put(56, c.groups);
     put(64, c.max_join);
-    const unsigned count_bytes = index_count_bytes(h);
-    out.resize(kIndexChunkV2HeaderBytes + count_bytes * c.last_block_points.size());
-    for (std::size_t f = 0; f < c.last_block_points.size(); ++f) {
-        const std::uint16_t n = c.last_block_points[f];
-        out[kIndexChunkV2HeaderBytes + count_bytes * f] = std::uint8_t(n);
-        if (count_bytes == 2) out[kIndexChunkV2HeaderBytes + 2 * f + 1] = std::uint8_t(n >> 8);
-    }
+    append_last_points(c, h, out);
     // Codes as one little-endian bit stream, least significant bit first.
     std::uint64_t acc = 0;
     unsigned filled = 0;
