@@ -583,11 +583,13 @@ void FiberEncoder::Encoding::append_decoded(std::vector<Vec3f>& decoded) const {
     const std::size_t at = decoded.size();
     decoded.resize(at + n_points);
     if (n_points == 0) return;
-    const float* in = &s.points[0].x;
-    float* world = &decoded[at].x;
-    const float offset[3] = {h.offset[0], h.offset[1], h.offset[2]};
+    // The header's fields in locals and restrict pointers: the stores could
+    // otherwise alias them, which kept this loop scalar, reloading them.
+    const float* __restrict in = &s.points[0].x;
+    float* __restrict world = &decoded[at].x;
+    const float scaling = h.scaling, offset[3] = {h.offset[0], h.offset[1], h.offset[2]};
     for (std::size_t k = 0; k < n_points; ++k)
-        for (int c = 0; c < 3; ++c) world[3 * k + c] = (in[3 * k + c] - 0.5f) * h.scaling - offset[c];
+        for (int c = 0; c < 3; ++c) world[3 * k + c] = (in[3 * k + c] - 0.5f) * scaling - offset[c];
 }
 
 // The exact decode of every 16-bit block: no bound on the walks' divergence
