@@ -95,12 +95,25 @@ def points_text(tck):
     return "\n".join(lines) + ("\n" if lines else "")
 
 
+def write_float64(exact_points, path):
+    """NAME.f64.txt: the float64 reference decode (a .fftz through the spec's unpacking, tests/fftz_spec_reader.hpp)."""
+    exact = subprocess.run([exact_points, str(path)], check=True, capture_output=True, text=True)
+    pathlib.Path(str(path) + ".f64.txt").write_text(exact.stdout)
+
+
 def main():
     a = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     a.add_argument("--fiblet", default=str(ROOT / "build" / "bin" / "fiblet"))
     a.add_argument("--exact-points", default=str(ROOT / "build" / "tests" / "fiblet_exact_points"),
                    help="the float64 reference decoder's text output (tests/tools/exact_points.cpp)")
+    a.add_argument("--add-float64", action="store_true",
+                   help="only write the NAME.f64.txt files missing beside the committed corpus files (no file is remade)")
     args = a.parse_args()
+    if args.add_float64:
+        for path in sorted(OUT.glob("*.fft*")):
+            if path.suffix in (".fft", ".fftz") and not pathlib.Path(str(path) + ".f64.txt").exists():
+                write_float64(args.exact_points, path)
+        return 0
     OUT.mkdir(parents=True, exist_ok=True)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -113,18 +126,16 @@ def main():
                 decoded = pathlib.Path(tmp) / "decoded.tck"
                 subprocess.run([args.fiblet, "decompress", "-q", "-f", str(out), "-o", str(decoded)], check=True)
                 (OUT / f"{name}-{suffix}.txt").write_text(points_text(decoded))
-                if out.suffix == ".fft":  # the reference decoder reads .fft bytes (zstd -d of a .fftz is transposed)
-                    exact = subprocess.run([args.exact_points, str(out)], check=True, capture_output=True, text=True)
-                    (OUT / f"{name}-{suffix}.f64.txt").write_text(exact.stdout)
+                write_float64(args.exact_points, out)
                 rows.append(f"| `{name}-{suffix}` | {version} | {what} |")
     (OUT / "README.md").write_text(
         "# Conformance corpus\n\nSmall files of every `.fft` version and chunk, each with the points fiblet decodes "
         "from it (`NAME.txt`: `fiber N: M points`, then `x y z` per point in world mm, float32 values printed "
-        "exactly with 9 significant digits) and, for the `.fft` files, the float64 reference decode "
+        "exactly with 9 significant digits) and the float64 reference decode "
         "(`NAME.f64.txt`, the same form, 17 significant digits: `tests/exact_decoder.hpp`, written from `formats/` "
-        "alone, every formula in double), for any reader of `formats/` to check itself against; the suite "
+        "alone, every formula in double; a `.fftz` unpacked as `formats/fftz.md` says by `tests/fftz_spec_reader.hpp`), for any reader of `formats/` to check itself against; the suite "
         "decodes each with every decoder (`tests/conformance_test.cpp`: bit for bit for scalar and lanes, within 0.5 µm for the warp decoders' prefix products, every decoder within 0.5 µm of the float64 points, which the reference decoder reproduces exactly). Made once by `scripts/make_conformance.py`; "
-        "never regenerated (older files must keep decoding to the same points).\n\n"
+        "never regenerated (older files must keep decoding to the same points; `--add-float64` writes a missing `NAME.f64.txt` only).\n\n"
         "| file | version | what it exercises |\n|---|---|---|\n" + "\n".join(rows) + "\n")
 
 

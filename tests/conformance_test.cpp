@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "exact_decoder.hpp"
+#include "fftz_spec_reader.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/fft_file.hpp"
 #include "test_util.hpp"
@@ -105,20 +106,22 @@ TEST(Conformance, EveryFileDecodesToItsCommittedPointsWithEveryDecoder) {
     EXPECT_GT(points, 5000u);
 }
 
-// The float64 points beside each .fft (NAME.f64.txt, the reference decoder
-// of tests/exact_decoder.hpp, written from formats/ alone): the reference
-// decoder reproduces them exactly, and every fiblet decoder comes within
-// 0.5 um of them (0.25 um at most on this corpus: float32 frames along the
-// fallback helper and 255-point fibers).
+// The float64 points beside each .fft and .fftz (NAME.f64.txt, the
+// reference decoder of tests/exact_decoder.hpp, written from formats/ alone;
+// a container unpacked by tests/fftz_spec_reader.hpp): the reference decoder
+// reproduces them exactly, and every fiblet decoder comes within 0.5 um of
+// them (0.25 um at most on this corpus: float32 frames along the fallback
+// helper and 255-point fibers; version 16 0.17 um).
 TEST(Conformance, FloatDecodersStayNearTheFloat64Points) {
-    std::size_t files = 0;
+    std::size_t files = 0, containers = 0;
     for (const fs::path& path : corpus()) {
         const fs::path f64 = path.string() + ".f64.txt";
-        if (path.extension() != ".fft") continue;
         ASSERT_TRUE(fs::exists(f64)) << f64;
         ++files;
         const Points<double> e = read_expected<double>(f64);
-        const auto exact = test::exact::decode(test::read_file(path.string()));
+        std::string bytes = test::read_file(path.string());
+        if (test::fftz_spec::is_fftz(bytes)) bytes = test::fftz_spec::unpack(bytes), ++containers;
+        const auto exact = test::exact::decode(bytes);
         ASSERT_EQ(exact.fibers.size(), e.counts.size()) << path;
         std::size_t at = 0, differ = 0;
         for (std::size_t f = 0; f < exact.fibers.size(); ++f) {
@@ -141,5 +144,22 @@ TEST(Conformance, FloatDecodersStayNearTheFloat64Points) {
             EXPECT_LE(worst, 5e-4) << path << " " << decoder;
         }
     }
-    EXPECT_GE(files, 10u);
+    EXPECT_GE(files, 20u);
+    EXPECT_GE(containers, 10u);
+}
+
+// The container's spec alone unpacks each 8-bit .fftz of the corpus to the
+// .fft beside it, byte for byte (tests/fftz_spec_reader.hpp shares no code
+// with the library's container reader).
+TEST(Conformance, ContainersUnpackByTheSpecToTheirFft) {
+    std::size_t pairs = 0;
+    for (const fs::path& path : corpus()) {
+        if (path.extension() != ".fftz") continue;
+        const std::string name = path.filename().string();
+        const fs::path fft = path.parent_path() / (name.substr(0, name.size() - 5) + ".fft");
+        if (!fs::exists(fft)) continue;  // version 16 exists only in the container
+        EXPECT_TRUE(test::fftz_spec::unpack(test::read_file(path.string())) == test::read_file(fft.string())) << path;
+        ++pairs;
+    }
+    EXPECT_GE(pairs, 5u);
 }

@@ -1,6 +1,6 @@
 // A float64 reference decoder of version-2 .fft files, written from
-// formats/fft.md alone, and of version-17 files (packed 16-bit blocks),
-// written from formats/fft16.md: it shares no code with the library's decoders (nor
+// formats/fft.md alone, and of version-16 and 17 files (16-bit blocks of a
+// fixed size, packed 16-bit blocks), written from formats/fft16.md: it shares no code with the library's decoders (nor
 // its frame or direction-table code), so that a test comparing the two
 // checks the format, not one implementation against itself. Every formula
 // is evaluated in double, so its output is the "exact" decode any
@@ -68,7 +68,9 @@ struct Header {
     std::uint32_t blocks = 0, points_per_block = 0;
     float scaling = 0, offset[3] = {}, ratio = 0, step = 0, max_error = 0, mean_error = 0;
     std::vector<std::uint64_t> buffer_ends;
-    std::size_t block_bytes() const { return (points_per_block + 16 + 3) / 4 * 4; }
+    std::size_t block_bytes() const {  // fixed-size blocks (versions 2 and 16)
+        return version == 16 ? (24 + 2 * (points_per_block - 2) + 3) / 4 * 4 : (points_per_block + 16 + 3) / 4 * 4;
+    }
 };
 
 template <class T>
@@ -82,7 +84,7 @@ T le(const std::string& b, std::size_t at) {
 inline Header read_header(const std::string& b) {
     Header h;
     h.version = le<std::uint8_t>(b, 0);
-    if (h.version != 2 && h.version != 17) throw std::runtime_error("exact decoder: version " + std::to_string(h.version));
+    if (h.version != 2 && h.version != 16 && h.version != 17) throw std::runtime_error("exact decoder: version " + std::to_string(h.version));
     h.fibers = le<std::uint64_t>(b, 1), h.points = le<std::uint64_t>(b, 9);
     h.blocks = le<std::uint32_t>(b, 17), h.points_per_block = le<std::uint32_t>(b, 21);
     h.scaling = le<float>(b, 25);
@@ -107,7 +109,7 @@ inline std::array<double, 6> anchors(const unsigned char* blk) {
 }
 
 // §5: one block's points, normalized coordinates.
-inline void decode_block(const unsigned char* blk, const std::array<Frame3, 256>& table, double step,
+inline void decode_block(const unsigned char* blk, const std::vector<Frame3>& table, double step,
                          std::vector<V3>& out, FrameRule rule) {
     const unsigned count = blk[16] & 63;
     const auto a = anchors(blk);
@@ -169,6 +171,29 @@ inline std::size_t decode_packed_block(const unsigned char* blk, unsigned count,
     return 18 + (15 * (count - 2) + 7) / 8;  // count >= 2 here
 }
 
+// fft16.md, version 16: one fixed-size block (18 anchor bytes, unorm24
+// least significant byte first; fiber id; u16 flags/count; u16 codes);
+// returns its point count. The first axis is that of the decoded anchors.
+inline unsigned decode_block16(const unsigned char* blk, const std::vector<Frame3>& table, double step,
+                               std::vector<V3>& out) {
+    double a[6];
+    for (int i = 0; i < 6; ++i) a[i] = double(blk[3 * i] | blk[3 * i + 1] << 8 | blk[3 * i + 2] << 16) / 16777215.0;
+    const unsigned count = (blk[22] | blk[23] << 8) & 0x3fff;
+    const V3 a0{a[0], a[1], a[2]}, a1{a[3], a[4], a[5]};
+    out.push_back(a0);
+    if (count < 2) return count;
+    out.push_back(a1);
+    const V3 d = a1 - a0;
+    Frame3 f = frame_of(dot(d, d) > 0 ? unit(d) : V3{1, 0, 0});
+    V3 p = a1;
+    for (unsigned k = 0; k + 2 < count; ++k) {
+        f = compose(f, table.at(blk[24 + 2 * k] | blk[25 + 2 * k] << 8));
+        p = p + step * f.c[0];
+        out.push_back(p);
+    }
+    return count;
+}
+
 // §6: the payload of trailer chunk `tag`, empty when the file has none.
 inline std::string trailer_chunk(const std::string& bytes, const char* tag) {
     if (bytes.size() < 16 || bytes.compare(bytes.size() - 8, 8, "FIBLETX1") != 0) return {};
@@ -223,8 +248,10 @@ inline Decoded decode(const std::string& bytes, FrameRule rule = FrameRule::fibl
         }
         return d;
     }
-    std::array<Frame3, 256> table;
-    for (unsigned c = 0; c < 256; ++c) table[c] = frame_of(code_direction(c, h.ratio), rule);
+    // Versions 2 and 16: fixed-size blocks found through the LUT.
+    const unsigned levels = h.version == 16 ? 256 : 16;
+    std::vector<Frame3> table(levels * levels);
+    for (unsigned c = 0; c < table.size(); ++c) table[c] = frame_of(code_direction(c, h.ratio, levels), rule);
     const std::size_t lut = 58 + 8 * h.buffer_ends.size(), blocks = lut + 8 * h.fibers;
     std::vector<V3> normalized;
     for (std::uint64_t i = 0; i < h.fibers; ++i) {
@@ -232,14 +259,20 @@ inline Decoded decode(const std::string& bytes, FrameRule rule = FrameRule::fibl
         const unsigned buffer = x >> 16, count = x & 0xffff;
         const std::uint64_t first = y + (buffer > 0 ? h.buffer_ends.at(buffer - 1) : 0);
         normalized.clear();
+        unsigned last_block_points = 0;
         for (unsigned b = 0; b < count; ++b) {
             const std::size_t at = blocks + (first + b) * h.block_bytes();
             if (at + h.block_bytes() > bytes.size()) throw std::runtime_error("exact decoder: block past the end");
-            decode_block(reinterpret_cast<const unsigned char*>(bytes.data()) + at, table, double(h.step), normalized,
-                         rule);
+            const auto* blk = reinterpret_cast<const unsigned char*>(bytes.data()) + at;
+            if (h.version == 16) {
+                last_block_points = decode_block16(blk, table, double(h.step), normalized);
+            } else {
+                decode_block(blk, table, double(h.step), normalized, rule);
+                last_block_points = blk[16] & 63;
+            }
         }
         d.fibers.push_back(to_millimetres(normalized, h));
-        if (count > 0) apply_end(d.fibers.back(), ends, i, bytes[blocks + (first + count - 1) * h.block_bytes() + 16] & 63);
+        if (count > 0) apply_end(d.fibers.back(), ends, i, last_block_points);
     }
     return d;
 }
