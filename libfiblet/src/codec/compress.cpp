@@ -25,8 +25,7 @@
 #include "core/streamline_label.hpp"
 #include "core/thread_count.hpp"
 #include "fiblet/block_index.hpp"
-#include "fiblet/checksum.hpp"
-#include "io/fft_sink.hpp"
+#include "io/fft_writer.hpp"
 #include "fiblet/encode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/fiber_ends.hpp"
@@ -161,32 +160,17 @@ double normalize(FftHeader& h, const TckScan& scan, double step, const std::stri
     return double(h.step) * double(h.scaling);
 }
 
-// The fiber table (LUT) and the header's block counts and buffer table:
-// each fiber's blocks in one GPU buffer of at most
-// fft_max_blocks_per_buffer blocks (formats/fft.md §3); version 17 stores
-// the fiber's point count where version 2 / 16 store its first block.
+// The fiber table (LUT) and the header's counts: each fiber's blocks at
+// the encoder's block size (plan_fiber_table, io/fft_writer.hpp).
 std::vector<FiberLutEntry> plan_blocks(FftHeader& h, const std::vector<std::uint32_t>& fiber_points,
-                                       const FiberEncoder& encoder, const BlockLayout& layout, const std::string& path) {
-    std::vector<FiberLutEntry> lut(fiber_points.size());
-    const std::uint64_t per_buffer = fft_max_blocks_per_buffer(h.block_bytes());
-    std::uint64_t blocks = 0, in_buffer = 0;
-    for (std::size_t f = 0; f < fiber_points.size(); ++f) {
-        const std::uint32_t nb = encoder.block_count(fiber_points[f]);
-        if (nb > 0xffff)
+                                       const FiberEncoder& encoder, const std::string& path) {
+    return detail::plan_fiber_table(h, fiber_points.size(), [&](std::size_t f) {
+        const std::uint32_t blocks = encoder.block_count(fiber_points[f]);
+        if (blocks > 0xffff)
             throw Error(Errc::unsupported, path + ": " + detail::streamline_label(f) + " needs more than 65535 blocks");
-        if (in_buffer + nb > per_buffer) h.buffer_ends.push_back(blocks), in_buffer = 0;
-        if (h.buffer_ends.size() > 254) throw Error(Errc::unsupported, path + ": more than 255 GPU buffers of blocks");
-        lut[f] = {std::uint32_t(h.buffer_ends.size()) << 16 | nb, layout.packed ? fiber_points[f] : std::uint32_t(in_buffer)};
-        if (layout.packed && nb > 0)
-            h.packed_block_bytes += (nb - 1) * std::uint64_t{packed16_block_bytes(layout.points_per_block)} +
-                                    packed16_block_bytes(fiber_points[f] - (nb - 1) * layout.points_per_block);
-        blocks += nb, in_buffer += nb;
         h.points += fiber_points[f];
-    }
-    if (blocks > std::numeric_limits<std::uint32_t>::max()) throw Error(Errc::unsupported, path + ": more than 2^32 - 1 blocks");
-    if (blocks > 0) h.buffer_ends.push_back(blocks);
-    h.blocks = std::uint32_t(blocks);
-    return lut;
+        return detail::FiberBlocks{blocks, fiber_points[f]};
+    }, path);
 }
 
 // One compress run, stage by stage: compress_tck calls them in order. The
@@ -227,8 +211,7 @@ private:
     std::optional<float> fixed_ratio_;
     std::optional<detail::TuningSet> tuning_set_;
     std::optional<FiberEncoder> encoder_;
-    std::unique_ptr<detail::FftSink> out_;
-    std::optional<FftChecksumBuilder> checksum_;
+    std::optional<detail::FftWriter> out_;
     FiberEndFractions end_fractions_;
     std::optional<IndexBuilder> index_;
 };
@@ -396,13 +379,8 @@ void CompressJob::tune() {
 // measured (compress_encode.cpp).
 void CompressJob::encode() {
     FftHeader& h = report.header;  // plan_blocks sets the block count
-    std::vector<FiberLutEntry> lut = plan_blocks(h, scanned_->fiber_points, *encoder_, layout_, input_);
-    out_ = detail::open_fft_sink(output_, options_.overwrite, options_.zstd, h.direction_bits(), h.block_bytes(), threads_);
-    checksum_.emplace(h.block_bytes());  // the CSUM trailer chunk (formats/fft-checksum.md)
-    const std::span<const std::uint8_t> lut_bytes{reinterpret_cast<const std::uint8_t*>(lut.data()),
-                                                  lut.size() * sizeof(FiberLutEntry)};
-    out_->begin(serialize_fft_header(h), lut_bytes);
-    checksum_->add_lut(lut_bytes.data(), lut_bytes.size());
+    std::vector<FiberLutEntry> lut = plan_blocks(h, scanned_->fiber_points, *encoder_, input_);
+    out_.emplace(output_, options_.overwrite, options_.zstd, h, lut, threads_);
     // The per-fiber tables are written: free them (12 bytes per fiber, 62 MB
     // for 5 M fibers) before the block index grows.
     std::vector<FiberLutEntry>().swap(lut);
@@ -418,7 +396,7 @@ void CompressJob::encode() {
                                        .tensions = &tensions_,
                                        .block_index = options_.block_index,
                                        .threads = threads_};
-    detail::EncodeStageResult r = detail::encode_stage(*source_, in, *out_, *checksum_, *index_, options_);
+    detail::EncodeStageResult r = detail::encode_stage(*source_, in, *out_, *index_, options_);
     report.error = std::move(r.error);
     report.geometry = std::move(r.geometry);
     report.timings += r.timings;
@@ -436,8 +414,6 @@ void CompressJob::finish() {
     if (report.resampled) report.error_vs_original = report.geometry.decoded_to_input();
     h.max_error_mm = float(report.error.max_mm());
     h.mean_error_mm = float(report.error.mean_mm());
-    const auto final_head = serialize_fft_header(h);
-    const std::uint64_t at = out_->logical_size();
     if (report.resampled)  // float per-point arrays are interpolated, stored as float32: their source dtype in PROP
         for (const StreamlineField& f : fields_)
             if (f.scope() == FieldScope::point && is_float_type(f.type) && f.type != FieldType::float32)
@@ -458,9 +434,7 @@ void CompressJob::finish() {
         FiberEndFractions().swap(end_fractions_);
     }
     if (index_chunk) chunks.push_back(std::move(*index_chunk));
-    chunks.push_back(checksum_->finish(final_head, chunks));  // last: it covers the chunks before it
-    out_->finish(serialize_trailer(chunks, at), final_head);
-    report.output_bytes = out_->stored_size();
+    report.output_bytes = out_->finish(h, std::move(chunks));
     out_->commit();
 }
 

@@ -258,18 +258,13 @@ void finish_batch(const EncodeStageInputs& in, const FiberBatch& b, std::vector<
 }
 
 // Stage 3: a batch's blocks, checksums and index entries, in task order.
-void write_batch(const FiberBatch& b, std::vector<Slot>& slots, FftSink& out, FftChecksumBuilder& checksum,
-                 IndexBuilder& index, CompressTimings& timings) {
+void write_batch(const FiberBatch& b, std::vector<Slot>& slots, FftWriter& out, IndexBuilder& index,
+                 CompressTimings& timings) {
     const StageClock clock(timings.write);
     for (std::size_t t = 0; t < b.tasks(); ++t) {
         const Slot& s = slots[t];
-        out.write_blocks(s.packed.empty() ? s.blocks : s.packed);
-        if (s.packed.empty()) {
-            checksum.add_blocks(s.blocks.data(), s.blocks.size());
-        } else {  // checksums cover the bytes as stored
-            const std::uint8_t* p = s.packed.data();
-            for (const std::uint32_t n : s.packed_sizes) checksum.add_block(p, n), p += n;
-        }
+        if (s.packed.empty()) out.write_blocks(s.blocks);
+        else out.write_packed_blocks(s.packed, s.packed_sizes);
         index.append(slots[t].index);
     }
 }
@@ -349,8 +344,8 @@ void PointFieldResampler::finish() {
     }
 }
 
-EncodeStageResult encode_stage(StreamlineSource& reader, const EncodeStageInputs& in, FftSink& out,
-                               FftChecksumBuilder& checksum, IndexBuilder& index, const CompressOptions& options) {
+EncodeStageResult encode_stage(StreamlineSource& reader, const EncodeStageInputs& in, FftWriter& out, IndexBuilder& index,
+                               const CompressOptions& options) {
     reader.rewind();
     EncodeStageResult r;
     std::vector<Slot> slots[2];
@@ -360,7 +355,7 @@ EncodeStageResult encode_stage(StreamlineSource& reader, const EncodeStageInputs
         [&](const FiberBatch& b, std::size_t t, Slot& s) { encode_task(in, b, t, s); }, [](const FiberBatch&) {},
         [&](const FiberBatch& b, std::vector<Slot>& batch_slots) {
             finish_batch(in, b, batch_slots);
-            write_batch(b, batch_slots, out, checksum, index, r.timings);
+            write_batch(b, batch_slots, out, index, r.timings);
             if (options.progress && reader.data_bytes() > 0)
                 options.progress("encode", double(reader.bytes_consumed()) / double(reader.data_bytes()));
         },

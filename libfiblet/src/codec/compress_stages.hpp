@@ -20,7 +20,6 @@
 
 #include "codec/parameters.hpp"
 #include "fiblet/block_index.hpp"
-#include "fiblet/checksum.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/encode.hpp"
 #include "fiblet/error_stats.hpp"
@@ -28,7 +27,7 @@
 #include "fiblet/geometry_error.hpp"
 #include "fiblet/resample.hpp"
 #include "fiblet/streamline_io.hpp"
-#include "io/fft_sink.hpp"
+#include "io/fft_writer.hpp"
 
 namespace fiblet::detail {
 
@@ -190,10 +189,10 @@ struct EncodeStageResult {
 };
 
 // Pass 2: reads `reader` from its start, encodes every fiber and writes the
-// blocks to `out` (and `checksum`, `index`) in fiber order. The output does
+// blocks to `out` (with their checksums) and `index` in fiber order. The output does
 // not depend on `threads`: batches and tasks are cut by point counts only,
 // and each task's statistics are merged in task order.
-EncodeStageResult encode_stage(StreamlineSource& reader, const EncodeStageInputs& in, FftSink& out,
-                               FftChecksumBuilder& checksum, IndexBuilder& index, const CompressOptions& options);
+EncodeStageResult encode_stage(StreamlineSource& reader, const EncodeStageInputs& in, FftWriter& out, IndexBuilder& index,
+                               const CompressOptions& options);
 
 }  // namespace fiblet::detail

@@ -6,12 +6,11 @@
 #include <utility>
 
 #include "fiblet/block_index.hpp"
-#include "fiblet/checksum.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
-#include "fiblet/output_file.hpp"
 #include "fiblet/streamline_data_chunk.hpp"
 #include "format/packed_blocks16.hpp"
+#include "io/fft_writer.hpp"
 #include "select/block_decoder.hpp"
 
 namespace fiblet {
@@ -130,100 +129,79 @@ TrailerChunk subset_streamline_data(const FftFile& source, const std::vector<Sel
     return make_streamline_data_chunk(kept);
 }
 
+// The new file's fiber table: each run's blocks as one fiber.
+std::vector<FiberLutEntry> plan_runs(FftHeader& h, const FftFile& source, const std::vector<SelectedRun>& runs,
+                                     const std::string& path) {
+    return detail::plan_fiber_table(h, runs.size(), [&](std::size_t i) {
+        const SelectedRun& r = runs[i];
+        if (r.coarse_blocks > 0)
+            throw Error(Errc::invalid_argument, "a level of detail (coarse blocks) cannot be stored in a .fft file");
+        if (r.fiber >= source.header().fibers || r.block_count == 0 || r.block_count > 0xffff ||
+            r.first_block < source.first_block(r.fiber) ||
+            r.first_block + r.block_count > source.first_block(r.fiber) + source.block_count(r.fiber))
+            throw Error(Errc::invalid_argument, "run " + std::to_string(i) + " is not a block range of its fiber");
+        return detail::FiberBlocks{r.block_count, h.packed() ? run_points(source, r) : 0};
+    }, path);
+}
+
+// copy_run's buffers, reused from run to run.
+struct CopyScratch {
+    std::vector<std::uint8_t> raw, packed;
+    std::vector<std::uint32_t> packed_sizes;
+    std::vector<float> xyz;
+};
+
+// Run i's blocks, read, renamed as fiber i and written; the block index
+// gets their decoded points, h and `points` their point counts.
+void copy_run(const FftFile& source, const DecodeContext& ctx, const SelectedRun& r, std::uint32_t i, FftHeader& h,
+              detail::FftWriter& out, IndexBuilder& index, std::uint32_t& points, CopyScratch& scratch) {
+    const std::uint32_t bb = h.block_bytes();
+    auto& [raw, packed, packed_sizes, xyz] = scratch;
+    raw.resize(std::size_t(r.block_count) * bb);
+    source.read_blocks(r.first_block, r.block_count, raw.data());
+    xyz.resize(3 * count_block_points(ctx, raw.data(), r.block_count));
+    detail::decode_selected_blocks(ctx, raw.data(), r.block_count, xyz.data());
+    const float* p = xyz.data();
+    for (std::uint32_t k = 0; k < r.block_count; ++k) {
+        std::uint8_t* b = &raw[std::size_t(k) * bb];
+        const std::uint32_t n = block_flags(h, b).point_count;
+        place_block(h, b, i, k, r.block_count);
+        index.add_block(p, n, k + 1 == r.block_count);
+        p += 3 * n;
+        h.points += n;
+        points += n;
+    }
+    if (!h.packed()) return out.write_blocks(raw);
+    packed.clear();
+    packed_sizes.clear();
+    detail::pack_blocks16(h, raw, packed, &packed_sizes);
+    out.write_packed_blocks(packed, packed_sizes);
+}
+
 }  // namespace
 
 SubsetReport write_fft_subset(const FftFile& source, const std::vector<SelectedRun>& runs, const std::string& path,
                               bool overwrite, BlockIndexFormat index_format) {
-    const FftHeader& src = source.header();
     if (runs.size() > std::numeric_limits<std::uint32_t>::max())
         throw Error(Errc::unsupported, path + ": more than 2^32 - 1 fibers (fiber IDs are 32-bit)");
-
-    // Header and LUT first: the same buffer split as the encoder makes.
-    FftHeader h = src;
+    FftHeader h = source.header();
     h.fibers = runs.size();
-    h.points = 0;
-    h.buffer_ends.clear();
-    std::vector<FiberLutEntry> lut(runs.size());
-    const std::uint64_t per_buffer = fft_max_blocks_per_buffer(h.block_bytes());
-    std::uint64_t blocks = 0, in_buffer = 0;
-    for (std::size_t i = 0; i < runs.size(); ++i) {
-        const SelectedRun& r = runs[i];
-        if (r.coarse_blocks > 0)
-            throw Error(Errc::invalid_argument, "a level of detail (coarse blocks) cannot be stored in a .fft file");
-        if (r.fiber >= src.fibers || r.block_count == 0 || r.block_count > 0xffff ||
-            r.first_block < source.first_block(r.fiber) ||
-            r.first_block + r.block_count > source.first_block(r.fiber) + source.block_count(r.fiber))
-            throw Error(Errc::invalid_argument, "run " + std::to_string(i) + " is not a block range of its fiber");
-        if (in_buffer + r.block_count > per_buffer) h.buffer_ends.push_back(blocks), in_buffer = 0;
-        if (h.buffer_ends.size() > 254) throw Error(Errc::unsupported, path + ": more than 255 GPU buffers of blocks");
-        lut[i] = {std::uint32_t(h.buffer_ends.size()) << 16 | r.block_count,
-                  h.packed() ? run_points(source, r) : std::uint32_t(in_buffer)};
-        blocks += r.block_count, in_buffer += r.block_count;
-    }
-    if (blocks > std::numeric_limits<std::uint32_t>::max())
-        throw Error(Errc::unsupported, path + ": more than 2^32 - 1 blocks");
-    if (blocks > 0) h.buffer_ends.push_back(blocks);
-    h.blocks = std::uint32_t(blocks);
-
-    AtomicOutputFile out(path, overwrite);
-    FftChecksumBuilder checksum(h.block_bytes());  // the CSUM chunk, as compress writes it
-    {
-        const auto head = serialize_fft_header(h);
-        out.write(head.data(), head.size());
-        out.write(lut.data(), lut.size() * sizeof(FiberLutEntry));
-        checksum.add_lut(lut.data(), lut.size() * sizeof(FiberLutEntry));
-    }
+    h.points = 0;  // counted as the blocks are copied
+    const std::vector<FiberLutEntry> lut = plan_runs(h, source, runs, path);
+    detail::FftWriter out(path, overwrite, std::nullopt, h, lut);
     const DecodeContext ctx(source);
-    const std::uint32_t bb = h.block_bytes();
     IndexBuilder index(h, index_format);
-    std::vector<std::uint8_t> raw, packed;
-    std::vector<std::uint32_t> packed_sizes;
-    std::vector<float> xyz;
     std::vector<std::uint32_t> run_points(runs.size(), 0);
-    for (std::size_t i = 0; i < runs.size(); ++i) {
-        const SelectedRun& r = runs[i];
-        raw.resize(std::size_t(r.block_count) * bb);
-        source.read_blocks(r.first_block, r.block_count, raw.data());
-        xyz.resize(3 * count_block_points(ctx, raw.data(), r.block_count));
-        detail::decode_selected_blocks(ctx, raw.data(), r.block_count, xyz.data());
-        const float* p = xyz.data();
-        const auto id = std::uint32_t(i);
-        for (std::uint32_t k = 0; k < r.block_count; ++k) {
-            std::uint8_t* b = &raw[std::size_t(k) * bb];
-            const std::uint32_t n = block_flags(h, b).point_count;
-            place_block(h, b, id, k, r.block_count);
-            index.add_block(p, n, k + 1 == r.block_count);
-            p += 3 * n;
-            h.points += n;
-            run_points[i] += n;
-        }
-        if (h.packed()) {  // checksums cover the bytes as stored
-            packed.clear();
-            packed_sizes.clear();
-            detail::pack_blocks16(h, raw, packed, &packed_sizes);
-            out.write(packed.data(), packed.size());
-            const std::uint8_t* b = packed.data();
-            for (const std::uint32_t n : packed_sizes) checksum.add_block(b, n), b += n;
-        } else {
-            out.write(raw.data(), raw.size());
-            checksum.add_blocks(raw.data(), raw.size());
-        }
-    }
-    const auto head = serialize_fft_header(h);
-    {
-        const std::uint64_t at = out.size();
-        std::vector<TrailerChunk> chunks;
-        for (const auto tag : {kPropertiesTag, kResampledTag})
-            if (const TrailerChunk* c = source.find_chunk(tag)) chunks.push_back(*c);
-        if (source.end_fractions()) chunks.push_back(subset_end_fractions(source, runs));
-        if (!source.streamline_fields().empty()) chunks.push_back(subset_streamline_data(source, runs, run_points));
-        if (auto bidx = index.finish()) chunks.push_back(std::move(*bidx));
-        chunks.push_back(checksum.finish(head, chunks));  // last: it covers the chunks before it
-        const auto trailer = serialize_trailer(chunks, at);
-        out.write(trailer.data(), trailer.size());
-    }
-    out.write_at(head.data(), head.size(), 0);
-    SubsetReport report{h.fibers, h.blocks, h.points, out.size()};
+    CopyScratch scratch;
+    for (std::size_t i = 0; i < runs.size(); ++i)
+        copy_run(source, ctx, runs[i], std::uint32_t(i), h, out, index, run_points[i], scratch);
+    std::vector<TrailerChunk> chunks;
+    for (const auto tag : {kPropertiesTag, kResampledTag})
+        if (const TrailerChunk* c = source.find_chunk(tag)) chunks.push_back(*c);
+    if (source.end_fractions()) chunks.push_back(subset_end_fractions(source, runs));
+    if (!source.streamline_fields().empty()) chunks.push_back(subset_streamline_data(source, runs, run_points));
+    if (auto bidx = index.finish()) chunks.push_back(std::move(*bidx));
+    const SubsetReport report{h.fibers, h.blocks, h.points, out.finish(h, std::move(chunks))};
     out.commit();
     return report;
 }
