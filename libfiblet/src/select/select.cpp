@@ -405,43 +405,86 @@ private:
         }
     }
 
+    // Pass 2 (fibers mode): what the regions test, fiber by fiber.
+    struct RegionTests {
+        std::vector<Bits> near_include, inside_include;  // per include region: blocks near it, wholly inside it
+        Bits near_exclude;                               // blocks near an exclude region
+        std::uint64_t all_includes = 0;                  // the bits of every include region
+        std::vector<std::uint64_t> met;                  // per fiber: the include regions its points meet
+        std::vector<std::uint8_t> excluded;              // per fiber: a point in an exclude region
+        bool tests(std::size_t k, std::uint64_t f, std::uint64_t b) const {  // include k, to be tested on block b?
+            return !(met[f] >> k & 1) && has_bit(near_include[k], b);
+        }
+    };
+
     // Pass 2 (fibers mode): a fiber must meet every include region and no
     // exclude region. Only blocks the index puts near a region are decoded.
     void fiber_regions() {
-        const std::size_t k_inc = q_.include.size();
-        std::vector<Bits> inc(k_inc), inside(k_inc);
-        for (std::size_t k = 0; k < k_inc; ++k) inc[k] = near(q_.include[k], &inside[k]);
-        const Bits exc = near_any(q_.exclude);
-        const std::uint64_t all = k_inc == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << k_inc) - 1;
+        RegionTests t = region_tests();
+        test_decoded_blocks(t, blocks_to_decode(t));
+        for (std::uint64_t f = 0; f < h_.fibers; ++f)
+            if (t.met[f] != t.all_includes || t.excluded[f]) keep_[f] = 0;
+    }
 
-        // Fibers with no block near some include region fail without
-        // decoding; a block wholly inside a region meets it without decoding.
-        std::vector<std::uint64_t> may_meet(h_.fibers, 0), met(h_.fibers, 0);
+    // The regions' blocks from the index. Fibers with no block near some
+    // include region fail without decoding; a block wholly inside a region
+    // meets it without decoding.
+    RegionTests region_tests() {
+        const std::size_t k_inc = q_.include.size();
+        RegionTests t{.near_include = std::vector<Bits>(k_inc),
+                      .inside_include = std::vector<Bits>(k_inc),
+                      .near_exclude = near_any(q_.exclude),
+                      .all_includes = k_inc == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << k_inc) - 1,
+                      .met = std::vector<std::uint64_t>(h_.fibers, 0),
+                      .excluded = std::vector<std::uint8_t>(h_.fibers, 0)};
+        std::vector<std::uint64_t> may_meet(h_.fibers, 0);
         for (std::size_t k = 0; k < k_inc; ++k) {
+            t.near_include[k] = near(q_.include[k], &t.inside_include[k]);
             FiberCursor cursor(file_);
-            for (std::size_t w = 0; w < inc[k].size(); ++w)
-                for (std::uint64_t bits = inc[k][w]; bits; bits &= bits - 1) {
+            for (std::size_t w = 0; w < t.near_include[k].size(); ++w)
+                for (std::uint64_t bits = t.near_include[k][w]; bits; bits &= bits - 1) {
                     const std::uint64_t b = w * 64 + std::uint64_t(std::countr_zero(bits));
                     const std::uint64_t f = cursor.fiber_of(b);
                     may_meet[f] |= std::uint64_t{1} << k;
-                    if (has_bit(inside[k], b)) met[f] |= std::uint64_t{1} << k;
+                    if (has_bit(t.inside_include[k], b)) t.met[f] |= std::uint64_t{1} << k;
                 }
         }
         for (std::uint64_t f = 0; f < h_.fibers; ++f)
-            if (may_meet[f] != all) keep_[f] = 0;
+            if (may_meet[f] != t.all_includes) keep_[f] = 0;
+        return t;
+    }
 
-        // Decoded: blocks near an exclude region, and blocks near (not
-        // wholly inside) an include region that their fiber has not met yet.
-        Bits to_test = exc;
-        for (std::size_t k = 0; k < k_inc; ++k) {
+    // Blocks near an exclude region, and blocks near (not wholly inside) an
+    // include region that their fiber has not met yet.
+    Bits blocks_to_decode(const RegionTests& t) const {
+        Bits to_test = t.near_exclude;
+        for (std::size_t k = 0; k < t.near_include.size(); ++k) {
             FiberCursor cursor(file_);
-            for (std::size_t w = 0; w < inc[k].size(); ++w)
-                for (std::uint64_t bits = inc[k][w] & ~inside[k][w]; bits; bits &= bits - 1) {
+            for (std::size_t w = 0; w < t.near_include[k].size(); ++w)
+                for (std::uint64_t bits = t.near_include[k][w] & ~t.inside_include[k][w]; bits; bits &= bits - 1) {
                     const std::uint64_t b = w * 64 + std::uint64_t(std::countr_zero(bits));
-                    if (!(met[cursor.fiber_of(b)] >> k & 1)) to_test[w] |= std::uint64_t{1} << (b & 63);
+                    if (!(t.met[cursor.fiber_of(b)] >> k & 1)) to_test[w] |= std::uint64_t{1} << (b & 63);
                 }
         }
-        std::vector<std::uint8_t> excluded(h_.fibers, 0);
+        return to_test;
+    }
+
+    // Whether block i of a read batch is decoded: its bound from headers
+    // (block_bound) meets a region it is tested against; the index's boxes
+    // are coarser (quantized, or of groups of blocks).
+    bool bound_meets_a_region(const RegionTests& t, std::size_t i, std::uint64_t f, std::uint64_t b) const {
+        if (!coarse_index_) return true;  // exact boxes (computed) or no join bound (version 1)
+        const std::size_t next = next_at_need_[i];
+        const BlockBound c = block_bound(spheres_[at_need_[i]], next != SIZE_MAX ? &spheres_[next] : nullptr, index_.max_join());
+        if (!q_.exclude.empty() && has_bit(t.near_exclude, b) && bound_may_meet(q_.exclude, c)) return true;
+        for (std::size_t k = 0; k < q_.include.size(); ++k)
+            if (t.tests(k, f, b) && bound_may_meet(q_.include[k], c)) return true;
+        return false;
+    }
+
+    // The candidate blocks decoded, a batch at a time, and their points
+    // tested against the regions.
+    void test_decoded_blocks(RegionTests& t, const Bits& to_test) {
         CandidateBlocks candidates(file_, keep_, &to_test);
         std::vector<std::uint32_t> blocks;
         std::vector<std::uint64_t> fibers;
@@ -451,48 +494,29 @@ private:
             stats_.blocks_tested += blocks.size();
             read_with_next(blocks, fibers, coarse_index_);  // the next block's first point narrows a bound
             if (coarse_index_) spheres_of_read(need_.size());
-            // Decoded: the blocks whose bound from headers (block_bound)
-            // meets a region they are tested against; the index's boxes
-            // are coarser (quantized, or of groups of blocks).
             tested.clear();
-            for (std::size_t i = 0; i < blocks.size(); ++i) {
-                const std::uint64_t f = fibers[i], b = blocks[i];
-                if (excluded[f]) continue;
-                if (!coarse_index_) {  // exact boxes (computed) or no join bound (version 1)
-                    tested.push_back(i);
-                    continue;
-                }
-                const std::size_t next = next_at_need_[i];
-                const BlockBound c =
-                    block_bound(spheres_[at_need_[i]], next != SIZE_MAX ? &spheres_[next] : nullptr, index_.max_join());
-                bool test = !q_.exclude.empty() && has_bit(exc, b) && bound_may_meet(q_.exclude, c);
-                for (std::size_t k = 0; k < k_inc && !test; ++k)
-                    test = !(met[f] >> k & 1) && has_bit(inc[k], b) && bound_may_meet(q_.include[k], c);
-                if (test) tested.push_back(i);
-            }
+            for (std::size_t i = 0; i < blocks.size(); ++i)
+                if (!t.excluded[fibers[i]] && bound_meets_a_region(t, i, fibers[i], blocks[i])) tested.push_back(i);
             if (tested.empty()) continue;
             // One decode call for the whole batch (SIMD decoders fill their lanes).
             const std::uint8_t* bytes =
                 contiguous(blocks, tested, [&](std::size_t i) { return reader_.block(at_need_[i]); });
             decode_into(ctx_, bytes, tested.size(), scratch_, 0);
             first_point.assign(tested.size() + 1, 0);
-            for (std::size_t t = 0; t < tested.size(); ++t)
-                first_point[t + 1] = first_point[t] + block_flags(h_, bytes + t * bb).point_count;
+            for (std::size_t j = 0; j < tested.size(); ++j)
+                first_point[j + 1] = first_point[j] + block_flags(h_, bytes + j * bb).point_count;
             stats_.blocks_decoded += tested.size();
-            for (std::size_t t = 0; t < tested.size(); ++t) {
-                const std::size_t i = tested[t];
+            for (std::size_t j = 0; j < tested.size(); ++j) {
+                const std::size_t i = tested[j];
                 const std::uint64_t f = fibers[i], b = blocks[i];
-                if (excluded[f]) continue;
-                const float* p = &scratch_[3 * first_point[t]];
-                const auto n = std::uint32_t(first_point[t + 1] - first_point[t]);
-                for (std::size_t k = 0; k < k_inc; ++k)
-                    if (!(met[f] >> k & 1) && has_bit(inc[k], b) && any_point_in(q_.include[k], p, n))
-                        met[f] |= std::uint64_t{1} << k;
-                if (!q_.exclude.empty() && has_bit(exc, b) && any_point_in(q_.exclude, p, n)) excluded[f] = 1;
+                if (t.excluded[f]) continue;
+                const float* p = &scratch_[3 * first_point[j]];
+                const auto n = std::uint32_t(first_point[j + 1] - first_point[j]);
+                for (std::size_t k = 0; k < q_.include.size(); ++k)
+                    if (t.tests(k, f, b) && any_point_in(q_.include[k], p, n)) t.met[f] |= std::uint64_t{1} << k;
+                if (!q_.exclude.empty() && has_bit(t.near_exclude, b) && any_point_in(q_.exclude, p, n)) t.excluded[f] = 1;
             }
         }
-        for (std::uint64_t f = 0; f < h_.fibers; ++f)
-            if (met[f] != all || excluded[f]) keep_[f] = 0;
     }
 
     // Pass 2 with ends_only: a fiber's first and last points must meet
