@@ -577,135 +577,154 @@ private:
         }
     }
 
+    // Pass 3's settings and the filters from the index, for the whole pass.
+    struct BlockPass {
+        bool blocks_mode = false, cull = false, include_tests = false;
+        std::optional<LevelOfDetail> lod;
+        Frustum frustum{};
+        std::optional<Bits> only;  // candidate blocks (none: every block of a kept fiber)
+        Bits exclude_near, include_inside;
+        // Point tests needed: near an include region but not wholly inside
+        // one, or near an exclude region.
+        bool include_test(const std::vector<Region>& include, std::uint64_t b) const {
+            return blocks_mode && !include.empty() && !has_bit(include_inside, b);
+        }
+        bool exclude_test(std::uint64_t b) const { return blocks_mode && !exclude_near.empty() && has_bit(exclude_near, b); }
+    };
+    enum BlockKind : std::uint8_t { dropped, fine, coarse };
+
     // Pass 3: the blocks of the kept fibers.
     void blocks(const std::function<void(const SelectedChunk&)>& sink) {
-        const bool blocks_mode = q_.roi_mode == RoiMode::blocks;
-        const bool cull = q_.view && q_.view->cull;
-        std::optional<LevelOfDetail> lod;
-        if (q_.has_level_of_detail()) lod.emplace(q_.view->camera, *q_.view->lod, q_.view->lod_pixels);
-        Frustum frustum{};
-        if (q_.view) frustum = frustum_from_camera(q_.view->camera);
-
-        // Candidate blocks from the index: near the frustum (grown by the
-        // largest sphere radius) and, in blocks mode, near an include region.
-        std::optional<Bits> only;
-        if (cull) {
-            Bits f;
-            const float margin = index_.max_sphere_radius() * (1 + 1e-5f) + 1e-3f;
-            index_.blocks_near_frustum(frustum, margin, f);
-            f.resize((h_.blocks + 63) / 64, 0);
-            only = std::move(f);
-        }
-        Bits exc, inc_inside;
-        if (blocks_mode && !q_.include.empty()) {
-            Bits inc = near_any(q_.include, &inc_inside);
-            if (only) and_bits(*only, inc);
-            else only = std::move(inc);
-        }
-        if (blocks_mode && !q_.exclude.empty()) exc = near_any(q_.exclude);
-
+        const BlockPass pass = block_pass();
         RunWriter out(options_, sink, stats_, batch_blocks(h_) * h_.points_per_block);
-        CandidateBlocks candidates(file_, keep_, only ? &*only : nullptr);
+        CandidateBlocks candidates(file_, keep_, pass.only ? &*pass.only : nullptr);
         std::vector<std::uint32_t> blocks;
         std::vector<std::uint64_t> fibers;
-        enum Kind : std::uint8_t { dropped, fine, coarse };
-        std::vector<Kind> kind;
-        const std::uint32_t bb = h_.block_bytes();
-        // Point tests needed: near an include region but not wholly inside one,
-        // or near an exclude region.
-        auto include_test = [&](std::size_t i) {
-            return blocks_mode && !q_.include.empty() && !has_bit(inc_inside, blocks[i]);
-        };
-        auto exclude_test = [&](std::size_t i) { return blocks_mode && !exc.empty() && has_bit(exc, blocks[i]); };
-        auto region_test = [&](std::size_t i) { return include_test(i) || exclude_test(i); };
-        auto passes_regions = [&](std::size_t i, const float* p, std::uint32_t n) {
-            if (include_test(i) && !any_point_in(q_.include, p, n)) return false;
-            return !(exclude_test(i) && any_point_in(q_.exclude, p, n));
-        };
-        const bool include_tests = coarse_index_ && blocks_mode && !q_.include.empty();
+        std::vector<BlockKind> kind;
         while (candidates.next(batch_blocks(h_), blocks, fibers)) {
             stats_.blocks_tested += blocks.size();
             // With a level of detail, the next block's first point may end a
             // segment; with include tests, it narrows the block's bound.
-            read_with_next(blocks, fibers, lod || include_tests);
-
-            // Header tests: the block's sphere against the frustum, the level
-            // of detail and, where its points would be tested, the include
-            // regions (the index's boxes are coarser than the block's bound).
-            kind.assign(blocks.size(), fine);
-            // Every header tested below, in one call (a call per block cost more than its arithmetic).
-            if (q_.view || include_tests) spheres_of_read(need_.size());
-            if (q_.view || include_tests)
-                for (std::size_t i = 0; i < blocks.size(); ++i) {
-                    const bool bound_test = include_tests && include_test(i);
-                    if (!q_.view && !bound_test) continue;
-                    const Sphere& s = spheres_[at_need_[i]];
-                    if (cull && !sphere_intersects_frustum(frustum, s.center, s.radius)) {
-                        kind[i] = dropped;
-                        continue;
-                    }
-                    if (bound_test) {
-                        const std::size_t k = next_at_need_[i];
-                        if (!bound_may_meet(q_.include,
-                                            block_bound(s, k != SIZE_MAX ? &spheres_[k] : nullptr, index_.max_join()))) {
-                            kind[i] = dropped;
-                            continue;
-                        }
-                    }
-                    if (lod && lod->coarse(s.center, s.radius)) kind[i] = coarse;
-                }
-
+            read_with_next(blocks, fibers, pass.lod || pass.include_tests);
+            classify_blocks(pass, blocks, kind);
             for (std::size_t i = 0, j; i < blocks.size(); i = j) {
                 j = i + 1;
-                if (kind[i] == dropped) continue;
-                const std::uint8_t* block = reader_.block(at_need_[i]);
-                if (kind[i] == coarse) {
-                    // First point, then the next block's first point or the fiber's last point.
-                    const std::uint32_t n = block_flags(h_, block).point_count;
-                    const bool last = next_at_need_[i] == SIZE_MAX;
-                    if (region_test(i) || (last && n > 1)) {
-                        decode_into(ctx_, block, 1, scratch_, 0);
-                        ++stats_.blocks_decoded;
-                        if (!passes_regions(i, scratch_.data(), n)) continue;
-                    }
-                    Vec3f end{};
-                    if (!last) end = first_point(h_, reader_.block(next_at_need_[i]));
-                    else if (n > 1) end = {scratch_[3 * (n - 1)], scratch_[3 * (n - 1) + 1], scratch_[3 * (n - 1) + 2]};
-                    out.coarse(fibers[i], blocks[i], first_point(h_, block), last && n < 2 ? nullptr : &end);
-                    out.maybe_flush();
-                    continue;
-                }
-                // Fine blocks up to the next coarse one (dropped ones left
-                // out): decoded with one call, straight into the output, then
-                // kept or dropped in place.
-                segment_.assign(1, i);
-                bool test = region_test(i);
-                for (; j < blocks.size() && kind[j] != coarse; ++j)
-                    if (kind[j] == fine) segment_.push_back(j), test |= region_test(j);
-                if (!options_.points && !test) {
-                    for (std::size_t k : segment_)
-                        out.fine(fibers[k], blocks[k], 0, block_flags(h_, reader_.block(at_need_[k])).point_count);
-                    out.maybe_flush();
-                    continue;
-                }
-                const std::uint8_t* bytes =
-                    contiguous(blocks, segment_, [&](std::size_t k) { return reader_.block(at_need_[k]); });
-                out.break_unless_continues(fibers[i], blocks[i]);
-                const std::size_t base = out.frontier();
-                const std::size_t decoded = decode_into(ctx_, bytes, segment_.size(), out.buffer(), base);
-                stats_.blocks_decoded += segment_.size();
-                std::size_t at = base;
-                for (std::size_t s = 0; s < segment_.size(); ++s) {
-                    const std::size_t k = segment_[s];
-                    const std::uint32_t n = block_flags(h_, bytes + s * bb).point_count;
-                    if (passes_regions(k, &out.buffer()[3 * at], n)) out.fine(fibers[k], blocks[k], at, n);
-                    at += n;
-                }
-                out.advance(decoded);
-                out.maybe_flush();
+                if (kind[i] == coarse) write_coarse_block(pass, blocks, fibers, i, out);
+                else if (kind[i] == fine) j = write_fine_blocks(pass, blocks, fibers, kind, i, out);
             }
         }
         out.finish();
+    }
+
+    // Candidate blocks from the index: near the frustum (grown by the
+    // largest sphere radius) and, in blocks mode, near an include region.
+    BlockPass block_pass() const {
+        BlockPass p;
+        p.blocks_mode = q_.roi_mode == RoiMode::blocks;
+        p.cull = q_.view && q_.view->cull;
+        if (q_.has_level_of_detail()) p.lod.emplace(q_.view->camera, *q_.view->lod, q_.view->lod_pixels);
+        if (q_.view) p.frustum = frustum_from_camera(q_.view->camera);
+        if (p.cull) {
+            Bits f;
+            const float margin = index_.max_sphere_radius() * (1 + 1e-5f) + 1e-3f;
+            index_.blocks_near_frustum(p.frustum, margin, f);
+            f.resize((h_.blocks + 63) / 64, 0);
+            p.only = std::move(f);
+        }
+        if (p.blocks_mode && !q_.include.empty()) {
+            Bits inc = near_any(q_.include, &p.include_inside);
+            if (p.only) and_bits(*p.only, inc);
+            else p.only = std::move(inc);
+        }
+        if (p.blocks_mode && !q_.exclude.empty()) p.exclude_near = near_any(q_.exclude);
+        p.include_tests = coarse_index_ && p.blocks_mode && !q_.include.empty();
+        return p;
+    }
+
+    // Header tests: the block's sphere against the frustum, the level of
+    // detail and, where its points would be tested, the include regions (the
+    // index's boxes are coarser than the block's bound).
+    void classify_blocks(const BlockPass& pass, const std::vector<std::uint32_t>& blocks, std::vector<BlockKind>& kind) {
+        kind.assign(blocks.size(), fine);
+        if (!q_.view && !pass.include_tests) return;
+        spheres_of_read(need_.size());  // every header tested below, in one call (a call per block cost more)
+        for (std::size_t i = 0; i < blocks.size(); ++i) {
+            const bool bound_test = pass.include_tests && pass.include_test(q_.include, blocks[i]);
+            if (!q_.view && !bound_test) continue;
+            const Sphere& s = spheres_[at_need_[i]];
+            if (pass.cull && !sphere_intersects_frustum(pass.frustum, s.center, s.radius)) {
+                kind[i] = dropped;
+                continue;
+            }
+            if (bound_test) {
+                const std::size_t k = next_at_need_[i];
+                if (!bound_may_meet(q_.include, block_bound(s, k != SIZE_MAX ? &spheres_[k] : nullptr, index_.max_join()))) {
+                    kind[i] = dropped;
+                    continue;
+                }
+            }
+            if (pass.lod && pass.lod->coarse(s.center, s.radius)) kind[i] = coarse;
+        }
+    }
+
+    bool region_test(const BlockPass& pass, std::uint64_t b) const {
+        return pass.include_test(q_.include, b) || pass.exclude_test(b);
+    }
+    bool passes_regions(const BlockPass& pass, std::uint64_t b, const float* p, std::uint32_t n) const {
+        if (pass.include_test(q_.include, b) && !any_point_in(q_.include, p, n)) return false;
+        return !(pass.exclude_test(b) && any_point_in(q_.exclude, p, n));
+    }
+
+    // A coarse block: its first point, then the next block's first point or
+    // the fiber's last point.
+    void write_coarse_block(const BlockPass& pass, const std::vector<std::uint32_t>& blocks,
+                            const std::vector<std::uint64_t>& fibers, std::size_t i, RunWriter& out) {
+        const std::uint8_t* block = reader_.block(at_need_[i]);
+        const std::uint32_t n = block_flags(h_, block).point_count;
+        const bool last = next_at_need_[i] == SIZE_MAX;
+        if (region_test(pass, blocks[i]) || (last && n > 1)) {
+            decode_into(ctx_, block, 1, scratch_, 0);
+            ++stats_.blocks_decoded;
+            if (!passes_regions(pass, blocks[i], scratch_.data(), n)) return;
+        }
+        Vec3f end{};
+        if (!last) end = first_point(h_, reader_.block(next_at_need_[i]));
+        else if (n > 1) end = {scratch_[3 * (n - 1)], scratch_[3 * (n - 1) + 1], scratch_[3 * (n - 1) + 2]};
+        out.coarse(fibers[i], blocks[i], first_point(h_, block), last && n < 2 ? nullptr : &end);
+        out.maybe_flush();
+    }
+
+    // Fine blocks from i up to the next coarse one (dropped ones left out):
+    // decoded with one call, straight into the output, then kept or dropped
+    // in place. Returns where the next coarse block (or the batch's end) is.
+    std::size_t write_fine_blocks(const BlockPass& pass, const std::vector<std::uint32_t>& blocks,
+                                  const std::vector<std::uint64_t>& fibers, const std::vector<BlockKind>& kind,
+                                  std::size_t i, RunWriter& out) {
+        segment_.assign(1, i);
+        bool test = region_test(pass, blocks[i]);
+        std::size_t j = i + 1;
+        for (; j < blocks.size() && kind[j] != coarse; ++j)
+            if (kind[j] == fine) segment_.push_back(j), test |= region_test(pass, blocks[j]);
+        if (!options_.points && !test) {
+            for (std::size_t k : segment_) out.fine(fibers[k], blocks[k], 0, block_flags(h_, reader_.block(at_need_[k])).point_count);
+            out.maybe_flush();
+            return j;
+        }
+        const std::uint8_t* bytes = contiguous(blocks, segment_, [&](std::size_t k) { return reader_.block(at_need_[k]); });
+        out.break_unless_continues(fibers[i], blocks[i]);
+        const std::size_t base = out.frontier();
+        const std::size_t decoded = decode_into(ctx_, bytes, segment_.size(), out.buffer(), base);
+        stats_.blocks_decoded += segment_.size();
+        std::size_t at = base;
+        for (std::size_t s = 0; s < segment_.size(); ++s) {
+            const std::size_t k = segment_[s];
+            const std::uint32_t n = block_flags(h_, bytes + s * h_.block_bytes()).point_count;
+            if (passes_regions(pass, blocks[k], &out.buffer()[3 * at], n)) out.fine(fibers[k], blocks[k], at, n);
+            at += n;
+        }
+        out.advance(decoded);
+        out.maybe_flush();
+        return j;
     }
 
     // Reads `blocks` and, with `with_next`, the next block of each in its
