@@ -23,6 +23,7 @@ PACKAGES=(
   valgrind  # callgrind: the compress instruction budget (bench/instruction_budget.py)
   slurm-wlm munge  # the cohort workflow on a single-node SLURM (ecosystem.cohort_workflow_slurm)
   clang-14 libclang-rt-14-dev  # libFuzzer harnesses (scripts/fuzz.sh)
+  clang-tidy-14  # library functions over 80 lines only with a reason (scripts/check_function_size.sh)
   libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libspng-dev
   libembree-dev  # test-only: the independent ray tracer the viewer's capsules are checked against
 )

@@ -78,7 +78,11 @@ struct Blocks16 {
 
 }  // namespace lanes
 
+// Over 80 lines with a reason: one SIMD kernel whose lane state (a frame
+// and point per block, 16 blocks a vector) stays in registers from the
+// anchors through the walk to the stores.
 template <class Blocks>
+// NOLINTNEXTLINE(readability-function-size): the reason above
 std::size_t decode_lanes_of(const DecodeContext& ctx, const float* rows_table, float unorm_max, bool axis_from_words,
                             const std::uint8_t* blocks, std::size_t count, float* xyz) {
     using F = V::F;

@@ -66,6 +66,9 @@ inline void sum_pass(V::F (&s)[3][kRegs], int regs, V::F zero) {
 
 }  // namespace warp
 
+// Over 80 lines with a reason: one SIMD kernel whose warp registers (the
+// prefix products of 32 lanes) stay in registers through its passes.
+// NOLINTNEXTLINE(readability-function-size): the reason above
 inline std::size_t decode_warp(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count, float* xyz) {
     using F = V::F;
     constexpr int W = V::W;
