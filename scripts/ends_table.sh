@@ -9,7 +9,7 @@
 # -minlength 100` count of the input and of each decoded file, .fft size and
 # its change (%).
 # Both compress with `--bits 8`: the table compares the 8-bit codec (the
-# default chooses 16 bits for smooth fixed-step fibers, codec/direction_bits.hpp).
+# default chooses 16 bits for smooth fixed-step fibers, encode/direction_bits.hpp).
 # Usage: FIBLET_BEFORE=old/bin/fiblet [FIBLET=build/bin/fiblet] scripts/ends_table.sh
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"

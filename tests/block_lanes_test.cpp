@@ -1,6 +1,6 @@
 // The encoder's searches with one block per SIMD lane: greedy
-// (codec/greedy_blocks.hpp) and lookahead at depths 1 and 2
-// (codec/lookahead_blocks.hpp: the first search and the length tails).
+// (encode/greedy_blocks.hpp) and lookahead at depths 1 and 2
+// (encode/lookahead_blocks.hpp: the first search and the length tails).
 // At every level this CPU supports, the same codes and the same decoded
 // points, bit for bit, as the scalar searches (search_codes,
 // LookaheadSearch), on random walks, on the shared tractogram and on the
@@ -12,9 +12,9 @@
 #include <cstring>
 #include <random>
 
-#include "codec/greedy_blocks.hpp"
-#include "codec/lookahead_blocks.hpp"
-#include "codec/nearest_code_lut.hpp"
+#include "encode/greedy_blocks.hpp"
+#include "encode/lookahead_blocks.hpp"
+#include "encode/nearest_code_lut.hpp"
 #include "core/vec_math.hpp"
 #include "fiblet/encode.hpp"
 #include "fiblet/error.hpp"

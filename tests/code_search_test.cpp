@@ -7,8 +7,8 @@
 #include <cstring>
 #include <random>
 
-#include "codec/code_search.hpp"
-#include "codec/nearest_code_lut.hpp"
+#include "encode/code_search.hpp"
+#include "encode/nearest_code_lut.hpp"
 #include "fiblet/decode.hpp"
 #include "fiblet/encode.hpp"
 #include "fiblet/error.hpp"

@@ -102,7 +102,7 @@ TEST_P(CodecRoundTrip, PreservesStructureAndStaysWithinTheErrorBound) {
     const double theta = covering_angle(table) + test::neighbourhood_reach(table, 1);
     const double delta = double(h.step) * h.scaling;
     // A full quantum: the encoder may round anchors the other way where the
-    // first frame is ill-conditioned (codec/anchor_conditioning.hpp).
+    // first frame is ill-conditioned (encode/anchor_conditioning.hpp).
     const double ea = std::sqrt(3.0) * h.scaling / 65535.0 + 1e-6;
     double max_e = 0, sum_e = 0;
     std::uint64_t n = 0, over = 0;

@@ -311,7 +311,7 @@ TEST(DecodeSimd, SharedTractogramsMatchTheReferenceDecoder) {
     for (const auto& tck : inputs) {
         const std::string fft = dir.file(tck.stem().string() + ".fft");
         // The SIMD decoders are the 8-bit layout's; the default would give
-        // the smooth files 16-bit codes (codec/direction_bits.hpp).
+        // the smooth files 16-bit codes (encode/direction_bits.hpp).
         CompressOptions o;
         o.direction_bits = 8;
         compress_tck(tck.string(), fft, o);

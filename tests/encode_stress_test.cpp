@@ -11,7 +11,7 @@
 #include <map>
 #include <random>
 
-#include "codec/nearest_code_lut.hpp"
+#include "encode/nearest_code_lut.hpp"
 #include "error_bound.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/decode.hpp"
@@ -95,7 +95,7 @@ test::BoundParams bound_params(const FftHeader& h, const SearchOptions& s, doubl
     const double ulp = std::ldexp(1.0, -24);
     // A full quantum, not half: where a block's first segment runs along the
     // helper vector the encoder may round an anchor the other way to
-    // condition the first frame (codec/anchor_conditioning.hpp).
+    // condition the first frame (encode/anchor_conditioning.hpp).
     p.anchor_error = std::sqrt(3.0) * (1.0 / 65535 + ulp) * h.scaling;
     p.step_slack = 4 * ulp * h.scaling;
     p.point_slack = 4 * ulp * (h.scaling + max_abs_coordinate);

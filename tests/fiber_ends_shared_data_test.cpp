@@ -214,11 +214,11 @@ void expect_lengths_within_the_recorded_error(const ResampledLengthChanges& m) {
 // defaults: the decoded length is the input's within the error the header
 // records, by brute force, nothing set aside; fiblet's decoder, and the
 // float64 reference decoder within 1.05x. Before the length feedback
-// (codec/length_feedback.hpp) the codes' lag at block ends added up to
+// (encode/length_feedback.hpp) the codes' lag at block ends added up to
 // 96 um on iFOD2 for 46 um recorded, and the end fraction left the raw
 // bundles 0.4-0.9 mm off. With --bits auto the 0.1 mm bundles whose fibers
 // 8-bit codes would zig-zag longer than the point error are written with 16-bit codes
-// (codec/direction_bits.hpp): at 8 bits, cingulum-1-step0.1 was 19.3 um
+// (encode/direction_bits.hpp): at 8 bits, cingulum-1-step0.1 was 19.3 um
 // off for 4.6 um recorded (36 um before the length feedback); before the
 // rounded corners and the finer step for fibers of few points
 // (docs/encode.md), the raw cingulum-1 was 1.14 mm off for 0.63 mm
@@ -267,13 +267,13 @@ TEST(FiberEndsSharedData, FineStepBundlesKeepLengthsWithinTheRecordedErrorAtEigh
 // input's points): the decoded length is the input polyline's within the
 // error the header records, for fiblet's decoder and for the float64
 // reference decoder (within 1.05x). Lengths by brute force over the decoded
-// and input points. Before the tail feedback (codec/length_feedback.hpp,
+// and input points. Before the tail feedback (encode/length_feedback.hpp,
 // feed_back_length_tails) and the sampling step for fixed-step input, the
 // decoder's tuned step (x1.0005) and the codes' lag made fibers up to
 // 52 um (small-ifod1) and 83 um (small-ifod1-step0.05) longer for 5.6 and
 // 2.6 um recorded. small-sdstream's smooth fibers zig-zag across the 8-bit
 // code grid (54 um for 5.4 um recorded, docs/encode.md); with --bits auto
-// they get 16-bit codes (codec/direction_bits.hpp), checked here too.
+// they get 16-bit codes (encode/direction_bits.hpp), checked here too.
 TEST(FiberEndsSharedData, FixedStepLengthsWithinTheRecordedError) {
     if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
     test::TempDir dir;

@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "codec/fiber_end_encoder.hpp"
+#include "encode/fiber_end_encoder.hpp"
 #include "fiblet/block_index.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/decode.hpp"

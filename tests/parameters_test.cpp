@@ -6,8 +6,8 @@
 #include <cmath>
 #include <random>
 
-#include "codec/compress_stages.hpp"
-#include "codec/parameters.hpp"
+#include "compress/compress_stages.hpp"
+#include "encode/parameters.hpp"
 #include "core/points_avx2.hpp"
 
 using namespace fiblet;

@@ -20,7 +20,7 @@
 #include "fiblet/streamline_field.hpp"
 #include "fiblet/tck.hpp"
 #include "test_util.hpp"
-#include "trx/trx_archive.hpp"
+#include "tractogram/trx/trx_archive.hpp"
 
 namespace fiblet {
 namespace {

@@ -77,7 +77,7 @@ inline ViewerGl& viewer_gl() {
 inline std::string compress_into(const TempDir& dir, const std::string& tck, const std::string& name) {
     const std::string out = dir.file(name);
     CompressOptions o;
-    o.direction_bits = 8;  // the default chooses 16 for smooth fibers (codec/direction_bits.hpp)
+    o.direction_bits = 8;  // the default chooses 16 for smooth fibers (encode/direction_bits.hpp)
     o.threads = 1;
     o.overwrite = true;
     compress_tck(tck, out, o);

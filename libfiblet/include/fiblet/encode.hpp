@@ -58,7 +58,7 @@ public:
     FiberEncoder with_step(float step) const;
     FiberEncoder with_search(const SearchOptions& search) const;
     // The same encoder keeping each fiber's length across its blocks
-    // (codec/length_feedback.hpp): the decoded length is steered towards
+    // (encode/length_feedback.hpp): the decoded length is steered towards
     // the targets' polyline length times `stretch` (the decoder's step over
     // the targets' spacing, for resampled input); 0 turns it off (default).
     // `tails_only` (fixed-step input, 8-bit codes): only where the fiber's

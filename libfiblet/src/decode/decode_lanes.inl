@@ -34,7 +34,7 @@ inline Vec select(V::M m, const Vec& a, const Vec& b) {
 // (`words[k][lane]`, as floats, exact) and the first frame. Operation for
 // operation the scalar anchor_axis() (core/block_geometry.hpp), or for
 // packed 16-bit blocks packed16_anchor_axis() (the words' difference), and
-// frame_from_axis() (codec/direction_code.cpp), so the frames are
+// frame_from_axis() (encode/direction_code.cpp), so the frames are
 // bit-identical (the lanes equivalence tests fail if they part).
 inline void block_starts(const float (&words)[6][V::W], float unorm_max, bool axis_from_words, Vec& a0, Vec& a1,
                          V::F (&frame)[9]) {

@@ -13,7 +13,7 @@
 #include "core/vec_math.hpp"
 #include "decode/decode_kernels.hpp"
 #include "fiblet/error.hpp"
-#include "format/packed_blocks16.hpp"
+#include "container/packed_blocks16.hpp"
 
 namespace fiblet {
 using namespace detail;

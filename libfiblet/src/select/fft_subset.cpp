@@ -9,8 +9,8 @@
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/streamline_data_chunk.hpp"
-#include "format/packed_blocks16.hpp"
-#include "io/fft_writer.hpp"
+#include "container/packed_blocks16.hpp"
+#include "container/fft_writer.hpp"
 #include "select/block_decoder.hpp"
 
 namespace fiblet {

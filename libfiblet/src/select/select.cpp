@@ -20,7 +20,7 @@
 #include "fiblet/select.hpp"
 #include "select/block_batch_reader.hpp"
 #include "select/block_decoder.hpp"
-#include "select/block_spheres.hpp"
+#include "index/block_spheres.hpp"
 #include "select/query_checks.hpp"
 
 namespace fiblet {

@@ -4,7 +4,7 @@
 #include <limits>
 
 #include "core/vec_math.hpp"
-#include "select/block_spheres.hpp"
+#include "index/block_spheres.hpp"
 
 namespace fiblet {
 using namespace detail;

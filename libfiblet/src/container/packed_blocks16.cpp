@@ -1,0 +1,78 @@
+#include "container/packed_blocks16.hpp"
+
+#include <cstring>
+
+namespace fiblet::detail {
+
+namespace {
+
+constexpr std::uint32_t kCodeMask = (1u << kPacked16CodeBits) - 1;
+
+std::uint16_t get_u16(const std::uint8_t* p) { return std::uint16_t(p[0] | p[1] << 8); }
+
+}  // namespace
+
+void pack_blocks16(const FftHeader& h, std::span<const std::uint8_t> blocks, std::vector<std::uint8_t>& out,
+                   std::vector<std::uint32_t>* sizes) {
+    const std::size_t bb = h.block_bytes();
+    for (std::size_t at = 0; at + bb <= blocks.size(); at += bb) {
+        const std::uint8_t* b = blocks.data() + at;
+        const std::uint32_t n = get_u16(b + kBlock16FlagsOffset) & kFlag16CountMask;
+        const std::size_t start = out.size();
+        out.resize(start + packed16_block_bytes(n));
+        if (sizes) sizes->push_back(packed16_block_bytes(n));
+        std::uint8_t* p = out.data() + start;
+        std::memcpy(p, b, kPacked16AnchorBytes);
+        p += kPacked16AnchorBytes;
+        // The codes as one bit stream, least significant bit first.
+        std::uint64_t acc = 0;
+        unsigned bits = 0;
+        for (std::uint32_t k = 0; k + 2 < n; ++k) {
+            acc |= std::uint64_t(get_u16(b + kBlock16DirectionsOffset + 2 * k) & kCodeMask) << bits;
+            for (bits += kPacked16CodeBits; bits >= 8; bits -= 8, acc >>= 8) *p++ = std::uint8_t(acc);
+        }
+        if (bits > 0) *p++ = std::uint8_t(acc);
+    }
+}
+
+std::string expand_block16(const FftHeader& h, const std::uint8_t* packed, const PackedBlockPlace& place,
+                           std::uint8_t* out) {
+    const std::uint32_t m = place.points > 2 ? place.points - 2 : 0;  // codes
+    const std::size_t code_bytes = (std::size_t{kPacked16CodeBits} * m + 7) / 8;
+    std::memcpy(out, packed, kPacked16AnchorBytes);
+    const std::uint32_t id = place.fiber_id;
+    std::memcpy(out + kBlock16FiberIdOffset, &id, 4);  // hosts are little-endian (checked in CMake)
+    const std::uint16_t flags = std::uint16_t((place.first ? 0u : kFlag16NotFirst) | (place.last ? 0u : kFlag16NotLast) |
+                                              place.points);
+    std::memcpy(out + kBlock16FlagsOffset, &flags, 2);
+    std::uint8_t* codes = out + kBlock16DirectionsOffset;
+    std::memset(codes + 2 * std::size_t(m), 0, h.block_bytes() - kBlock16DirectionsOffset - 2 * std::size_t(m));
+    const std::uint8_t* p = packed + kPacked16AnchorBytes;
+    const std::uint32_t levels = h.code_levels(), code_count = levels * levels;
+    std::uint32_t bad = 0;  // OR of (code >= code_count): one test after the loops
+    std::uint32_t k = 0;
+    // Code k starts at bit 15k: one unaligned 8-byte load while it stays inside the block...
+    for (; k < m && std::size_t(kPacked16CodeBits) * k / 8 + 8 <= code_bytes; ++k) {
+        const std::size_t bit = std::size_t(kPacked16CodeBits) * k;
+        std::uint64_t w;
+        std::memcpy(&w, p + bit / 8, 8);
+        const auto code = std::uint16_t((w >> (bit % 8)) & kCodeMask);
+        bad |= code >= code_count;
+        std::memcpy(codes + 2 * k, &code, 2);
+    }
+    // ...then byte by byte for the last few.
+    for (; k < m; ++k) {
+        const std::size_t bit = std::size_t(kPacked16CodeBits) * k;
+        std::uint32_t w = 0;
+        for (std::size_t j = bit / 8, s = 0; j < code_bytes && s < 24; ++j, s += 8) w |= std::uint32_t(p[j]) << s;
+        const auto code = std::uint16_t((w >> (bit % 8)) & kCodeMask);
+        bad |= code >= code_count;
+        std::memcpy(codes + 2 * k, &code, 2);
+    }
+    if (bad) return "a direction code past the " + std::to_string(levels) + " x " + std::to_string(levels) + " levels";
+    if (const unsigned used = (kPacked16CodeBits * m) % 8; used != 0 && (p[code_bytes - 1] >> used) != 0)
+        return "non-zero padding bits after the last direction code";
+    return {};
+}
+
+}  // namespace fiblet::detail

@@ -1,0 +1,227 @@
+// Internal: the code search's per-step operations with one block per SIMD
+// lane, for the Highway kernels (greedy_blocks.cpp, lookahead_blocks.cpp).
+//
+// Highway's per-target header pattern: included once per target from a
+// file that includes hwy/foreach_target.h, inside its target check (SSE4,
+// AVX2 and AVX3 only). Each operation repeats the scalar search's float
+// operations in the same order (row_frame.hpp, NearestCodeLut::operator(),
+// the library builds with -ffp-contract=off: no fused multiply-add), so
+// every lane gets the scalar search's bits.
+#if defined(FIBLET_CODE_LANES_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef FIBLET_CODE_LANES_INL_H_
+#undef FIBLET_CODE_LANES_INL_H_
+#else
+#define FIBLET_CODE_LANES_INL_H_
+#endif
+
+#include <hwy/highway.h>
+
+#include "encode/code_search.hpp"
+#include "encode/greedy_blocks.hpp"
+
+HWY_BEFORE_NAMESPACE();
+namespace fiblet::detail::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+constexpr std::size_t kMaxLanes = 16;
+
+// The 8-bit code book, one code per lane. A frame is held as nine vectors,
+// f[3 * c + i] = component i of column c (column 0: the step's direction).
+template <class D>
+struct CodeLanes {
+    using DI = hn::RebindToSigned<D>;
+    using VF = hn::Vec<D>;
+    using VI = hn::Vec<DI>;
+    static_assert(sizeof(Frame) == 9 * sizeof(float), "frames are gathered as 9 floats");
+
+    D d;
+    DI di;
+    const float* code_frames;
+    NearestCodeLut::Gnomonic g;
+    VF zero, one, rim_tan, rim_tan2, cell_scale, last_cell, int_range;
+    VI zero_code, back_code, last_word, byte;
+
+    explicit CodeLanes(const Codebook8& cb)
+        : code_frames(&cb.table.frame(0).c[0].x), g(cb.lut.gnomonic()), zero(hn::Zero(d)), one(hn::Set(d, 1.0f)),
+          rim_tan(hn::Set(d, g.rim_tan)), rim_tan2(hn::Set(d, g.rim_tan2)), cell_scale(hn::Set(d, g.cell_scale)),
+          last_cell(hn::Set(d, float(NearestCodeLut::kGrid - 1))), int_range(hn::Set(d, 2147483648.0f)),
+          zero_code(hn::Set(di, g.zero_code)), back_code(hn::Set(di, g.back_code)),
+          last_word(hn::Set(di, NearestCodeLut::kGrid * NearestCodeLut::kGrid - 4)), byte(hn::Set(di, 0xff)) {}
+
+    // apply_transposed(f, v): dot(c_j, v) = (c_j.x v.x + c_j.y v.y) + c_j.z v.z.
+    static void local(const VF* f, VF vx, VF vy, VF vz, VF& x, VF& y, VF& z) {
+        auto dot_v = [&](int c) {
+            return hn::Add(hn::Add(hn::Mul(f[3 * c], vx), hn::Mul(f[3 * c + 1], vy)), hn::Mul(f[3 * c + 2], vz));
+        };
+        x = dot_v(0), y = dot_v(1), z = dot_v(2);
+    }
+
+    // NearestCodeLut::cell(): int((u + rim_tan) * cell_scale) clamped to [0, kGrid - 1].
+    // The scalar conversion (cvttss2si) gives INT_MIN for NaN and for values
+    // out of int range, which the clamp turns into 0; Highway's saturates
+    // instead, so those lanes are zeroed before converting.
+    VI cell(VF u) const {
+        const VF f = hn::Mul(hn::Add(u, rim_tan), cell_scale);
+        const VF in_range = hn::IfThenElseZero(hn::Lt(f, int_range), f);  // NaN, >= 2^31: 0
+        return hn::ConvertTo(di, hn::Min(hn::Max(in_range, zero), last_cell));
+    }
+
+    // NearestCodeLut::operator()(local): both the cap's and the rim's
+    // (u, v), then per lane the one it takes.
+    VI nearest(VF x, VF y, VF z) const {
+        const VF lateral2 = hn::Add(hn::Mul(y, y), hn::Mul(z, z));
+        const auto in_cap = hn::And(hn::Gt(x, zero), hn::Le(lateral2, hn::Mul(rim_tan2, hn::Mul(x, x))));
+        const VF inv = hn::Div(one, x);
+        VF u = hn::Mul(y, inv), v = hn::Mul(z, inv);
+        // The rim's square root and division only when a lane needs them
+        // (rare: they would lengthen every step's dependency chain).
+        if (!hn::AllTrue(d, in_cap)) {
+            const VF s = hn::Div(rim_tan, hn::Sqrt(lateral2));
+            u = hn::IfThenElse(in_cap, u, hn::Mul(y, s));
+            v = hn::IfThenElse(in_cap, v, hn::Mul(z, s));
+        }
+        const VI index = hn::Add(hn::ShiftLeft<8>(cell(u)), cell(v));
+        // The cell's byte: a 32-bit gather at its offset, moved back from
+        // the table's last 3 bytes so that it never reads past the end.
+        const VI word_at = hn::Min(index, last_word);
+        const VI word = hn::GatherOffset(di, reinterpret_cast<const std::int32_t*>(g.cells), word_at);
+        const VI looked_up = hn::And(word >> hn::ShiftLeft<3>(hn::Sub(index, word_at)), byte);
+        // Outside the cap with no lateral direction: straight back or the zero vector's code.
+        const auto no_lateral = hn::RebindMask(di, hn::AndNot(in_cap, hn::Not(hn::Gt(lateral2, zero))));
+        const VI behind = hn::IfThenElse(hn::RebindMask(di, hn::Lt(x, zero)), back_code, zero_code);
+        return hn::IfThenElse(no_lateral, behind, looked_up);
+    }
+
+    // Where the code's frame starts in the table, in floats: code * 9.
+    static VI frame_at(VI code) { return hn::Add(hn::ShiftLeft<3>(code), code); }
+
+    // The code's frame (its first column is its direction).
+    void frame(VI code, VF* l) const {
+        const VI at = frame_at(code);
+        for (int j = 0; j < 9; ++j) l[j] = hn::GatherIndex(d, code_frames + j, at);
+    }
+
+    // The code's direction (its frame's first column).
+    void direction(VI code, VF& x, VF& y, VF& z) const {
+        const VI at = frame_at(code);
+        x = hn::GatherIndex(d, code_frames, at), y = hn::GatherIndex(d, code_frames + 1, at);
+        z = hn::GatherIndex(d, code_frames + 2, at);
+    }
+
+    // compose(f, l): column c of the result is apply(f, l.c_c) =
+    // (f.c0 l.x + f.c1 l.y) + f.c2 l.z, per component.
+    static void compose(const VF* f, const VF* l, VF* out) {
+        for (int c = 0; c < 3; ++c)
+            for (int i = 0; i < 3; ++i)
+                out[3 * c + i] =
+                    hn::Add(hn::Add(hn::Mul(f[i], l[3 * c]), hn::Mul(f[3 + i], l[3 * c + 1])), hn::Mul(f[6 + i], l[3 * c + 2]));
+    }
+};
+
+// Blocks j0 .. j0 + active - 1 of a batch, one per lane of `d` (lanes past
+// `active` repeat the last block; their results are dropped): the decoder's
+// state (frame f, point p), where each lane's next target is, and where its
+// results go.
+template <class D>
+struct BatchLanes {
+    using VF = hn::Vec<D>;
+    using VI = hn::Vec<hn::RebindToSigned<D>>;
+    static_assert(sizeof(Vec3f) == 3 * sizeof(float), "points are gathered as 3 floats");
+
+    D d;
+    VF f[9], px, py, pz;
+    // Lane i's target k at float index first_at[i] + 3 k (relative to block
+    // j0's targets), held at its last target once its block is done (a
+    // shorter last block).
+    VI at, at_end;
+    const float* targets;
+    std::size_t m_of[kMaxLanes], steps = 0, active;
+    Vec3f* decoded[kMaxLanes];
+    std::uint8_t* codes[kMaxLanes];
+
+    BatchLanes(const GreedyBatch& batch, std::size_t j0, std::size_t n) : targets(&batch.targets[j0 * batch.stride].x), active(std::min(n, hn::Lanes(D()))) {
+        const hn::RebindToSigned<D> di;
+        alignas(64) float start[12][kMaxLanes];
+        alignas(64) std::int32_t first_at[kMaxLanes], last_at[kMaxLanes];
+        for (std::size_t i = 0; i < hn::Lanes(d); ++i) {
+            const std::size_t j = j0 + std::min(i, active - 1);
+            const Frame& fr = batch.frames[j];
+            const Vec3f& p = batch.starts[j * batch.stride];
+            for (int c = 0; c < 3; ++c)
+                start[3 * c][i] = fr.c[c].x, start[3 * c + 1][i] = fr.c[c].y, start[3 * c + 2][i] = fr.c[c].z;
+            start[9][i] = p.x, start[10][i] = p.y, start[11][i] = p.z;
+            m_of[i] = batch.length(j);
+            steps = std::max(steps, m_of[i]);
+            first_at[i] = std::int32_t(3 * (j - j0) * batch.stride);
+            last_at[i] = std::int32_t(3 * ((j - j0) * batch.stride + m_of[i] - 1));
+        }
+        for (int j = 0; j < 9; ++j) f[j] = hn::Load(d, start[j]);
+        px = hn::Load(d, start[9]), py = hn::Load(d, start[10]), pz = hn::Load(d, start[11]);
+        at = hn::Load(di, first_at), at_end = hn::Load(di, last_at);
+        for (std::size_t i = 0; i < active; ++i)
+            decoded[i] = batch.decoded + (j0 + i) * batch.stride, codes[i] = batch.codes + (j0 + i) * batch.code_stride;
+    }
+
+    // The lanes' targets at `where`.
+    void target(VI where, VF& x, VF& y, VF& z) const {
+        x = hn::GatherIndex(d, targets, where), y = hn::GatherIndex(d, targets + 1, where);
+        z = hn::GatherIndex(d, targets + 2, where);
+    }
+    VI next_at() const { return ahead_at(1); }
+    // Where the targets n points ahead are (the last target past a lane's end).
+    VI ahead_at(int n) const { return hn::Min(hn::Add(at, hn::Set(hn::RebindToSigned<D>(), 3 * n)), at_end); }
+    // Lanes still having a target after step k.
+    hn::Mask<D> more_after(std::size_t k) const {
+        alignas(64) float more[kMaxLanes];
+        for (std::size_t i = 0; i < hn::Lanes(d); ++i) more[i] = k + 1 < m_of[i] ? 1.0f : 0.0f;
+        return hn::Gt(hn::Load(d, more), hn::Zero(d));
+    }
+
+    // Step k's point and code to each active lane's block (scalar stores,
+    // which the CPU overlaps with the next step's dependency chain); on to
+    // the next targets.
+    void store(std::size_t k, VI code) {
+        alignas(64) float out[3][kMaxLanes];
+        alignas(64) std::int32_t out_code[kMaxLanes];
+        hn::Store(px, d, out[0]);
+        hn::Store(py, d, out[1]);
+        hn::Store(pz, d, out[2]);
+        hn::Store(code, hn::RebindToSigned<D>(), out_code);
+        for (std::size_t i = 0; i < active; ++i) {
+            if (k >= m_of[i]) continue;
+            decoded[i][k] = {out[0][i], out[1][i], out[2][i]};
+            codes[i][k] = std::uint8_t(out_code[i]);
+        }
+        at = next_at();
+    }
+};
+
+// Blocks [0, batch.blocks) in vectors of Kernel(d, cb, step, batch, j0,
+// active): full ones of the widest width, then the rest in the narrowest
+// width that holds it (at least 2 blocks a vector); returns the blocks done
+// (the few left are the scalar search's).
+template <class Kernel>
+std::size_t AllVectors(const Codebook8& cb, float step, const GreedyBatch& batch, Kernel kernel) {
+    const hn::ScalableTag<float> d;
+    const std::size_t lanes = hn::Lanes(d);
+    std::size_t j = 0;
+    for (; j + lanes <= batch.blocks; j += lanes) kernel(d, cb, step, batch, j, lanes);
+    const std::size_t left = batch.blocks - j;
+    if (left < 2) return j;
+#if HWY_TARGET == HWY_AVX3
+    if (left > 8) kernel(d, cb, step, batch, j, left);
+    else if (left > 4) kernel(hn::CappedTag<float, 8>(), cb, step, batch, j, left);
+    else kernel(hn::CappedTag<float, 4>(), cb, step, batch, j, left);
+#elif HWY_TARGET == HWY_AVX2
+    if (left > 4) kernel(d, cb, step, batch, j, left);
+    else kernel(hn::CappedTag<float, 4>(), cb, step, batch, j, left);
+#else
+    kernel(d, cb, step, batch, j, left);
+#endif
+    return batch.blocks;
+}
+
+}  // namespace fiblet::detail::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#endif  // FIBLET_CODE_LANES_INL_H_

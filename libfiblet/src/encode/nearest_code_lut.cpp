@@ -1,0 +1,72 @@
+#include "encode/nearest_code_lut.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace fiblet::detail {
+
+NearestCodeLut::NearestCodeLut(const DirectionTable& table) {
+    const float ratio = table.ratio();
+    rows_.resize(256);
+    for (unsigned c = 0; c < 256; ++c) rows_[c] = row_frame(table.frame(std::uint8_t(c)));
+    neighbours_.resize(256);
+    for (unsigned c = 0; c < 256; ++c) {
+        Neighbours& nb = neighbours_[c];
+        nb.count = 0;
+        nb.before = 0;
+        const int h0 = int(c >> 4), l0 = int(c & 15);
+        for (int h = std::max(h0 - 1, 0); h <= std::min(h0 + 1, 15); ++h)
+            for (int l = std::max(l0 - 1, 0); l <= std::min(l0 + 1, 15); ++l) {
+                const auto code = unsigned(h << 4 | l);
+                if (code == c) {
+                    nb.before = nb.count;
+                    continue;
+                }
+                const Vec3f& d = table.direction(std::uint8_t(code));
+                nb.x[nb.count] = d.x, nb.y[nb.count] = d.y, nb.z[nb.count] = d.z, nb.pad[nb.count] = 0.0f;
+                nb.code[nb.count++] = std::uint8_t(code);
+            }
+        for (unsigned i = nb.count; i < 8; ++i) nb.x[i] = nb.y[i] = nb.z[i] = 0.0f, nb.pad[i] = INFINITY, nb.code[i] = 0;
+    }
+    zero_code_ = table.nearest_code({0, 0, 0});
+    back_code_ = table.nearest_code({-1, 0, 0});
+    if (!(ratio < 1.0f)) return;  // the cap reaches the half sphere's rim: no gnomonic view of it
+    const double rim_x = 1.0 - double(ratio);
+    const double tan_rim = std::sqrt(std::max(1.0 - rim_x * rim_x, 0.0)) / rim_x;
+    if (!(tan_rim > 0.0) || !std::isfinite(tan_rim)) return;
+    rim_tan_ = float(tan_rim);
+    rim_tan2_ = rim_tan_ * rim_tan_;
+    cell_scale_ = float(kGrid) / (2.0f * rim_tan_);
+    cells_.resize(std::size_t(kGrid) * kGrid);
+    const double cell = 2.0 * double(rim_tan_) / kGrid;
+    // Each cell starts from its neighbour's code and climbs over the 3x3
+    // code neighbourhood (the nearest code changes by at most a level or
+    // two between adjacent cells); each row starts with the full search.
+    auto closeness = [&](unsigned code, Vec3f d) { return dot(table.direction(std::uint8_t(code)), d); };
+    for (int iy = 0; iy < kGrid; ++iy) {
+        unsigned code = 0;
+        for (int iz = 0; iz < kGrid; ++iz) {
+            double u = -double(rim_tan_) + (iy + 0.5) * cell, v = -double(rim_tan_) + (iz + 0.5) * cell;
+            const double l = std::sqrt(u * u + v * v);
+            if (l > double(rim_tan_)) u *= double(rim_tan_) / l, v *= double(rim_tan_) / l;
+            const Vec3f d{1.0f, float(u), float(v)};  // any length: only the angle matters
+            if (iz == 0) {
+                code = table.nearest_code(d);
+            } else {
+                for (bool moved = true; moved;) {
+                    moved = false;
+                    const int h0 = int(code >> 4), l0 = int(code & 15);
+                    float best = closeness(code, d);
+                    for (int h = std::max(h0 - 1, 0); h <= std::min(h0 + 1, 15); ++h)
+                        for (int k = std::max(l0 - 1, 0); k <= std::min(l0 + 1, 15); ++k) {
+                            const unsigned c = unsigned(h << 4 | k);
+                            if (const float val = closeness(c, d); val > best) best = val, code = c, moved = true;
+                        }
+                }
+            }
+            cells_[std::size_t(iy) * kGrid + std::size_t(iz)] = std::uint8_t(code);
+        }
+    }
+}
+
+}  // namespace fiblet::detail

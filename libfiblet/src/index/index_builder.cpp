@@ -1,0 +1,227 @@
+// IndexBuilder: block boxes quantized as blocks are written, so that the
+// index costs no extra pass over the data.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "fiblet/block_index.hpp"
+#include "fiblet/error.hpp"
+#include "index/box_stream.hpp"
+#include "index/index_chunk.hpp"
+
+namespace fiblet {
+
+namespace {
+
+Aabb bounds_of(const float* xyz, std::uint32_t n) {
+    Aabb b{{xyz[0], xyz[1], xyz[2]}, {xyz[0], xyz[1], xyz[2]}};
+    for (std::uint32_t k = 1; k < n; ++k) {
+        const float* p = xyz + 3 * k;
+        b.min = {std::min(b.min.x, p[0]), std::min(b.min.y, p[1]), std::min(b.min.z, p[2])};
+        b.max = {std::max(b.max.x, p[0]), std::max(b.max.y, p[1]), std::max(b.max.z, p[2])};
+    }
+    return b;
+}
+
+}  // namespace
+
+// The boxes as one BIDX version stores them: the only part of the builder
+// that differs between the formats.
+struct IndexBuilder::Coder {
+    virtual ~Coder() = default;
+    virtual std::unique_ptr<Coder> clone() const = 0;
+    virtual std::unique_ptr<Coder> fresh() const = 0;  // same format and grid, no boxes
+    virtual BlockIndexFormat format() const = 0;
+    // One block's bounds, in file order.
+    virtual void add(const Aabb& box, bool first_of_fiber, bool last_of_fiber) = 0;
+    // The boxes of a builder of the same format on the next fibers.
+    virtual void append(const Coder& later) = 0;
+    // The payload of a chunk with c's common fields filled in.
+    virtual std::vector<std::uint8_t> finish(detail::IndexChunk& c, const FftHeader& h) const = 0;
+    std::uint64_t unbounded = 0;
+};
+
+// Version 2: a fixed-width box code per group of up to 8 blocks of a fiber.
+struct IndexBuilder::GroupCoder final : Coder {
+    explicit GroupCoder(const FftHeader& h)
+        : grid(detail::IndexGrid::for_groups(h, detail::kIndexV2BitsPerBox, detail::kIndexV2GroupBlocks)) {}
+    std::unique_ptr<Coder> clone() const override { return std::make_unique<GroupCoder>(*this); }
+    std::unique_ptr<Coder> fresh() const override {
+        auto c = std::make_unique<GroupCoder>(*this);
+        c->codes.clear(), c->fill = 0, c->unbounded = 0;
+        return c;
+    }
+    BlockIndexFormat format() const override { return BlockIndexFormat::group_boxes; }
+    void add(const Aabb& b, bool, bool last_of_fiber) override {
+        if (fill == 0) {
+            group = b;
+        } else {
+            group.min = {std::min(group.min.x, b.min.x), std::min(group.min.y, b.min.y), std::min(group.min.z, b.min.z)};
+            group.max = {std::max(group.max.x, b.max.x), std::max(group.max.y, b.max.y), std::max(group.max.z, b.max.z)};
+        }
+        if (++fill == detail::kIndexV2GroupBlocks || last_of_fiber) {
+            const std::uint32_t code = grid.encode(group);
+            unbounded += code == grid.unbounded_code();
+            codes.push_back(code);
+            fill = 0;
+        }
+    }
+    void append(const Coder& later) override {
+        const auto& o = static_cast<const GroupCoder&>(later);
+        codes.insert(codes.end(), o.codes.begin(), o.codes.end());
+        unbounded += o.unbounded;
+    }
+    std::vector<std::uint8_t> finish(detail::IndexChunk& c, const FftHeader& h) const override {
+        c.version = detail::kIndexChunkV2Version;
+        c.grid = grid;
+        c.group_blocks = detail::kIndexV2GroupBlocks;
+        c.groups = codes.size();
+        c.codes = codes;
+        return detail::serialize_index_chunk_v2(c, h);
+    }
+    detail::IndexGrid grid;
+    std::vector<std::uint32_t> codes;  // per closed group
+    Aabb group{};                      // the open group's bounds
+    std::uint32_t fill = 0;            // blocks in the open group
+};
+
+// Version 3: a box per block, range-coded against the previous one.
+struct IndexBuilder::BlockCoder final : Coder {
+    explicit BlockCoder(const FftHeader& h) : grid(detail::IndexGrid::for_blocks(h)), stream(grid.min_levels) {}
+    std::unique_ptr<Coder> clone() const override { return std::make_unique<BlockCoder>(*this); }
+    std::unique_ptr<Coder> fresh() const override {
+        auto c = std::make_unique<BlockCoder>(*this);
+        c->pending.clear(), c->stream = detail::BoxStreamEncoder(grid.min_levels), c->coded = false,
+        c->unbounded = 0;
+        return c;
+    }
+    BlockIndexFormat format() const override { return BlockIndexFormat::block_boxes; }
+    void add(const Aabb& b, bool first_of_fiber, bool) override {
+        const auto box = grid.quantize(b);
+        unbounded += !box;
+        pending.push_back({box, first_of_fiber});
+    }
+    void append(const Coder& later) override {
+        const auto& o = static_cast<const BlockCoder&>(later);
+        if (o.coded) throw Error(Errc::invalid_argument, "IndexBuilder::append: the later part has coded boxes");
+        code_pending();
+        pending = o.pending;
+        code_pending();
+        coded = coded || !o.pending.empty();
+        unbounded += o.unbounded;
+    }
+    std::vector<std::uint8_t> finish(detail::IndexChunk& c, const FftHeader& h) const override {
+        BlockCoder all = *this;
+        all.code_pending();
+        c.version = detail::kIndexChunkVersion;
+        c.grid = grid;
+        return detail::serialize_index_chunk(c, h, all.stream.finish());
+    }
+    // Codes the pending boxes after those coded already.
+    void code_pending() {
+        for (const Pending& p : pending) stream.add(p.box, p.first_of_fiber);
+        pending.clear();
+    }
+    struct Pending {
+        std::optional<detail::GridBox> box;
+        bool first_of_fiber;
+    };
+    detail::IndexGrid grid;
+    std::vector<Pending> pending;
+    detail::BoxStreamEncoder stream;
+    bool coded = false;  // the stream holds boxes
+};
+
+IndexBuilder::IndexBuilder() = default;
+IndexBuilder::IndexBuilder(const FftHeader& header, BlockIndexFormat format) : header_(header) {
+    switch (format) {
+    case BlockIndexFormat::group_boxes: coder_ = std::make_unique<GroupCoder>(header); return;
+    case BlockIndexFormat::block_boxes: coder_ = std::make_unique<BlockCoder>(header); return;
+    }
+    throw Error(Errc::invalid_argument, "unknown block index format");
+}
+IndexBuilder::IndexBuilder(const IndexBuilder& o)
+    : header_(o.header_), coder_(o.coder_ ? o.coder_->clone() : nullptr), blocks_(o.blocks_),
+      last_points_(o.last_points_), open_fiber_blocks_(o.open_fiber_blocks_), layout_ok_(o.layout_ok_),
+      max_sphere_radius_(o.max_sphere_radius_), max_join_(o.max_join_), last_point_(o.last_point_) {}
+IndexBuilder& IndexBuilder::operator=(const IndexBuilder& o) {
+    if (this != &o) *this = IndexBuilder(o);
+    return *this;
+}
+IndexBuilder::IndexBuilder(IndexBuilder&&) noexcept = default;
+IndexBuilder& IndexBuilder::operator=(IndexBuilder&&) noexcept = default;
+IndexBuilder::~IndexBuilder() = default;
+
+BlockIndexFormat IndexBuilder::format() const { return coder_->format(); }
+std::uint64_t IndexBuilder::unbounded_blocks() const { return coder_->unbounded; }
+
+void IndexBuilder::add_fiber(std::span<const Vec3f> decoded) {
+    static_assert(sizeof(Vec3f) == 3 * sizeof(float));
+    const std::uint32_t ppb = header_.points_per_block;
+    if (decoded.empty()) {
+        last_points_.push_back(0);
+        return;
+    }
+    for (std::size_t i = 0; i < decoded.size(); i += ppb) {
+        const auto n = std::uint32_t(std::min<std::size_t>(ppb, decoded.size() - i));
+        add_block(&decoded[i].x, n, i + n == decoded.size());
+    }
+}
+
+void IndexBuilder::add_block(const float* xyz, std::uint32_t n, bool last_of_fiber) {
+    const Vec3f p0{xyz[0], xyz[1], xyz[2]};
+    if (open_fiber_blocks_ > 0) {  // the previous block is of the same fiber
+        const double dx = double(p0.x) - last_point_.x, dy = double(p0.y) - last_point_.y,
+                     dz = double(p0.z) - last_point_.z;
+        max_join_ = std::max(max_join_, std::sqrt(dx * dx + dy * dy + dz * dz));
+    }
+    last_point_ = {xyz[3 * (n - 1)], xyz[3 * (n - 1) + 1], xyz[3 * (n - 1) + 2]};
+    const Vec3f p1 = n >= 2 ? Vec3f{xyz[3], xyz[4], xyz[5]} : p0;
+    max_sphere_radius_ = std::max(max_sphere_radius_, block_bounding_sphere(header_, p0, p1, n).radius);
+    coder_->add(bounds_of(xyz, n), open_fiber_blocks_ == 0, last_of_fiber);
+    ++blocks_, ++open_fiber_blocks_;
+    if (last_of_fiber) {
+        last_points_.push_back(std::uint16_t(n));
+        open_fiber_blocks_ = 0;
+    } else if (n != header_.points_per_block) {
+        layout_ok_ = false;  // only a fiber's last block may be partial
+    }
+}
+
+void IndexBuilder::append(const IndexBuilder& later) {
+    if (later.coder_->format() != coder_->format())
+        throw Error(Errc::invalid_argument, "IndexBuilder::append: the parts are of different index formats");
+    layout_ok_ = layout_ok_ && open_fiber_blocks_ == 0;  // blocks of a fiber are added to one builder
+    coder_->append(*later.coder_);
+    blocks_ += later.blocks_;
+    last_points_.insert(last_points_.end(), later.last_points_.begin(), later.last_points_.end());
+    layout_ok_ = layout_ok_ && later.layout_ok_ && later.open_fiber_blocks_ == 0;
+    max_sphere_radius_ = std::max(max_sphere_radius_, later.max_sphere_radius_);
+    max_join_ = std::max(max_join_, later.max_join_);
+    last_point_ = later.last_point_;
+}
+
+void IndexBuilder::clear() {
+    coder_ = coder_->fresh();
+    last_points_.clear();
+    blocks_ = 0;
+    open_fiber_blocks_ = 0;
+    layout_ok_ = true;
+    max_sphere_radius_ = 0;
+    max_join_ = 0;
+}
+
+std::optional<TrailerChunk> IndexBuilder::finish() const {
+    if (!layout_ok_ || open_fiber_blocks_ != 0) return std::nullopt;
+    detail::IndexChunk c;
+    c.fibers = last_points_.size();
+    c.blocks = blocks_;
+    c.max_sphere_radius = max_sphere_radius_;
+    // Rounded up, with room for the float rounding of the readers' tests.
+    c.max_join = std::nextafter(float(max_join_ * (1 + 1e-6)), std::numeric_limits<float>::infinity());
+    c.last_block_points = last_points_;
+    return TrailerChunk{kBlockIndexTag, coder_->finish(c, header_)};
+}
+
+}  // namespace fiblet
