@@ -3,7 +3,8 @@
 the format library (libfiblet/) knows nothing of the CLI, the viewer or the
 Python module; those use only public headers (libfiblet/include/fiblet/,
 apps/viewer/include/fiblet_viewer/ for the CLI) besides their own files;
-no quoted include climbs with "..". Prints each violation; exit 1 if any.
+no quoted include climbs with ".."; the umbrella header fiblet.hpp includes
+every public header. Prints each violation; exit 1 if any.
 
   scripts/check_layers.py [ROOT]
 """
@@ -43,7 +44,16 @@ def violations():
                 yield f"{where}: not {name}'s own file nor a public header it may use"
 
 
-found = list(violations())
+def umbrella_gaps():
+    """The umbrella header fiblet.hpp includes every public header."""
+    umbrella = PUBLIC["fiblet"] / "fiblet/fiblet.hpp"
+    listed = set(INCLUDE.findall(umbrella.read_text()))
+    for h in sorted((PUBLIC["fiblet"] / "fiblet").glob("*.hpp")):
+        if h != umbrella and f"fiblet/{h.name}" not in listed:
+            yield f"{umbrella.relative_to(ROOT)}: does not include fiblet/{h.name}"
+
+
+found = list(violations()) + list(umbrella_gaps())
 for v in found:
     print(v)
 print(f"check_layers: {len(found)} violation(s)")
