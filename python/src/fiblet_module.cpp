@@ -454,7 +454,6 @@ PYBIND11_MODULE(_fiblet, m) {
     using namespace fiblet::python;
     m.doc() = "fiblet's compiled core; use the `fiblet` package instead.";
     m.attr("version") = FIBLET_VERSION;
-    // Which block decoder fiblet.load() runs on (decode_range.hpp).
 
     // fiblet::Error -> fiblet.FibletError, with the stable category name
     // (errc_name: "io", "fft_format", ...) as its `category` attribute.
