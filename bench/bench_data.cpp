@@ -199,7 +199,7 @@ Fixture::Fixture() : tck(default_bench_tck()) {
     if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
     dir = tmpl;
     fft = dir + "/bench.fft";
-    compress_tck(tck, fft, {});
+    compress_file(tck, fft, {});
     read_tck(tck, tractogram);
     const FftFile file(fft);
     header = file.header();

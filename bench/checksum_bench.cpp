@@ -49,7 +49,7 @@ const std::string& sample_fft() {
         w.finish();
         fiblet::CompressOptions o;
         o.overwrite = true;
-        fiblet::compress_tck(tck, fft, o);
+        fiblet::compress_file(tck, fft, o);
         std::filesystem::remove(tck);
         return fft;
     }();

@@ -48,7 +48,7 @@ const Input& input(unsigned bits, int effort) {
         o.search = fiblet::search_for_effort(effort);
         o.overwrite = true;
         const std::string tmp = std::filesystem::temp_directory_path() / "fiblet-encode-bench.fft";
-        in.report = fiblet::compress_tck(bench_tck(), tmp, o);
+        in.report = fiblet::compress_file(bench_tck(), tmp, o);
         std::filesystem::remove(tmp);
     }
     return in;
@@ -109,7 +109,7 @@ void BM_EncodePipeline(benchmark::State& state) {
     o.threads = 1;
     o.search = fiblet::search_for_effort(int(state.range(0)));
     std::uint64_t points = 0;
-    for (auto _ : state) points += fiblet::compress_tck(bench_tck(), tmp, o).header.points;
+    for (auto _ : state) points += fiblet::compress_file(bench_tck(), tmp, o).header.points;
     std::filesystem::remove(tmp);
     state.SetItemsProcessed(std::int64_t(points));
 }

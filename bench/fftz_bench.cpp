@@ -35,7 +35,7 @@ const std::string& file_for(int kind) {
         fiblet::CompressOptions o;
         o.overwrite = true;
         if (kind) o.zstd = fiblet::ZstdOptions{fiblet::ZstdOptions{}.level, fiblet::ZstdOptions{}.group_blocks, kind == 1};
-        fiblet::compress_tck(source_tck(), path, o);
+        fiblet::compress_file(source_tck(), path, o);
         it = paths.emplace(kind, path).first;
     }
     return it->second;

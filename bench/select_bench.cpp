@@ -60,7 +60,7 @@ BenchFile& bench_file() {
         if (!fs::exists(fft) || fs::last_write_time(fft) < fs::last_write_time(tck)) {
             CompressOptions o;
             o.overwrite = true;
-            compress_tck(tck.string(), fft.string(), o);
+            compress_file(tck.string(), fft.string(), o);
         }
         b.path = fft.string();
         b.file = std::make_unique<FftFile>(b.path);

@@ -152,7 +152,7 @@ inline void compress_reads_back(const std::string& path, const std::vector<std::
         CompressOptions options;
         options.threads = 1;
         options.overwrite = true;
-        report = compress_tck(path, out, options);
+        report = compress_file(path, out, options);
     } catch (const Error& e) {
         if (content_refusals_only)
             check(e.code() == Errc::invalid_input || e.code() == Errc::unsupported, "compress failed on a valid input's format");

@@ -116,7 +116,7 @@ bool compress_seed(const fs::path& tck, const fs::path& fft, CompressOptions opt
     options.overwrite = true;
     options.threads = 1;
     try {
-        compress_tck(tck.string(), fft.string(), options);
+        compress_file(tck.string(), fft.string(), options);
     } catch (const Error&) {
         return false;
     }

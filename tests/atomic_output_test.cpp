@@ -149,10 +149,10 @@ TEST(AtomicOutput, PendingTemporariesAreRemovedByTheSignalCleanup) {
 TEST(AtomicOutput, CompressAndDecompressRefuseToOverwriteWithoutForce) {
     test::TempDir dir;
     write_long_tractogram(dir.file("in.tck"), 5000);
-    compress_tck(dir.file("in.tck"), dir.file("a.fft"), {});
+    compress_file(dir.file("in.tck"), dir.file("a.fft"), {});
     test::write_file(dir.file("b.tck"), "precious");
     CompressOptions o;
-    EXPECT_EQ(error_of([&] { compress_tck(dir.file("in.tck"), dir.file("b.tck"), o); }), Errc::exists);
+    EXPECT_EQ(error_of([&] { compress_file(dir.file("in.tck"), dir.file("b.tck"), o); }), Errc::exists);
     const std::string cli = FIBLET_CLI;
     EXPECT_EQ(WEXITSTATUS(std::system((cli + " decompress -q " + dir.file("a.fft") + " -o " + dir.file("b.tck") +
                                        " 2>/dev/null")
@@ -182,7 +182,7 @@ TEST_P(SignalDuringWrite, LeavesNoTemporaryAndNoOutput) {
               128 + sig);
     EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"in.tck"});
 
-    compress_tck(dir.file("in.tck"), dir.file("in.fft"), {});
+    compress_file(dir.file("in.tck"), dir.file("in.fft"), {});
     EXPECT_EQ(signal_cli_while_writing({"decompress", "-q", dir.file("in.fft"), "-o", dir.file("out.tck")}, dir.path(),
                                        sig),
               128 + sig);

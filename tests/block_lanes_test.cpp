@@ -348,7 +348,7 @@ TEST(BlockLanes, CompressReportsItsLevelAndTheSameBytesAtEach) {
             CompressReport r;
             {
                 const ForcedLevel forced(level);
-                r = compress_tck(tck, dir.file("x.fft"), o);
+                r = compress_file(tck, dir.file("x.fft"), o);
             }
             EXPECT_EQ(r.simd, detail::simd_level_name(level));
             const std::string bytes = test::read_file(dir.file("x.fft"));

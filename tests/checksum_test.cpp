@@ -56,7 +56,7 @@ struct Fixture {
         // 60-point blocks (the default gives these smooth fibers 16 bits).
         CompressOptions o;
         o.direction_bits = 8;
-        compress_tck(dir.file("a.tck"), fft, o);
+        compress_file(dir.file("a.tck"), fft, o);
         bytes = test::read_file(fft);
         header = FftFile(fft).header();
     }

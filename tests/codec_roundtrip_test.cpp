@@ -64,7 +64,7 @@ TEST_P(CodecRoundTrip, PreservesStructureAndStaysWithinTheErrorBound) {
     const std::string out = dir.file("out.fft");
     CompressOptions o;
     o.direction_bits = 8;  // the 8-bit layout's blocks (the default gives small-sdstream 16 bits)
-    const CompressReport report = compress_tck(input, out, o);
+    const CompressReport report = compress_file(input, out, o);
     ASSERT_FALSE(report.resampled) << "fixed-step input must not be resampled";
 
     const FftFile file(out);

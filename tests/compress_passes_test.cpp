@@ -43,7 +43,7 @@ std::string compress_editing(const std::string& in, const std::string& out, cons
         if (!done && std::strcmp(phase, "scan") == 0) edit(), done = true;
     };
     try {
-        compress_tck(in, out, o);
+        compress_file(in, out, o);
     } catch (const Error& e) {
         EXPECT_EQ(e.code(), Errc::io) << e.what();
         return e.what();
@@ -132,12 +132,12 @@ TEST(CompressPasses, TheStagesAreTimedWithinTheRunsTime) {
     write_tck(dir.file("in.tck"));
     CompressOptions o;
     o.threads = 1;
-    const CompressReport r = compress_tck(dir.file("in.tck"), dir.file("out.fft"), o);
+    const CompressReport r = compress_file(dir.file("in.tck"), dir.file("out.fft"), o);
     const CompressTimings& t = r.timings;
     for (const double s : {t.read, t.scan, t.tune, t.encode, t.metrics, t.index, t.write}) EXPECT_GT(s, 0.0);
     EXPECT_LE(t.total(), r.seconds);
     // No index asked: no time in it.
     o.block_index = false;
     o.overwrite = true;
-    EXPECT_EQ(compress_tck(dir.file("in.tck"), dir.file("out.fft"), o).timings.index, 0.0);
+    EXPECT_EQ(compress_file(dir.file("in.tck"), dir.file("out.fft"), o).timings.index, 0.0);
 }

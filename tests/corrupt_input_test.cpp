@@ -183,7 +183,7 @@ void poke(std::string& b, std::size_t off, T v) {
 // A valid .fft with checksums: 3 fibers of 70, 10 and 1 points (blocks 2 + 1 + 1).
 std::string valid_fft(const test::TempDir& dir) {
     test::write_three_fiber_tck(dir.file("src.tck"));
-    compress_tck(dir.file("src.tck"), dir.file("valid.fft"), {});
+    compress_file(dir.file("src.tck"), dir.file("valid.fft"), {});
     std::string b = test::read_file(dir.file("valid.fft"));
     fs::remove(dir.file("src.tck"));
     fs::remove(dir.file("valid.fft"));
@@ -254,7 +254,7 @@ TEST(CorruptTck, EachCaseFailsWithItsCategoryAndLeavesNoOutput) {
         test::write_file(in, c.bytes);
         // API: reading, then the whole compression.
         EXPECT_EQ(error_of([&] { test::read_tck_fibers(in); }), c.readable ? std::nullopt : c.error);
-        EXPECT_EQ(error_of([&] { compress_tck(in, out, {}); }), c.error);
+        EXPECT_EQ(error_of([&] { compress_file(in, out, {}); }), c.error);
         if (c.error) {
             EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"in.tck"});
         } else {
@@ -287,11 +287,11 @@ TEST(CorruptTck, EachCaseFailsWithItsCategoryAndLeavesNoOutput) {
 
 TEST(CorruptTck, MissingOrUnreadableInputIsAnIoError) {
     test::TempDir dir;
-    EXPECT_EQ(error_of([&] { compress_tck(dir.file("nope.tck"), dir.file("o.fft"), {}); }), Errc::io);
-    EXPECT_EQ(error_of([&] { compress_tck(dir.path(), dir.file("o.fft"), {}); }), Errc::io);
+    EXPECT_EQ(error_of([&] { compress_file(dir.file("nope.tck"), dir.file("o.fft"), {}); }), Errc::io);
+    EXPECT_EQ(error_of([&] { compress_file(dir.path(), dir.file("o.fft"), {}); }), Errc::io);
     // The output directory does not exist.
     test::write_file(dir.file("in.tck"), tck(kTwoFibers));
-    EXPECT_EQ(error_of([&] { compress_tck(dir.file("in.tck"), dir.file("no/such/dir/o.fft"), {}); }), Errc::io);
+    EXPECT_EQ(error_of([&] { compress_file(dir.file("in.tck"), dir.file("no/such/dir/o.fft"), {}); }), Errc::io);
     EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"in.tck"});
 }
 
@@ -336,7 +336,7 @@ TEST(CorruptTck, AStreamlineLongerThanAFiberCanHoldIsRefusedBeforeItFillsMemory)
     test::write_file(dir.file("in.tck"), tck(data + kSep + kEnd));
     CompressOptions o;
     o.points_per_block = 2;
-    EXPECT_EQ(error_of([&] { compress_tck(dir.file("in.tck"), dir.file("out.fft"), o); }), Errc::unsupported);
+    EXPECT_EQ(error_of([&] { compress_file(dir.file("in.tck"), dir.file("out.fft"), o); }), Errc::unsupported);
     EXPECT_EQ(listing(dir.path()), std::vector<std::string>{"in.tck"});
     // The reader's own limit.
     EXPECT_EQ(error_of([&] {

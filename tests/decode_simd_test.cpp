@@ -314,7 +314,7 @@ TEST(DecodeSimd, SharedTractogramsMatchTheReferenceDecoder) {
         // the smooth files 16-bit codes (encode/direction_bits.hpp).
         CompressOptions o;
         o.direction_bits = 8;
-        compress_tck(tck.string(), fft, o);
+        compress_file(tck.string(), fft, o);
         expect_file_matches_reference(fft);
     }
     // And 16-bit files (version 17) of a smooth and of a folded tractogram.
@@ -323,7 +323,7 @@ TEST(DecodeSimd, SharedTractogramsMatchTheReferenceDecoder) {
         CompressOptions o;
         o.direction_bits = 16;
         o.overwrite = true;
-        compress_tck(test::shared_data(name), fft, o);
+        compress_file(test::shared_data(name), fft, o);
         ASSERT_EQ(FftFile(fft).header().direction_bits(), 16u);
         expect_file_matches_reference(fft);
     }

@@ -35,7 +35,7 @@ protected:
         path_ = dir_->file("sdstream.fft");
         CompressOptions o;
         o.direction_bits = 8;
-        compress_tck(test::shared_data("small-sdstream.tck"), path_, o);
+        compress_file(test::shared_data("small-sdstream.tck"), path_, o);
     }
     static void TearDownTestSuite() { dir_.reset(); }
     void SetUp() override {

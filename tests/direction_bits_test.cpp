@@ -148,7 +148,7 @@ CompressReport compress(const std::string& tck, const std::string& fft, std::opt
     o.overwrite = true;
     o.direction_bits = bits;
     o.threads = threads;
-    return compress_tck(tck, fft, o);
+    return compress_file(tck, fft, o);
 }
 
 }  // namespace

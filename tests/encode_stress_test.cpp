@@ -270,7 +270,7 @@ TEST(EncodeStress, StepJitterOf15Percent) {
     }
     CompressOptions o;
     o.search = search_for_effort(2);
-    const CompressReport r = compress_tck(dir.file("jitter.tck"), dir.file("jitter.fft"), o);
+    const CompressReport r = compress_file(dir.file("jitter.tck"), dir.file("jitter.fft"), o);
     ASSERT_TRUE(r.resampled);
     const FftFile file(dir.file("jitter.fft"));
     const Streamlines s = decode_fibers(file, 0, file.header().fibers);
@@ -388,7 +388,7 @@ TEST(EncodeStress, Float64Input) {
     test::write_file(dir.file("f64.tck"), data);
 
     CompressOptions o;
-    const CompressReport r = compress_tck(dir.file("f64.tck"), dir.file("f64.fft"), o);
+    const CompressReport r = compress_file(dir.file("f64.tck"), dir.file("f64.fft"), o);
     ASSERT_FALSE(r.resampled);
     const FftFile file(dir.file("f64.fft"));
     const Streamlines s = decode_fibers(file, 0, file.header().fibers);

@@ -79,7 +79,7 @@ Outcome compress_and_measure(const std::vector<Fiber>& fibers, const std::string
     }
     CompressOptions o;
     o.overwrite = true;
-    compress_tck(tck, fft, o);
+    compress_file(tck, fft, o);
     return {test::measure_exact(fft, tck)};
 }
 

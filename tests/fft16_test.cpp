@@ -50,7 +50,7 @@ TEST(Fft16, CompressesToPackedVersion17AndDecodesBelowAMicrometre) {
     write_helices(dir.file("h.tck"), 12);
     CompressOptions o;
     o.direction_bits = 16;
-    const CompressReport r = compress_tck(dir.file("h.tck"), dir.file("h.fft"), o);
+    const CompressReport r = compress_file(dir.file("h.tck"), dir.file("h.fft"), o);
     EXPECT_EQ(r.header.version, kFft16PackedVersion);
     EXPECT_EQ(r.header.points_per_block, 254u);
     EXPECT_EQ(r.header.code_levels(), 181u);
@@ -87,7 +87,7 @@ TEST(Fft16, CompressesToPackedVersion17AndDecodesBelowAMicrometre) {
     // Same data in 8 bits: the 181-level codes are 12 times finer per axis
     // (9.3 times smaller a mean error measured on these helices).
     o.direction_bits = 8;
-    const CompressReport r8 = compress_tck(dir.file("h.tck"), dir.file("h8.fft"), o);
+    const CompressReport r8 = compress_file(dir.file("h.tck"), dir.file("h8.fft"), o);
     EXPECT_EQ(r8.header.version, kFftVersion);
     EXPECT_LT(6 * r.error.mean_mm(), r8.error.mean_mm());
 }
@@ -98,7 +98,7 @@ TEST(Fft16, ZstdContainersHoldVersion16) {
     CompressOptions o;
     o.direction_bits = 16;
     o.zstd = ZstdOptions{};
-    const CompressReport r = compress_tck(dir.file("h.tck"), dir.file("h.fftz"), o);
+    const CompressReport r = compress_file(dir.file("h.tck"), dir.file("h.fftz"), o);
     EXPECT_EQ(r.header.version, kFft16Version);
     EXPECT_EQ(r.header.points_per_block, kDefaultPointsPerBlock16);
     EXPECT_EQ(r.header.block_bytes(), 24u + 2 * (126 - 2));
@@ -118,7 +118,7 @@ TEST(Fft16, BlockFieldsHoldTheFiberLayout) {
     CompressOptions o;
     o.direction_bits = 16;
     o.points_per_block = 100;
-    compress_tck(dir.file("h.tck"), dir.file("h.fft"), o);
+    compress_file(dir.file("h.tck"), dir.file("h.fft"), o);
     const FftFile file(dir.file("h.fft"));
     ASSERT_EQ(file.header().points_per_block, 100u);
     const std::uint32_t expected_counts[3][3] = {{100, 100, 0}, {100, 100, 37}, {100, 100, 74}};
@@ -143,7 +143,7 @@ TEST(Fft16, RejectsMalformedPackedFiles) {
     write_helices(dir.file("h.tck"), 2);  // 200 and 237 points: one block each
     CompressOptions o;
     o.direction_bits = 16;
-    compress_tck(dir.file("h.tck"), dir.file("h.fft"), o);
+    compress_file(dir.file("h.tck"), dir.file("h.fft"), o);
     const std::string bytes = test::read_file(dir.file("h.fft"));
     const FftFile good(dir.file("h.fft"));
     const std::size_t first_block = good.header().blocks_offset(), lut = good.header().lut_offset();
@@ -217,7 +217,7 @@ TEST(Fft16, RejectsMalformedPackedFiles) {
 
     CompressOptions wrong;
     wrong.direction_bits = 12;
-    EXPECT_THROW(compress_tck(dir.file("h.tck"), dir.file("x.fft"), wrong), Error);
+    EXPECT_THROW(compress_file(dir.file("h.tck"), dir.file("x.fft"), wrong), Error);
 }
 
 // Version 17's checksum groups hash the blocks as stored, packed
@@ -229,7 +229,7 @@ TEST(Fft16, ChecksumGroupsHashThePackedBytes) {
     write_helices(dir.file("h.tck"), 3);  // 200, 237, 274 points: 4 blocks
     CompressOptions o;
     o.direction_bits = 16;
-    compress_tck(dir.file("h.tck"), dir.file("h.fft"), o);
+    compress_file(dir.file("h.tck"), dir.file("h.fft"), o);
     const std::string bytes = test::read_file(dir.file("h.fft"));
     const FftFile good(dir.file("h.fft"));
     const std::size_t first_block = good.header().blocks_offset(), end = good.header().file_bytes();

@@ -20,7 +20,7 @@ namespace {
 // A small valid .fft (3 fibers, 4 blocks) as bytes.
 std::string make_valid(const test::TempDir& dir) {
     test::write_three_fiber_tck(dir.file("in.tck"));
-    compress_tck(dir.file("in.tck"), dir.file("ok.fft"), {.overwrite = true});
+    compress_file(dir.file("in.tck"), dir.file("ok.fft"), {.overwrite = true});
     return test::read_file(dir.file("ok.fft"));
 }
 

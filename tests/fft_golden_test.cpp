@@ -36,7 +36,7 @@ TEST(FftGolden, TinyTractogramLayout) {
     o.step_mm = 1.0;
     o.step_tolerance = 100;  // never resample (fiber 1's spacing is 4/61): this test is about layout
     o.direction_bits = 8;    // version 2's layout (the default gives straight fibers 16 bits)
-    compress_tck(dir.file("in.tck"), dir.file("out.fft"), o);
+    compress_file(dir.file("in.tck"), dir.file("out.fft"), o);
     const std::string b = test::read_file(dir.file("out.fft"));
 
     // Header.

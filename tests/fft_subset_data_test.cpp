@@ -84,7 +84,7 @@ void make_source(const std::string& trx, const std::string& fft, std::vector<std
     }
     CompressOptions o;
     o.threads = 1;
-    const CompressReport r = compress_tck(trx, fft, o);
+    const CompressReport r = compress_file(trx, fft, o);
     ASSERT_FALSE(r.resampled) << "the test's fibers have a fixed step";
     ASSERT_EQ(r.header.points, points);
 }

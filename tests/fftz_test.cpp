@@ -57,10 +57,10 @@ void make(Files& f, unsigned bits, bool transpose, std::uint32_t group = 7) {
     o.step_scale = 1.0;
     o.cap_ratio = 0.1;
     f.plain = f.dir.file("w.fft");
-    compress_tck(f.dir.file("w.tck"), f.plain, o);
+    compress_file(f.dir.file("w.tck"), f.plain, o);
     o.zstd = ZstdOptions{9, group, transpose};
     f.packed = f.dir.file("w.fftz");
-    compress_tck(f.dir.file("w.tck"), f.packed, o);
+    compress_file(f.dir.file("w.tck"), f.packed, o);
 }
 
 }  // namespace

@@ -65,7 +65,7 @@ TEST(FiberEndsSharedData, EndpointsAndLengthsMatchTheInput) {
         SCOPED_TRACE(tck);
         CompressOptions o;
         o.overwrite = true;
-        const CompressReport r = compress_tck(tck, dir.file("f.fft"), o);
+        const CompressReport r = compress_file(tck, dir.file("f.fft"), o);
         const FftFile file(dir.file("f.fft"));
         const Comparison c = compare_to_reference(file, tck);
         const double recorded = double(file.header().max_error_mm) * (1 + 1e-6) + 1e-7;
@@ -178,7 +178,7 @@ struct ResampledLengthChanges {
 ResampledLengthChanges measure_resampled_lengths(const std::string& tck, const std::string& fft,
                                                  const CompressOptions& o) {
     ResampledLengthChanges m;
-    m.resampled = compress_tck(tck, fft, o).resampled;
+    m.resampled = compress_file(tck, fft, o).resampled;
     if (!m.resampled) return m;
     const FftFile file(fft);
     const Resampling how = *file.resampling();
@@ -283,7 +283,7 @@ TEST(FiberEndsSharedData, FixedStepLengthsWithinTheRecordedError) {
         CompressOptions o;
         o.overwrite = true;
         o.direction_bits = std::nullopt;  // --bits auto (the default's 8 bits: compress says so, CompressLengthNote)
-        const CompressReport r = compress_tck(tck, dir.file("f.fft"), o);
+        const CompressReport r = compress_file(tck, dir.file("f.fft"), o);
         if (r.resampled) continue;
         ++checked;
         sixteen_bit += r.header.direction_bits() == 16;
@@ -324,9 +324,9 @@ TEST(FiberEndsSharedData, FewPointFibersGetAFinerStepInTheSameBytes) {
         CompressOptions o;
         o.overwrite = true;
         o.direction_bits = 8;  // fixed-size 60-point blocks (at the median step the default may choose 16)
-        const CompressReport finer = compress_tck(tck, dir.file("finer.fft"), o);
+        const CompressReport finer = compress_file(tck, dir.file("finer.fft"), o);
         o.step_mm = finer.scan.step_median;
-        const CompressReport median = compress_tck(tck, dir.file("median.fft"), o);
+        const CompressReport median = compress_file(tck, dir.file("median.fft"), o);
         EXPECT_LE(finer.step_mm, 0.95 * median.step_mm);
         EXPECT_EQ(finer.header.blocks, median.header.blocks);
         // The same bytes but for the block index, whose coded boxes take

@@ -73,7 +73,7 @@ Encoded encode(const test::TempDir& dir, const std::vector<Fiber>& fibers, Compr
     }
     o.overwrite = true;
     Encoded e;
-    e.report = compress_tck(dir.file("in.tck"), dir.file("out.fft"), o);
+    e.report = compress_file(dir.file("in.tck"), dir.file("out.fft"), o);
     const FftFile file(dir.file("out.fft"));
     e.decoded = decode_fibers(file, 0, file.header().fibers);
     return e;

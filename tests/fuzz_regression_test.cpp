@@ -95,10 +95,10 @@ TEST(FuzzRegression, FftTargets) {
             replay_regressions("decode_blocks_fuzz", fuzz::blocks_target);
     if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
     test::TempDir dir;
-    compress_tck(test::shared_data("bundles/AF_L.tck"), dir.file("a.fft"), {});
+    compress_file(test::shared_data("bundles/AF_L.tck"), dir.file("a.fft"), {});
     CompressOptions wide;
     wide.direction_bits = 16;
-    compress_tck(test::shared_data("bundles/AF_L.tck"), dir.file("a16.fft"), wide);
+    compress_file(test::shared_data("bundles/AF_L.tck"), dir.file("a16.fft"), wide);
     // Every 97th byte flipped in turn: checksum failures, malformed blocks,
     // broken headers and LUT entries, each through every decoder.
     for (const char* name : {"a.fft", "a16.fft"}) {
@@ -114,7 +114,7 @@ TEST(FuzzRegression, FftTargets) {
     // time, of a plain file and of a .fftz container.
     CompressOptions zstd;
     zstd.zstd = ZstdOptions{.level = 3, .group_blocks = 8, .transpose = true};
-    compress_tck(test::shared_data("bundles/AF_L.tck"), dir.file("a.fftz"), zstd);
+    compress_file(test::shared_data("bundles/AF_L.tck"), dir.file("a.fftz"), zstd);
     for (const char* name : {"a.fft", "a.fftz"}) {
         const std::string good = test::read_file(dir.file(name));
         for (unsigned seed = 0; seed < 150; ++seed) {

@@ -308,11 +308,11 @@ TEST(GeometryError, CompressReportsTheSameBitsWithoutAvx2Loops) {
         SCOPED_TRACE(step);
         o.step_mm = step > 0 ? std::optional<double>(step) : std::nullopt;
         const std::string tck = test::shared_data(step > 0 ? "small-sdstream.tck" : "small-ifod1.tck");
-        const CompressReport vectors = compress_tck(tck, dir.file("v.fft"), o);
+        const CompressReport vectors = compress_file(tck, dir.file("v.fft"), o);
         detail::avx512_loops_enabled() = false;
-        const CompressReport avx2 = compress_tck(tck, dir.file("a.fft"), o);
+        const CompressReport avx2 = compress_file(tck, dir.file("a.fft"), o);
         detail::avx2_loops_enabled() = false;
-        const CompressReport scalar = compress_tck(tck, dir.file("s.fft"), o);
+        const CompressReport scalar = compress_file(tck, dir.file("s.fft"), o);
         detail::avx2_loops_enabled() = true, detail::avx512_loops_enabled() = true;
         EXPECT_TRUE(test::read_file(dir.file("v.fft")) == test::read_file(dir.file("s.fft")));
         EXPECT_TRUE(test::read_file(dir.file("a.fft")) == test::read_file(dir.file("s.fft")));

@@ -58,7 +58,7 @@ TEST_P(ScaledCoordinates, EncodeAsWellAsInMillimetres) {
         write_tck(tck, scaled_fibers(scale, 0));
         CompressOptions o;
         o.overwrite = true;
-        const CompressReport r = compress_tck(tck, fft, o);
+        const CompressReport r = compress_file(tck, fft, o);
         const auto m = test::measure_exact(fft, tck);
         EXPECT_LE(m.exact.max_mm, 1.05 * r.error.max_mm()) << scale;
         max[i] = m.exact.max_mm / scale, mean[i] = m.exact.mean_mm() / scale;
@@ -86,7 +86,7 @@ TEST(NumericRange, StepLostAgainstTheExtentIsRefused) {
     CompressOptions o;
     o.overwrite = true;
     try {
-        compress_tck(tck, dir.file("far.fft"), o);
+        compress_file(tck, dir.file("far.fft"), o);
         ADD_FAILURE() << "compressed";
     } catch (const Error& e) {
         EXPECT_EQ(e.code(), Errc::invalid_input);
@@ -116,7 +116,7 @@ TEST(NumericRange, StepsNearTheFloatRangeKeepTheFileReadable) {
             CompressOptions o;
             o.overwrite = true;
             o.direction_bits = bits;
-            compress_tck(tck, dir.file("huge.fft"), o);
+            compress_file(tck, dir.file("huge.fft"), o);
             const FftFile f(dir.file("huge.fft"));
             const Streamlines s = decode_fibers(f, 0, f.header().fibers);
             ASSERT_EQ(s.offsets.back(), t == 0 ? 2u : 4u);
@@ -135,7 +135,7 @@ TEST(NumericRange, SinglePointAndCoincidentPoints) {
         write_tck(tck, fibers);
         CompressOptions o;
         o.overwrite = true;
-        const CompressReport r = compress_tck(tck, fft, o);
+        const CompressReport r = compress_file(tck, fft, o);
         // The box has no extent: scaling 1 mm, and the point at 0.5, half
         // an anchor quantum off the unorm16 grid on each axis.
         const double anchor = std::sqrt(3.0) * 0.5 / 65535.0;

@@ -104,7 +104,7 @@ TEST(OutputTarget, AnOpenInputIsNeverReplacedWhateverItsName) {
     EXPECT_EQ(test::read_file(dir.file("hard.tck")), "x");
 
     // The same for .fft inputs, and through the library's writers.
-    compress_tck(dir.file("in.tck"), dir.file("in.fft"), {});
+    compress_file(dir.file("in.tck"), dir.file("in.fft"), {});
     const std::string fft = test::read_file(dir.file("in.fft"));
     {
         const FftFile file(dir.file("in.fft"));
@@ -112,7 +112,7 @@ TEST(OutputTarget, AnOpenInputIsNeverReplacedWhateverItsName) {
     }
     CompressOptions o;
     o.overwrite = true;
-    EXPECT_EQ(error_of([&] { compress_tck(dir.file("in.tck"), dir.file("soft.tck"), o); }), Errc::invalid_argument);
+    EXPECT_EQ(error_of([&] { compress_file(dir.file("in.tck"), dir.file("soft.tck"), o); }), Errc::invalid_argument);
     EXPECT_EQ(test::read_file(dir.file("in.tck")), original);
     EXPECT_EQ(test::read_file(dir.file("in.fft")), fft);
 }
@@ -168,11 +168,11 @@ TEST(OutputTarget, CompressRefusesBeforeItReadsItsInput) {
     int progress_calls = 0;
     CompressOptions o;
     o.progress = [&](const char*, double) { ++progress_calls; };
-    EXPECT_EQ(error_of([&] { compress_tck(dir.file("in.tck"), dir.file("exists.fft"), o); }), Errc::exists);
+    EXPECT_EQ(error_of([&] { compress_file(dir.file("in.tck"), dir.file("exists.fft"), o); }), Errc::exists);
     o.overwrite = true;
-    EXPECT_EQ(error_of([&] { compress_tck(dir.file("in.tck"), dir.file("in.tck"), o); }), Errc::invalid_argument);
+    EXPECT_EQ(error_of([&] { compress_file(dir.file("in.tck"), dir.file("in.tck"), o); }), Errc::invalid_argument);
     EXPECT_EQ(progress_calls, 0);  // refused before the first pass, not after it
-    compress_tck(dir.file("in.tck"), dir.file("exists.fft"), o);
+    compress_file(dir.file("in.tck"), dir.file("exists.fft"), o);
     EXPECT_GT(progress_calls, 0);
 }
 

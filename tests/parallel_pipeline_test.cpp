@@ -114,7 +114,7 @@ std::string compressed(const std::string& tck, const std::string& out, unsigned 
     o.threads = threads;
     o.overwrite = true;
     if (zstd) o.zstd = ZstdOptions{.level = 3};
-    compress_tck(tck, out, o);
+    compress_file(tck, out, o);
     return test::read_file(out);
 }
 
@@ -143,7 +143,7 @@ TEST(DecodePipeline, OverlappedSinkGetsTheSameChunksInOrder) {
     const std::string path = dir.file("s.fft");
     CompressOptions co;
     co.direction_bits = 8;  // 14,736 blocks: five chunks (16 bits, the default here, has 3,937)
-    compress_tck(test::shared_data("small-sdstream.tck"), path, co);
+    compress_file(test::shared_data("small-sdstream.tck"), path, co);
     const FftFile file(path);
     auto run = [&](bool overlap, unsigned threads) {
         DecodeOptions o;

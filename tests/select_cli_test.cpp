@@ -50,7 +50,7 @@ protected:
         dir_ = new TempDir;
         CompressOptions o;
         o.threads = 2;
-        compress_tck(shared_data("small-sdstream.tck"), dir_->file("s.fft"), o);
+        compress_file(shared_data("small-sdstream.tck"), dir_->file("s.fft"), o);
     }
     static void TearDownTestSuite() {
         delete dir_;

@@ -47,7 +47,7 @@ protected:
             o.threads = 2;
             // The 8-bit layout unless a test asks for 16 (the default gives small-sdstream 16 bits).
             if (!o.direction_bits) o.direction_bits = 8;
-            compress_tck(shared_data(tck), out, o);
+            compress_file(shared_data(tck), out, o);
         }
         return out;
     }

@@ -133,7 +133,7 @@ protected:
         dir_ = new TempDir;
         CompressOptions o;
         o.threads = 2;
-        compress_tck(shared_data("small-sdstream.tck"), dir_->file("s.fft"), o);
+        compress_file(shared_data("small-sdstream.tck"), dir_->file("s.fft"), o);
         const FftFile file(dir_->file("s.fft"));
         decoded_ = new DecodedFile(decode_everything(file));
         QueryGenerator gen(*decoded_, 11);

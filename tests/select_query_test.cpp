@@ -65,13 +65,13 @@ protected:
             case 0:  // short fibers from a real scan
                 s->name = "fiblet dwi-small64d";
                 fft = dir_->file("dwi.fft");
-                compress_tck(shared_data("dwi-small64d-ifod1.tck"), fft, o);
+                compress_file(shared_data("dwi-small64d-ifod1.tck"), fft, o);
                 break;
             case 1:  // long real bundle
                 s->name = "fiblet CST_R";
                 fft = dir_->file("cst.fft");
                 o.direction_bits = 8;  // the default gives it 16 bits: cases 3 and 4 cover those
-                compress_tck(shared_data("bundles/CST_R-step0.1.tck"), fft, o);
+                compress_file(shared_data("bundles/CST_R-step0.1.tck"), fft, o);
                 break;
             case 2:  // written by another tool, no stored index
                 s->name = "official small-sdstream";
@@ -81,7 +81,7 @@ protected:
                 s->name = "fiblet 16-bit dwi-small64d";
                 fft = dir_->file("dwi16.fft");
                 o.direction_bits = 16;
-                compress_tck(shared_data("dwi-small64d-ifod1.tck"), fft, o);
+                compress_file(shared_data("dwi-small64d-ifod1.tck"), fft, o);
                 break;
             case 5:  // a version-2 index (a box per 8 blocks), as fiblet wrote it before version 3
                 s->name = "fiblet dwi-small64d, version-2 index";
@@ -92,7 +92,7 @@ protected:
                 fft = dir_->file("cst16.fft");
                 o.direction_bits = 16;
                 o.points_per_block = 400;
-                compress_tck(shared_data("bundles/CST_R-step0.1.tck"), fft, o);
+                compress_file(shared_data("bundles/CST_R-step0.1.tck"), fft, o);
         }
         s->file = std::make_unique<FftFile>(fft);
         s->decoded = decode_everything(*s->file);

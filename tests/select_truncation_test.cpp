@@ -56,7 +56,7 @@ struct TruncatedAfterOpen {
 TEST(SelectTruncation, ATruncatedFileIsAnErrorNotACrash) {
     test::TempDir dir;
     write_tractogram(dir.file("in.tck"));
-    compress_tck(dir.file("in.tck"), dir.file("in.fft"), {});
+    compress_file(dir.file("in.tck"), dir.file("in.fft"), {});
     TruncatedAfterOpen t(dir.file("in.fft"));
     t.cut();
     Query everything;  // reads the blocks past the cut
@@ -72,7 +72,7 @@ TEST(SelectTruncation, ATruncatedFileIsAnErrorNotACrash) {
 TEST(SelectTruncation, ASubsetBeingWrittenIsRemoved) {
     test::TempDir dir;
     write_tractogram(dir.file("in.tck"));
-    compress_tck(dir.file("in.tck"), dir.file("in.fft"), {});
+    compress_file(dir.file("in.tck"), dir.file("in.fft"), {});
     fs::create_directory(dir.file("out"));
     TruncatedAfterOpen t(dir.file("in.fft"));
     const auto runs = select_runs(t.file, t.index, Query{});

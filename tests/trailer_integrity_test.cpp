@@ -71,7 +71,7 @@ struct Fixture {
     FftHeader header;
     explicit Fixture(int fibers = 40, CompressOptions o = {}) {
         write_tractogram(tck, fibers);
-        compress_tck(tck, fft, o);
+        compress_file(tck, fft, o);
         bytes = test::read_file(fft);
         header = FftFile(fft).header();
     }
@@ -346,7 +346,7 @@ TEST(TrailerIntegrity, ManyEmptyFibersCostTheirTablesOnly) {
     }
     CompressOptions o;
     o.zstd = ZstdOptions{};
-    compress_tck(tck, fftz, o);
+    compress_file(tck, fftz, o);
     ASSERT_LT(std::filesystem::file_size(fftz), 64u << 10);
     for (const char* command : {"info", "verify"}) {
         const pid_t pid = test::spawn_cli({command, fftz});

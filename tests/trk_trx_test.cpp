@@ -328,7 +328,7 @@ TEST(TrkThroughFft, DataAndSpaceKeptAndChecksummed) {
     const std::string fft = dir.path() + "/c.fft";
     CompressOptions o;
     o.threads = 1;
-    const CompressReport rep = compress_tck(src, fft, o);
+    const CompressReport rep = compress_file(src, fft, o);
     EXPECT_FALSE(rep.resampled);
     TrkReader in(src);
     read_all(in);

@@ -80,7 +80,7 @@ inline std::string compress_into(const TempDir& dir, const std::string& tck, con
     o.direction_bits = 8;  // the default chooses 16 for smooth fibers (encode/direction_bits.hpp)
     o.threads = 1;
     o.overwrite = true;
-    compress_tck(tck, out, o);
+    compress_file(tck, out, o);
     return out;
 }
 
@@ -110,7 +110,7 @@ inline std::string compress16_into(const TempDir& dir, const std::string& tck, c
     o.direction_bits = 16;
     o.points_per_block = points_per_block;
     if (zstd) o.zstd = ZstdOptions{};
-    compress_tck(tck, out, o);
+    compress_file(tck, out, o);
     return out;
 }
 

@@ -179,7 +179,7 @@ void run(const CompressArgs& args) {
             o.overwrite = a.force || stdout_spool;
             const CompressReport r = [&] {
                 try {
-                    return compress_tck(readable_path(in, ".tck", stdin_spool), out_path, o);
+                    return compress_file(readable_path(in, ".tck", stdin_spool), out_path, o);
                 } catch (const Error& e) {
                     throw named_for_user(e, stdin_spool, stdout_spool);
                 }

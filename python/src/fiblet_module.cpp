@@ -340,7 +340,7 @@ py::dict compress(const std::string& tck_path, const std::string& fft_path, std:
     CompressReport r;
     {
         py::gil_scoped_release release;
-        r = compress_tck(tck_path, fft_path, o);
+        r = compress_file(tck_path, fft_path, o);
     }
     py::dict d;
     d["input"] = tck_path, d["output"] = fft_path;

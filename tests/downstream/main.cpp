@@ -17,7 +17,7 @@ int main(int argc, char** argv) {
     try {
         fiblet::CompressOptions options;
         options.overwrite = true;
-        fiblet::compress_tck(argv[1], argv[2], options);
+        fiblet::compress_file(argv[1], argv[2], options);
 
         const fiblet::FftFile file(argv[2]);
         const fiblet::Streamlines decoded = fiblet::decode_fibers(file, 0, file.header().fibers);

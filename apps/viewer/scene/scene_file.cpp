@@ -26,7 +26,7 @@ FftFile open_scene_file(const std::string& path) {
     } cleanup{dir};
     const std::string fft = dir + "/scene.fft";
     CompressOptions options;
-    compress_tck(path, fft, options);
+    compress_file(path, fft, options);
     return FftFile(fft);  // FftFile keeps its descriptor: the file may go
 }
 

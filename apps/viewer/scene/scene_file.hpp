@@ -8,7 +8,7 @@
 
 namespace fiblet::viewer {
 
-// Throws fiblet::Error like FftFile / compress_tck.
+// Throws fiblet::Error like FftFile / compress_file.
 FftFile open_scene_file(const std::string& path);
 
 }  // namespace fiblet::viewer

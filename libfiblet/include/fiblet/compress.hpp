@@ -17,8 +17,8 @@
 
 namespace fiblet {
 
-// What a first pass over a .tck learns about it.
-struct TckScan {
+// What a first pass over a tractogram (.tck, .trk, TRX) learns about it.
+struct SourceScan {
     std::uint64_t fibers = 0, points = 0, segments = 0;
     std::uint64_t empty_fibers = 0, single_point_fibers = 0;
     std::array<double, 3> min{}, max{};  // bounding box, mm
@@ -116,7 +116,7 @@ struct CompressTimings {
 };
 
 struct CompressReport {
-    TckScan scan;
+    SourceScan scan;
     DirectionBitsChoice bits;
     FftHeader header;
     double step_mm = 0;              // sampling step: the spacing of the encoded points
@@ -137,9 +137,17 @@ struct CompressReport {
 // under `ulimit -v`/`-d` or a cgroup v2 memory.max (src/core/memory_budget.cpp).
 std::uint64_t default_memory_budget();
 
-// Compresses `tck_path` (a .tck, .trk or TRX: open_streamline_source) into
+// Compresses `input_path` (a .tck, .trk or TRX: open_streamline_source) into
 // `fft_path` (atomically; see AtomicOutputFile). Per-streamline and per-point
 // data go to the DATA chunk (formats/fft-data.md); the input header to PROP.
-CompressReport compress_tck(const std::string& tck_path, const std::string& fft_path, const CompressOptions& options);
+CompressReport compress_file(const std::string& input_path, const std::string& fft_path, const CompressOptions& options);
+
+// The earlier names, from when compress read .tck files only.
+using TckScan [[deprecated("use SourceScan")]] = SourceScan;
+[[deprecated("use compress_file")]] inline CompressReport compress_tck(const std::string& input_path,
+                                                                       const std::string& fft_path,
+                                                                       const CompressOptions& options) {
+    return compress_file(input_path, fft_path, options);
+}
 
 }  // namespace fiblet

@@ -121,7 +121,7 @@ std::string bits_reason(const DirectionBitsChoice& c, unsigned bits, bool wide_b
 // median spacing, made finer where every fiber keeps its block count
 // (block_keeping_step); options.step_mm overrides. `resampled`: whether the
 // spacing departs from the chosen step by more than the tolerance.
-double choose_step(const TckScan& scan, std::span<const float> fiber_lengths, const CompressOptions& options,
+double choose_step(const SourceScan& scan, std::span<const float> fiber_lengths, const CompressOptions& options,
                    std::uint32_t points_per_block, bool& resampled) {
     const double tol = options.step_tolerance;
     const bool variable = scan.segments > 0 && (scan.step_max > scan.step_mean * (1 + tol) ||
@@ -143,7 +143,7 @@ double choose_step(const TckScan& scan, std::span<const float> fiber_lengths, co
 // Normalization into the unit cube: the header's offset, scaling and step.
 // Returns the step the decoder will walk (float, normalized) in mm:
 // resampling uses exactly that length.
-double normalize(FftHeader& h, const TckScan& scan, double step, const std::string& path) {
+double normalize(FftHeader& h, const SourceScan& scan, double step, const std::string& path) {
     double extent = 0;
     for (int a = 0; a < 3; ++a) {
         h.offset[a] = float(-0.5 * (scan.min[a] + scan.max[a]));
@@ -173,7 +173,7 @@ std::vector<FiberLutEntry> plan_blocks(FftHeader& h, const std::vector<std::uint
     }, path);
 }
 
-// One compress run, stage by stage: compress_tck calls them in order. The
+// One compress run, stage by stage: compress_file calls them in order. The
 // state passes from stage to stage in these members; each stage says what
 // it reads and what it sets.
 class CompressJob {
@@ -248,7 +248,7 @@ CompressJob::CompressJob(const std::string& input, const std::string& output, co
 // bits samples (the bits on a larger sample than the tuning's:
 // direction_bits.hpp); then the data fields against the counts.
 void CompressJob::scan() {
-    TckScan& scan = report.scan;
+    SourceScan& scan = report.scan;
     const std::size_t bits_sample_points =
         choose_bits_ && !wide_blocks_asked_ ? std::max(options_.tuning_points, detail::kBitsSamplePoints) : 0;
     scanned_.emplace(detail::scan_stage(*source_, scan, layout_.points_per_block, kSharpBlocks, options_.tuning_points,
@@ -440,11 +440,11 @@ void CompressJob::finish() {
 
 }  // namespace
 
-CompressReport compress_tck(const std::string& tck_path, const std::string& fft_path, const CompressOptions& options) {
+CompressReport compress_file(const std::string& input_path, const std::string& fft_path, const CompressOptions& options) {
     const Timer timer;
     if (options.direction_bits && *options.direction_bits != 8 && *options.direction_bits != 16)
         throw Error(Errc::invalid_argument, "direction bits must be 8 or 16");
-    CompressJob job(tck_path, fft_path, options);
+    CompressJob job(input_path, fft_path, options);
     job.scan();
     job.choose_step();
     job.resample_scan();
@@ -453,7 +453,7 @@ CompressReport compress_tck(const std::string& tck_path, const std::string& fft_
     job.finish();
     if (options.progress) options.progress("encode", 1.0);
     CompressReport& report = job.report;
-    report.input_bytes = tractogram_bytes(tck_path);  // a TRX directory: its files
+    report.input_bytes = tractogram_bytes(input_path);  // a TRX directory: its files
     report.seconds = timer.seconds();
     return std::move(report);
 }

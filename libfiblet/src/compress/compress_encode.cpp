@@ -1,4 +1,4 @@
-// The encode stage of compress_tck (compress_stages.hpp): a three-stage
+// The encode stage of compress_file (compress_stages.hpp): a three-stage
 // pipeline over batches of whole fibers,
 //
 //   read_fiber_batch  the caller's thread parses the next batch of the

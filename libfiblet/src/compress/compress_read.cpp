@@ -1,4 +1,4 @@
-// The read stage of compress_tck (compress_stages.hpp): batches of whole
+// The read stage of compress_file (compress_stages.hpp): batches of whole
 // fibers, parsed by the caller's thread while the worker pool works on the
 // batch before.
 #include <algorithm>

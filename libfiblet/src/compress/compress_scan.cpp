@@ -1,4 +1,4 @@
-// The scan stage of compress_tck (compress_stages.hpp): pass 1 (counts,
+// The scan stage of compress_file (compress_stages.hpp): pass 1 (counts,
 // bounds, spacing, turning angles) and, when resampling, pass 1b (the
 // resampled counts and turns). Both are pipelines over batches of whole
 // fibers (batch_pipeline.hpp): the caller's thread reads the next batch
@@ -134,7 +134,7 @@ double LengthHistogram::median() const {
     return 0.0;
 }
 
-ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_t points_per_block,
+ScanStageResult scan_stage(StreamlineSource& reader, SourceScan& scan, std::uint32_t points_per_block,
                            std::size_t sharp_blocks, std::size_t tuning_points, std::size_t bits_sample_points,
                            unsigned threads, const CompressOptions& options, CompressTimings& timings) {
     ScanStageResult r{.fiber_points = {},
@@ -207,7 +207,7 @@ double block_keeping_step(std::span<const float> fiber_lengths, double step, std
 }
 
 void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double tolerance,
-                         std::size_t max_fiber_points, TckScan& scan, std::vector<std::uint32_t>& fiber_points,
+                         std::size_t max_fiber_points, SourceScan& scan, std::vector<std::uint32_t>& fiber_points,
                          std::vector<std::uint16_t>& tensions, TurnStatistics& turns, std::uint32_t points_per_block,
                          std::size_t sharp_blocks, unsigned threads, const CompressOptions& options,
                          CompressTimings& timings) {

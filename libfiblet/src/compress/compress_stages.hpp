@@ -1,4 +1,4 @@
-// Internal: the stages of compress_tck (compress.cpp), one file each:
+// Internal: the stages of compress_file (compress.cpp), one file each:
 //   read    (compress_read.cpp)   batches of whole fibers from the input,
 //                                 cut into tasks for the worker pool;
 //   scan    (compress_scan.cpp)   pass 1: counts, bounds, spacing, turns;
@@ -119,7 +119,7 @@ double block_keeping_step(std::span<const float> fiber_lengths, double step, std
 // Pass 1 over `reader` (from where it stands: its start): fills scan's
 // counts, bounds and step extremes (not step_mean/median: from the result).
 // `bits_sample_points` 0: no bits sample.
-ScanStageResult scan_stage(StreamlineSource& reader, TckScan& scan, std::uint32_t points_per_block,
+ScanStageResult scan_stage(StreamlineSource& reader, SourceScan& scan, std::uint32_t points_per_block,
                            std::size_t sharp_blocks, std::size_t tuning_points, std::size_t bits_sample_points,
                            unsigned threads, const CompressOptions& options, CompressTimings& timings);
 
@@ -135,7 +135,7 @@ struct ResampleStep {
 // scan.off_step_segments. A fiber needing more than max_fiber_points:
 // Error{unsupported} (the first in file order).
 void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double tolerance,
-                         std::size_t max_fiber_points, TckScan& scan, std::vector<std::uint32_t>& fiber_points,
+                         std::size_t max_fiber_points, SourceScan& scan, std::vector<std::uint32_t>& fiber_points,
                          std::vector<std::uint16_t>& tensions, TurnStatistics& turns, std::uint32_t points_per_block,
                          std::size_t sharp_blocks, unsigned threads, const CompressOptions& options,
                          CompressTimings& timings);
