@@ -218,6 +218,16 @@ TEST_F(SelectIndex, FineIndexFlagChoosesTheVersionCompressAndExtractWrite) {
     ASSERT_EQ(test::run_cli("compress -q -f --fine-index " + tck + " -o " + fine).status, 0);
     EXPECT_EQ(version_of(plain), 2u);
     EXPECT_EQ(version_of(fine), 3u);
+    // info says which, read from the chunk without loading it (none: null).
+    const std::string bare = work_file("cli-bare.fft");
+    ASSERT_EQ(test::run_cli("compress -q -f --no-index " + tck + " -o " + bare).status, 0);
+    for (const auto& [path, version] : {std::pair{plain, "2"}, std::pair{fine, "3"}, std::pair{bare, "null"}}) {
+        const auto info = test::run_cli("info --json " + path);
+        ASSERT_EQ(info.status, 0) << info.output;
+        EXPECT_NE(info.output.find(std::string("\"block_index_version\": ") + version), std::string::npos) << info.output;
+        EXPECT_EQ(BlockIndex::stored_version(FftFile(path)), version == std::string("null") ? std::nullopt
+                                                                                           : std::optional(version_of(path)));
+    }
     for (const std::string& from : {plain, fine}) {
         const std::string sub = work_file("cli-sub.fft"), sub_fine = work_file("cli-sub-fine.fft");
         const std::string region = " --include 0,0,0,30";

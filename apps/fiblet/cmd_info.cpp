@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "cli_common.hpp"
+#include "fiblet/block_index.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/tck.hpp"
 #include "fiblet/tractogram_format.hpp"
@@ -102,12 +103,24 @@ std::uint64_t partial_last_steps(const FftFile& f) {
     return n;
 }
 
+// The stored block index (BIDX, formats/fft-index.md): which version, and
+// what a version holds.
+std::string block_index_text(std::uint32_t version, std::uint64_t bytes) {
+    const char* holds = version == 3   ? "a coded box per block"
+                        : version == 2 ? "a box per group of 8 blocks"
+                        : version == 1 ? "a box per block"
+                                       : "unknown to this fiblet";
+    return fmt::format("version {}: {}, {}", version, holds, human_bytes(bytes));
+}
+
 void info_fft(const InfoArgs& a) {
     const FftFile f = open_fft_input(a.input, a.ignore_trailer);
     const FftHeader& h = f.header();
     const std::uint64_t partial = partial_last_steps(f);
     std::string chunks;
     for (const auto& c : f.trailer()) chunks += (chunks.empty() ? "" : " ") + std::string(c.tag.data(), 4);
+    const std::optional<std::uint32_t> index_version = BlockIndex::stored_version(f);
+    const std::uint64_t index_bytes = index_version ? f.find_chunk(kBlockIndexTag)->payload.size() : 0;
     if (a.json) {
         Json j;
         j.str("file", a.input).str("format", f.is_zstd_container() ? "fftz" : "fft").integer("version", h.version);
@@ -120,6 +133,8 @@ void info_fft(const InfoArgs& a) {
         j.num("max_error_um", h.max_error_mm * 1e3).num("mean_error_um", h.mean_error_mm * 1e3);
         j.integer("gpu_buffers", h.buffer_ends.size()).integer("file_bytes", f.file_size());
         j.raw("trailer_chunks", chunk_tags_json(f));
+        if (index_version) j.integer("block_index_version", *index_version).integer("block_index_bytes", index_bytes);
+        else j.raw("block_index_version", "null");
         j.boolean("ends_kept", f.end_fractions() != nullptr).integer("fibers_with_partial_last_step", partial);
         j.raw("properties", properties_json(f.properties()));
         fmt::print("{}\n", j.render());
@@ -142,6 +157,8 @@ void info_fft(const InfoArgs& a) {
     fmt::print("  recorded error         max {}, mean {}\n", micrometres(h.max_error_mm, 3), micrometres(h.mean_error_mm, 3));
     fmt::print("  GPU buffers            {}\n", h.buffer_ends.size());
     if (!chunks.empty()) fmt::print("  trailer chunks         {}\n", chunks);
+    fmt::print("  block index            {}\n", index_version ? block_index_text(*index_version, index_bytes)
+                                                          : std::string("none stored (computed when a selection needs it)"));
     if (!f.streamline_fields().empty()) fmt::print("  data (DATA)            {}\n", fields_text(f.streamline_fields()));
     if (f.end_fractions())
         fmt::print("  fiber ends             kept (ENDS): {} of {} fibers end on a partial last step\n", partial, h.fibers);

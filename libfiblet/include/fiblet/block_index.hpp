@@ -106,6 +106,10 @@ public:
     static BlockIndex load(const FftFile& file);
     // Always computed by decoding (exact boxes), ignoring any chunk.
     static BlockIndex compute(const FftFile& file);
+    // The version of the file's BIDX chunk (its first field), without
+    // loading it; nullopt when the file has none. Throws Error{fft_format}
+    // on a chunk too short to hold it.
+    static std::optional<std::uint32_t> stored_version(const FftFile& file);
 
     Source source() const { return source_; }
     // The stored chunk's version (1, 2 or 3; BlockIndexFormat's values for

@@ -10,6 +10,7 @@
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 #include "select/block_decoder.hpp"
+#include "core/bytes.hpp"
 #include "index/index_chunk.hpp"
 
 namespace fiblet {
@@ -56,6 +57,14 @@ void radix_sort(std::vector<std::uint64_t>& items, unsigned key_bits) {
 void set_bit(std::vector<std::uint64_t>& bits, std::uint32_t b) { bits[b >> 6] |= std::uint64_t{1} << (b & 63); }
 
 }  // namespace
+
+std::optional<std::uint32_t> BlockIndex::stored_version(const FftFile& file) {
+    const TrailerChunk* chunk = file.find_chunk(kBlockIndexTag);
+    if (!chunk) return std::nullopt;
+    if (chunk->payload.size() < 4)
+        throw Error(Errc::fft_format, file.path() + ": malformed BIDX (block index) chunk: shorter than its version field");
+    return detail::get_le<std::uint32_t>(chunk->payload.data());
+}
 
 BlockIndex BlockIndex::load(const FftFile& file) {
     const TrailerChunk* chunk = file.find_chunk(kBlockIndexTag);
