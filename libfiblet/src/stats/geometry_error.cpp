@@ -311,21 +311,27 @@ FIBLET_AVX512 __m512d segment_dist2_avx512(const Segments& g, __m512d x, __m512d
 
 __attribute__((target("avx512f,avx512dq,avx512bw,avx512vl"))) void forward_avx512(const Segments& g, OwnSegments& out) {
     const std::size_t n = g.count;
-    for (std::size_t d = 0; d < 3; ++d) at_least(out.forward[d], n + 8);
+    // Pointers in locals: `out` and `g` are thread_local, and with -fPIC the
+    // loop reloaded their addresses through TLS calls (spilling every
+    // vector register around them) after each store.
+    double* forward[3];
+    for (std::size_t d = 0; d < 3; ++d) forward[d] = at_least(out.forward[d], n + 8);
+    const double *ux = g.ux.data(), *uy = g.uy.data(), *uz = g.uz.data();
     for (std::size_t s = 0; s < n; s += 8)  // reads up to segment n + 10: padding
         for (std::size_t d = 0; d < 3; ++d) {
             const std::size_t a = s + d + 1;
-            const __m512d dot = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(column8(g.ux, a), column8(g.ux, s)),
-                                                            _mm512_mul_pd(column8(g.uy, a), column8(g.uy, s))),
-                                              _mm512_mul_pd(column8(g.uz, a), column8(g.uz, s)));
+            const __m512d dot = _mm512_add_pd(
+                _mm512_add_pd(_mm512_mul_pd(_mm512_loadu_pd(ux + a), _mm512_loadu_pd(ux + s)),
+                              _mm512_mul_pd(_mm512_loadu_pd(uy + a), _mm512_loadu_pd(uy + s))),
+                _mm512_mul_pd(_mm512_loadu_pd(uz + a), _mm512_loadu_pd(uz + s)));
             const __mmask8 ok = _mm512_cmp_pd_mask(dot, _mm512_setzero_pd(), _CMP_GE_OQ);
-            _mm512_storeu_pd(out.forward[d].data() + s, _mm512_castsi512_pd(_mm512_movm_epi64(ok)));
+            _mm512_storeu_pd(forward[d] + s, _mm512_castsi512_pd(_mm512_movm_epi64(ok)));
         }
 }
 
 // Lanes of a forward mask that are set.
-FIBLET_AVX512 __mmask8 set_lanes(const std::vector<double>& m, std::size_t s) {
-    const __m512i v = _mm512_castpd_si512(column8(m, s));
+FIBLET_AVX512 __mmask8 set_lanes(const double* m, std::size_t s) {
+    const __m512i v = _mm512_castpd_si512(_mm512_loadu_pd(m + s));
     return _mm512_test_epi64_mask(v, v);
 }
 
@@ -338,7 +344,9 @@ FIBLET_AVX512 __mmask8 within_half_step8(__m512d e4, const Segments& g, std::siz
 // eight fit before k1; returns where it stopped.
 __attribute__((target("avx512f,avx512dq,avx512bw,avx512vl"))) std::size_t own_segments_avx512(
     const Segments& g, const Segments& from_g, std::size_t k0, std::size_t k1, double* nearest, OwnSegments& out) {
-    const std::vector<double>* f = out.forward;
+    // Pointers in locals, as in forward_avx512.
+    const double* f[3] = {out.forward[0].data(), out.forward[1].data(), out.forward[2].data()};
+    std::uint8_t *proven = out.proven.data(), *later_out = out.later.data();
     const __m128i ones = _mm_set1_epi8(1);
     std::size_t k = k0;
     for (; k + 8 <= k1; k += 8) {
@@ -352,8 +360,8 @@ __attribute__((target("avx512f,avx512dq,avx512bw,avx512vl"))) std::size_t own_se
         const __mmask8 ahead = set_lanes(f[0], k) & set_lanes(f[1], k) & set_lanes(f[2], k);
         const __mmask8 behind = set_lanes(f[0], k - 2) & set_lanes(f[1], k - 3) & set_lanes(f[2], k - 4);
         const __mmask8 ok = within_half_step8(e4, g, k - 1) & within_half_step8(e4, g, k) & ahead & behind;
-        _mm_storel_epi64(reinterpret_cast<__m128i*>(out.proven.data() + k), _mm_maskz_mov_epi8(ok, ones));
-        _mm_storel_epi64(reinterpret_cast<__m128i*>(out.later.data() + k), _mm_maskz_mov_epi8(later, ones));
+        _mm_storel_epi64(reinterpret_cast<__m128i*>(proven + k), _mm_maskz_mov_epi8(ok, ones));
+        _mm_storel_epi64(reinterpret_cast<__m128i*>(later_out + k), _mm_maskz_mov_epi8(later, ones));
     }
     return k;
 }
