@@ -113,6 +113,8 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& requested, cons
     // A transparent frame blends every segment of what it selects: no coarse blocks.
     if (o.transparent()) o.level_of_detail = false;
     o.fiber_colors = options.fiber_colors && scene.has_fiber_colors();
+    o.point_values = options.point_values && scene.has_point_values();
+    if (o.point_values && !o.value_range) o.value_range = scene.point_value_range();
     o.fiber_radii = options.fiber_radii && scene.has_fiber_radii();
     ensure_buffers(scene, o.record_decisions);
     // --ao: occlusion from one chord per block, built once per scene and grid.
