@@ -11,7 +11,10 @@
 #include "cli_runner.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/streamline_field.hpp"
+#include "overlays/color_bar/color_bar.hpp"
+#include "overlays/color_bar/color_bar_font.hpp"
 #include "render/render_target.hpp"
+#include "window/orbit_camera.hpp"
 #include "render/renderer.hpp"
 #include "scene/colormaps.hpp"
 #include "scene/gpu_scene.hpp"
@@ -182,6 +185,10 @@ TEST(ViewerPointValues, CommandLineRefusesMismatchedFiles) {
     const std::string common = "render " + fft + " --size 64x48 -f -o " + dir.file("a.png") + " --point-values ";
     const CommandResult ok = run_cli(common + dir.file("ok.tsf") + " --colormap magma --value-range 0,80");
     EXPECT_EQ(ok.status, 0) << ok.output;
+    const CommandResult no_bar = run_cli("render " + fft + " --size 64x48 -f -o " + dir.file("n.png") + " --point-values " +
+                                         dir.file("ok.tsf") + " --colormap magma --value-range 0,80 --no-color-bar");
+    EXPECT_EQ(no_bar.status, 0) << no_bar.output;
+    EXPECT_NE(read_file(dir.file("a.png")), read_file(dir.file("n.png")));  // render's image has the bar
     const CommandResult count = run_cli(common + dir.file("count.tsf"));
     EXPECT_EQ(count.status, 4) << count.output;
     EXPECT_NE(count.output.find("1 streamlines for the .fft's 2"), std::string::npos) << count.output;
@@ -241,4 +248,66 @@ TEST(ViewerPointValues, ValuesFromTheFilesOwnPerPointData) {
     const CommandResult colors = run_cli(common + "dpv/colors -o " + dir.file("m.png"));
     EXPECT_EQ(colors.status, 4) << colors.output;
     EXPECT_NE(colors.output.find("3 values per point"), std::string::npos) << colors.output;
+}
+
+TEST(ViewerPointValues, ColourBarLabelsPutTheNameBetweenTheEnds) {
+    EXPECT_EQ(viewer::color_bar_labels(0, 1, "fa", 20), "0        fa        1");
+    EXPECT_EQ(viewer::color_bar_labels(-0.5f, 1200, "a_very_long_name", 20), "-0.5         1.2e+03");
+    EXPECT_EQ(viewer::glyph_bits('0'), 0b111101101101111u);
+    EXPECT_EQ(viewer::glyph_bits('A'), viewer::glyph_bits('a'));
+    EXPECT_EQ(viewer::glyph_bits('#'), 0u);
+}
+
+// The bar at the bottom edge: the colour map across its gradient (a CPU
+// colouring of t at each pixel's centre), the glyphs of its labels under
+// it, and no fiber where it lies.
+TEST(ViewerPointValues, ColourBarShowsTheMapAndItsRange) {
+    FIBLET_REQUIRE_GL();
+    CompressedScene compressed({straight_fiber()});
+    std::vector<float> values;
+    for (const Vec3f& p : straight_fiber()) values.push_back(p.x);
+    compressed.scene.set_point_values(values);
+    const int w = 256, h = 128;
+    viewer::Renderer renderer(*viewer_gl().programs);
+    viewer::RenderTarget target(w, h);
+    const Camera cam = viewer::camera_from_spec("top", compressed.scene, float(w) / float(h), 35, 1);
+    viewer::RenderOptions o;
+    o.point_values = true;
+    o.colormap = viewer::ColormapName::magma;
+    o.value_range = std::array<float, 2>{0, 1};
+    o.value_name = "fa";
+    renderer.render(compressed.scene, cam, o, target);
+    const auto rgba = target.read_rgba();
+    const auto ids = target.read_fibers();
+    const viewer::ColorBarLayout l = viewer::color_bar_layout(w, h);
+    ASSERT_GE(l.cells, 8);
+    auto at = [&](int x, int y_up) { return std::size_t(h - 1 - y_up) * w + std::size_t(x); };  // GL rows from the bottom
+    const int gy = int((l.gradient[1] + l.gradient[3]) / 2);
+    int checked = 0;
+    for (int x = int(l.gradient[0]); x < int(l.gradient[2]); ++x) {
+        const float t = (float(x) + 0.5f - l.gradient[0]) / (l.gradient[2] - l.gradient[0]);
+        const auto c = viewer::colormap_color(o.colormap, t);
+        for (std::size_t k = 0; k < 3; ++k)
+            EXPECT_NEAR(int(rgba[4 * at(x, gy) + k]), int(std::lround(c[k] * 255)), 3) << x;
+        EXPECT_EQ(ids[at(x, gy)], 0u);
+        ++checked;
+    }
+    EXPECT_GT(checked, 100);
+    // The first label cell is "0", the last "1": their glyphs pixel by pixel.
+    const std::string labels = viewer::color_bar_labels(0, 1, "fa", l.cells);
+    const int s = int(l.scale);
+    for (const int cell : {0, l.cells - 1}) {
+        const std::uint32_t bits = viewer::glyph_bits(labels[std::size_t(cell)]);
+        ASSERT_NE(bits, 0u);
+        for (int r = 0; r < 5; ++r)
+            for (int c = 0; c < 3; ++c) {
+                const int x = int(l.box[0]) + (4 * cell + c) * s, y = int(l.box[1]) + (5 - r) * s;
+                const bool lit = (bits >> (14 - (3 * r + c))) & 1u;
+                EXPECT_EQ(int(rgba[4 * at(x, y)]), lit ? 255 : 0) << "cell " << cell << " row " << r << " column " << c;
+            }
+    }
+    // Off: the frame without the bar is another image.
+    o.color_bar = false;
+    renderer.render(compressed.scene, cam, o, target);
+    EXPECT_NE(target.read_rgba(), rgba);
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include <cstdlib>
+#include <filesystem>
 #include <limits>
 
 #include "fiber_ranges.hpp"
@@ -60,6 +61,10 @@ void set_point_values(const ViewerArgs& a, viewer::RenderOptions& o) {
     o.colormap = *map;
     o.point_values = !a.point_values.empty();
     if (o.point_values && !a.value_range.empty()) o.value_range = parse_value_range(a.value_range);
+    // The colour bar's name: NAME of dpv/NAME, else the file's stem.
+    const bool data = a.point_values.rfind("dpv/", 0) == 0 && !std::filesystem::exists(a.point_values);
+    o.value_name = data ? a.point_values.substr(4) : std::filesystem::path(a.point_values).stem().string();
+    o.color_bar = !a.no_color_bar;
 }
 
 // --opacity and --transparency: the default order is sorted; voxlines
@@ -128,6 +133,7 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
     cmd->add_option("--colormap", a.colormap, "Colour map of --point-values")
         ->check(one_of("viridis, magma, coolwarm"))
         ->capture_default_str();
+    cmd->add_flag("--no-color-bar", a.no_color_bar, "No colour bar of --point-values (drawn at the bottom edge)");
     cmd->add_option("--value-range", a.value_range, "MIN:MAX (or MIN,MAX) of --fiber-values or --point-values mapped to "
                                                     "the colour map (default: the values' range)");
     cmd->add_option("--background", a.background, "Background colour: RRGGBB, black, white, gray")

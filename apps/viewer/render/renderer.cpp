@@ -173,6 +173,15 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& requested, cons
         timer.end();
     }
 
+    // The colour bar of the per-point values, over everything.
+    if (o.point_values && o.color_bar) {
+        if (!color_bar_) color_bar_ = std::make_unique<ColorBar>();
+        glDisable(GL_DEPTH_TEST);
+        color_bar_->draw(target.width(), target.height(), o);
+        glEnable(GL_DEPTH_TEST);
+        glBindVertexArray(empty_vertex_array_.get());
+    }
+
     const auto ms = timer.collect();
     stats.cull_ms = ms[0], stats.decode_ms = ms[1], stats.draw_ms = ms[2];
     return stats;

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "fiblet_viewer/colormap_name.hpp"
@@ -46,6 +47,7 @@ struct RenderOptions {
     ColormapName colormap = ColormapName::viridis;
     std::optional<std::array<float, 2>> value_range;
     bool color_bar = true;                             // the colour bar of the point values, when they are on
+    std::string value_name;                            // under the colour bar
     // Fibers drawn as they are while every other is dimmed (picking; at
     // most kMaxHighlightedFibers, sorted, unique); empty: none dimmed.
     std::vector<std::uint32_t> highlighted_fibers;
