@@ -142,7 +142,7 @@ TEST(ViewerPointValues, LinesShowTheColormapOfTheirPointsValues) {
     const double half_width_mm = std::tan(15.0 * M_PI / 180.0) * cam.aspect * 60.0;
     viewer::Renderer renderer(*viewer_gl().programs);
     viewer::RenderTarget target(w, h);
-    for (const auto style : {viewer::DrawStyle::lines, viewer::DrawStyle::tubes})
+    for (const auto style : {viewer::DrawStyle::lines, viewer::DrawStyle::tubes, viewer::DrawStyle::capsules})
     for (const auto map : {viewer::ColormapName::viridis, viewer::ColormapName::magma, viewer::ColormapName::coolwarm})
         for (const bool coarse : {false, true}) {
             SCOPED_TRACE(std::string(viewer::draw_style_name(style)) + " " + viewer::colormap_name(map) +
