@@ -176,6 +176,49 @@ TEST(ViewerPointValues, LinesShowTheColormapOfTheirPointsValues) {
         }
 }
 
+// Transparent lines (sorted and unsorted blending) over a black background:
+// the colour map at the pixel's x, times the opacity.
+TEST(ViewerPointValues, TransparentLinesBlendTheColormapOfTheirValues) {
+    FIBLET_REQUIRE_GL();
+    CompressedScene compressed({straight_fiber()});
+    std::vector<float> values;
+    for (const Vec3f& p : straight_fiber()) values.push_back(p.x);
+    compressed.scene.set_point_values(values);
+    const int w = 200, h = 64;
+    Camera cam;
+    cam.position = {0, 0, 60}, cam.target = {0, 0, 0}, cam.up = {0, 1, 0};
+    cam.fov_y_deg = 30, cam.aspect = float(w) / float(h), cam.near_mm = 1, cam.far_mm = 200;
+    const double half_width_mm = std::tan(15.0 * M_PI / 180.0) * cam.aspect * 60.0;
+    viewer::Renderer renderer(*viewer_gl().programs);
+    viewer::RenderTarget target(w, h);
+    for (const auto mode : {viewer::TransparencyMode::sorted, viewer::TransparencyMode::unsorted}) {
+        viewer::RenderOptions o;
+        o.lighting = false;
+        o.point_values = true;
+        o.color_bar = false;
+        o.value_range = std::array<float, 2>{-15, 15};
+        o.opacity = 0.5f;
+        o.transparency = mode;
+        o.background = {0, 0, 0};
+        renderer.render(compressed.scene, cam, o, target);
+        const auto rgba = target.read_rgba();
+        std::size_t drawn = 0, right = 0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const std::size_t i = std::size_t(y) * w + std::size_t(x);
+                if (rgba[4 * i] == 0 && rgba[4 * i + 1] == 0 && rgba[4 * i + 2] == 0) continue;
+                ++drawn;
+                const float world_x = float(((x + 0.5) / w * 2 - 1) * half_width_mm);
+                const auto c = viewer::colormap_color(o.colormap, viewer::colormap_position(world_x, -15, 15));
+                bool same = true;
+                for (std::size_t k = 0; k < 3; ++k) same &= std::abs(int(rgba[4 * i + k]) - int(std::lround(c[k] * 0.5f * 255))) <= 4;
+                right += same;
+            }
+        EXPECT_GT(drawn, 70u);
+        EXPECT_EQ(right, drawn);
+    }
+}
+
 TEST(ViewerPointValues, CommandLineRefusesMismatchedFiles) {
     FIBLET_REQUIRE_GL();
     const TempDir dir;

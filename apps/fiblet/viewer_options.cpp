@@ -123,7 +123,7 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
                     "properties, a TRX's dps/)")
         ->check(fiber_values_check());
     cmd->add_option("--point-values", a.point_values,
-                    "Colour each point by a value (lines, tubes, capsules): an MRtrix3 track scalar file (.tsf, as tcksample writes; "
+                    "Colour each point by a value (lines, tubes, capsules; not voxlines or voxel-rt): an MRtrix3 track scalar file (.tsf, as tcksample writes; "
                     "one value per point of every streamline) or dpv/NAME, the per-point data the .fft carries")
         ->check(CLI::ExistingFile | CLI::Validator(
                                         [](const std::string& v) {

@@ -42,7 +42,8 @@ struct RenderOptions {
     bool fiber_colors = false;                         // the scene's per-fiber colours (GpuScene::set_fiber_colors), when it has them
     // The scene's per-point values (GpuScene::set_point_values), when it has
     // them, through `colormap` over `value_range` (default: the values'
-    // min..max); before per-fiber colours. Opaque lines, tubes and capsules.
+    // min..max); before per-fiber colours. Lines (not voxlines), tubes and
+    // capsules; not the voxel ray tracer.
     bool point_values = false;
     ColormapName colormap = ColormapName::viridis;
     std::optional<std::array<float, 2>> value_range;
