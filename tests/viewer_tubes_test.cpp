@@ -358,11 +358,11 @@ TEST(ViewerTubes, BoxesContainTheSweptTube) {
         const std::uint32_t count = tubes.build_pieces({scene, cam, o, false},
                                                        {decoder.points_buffer(), decoder.tangents_buffer(), 0,
                                                         scene.block_count()});
-        std::vector<float> raw(std::size_t(count) * 28);
+        std::vector<float> raw(std::size_t(count) * 32);  // TubePiece: eight vec4
         glGetNamedBufferSubData(tubes.pieces_buffer(), 0, GLsizeiptr(raw.size() * 4), raw.data());
         std::vector<std::size_t> live;
         for (std::size_t i = 0; i < count; ++i)
-            if (raw[28 * i + 3] >= 0) live.push_back(i);
+            if (raw[32 * i + 3] >= 0) live.push_back(i);
         // As many pieces as the CPU model has.
         EXPECT_EQ(live.size(), reference_pieces(file, radius, 0.25).size());
         std::uniform_int_distribution<std::size_t> pick(0, live.size() - 1);
@@ -370,7 +370,7 @@ TEST(ViewerTubes, BoxesContainTheSweptTube) {
         std::normal_distribution<double> gauss(0, 1);
         std::size_t outside = 0;
         for (int i = 0; i < 34000; ++i, ++samples) {
-            const float* p = &raw[28 * live[pick(rng)]];
+            const float* p = &raw[32 * live[pick(rng)]];
             const D3 c0{p[0], p[1], p[2]}, c1{p[4], p[5], p[6]}, c2{p[8], p[9], p[10]}, centre{p[12], p[13], p[14]};
             const D3 point = bezier(c0, c1, c2, u01(rng)) + double(p[3]) * unit({gauss(rng), gauss(rng), gauss(rng)});
             for (int a = 0; a < 3; ++a) {

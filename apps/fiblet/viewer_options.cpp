@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include <cstdlib>
+#include <filesystem>
 #include <limits>
 
 #include "fiber_ranges.hpp"
@@ -40,6 +41,30 @@ std::uint32_t fiber_id(std::uint64_t id) {
     if (id > std::numeric_limits<std::uint32_t>::max())
         throw Error(Errc::invalid_argument, "--fibers: " + std::to_string(id) + " is not a fiber ID (at most 2^32-1)");
     return std::uint32_t(id);
+}
+
+// "MIN:MAX" or "MIN,MAX" with MIN < MAX.
+std::array<float, 2> parse_value_range(const std::string& text) {
+    const std::size_t sep = text.find_first_of(":,");
+    char *e1 = nullptr, *e2 = nullptr;
+    const std::string lo = text.substr(0, sep), hi = sep == std::string::npos ? "" : text.substr(sep + 1);
+    const float low = std::strtof(lo.c_str(), &e1), high = std::strtof(hi.c_str(), &e2);
+    if (sep == std::string::npos || lo.empty() || hi.empty() || *e1 != '\0' || *e2 != '\0' || !(low < high))
+        throw Error(Errc::invalid_argument, "--value-range: '" + text + "' is not MIN:MAX with MIN < MAX");
+    return {low, high};
+}
+
+// --point-values, --colormap and their --value-range.
+void set_point_values(const ViewerArgs& a, viewer::RenderOptions& o) {
+    const auto map = viewer::parse_colormap(a.colormap);
+    if (!map) throw Error(Errc::invalid_argument, "--colormap: '" + a.colormap + "' is not viridis, magma or coolwarm");
+    o.colormap = *map;
+    o.point_values = !a.point_values.empty();
+    if (o.point_values && !a.value_range.empty()) o.value_range = parse_value_range(a.value_range);
+    // The colour bar's name: NAME of dpv/NAME, else the file's stem.
+    const bool data = a.point_values.rfind("dpv/", 0) == 0 && !std::filesystem::exists(a.point_values);
+    o.value_name = data ? a.point_values.substr(4) : std::filesystem::path(a.point_values).stem().string();
+    o.color_bar = !a.no_color_bar;
 }
 
 // --opacity and --transparency: the default order is sorted; voxlines
@@ -97,8 +122,20 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
                     "MRtrix3's per-streamline files) or dps/NAME, the per-streamline data the .fft carries (a .trk's "
                     "properties, a TRX's dps/)")
         ->check(fiber_values_check());
-    cmd->add_option("--value-range", a.value_range, "MIN:MAX of --fiber-values mapped to the colour map (default: "
-                                                    "the values' range)");
+    cmd->add_option("--point-values", a.point_values,
+                    "Colour each point by a value (lines, tubes, capsules; not voxlines or voxel-rt): an MRtrix3 track scalar file (.tsf, as tcksample writes; "
+                    "one value per point of every streamline) or dpv/NAME, the per-point data the .fft carries")
+        ->check(CLI::ExistingFile | CLI::Validator(
+                                        [](const std::string& v) {
+                                            return v.rfind("dpv/", 0) == 0 && v.size() > 4 ? std::string() : "not dpv/NAME";
+                                        },
+                                        "dpv/NAME"));
+    cmd->add_option("--colormap", a.colormap, "Colour map of --point-values")
+        ->check(one_of("viridis, magma, coolwarm"))
+        ->capture_default_str();
+    cmd->add_flag("--no-color-bar", a.no_color_bar, "No colour bar of --point-values (drawn at the bottom edge)");
+    cmd->add_option("--value-range", a.value_range, "MIN:MAX (or MIN,MAX) of --fiber-values or --point-values mapped to "
+                                                    "the colour map (default: the values' range)");
     cmd->add_option("--background", a.background, "Background colour: RRGGBB, black, white, gray")
         ->capture_default_str();
     cmd->add_flag("--no-lighting", a.no_lighting, "Flat colours instead of illuminated lines");
@@ -273,26 +310,20 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
     if (a.max_length > 0) o.max_length_mm = a.max_length;
     set_transparency(a, o);
     o.fiber_colors = !fiber_color_source(a).empty();
+    set_point_values(a, o);
     o.fiber_radii = !a.fiber_radii.empty();
     o.fiber_opacity = !a.fiber_opacity.empty();
     return o;
 }
 
 viewer::FiberColorSource fiber_color_source(const ViewerArgs& a) {
-    if (!a.fiber_colors.empty() && !a.fiber_values.empty())
-        throw Error(Errc::invalid_argument, "--fiber-colors and --fiber-values exclude each other");
-    if (!a.value_range.empty() && a.fiber_values.empty())
-        throw Error(Errc::invalid_argument, "--value-range needs --fiber-values");
-    viewer::FiberColorSource s{a.fiber_colors, a.fiber_values, std::nullopt};
-    if (!a.value_range.empty()) {
-        const std::size_t colon = a.value_range.find(':');
-        char *e1 = nullptr, *e2 = nullptr;
-        const std::string lo = a.value_range.substr(0, colon), hi = colon == std::string::npos ? "" : a.value_range.substr(colon + 1);
-        const float low = std::strtof(lo.c_str(), &e1), high = std::strtof(hi.c_str(), &e2);
-        if (colon == std::string::npos || lo.empty() || hi.empty() || *e1 != '\0' || *e2 != '\0' || !(low < high))
-            throw Error(Errc::invalid_argument, "--value-range: '" + a.value_range + "' is not MIN:MAX with MIN < MAX");
-        s.value_range = std::array<float, 2>{low, high};
-    }
+    const int sources = !a.fiber_colors.empty() + !a.fiber_values.empty() + !a.point_values.empty();
+    if (sources > 1)
+        throw Error(Errc::invalid_argument, "--fiber-colors, --fiber-values and --point-values exclude each other");
+    if (!a.value_range.empty() && a.fiber_values.empty() && a.point_values.empty())
+        throw Error(Errc::invalid_argument, "--value-range needs --fiber-values or --point-values");
+    viewer::FiberColorSource s{a.fiber_colors, a.fiber_values, std::nullopt, a.point_values};
+    if (!a.value_range.empty()) s.value_range = parse_value_range(a.value_range);
     return s;
 }
 

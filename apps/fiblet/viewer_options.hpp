@@ -22,6 +22,8 @@ struct ViewerArgs {
     float radius = 0.25f;
     int supersample = 1;
     std::string fiber_colors, fiber_values, value_range, fiber_radii;
+    std::string point_values, colormap = "viridis";  // per-point values (a .tsf or dpv/NAME) through a colour map
+    bool no_color_bar = false;
     double min_length = 0, max_length = 0;
     // Overlays: ODF glyphs of an SH image, a background image slice, a fiber slab.
     std::string odf, odf_slice, sh_basis = "mrtrix", image, slice;

@@ -33,6 +33,7 @@ std::string gpu_binding_defines() {
     def("BINDING_VOXLINE_ORDERS", binding::kVoxlineOrders);
     def("BINDING_LOCAL_FRAMES", binding::kLocalFrames);
     def("BINDING_WIDE_FRAMES", binding::kWideFrames);
+    def("BINDING_POINT_VALUES", binding::kPointValues);
     def_uint("DECISION_OUTSIDE_FRUSTUM", unsigned(BlockDecision::outside_frustum));
     def_uint("DECISION_COARSE", unsigned(BlockDecision::coarse));
     def_uint("DECISION_FINE", unsigned(BlockDecision::fine));

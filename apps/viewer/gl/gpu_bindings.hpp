@@ -25,7 +25,8 @@ inline constexpr unsigned kFiberRadii = 13;   // per fiber: tube radius (mm), wh
 inline constexpr unsigned kGlyphCoefficients = 14;  // overlays/odf_glyphs: SH coefficients, glyph units
 inline constexpr unsigned kGlyphCenters = 15;       // overlays/odf_glyphs: centre, radius (mm) and box (glyph_boxes.glsl)
 inline constexpr unsigned kWideFrames = 16;  // the levels^2 frames of a 16-bit direction code (DirectionTable16)
-inline constexpr unsigned kStorageCount = 17;
+inline constexpr unsigned kPointValues = 17;  // per block: pointsPerBlock slots of per-point values (one float each)
+inline constexpr unsigned kStorageCount = 18;
 // Transparent frames (transparency/) reuse the binding points of buffers
 // that no pass using them binds (no level of detail, no decisions; tube
 // pieces and tangents only in the draw passes, after the sort), so that the

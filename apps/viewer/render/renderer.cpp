@@ -113,6 +113,8 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& requested, cons
     // A transparent frame blends every segment of what it selects: no coarse blocks.
     if (o.transparent()) o.level_of_detail = false;
     o.fiber_colors = options.fiber_colors && scene.has_fiber_colors();
+    o.point_values = options.point_values && scene.has_point_values();
+    if (o.point_values && !o.value_range) o.value_range = scene.point_value_range();
     o.fiber_radii = options.fiber_radii && scene.has_fiber_radii();
     ensure_buffers(scene, o.record_decisions);
     // --ao: occlusion from one chord per block, built once per scene and grid.
@@ -169,6 +171,15 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& requested, cons
         for (const auto& overlay : overlays_) overlay->draw(camera, o);
         glBindVertexArray(empty_vertex_array_.get());
         timer.end();
+    }
+
+    // The colour bar of the per-point values, over everything.
+    if (o.point_values && o.color_bar) {
+        if (!color_bar_) color_bar_ = std::make_unique<ColorBar>();
+        glDisable(GL_DEPTH_TEST);
+        color_bar_->draw(target.width(), target.height(), o);
+        glEnable(GL_DEPTH_TEST);
+        glBindVertexArray(empty_vertex_array_.get());
     }
 
     const auto ms = timer.collect();

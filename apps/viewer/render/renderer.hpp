@@ -18,6 +18,7 @@
 #include "gl/gpu_bindings.hpp"
 #include "scene/gpu_programs.hpp"
 #include "scene/gpu_scene.hpp"
+#include "overlays/color_bar/color_bar.hpp"
 #include "overlays/overlay.hpp"
 #include "gl/gpu_timer.hpp"
 #include "fiblet_viewer/render_options.hpp"
@@ -91,6 +92,7 @@ private:
     // Transparency (transparency/), made on first use.
     BlendTarget blend_target_;
     std::unique_ptr<TransparentLines> transparent_lines_;
+    std::unique_ptr<ColorBar> color_bar_;  // made when a frame first shows one
     std::unique_ptr<SortedChunks> sorted_chunks_;
     std::unique_ptr<Voxlines> voxlines_;
 };

@@ -4,6 +4,7 @@
 
 #include "gl/shader_program.hpp"
 #include "render/vec_ops.hpp"
+#include "scene/colormaps.hpp"
 
 namespace fiblet::viewer {
 
@@ -13,12 +14,23 @@ CameraBasis camera_basis(const Camera& c) {
     return {right, cross(back, right), back};
 }
 
+void set_colormap_uniforms(const GlProgram& p, const RenderOptions& o) {
+    const GLuint id = p.get();
+    glProgramUniform1i(id, uniform(p, "uPointValues"), o.point_values ? 1 : 0);
+    if (!o.point_values) return;
+    const ColormapAnchors& a = colormap_anchors(o.colormap);
+    glProgramUniform3fv(id, uniform(p, "uColormap"), kColormapAnchors, a[0].data());
+    const std::array<float, 2> r = o.value_range.value_or(std::array<float, 2>{0, 1});
+    glProgramUniform2f(id, uniform(p, "uValueRange"), r[0], r[1]);
+}
+
 void set_shading_uniforms(const GlProgram& p, const Camera& camera, const RenderOptions& o) {
     const GLuint id = p.get();
     const Mat4 vp = view_projection_matrix(camera);
     glProgramUniformMatrix4fv(id, uniform(p, "uViewProjection"), 1, GL_FALSE, vp.data());
     glProgramUniform1i(id, uniform(p, "uColorByDirection"), o.color_by_direction ? 1 : 0);
     glProgramUniform1i(id, uniform(p, "uFiberColors"), o.fiber_colors ? 1 : 0);
+    set_colormap_uniforms(p, o);
     glProgramUniform3f(id, uniform(p, "uFixedColor"), o.fixed_color[0], o.fixed_color[1], o.fixed_color[2]);
     glProgramUniform1i(id, uniform(p, "uLighting"), o.lighting ? 1 : 0);
     glProgramUniform1i(id, uniform(p, "uShowNormals"), o.color_by_normal ? 1 : 0);

@@ -12,6 +12,9 @@
 namespace fiblet::viewer {
 
 void set_shading_uniforms(const GlProgram& program, const Camera& camera, const RenderOptions& options);
+// The per-point values' colour map (uPointValues, uColormap, uValueRange;
+// fiber_colors.glsl), part of set_shading_uniforms.
+void set_colormap_uniforms(const GlProgram& program, const RenderOptions& options);
 
 // The camera's unit axes, as view.hpp builds them; the camera looks along -back.
 struct CameraBasis {

@@ -11,6 +11,7 @@
 #include "fiblet/fft_file.hpp"
 #include "fiblet/streamline_field.hpp"
 #include "scene/gpu_scene.hpp"
+#include "scene/point_values.hpp"
 
 namespace fiblet::viewer {
 
@@ -132,6 +133,8 @@ void load_fiber_colors(const FiberColorSource& source, const FftFile& file, GpuS
     } else if (!source.values_path.empty()) {
         scene.set_fiber_colors(colors_from_values(read_fiber_value_source(source.values_path, file), source.value_range));
     }
+    if (!source.point_values_path.empty())
+        scene.set_point_values(read_point_value_source(source.point_values_path, file, scene.fiber_point_counts()));
 }
 
 }  // namespace fiblet::viewer

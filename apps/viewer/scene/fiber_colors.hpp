@@ -42,8 +42,8 @@ std::vector<float> read_fiber_value_source(const std::string& source, const FftF
 std::vector<Rgb> colors_from_values(const std::vector<float>& values, std::optional<std::array<float, 2>> range = {});
 
 class GpuScene;
-// Reads the source for `scene` (made from `file`) and sets its colours
-// (nothing when empty).
+// Reads the source for `scene` (made from `file`) and sets its colours and
+// its per-point values (nothing when empty).
 void load_fiber_colors(const FiberColorSource& source, const FftFile& file, GpuScene& scene);
 
 // Viridis at t in [0, 1] (clamped), from 9 samples of matplotlib's table.

@@ -118,6 +118,7 @@ GpuScene::GpuScene(const FftFile& file, const GpuPrograms& programs, std::option
     const float no_colors[4] = {1, 1, 1, 1};
     fiber_colors_ = make_buffer(16, no_colors, 0);
     fiber_radii_ = make_buffer(16, no_colors, 0);
+    point_values_ = make_buffer(16, no_colors, 0);
     const std::vector<float> frames = local_frames(ctx);
     local_frames_ = make_buffer(GLsizeiptr(frames.size() * 4), frames.data(), 0);
 
@@ -182,6 +183,25 @@ void GpuScene::set_fiber_radii(const std::vector<float>& mm) {
     min_radius_ = *lo, max_radius_ = *hi;
 }
 
+void GpuScene::set_point_values(const std::vector<float>& values) {
+    std::uint64_t points = 0;
+    for (const std::uint32_t n : fiber_points_) points += n;
+    if (values.size() != points)
+        throw Error(Errc::invalid_argument, fmt::format("{} point values for {} points", values.size(), points));
+    if (values.empty()) return;
+    // The blocks hold the fibers' points in order, block after block.
+    const std::uint32_t ppb = header_.points_per_block;
+    std::vector<float> slots(std::size_t(header_.blocks) * ppb, 0.0f);
+    std::size_t next = 0;
+    for (std::uint32_t b = 0; b < header_.blocks; ++b)
+        for (std::uint32_t k = 0; k < block_points_[b] && next < values.size(); ++k) slots[std::size_t(b) * ppb + k] = values[next++];
+    check_fits(slots.size() * 4, "point values");
+    point_values_ = make_buffer(GLsizeiptr(slots.size() * 4), slots.data(), 0);
+    const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+    point_value_range_ = {*lo, *hi};
+    has_point_values_ = true;
+}
+
 std::vector<Vec3f> GpuScene::read_fiber_ends() const {
     std::vector<float> xyzw(fiber_count() * 4);
     if (!xyzw.empty()) glGetNamedBufferSubData(fiber_ends_.get(), 0, GLsizeiptr(xyzw.size() * 4), xyzw.data());
@@ -198,6 +218,7 @@ void GpuScene::bind(const GlProgram& program) const {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberEndFraction, fiber_end_fraction_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberColors, fiber_colors_.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFiberRadii, fiber_radii_.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kPointValues, point_values_.get());
     if (header_.direction_bits() == 16)
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kWideFrames, local_frames_.get());
     else

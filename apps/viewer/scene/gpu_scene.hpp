@@ -76,6 +76,16 @@ public:
     float min_fiber_radius() const { return min_radius_; }
     float max_fiber_radius() const { return max_radius_; }
 
+    // Per-point values (point_values.hpp; every point of every fiber, file
+    // order) for RenderOptions::point_values, uploaded beside the blocks:
+    // point k of block b in slot b * pointsPerBlock + k (point_values.glsl).
+    // Throws fiblet::Error{invalid_argument} on a count that is not the
+    // scene's point count.
+    void set_point_values(const std::vector<float>& values);
+    bool has_point_values() const { return has_point_values_; }
+    std::array<float, 2> point_value_range() const { return point_value_range_; }  // min, max
+    const std::vector<std::uint32_t>& fiber_point_counts() const { return fiber_points_; }
+
     // The last point of every fiber as decoded on the GPU at load (world mm).
     std::vector<Vec3f> read_fiber_ends() const;
 
@@ -92,6 +102,9 @@ private:
     GlBuffer fiber_colors_;            // one vec4 when there are neither colours nor opacities (a binding must hold a buffer)
     std::vector<float> fiber_rgba_;    // per fiber: colour (white without) and opacity (1 without)
     bool has_fiber_colors_ = false, has_fiber_opacities_ = false;
+    GlBuffer point_values_;            // one float when there are none
+    bool has_point_values_ = false;
+    std::array<float, 2> point_value_range_{0, 1};
     GlBuffer fiber_radii_;             // one float when there are none
     std::vector<float> fiber_radii_mm_;
     float min_radius_ = 0, max_radius_ = 0;

@@ -21,9 +21,17 @@ float windowDepth(vec3 world) {
 
 // Colour of a surface point of fiber `fiber`: unit normal, the fiber's
 // tangent there (any length), `toEye` the unit direction towards the camera.
+vec3 shadeBase(vec3 base, vec3 normal, vec3 toEye, uint fiber);
+
 vec3 shadeSurface(vec3 normal, vec3 tangent, vec3 toEye, uint fiber) {
-    if (uShowNormals) return 0.5 * normal + 0.5;
-    vec3 base = baseColor(tangent, fiber);
+    return uShowNormals ? 0.5 * normal + 0.5 : shadeBase(baseColor(tangent, fiber), normal, toEye, fiber);
+}
+// With the point's value (per-point values, fiber_colors.glsl).
+vec3 shadeSurface(vec3 normal, vec3 tangent, vec3 toEye, uint fiber, float value) {
+    return uShowNormals ? 0.5 * normal + 0.5 : shadeBase(baseColor(tangent, fiber, value), normal, toEye, fiber);
+}
+
+vec3 shadeBase(vec3 base, vec3 normal, vec3 toEye, uint fiber) {
     if (!uLighting) return base;
     float diffuse = max(dot(normal, uLightDirection), 0.0);
     float specular = pow(max(dot(normal, normalize(uLightDirection + toEye)), 0.0), uShininess);

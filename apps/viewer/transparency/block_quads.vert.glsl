@@ -5,6 +5,7 @@
 // (sorted, uChunksPerBlock > 0: the list holds block x uChunksPerBlock + chunk).
 #include "scene_buffers.glsl"
 #include "segment_quads.glsl"
+#include "point_values.glsl"
 
 layout(std430, binding = BINDING_FINE_LIST) readonly buffer FineList { uint fineList[]; };
 layout(std430, binding = BINDING_POINTS) readonly buffer Points { vec4 points[]; };
@@ -26,4 +27,5 @@ void main() {
     }
     uint base = slot * (uPointsPerBlock + 1u) + segment;
     emitSegmentQuadVertex(points[base].xyz, points[base + 1u].xyz, v % 6u, blockFiber[block]);
+    vValues = vec2(pointValue(block, segment), pointValue(block, segment + 1u));
 }

@@ -8,6 +8,7 @@ layout(location = 0) flat out vec3 vTangent;
 layout(location = 1) flat out vec3 vWorld;
 layout(location = 2) flat out uint vFiber;
 layout(location = 3) flat out vec4 vWindowEnds;  // the segment's ends, window pixels
+layout(location = 4) flat out vec2 vValues;      // the per-point values at both ends (block_quads.vert.glsl)
 
 vec2 toWindow(vec4 clip) { return (clip.xy / clip.w * 0.5 + 0.5) * uViewportSize; }
 
@@ -17,6 +18,7 @@ void emitNothing() {
     vWorld = vec3(0.0);
     vFiber = 0u;
     vWindowEnds = vec4(0.0);
+    vValues = vec2(0.0);
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
 }
 
@@ -41,5 +43,6 @@ void emitSegmentQuadVertex(vec3 p0, vec3 p1, uint corner, uint fiber) {
     vWorld = 0.5 * (p0 + p1);
     vFiber = fiber;
     vWindowEnds = vec4(a, b);
+    vValues = vec2(0.0);
     gl_Position = vec4(w / uViewportSize * 2.0 - 1.0, 0.0, 1.0);
 }

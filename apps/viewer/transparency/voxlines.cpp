@@ -111,6 +111,8 @@ std::vector<std::uint32_t> Voxlines::back_to_front(const Camera& camera) const {
 void Voxlines::draw(const FrameInputs& in) {
     const GLuint id = program_.get();
     TransparentLines::set_uniforms(program_, in);
+    // Voxel segments carry no per-point values: they keep their colours.
+    glProgramUniform1i(id, uniform(program_, "uPointValues"), 0);
     glUseProgram(id);
     in.scene.bind(program_);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kVoxlineSegments, segment_ends_.get());

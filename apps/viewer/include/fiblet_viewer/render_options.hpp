@@ -5,8 +5,10 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <string>
 #include <vector>
 
+#include "fiblet_viewer/colormap_name.hpp"
 #include "fiblet_viewer/decoder_kind.hpp"
 #include "fiblet_viewer/draw_style.hpp"
 #include "fiblet_viewer/render_engine.hpp"
@@ -38,6 +40,15 @@ struct RenderOptions {
     bool color_by_direction = true;                    // |direction| as RGB, else fixed_color
     std::array<float, 3> fixed_color{0.95f, 0.85f, 0.6f};
     bool fiber_colors = false;                         // the scene's per-fiber colours (GpuScene::set_fiber_colors), when it has them
+    // The scene's per-point values (GpuScene::set_point_values), when it has
+    // them, through `colormap` over `value_range` (default: the values'
+    // min..max); before per-fiber colours. Lines (not voxlines), tubes and
+    // capsules; not the voxel ray tracer.
+    bool point_values = false;
+    ColormapName colormap = ColormapName::viridis;
+    std::optional<std::array<float, 2>> value_range;
+    bool color_bar = true;                             // the colour bar of the point values, when they are on
+    std::string value_name;                            // under the colour bar
     // Fibers drawn as they are while every other is dimmed (picking; at
     // most kMaxHighlightedFibers, sorted, unique); empty: none dimmed.
     std::vector<std::uint32_t> highlighted_fibers;

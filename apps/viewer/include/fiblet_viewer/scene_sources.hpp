@@ -12,11 +12,13 @@
 namespace fiblet::viewer {
 
 // Where a scene's per-fiber colours come from (at most one source): a text
-// file, or for values "dps/NAME", the file's own per-streamline data.
+// file, or for values "dps/NAME", the file's own per-streamline data; or
+// per-point values (point_values_path: a .tsf or "dpv/NAME").
 struct FiberColorSource {
     std::string colors_path, values_path;
     std::optional<std::array<float, 2>> value_range;
-    bool empty() const { return colors_path.empty() && values_path.empty(); }
+    std::string point_values_path;
+    bool empty() const { return colors_path.empty() && values_path.empty() && point_values_path.empty(); }
 };
 
 // Whether a values source is such a name ("dps/" and more); a file of that

@@ -7,6 +7,7 @@
 #include "scene_buffers.glsl"
 #include "box_proxy.glsl"
 #include "fiber_radii.glsl"
+#include "point_values.glsl"
 
 layout(std430, binding = BINDING_FINE_LIST) readonly buffer FineList { uint fineList[]; };
 layout(std430, binding = BINDING_POINTS) readonly buffer Points { vec4 points[]; };
@@ -22,6 +23,7 @@ layout(location = 1) flat out vec3 vEnd1;
 layout(location = 2) flat out uint vFiber;
 layout(location = 3) out vec3 vWorld;
 layout(location = 4) flat out float vRadius;
+layout(location = 5) flat out vec2 vValues;  // the per-point values at both ends
 
 void main() {
     uint v = uint(gl_VertexID);
@@ -37,12 +39,14 @@ void main() {
         vEnd0 = vEnd1 = vWorld = vec3(0.0);
         vFiber = 0u;
         vRadius = 0.0;
+        vValues = vec2(0.0);
         gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
         return;
     }
     uint base = slot * (uPointsPerBlock + 1u) + segment;
     vec3 a = points[base].xyz, b = points[base + 1u].xyz;
     vEnd0 = a, vEnd1 = b, vFiber = blockFiber[block];
+    vValues = vec2(pointValue(block, segment), pointValue(block, segment + 1u));
     vec3 axis = b - a;
     float len = length(axis);
     vec3 x = len > 0.0 ? axis / len : vec3(1.0, 0.0, 0.0);

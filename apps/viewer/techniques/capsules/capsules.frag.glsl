@@ -13,6 +13,7 @@ layout(location = 1) flat in vec3 vEnd1;
 layout(location = 2) flat in uint vFiber;
 layout(location = 3) in vec3 vWorld;
 layout(location = 4) flat in float vRadius;
+layout(location = 5) flat in vec2 vValues;
 
 layout(location = 0) out vec4 outColor;
 layout(location = 1) out uint outFiber;
@@ -57,6 +58,8 @@ void main() {
     if (outsideSlab(hit)) discard;
     gl_FragDepth = windowDepth(hit);
     vec3 n = normalize(normal);
-    outColor = vec4(shadeSurface(n, ba, -dir, vFiber) * (1.0 - rasterOcclusion(hit, n)), fiberAlpha(vFiber));
+    // The value at the hit's projection on the axis (the caps: the ends').
+    float s = dot(ba, ba) > 0.0 ? clamp(dot(hit - vEnd0, ba) / dot(ba, ba), 0.0, 1.0) : 0.0;
+    outColor = vec4(shadeSurface(n, ba, -dir, vFiber, mix(vValues.x, vValues.y, s)) * (1.0 - rasterOcclusion(hit, n)), fiberAlpha(vFiber));
     outFiber = vFiber + 1u;
 }

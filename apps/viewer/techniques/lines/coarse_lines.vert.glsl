@@ -5,6 +5,7 @@
 // the raw blocks: nothing is decoded per frame.
 #include "scene_buffers.glsl"
 #include "line_shading.glsl"
+#include "point_values.glsl"
 
 layout(std430, binding = BINDING_COARSE_LIST) readonly buffer CoarseList { uint coarseList[]; };
 layout(std430, binding = BINDING_FIBER_ENDS) readonly buffer FiberEnds { vec4 fiberEnds[]; };
@@ -15,5 +16,6 @@ void main() {
     uint fiber = blockFiber[block];
     vec3 p0 = toWorld(blockAnchor0(block));
     vec3 p1 = isLastBlockOfFiber(block) ? fiberEnds[fiber].xyz : toWorld(blockAnchor0(block + 1u));
-    emitSegmentVertex(p0, p1, v & 1u, fiber);
+    float v1 = isLastBlockOfFiber(block) ? pointValue(block, blockPointCount(block) - 1u) : pointValue(block + 1u, 0u);
+    emitSegmentVertex(p0, p1, v & 1u, fiber, pointValue(block, 0u), v1);
 }

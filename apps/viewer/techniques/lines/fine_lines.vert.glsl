@@ -4,6 +4,7 @@
 // segments a block does not have are sent outside the clip volume.
 #include "scene_buffers.glsl"
 #include "line_shading.glsl"
+#include "point_values.glsl"
 
 layout(std430, binding = BINDING_FINE_LIST) readonly buffer FineList { uint fineList[]; };
 layout(std430, binding = BINDING_POINTS) readonly buffer Points { vec4 points[]; };
@@ -21,5 +22,6 @@ void main() {
         return;
     }
     uint base = slot * (uPointsPerBlock + 1u) + segment;
-    emitSegmentVertex(points[base].xyz, points[base + 1u].xyz, v & 1u, blockFiber[block]);
+    emitSegmentVertex(points[base].xyz, points[base + 1u].xyz, v & 1u, blockFiber[block], pointValue(block, segment),
+                      pointValue(block, segment + 1u));
 }

@@ -14,8 +14,15 @@ uniform float uDiffuse;
 uniform float uSpecular;
 uniform float uShininess;
 
-vec3 lineColor(vec3 tangent, vec3 world, uint fiber) {
-    vec3 base = baseColor(tangent, fiber);
+vec3 litLineColor(vec3 base, vec3 tangent, vec3 world, uint fiber);
+
+vec3 lineColor(vec3 tangent, vec3 world, uint fiber) { return litLineColor(baseColor(tangent, fiber), tangent, world, fiber); }
+// With the point's value (per-point values, fiber_colors.glsl).
+vec3 lineColor(vec3 tangent, vec3 world, uint fiber, float value) {
+    return litLineColor(baseColor(tangent, fiber, value), tangent, world, fiber);
+}
+
+vec3 litLineColor(vec3 base, vec3 tangent, vec3 world, uint fiber) {
     if (!uLighting) return base;
     vec3 view = normalize(uCameraPosition - world);
     float lt = dot(uLightDirection, tangent), vt = dot(view, tangent);

@@ -12,6 +12,7 @@ layout(local_size_x = 64) in;
 #include "scene_buffers.glsl"
 #include "tube_piece.glsl"
 #include "fiber_radii.glsl"
+#include "point_values.glsl"
 
 layout(std430, binding = BINDING_FINE_LIST) readonly buffer FineList { uint fineList[]; };
 layout(std430, binding = BINDING_POINTS) readonly buffer Points { vec4 points[]; };
@@ -88,6 +89,18 @@ TubePiece makePiece(vec3 p0, vec3 p1, vec3 p2, float r, uint fiber) {
     return q;
 }
 
+// The value at fractional point u of the slot (linear between its points).
+float valueAt(uint block, float u) {
+    uint k = uint(u);
+    float f = u - float(k);
+    return f > 0.0 ? mix(pointValue(block, k), pointValue(block, k + 1u), f) : pointValue(block, k);
+}
+
+// A piece's values at t = 0, 0.5, 1: points u0..u1 of the slot.
+vec4 pieceValues(uint block, float u0, float u1) {
+    return vec4(valueAt(block, u0), valueAt(block, 0.5 * (u0 + u1)), valueAt(block, u1), 0.0);
+}
+
 void main() {
     uint id = gl_GlobalInvocationID.x;  // piece pair id of this run
     uint slot = uFirstSlot + id / uSegmentsPerSlot, segment = id % uSegmentsPerSlot;
@@ -115,6 +128,10 @@ void main() {
     vec3 a2 = n0 + uTangentScale * m0, b2 = n1 - uTangentScale * m1, join = 0.5 * (a2 + b2);
     uint fiber = blockFiber[block];
     float radius = fiberRadius(fiber);
-    pieces[2u * id] = makePiece(n0, a2, join, radius, fiber);
-    pieces[2u * id + 1u] = makePiece(join, b2, n1, radius, fiber);
+    TubePiece first = makePiece(n0, a2, join, radius, fiber), second = makePiece(join, b2, n1, radius, fiber);
+    float u0 = float(k0), u1 = float(k1), um = 0.5 * (u0 + u1);
+    first.values = pieceValues(block, u0, um);
+    second.values = pieceValues(block, um, u1);
+    pieces[2u * id] = first;
+    pieces[2u * id + 1u] = second;
 }

@@ -173,6 +173,7 @@ void main() {
     vec3 normal = normalize(hit - centre);
     vec3 tangent = 2.0 * (1.0 - t) * (q.c1.xyz - q.c0.xyz) + 2.0 * t * (q.c2.xyz - q.c1.xyz);
     uint fiber = floatBitsToUint(q.center.w);
-    outColor = vec4(shadeSurface(normal, tangent, -dir, fiber) * (1.0 - rasterOcclusion(hit, normal)), fiberAlpha(fiber));
+    float value = t < 0.5 ? mix(q.values.x, q.values.y, 2.0 * t) : mix(q.values.y, q.values.z, 2.0 * t - 1.0);
+    outColor = vec4(shadeSurface(normal, tangent, -dir, fiber, value) * (1.0 - rasterOcclusion(hit, normal)), fiberAlpha(fiber));
     outFiber = fiber + 1u;
 }

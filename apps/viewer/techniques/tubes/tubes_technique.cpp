@@ -10,7 +10,7 @@
 namespace fiblet::viewer {
 
 namespace {
-constexpr std::uint64_t kPieceBytes = 7 * 16;  // TubePiece: seven vec4
+constexpr std::uint64_t kPieceBytes = 8 * 16;  // TubePiece: eight vec4
 }  // namespace
 
 TubesTechnique::TubesTechnique(float tangent_scale)
@@ -54,6 +54,7 @@ std::uint32_t TubesTechnique::build_pieces(const FrameInputs& in, const DecodedB
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kTangents, batch.tangents);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kTubePieces, pieces_.get());
     glProgramUniform1i(id, uniform(build_, "uUseList"), use_list ? 1 : 0);
+    glProgramUniform1i(id, uniform(build_, "uPointValues"), in.options.point_values ? 1 : 0);
     glProgramUniform1ui(id, uniform(build_, "uChunksPerBlock"), chunks_per_block);
     glProgramUniform1ui(id, uniform(build_, "uChunkSegments"), std::max(chunk_segments, 1u));
     glProgramUniform1ui(id, uniform(build_, "uFirst"), batch.first);

@@ -1,0 +1,40 @@
+// Per-point values (--point-values): an MRtrix3 track scalar file (.tsf, as
+// tcksample writes it) or "dpv/NAME", a per-point array of the .fft's own
+// DATA chunk. Either gives one finite number per point, fibers in file order.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace fiblet {
+class FftFile;
+}
+
+namespace fiblet::viewer {
+
+// The values of a .tsf, one vector per streamline: the text header ("mrtrix
+// track scalars", "datatype: Float32LE|Float32BE|Float64LE|Float64BE",
+// "file: . OFFSET", "END"), then the values with NaN after each streamline
+// and Inf at the end. Throws fiblet::Error{io} when unreadable,
+// {invalid_input} when malformed (no END, bad datatype, truncated data, a
+// value that is not finite).
+std::vector<std::vector<float>> read_track_scalars(const std::string& path);
+
+// The values of `path` checked against the fibers' point counts
+// (`fiber_points`, file order): Error{invalid_input} naming the first
+// mismatch. A file resampled at compress time (`resampled`) holds other
+// points than the tractogram the .tsf was sampled on; its message says so.
+std::vector<float> read_point_values(const std::string& path, const std::vector<std::uint32_t>& fiber_points,
+                                     bool resampled);
+
+// "dpv/NAME" of the file's DATA chunk (one component, finite values);
+// Error{invalid_argument} naming the file's per-point fields when absent.
+// A resampled file's DATA was resampled with its points (PointFieldResampler).
+std::vector<float> point_values_from_data(const FftFile& file, const std::string& name);
+
+// What --point-values reads: "dpv/NAME" (when no such file exists) or a .tsf.
+std::vector<float> read_point_value_source(const std::string& source, const FftFile& file,
+                                           const std::vector<std::uint32_t>& fiber_points);
+
+}  // namespace fiblet::viewer
