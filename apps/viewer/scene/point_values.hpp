@@ -13,15 +13,8 @@ class FftFile;
 
 namespace fiblet::viewer {
 
-// The values of a .tsf, one vector per streamline: the text header ("mrtrix
-// track scalars", "datatype: Float32LE|Float32BE|Float64LE|Float64BE",
-// "file: . OFFSET", "END"), then the values with NaN after each streamline
-// and Inf at the end. Throws fiblet::Error{io} when unreadable,
-// {invalid_input} when malformed (no END, bad datatype, truncated data, a
-// value that is not finite).
-std::vector<std::vector<float>> read_track_scalars(const std::string& path);
-
-// The values of `path` checked against the fibers' point counts
+// The values of the .tsf `path` (fiblet::read_track_scalars) checked
+// against the fibers' point counts
 // (`fiber_points`, file order): Error{invalid_input} naming the first
 // mismatch. A file resampled at compress time (`resampled`) holds other
 // points than the tractogram the .tsf was sampled on; its message says so.

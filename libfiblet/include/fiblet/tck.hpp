@@ -52,6 +52,13 @@ struct TckHeader {
 // Parses the header of a .tck file (throws Error{tck_format|io}).
 TckHeader read_tck_header(const std::string& path);
 
+// An MRtrix3 track scalar file (.tsf, tcksample's output): the values of
+// each streamline's points (Float64 files narrowed to float). Throws
+// Error{tck_format} when malformed (the .tck header rules; NaN after each
+// streamline, then Inf or the end of the file; finite values), Error{unsupported} for a
+// datatype other than Float32/64 LE/BE, Error{io}.
+std::vector<std::vector<float>> read_track_scalars(const std::string& path);
+
 struct TckReadOptions {
     std::size_t chunk_bytes = 4u << 20;  // size of each read from disk
     // A "count:" that disagrees with the data is an error unless this is set

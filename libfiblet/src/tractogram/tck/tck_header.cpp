@@ -9,6 +9,7 @@
 #include "fiblet/error.hpp"
 #include "fiblet/tck.hpp"
 #include "io/key_value_header.hpp"
+#include "tractogram/tck/track_header.hpp"
 
 namespace fiblet {
 namespace {
@@ -51,10 +52,6 @@ std::optional<std::uint64_t> parse_file_entry(std::string_view v) {
     v.remove_prefix(1);
     if (v.empty() || !is_space(v.front())) return std::nullopt;
     return parse_u64(trim(v));
-}
-
-[[noreturn]] void fail(const std::string& path, const std::string& what) {
-    throw Error(Errc::tck_format, path + ": invalid .tck header: " + what);
 }
 
 }  // namespace
@@ -108,37 +105,45 @@ std::optional<double> TckHeader::step_size() const {
     return d;
 }
 
-TckHeader read_tck_header(const std::string& path) {
-    const detail::KeyValueHeader kv = detail::read_key_value_header(path, kMagic, Errc::tck_format, ".tck");
+TckHeader read_tck_header(const std::string& path) { return detail::read_track_header(path, kMagic, ".tck"); }
+
+namespace detail {
+
+TckHeader read_track_header(const std::string& path, std::string_view magic, std::string_view what) {
+    const KeyValueHeader kv = read_key_value_header(path, magic, Errc::tck_format, what);
+    auto fail = [&](const std::string& why) {
+        throw Error(Errc::tck_format, path + ": invalid " + std::string(what) + " header: " + why);
+    };
     const std::uint64_t file_size = kv.file_size;
     TckHeader h;  // no datatype entry: Float32LE, what MRtrix writes by default
     std::optional<std::uint64_t> offset;
-    for (const detail::KeyValueEntry& e : kv.entries) {
+    for (const KeyValueEntry& e : kv.entries) {
         const bool parsed = e.key == "file" || e.key == "datatype";
-        if (parsed && e.continued) fail(path, "line " + std::to_string(e.line + 1) + " continues a file/datatype entry");
+        if (parsed && e.continued) fail("line " + std::to_string(e.line + 1) + " continues a file/datatype entry");
         if (e.key == "file") {
             offset = parse_file_entry(e.value);
-            if (!offset) fail(path, "bad \"file:\" entry \"" + e.value + "\" (expected \". OFFSET\")");
+            if (!offset) fail("bad \"file:\" entry \"" + e.value + "\" (expected \". OFFSET\")");
         } else if (e.key == "datatype") {
             const auto t = parse_datatype(e.value);
             if (!t)
-                throw Error(Errc::unsupported, path + ": unsupported .tck datatype \"" + e.value +
+                throw Error(Errc::unsupported, path + ": unsupported " + std::string(what) + " datatype \"" + e.value +
                                                    "\" (supported: Float32LE, Float32BE, Float64LE, Float64BE)");
             h.datatype = *t;
         } else {
             h.properties.emplace_back(e.key, e.value);
         }
     }
-    if (!offset) fail(path, "missing \"file: . OFFSET\" entry");
+    if (!offset) fail("missing \"file: . OFFSET\" entry");
     const std::uint64_t header_end = kv.end;
     if (*offset < header_end)
-        fail(path, "data offset " + std::to_string(*offset) + " lies inside the header (which ends at byte " +
+        fail("data offset " + std::to_string(*offset) + " lies inside the header (which ends at byte " +
                        std::to_string(header_end) + ")");
     if (*offset > file_size)
-        fail(path, "data offset " + std::to_string(*offset) + " is past the end of the file (" +
+        fail("data offset " + std::to_string(*offset) + " is past the end of the file (" +
                        std::to_string(file_size) + " bytes)");
     h.data_offset = *offset;
     return h;
 }
 
+}  // namespace detail
 }  // namespace fiblet
