@@ -15,7 +15,7 @@ using namespace fiblet::test;
 
 namespace {
 
-constexpr viewer::DecoderKind kBothDecoders[] = {viewer::DecoderKind::scan, viewer::DecoderKind::sequential};
+constexpr viewer::GpuDecoder kBothDecoders[] = {viewer::GpuDecoder::scan, viewer::GpuDecoder::sequential};
 
 // Largest coordinate difference between the two decoders, in mm. Both
 // decode the same bytes; the GPU multiplies the frames in a different order
@@ -26,7 +26,7 @@ struct Comparison {
     double max_diff_mm = 0;
 };
 
-Comparison compare_decoders(const std::string& fft_path, viewer::DecoderKind kind) {
+Comparison compare_decoders(const std::string& fft_path, viewer::GpuDecoder kind) {
     const FftFile file(fft_path);
     const viewer::GpuScene scene(file, *viewer_gl().programs, kind);
     const std::vector<float> gpu =
@@ -71,9 +71,9 @@ void expect_gpu_decoders_match_scalar(const std::string& fft, const char* name, 
     for (const auto kind : kBothDecoders) {
         const Comparison c = compare_decoders(fft, kind);
         EXPECT_GT(c.points, more_points_than) << name;
-        EXPECT_LE(c.max_diff_mm, tolerance_mm(fft)) << name << " " << viewer::decoder_name(kind);
+        EXPECT_LE(c.max_diff_mm, tolerance_mm(fft)) << name << " " << viewer::gpu_decoder_name(kind);
         std::printf("%s: %zu points, GPU (%s) vs scalar decoder max %.3g mm\n", name, c.points,
-                    viewer::decoder_name(kind), c.max_diff_mm);
+                    viewer::gpu_decoder_name(kind), c.max_diff_mm);
     }
 }
 
@@ -81,8 +81,8 @@ void expect_gpu_decoders_match_scalar(const std::string& fft, const char* name, 
 // step arriving at each point (F0), the first point taking its first step's.
 void expect_tangents_are_unit_step_directions(const FftFile& file, const viewer::GpuScene& scene) {
     const CpuDecoded cpu = cpu_decode_blocks(file);
-    for (const auto kind : {viewer::DecoderKind::sequential, viewer::DecoderKind::scan}) {
-        SCOPED_TRACE(viewer::decoder_name(kind));
+    for (const auto kind : {viewer::GpuDecoder::sequential, viewer::GpuDecoder::scan}) {
+        SCOPED_TRACE(viewer::gpu_decoder_name(kind));
         const auto t = viewer::decode_tangents_on_gpu(scene, *viewer_gl().programs, kind, 0, scene.block_count());
         ASSERT_EQ(t.size(), cpu.xyz.size());
         double worst = 0;
@@ -107,7 +107,7 @@ void expect_tangents_are_unit_step_directions(const FftFile& file, const viewer:
         }
         EXPECT_GT(checked, 10000u);
         EXPECT_LE(worst, 1.0);  // error / tolerance
-        std::printf("%s tangents: %zu points, worst error / tolerance %.3g\n", viewer::decoder_name(kind), checked, worst);
+        std::printf("%s tangents: %zu points, worst error / tolerance %.3g\n", viewer::gpu_decoder_name(kind), checked, worst);
     }
 }
 
@@ -150,8 +150,8 @@ TEST(ViewerGpuDecode, EveryBlockBoundaryCase) {
     const std::string fft = compress_into(dir, dir.file("cases.tck"), "cases.fft");
     for (const auto kind : kBothDecoders) {
         const Comparison c = compare_decoders(fft, kind);
-        EXPECT_EQ(c.points, FftFile(fft).header().points) << viewer::decoder_name(kind);
-        EXPECT_LE(c.max_diff_mm, tolerance_mm(fft)) << viewer::decoder_name(kind);
+        EXPECT_EQ(c.points, FftFile(fft).header().points) << viewer::gpu_decoder_name(kind);
+        EXPECT_LE(c.max_diff_mm, tolerance_mm(fft)) << viewer::gpu_decoder_name(kind);
     }
 }
 
@@ -203,7 +203,7 @@ TEST(ViewerGpuDecode, SixteenBitBlockBoundaryCases) {
     for (const bool zstd : {false, true}) {
         const std::string fft = compress16_into(dir, dir.file("cases.tck"), zstd ? "cases.fftz" : "cases.fft", zstd);
         for (const auto kind : kBothDecoders) {
-            SCOPED_TRACE(std::string(viewer::decoder_name(kind)) + (zstd ? " version 16" : " version 17"));
+            SCOPED_TRACE(std::string(viewer::gpu_decoder_name(kind)) + (zstd ? " version 16" : " version 17"));
             const Comparison c = compare_decoders(fft, kind);
             EXPECT_EQ(c.points, FftFile(fft).header().points);
             EXPECT_LE(c.max_diff_mm, tolerance_mm(fft));

@@ -97,7 +97,7 @@ std::vector<Case> every_technique() {
         return &cases.back();
     };
     add("lines", [](viewer::RenderOptions&) {}, true);
-    add("lines, scan decoder", [](viewer::RenderOptions& o) { o.decoder = viewer::DecoderKind::scan; }, true);
+    add("lines, scan decoder", [](viewer::RenderOptions& o) { o.decoder = viewer::GpuDecoder::scan; }, true);
     add("tubes", [](viewer::RenderOptions& o) { o.style = viewer::DrawStyle::tubes; }, true);
     add("capsules", [](viewer::RenderOptions& o) { o.style = viewer::DrawStyle::capsules; }, true);
     add("lines, sorted transparency", [](viewer::RenderOptions& o) { o.opacity = 0.4f; }, false);

@@ -79,7 +79,7 @@ void print_bench(const RenderArgs& a, const viewer::HeadlessScene& scene, int wi
     const std::vector<viewer::BenchCase>& cases = bench.cases;
     const std::optional<viewer::FullDecodeTimes>& full = bench.full_decode;
     const std::optional<viewer::TransparencyBench>& transparency = bench.transparency;
-    const viewer::DecoderKind decoder = bench.decoder;
+    const viewer::GpuDecoder decoder = bench.decoder;
     const viewer::DrawStyle style = options.style;
     // The voxel ray tracer's one-off preprocessing (the warm-up frame's).
     const std::optional<viewer::VoxelRtPreprocessing>& vs = bench.voxel_rt;
@@ -103,7 +103,7 @@ void print_bench(const RenderArgs& a, const viewer::HeadlessScene& scene, int wi
                                .integer("frames", std::uint64_t(a.frames))
                                .integer("fibers", scene.fibers)
                                .integer("blocks", scene.blocks)
-                               .str("decoder", viewer::decoder_name(decoder))
+                               .str("decoder", viewer::gpu_decoder_name(decoder))
                                .str("style", viewer::draw_style_name(style))
                                .str("engine", a.view.engine)
                                .raw("voxel_rt", vs ? Json{}
@@ -141,7 +141,7 @@ void print_bench(const RenderArgs& a, const viewer::HeadlessScene& scene, int wi
                    double(vs->fragments) * 4 / (1 << 20));
     if (full)
         fmt::print("decoding all {} blocks: scan {:.2f} ms, sequential {:.2f} ms; frames below use the {} decoder\n",
-                   scene.blocks, full->scan_ms, full->sequential_ms, viewer::decoder_name(decoder));
+                   scene.blocks, full->scan_ms, full->sequential_ms, viewer::gpu_decoder_name(decoder));
     fmt::print("{:<9} {:<12} {:>10} {:>10} {:>11} {:>9} {:>10} {:>9} {:>10} {:>9}\n", "view", "culling+LoD",
                "full blks", "coarse", "segments", "cull ms", "decode ms", "draw ms", "GPU ms", "frame ms");
     for (const auto& c : cases) {

@@ -304,7 +304,7 @@ viewer::RenderOptions render_options_from(const ViewerArgs& a) {
     if (a.min_length < 0 || a.max_length < 0) throw Error(Errc::invalid_argument, "fiber lengths must be positive");
     o.min_length_mm = a.min_length;
     if (a.decoder != "auto") {
-        o.decoder = viewer::parse_decoder(a.decoder);
+        o.decoder = viewer::parse_gpu_decoder(a.decoder);
         if (!o.decoder) throw Error(Errc::invalid_argument, "--decoder: '" + a.decoder + "' is not auto, scan or sequential");
     }
     if (a.max_length > 0) o.max_length_mm = a.max_length;

@@ -71,8 +71,8 @@ HeadlessRenderResult render_headless(const HeadlessRenderJob& job,
         RenderBench bench;
         bench.cases = run_render_bench(scene, renderer, target, camera_for, options, job.frames, job.bench_views);
         if (std::find(job.bench_views.begin(), job.bench_views.end(), "decode") != job.bench_views.end())
-            bench.full_decode = FullDecodeTimes{time_full_decode(scene, programs, DecoderKind::scan, job.frames),
-                                                time_full_decode(scene, programs, DecoderKind::sequential, job.frames)};
+            bench.full_decode = FullDecodeTimes{time_full_decode(scene, programs, GpuDecoder::scan, job.frames),
+                                                time_full_decode(scene, programs, GpuDecoder::sequential, job.frames)};
         if (options.transparent())
             bench.transparency = run_transparency_bench(scene, renderer, target, camera_for(1), options, job.frames);
         bench.timing = timing_method_name(default_timing_method());

@@ -83,7 +83,7 @@ TransparencyBench run_transparency_bench(const GpuScene& scene, Renderer& render
     return b;
 }
 
-double time_full_decode(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind, int frames) {
+double time_full_decode(const GpuScene& scene, const GpuPrograms& programs, GpuDecoder kind, int frames) {
     const BlockDecoder decoder(programs, scene.header().points_per_block);
     std::vector<double> ms;
     for (int f = -1; f < frames; ++f) {

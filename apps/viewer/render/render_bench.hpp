@@ -34,6 +34,6 @@ TransparencyBench run_transparency_bench(const GpuScene& scene, Renderer& render
 
 // Median time (ms) to decode every block of the scene with `kind`, in
 // batches as the renderer does, without drawing.
-double time_full_decode(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind, int frames);
+double time_full_decode(const GpuScene& scene, const GpuPrograms& programs, GpuDecoder kind, int frames);
 
 }  // namespace fiblet::viewer

@@ -127,7 +127,7 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& requested, cons
     glBindVertexArray(empty_vertex_array_.get());
 
     GpuTimer timer(o.time_stages ? default_timing_method() : TimingMethod::none);
-    const DecoderKind decoder = o.decoder.value_or(default_decoder());
+    const GpuDecoder decoder = o.decoder.value_or(default_decoder());
     FrameStats stats;
     const bool select = o.frustum_culling || o.level_of_detail || o.subset_active();
     if (select) {
@@ -193,7 +193,7 @@ DrawTechnique& Renderer::block_technique(const RenderOptions& o) {
     return *transparent_lines_;
 }
 
-void Renderer::draw_blocks(const FrameInputs& in, DrawTechnique& draw, DecoderKind decoder, std::uint32_t blocks,
+void Renderer::draw_blocks(const FrameInputs& in, DrawTechnique& draw, GpuDecoder decoder, std::uint32_t blocks,
                            GpuTimer& timer) {
     for (std::uint32_t first = 0; first < blocks; first += decoder_->capacity()) {
         const std::uint32_t count = std::min<std::uint32_t>(decoder_->capacity(), blocks - first);
@@ -210,7 +210,7 @@ void Renderer::draw_blocks(const FrameInputs& in, DrawTechnique& draw, DecoderKi
     }
 }
 
-void Renderer::draw_ordered(const FrameInputs& in, DecoderKind decoder, std::uint32_t blocks) {
+void Renderer::draw_ordered(const FrameInputs& in, GpuDecoder decoder, std::uint32_t blocks) {
     if (in.options.transparency == TransparencyMode::voxlines && in.options.style == DrawStyle::lines) {
         // Voxlines keep their own copy of every segment, built once per scene.
         if (!voxlines_ || &voxlines_->scene() != &in.scene)

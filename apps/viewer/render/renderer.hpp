@@ -75,11 +75,11 @@ private:
     // transparent lines when lines blend.
     DrawTechnique& block_technique(const RenderOptions& o);
     // The fine blocks decoded and drawn a batch at a time, in list order.
-    void draw_blocks(const FrameInputs& in, DrawTechnique& draw, DecoderKind decoder, std::uint32_t blocks,
+    void draw_blocks(const FrameInputs& in, DrawTechnique& draw, GpuDecoder decoder, std::uint32_t blocks,
                      GpuTimer& timer);
     // A transparent frame in the order of o.transparency (transparency/):
     // voxlines (lines), or sorted chunks drawn through the frame's technique.
-    void draw_ordered(const FrameInputs& in, DecoderKind decoder, std::uint32_t blocks);
+    void draw_ordered(const FrameInputs& in, GpuDecoder decoder, std::uint32_t blocks);
 
     const GpuPrograms& programs_;
     std::unique_ptr<voxel_rt::VoxelRayTracer> voxel_ray_tracer_;  // made on first use

@@ -8,15 +8,15 @@
 
 namespace fiblet::viewer {
 
-const char* decoder_name(DecoderKind k) { return k == DecoderKind::scan ? "scan" : "sequential"; }
+const char* gpu_decoder_name(GpuDecoder k) { return k == GpuDecoder::scan ? "scan" : "sequential"; }
 
-std::optional<DecoderKind> parse_decoder(const std::string& name) {
-    if (name == "scan") return DecoderKind::scan;
-    if (name == "sequential") return DecoderKind::sequential;
+std::optional<GpuDecoder> parse_gpu_decoder(const std::string& name) {
+    if (name == "scan") return GpuDecoder::scan;
+    if (name == "sequential") return GpuDecoder::sequential;
     return std::nullopt;
 }
 
-DecoderKind default_decoder() { return is_software_renderer() ? DecoderKind::sequential : DecoderKind::scan; }
+GpuDecoder default_decoder() { return is_software_renderer() ? GpuDecoder::sequential : GpuDecoder::scan; }
 
 namespace {
 // GL guarantees 65535 workgroups per dispatch dimension (the scan decoder
@@ -27,7 +27,7 @@ constexpr std::uint32_t kMaxPassBlocks = 65535;
 constexpr std::uint32_t kPointBytes = 16;  // vec4
 }  // namespace
 
-void dispatch_decode(const GpuPrograms& programs, DecoderKind kind, const GpuScene& scene, bool use_list,
+void dispatch_decode(const GpuPrograms& programs, GpuDecoder kind, const GpuScene& scene, bool use_list,
                      std::uint32_t first, std::uint32_t count, bool ends_only, bool tangents) {
     const GlProgram& p = programs.decoder(kind, scene.header().direction_bits() == 16);
     glUseProgram(p.get());
@@ -39,7 +39,7 @@ void dispatch_decode(const GpuPrograms& programs, DecoderKind kind, const GpuSce
         const std::uint32_t n = std::min(kMaxPassBlocks, count - done);
         glProgramUniform1ui(p.get(), uniform(p, "uFirst"), first + done);
         glProgramUniform1ui(p.get(), uniform(p, "uCount"), n);
-        glDispatchCompute(kind == DecoderKind::scan ? n : (n + 63) / 64, 1, 1);
+        glDispatchCompute(kind == GpuDecoder::scan ? n : (n + 63) / 64, 1, 1);
         done += n;
         if (!ends_only) break;  // slots start at 0: one pass fills the points buffer
     }
@@ -52,7 +52,7 @@ BlockDecoder::BlockDecoder(const GpuPrograms& programs, std::uint32_t points_per
     points_ = make_buffer(GLsizeiptr(capacity_ * slot_bytes), nullptr, 0);
 }
 
-void BlockDecoder::decode(const GpuScene& scene, DecoderKind kind, bool use_list, std::uint32_t first,
+void BlockDecoder::decode(const GpuScene& scene, GpuDecoder kind, bool use_list, std::uint32_t first,
                           std::uint32_t count, bool tangents) const {
     if (count == 0) return;
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kPoints, points_.get());
@@ -67,7 +67,7 @@ void BlockDecoder::decode(const GpuScene& scene, DecoderKind kind, bool use_list
 namespace {
 // Decodes blocks [first, first + count) and reads back the points (or the
 // tangents) of each block, xyz one after the other.
-std::vector<float> decode_and_read(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind,
+std::vector<float> decode_and_read(const GpuScene& scene, const GpuPrograms& programs, GpuDecoder kind,
                                    std::uint32_t first, std::uint32_t count, bool tangents) {
     const std::uint32_t ppb = scene.header().points_per_block;
     const BlockDecoder decoder(programs, ppb);
@@ -91,12 +91,12 @@ std::vector<float> decode_and_read(const GpuScene& scene, const GpuPrograms& pro
 }
 }  // namespace
 
-std::vector<float> decode_blocks_on_gpu(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind,
+std::vector<float> decode_blocks_on_gpu(const GpuScene& scene, const GpuPrograms& programs, GpuDecoder kind,
                                         std::uint32_t first, std::uint32_t count) {
     return decode_and_read(scene, programs, kind, first, count, false);
 }
 
-std::vector<float> decode_tangents_on_gpu(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind,
+std::vector<float> decode_tangents_on_gpu(const GpuScene& scene, const GpuPrograms& programs, GpuDecoder kind,
                                           std::uint32_t first, std::uint32_t count) {
     return decode_and_read(scene, programs, kind, first, count, true);
 }

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "fiblet_viewer/decoder_kind.hpp"
+#include "fiblet_viewer/gpu_decoder.hpp"
 #include "gl/gl_objects.hpp"
 #include "scene/gpu_programs.hpp"
 #include "scene/gpu_scene.hpp"
@@ -14,7 +14,7 @@
 namespace fiblet::viewer {
 
 // scan, or sequential on a software renderer (current context).
-DecoderKind default_decoder();
+GpuDecoder default_decoder();
 
 // One decode pass over `count` blocks: list[first + i] of the list bound at
 // binding::kFineList when `use_list`, else blocks first + i. With
@@ -23,7 +23,7 @@ DecoderKind default_decoder();
 // writes slot i of the points buffer bound at binding::kPoints (at most 65535
 // blocks per pass), and with `tangents` also slot i of the tangents buffer
 // bound at binding::kTangents (decode_common.glsl says which tangent).
-void dispatch_decode(const GpuPrograms& programs, DecoderKind kind, const GpuScene& scene, bool use_list,
+void dispatch_decode(const GpuPrograms& programs, GpuDecoder kind, const GpuScene& scene, bool use_list,
                      std::uint32_t first, std::uint32_t count, bool ends_only, bool tangents = false);
 
 class BlockDecoder {
@@ -41,7 +41,7 @@ public:
     // vec4 (world mm): the block's points, then the first point of the next
     // block of its fiber. With `tangents`, the tangents buffer gets each
     // point's unit tangent in the same layout.
-    void decode(const GpuScene& scene, DecoderKind kind, bool use_list, std::uint32_t first,
+    void decode(const GpuScene& scene, GpuDecoder kind, bool use_list, std::uint32_t first,
                 std::uint32_t count, bool tangents = false) const;
 
 private:
@@ -54,10 +54,10 @@ private:
 // Decodes blocks [first, first + count) of the scene on the GPU and reads
 // the points back: xyz world mm, the blocks' points one after the other (the
 // layout of fiblet::decode_blocks_scalar). For tests and tools.
-std::vector<float> decode_blocks_on_gpu(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind,
+std::vector<float> decode_blocks_on_gpu(const GpuScene& scene, const GpuPrograms& programs, GpuDecoder kind,
                                         std::uint32_t first, std::uint32_t count);
 // The same blocks' unit tangents (xyz, same layout).
-std::vector<float> decode_tangents_on_gpu(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind,
+std::vector<float> decode_tangents_on_gpu(const GpuScene& scene, const GpuPrograms& programs, GpuDecoder kind,
                                           std::uint32_t first, std::uint32_t count);
 
 }  // namespace fiblet::viewer

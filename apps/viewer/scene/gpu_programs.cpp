@@ -31,8 +31,8 @@ GpuPrograms::GpuPrograms() {
     decode_sequential_wide = build_program({"decode_blocks_sequential.comp.glsl"}, defines + "#define WIDE_BLOCKS 1\n");
 }
 
-const GlProgram& GpuPrograms::decoder(DecoderKind kind, bool wide_blocks) const {
-    if (kind == DecoderKind::scan) return wide_blocks ? decode_scan_wide : decode_scan;
+const GlProgram& GpuPrograms::decoder(GpuDecoder kind, bool wide_blocks) const {
+    if (kind == GpuDecoder::scan) return wide_blocks ? decode_scan_wide : decode_scan;
     return wide_blocks ? decode_sequential_wide : decode_sequential;
 }
 

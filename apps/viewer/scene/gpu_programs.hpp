@@ -2,7 +2,7 @@
 // context (the drawing styles compile their own: techniques/).
 #pragma once
 
-#include "fiblet_viewer/decoder_kind.hpp"
+#include "fiblet_viewer/gpu_decoder.hpp"
 #include "gl/gl_objects.hpp"
 
 namespace fiblet::viewer {
@@ -21,7 +21,7 @@ struct GpuPrograms {
     GlProgram decode_sequential;  // decode_blocks_sequential.comp.glsl
     GlProgram decode_scan_wide;
     GlProgram decode_sequential_wide;
-    const GlProgram& decoder(DecoderKind kind, bool wide_blocks) const;
+    const GlProgram& decoder(GpuDecoder kind, bool wide_blocks) const;
 };
 
 }  // namespace fiblet::viewer

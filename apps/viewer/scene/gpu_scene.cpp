@@ -59,7 +59,7 @@ void check_fits(std::uint64_t bytes, const char* what) {
 
 }  // namespace
 
-GpuScene::GpuScene(const FftFile& file, const GpuPrograms& programs, std::optional<DecoderKind> decoder)
+GpuScene::GpuScene(const FftFile& file, const GpuPrograms& programs, std::optional<GpuDecoder> decoder)
     : header_(file.header()) {
     const FftHeader& h = header_;
     const std::uint32_t bb = h.block_bytes();

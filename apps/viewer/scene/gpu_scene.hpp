@@ -12,7 +12,7 @@
 #include <optional>
 #include <vector>
 
-#include "fiblet_viewer/decoder_kind.hpp"
+#include "fiblet_viewer/gpu_decoder.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/geometry.hpp"
 #include "gl/gl_objects.hpp"
@@ -33,7 +33,7 @@ public:
     // `decoder` (default: default_decoder()) decodes the fibers' last points.
     // Throws fiblet::Error{fft_format} on bad blocks, {unsupported} when the
     // blocks exceed the driver's largest storage buffer.
-    GpuScene(const FftFile& file, const GpuPrograms& programs, std::optional<DecoderKind> decoder = {});
+    GpuScene(const FftFile& file, const GpuPrograms& programs, std::optional<GpuDecoder> decoder = {});
 
     const FftHeader& header() const { return header_; }
     std::uint32_t block_count() const { return header_.blocks; }

@@ -42,7 +42,7 @@ void SortedChunks::ensure_buffers(std::uint32_t scene_chunks) {
     sorted_chunks_ = make_buffer(GLsizeiptr(capacity_) * 4, nullptr, 0);
 }
 
-void SortedChunks::draw(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind, GLuint fine_list,
+void SortedChunks::draw(const FrameInputs& in, const BlockDecoder& decoder, GpuDecoder kind, GLuint fine_list,
                         std::uint32_t blocks, DrawTechnique& technique) {
     if (blocks == 0) return;
     chunks_per_block_ = (in.scene.header().points_per_block + kChunkSegments - 1) / kChunkSegments;
@@ -53,7 +53,7 @@ void SortedChunks::draw(const FrameInputs& in, const BlockDecoder& decoder, Deco
     draw_sorted(in, decoder, kind, blocks * chunks_per_block_, technique);
 }
 
-void SortedChunks::key_chunks(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind,
+void SortedChunks::key_chunks(const FrameInputs& in, const BlockDecoder& decoder, GpuDecoder kind,
                               GLuint fine_list, std::uint32_t blocks) {
     const GLuint id = keys_.get();
     const Camera& camera = in.camera;
@@ -115,7 +115,7 @@ void SortedChunks::sort_chunks(std::uint32_t chunks) {
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
-void SortedChunks::draw_sorted(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind,
+void SortedChunks::draw_sorted(const FrameInputs& in, const BlockDecoder& decoder, GpuDecoder kind,
                                std::uint32_t chunks, DrawTechnique& technique) {
     // Each sorted place decodes its chunk's whole block into its own slot
     // (a block is decoded once per chunk: the price of keeping nothing); the

@@ -28,17 +28,17 @@ public:
 
     // Draws `blocks` blocks: the fine list's first ones (bound by the caller
     // to `fine_list`) when in.use_list, else blocks 0..blocks-1.
-    void draw(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind, GLuint fine_list,
+    void draw(const FrameInputs& in, const BlockDecoder& decoder, GpuDecoder kind, GLuint fine_list,
               std::uint32_t blocks, DrawTechnique& technique);
 
     std::uint64_t gpu_bytes() const { return std::uint64_t(capacity_) * 12 + std::uint64_t(kBuckets) * kLanes * 4; }
 
 private:
     void ensure_buffers(std::uint32_t scene_chunks);
-    void key_chunks(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind, GLuint fine_list,
+    void key_chunks(const FrameInputs& in, const BlockDecoder& decoder, GpuDecoder kind, GLuint fine_list,
                     std::uint32_t blocks);
     void sort_chunks(std::uint32_t scene_chunks);
-    void draw_sorted(const FrameInputs& in, const BlockDecoder& decoder, DecoderKind kind, std::uint32_t chunks,
+    void draw_sorted(const FrameInputs& in, const BlockDecoder& decoder, GpuDecoder kind, std::uint32_t chunks,
                      DrawTechnique& technique);
 
     std::uint32_t chunks_per_block_ = 0;

@@ -19,7 +19,7 @@ float axis_of(Vec3f v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.
 
 // Both ends of every segment of every fiber (file order), the fiber's index
 // in p0's w, from the GPU decoder's points (fibers' blocks are consecutive).
-std::vector<float> segment_ends(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind) {
+std::vector<float> segment_ends(const GpuScene& scene, const GpuPrograms& programs, GpuDecoder kind) {
     const std::vector<float> xyz = decode_blocks_on_gpu(scene, programs, kind, 0, scene.block_count());
     std::vector<float> ends;
     ends.reserve(std::size_t(scene.segment_count()) * 8);
@@ -40,7 +40,7 @@ std::vector<float> segment_ends(const GpuScene& scene, const GpuPrograms& progra
 
 }  // namespace
 
-Voxlines::Voxlines(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind)
+Voxlines::Voxlines(const GpuScene& scene, const GpuPrograms& programs, GpuDecoder kind)
     : scene_(&scene),
       program_(build_program({"voxline_quads.vert.glsl", "transparent_lines.frag.glsl"}, gpu_binding_defines())) {
     const std::vector<float> ends = segment_ends(scene, programs, kind);

@@ -20,7 +20,7 @@ class Voxlines {
 public:
     static constexpr float kVoxelMm = 10;  // the paper's voxel size
 
-    Voxlines(const GpuScene& scene, const GpuPrograms& programs, DecoderKind kind);
+    Voxlines(const GpuScene& scene, const GpuPrograms& programs, GpuDecoder kind);
 
     const GpuScene& scene() const { return *scene_; }
     std::uint64_t gpu_bytes() const { return gpu_bytes_; }

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "fiblet_viewer/decoder_kind.hpp"
+#include "fiblet_viewer/gpu_decoder.hpp"
 #include "fiblet_viewer/render_options.hpp"
 #include "fiblet_viewer/scene_sources.hpp"
 
@@ -81,7 +81,7 @@ struct VoxelRtPreprocessing {
 
 struct RenderBench {
     const char* timing = "";  // how stages are timed (timing_method_name of default_timing_method)
-    DecoderKind decoder = DecoderKind::scan;  // the decoder of the timed frames
+    GpuDecoder decoder = GpuDecoder::scan;  // the decoder of the timed frames
     std::vector<BenchCase> cases;
     std::optional<FullDecodeTimes> full_decode;      // bench_views holds "decode"
     std::optional<TransparencyBench> transparency;   // render.transparent()

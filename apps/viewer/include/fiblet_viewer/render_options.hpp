@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "fiblet_viewer/colormap_name.hpp"
-#include "fiblet_viewer/decoder_kind.hpp"
+#include "fiblet_viewer/gpu_decoder.hpp"
 #include "fiblet_viewer/draw_style.hpp"
 #include "fiblet_viewer/render_engine.hpp"
 #include "fiblet/view.hpp"
@@ -31,7 +31,7 @@ struct RenderOptions {
     std::uint32_t id_min = 0, id_max = std::numeric_limits<std::uint32_t>::max();
     double min_length_mm = 0, max_length_mm = std::numeric_limits<double>::infinity();
 
-    std::optional<DecoderKind> decoder;  // unset: default_decoder()
+    std::optional<GpuDecoder> decoder;  // unset: default_decoder()
 
     // Drawing style (techniques/) and shading.
     DrawStyle style = DrawStyle::lines;

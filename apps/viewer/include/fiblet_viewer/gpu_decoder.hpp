@@ -12,9 +12,9 @@
 
 namespace fiblet::viewer {
 
-enum class DecoderKind { scan, sequential };
+enum class GpuDecoder { scan, sequential };
 
-const char* decoder_name(DecoderKind k);
-std::optional<DecoderKind> parse_decoder(const std::string& name);
+const char* gpu_decoder_name(GpuDecoder k);
+std::optional<GpuDecoder> parse_gpu_decoder(const std::string& name);
 
 }  // namespace fiblet::viewer
