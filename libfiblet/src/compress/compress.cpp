@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <numeric>
 #include <memory>
 #include <span>
 #include <utility>
@@ -164,11 +165,11 @@ double normalize(FftHeader& h, const SourceScan& scan, double step, const std::s
 // the encoder's block size (plan_fiber_table, container/fft_writer.hpp).
 std::vector<FiberLutEntry> plan_blocks(FftHeader& h, const std::vector<std::uint32_t>& fiber_points,
                                        const FiberEncoder& encoder, const std::string& path) {
+    h.points += std::accumulate(fiber_points.begin(), fiber_points.end(), std::uint64_t{0});
     return detail::plan_fiber_table(h, fiber_points.size(), [&](std::size_t f) {
         const std::uint32_t blocks = encoder.block_count(fiber_points[f]);
         if (blocks > 0xffff)
             throw Error(Errc::unsupported, path + ": " + detail::streamline_label(f) + " needs more than 65535 blocks");
-        h.points += fiber_points[f];
         return detail::FiberBlocks{blocks, fiber_points[f]};
     }, path);
 }

@@ -12,6 +12,7 @@
 #include "fiblet/checksum.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/tck.hpp"
+#include "tractogram/tck/track_header.hpp"
 #include "core/points_avx2.hpp"
 #include "core/streamline_label.hpp"
 #include "io/open_inputs.hpp"
@@ -57,35 +58,9 @@ inline Kind classify(int n_nan, int n_inf) {
     return Kind::bad;
 }
 
-template <class U>
-U load_swapped(const char* p, bool swap) {
-    U u;
-    std::memcpy(&u, p, sizeof(U));
-    if (swap) {
-        if constexpr (sizeof(U) == 4)
-            u = __builtin_bswap32(u);
-        else
-            u = __builtin_bswap64(u);
-    }
-    return u;
-}
-
 // Decodes one triplet of any datatype into doubles (float32 converts exactly).
 inline void decode_triplet(const char* p, TckDataType t, double out[3]) {
-    const bool swap = t == TckDataType::float32be || t == TckDataType::float64be;
-    if (tck_datatype_size(t) == 4) {
-        for (int i = 0; i < 3; ++i) {
-            const auto u = load_swapped<std::uint32_t>(p + 4 * i, swap);
-            float f;
-            std::memcpy(&f, &u, 4);
-            out[i] = f;
-        }
-    } else {
-        for (int i = 0; i < 3; ++i) {
-            const auto u = load_swapped<std::uint64_t>(p + 8 * i, swap);
-            std::memcpy(&out[i], &u, 8);
-        }
-    }
+    for (int i = 0; i < 3; ++i) out[i] = detail::decode_track_value(p + i * tck_datatype_size(t), t);
 }
 
 }  // namespace

@@ -1,10 +1,7 @@
 // MRtrix3 track scalar files (.tsf, tcksample's output): the .tck header
 // with its own first line, then one value per point in the header's
 // datatype, NaN after each streamline, and Inf or the end of the file.
-#include <algorithm>
-#include <bit>
 #include <cmath>
-#include <cstring>
 #include <fstream>
 
 #include "fiblet/error.hpp"
@@ -17,23 +14,9 @@ namespace {
 
 // The values of the data section as the datatype says (Float32/64, LE/BE).
 std::vector<double> decode_values(TckDataType type, const std::string& data) {
-    const bool f32 = type == TckDataType::float32le || type == TckDataType::float32be;
-    const bool le = type == TckDataType::float32le || type == TckDataType::float64le;
-    const std::size_t width = f32 ? 4 : 8;
-    const bool swap = le != (std::endian::native == std::endian::little);
+    const std::size_t width = std::size_t(tck_datatype_size(type));
     std::vector<double> out(data.size() / width);
-    for (std::size_t i = 0; i < out.size(); ++i) {
-        unsigned char b[8];
-        std::memcpy(b, data.data() + i * width, width);
-        if (swap) std::reverse(b, b + width);
-        if (f32) {
-            float v;
-            std::memcpy(&v, b, 4);
-            out[i] = v;
-        } else {
-            std::memcpy(&out[i], b, 8);
-        }
-    }
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = detail::decode_track_value(data.data() + i * width, type);
     return out;
 }
 
