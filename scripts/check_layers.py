@@ -4,7 +4,9 @@ the format library (libfiblet/) knows nothing of the CLI, the viewer or the
 Python module; those use only public headers (libfiblet/include/fiblet/,
 apps/viewer/include/fiblet_viewer/ for the CLI) besides their own files;
 no quoted include climbs with ".."; the umbrella header fiblet.hpp includes
-every public header. Prints each violation; exit 1 if any.
+every public header; inside the viewer only the technique registry
+(techniques/technique_registry.cpp) switches on a drawing style,
+transparency mode or engine. Prints each violation; exit 1 if any.
 
   scripts/check_layers.py [ROOT]
 """
@@ -53,7 +55,22 @@ def umbrella_gaps():
             yield f"{umbrella.relative_to(ROOT)}: does not include fiblet/{h.name}"
 
 
-found = list(violations()) + list(umbrella_gaps())
+CHOICE = re.compile(r"(==|!=|case)\s*(viewer::)?(DrawStyle|RenderEngine|TransparencyMode)::"
+                    r"|(DrawStyle|RenderEngine|TransparencyMode)::\w+\s*(==|!=|\?)")
+REGISTRY = ROOT / "apps/viewer/techniques/technique_registry.cpp"
+
+
+def technique_switches():
+    """Comparisons with a style, mode or engine outside the registry."""
+    for src in sorted((ROOT / "apps/viewer").rglob("*")):
+        if src.suffix not in {".cpp", ".hpp"} or src == REGISTRY:
+            continue
+        for number, line in enumerate(src.read_text(errors="replace").splitlines(), 1):
+            if CHOICE.search(line):
+                yield f"{src.relative_to(ROOT)}:{number}: chooses a technique outside {REGISTRY.relative_to(ROOT)}"
+
+
+found = list(violations()) + list(umbrella_gaps()) + list(technique_switches())
 for v in found:
     print(v)
 print(f"check_layers: {len(found)} violation(s)")

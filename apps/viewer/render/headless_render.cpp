@@ -12,6 +12,7 @@
 #include "render/render_bench.hpp"
 #include "render/render_target.hpp"
 #include "render/renderer.hpp"
+#include "techniques/technique_registry.hpp"
 #include "render/supersampling.hpp"
 #include "scene/block_decoder.hpp"
 #include "scene/fiber_colors.hpp"
@@ -29,7 +30,7 @@ namespace {
 // The voxel ray tracer's one-off preprocessing, when it ran.
 std::optional<VoxelRtPreprocessing> voxel_rt_preprocessing(const Renderer& renderer, const RenderOptions& options) {
     const voxel_rt::VoxelRayTracer* rt =
-        options.engine == RenderEngine::voxel_rt ? renderer.voxel_ray_tracer_if_made() : nullptr;
+        ray_traced(options) ? renderer.voxel_ray_tracer_if_made() : nullptr;
     const voxel_rt::VoxelStructure* vs = rt ? rt->structure() : nullptr;
     if (!vs) return std::nullopt;
     const voxel_rt::BuildTimes& bt = vs->times();

@@ -6,7 +6,6 @@
 #include "gl/gpu_timer.hpp"
 #include "gl/shader_program.hpp"
 #include "render/shading_uniforms.hpp"
-#include "techniques/make_technique.hpp"
 #include "render/vec_ops.hpp"
 
 namespace fiblet::viewer {
@@ -23,7 +22,7 @@ std::uint32_t points_for_length(double mm, double step_mm, bool round_up) {
 
 }  // namespace
 
-Renderer::Renderer(const GpuPrograms& programs) : programs_(programs) {
+Renderer::Renderer(const GpuPrograms& programs) : programs_(programs), techniques_(programs) {
     GLuint vao = 0;
     glCreateVertexArrays(1, &vao);
     empty_vertex_array_ = GlVertexArray(vao);
@@ -71,7 +70,7 @@ DrawCounters Renderer::select_blocks(const GpuScene& scene, const Camera& camera
     glProgramUniform1i(id, uniform(p, "uFrustumCulling"), o.frustum_culling ? 1 : 0);
     glProgramUniform4fv(id, uniform(p, "uPlanes"), 6, planes);
     // Spheres grow by what the style draws beyond the centre lines (a tube's radius).
-    glProgramUniform1f(id, uniform(p, "uSphereMargin"), technique(o.style).reach_mm(scene, o));
+    glProgramUniform1f(id, uniform(p, "uSphereMargin"), techniques_.style(o.style).reach_mm(scene, o));
     const CameraBasis basis = camera_basis(camera);
     glProgramUniform1i(id, uniform(p, "uLevelOfDetail"), o.level_of_detail ? 1 : 0);
     glProgramUniform1f(id, uniform(p, "uLodPixels"), o.lod_pixels);
@@ -92,12 +91,6 @@ DrawCounters Renderer::select_blocks(const GpuScene& scene, const Camera& camera
     return c;
 }
 
-DrawTechnique& Renderer::technique(DrawStyle style) {
-    auto& t = techniques_[style];
-    if (!t) t = make_technique(style);
-    return *t;
-}
-
 voxel_rt::VoxelRayTracer& Renderer::voxel_ray_tracer() {
     if (!voxel_ray_tracer_) voxel_ray_tracer_ = std::make_unique<voxel_rt::VoxelRayTracer>(programs_);
     return *voxel_ray_tracer_;
@@ -105,7 +98,7 @@ voxel_rt::VoxelRayTracer& Renderer::voxel_ray_tracer() {
 
 FrameStats Renderer::render(const GpuScene& scene, const Camera& requested, const RenderOptions& options,
                             RenderTarget& target) {
-    if (options.engine == RenderEngine::voxel_rt) return voxel_ray_tracer().render(scene, requested, options, target);
+    if (ray_traced(options)) return voxel_ray_tracer().render(scene, requested, options, target);
     // Near and far planes widened to hold the overlays (overlay.hpp).
     const Camera camera = clip_planes_covering(requested, overlays_);
     RenderOptions o = options;
@@ -143,22 +136,15 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& requested, cons
 
     const FrameInputs in{scene, camera, o, select, o.ambient_occlusion ? &occlusion : nullptr};
     if (o.transparent()) blend_target_.begin(target, o.clear, o.background);
-    if (o.transparent() && o.transparency != TransparencyMode::unsorted &&
-        (o.style == DrawStyle::lines || block_technique(o).draws_chunks())) {
-        timer.begin(Stage::draw);
-        draw_ordered(in, decoder, std::uint32_t(stats.fine_blocks));
-        timer.end();
-    } else {
-        DrawTechnique& draw = block_technique(o);
-        draw.begin_frame(in);
-        draw_blocks(in, draw, decoder, std::uint32_t(stats.fine_blocks), timer);
-    }
+    const FramePlan plan = techniques_.plan(o);
+    plan.order.draw(in, {*decoder_, decoder, fine_list_.get(), std::uint32_t(stats.fine_blocks), timer},
+                    plan.technique);
 
     // Coarse blocks: one segment each, straight from the raw blocks.
     if (stats.coarse_blocks > 0) {
         timer.begin(Stage::draw);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kCoarseList, coarse_list_.get());
-        technique(o.style).draw_coarse(in, std::uint32_t(stats.coarse_blocks));
+        techniques_.style(o.style).draw_coarse(in, std::uint32_t(stats.coarse_blocks));
         timer.end();
     }
 
@@ -187,46 +173,8 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& requested, cons
     return stats;
 }
 
-DrawTechnique& Renderer::block_technique(const RenderOptions& o) {
-    if (!o.transparent() || o.style != DrawStyle::lines) return technique(o.style);
-    if (!transparent_lines_) transparent_lines_ = std::make_unique<TransparentLines>();
-    return *transparent_lines_;
-}
-
-void Renderer::draw_blocks(const FrameInputs& in, DrawTechnique& draw, GpuDecoder decoder, std::uint32_t blocks,
-                           GpuTimer& timer) {
-    for (std::uint32_t first = 0; first < blocks; first += decoder_->capacity()) {
-        const std::uint32_t count = std::min<std::uint32_t>(decoder_->capacity(), blocks - first);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, fine_list_.get());
-        timer.begin(Stage::decode);
-        decoder_->decode(in.scene, decoder, in.use_list, first, count, draw.needs_tangents());
-        timer.end();
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        timer.begin(Stage::draw);
-        draw.draw_batch(in, {decoder_->points_buffer(), decoder_->tangents_buffer(), first, count});
-        timer.end();
-        // The next batch overwrites the points this draw reads.
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-    }
-}
-
-void Renderer::draw_ordered(const FrameInputs& in, GpuDecoder decoder, std::uint32_t blocks) {
-    if (in.options.transparency == TransparencyMode::voxlines && in.options.style == DrawStyle::lines) {
-        // Voxlines keep their own copy of every segment, built once per scene.
-        if (!voxlines_ || &voxlines_->scene() != &in.scene)
-            voxlines_ = std::make_unique<Voxlines>(in.scene, programs_, decoder);
-        voxlines_->draw(in);
-        return;
-    }
-    if (!sorted_chunks_) sorted_chunks_ = std::make_unique<SortedChunks>();
-    DrawTechnique& draw = block_technique(in.options);
-    draw.begin_frame(in);
-    sorted_chunks_->draw(in, *decoder_, decoder, fine_list_.get(), blocks, draw);
-}
-
 std::uint64_t Renderer::transparency_bytes() const {
-    return blend_target_.gpu_bytes() + (sorted_chunks_ ? sorted_chunks_->gpu_bytes() : 0) +
-           (voxlines_ ? voxlines_->gpu_bytes() : 0);
+    return blend_target_.gpu_bytes() + techniques_.order_bytes();
 }
 
 std::vector<BlockDecision> Renderer::read_decisions(const GpuScene& scene) const {

@@ -8,7 +8,6 @@
 // Overlays (overlays/) follow the fibers in the same frame.
 #pragma once
 
-#include <map>
 #include <memory>
 #include <vector>
 
@@ -23,11 +22,8 @@
 #include "gl/gpu_timer.hpp"
 #include "fiblet_viewer/render_options.hpp"
 #include "render/render_target.hpp"
-#include "techniques/draw_technique.hpp"
+#include "techniques/technique_registry.hpp"
 #include "transparency/blend_target.hpp"
-#include "transparency/sorted_chunks.hpp"
-#include "transparency/transparent_lines.hpp"
-#include "transparency/voxlines.hpp"
 #include "voxel_rt/voxel_ray_tracer.hpp"
 
 namespace fiblet::viewer {
@@ -54,7 +50,7 @@ public:
     // Draws `style` with `technique` from now on instead of its default
     // module (tests: a technique built with other parameters).
     void use_technique(DrawStyle style, std::unique_ptr<DrawTechnique> technique) {
-        techniques_[style] = std::move(technique);
+        techniques_.replace(style, std::move(technique));
     }
 
     // Overlays (glyphs, image slices) drawn after the fibers of every frame,
@@ -69,32 +65,17 @@ public:
 
 private:
     void ensure_buffers(const GpuScene& scene, bool decisions);
-    // The style's technique, compiled on first use.
-    DrawTechnique& technique(DrawStyle style);
-    // What draws the frame's fine blocks: the style's technique, or the
-    // transparent lines when lines blend.
-    DrawTechnique& block_technique(const RenderOptions& o);
-    // The fine blocks decoded and drawn a batch at a time, in list order.
-    void draw_blocks(const FrameInputs& in, DrawTechnique& draw, GpuDecoder decoder, std::uint32_t blocks,
-                     GpuTimer& timer);
-    // A transparent frame in the order of o.transparency (transparency/):
-    // voxlines (lines), or sorted chunks drawn through the frame's technique.
-    void draw_ordered(const FrameInputs& in, GpuDecoder decoder, std::uint32_t blocks);
 
     const GpuPrograms& programs_;
     std::unique_ptr<voxel_rt::VoxelRayTracer> voxel_ray_tracer_;  // made on first use
     std::unique_ptr<BlockDecoder> decoder_;
-    std::map<DrawStyle, std::unique_ptr<DrawTechnique>> techniques_;
+    TechniqueRegistry techniques_;
     GlBuffer fine_list_, coarse_list_, counters_, decisions_;
     std::uint32_t list_capacity_ = 0, decisions_capacity_ = 0;
     std::vector<std::shared_ptr<Overlay>> overlays_;
     GlVertexArray empty_vertex_array_;  // core profile draws need one bound
-    // Transparency (transparency/), made on first use.
-    BlendTarget blend_target_;
-    std::unique_ptr<TransparentLines> transparent_lines_;
+    BlendTarget blend_target_;             // transparent frames (transparency/)
     std::unique_ptr<ColorBar> color_bar_;  // made when a frame first shows one
-    std::unique_ptr<SortedChunks> sorted_chunks_;
-    std::unique_ptr<Voxlines> voxlines_;
 };
 
 }  // namespace fiblet::viewer

@@ -42,19 +42,22 @@ void SortedChunks::ensure_buffers(std::uint32_t scene_chunks) {
     sorted_chunks_ = make_buffer(GLsizeiptr(capacity_) * 4, nullptr, 0);
 }
 
-void SortedChunks::draw(const FrameInputs& in, const BlockDecoder& decoder, GpuDecoder kind, GLuint fine_list,
-                        std::uint32_t blocks, DrawTechnique& technique) {
-    if (blocks == 0) return;
+void SortedChunks::draw(const FrameInputs& in, const FrameBlocks& blocks, DrawTechnique& technique) {
+    technique.begin_frame(in);
+    if (blocks.count == 0) return;
+    // Timed as one draw stage: its decodes interleave with the sort.
+    blocks.timer.begin(Stage::draw);
     chunks_per_block_ = (in.scene.header().points_per_block + kChunkSegments - 1) / kChunkSegments;
     const std::uint32_t scene_chunks = in.scene.block_count() * chunks_per_block_;
     ensure_buffers(scene_chunks);
-    key_chunks(in, decoder, kind, fine_list, blocks);
+    key_chunks(in, blocks);
     sort_chunks(scene_chunks);
-    draw_sorted(in, decoder, kind, blocks * chunks_per_block_, technique);
+    draw_sorted(in, blocks, blocks.count * chunks_per_block_, technique);
+    blocks.timer.end();
 }
 
-void SortedChunks::key_chunks(const FrameInputs& in, const BlockDecoder& decoder, GpuDecoder kind,
-                              GLuint fine_list, std::uint32_t blocks) {
+void SortedChunks::key_chunks(const FrameInputs& in, const FrameBlocks& blocks) {
+    const BlockDecoder& decoder = blocks.decoder;
     const GLuint id = keys_.get();
     const Camera& camera = in.camera;
     const Vec3f forward = normalized(sub(camera.target, camera.position));
@@ -70,10 +73,10 @@ void SortedChunks::key_chunks(const FrameInputs& in, const BlockDecoder& decoder
     const GLuint no_key = 0xffffffffu;  // chunk_count.comp.glsl's NO_KEY: blocks this frame does not draw
     glClearNamedBufferData(chunk_keys_.get(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &no_key);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-    for (std::uint32_t first = 0; first < blocks; first += decoder.capacity()) {
-        const std::uint32_t count = std::min(decoder.capacity(), blocks - first);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, fine_list);
-        decoder.decode(in.scene, kind, in.use_list, first, count);
+    for (std::uint32_t first = 0; first < blocks.count; first += decoder.capacity()) {
+        const std::uint32_t count = std::min(decoder.capacity(), blocks.count - first);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, blocks.fine_list);
+        decoder.decode(in.scene, blocks.kind, in.use_list, first, count);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         glUseProgram(id);
         in.scene.bind(keys_);
@@ -115,15 +118,16 @@ void SortedChunks::sort_chunks(std::uint32_t chunks) {
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
-void SortedChunks::draw_sorted(const FrameInputs& in, const BlockDecoder& decoder, GpuDecoder kind,
-                               std::uint32_t chunks, DrawTechnique& technique) {
+void SortedChunks::draw_sorted(const FrameInputs& in, const FrameBlocks& blocks, std::uint32_t chunks,
+                               DrawTechnique& technique) {
+    const BlockDecoder& decoder = blocks.decoder;
     // Each sorted place decodes its chunk's whole block into its own slot
     // (a block is decoded once per chunk: the price of keeping nothing); the
     // technique then reads the places' entries as its list.
     for (std::uint32_t first = 0; first < chunks; first += decoder.capacity()) {
         const std::uint32_t count = std::min(decoder.capacity(), chunks - first);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, sorted_blocks_.get());
-        decoder.decode(in.scene, kind, true, first, count, technique.needs_tangents());
+        decoder.decode(in.scene, blocks.kind, true, first, count, technique.needs_tangents());
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding::kFineList, sorted_chunks_.get());
         technique.draw_chunks(in, {decoder.points_buffer(), decoder.tangents_buffer(), first, count}, kChunkSegments,

@@ -13,12 +13,11 @@
 
 #include <cstdint>
 
-#include "scene/block_decoder.hpp"
-#include "techniques/draw_technique.hpp"
+#include "techniques/frame_order.hpp"
 
 namespace fiblet::viewer {
 
-class SortedChunks {
+class SortedChunks final : public FrameOrder {
 public:
     static constexpr std::uint32_t kChunkSegments = 10;  // ~1 mm at 0.1 mm steps
     static constexpr std::uint32_t kBuckets = 1024;      // depth buckets across the scene's box
@@ -26,20 +25,15 @@ public:
 
     SortedChunks();
 
-    // Draws `blocks` blocks: the fine list's first ones (bound by the caller
-    // to `fine_list`) when in.use_list, else blocks 0..blocks-1.
-    void draw(const FrameInputs& in, const BlockDecoder& decoder, GpuDecoder kind, GLuint fine_list,
-              std::uint32_t blocks, DrawTechnique& technique);
-
-    std::uint64_t gpu_bytes() const { return std::uint64_t(capacity_) * 12 + std::uint64_t(kBuckets) * kLanes * 4; }
+    // The technique must draw chunks (DrawTechnique::draws_chunks).
+    void draw(const FrameInputs& in, const FrameBlocks& blocks, DrawTechnique& technique) override;
+    std::uint64_t gpu_bytes() const override { return std::uint64_t(capacity_) * 12 + std::uint64_t(kBuckets) * kLanes * 4; }
 
 private:
     void ensure_buffers(std::uint32_t scene_chunks);
-    void key_chunks(const FrameInputs& in, const BlockDecoder& decoder, GpuDecoder kind, GLuint fine_list,
-                    std::uint32_t blocks);
+    void key_chunks(const FrameInputs& in, const FrameBlocks& blocks);
     void sort_chunks(std::uint32_t scene_chunks);
-    void draw_sorted(const FrameInputs& in, const BlockDecoder& decoder, GpuDecoder kind, std::uint32_t chunks,
-                     DrawTechnique& technique);
+    void draw_sorted(const FrameInputs& in, const FrameBlocks& blocks, std::uint32_t chunks, DrawTechnique& technique);
 
     std::uint32_t chunks_per_block_ = 0;
     GlProgram keys_, count_, scan_, scatter_;

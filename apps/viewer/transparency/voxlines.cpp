@@ -135,4 +135,13 @@ void Voxlines::draw(const FrameInputs& in) {
     }
 }
 
+void VoxlineOrder::draw(const FrameInputs& in, const FrameBlocks& blocks, DrawTechnique& /*transparent lines*/) {
+    blocks.timer.begin(Stage::draw);
+    // Voxlines keep their own copy of every segment, built once per scene.
+    if (!voxlines_ || &voxlines_->scene() != &in.scene)
+        voxlines_ = std::make_unique<Voxlines>(in.scene, programs_, blocks.kind);
+    voxlines_->draw(in);
+    blocks.timer.end();
+}
+
 }  // namespace fiblet::viewer

@@ -11,8 +11,10 @@
 #include <cstdint>
 #include <vector>
 
+#include <memory>
+
 #include "scene/gpu_programs.hpp"
-#include "techniques/draw_technique.hpp"
+#include "techniques/frame_order.hpp"
 
 namespace fiblet::viewer {
 
@@ -42,6 +44,19 @@ private:
     GlBuffer segment_ends_, orders_;
     std::uint64_t gpu_bytes_ = 0;
     GlProgram program_;
+};
+
+// Voxlines as a frame's order (lines only): built on a scene's first frame,
+// drawn instead of the decoded blocks, with the transparent lines' shading.
+class VoxlineOrder final : public FrameOrder {
+public:
+    explicit VoxlineOrder(const GpuPrograms& programs) : programs_(programs) {}
+    void draw(const FrameInputs& in, const FrameBlocks& blocks, DrawTechnique& technique) override;
+    std::uint64_t gpu_bytes() const override { return voxlines_ ? voxlines_->gpu_bytes() : 0; }
+
+private:
+    const GpuPrograms& programs_;
+    std::unique_ptr<Voxlines> voxlines_;
 };
 
 }  // namespace fiblet::viewer

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "render/renderer.hpp"
+#include "techniques/technique_registry.hpp"
 
 namespace fiblet::viewer {
 
@@ -32,7 +33,7 @@ std::optional<PickedFiber> pick_fiber(const RenderTarget& target, const GpuScene
 std::optional<PickedFiber> pick_fiber_in_frame(Renderer& renderer, const GpuScene& scene, const Camera& camera,
                                                const RenderOptions& options, RenderTarget& target, int x, int y,
                                                int radius_px) {
-    if (options.transparent() && options.engine == RenderEngine::raster) {
+    if (options.transparent() && !ray_traced(options)) {
         RenderOptions opaque = options;
         opaque.opacity = 1;
         opaque.fiber_opacity = false;

@@ -25,6 +25,7 @@
 #include "gl/png_file.hpp"
 #include "render/render_target.hpp"
 #include "render/renderer.hpp"
+#include "techniques/technique_registry.hpp"
 #include "scene/fiber_opacity.hpp"
 #include "scene/fiber_radii.hpp"
 #include "render/supersampling.hpp"
@@ -98,13 +99,10 @@ void on_key(GLFWwindow* w, int key, int, int action, int) {
         case GLFW_KEY_MINUS:
         case GLFW_KEY_KP_SUBTRACT: s.render.line_width = std::max(s.render.line_width - 1, 1.0f); break;
         case GLFW_KEY_T:
-            s.render.style = s.render.style == DrawStyle::lines   ? DrawStyle::tubes
-                             : s.render.style == DrawStyle::tubes ? DrawStyle::capsules
-                                                                  : DrawStyle::lines;
+            s.render.style = next_style(s.render.style);
             break;
         case GLFW_KEY_E:
-            s.render.engine =
-                s.render.engine == RenderEngine::raster ? RenderEngine::voxel_rt : RenderEngine::raster;
+            s.render.engine = next_engine(s.render.engine);
             break;
         case GLFW_KEY_W: s.save_selection = true; break;
         case GLFW_KEY_H: fmt::print("{}", window_controls_help()); break;
@@ -237,7 +235,7 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
         } catch (const Error& e) {
             // E on a scene the voxel ray tracer refuses (its buffers): say
             // why and keep drawing with the rasterizer.
-            if (s.render.engine != RenderEngine::voxel_rt || e.code() != Errc::unsupported) throw;
+            if (!ray_traced(s.render) || e.code() != Errc::unsupported) throw;
             fmt::print(stderr, "{}; back to --engine raster\n", e.what());
             s.render.engine = RenderEngine::raster;
             s.dirty = true;
@@ -255,7 +253,7 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
                            "segments | {} | culling {} LoD {}",
                            title, frame_ms, st.cull_ms, st.decode_ms, st.draw_ms, st.drawn_blocks(), st.coarse_blocks,
                            st.drawn_segments(),
-                           s.render.engine == RenderEngine::voxel_rt ? "voxel-rt" : draw_style_name(s.render.style),
+                           technique_label(s.render),
                            s.render.frustum_culling ? "on" : "off",
                            s.render.level_of_detail ? "on" : "off")
                    .c_str());

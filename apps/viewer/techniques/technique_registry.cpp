@@ -1,0 +1,93 @@
+#include "techniques/technique_registry.hpp"
+
+#include <array>
+
+#include "techniques/capsules/capsules_technique.hpp"
+#include "techniques/lines/lines_technique.hpp"
+#include "techniques/tubes/tubes_technique.hpp"
+#include "transparency/sorted_chunks.hpp"
+#include "transparency/transparent_lines.hpp"
+#include "transparency/voxlines.hpp"
+
+namespace fiblet::viewer {
+
+namespace {
+
+// In the order the window's T key cycles them.
+constexpr std::array kStyles{std::pair{DrawStyle::lines, "lines"}, std::pair{DrawStyle::tubes, "tubes"},
+                             std::pair{DrawStyle::capsules, "capsules"}};
+
+std::unique_ptr<DrawTechnique> make_technique(DrawStyle style) {
+    switch (style) {
+        case DrawStyle::lines: return std::make_unique<LinesTechnique>();
+        case DrawStyle::tubes: return std::make_unique<TubesTechnique>();
+        case DrawStyle::capsules: return std::make_unique<CapsulesTechnique>();
+    }
+    return nullptr;
+}
+
+}  // namespace
+
+const char* draw_style_name(DrawStyle style) {
+    for (const auto& [s, name] : kStyles)
+        if (s == style) return name;
+    return "?";
+}
+
+std::optional<DrawStyle> parse_draw_style(const std::string& name) {
+    for (const auto& [s, n] : kStyles)
+        if (name == n) return s;
+    return std::nullopt;
+}
+
+std::string draw_style_names() {
+    std::string out;
+    for (const auto& [s, name] : kStyles) out += (out.empty() ? "" : ", ") + std::string(name);
+    return out;
+}
+
+bool ray_traced(const RenderOptions& options) { return options.engine == RenderEngine::voxel_rt; }
+
+DrawStyle next_style(DrawStyle style) {
+    for (std::size_t i = 0; i < kStyles.size(); ++i)
+        if (kStyles[i].first == style) return kStyles[(i + 1) % kStyles.size()].first;
+    return kStyles[0].first;
+}
+
+RenderEngine next_engine(RenderEngine engine) {
+    return engine == RenderEngine::raster ? RenderEngine::voxel_rt : RenderEngine::raster;
+}
+
+std::string technique_label(const RenderOptions& options) {
+    return ray_traced(options) ? render_engine_name(options.engine) : draw_style_name(options.style);
+}
+
+DrawTechnique& TechniqueRegistry::style(DrawStyle style) {
+    auto& t = styles_[style];
+    if (!t) t = make_technique(style);
+    return *t;
+}
+
+DrawTechnique& TechniqueRegistry::blending(DrawStyle s) {
+    if (s != DrawStyle::lines) return style(s);
+    if (!transparent_lines_) transparent_lines_ = std::make_unique<TransparentLines>();
+    return *transparent_lines_;
+}
+
+FramePlan TechniqueRegistry::plan(const RenderOptions& o) {
+    if (!o.transparent()) return {style(o.style), list_order_};
+    DrawTechnique& technique = blending(o.style);
+    if (o.transparency == TransparencyMode::voxlines && o.style == DrawStyle::lines) {
+        if (!voxlines_) voxlines_ = std::make_unique<VoxlineOrder>(programs_);
+        return {technique, *voxlines_};
+    }
+    if (o.transparency == TransparencyMode::unsorted || !technique.draws_chunks()) return {technique, list_order_};
+    if (!sorted_chunks_) sorted_chunks_ = std::make_unique<SortedChunks>();
+    return {technique, *sorted_chunks_};
+}
+
+std::uint64_t TechniqueRegistry::order_bytes() const {
+    return (sorted_chunks_ ? sorted_chunks_->gpu_bytes() : 0) + (voxlines_ ? voxlines_->gpu_bytes() : 0);
+}
+
+}  // namespace fiblet::viewer
