@@ -266,56 +266,63 @@ struct FiberEncoder::Encoding {
     };
 
     const FiberEncoder& enc;
-    const FftHeader& h;
+    const FftHeader& header;
     std::span<const Vec3f> fiber;
     std::uint32_t fiber_id;
     std::vector<std::uint8_t>& out;
-    Scratch& s;
-    const std::uint32_t ppb, bb;
+    Scratch& scratch;
+    const std::uint32_t points_per_block, block_bytes;
     const std::size_t n_points, base;
     const std::uint32_t n_blocks;
     const bool wide;
 
-    Encoding(const FiberEncoder& e, std::span<const Vec3f> f, std::uint32_t id, std::vector<std::uint8_t>& o, Scratch& scratch)
-        : enc(e), h(e.header_), fiber(f), fiber_id(id), out(o), s(scratch), ppb(h.points_per_block),
-          bb(h.block_bytes()), n_points(f.size()), base(o.size()), n_blocks(e.block_count(f.size())),
-          wide(e.tables_->table16.has_value()) {
-        out.resize(base + std::size_t(n_blocks) * bb, 0);
-        s.targets.resize(n_points);
-        s.points.resize(n_points);
-        s.frames.resize(n_blocks);
-        s.starts.resize(wide ? 0 : n_blocks);
-        if (wide) s.codes16.assign(n_points, 0);
+    Encoding(const FiberEncoder& e, std::span<const Vec3f> f, std::uint32_t id, std::vector<std::uint8_t>& o,
+             Scratch& s)
+        : enc(e), header(e.header_), fiber(f), fiber_id(id), out(o), scratch(s),
+          points_per_block(header.points_per_block), block_bytes(header.block_bytes()), n_points(f.size()),
+          base(o.size()), n_blocks(e.block_count(f.size())), wide(e.tables_->table16.has_value()) {
+        out.resize(base + std::size_t(n_blocks) * block_bytes, 0);
+        scratch.targets.resize(n_points);
+        scratch.points.resize(n_points);
+        scratch.frames.resize(n_blocks);
+        scratch.starts.resize(wide ? 0 : n_blocks);
+        if (wide) scratch.codes16.assign(n_points, 0);
         // Normalized; written per coordinate so that the compiler vectorizes it.
-        const double inv_scaling = 1.0 / double(h.scaling), offset[3] = {h.offset[0], h.offset[1], h.offset[2]};
+        const double inv_scaling = 1.0 / double(header.scaling),
+                     offset[3] = {header.offset[0], header.offset[1], header.offset[2]};
         const float* in = n_points ? &fiber[0].x : nullptr;
-        float* target = n_points ? &s.targets[0].x : nullptr;
+        float* target = n_points ? &scratch.targets[0].x : nullptr;
         for (std::size_t k = 0; k < n_points; ++k)
             for (int c = 0; c < 3; ++c) target[3 * k + c] = float((double(in[3 * k + c]) + offset[c]) * inv_scaling + 0.5);
     }
 
     std::uint32_t block_points(std::uint32_t b) const {
-        return std::uint32_t(std::min<std::size_t>(ppb, n_points - std::size_t(b) * ppb));
+        return std::uint32_t(std::min<std::size_t>(points_per_block, n_points - std::size_t(b) * points_per_block));
     }
     // How far a block of n points reaches from its second anchor (normalized).
-    double block_reach(std::uint32_t n) const { return n > 2 ? double(h.step) * double(n - 2) * 1.01 : 0.0; }
+    double block_reach(std::uint32_t n) const { return n > 2 ? double(header.step) * double(n - 2) * 1.01 : 0.0; }
     // The codes of block b: points i0 + 2 .. i0 + n.
-    std::uint8_t* codes8_of(std::uint32_t b) { return &out[base + std::size_t(b) * bb + kBlockDirectionsOffset]; }
+    std::uint8_t* codes8_of(std::uint32_t b) {
+        return &out[base + std::size_t(b) * block_bytes + kBlockDirectionsOffset];
+    }
     Codebook8 codebook8() const { return {*enc.tables_->table8, *enc.tables_->lut8}; }
-    bool robust(std::uint32_t b) const { return s.starts[b].divergence > kRobustDivergence; }
+    bool robust(std::uint32_t b) const { return scratch.starts[b].divergence > kRobustDivergence; }
     const SearchOptions& search() const { return enc.search_; }
     Vec3f world(Vec3d p) const {
-        return Vec3f{float((p.x - 0.5) * double(h.scaling) - double(h.offset[0])),
-                     float((p.y - 0.5) * double(h.scaling) - double(h.offset[1])),
-                     float((p.z - 0.5) * double(h.scaling) - double(h.offset[2]))};
+        return Vec3f{float((p.x - 0.5) * double(header.scaling) - double(header.offset[0])),
+                     float((p.y - 0.5) * double(header.scaling) - double(header.offset[1])),
+                     float((p.z - 0.5) * double(header.scaling) - double(header.offset[2]))};
     }
 
     // Block b's codes with the beam search `sp`, into c8 / c16 and `dec`.
     void search_block(std::uint32_t b, const SearchParams& sp, std::uint8_t* c8, std::uint16_t* c16, Vec3f* dec) const {
-        const std::size_t i0 = std::size_t(b) * ppb;
-        const std::span<const Vec3f> t(&s.targets[i0 + 2], block_points(b) - 2);
-        if (wide) search_codes(Codebook16{*enc.tables_->table16}, sp, s.frames[b], s.points[i0 + 1], h.step, t, c16, dec);
-        else search_codes(codebook8(), sp, s.frames[b], s.points[i0 + 1], h.step, t, c8, dec);
+        const std::size_t i0 = std::size_t(b) * points_per_block;
+        const std::span<const Vec3f> t(&scratch.targets[i0 + 2], block_points(b) - 2);
+        if (wide)
+            search_codes(Codebook16{*enc.tables_->table16}, sp, scratch.frames[b], scratch.points[i0 + 1], header.step,
+                         t, c16, dec);
+        else
+            search_codes(codebook8(), sp, scratch.frames[b], scratch.points[i0 + 1], header.step, t, c8, dec);
     }
 
     void write_block_heads();
@@ -338,7 +345,7 @@ struct FiberEncoder::Encoding {
 // a renderer needs), a one-point fiber the point itself.
 void FiberEncoder::Encoding::write_block_heads() {
     for (std::uint32_t b = 0; b < n_blocks; ++b) {
-        const std::size_t i0 = std::size_t(b) * ppb;
+        const std::size_t i0 = std::size_t(b) * points_per_block;
         const std::uint32_t n = block_points(b);
         const Vec3f p0 = fiber[i0];
         Vec3f p1 = p0;
@@ -347,14 +354,17 @@ void FiberEncoder::Encoding::write_block_heads() {
         } else if (i0 > 0) {
             p1 = {2 * p0.x - fiber[i0 - 1].x, 2 * p0.y - fiber[i0 - 1].y, 2 * p0.z - fiber[i0 - 1].z};
         }
-        const DecoderStarts head =
-            write_block_head(h, &out[base + std::size_t(b) * bb], p0, p1, fiber_id, b, n_blocks, n, block_reach(n));
-        s.points[i0] = head.a0;
-        if (n >= 2) s.points[i0 + 1] = head.a1;
-        const BlockView16 written{&out[base + std::size_t(b) * bb]};
-        if (wide) s.frames[b] = frame_from_axis(h.packed() ? packed16_anchor_axis(written) : anchor_axis(head.a0, head.a1));
-        else s.frames[b] = head.frame;
-        if (!wide) s.starts[b] = head;
+        const DecoderStarts head = write_block_head(header, &out[base + std::size_t(b) * block_bytes], p0, p1, fiber_id,
+                                                    b, n_blocks, n, block_reach(n));
+        scratch.points[i0] = head.a0;
+        if (n >= 2) scratch.points[i0 + 1] = head.a1;
+        const BlockView16 written{&out[base + std::size_t(b) * block_bytes]};
+        if (wide)
+            scratch.frames[b] =
+                frame_from_axis(header.packed() ? packed16_anchor_axis(written) : anchor_axis(head.a0, head.a1));
+        else
+            scratch.frames[b] = head.frame;
+        if (!wide) scratch.starts[b] = head;
     }
 }
 
@@ -365,8 +375,9 @@ void FiberEncoder::Encoding::search_blocks() {
     const SearchParams params{search().beam_width, search().radius};
     for (std::uint32_t b = 0; b < n_blocks; ++b)
         if (block_points(b) > 2)
-            search_block(b, params, wide ? nullptr : codes8_of(b), wide ? s.codes16.data() + std::size_t(b) * ppb : nullptr,
-                         &s.points[std::size_t(b) * ppb + 2]);
+            search_block(b, params, wide ? nullptr : codes8_of(b),
+                         wide ? scratch.codes16.data() + std::size_t(b) * points_per_block : nullptr,
+                         &scratch.points[std::size_t(b) * points_per_block + 2]);
 }
 
 // The first search of several fibers' blocks: 8-bit greedy or lookahead
@@ -376,7 +387,7 @@ void FiberEncoder::Encoding::search_blocks() {
 void FiberEncoder::Encoding::search_blocks_together(std::span<Encoding> fibers) {
     if (fibers.empty()) return;
     const Encoding& first = fibers.front();
-    if (first.wide || first.search().beam_width > 1 || first.ppb <= 2) {
+    if (first.wide || first.search().beam_width > 1 || first.points_per_block <= 2) {
         for (Encoding& e : fibers) e.search_blocks();
         return;
     }
@@ -392,17 +403,21 @@ void FiberEncoder::Encoding::search_blocks_together(std::span<Encoding> fibers) 
     if (blocks.empty()) return;  // fibers of at most two points a block: no codes
     std::stable_sort(blocks.begin(), blocks.end(), [](const Block& x, const Block& y) { return x.m > y.m; });
     thread_local BlockBatch batch;
-    batch.reset(first.ppb - 2, blocks.size());
+    batch.reset(first.points_per_block - 2, blocks.size());
     for (std::size_t j = 0; j < blocks.size(); ++j) {
         const Encoding& e = *blocks[j].e;
-        const std::size_t i0 = std::size_t(blocks[j].b) * e.ppb;
-        batch.set(j, e.s.frames[blocks[j].b], e.s.points[i0 + 1], std::span<const Vec3f>(&e.s.targets[i0 + 2], blocks[j].m));
+        const std::size_t i0 = std::size_t(blocks[j].b) * e.points_per_block;
+        batch.set(j, e.scratch.frames[blocks[j].b], e.scratch.points[i0 + 1],
+                  std::span<const Vec3f>(&e.scratch.targets[i0 + 2], blocks[j].m));
     }
-    if (first.search().lookahead > 0) lookahead_blocks(first.codebook8(), first.h.step, first.search().lookahead, batch.batch());
-    else greedy_blocks(first.codebook8(), first.h.step, batch.batch());
+    if (first.search().lookahead > 0)
+        lookahead_blocks(first.codebook8(), first.header.step, first.search().lookahead, batch.batch());
+    else
+        greedy_blocks(first.codebook8(), first.header.step, batch.batch());
     for (std::size_t j = 0; j < blocks.size(); ++j) {
         Encoding& e = *blocks[j].e;
-        std::copy_n(batch.decoded_of(j), blocks[j].m, &e.s.points[std::size_t(blocks[j].b) * e.ppb + 2]);
+        std::copy_n(batch.decoded_of(j), blocks[j].m,
+                    &e.scratch.points[std::size_t(blocks[j].b) * e.points_per_block + 2]);
         std::copy_n(batch.codes_of(j), blocks[j].m, e.codes8_of(blocks[j].b));
     }
 }
@@ -411,7 +426,8 @@ void FiberEncoder::Encoding::search_blocks_together(std::span<Encoding> fibers) 
 // again with the retry beam; the smaller max error wins.
 void FiberEncoder::Encoding::retry_worst_blocks() {
     if (!(search().retry_beam_width > 0 && search().retry_error_mm > 0)) return;
-    const float threshold2 = float(search().retry_error_mm / h.scaling) * float(search().retry_error_mm / h.scaling);
+    const float threshold2 =
+        float(search().retry_error_mm / header.scaling) * float(search().retry_error_mm / header.scaling);
     const SearchParams retry_params{search().retry_beam_width, search().retry_radius};
     // Fixed-step input keeping its lengths walks the sampling step, where
     // a few blocks at sharp turns stay above the retry's reach: those get
@@ -419,24 +435,27 @@ void FiberEncoder::Encoding::retry_worst_blocks() {
     const bool rescue = enc.length_stretch_ > 0 && enc.length_tails_only_ && !wide;
     const float rescue2 = kLengthRescueOverRetry * kLengthRescueOverRetry * threshold2;
     for (std::uint32_t b = 0; b < n_blocks; ++b) {
-        const std::size_t i0 = std::size_t(b) * ppb, m = block_points(b) >= 2 ? block_points(b) - 2 : 0;
+        const std::size_t i0 = std::size_t(b) * points_per_block, m = block_points(b) >= 2 ? block_points(b) - 2 : 0;
         if (m == 0) continue;
-        float first = max_distance2(&s.points[i0 + 2], &s.targets[i0 + 2], m);
+        float first = max_distance2(&scratch.points[i0 + 2], &scratch.targets[i0 + 2], m);
         if (!(first > threshold2)) continue;
-        s.retry_points.resize(m);
-        s.retry_codes8.resize(m);
-        s.retry_codes16.resize(m);
+        scratch.retry_points.resize(m);
+        scratch.retry_codes8.resize(m);
+        scratch.retry_codes16.resize(m);
         for (int pass = 0; pass < 2; ++pass) {
             const unsigned width = pass == 0 ? retry_params.beam : kLengthRescueBeam;
             if (pass == 1 && !(rescue && first > rescue2 && width > retry_params.beam)) break;
-            search_block(b, SearchParams{width, retry_params.radius}, s.retry_codes8.data(), s.retry_codes16.data(),
-                         s.retry_points.data());
-            const float now = max_distance2(s.retry_points.data(), &s.targets[i0 + 2], m);
+            search_block(b, SearchParams{width, retry_params.radius}, scratch.retry_codes8.data(),
+                         scratch.retry_codes16.data(), scratch.retry_points.data());
+            const float now = max_distance2(scratch.retry_points.data(), &scratch.targets[i0 + 2], m);
             if (!(now < first)) continue;
             first = now;
-            std::copy(s.retry_points.begin(), s.retry_points.end(), &s.points[i0 + 2]);
-            if (wide) std::copy(s.retry_codes16.begin(), s.retry_codes16.end(), s.codes16.begin() + std::ptrdiff_t(i0));
-            else std::copy(s.retry_codes8.begin(), s.retry_codes8.end(), codes8_of(b));
+            std::copy(scratch.retry_points.begin(), scratch.retry_points.end(), &scratch.points[i0 + 2]);
+            if (wide)
+                std::copy(scratch.retry_codes16.begin(), scratch.retry_codes16.end(),
+                          scratch.codes16.begin() + std::ptrdiff_t(i0));
+            else
+                std::copy(scratch.retry_codes8.begin(), scratch.retry_codes8.end(), codes8_of(b));
         }
     }
 }
@@ -449,31 +468,32 @@ void FiberEncoder::Encoding::search_robust_blocks() {
     const Codebook8 cb = codebook8();
     const unsigned robust_beam = std::max({8u, search().beam_width, search().retry_beam_width});
     for (std::uint32_t b = 0; b < n_blocks; ++b) {
-        const std::size_t i0 = std::size_t(b) * ppb, m = block_points(b) > 2 ? block_points(b) - 2 : 0;
+        const std::size_t i0 = std::size_t(b) * points_per_block, m = block_points(b) > 2 ? block_points(b) - 2 : 0;
         if (m == 0 || !robust(b)) continue;
-        const std::span<const Vec3f> t(&s.targets[i0 + 2], m);
-        s.alt.resize(m);
-        exact_decoder_targets(s.starts[b], t, s.alt.data());
-        float best = worst_error2(&s.points[i0 + 2], t.data(), s.alt.data(), m);
+        const std::span<const Vec3f> t(&scratch.targets[i0 + 2], m);
+        scratch.alt.resize(m);
+        exact_decoder_targets(scratch.starts[b], t, scratch.alt.data());
+        float best = worst_error2(&scratch.points[i0 + 2], t.data(), scratch.alt.data(), m);
         // What the float decoder alone gets: once the robust codes come
         // within 10 % of it for both decoders, the wide beam is not worth its cost.
-        const float float_only = max_distance2(&s.points[i0 + 2], t.data(), m);
-        s.retry_points.resize(m);
-        s.retry_codes8.resize(m);
+        const float float_only = max_distance2(&scratch.points[i0 + 2], t.data(), m);
+        scratch.retry_points.resize(m);
+        scratch.retry_codes8.resize(m);
         for (unsigned width : {1u, robust_beam}) {
             if (width > 1 && best <= 1.21f * float_only) break;
             if (width == 1 && search().lookahead > 0)  // as the first search: greedy aiming with lookahead
-                LookaheadSearch<Codebook8>(cb, h.step, search().lookahead)
-                    .run(s.frames[b], s.points[i0 + 1], t, s.retry_codes8.data(), s.retry_points.data(),
-                         std::span<const Vec3f>(s.alt));
+                LookaheadSearch<Codebook8>(cb, header.step, search().lookahead)
+                    .run(scratch.frames[b], scratch.points[i0 + 1], t, scratch.retry_codes8.data(),
+                         scratch.retry_points.data(), std::span<const Vec3f>(scratch.alt));
             else
-                search_codes(cb, SearchParams{width, 1}, s.frames[b], s.points[i0 + 1], h.step, t, s.retry_codes8.data(),
-                             s.retry_points.data(), std::span<const Vec3f>(s.alt));
-            const float worst = worst_error2(s.retry_points.data(), t.data(), s.alt.data(), m);
+                search_codes(cb, SearchParams{width, 1}, scratch.frames[b], scratch.points[i0 + 1], header.step, t,
+                             scratch.retry_codes8.data(), scratch.retry_points.data(),
+                             std::span<const Vec3f>(scratch.alt));
+            const float worst = worst_error2(scratch.retry_points.data(), t.data(), scratch.alt.data(), m);
             if (!(worst < best)) continue;
             best = worst;
-            std::copy(s.retry_points.begin(), s.retry_points.end(), &s.points[i0 + 2]);
-            std::copy(s.retry_codes8.begin(), s.retry_codes8.end(), codes8_of(b));
+            std::copy(scratch.retry_points.begin(), scratch.retry_points.end(), &scratch.points[i0 + 2]);
+            std::copy(scratch.retry_codes8.begin(), scratch.retry_codes8.end(), codes8_of(b));
         }
     }
 }
@@ -485,24 +505,26 @@ void FiberEncoder::Encoding::keep_lengths() {
     const float stretch = enc.length_stretch_;
     if (!(stretch > 0)) return;
     const SearchParams feedback_params{std::max({8u, search().beam_width, search().retry_beam_width}), 1};
-    s.retry_codes8.resize(ppb);
-    s.retry_codes16.resize(ppb);
+    scratch.retry_codes8.resize(points_per_block);
+    scratch.retry_codes16.resize(points_per_block);
     feed_back_length(
-        std::span<const Vec3f>(s.targets), std::span<Vec3f>(s.points), ppb, stretch,
+        std::span<const Vec3f>(scratch.targets), std::span<Vec3f>(scratch.points), points_per_block, stretch,
         [&](std::uint32_t blk) { return wide || !robust(blk); },
         [&](std::uint32_t blk, std::span<const Vec3f> t, Vec3f* dec) {
-            const std::size_t i0 = std::size_t(blk) * ppb;
+            const std::size_t i0 = std::size_t(blk) * points_per_block;
             if (wide)
-                search_codes(Codebook16{*enc.tables_->table16}, feedback_params, s.frames[blk], s.points[i0 + 1], h.step, t,
-                             s.retry_codes16.data(), dec);
+                search_codes(Codebook16{*enc.tables_->table16}, feedback_params, scratch.frames[blk],
+                             scratch.points[i0 + 1], header.step, t, scratch.retry_codes16.data(), dec);
             else
-                search_codes(codebook8(), feedback_params, s.frames[blk], s.points[i0 + 1], h.step, t,
-                             s.retry_codes8.data(), dec);
+                search_codes(codebook8(), feedback_params, scratch.frames[blk], scratch.points[i0 + 1], header.step, t,
+                             scratch.retry_codes8.data(), dec);
         },
         [&](std::uint32_t blk) {
-            const std::size_t i0 = std::size_t(blk) * ppb, m = block_points(blk) - 2;
-            if (wide) std::copy_n(s.retry_codes16.begin(), m, s.codes16.begin() + std::ptrdiff_t(i0));
-            else std::copy_n(s.retry_codes8.begin(), m, codes8_of(blk));
+            const std::size_t i0 = std::size_t(blk) * points_per_block, m = block_points(blk) - 2;
+            if (wide)
+                std::copy_n(scratch.retry_codes16.begin(), m, scratch.codes16.begin() + std::ptrdiff_t(i0));
+            else
+                std::copy_n(scratch.retry_codes8.begin(), m, codes8_of(blk));
         });
 }
 
@@ -510,10 +532,10 @@ void FiberEncoder::Encoding::keep_lengths() {
 // from the block's start.
 std::pair<Frame, Vec3f> FiberEncoder::Encoding::tail_start(const LengthTails::Search& t) {
     const Codebook8 cb = codebook8();
-    Frame f = s.frames[t.block];
+    Frame f = scratch.frames[t.block];
     const std::uint8_t* codes = codes8_of(t.block);
     for (std::size_t k = 0; k < t.j0; ++k) f = compose(f, cb.frame(codes[k]));
-    return {f, s.points[std::size_t(t.block) * ppb + 1 + t.j0]};
+    return {f, scratch.points[std::size_t(t.block) * points_per_block + 1 + t.j0]};
 }
 
 // The fixed-step length tails (length_feedback.hpp) of several fibers,
@@ -529,11 +551,11 @@ void FiberEncoder::Encoding::keep_length_tails(std::span<Encoding> fibers) {
     std::vector<Pending> waiting, group;
     auto next = [&](Encoding& e) {
         Pending p{&e, {}};
-        if (e.s.tails->next([&](std::uint32_t b) { return !e.robust(b); }, p.search)) waiting.push_back(p);
+        if (e.scratch.tails->next([&](std::uint32_t b) { return !e.robust(b); }, p.search)) waiting.push_back(p);
     };
     for (Encoding& e : fibers) {
-        e.s.tails.emplace(std::span<const Vec3f>(e.s.targets), std::span<Vec3f>(e.s.points), e.ppb, kLengthFeedbackTail,
-                          kLengthFeedbackActShare);
+        e.scratch.tails.emplace(std::span<const Vec3f>(e.scratch.targets), std::span<Vec3f>(e.scratch.points),
+                                e.points_per_block, kLengthFeedbackTail, kLengthFeedbackActShare);
         next(e);
     }
     if (fibers.empty()) return;
@@ -559,14 +581,15 @@ void FiberEncoder::Encoding::keep_length_tails(std::span<Encoding> fibers) {
             batch.set(i, f, p, group[i].search.targets);
         }
         if (lookahead)
-            lookahead_blocks(cb, first.h.step, depth, batch.batch());
+            lookahead_blocks(cb, first.header.step, depth, batch.batch());
         else
-            search_codes(cb, SearchParams{search.beam_width, search.radius}, batch.frames[0], batch.points[0], first.h.step,
-                         group[0].search.targets, batch.codes.data(), batch.decoded.data() + 1);
+            search_codes(cb, SearchParams{search.beam_width, search.radius}, batch.frames[0], batch.points[0],
+                         first.header.step, group[0].search.targets, batch.codes.data(), batch.decoded.data() + 1);
         for (std::size_t i = 0; i < group.size(); ++i) {
             Encoding& e = *group[i].e;
-            std::copy_n(batch.decoded_of(i), m, e.s.tails->candidate());
-            if (e.s.tails->judge()) std::copy_n(batch.codes_of(i), m, e.codes8_of(group[i].search.block) + group[i].search.j0);
+            std::copy_n(batch.decoded_of(i), m, e.scratch.tails->candidate());
+            if (e.scratch.tails->judge())
+                std::copy_n(batch.codes_of(i), m, e.codes8_of(group[i].search.block) + group[i].search.j0);
             next(e);
         }
     }
@@ -575,7 +598,8 @@ void FiberEncoder::Encoding::keep_length_tails(std::span<Encoding> fibers) {
 void FiberEncoder::Encoding::store_codes16() {
     for (std::uint32_t b = 0; b < n_blocks; ++b)
         for (std::size_t k = 0; k + 2 < block_points(b); ++k)
-            put_le(&out[base + std::size_t(b) * bb + kBlock16DirectionsOffset + 2 * k], s.codes16[std::size_t(b) * ppb + k], 2);
+            put_le(&out[base + std::size_t(b) * block_bytes + kBlock16DirectionsOffset + 2 * k],
+                   scratch.codes16[std::size_t(b) * points_per_block + k], 2);
 }
 
 void FiberEncoder::Encoding::append_decoded(std::vector<Vec3f>& decoded) const {
@@ -585,9 +609,9 @@ void FiberEncoder::Encoding::append_decoded(std::vector<Vec3f>& decoded) const {
     if (n_points == 0) return;
     // The header's fields in locals and restrict pointers: the stores could
     // otherwise alias them, which kept this loop scalar, reloading them.
-    const float* __restrict in = &s.points[0].x;
+    const float* __restrict in = &scratch.points[0].x;
     float* __restrict world = &decoded[at].x;
-    const float scaling = h.scaling, offset[3] = {h.offset[0], h.offset[1], h.offset[2]};
+    const float scaling = header.scaling, offset[3] = {header.offset[0], header.offset[1], header.offset[2]};
     for (std::size_t k = 0; k < n_points; ++k)
         for (int c = 0; c < 3; ++c) world[3 * k + c] = (in[3 * k + c] - 0.5f) * scaling - offset[c];
 }
@@ -596,22 +620,22 @@ void FiberEncoder::Encoding::append_decoded(std::vector<Vec3f>& decoded) const {
 // is tight enough at 254 points to skip blocks (walk_divergence gives ~3 um
 // where they differ by ~0.1 um).
 void FiberEncoder::Encoding::append_exact16(std::vector<Vec3f>& decoded_exact) {
-    s.walked.resize(ppb);
+    scratch.walked.resize(points_per_block);
     decoded_exact.reserve(decoded_exact.size() + n_points);
     for (std::uint32_t b = 0; b < n_blocks; ++b) {
-        const BlockView16 blk{&out[base + std::size_t(b) * bb]};
+        const BlockView16 blk{&out[base + std::size_t(b) * block_bytes]};
         const std::array<std::uint32_t, 3> q0{blk.anchor_word(0), blk.anchor_word(1), blk.anchor_word(2)};
         const std::array<std::uint32_t, 3> q1{blk.anchor_word(3), blk.anchor_word(4), blk.anchor_word(5)};
         auto anchor = [](const std::array<std::uint32_t, 3>& q) {
             return Vec3d{double(q[0]) / kUnorm24Max, double(q[1]) / kUnorm24Max, double(q[2]) / kUnorm24Max};
         };
-        const std::size_t i0 = std::size_t(b) * ppb, n = block_points(b), m = n > 2 ? n - 2 : 0;
+        const std::size_t i0 = std::size_t(b) * points_per_block, n = block_points(b), m = n > 2 ? n - 2 : 0;
         decoded_exact.push_back(world(anchor(q0)));
         if (n < 2) continue;
         decoded_exact.push_back(world(anchor(q1)));
-        exact_walk(*enc.tables_->exact16, exact_block_frame24(q0, q1), anchor(q1), double(h.step), s.codes16.data() + i0,
-                   m, s.walked.data());
-        for (std::size_t k = 0; k < m; ++k) decoded_exact.push_back(world(s.walked[k]));
+        exact_walk(*enc.tables_->exact16, exact_block_frame24(q0, q1), anchor(q1), double(header.step),
+                   scratch.codes16.data() + i0, m, scratch.walked.data());
+        for (std::size_t k = 0; k < m; ++k) decoded_exact.push_back(world(scratch.walked[k]));
     }
 }
 
@@ -620,36 +644,41 @@ void FiberEncoder::Encoding::append_exact16(std::vector<Vec3f>& decoded_exact) {
 // float error cannot raise the max error: it gets the float points (most
 // blocks), which keeps the cost of this pass small.
 void FiberEncoder::Encoding::append_exact8(std::vector<Vec3f>& decoded_exact, const Vec3f* decoded) {
-    s.walked.resize(ppb);
-    s.block_errors.resize(n_blocks);
+    scratch.walked.resize(points_per_block);
+    scratch.block_errors.resize(n_blocks);
     const double out_slack =
-        4 * 0x1p-24 * (1 + std::max({std::fabs(h.offset[0]), std::fabs(h.offset[1]), std::fabs(h.offset[2])}) / h.scaling);
+        4 * 0x1p-24 *
+        (1 + std::max({std::fabs(header.offset[0]), std::fabs(header.offset[1]), std::fabs(header.offset[2])}) /
+                 header.scaling);
     double fiber_max = 0;
     for (std::uint32_t b = 0; b < n_blocks; ++b) {
-        const std::size_t i0 = std::size_t(b) * ppb;
-        s.block_errors[b] = std::sqrt(double(max_distance2(&s.points[i0], &s.targets[i0], block_points(b))));
-        fiber_max = std::max(fiber_max, s.block_errors[b]);
+        const std::size_t i0 = std::size_t(b) * points_per_block;
+        scratch.block_errors[b] =
+            std::sqrt(double(max_distance2(&scratch.points[i0], &scratch.targets[i0], block_points(b))));
+        fiber_max = std::max(fiber_max, scratch.block_errors[b]);
     }
     decoded_exact.reserve(decoded_exact.size() + n_points);
     for (std::uint32_t b = 0; b < n_blocks; ++b) {
-        const DecoderStarts& e = s.starts[b];
-        const std::size_t i0 = std::size_t(b) * ppb, n = block_points(b), m = n > 2 ? n - 2 : 0;
-        const double bound = e.divergence + walk_divergence(m, double(h.step)) + out_slack;
-        if (s.block_errors[b] + bound <= fiber_max) {
+        const DecoderStarts& e = scratch.starts[b];
+        const std::size_t i0 = std::size_t(b) * points_per_block, n = block_points(b), m = n > 2 ? n - 2 : 0;
+        const double bound = e.divergence + walk_divergence(m, double(header.step)) + out_slack;
+        if (scratch.block_errors[b] + bound <= fiber_max) {
             // Not the fiber's worst even if the exact decode is off by the
             // bound: the float decode's points stand for it.
             if (decoded) {
                 decoded_exact.insert(decoded_exact.end(), decoded + i0, decoded + i0 + n);
             } else {
                 for (std::size_t k = 0; k < n; ++k)
-                    decoded_exact.push_back(h.to_world(s.points[i0 + k].x, s.points[i0 + k].y, s.points[i0 + k].z));
+                    decoded_exact.push_back(
+                        header.to_world(scratch.points[i0 + k].x, scratch.points[i0 + k].y, scratch.points[i0 + k].z));
             }
             continue;
         }
-        exact_walk(*enc.tables_->exact8, e.exact_frame, e.exact1, double(h.step), codes8_of(b), m, s.walked.data());
+        exact_walk(*enc.tables_->exact8, e.exact_frame, e.exact1, double(header.step), codes8_of(b), m,
+                   scratch.walked.data());
         decoded_exact.push_back(world(e.exact0));
         if (n >= 2) decoded_exact.push_back(world(e.exact1));
-        for (std::size_t k = 0; k < m; ++k) decoded_exact.push_back(world(s.walked[k]));
+        for (std::size_t k = 0; k < m; ++k) decoded_exact.push_back(world(scratch.walked[k]));
     }
 }
 
