@@ -25,6 +25,8 @@ PACKAGES=(
   clang-14 libclang-rt-14-dev  # libFuzzer harnesses (scripts/fuzz.sh)
   clang-tidy-14  # library functions over 80 lines only with a reason (scripts/check_function_size.sh)
   libglfw3-dev libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri libspng-dev
+  libimgui-dev  # the viewer's control panel
+  xvfb xdotool  # the window test (scripts/view_window_test.sh): a virtual display, keys and clicks
   libembree-dev  # test-only: the independent ray tracer the viewer's capsules are checked against
 )
 

@@ -2,6 +2,8 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
+
 #include "fiblet/error.hpp"
 
 namespace fiblet::viewer {
@@ -18,6 +20,13 @@ GlBuffer make_buffer(GLsizeiptr bytes, const void* data, GLbitfield flags) {
         throw Error(Errc::unsupported,
                     fmt::format("the GL driver could not allocate a buffer of {} bytes (GL error 0x{:04x})", bytes, e));
     return buffer;
+}
+
+std::uint64_t buffer_bytes(const GlBuffer& buffer) {
+    if (!buffer) return 0;
+    GLint64 size = 0;
+    glGetNamedBufferParameteri64v(buffer.get(), GL_BUFFER_SIZE, &size);
+    return std::uint64_t(std::max<GLint64>(size, 0));
 }
 
 }  // namespace fiblet::viewer

@@ -4,6 +4,7 @@
 
 #include <epoxy/gl.h>
 
+#include <cstdint>
 #include <utility>
 
 namespace fiblet::viewer {
@@ -53,5 +54,7 @@ using GlVertexArray = GlName<gl_delete::vertex_array>;
 // filled from `data`. Throws fiblet::Error{unsupported} when the driver runs
 // out of memory.
 GlBuffer make_buffer(GLsizeiptr bytes, const void* data, GLbitfield flags);
+// The buffer's size in bytes (0 for none).
+std::uint64_t buffer_bytes(const GlBuffer& buffer);
 
 }  // namespace fiblet::viewer

@@ -44,6 +44,11 @@ const char* colormap_name(ColormapName map) {
     }
 }
 
+std::span<const ColormapName> colormaps() {
+    static constexpr std::array kMaps{ColormapName::viridis, ColormapName::magma, ColormapName::coolwarm};
+    return kMaps;
+}
+
 const ColormapAnchors& colormap_anchors(ColormapName map) {
     switch (map) {
     case ColormapName::magma: return kMagma;

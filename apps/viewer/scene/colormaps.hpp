@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <span>
 
 #include "fiblet_viewer/colormap_name.hpp"
 
@@ -12,6 +13,8 @@ namespace fiblet::viewer {
 inline constexpr int kColormapAnchors = 17;  // fiber_colors.glsl's kColormapAnchors
 using ColormapAnchors = std::array<std::array<float, 3>, kColormapAnchors>;
 
+// Every map, in the order the panel offers them.
+std::span<const ColormapName> colormaps();
 const ColormapAnchors& colormap_anchors(ColormapName map);
 
 // The map at t in [0, 1] (clamped; NaN maps to 0).

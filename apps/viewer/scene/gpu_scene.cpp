@@ -234,4 +234,12 @@ void GpuScene::bind(const GlProgram& program) const {
     glProgramUniform1i(p, uniform(program, "uAxisFromAnchorIntegers"), header_.packed() ? 1 : 0);
 }
 
+std::uint64_t GpuScene::gpu_bytes() const {
+    std::uint64_t bytes = 0;
+    for (const GlBuffer* b : {&blocks_, &block_fiber_, &fiber_points_buffer_, &fiber_ends_, &fiber_end_fraction_,
+                              &local_frames_, &fiber_colors_, &point_values_, &fiber_radii_})
+        bytes += buffer_bytes(*b);
+    return bytes;
+}
+
 }  // namespace fiblet::viewer

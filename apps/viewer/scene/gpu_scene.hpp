@@ -86,6 +86,9 @@ public:
     std::array<float, 2> point_value_range() const { return point_value_range_; }  // min, max
     const std::vector<std::uint32_t>& fiber_point_counts() const { return fiber_points_; }
 
+    // GPU memory the scene's buffers hold.
+    std::uint64_t gpu_bytes() const;
+
     // The last point of every fiber as decoded on the GPU at load (world mm).
     std::vector<Vec3f> read_fiber_ends() const;
 

@@ -1,5 +1,6 @@
 #include "techniques/technique_registry.hpp"
 
+#include <algorithm>
 #include <array>
 
 #include "techniques/capsules/capsules_technique.hpp"
@@ -49,14 +50,41 @@ std::string draw_style_names() {
 bool ray_traced(const RenderOptions& options) { return options.engine == RenderEngine::voxel_rt; }
 
 DrawStyle next_style(DrawStyle style) {
-    for (std::size_t i = 0; i < kStyles.size(); ++i)
-        if (kStyles[i].first == style) return kStyles[(i + 1) % kStyles.size()].first;
-    return kStyles[0].first;
+    const auto styles = draw_styles();
+    const auto at = std::find(styles.begin(), styles.end(), style);
+    return at == styles.end() || at + 1 == styles.end() ? styles.front() : *(at + 1);
 }
 
 RenderEngine next_engine(RenderEngine engine) {
     return engine == RenderEngine::raster ? RenderEngine::voxel_rt : RenderEngine::raster;
 }
+
+std::span<const DrawStyle> draw_styles() {
+    static constexpr auto kList = [] {
+        std::array<DrawStyle, kStyles.size()> list{};
+        for (std::size_t i = 0; i < kStyles.size(); ++i) list[i] = kStyles[i].first;
+        return list;
+    }();
+    return kList;
+}
+
+std::span<const RenderEngine> render_engines() {
+    static constexpr std::array kList{RenderEngine::raster, RenderEngine::voxel_rt};
+    return kList;
+}
+
+std::span<const TransparencyMode> transparency_modes() {
+    static constexpr std::array kList{TransparencyMode::sorted, TransparencyMode::voxlines, TransparencyMode::unsorted};
+    return kList;
+}
+
+bool orders_style(TransparencyMode mode, DrawStyle style) {
+    return mode != TransparencyMode::voxlines || style == DrawStyle::lines;
+}
+
+bool uses_radius(const RenderOptions& o) { return ray_traced(o) || o.style != DrawStyle::lines; }
+
+bool uses_line_width(const RenderOptions& o) { return !ray_traced(o) && o.style == DrawStyle::lines; }
 
 std::string technique_label(const RenderOptions& options) {
     return ray_traced(options) ? render_engine_name(options.engine) : draw_style_name(options.style);

@@ -6,6 +6,7 @@
 
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "fiblet_viewer/draw_style.hpp"
@@ -19,9 +20,18 @@ namespace fiblet::viewer {
 // Whether the frame is the voxel ray tracer's (voxel_rt/), which selects and
 // decodes for itself, rather than the raster pipeline's.
 bool ray_traced(const RenderOptions& options);
-// What the window's keys cycle through.
+// What the window's keys cycle through and its panel offers.
 DrawStyle next_style(DrawStyle style);
 RenderEngine next_engine(RenderEngine engine);
+std::span<const DrawStyle> draw_styles();
+std::span<const RenderEngine> render_engines();
+std::span<const TransparencyMode> transparency_modes();
+// Whether `mode` orders the blending of `style` (voxlines: lines only;
+// plan() falls back to sorted chunks for the others).
+bool orders_style(TransparencyMode mode, DrawStyle style);
+// Whether the frame's technique reads the radius / the line width.
+bool uses_radius(const RenderOptions& options);
+bool uses_line_width(const RenderOptions& options);
 // "tubes", "voxel-rt": what draws, for titles and reports.
 std::string technique_label(const RenderOptions& options);
 

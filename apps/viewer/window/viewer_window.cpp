@@ -4,6 +4,9 @@
 #include <epoxy/gl.h>
 // GLFW after epoxy: epoxy provides the GL declarations.
 #include <GLFW/glfw3.h>
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
 
 #include <algorithm>
 #include <chrono>
@@ -15,6 +18,7 @@
 
 #include "overlays/overlay_sources.hpp"
 #include "scene/fiber_colors.hpp"
+#include "window/control_panel.hpp"
 #include "window/fiber_picking.hpp"
 #include "window/fiber_selection.hpp"
 #include "fiblet/error.hpp"
@@ -41,7 +45,8 @@ const char* window_controls_help() {
            "  shift+click: add the fiber to the highlighted ones (or take it out)    W: save them as a fiber list\n"
            "  R: reset view    S: screenshot (PNG)    C: culling on/off    L: level of detail on/off\n"
            "  D: colour by direction / fixed    I: lighting on/off    +/-: line width    T: lines / tubes / capsules\n"
-           "  E: engine raster / voxel-rt    H: help    Q, Esc: quit\n";
+           "  E: engine raster / voxel-rt    P: control panel on/off    ?: keys in the window    H: help    "
+           "Q, Esc: quit\n";
 }
 
 namespace {
@@ -64,6 +69,25 @@ struct GlfwSession {
     GlfwSession& operator=(const GlfwSession&) = delete;
 };
 
+// Dear ImGui on the window: its GLFW callbacks chain to the window's, which
+// are installed first.
+struct ImGuiSession {
+    explicit ImGuiSession(GLFWwindow* w) {
+        IMGUI_CHECKVERSION();
+        ImGui::CreateContext();
+        ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini in the working directory
+        ImGui_ImplGlfw_InitForOpenGL(w, true);
+        ImGui_ImplOpenGL3_Init("#version 450 core");
+    }
+    ~ImGuiSession() {
+        ImGui_ImplOpenGL3_Shutdown();
+        ImGui_ImplGlfw_Shutdown();
+        ImGui::DestroyContext();
+    }
+    ImGuiSession(const ImGuiSession&) = delete;
+    ImGuiSession& operator=(const ImGuiSession&) = delete;
+};
+
 struct WindowDeleter {
     void operator()(GLFWwindow* w) const { glfwDestroyWindow(w); }
 };
@@ -78,14 +102,24 @@ struct Interaction {
     std::optional<std::pair<double, double>> pick;  // window coordinates of a click
     bool pick_adds = false;                          // a shift-click: add to the selection
     bool save_selection = false;
+    ControlPanel panel;
 };
+
+// Whether the panel takes this event (the pointer or the keyboard is its).
+bool panel_takes_mouse() { return ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse; }
+bool panel_takes_keys() { return ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureKeyboard; }
 
 Interaction& state_of(GLFWwindow* w) { return *static_cast<Interaction*>(glfwGetWindowUserPointer(w)); }
 
-void on_key(GLFWwindow* w, int key, int, int action, int) {
+void on_key(GLFWwindow* w, int key, int, int action, int mods) {
     if (action != GLFW_PRESS && action != GLFW_REPEAT) return;
+    if (panel_takes_keys()) return;
     Interaction& s = state_of(w);
     switch (key) {
+        case GLFW_KEY_P: s.panel.visible = !s.panel.visible; return;
+        case GLFW_KEY_SLASH:
+            if (mods & GLFW_MOD_SHIFT) s.panel.show_keys = !s.panel.show_keys;
+            return;
         case GLFW_KEY_ESCAPE:
         case GLFW_KEY_Q: s.quit = true; break;
         case GLFW_KEY_R: s.orbit = s.home; break;
@@ -113,6 +147,7 @@ void on_key(GLFWwindow* w, int key, int, int action, int) {
 
 void on_button(GLFWwindow* w, int button, int action, int mods) {
     Interaction& s = state_of(w);
+    if (action == GLFW_PRESS && panel_takes_mouse()) return;
     double x = 0, y = 0;
     glfwGetCursorPos(w, &x, &y);
     if (action == GLFW_PRESS) {
@@ -143,6 +178,7 @@ void on_cursor(GLFWwindow* w, double x, double y) {
 }
 
 void on_scroll(GLFWwindow* w, double, double dy) {
+    if (panel_takes_mouse()) return;
     Interaction& s = state_of(w);
     s.orbit.zoom(std::pow(1.15f, float(dy)));
     s.dirty = true;
@@ -173,6 +209,101 @@ std::string next_screenshot_name(const std::string& prefix) {
         const std::string name = fmt::format("{}-{:03}.png", prefix, i);
         if (!std::filesystem::exists(name)) return name;
     }
+}
+
+void take_screenshot(const WindowOptions& options, Renderer& renderer, const GpuScene& scene, const Camera& camera,
+                     const RenderOptions& render, const RenderTarget& target) {
+    const std::string name = next_screenshot_name(options.screenshot_prefix);
+    if (options.screenshot_supersample > 1)
+        write_png(name,
+                  render_supersampled(renderer, scene, camera, render, target.width(), target.height(),
+                                      options.screenshot_supersample)
+                      .image,
+                  false);
+    else
+        write_png(name, {target.width(), target.height(), target.read_rgba()}, false);
+    fmt::print("screenshot: {}\n", name);
+    std::fflush(stdout);
+}
+
+// The click's fiber into the highlighted ones and the panel; true when the
+// target now holds the opaque frame picked from (a transparent frame).
+bool pick(Interaction& s, GLFWwindow* w, Renderer& renderer, const GpuScene& scene, const Camera& camera,
+          RenderTarget& target, PanelFrame& frame) {
+    int win_width = 1, win_height = 1;
+    glfwGetWindowSize(w, &win_width, &win_height);
+    const int px = int(s.pick->first * target.width() / std::max(win_width, 1));
+    const int py = int(s.pick->second * target.height() / std::max(win_height, 1));
+    s.pick.reset();
+    const bool stale = s.render.transparent();
+    const auto f = pick_fiber_in_frame(renderer, scene, camera, s.render, target, px, py);
+    if (f)
+        fmt::print("fiber ID {} (index {}): {} points, {:.2f} mm\n", f->id, f->index, f->points, f->length_mm);
+    else
+        fmt::print("no fiber at ({}, {})\n", px, py);
+    frame.picked = f;
+    if (!update_selection(s.render.highlighted_fibers, f ? std::optional<std::uint64_t>(f->index) : std::nullopt,
+                          s.pick_adds))
+        fmt::print("at most {} fibers are highlighted\n", kMaxHighlightedFibers);
+    s.dirty = true;
+    std::fflush(stdout);
+    return stale;
+}
+
+void apply_panel_requests(const PanelRequests& asked, Interaction& s, const OverlaySources& overlays,
+                          Renderer& renderer, PanelFrame& frame) {
+    if (asked.overlays) {
+        RenderOptions changed = s.render;
+        changed.slab_half_width_mm = 0;  // make_overlays sets it again for a slab
+        try {
+            renderer.set_overlays(make_overlays(overlays, changed));
+            s.render.slab_plane = changed.slab_plane, s.render.slab_half_width_mm = changed.slab_half_width_mm;
+            frame.message.clear();
+        } catch (const Error& e) {
+            frame.message = e.what();  // e.g. a slice outside the image: the overlays stay as they were
+        }
+    }
+    if (asked.clear_selection) s.render.highlighted_fibers.clear(), frame.picked.reset();
+    if (asked.save_selection) s.save_selection = true;
+    if (asked.render || asked.save_selection) s.dirty = true;
+}
+
+// One line per control: label, then its rectangle x0 y0 x1 y1 (window pixels).
+void write_panel_layout(const char* path, const PanelLayout& layout) {
+    std::FILE* f = std::fopen(path, "w");
+    if (!f) return;
+    for (const auto& [label, rect] : layout)
+        fmt::print(f, "{}\t{:.0f} {:.0f} {:.0f} {:.0f}\n", label, rect.first[0], rect.first[1], rect.second[0],
+                   rect.second[1]);
+    std::fclose(f);
+}
+
+// What the panel offers: the colour sources the scene has, and every
+// per-streamline value a picked fiber shows.
+PanelScene panel_scene(const FftFile& file, const GpuScene& scene) {
+    PanelScene p;
+    p.fiber_colors = scene.has_fiber_colors();
+    p.point_values = scene.has_point_values();
+    p.point_value_range = scene.point_value_range();
+    p.fibers = scene.fiber_count();
+    for (const StreamlineField& f : file.streamline_fields()) {
+        if (f.scope() != FieldScope::streamline || f.components != 1 || f.rows() != scene.fiber_count()) continue;
+        std::vector<float> values(f.rows());
+        for (std::uint64_t r = 0; r < f.rows(); ++r) values[r] = narrow_to_float(f.at(r, 0));
+        p.fiber_values.emplace_back(f.name, std::move(values));
+    }
+    return p;
+}
+
+void save_highlighted(const WindowOptions& options, const std::vector<std::uint32_t>& fibers) {
+    try {
+        save_selection(options.selection_path, fibers);
+        fmt::print("{} highlighted fibers saved to {} (fiblet extract --fibers $(cat {}))\n", fibers.size(),
+                   options.selection_path, options.selection_path);
+    } catch (const Error& e) {
+        fmt::print(stderr, "fiblet: error: {}\n", e.what());
+    }
+    std::fflush(stdout);
 }
 
 }  // namespace
@@ -206,7 +337,8 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
     Interaction s;
     s.render = options.render;
     s.render.time_stages = true;
-    renderer.set_overlays(make_overlays(options.overlays, s.render));
+    OverlaySources overlays = options.overlays;
+    renderer.set_overlays(make_overlays(overlays, s.render));
     s.home = s.orbit = initial_orbit(options, scene, float(target.width()) / float(target.height()));
     glfwSetWindowUserPointer(w, &s);
     glfwSetKeyCallback(w, on_key);
@@ -214,95 +346,75 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
     glfwSetCursorPosCallback(w, on_cursor);
     glfwSetScrollCallback(w, on_scroll);
     glfwSetFramebufferSizeCallback(w, [](GLFWwindow* win, int, int) { state_of(win).dirty = true; });
+    const ImGuiSession imgui(w);
+    const PanelScene panel_info = panel_scene(file, scene);
+    PanelFrame frame;
+    // The panel's controls, written for the window test (scripts/view_window_test.sh).
+    const char* layout_file = std::getenv("FIBLET_VIEW_PANEL_LAYOUT");
+    PanelLayout layout;
     fmt::print("{}: {} fibers, {} blocks on {}\n{}", title, scene.fiber_count(), scene.block_count(),
                current_gl_description(), window_controls_help());
     std::fflush(stdout);
 
     while (!glfwWindowShouldClose(w) && !s.quit) {
-        // Sleep until something happens; redraw only when the view changed.
+        // Sleep until something happens; draw the scene again only when the
+        // view changed, the panel at every event.
         if (!s.dirty) glfwWaitEventsTimeout(0.5);
         glfwPollEvents();
-        if (!s.dirty) continue;
-        s.dirty = false;
         glfwGetFramebufferSize(w, &fb_width, &fb_height);
         if (fb_width < 1 || fb_height < 1) continue;  // minimized
-        target.resize(fb_width, fb_height);
         const Camera camera = s.orbit.camera(float(fb_width) / float(fb_height));
-        const auto t0 = std::chrono::steady_clock::now();
-        FrameStats st;
-        try {
-            st = renderer.render(scene, camera, s.render, target);
-        } catch (const Error& e) {
-            // E on a scene the voxel ray tracer refuses (its buffers): say
-            // why and keep drawing with the rasterizer.
-            if (!ray_traced(s.render) || e.code() != Errc::unsupported) throw;
-            fmt::print(stderr, "{}; back to --engine raster\n", e.what());
-            s.render.engine = RenderEngine::raster;
-            s.dirty = true;
-            continue;
-        }
-        const double frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-
-        glNamedFramebufferReadBuffer(target.framebuffer(), GL_COLOR_ATTACHMENT0);
-        glBindFramebuffer(GL_FRAMEBUFFER, 0);
-        glBlitNamedFramebuffer(target.framebuffer(), 0, 0, 0, fb_width, fb_height, 0, 0, fb_width, fb_height,
-                               GL_COLOR_BUFFER_BIT, GL_NEAREST);
-        glfwSwapBuffers(w);
-        glfwSetWindowTitle(
-            w, fmt::format("{} | {:.1f} ms (GPU cull {:.1f} decode {:.1f} draw {:.1f}) | {} blocks ({} coarse), {} "
-                           "segments | {} | culling {} LoD {}",
-                           title, frame_ms, st.cull_ms, st.decode_ms, st.draw_ms, st.drawn_blocks(), st.coarse_blocks,
-                           st.drawn_segments(),
-                           technique_label(s.render),
-                           s.render.frustum_culling ? "on" : "off",
-                           s.render.level_of_detail ? "on" : "off")
-                   .c_str());
-
-        // Screenshots first: picking a transparent frame draws over the target.
-        if (s.screenshot) {
-            s.screenshot = false;
-            const std::string name = next_screenshot_name(options.screenshot_prefix);
-            if (options.screenshot_supersample > 1)
-                write_png(name,
-                          render_supersampled(renderer, scene, camera, s.render, target.width(), target.height(),
-                                              options.screenshot_supersample)
-                              .image,
-                          false);
-            else
-                write_png(name, {target.width(), target.height(), target.read_rgba()}, false);
-            fmt::print("screenshot: {}\n", name);
-            std::fflush(stdout);
-        }
-        if (s.pick) {
-            int win_width = 1, win_height = 1;
-            glfwGetWindowSize(w, &win_width, &win_height);
-            const int px = int(s.pick->first * fb_width / std::max(win_width, 1));
-            const int py = int(s.pick->second * fb_height / std::max(win_height, 1));
-            s.pick.reset();
-            // A transparent frame is drawn again opaque to pick from: draw it again after.
-            if (s.render.transparent()) s.dirty = true;
-            const auto f = pick_fiber_in_frame(renderer, scene, camera, s.render, target, px, py);
-            if (f)
-                fmt::print("fiber ID {} (index {}): {} points, {:.2f} mm\n", f->id, f->index, f->points, f->length_mm);
-            else
-                fmt::print("no fiber at ({}, {})\n", px, py);
-            if (!update_selection(s.render.highlighted_fibers, f ? std::optional<std::uint64_t>(f->index) : std::nullopt,
-                                  s.pick_adds))
-                fmt::print("at most {} fibers are highlighted\n", kMaxHighlightedFibers);
-            s.dirty = true;
-            std::fflush(stdout);
+        bool target_stale = false;  // a transparent frame's pick drew over it
+        if (s.dirty) {
+            s.dirty = false;
+            target.resize(fb_width, fb_height);
+            const auto t0 = std::chrono::steady_clock::now();
+            try {
+                frame.stats = renderer.render(scene, camera, s.render, target);
+            } catch (const Error& e) {
+                // E on a scene the voxel ray tracer refuses (its buffers): say
+                // why and keep drawing with the rasterizer.
+                if (!ray_traced(s.render) || e.code() != Errc::unsupported) throw;
+                fmt::print(stderr, "{}; back to --engine raster\n", e.what());
+                frame.message = std::string(e.what()) + "; back to raster";
+                s.render.engine = RenderEngine::raster;
+                s.dirty = true;
+                continue;
+            }
+            frame.frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+            frame.gpu_bytes = scene.gpu_bytes() + renderer.transparency_bytes();
+            glfwSetWindowTitle(w, fmt::format("{} | {:.1f} ms | {} blocks ({} coarse), {} segments | {}", title,
+                                              frame.frame_ms, frame.stats.drawn_blocks(), frame.stats.coarse_blocks,
+                                              frame.stats.drawn_segments(), technique_label(s.render))
+                                      .c_str());
+            // Screenshots first (the scene alone, never the panel): picking
+            // a transparent frame draws over the target.
+            if (s.screenshot) {
+                s.screenshot = false;
+                take_screenshot(options, renderer, scene, camera, s.render, target);
+            }
+            if (s.pick) target_stale = pick(s, w, renderer, scene, camera, target, frame);
         }
         if (s.save_selection) {
             s.save_selection = false;
-            try {
-                save_selection(options.selection_path, s.render.highlighted_fibers);
-                fmt::print("{} highlighted fibers saved to {} (fiblet extract --fibers $(cat {}))\n",
-                           s.render.highlighted_fibers.size(), options.selection_path, options.selection_path);
-            } catch (const Error& e) {
-                fmt::print(stderr, "fiblet: error: {}\n", e.what());
-            }
-            std::fflush(stdout);
+            save_highlighted(options, s.render.highlighted_fibers);
         }
+        if (target_stale) continue;  // drawn again at once
+
+        glNamedFramebufferReadBuffer(target.framebuffer(), GL_COLOR_ATTACHMENT0);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glBlitNamedFramebuffer(target.framebuffer(), 0, 0, 0, target.width(), target.height(), 0, 0, fb_width,
+                               fb_height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+        frame.highlighted = s.render.highlighted_fibers.size();
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        const PanelRequests asked = s.panel.draw(s.render, overlays, panel_info, frame, layout_file ? &layout : nullptr);
+        if (layout_file) write_panel_layout(layout_file, layout);
+        ImGui::Render();
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        glfwSwapBuffers(w);
+        apply_panel_requests(asked, s, overlays, renderer, frame);
     }
 }
 
