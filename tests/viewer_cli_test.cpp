@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
 #include "gl/png_file.hpp"
@@ -116,6 +117,44 @@ TEST(ViewerCli, BenchPrintsEveryStageForEveryCase) {
     ASSERT_EQ(r.status, 0) << r.output;
     for (const char* key : {"\"overview\"", "\"close-up\"", "\"far\"", "\"cull_ms\"", "\"decode_ms\"", "\"draw_ms\""})
         EXPECT_NE(r.output.find(key), std::string::npos) << key << " in " << r.output;
+}
+
+// render --json: the blocks the GPU selection tested, drew and skipped. A
+// close-up skips what lies outside its frustum; a subset of fibers skips
+// the others' blocks; without culling, LoD or a subset nothing is tested.
+TEST(ViewerCli, RenderReportsBlocksTestedDrawnAndSkipped) {
+    FIBLET_REQUIRE_GL();
+    const TempDir dir;
+    const std::string fft = compress_into(dir, shared_data("bundles/CST_R-step0.1.tck"), "cst.fft");
+    const auto frame = [&](const std::string& options) {
+        const CommandResult r =
+            run_cli("render " + fft + " -o " + dir.file("a.png") + " -f --size 96x72 --json " + options);
+        EXPECT_EQ(r.status, 0) << r.output;
+        return nlohmann::json::parse(r.output.substr(r.output.find('{')))["frame"];
+    };
+    const auto info = nlohmann::json::parse(run_cli("info --json " + fft).output);
+    const std::uint64_t blocks = info["blocks"].get<std::uint64_t>();
+    const auto check = [&](const nlohmann::json& f) {
+        EXPECT_EQ(f["blocks_drawn"].get<std::uint64_t>(),
+                  f["full_blocks"].get<std::uint64_t>() + f["coarse_blocks"].get<std::uint64_t>());
+        EXPECT_EQ(f["blocks_drawn"].get<std::uint64_t>() + f["blocks_skipped"].get<std::uint64_t>(),
+                  f["blocks_tested"].get<std::uint64_t>());
+    };
+    const auto whole = frame("--camera front");
+    check(whole);
+    EXPECT_EQ(whole["blocks_tested"], blocks);
+    EXPECT_EQ(whole["blocks_skipped"], 0);
+    const auto close = frame("--camera front --zoom 6");
+    check(close);
+    EXPECT_EQ(close["blocks_tested"], blocks);
+    EXPECT_GT(close["blocks_skipped"].get<std::uint64_t>(), blocks / 4);
+    const auto subset = frame("--camera front --fibers 0-9 --no-culling --no-lod");
+    check(subset);
+    EXPECT_GT(subset["blocks_skipped"].get<std::uint64_t>(), 0u);
+    EXPECT_LT(subset["blocks_drawn"].get<std::uint64_t>(), blocks / 2);
+    const auto everything = frame("--camera front --no-culling --no-lod");
+    EXPECT_EQ(everything["blocks_tested"], 0);
+    EXPECT_EQ(everything["blocks_drawn"], blocks);
 }
 
 TEST(ViewerCli, ViewWithoutADisplayFailsClearly) {

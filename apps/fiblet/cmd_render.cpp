@@ -55,6 +55,9 @@ std::string frame_path(const std::string& output, int i, int n) {
 
 std::string stats_json(const viewer::FrameStats& s) {
     return Json{}
+        .integer("blocks_tested", s.tested_blocks)
+        .integer("blocks_drawn", s.drawn_blocks())
+        .integer("blocks_skipped", s.skipped_blocks())
         .integer("full_blocks", s.fine_blocks)
         .integer("coarse_blocks", s.coarse_blocks)
         .integer("segments", s.drawn_segments())
@@ -220,8 +223,9 @@ void run(const RenderArgs& a) {
                                .render());
     } else if (!a.quiet && !a.bench) {
         fmt::print("{} -> {} ({}x{})\n", a.view.input, a.output, width, height);
-        fmt::print("  drew {} of {} blocks ({} full, {} as one segment), {} segments\n", stats.drawn_blocks(),
-                   scene.blocks, stats.fine_blocks, stats.coarse_blocks, stats.drawn_segments());
+        fmt::print("  drew {} of {} blocks ({} full, {} as one segment), {} segments; {} tested, {} skipped\n",
+                   stats.drawn_blocks(), scene.blocks, stats.fine_blocks, stats.coarse_blocks, stats.drawn_segments(),
+                   stats.tested_blocks, stats.skipped_blocks());
     }
 }
 

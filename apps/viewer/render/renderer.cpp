@@ -127,6 +127,7 @@ FrameStats Renderer::render(const GpuScene& scene, const Camera& requested, cons
         timer.begin(Stage::cull);
         const DrawCounters c = select_blocks(scene, camera, viewport, o);
         timer.end();
+        stats.tested_blocks = scene.block_count();
         stats.fine_blocks = c.fine_blocks, stats.coarse_blocks = c.coarse_blocks;
         stats.fine_segments = c.fine_segments, stats.coarse_segments = c.coarse_segments;
     } else {

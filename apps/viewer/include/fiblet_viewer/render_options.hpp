@@ -1,6 +1,7 @@
 // What a frame draws and how, and what it measured.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -84,10 +85,13 @@ struct RenderOptions {
 };
 
 struct FrameStats {
+    std::uint64_t tested_blocks = 0;  // blocks the selection pass tested (0: every block drawn untested)
     std::uint64_t fine_blocks = 0, coarse_blocks = 0;      // blocks drawn in full / as one segment
     std::uint64_t fine_segments = 0, coarse_segments = 0;  // line segments drawn
     double cull_ms = 0, decode_ms = 0, draw_ms = 0;         // GPU time (time_stages)
     std::uint64_t drawn_blocks() const { return fine_blocks + coarse_blocks; }
+    // Tested and not drawn: outside the view frustum, or left out by the fiber subset.
+    std::uint64_t skipped_blocks() const { return tested_blocks - std::min(tested_blocks, drawn_blocks()); }
     std::uint64_t drawn_segments() const { return fine_segments + coarse_segments; }
 };
 
