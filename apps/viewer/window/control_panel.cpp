@@ -131,7 +131,9 @@ bool slice_controls(const char* what, SliceSpec& slice, PanelLayout* layout) {
                              [](int a) { return std::string(kAxes[a]); }, layout);
     if (changed) slice.axis = axis, slice.index = -1;
     ImGui::PushID(what);
-    if (ImGui::InputInt(kSliceLabel, &index)) slice.index = std::max(index, -1), changed = true;
+    // Typed values apply on Enter (each keystroke would make the overlays again); -/+ at once.
+    if (ImGui::InputInt(kSliceLabel, &index, 1, 10, ImGuiInputTextFlags_EnterReturnsTrue))
+        slice.index = std::max(index, -1), changed = true;
     record(layout, std::string(what) + "/slice");
     ImGui::PopID();
     return changed;

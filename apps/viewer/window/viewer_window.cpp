@@ -250,17 +250,21 @@ bool pick(Interaction& s, GLFWwindow* w, Renderer& renderer, const GpuScene& sce
     return stale;
 }
 
-void apply_panel_requests(const PanelRequests& asked, Interaction& s, const OverlaySources& overlays,
-                          Renderer& renderer, PanelFrame& frame) {
+// `overlays` as the panel left them; `drawn`, those the overlays were made
+// from, which a refused change (e.g. a slice outside the image) goes back to.
+void apply_panel_requests(const PanelRequests& asked, Interaction& s, OverlaySources& overlays,
+                          OverlaySources& drawn, Renderer& renderer, PanelFrame& frame) {
     if (asked.overlays) {
         RenderOptions changed = s.render;
         changed.slab_half_width_mm = 0;  // make_overlays sets it again for a slab
         try {
             renderer.set_overlays(make_overlays(overlays, changed));
             s.render.slab_plane = changed.slab_plane, s.render.slab_half_width_mm = changed.slab_half_width_mm;
+            drawn = overlays;
             frame.message.clear();
         } catch (const Error& e) {
-            frame.message = e.what();  // e.g. a slice outside the image: the overlays stay as they were
+            frame.message = e.what();
+            overlays = drawn;
         }
     }
     if (asked.clear_selection) s.render.highlighted_fibers.clear(), frame.picked.reset();
@@ -337,7 +341,7 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
     Interaction s;
     s.render = options.render;
     s.render.time_stages = true;
-    OverlaySources overlays = options.overlays;
+    OverlaySources overlays = options.overlays, drawn_overlays = overlays;
     renderer.set_overlays(make_overlays(overlays, s.render));
     s.home = s.orbit = initial_orbit(options, scene, float(target.width()) / float(target.height()));
     glfwSetWindowUserPointer(w, &s);
@@ -414,7 +418,7 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
         ImGui::Render();
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
         glfwSwapBuffers(w);
-        apply_panel_requests(asked, s, overlays, renderer, frame);
+        apply_panel_requests(asked, s, overlays, drawn_overlays, renderer, frame);
     }
 }
 
