@@ -4,7 +4,7 @@
 # screenshots (S: the scene alone, never the panel) compared:
 #   T cycles lines -> tubes -> capsules -> lines (lines again: the same image);
 #   the panel's "tubes" button draws what T draws;
-#   the wheel zooms, R resets (the first image again);
+#   the wheel zooms, a drag orbits, R resets (the first image again);
 #   a click on a fiber prints it and highlights it (the others dimmed);
 #   P hides the panel (a click where a button was reaches the scene);
 #   Q quits with status 0.
@@ -90,6 +90,15 @@ zoomed=$(shot)
 differ "$lines" "$zoomed" "the wheel's zoom"
 reset=$(shot r)
 same "$lines" "$reset" "R: reset"
+# A left drag orbits (no pick: the pointer moved), R resets again.
+xdotool mousemove --window "$WINDOW" 480 240 mousedown --window "$WINDOW" 1
+for x in 490 500 520 540; do xdotool mousemove --window "$WINDOW" "$x" 250; sleep 0.1; done
+xdotool mouseup --window "$WINDOW" 1
+sleep 0.5
+orbited=$(shot)
+differ "$lines" "$orbited" "a drag's orbit"
+grep -q "^fiber ID\|^no fiber" view.log && fail "a drag picked"
+same "$lines" "$(shot r)" "R after the orbit"
 
 # A fiber's pixel, right of the panel: the brightest of the lines image.
 read -r fx fy < <(python3 - "$lines" "$(centre "style/capsules" | cut -d' ' -f1)" <<'EOF'
