@@ -66,6 +66,11 @@ click() {  # click X Y
   xdotool click --window "$WINDOW" 1
   sleep 0.5
 }
+click_control() {  # click LABEL: the panel control's centre
+  local x y
+  read -r x y < <(centre "$1")
+  click "$x" "$y"
+}
 same() { cmp -s "$1" "$2" || fail "$3: $1 and $2 differ"; }
 differ() { cmp -s "$1" "$2" && fail "$3: $1 and $2 are the same" || true; }
 
@@ -77,12 +82,10 @@ differ "$tubes" "$capsules" "T: capsules"
 again=$(shot t)
 same "$lines" "$again" "T back to lines"
 
-read -r x y < <(centre "style/tubes")
-click "$x" "$y"
+click_control "style/tubes"
 panel_tubes=$(shot)
 same "$tubes" "$panel_tubes" "the panel's tubes button"
-read -r x y < <(centre "style/lines")
-click "$x" "$y"
+click_control "style/lines"
 
 xdotool mousemove --window "$WINDOW" 480 240 click --window "$WINDOW" 4
 sleep 0.5
@@ -141,8 +144,7 @@ click "$fx" "$fy"
 grep -q "^fiber ID" view.log || fail "a click on a fiber at ($fx, $fy) printed no fiber"
 picked=$(shot)
 differ "$lines" "$picked" "the picked fiber's highlight"
-read -r x y < <(centre "clear")
-click "$x" "$y"
+click_control "clear"
 cleared=$(shot)
 same "$lines" "$cleared" "the panel's clear button"
 

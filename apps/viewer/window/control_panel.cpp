@@ -122,8 +122,8 @@ bool color_section(RenderOptions& o, const PanelScene& scene, PanelLayout* layou
     return changed;
 }
 
-// Slices, glyph scale and slab: applied when a control is released (the
-// overlays are made again from the images).
+// A slice's axis and index: a request to make the overlays again from the
+// images (the glyph scale and slab sliders ask when released).
 bool slice_controls(const char* what, SliceSpec& slice, PanelLayout* layout) {
     constexpr std::array kAxisIndices{0, 1, 2};
     int axis = slice.axis, index = int(slice.index);

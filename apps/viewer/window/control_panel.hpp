@@ -17,8 +17,6 @@
 #include "fiblet_viewer/scene_sources.hpp"
 #include "window/fiber_picking.hpp"
 
-struct ImVec2;
-
 namespace fiblet::viewer {
 
 // What the scene offers the colour modes, and what a picked fiber shows.
