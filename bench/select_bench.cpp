@@ -13,6 +13,7 @@
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -78,7 +79,31 @@ std::uint64_t kept_blocks(const Query& q) {
 
 // The query of a family keeping about `percent` % of the blocks: a
 // parameter found by bisection (cached).
-enum class Family { region_blocks, region_fibers, frustum, frustum_lod, random_fibers };
+enum class Family { region_blocks, region_fibers, mask, frustum, frustum_lod, random_fibers };
+
+// A mask image on a 2 mm grid over the scene: the voxels whose centre lies
+// within `radius` of the origin (a region as a user's ROI image is one).
+std::shared_ptr<const ImageMask> sphere_mask(float radius) {
+    constexpr double kVoxelMm = 2;
+    const auto n = std::int64_t(std::ceil(2 * (radius + kVoxelMm) / kVoxelMm)) + 1;
+    MaskImage m;
+    m.geometry.path = "sphere-mask";
+    m.geometry.dims = {n, n, n};
+    m.geometry.spacing = {kVoxelMm, kVoxelMm, kVoxelMm};
+    const double origin = -kVoxelMm * double(n - 1) / 2;
+    m.geometry.voxel_to_world = {{{kVoxelMm, 0, 0, origin}, {0, kVoxelMm, 0, origin}, {0, 0, kVoxelMm, origin}}};
+    m.counts.assign(std::size_t(n * n * n), 0);
+    for (std::int64_t k = 0; k < n; ++k)
+        for (std::int64_t j = 0; j < n; ++j)
+            for (std::int64_t i = 0; i < n; ++i) {
+                const double x = origin + kVoxelMm * double(i), y = origin + kVoxelMm * double(j),
+                             z = origin + kVoxelMm * double(k);
+                m.counts[m.geometry.offset(i, j, k)] = x * x + y * y + z * z <= double(radius) * radius;
+            }
+    if (std::find(m.counts.begin(), m.counts.end(), 1) == m.counts.end())
+        m.counts[m.geometry.offset(n / 2, n / 2, n / 2)] = 1;  // at least the centre voxel
+    return std::make_shared<const ImageMask>(m);
+}
 
 Query make_query(Family family, double t) {
     Query q;
@@ -90,6 +115,9 @@ Query make_query(Family family, double t) {
             break;
         case Family::region_fibers:
             q.include.push_back(Region::sphere(centre, float(t)));
+            break;
+        case Family::mask:
+            q.include.push_back(Region::image(sphere_mask(float(t))));
             break;
         case Family::frustum:
         case Family::frustum_lod: {
@@ -184,6 +212,7 @@ BENCHMARK_CAPTURE(BM_SelectQueryMapped, RegionBlocks, Family::region_blocks)->Ar
 BENCHMARK_CAPTURE(BM_SelectQueryMapped, RandomFibers, Family::random_fibers)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SelectQuery, RegionBlocks, Family::region_blocks)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SelectQuery, RegionFibers, Family::region_fibers)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SelectQuery, Mask, Family::mask)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SelectQuery, Frustum, Family::frustum)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SelectQuery, FrustumLod, Family::frustum_lod)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SelectQuery, RandomFibers, Family::random_fibers)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
