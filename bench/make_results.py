@@ -10,12 +10,15 @@ import json
 import os
 import platform
 import subprocess
+import sys
 import time
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from results_sections import replace_section  # noqa: E402
 
 LABELS = {
     "tck": ".tck float32, parsed by fiblet's TckReader",
@@ -198,12 +201,14 @@ def main():
         md.append(f"\n(Google Benchmark: {ctx.get('num_cpus', '?')} CPUs at {ctx.get('mhz_per_cpu', '?')} MHz, "
                   f"load average {', '.join(f'{x:.1f}' for x in ctx.get('load_avg', []))}.)\n")
 
-    # The parallel-pipeline table (scripts/bench_pipeline.sh) keeps its place.
-    pipeline = os.path.join(os.path.dirname(os.path.abspath(a.md)), "results-pipeline.md")
-    if os.path.exists(pipeline):
-        md.append("\n" + open(pipeline).read())
+    # The sections other scripts write (bench_pipeline.sh, bench_front.sh) follow.
+    doc = "\n".join(md)
+    for name in ("results-pipeline.md", "results-front.md"):
+        section = os.path.join(os.path.dirname(os.path.abspath(a.md)), name)
+        if os.path.exists(section):
+            doc = replace_section(doc, open(section).read())
     with open(a.md, "w") as f:
-        f.write("\n".join(md))
+        f.write(doc)
 
     # The plot: decode speed (one thread) and size against the error, the
     # line from the mean error (tick) to the max (marker).

@@ -2,7 +2,7 @@
 # Compress run time against error (bench/time_error_front.py): fiblet at
 # every effort, 8 and 16 bits, --zstd, 2 threads, and the peers, in one
 # interleaved run on one pinned core; writes bench/front.png (the README's
-# picture), bench/results-front.md, and the last section of bench/results.md.
+# picture), bench/results-front.md, and its section of bench/results.md.
 # Makes the medium tractogram if missing (shared/data/make-tractograms.sh).
 #   scripts/bench_front.sh [TCK] [time_error_front.py options: --rounds N --max-effort E --baseline OLD_FIBLET]
 # Peers (built out of tree, never part of fiblet; skipped with a note when unset):
@@ -27,17 +27,5 @@ cp "$work/front.png" "$out/front.png"
 } >"$out/results-front.md"
 cp "$work/front.json" "$out/results-front.json"
 if [ -f "$out/results.md" ]; then
-  # The section is replaced in place (the sections after it are kept).
-  /usr/bin/python3 - "$out/results.md" "$out/results-front.md" <<'EOF'
-import re, sys
-doc, section = open(sys.argv[1]).read(), open(sys.argv[2]).read()
-head = "## Compress time against error (scripts/bench_front.sh)"
-if head in doc:
-    start = doc.index(head)
-    nxt = doc.find("\n## ", start + len(head))
-    doc = doc[:start] + section + ("\n" + doc[nxt + 1:] if nxt >= 0 else "")
-else:
-    doc = doc.rstrip("\n") + "\n\n" + section
-open(sys.argv[1], "w").write(doc)
-EOF
+  /usr/bin/python3 "$root/bench/results_sections.py" "$out/results.md" "$out/results-front.md"
 fi

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The parallel-pipeline table (issue 14, docs/parallel.md): every row from
 # one run, with the machine's load (bench/pipeline_table.py), written to
-# bench/results-pipeline.md and as the last section of bench/results.md.
+# bench/results-pipeline.md and as its section of bench/results.md.
 # Makes the medium tractogram if missing (shared/data/make-tractograms.sh,
 # about 80 s on a quiet machine).
 #   scripts/bench_pipeline.sh [TCK] [pipeline_table.py options: --repeat N --json OUT --skip-select]
@@ -22,6 +22,5 @@ trap 'rm -f "$table"' EXIT
   cat "$table"
 } >"$out/results-pipeline.md"
 if [ -f "$out/results.md" ]; then
-  sed -i '/^## Parallel pipeline (scripts\/bench_pipeline.sh)/,$d' "$out/results.md"
-  { echo; cat "$out/results-pipeline.md"; } >>"$out/results.md"
+  /usr/bin/python3 "$root/bench/results_sections.py" "$out/results.md" "$out/results-pipeline.md"
 fi

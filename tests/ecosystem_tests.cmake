@@ -53,6 +53,11 @@ if(DEFINED Python_EXECUTABLE)
   fiblet_add_pytest(ecosystem.check_skips ${PROJECT_SOURCE_DIR}/tests/test_check_skips.py 60)
 endif()
 
+# The sections of bench/results.md, each replaced in place by its script.
+if(DEFINED Python_EXECUTABLE)
+  fiblet_add_pytest(bench.results_sections ${PROJECT_SOURCE_DIR}/tests/test_results_sections.py 60)
+endif()
+
 # The viewer benchmark's quick form on this machine's renderer, and the
 # build it carries to a GPU machine (scripts/bench_viewer.sh).
 if(DEFINED Python_EXECUTABLE AND FIBLET_BUILD_VIEWER)
