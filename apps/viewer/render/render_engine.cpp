@@ -1,30 +1,19 @@
 #include "fiblet_viewer/render_engine.hpp"
 
-#include <array>
-#include <utility>
+#include "render/option_names.hpp"
+#include "techniques/technique_registry.hpp"
 
 namespace fiblet::viewer {
 
 namespace {
-constexpr std::array kEngines{std::pair{RenderEngine::raster, "raster"}, std::pair{RenderEngine::voxel_rt, "voxel-rt"}};
+constexpr auto kEngines =
+    option_names(std::pair{RenderEngine::raster, "raster"}, std::pair{RenderEngine::voxel_rt, "voxel-rt"});
+constexpr auto kEngineList = kEngines.values();
 }  // namespace
 
-const char* render_engine_name(RenderEngine engine) {
-    for (const auto& [e, name] : kEngines)
-        if (e == engine) return name;
-    return "?";
-}
-
-std::optional<RenderEngine> parse_render_engine(const std::string& name) {
-    for (const auto& [e, n] : kEngines)
-        if (name == n) return e;
-    return std::nullopt;
-}
-
-std::string render_engine_names() {
-    std::string out;
-    for (const auto& [e, name] : kEngines) out += (out.empty() ? "" : ", ") + std::string(name);
-    return out;
-}
+const char* render_engine_name(RenderEngine engine) { return kEngines.name(engine); }
+std::optional<RenderEngine> parse_render_engine(const std::string& name) { return kEngines.parse(name); }
+std::string render_engine_names() { return kEngines.names(); }
+std::span<const RenderEngine> render_engines() { return kEngineList; }  // technique_registry.hpp
 
 }  // namespace fiblet::viewer

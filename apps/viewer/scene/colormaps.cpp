@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "render/option_names.hpp"
+
 namespace fiblet::viewer {
 
 namespace {
@@ -27,27 +29,15 @@ constexpr ColormapAnchors kCoolwarm{{{0.230f, 0.299f, 0.754f}, {0.304f, 0.407f, 
                                      {0.957f, 0.598f, 0.477f}, {0.921f, 0.491f, 0.383f}, {0.865f, 0.371f, 0.296f},
                                      {0.791f, 0.231f, 0.216f}, {0.706f, 0.016f, 0.150f}}};
 
+constexpr auto kMaps = option_names(std::pair{ColormapName::viridis, "viridis"}, std::pair{ColormapName::magma, "magma"},
+                                    std::pair{ColormapName::coolwarm, "coolwarm"});
+constexpr auto kMapList = kMaps.values();
+
 }  // namespace
 
-std::optional<ColormapName> parse_colormap(const std::string& name) {
-    if (name == "viridis") return ColormapName::viridis;
-    if (name == "magma") return ColormapName::magma;
-    if (name == "coolwarm") return ColormapName::coolwarm;
-    return std::nullopt;
-}
-
-const char* colormap_name(ColormapName map) {
-    switch (map) {
-    case ColormapName::magma: return "magma";
-    case ColormapName::coolwarm: return "coolwarm";
-    default: return "viridis";
-    }
-}
-
-std::span<const ColormapName> colormaps() {
-    static constexpr std::array kMaps{ColormapName::viridis, ColormapName::magma, ColormapName::coolwarm};
-    return kMaps;
-}
+std::optional<ColormapName> parse_colormap(const std::string& name) { return kMaps.parse(name); }
+const char* colormap_name(ColormapName map) { return kMaps.name(map); }
+std::span<const ColormapName> colormaps() { return kMapList; }
 
 const ColormapAnchors& colormap_anchors(ColormapName map) {
     switch (map) {

@@ -1,8 +1,8 @@
 #include "techniques/technique_registry.hpp"
 
 #include <algorithm>
-#include <array>
 
+#include "render/option_names.hpp"
 #include "techniques/capsules/capsules_technique.hpp"
 #include "techniques/lines/lines_technique.hpp"
 #include "techniques/tubes/tubes_technique.hpp"
@@ -15,8 +15,9 @@ namespace fiblet::viewer {
 namespace {
 
 // In the order the window's T key cycles them.
-constexpr std::array kStyles{std::pair{DrawStyle::lines, "lines"}, std::pair{DrawStyle::tubes, "tubes"},
-                             std::pair{DrawStyle::capsules, "capsules"}};
+constexpr auto kStyles = option_names(std::pair{DrawStyle::lines, "lines"}, std::pair{DrawStyle::tubes, "tubes"},
+                                      std::pair{DrawStyle::capsules, "capsules"});
+constexpr auto kStyleList = kStyles.values();
 
 std::unique_ptr<DrawTechnique> make_technique(DrawStyle style) {
     switch (style) {
@@ -29,23 +30,9 @@ std::unique_ptr<DrawTechnique> make_technique(DrawStyle style) {
 
 }  // namespace
 
-const char* draw_style_name(DrawStyle style) {
-    for (const auto& [s, name] : kStyles)
-        if (s == style) return name;
-    return "?";
-}
-
-std::optional<DrawStyle> parse_draw_style(const std::string& name) {
-    for (const auto& [s, n] : kStyles)
-        if (name == n) return s;
-    return std::nullopt;
-}
-
-std::string draw_style_names() {
-    std::string out;
-    for (const auto& [s, name] : kStyles) out += (out.empty() ? "" : ", ") + std::string(name);
-    return out;
-}
+const char* draw_style_name(DrawStyle style) { return kStyles.name(style); }
+std::optional<DrawStyle> parse_draw_style(const std::string& name) { return kStyles.parse(name); }
+std::string draw_style_names() { return kStyles.names(); }
 
 bool ray_traced(const RenderOptions& options) { return options.engine == RenderEngine::voxel_rt; }
 
@@ -59,20 +46,9 @@ RenderEngine next_engine(RenderEngine engine) {
     return engine == RenderEngine::raster ? RenderEngine::voxel_rt : RenderEngine::raster;
 }
 
-std::span<const DrawStyle> draw_styles() {
-    static constexpr auto kList = [] {
-        std::array<DrawStyle, kStyles.size()> list{};
-        for (std::size_t i = 0; i < kStyles.size(); ++i) list[i] = kStyles[i].first;
-        return list;
-    }();
-    return kList;
-}
+std::span<const DrawStyle> draw_styles() { return kStyleList; }
 
-std::span<const RenderEngine> render_engines() {
-    static constexpr std::array kList{RenderEngine::raster, RenderEngine::voxel_rt};
-    return kList;
-}
-
+// The panel's order: the default first (the names' table lists voxlines first).
 std::span<const TransparencyMode> transparency_modes() {
     static constexpr std::array kList{TransparencyMode::sorted, TransparencyMode::voxlines, TransparencyMode::unsorted};
     return kList;

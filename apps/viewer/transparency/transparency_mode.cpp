@@ -1,32 +1,17 @@
 #include "fiblet_viewer/transparency_mode.hpp"
 
-#include <array>
-#include <utility>
+#include "render/option_names.hpp"
 
 namespace fiblet::viewer {
 
 namespace {
-constexpr std::array kModes{std::pair{TransparencyMode::voxlines, "voxlines"},
-                            std::pair{TransparencyMode::sorted, "sorted"},
-                            std::pair{TransparencyMode::unsorted, "unsorted"}};
+constexpr auto kModes = option_names(std::pair{TransparencyMode::voxlines, "voxlines"},
+                                     std::pair{TransparencyMode::sorted, "sorted"},
+                                     std::pair{TransparencyMode::unsorted, "unsorted"});
 }  // namespace
 
-const char* transparency_mode_name(TransparencyMode mode) {
-    for (const auto& [m, name] : kModes)
-        if (m == mode) return name;
-    return "?";
-}
-
-std::optional<TransparencyMode> parse_transparency_mode(const std::string& name) {
-    for (const auto& [m, n] : kModes)
-        if (name == n) return m;
-    return std::nullopt;
-}
-
-std::string transparency_mode_names() {
-    std::string out;
-    for (const auto& [m, name] : kModes) out += (out.empty() ? "" : ", ") + std::string(name);
-    return out;
-}
+const char* transparency_mode_name(TransparencyMode mode) { return kModes.name(mode); }
+std::optional<TransparencyMode> parse_transparency_mode(const std::string& name) { return kModes.parse(name); }
+std::string transparency_mode_names() { return kModes.names(); }
 
 }  // namespace fiblet::viewer
