@@ -61,6 +61,26 @@ std::vector<Vec3f> straight_fiber() {
     return f;
 }
 
+// Its points' x as their values.
+std::vector<float> x_values() {
+    std::vector<float> values;
+    for (const Vec3f& p : straight_fiber()) values.push_back(p.x);
+    return values;
+}
+
+// A camera 60 mm up the z axis looking at the origin (30° field of view),
+// and how far (mm) the image reaches along x from its centre.
+struct TopView {
+    Camera camera;
+    double half_width_mm;
+};
+TopView top_view(int w, int h) {
+    Camera cam;
+    cam.position = {0, 0, 60}, cam.target = {0, 0, 0}, cam.up = {0, 1, 0};
+    cam.fov_y_deg = 30, cam.aspect = float(w) / float(h), cam.near_mm = 1, cam.far_mm = 200;
+    return {cam, std::tan(15.0 * M_PI / 180.0) * cam.aspect * 60.0};
+}
+
 }  // namespace
 
 TEST(ViewerPointValues, ReadsTrackScalarFilesOfEveryDatatype) {
@@ -135,15 +155,10 @@ TEST(ViewerPointValues, LinesShowTheColormapOfTheirPointsValues) {
     FIBLET_REQUIRE_GL();
     CompressedScene compressed({straight_fiber()});
     viewer::GpuScene& scene = compressed.scene;
-    std::vector<float> values;
-    for (const Vec3f& p : straight_fiber()) values.push_back(p.x);
-    scene.set_point_values(values);
+    scene.set_point_values(x_values());
     EXPECT_THROW(scene.set_point_values({1, 2}), Error);
     const int w = 200, h = 64;
-    Camera cam;
-    cam.position = {0, 0, 60}, cam.target = {0, 0, 0}, cam.up = {0, 1, 0};
-    cam.fov_y_deg = 30, cam.aspect = float(w) / float(h), cam.near_mm = 1, cam.far_mm = 200;
-    const double half_width_mm = std::tan(15.0 * M_PI / 180.0) * cam.aspect * 60.0;
+    const auto [cam, half_width_mm] = top_view(w, h);
     viewer::Renderer renderer(*viewer_gl().programs);
     viewer::RenderTarget target(w, h);
     for (const auto style : {viewer::DrawStyle::lines, viewer::DrawStyle::tubes, viewer::DrawStyle::capsules})
@@ -185,14 +200,9 @@ TEST(ViewerPointValues, LinesShowTheColormapOfTheirPointsValues) {
 TEST(ViewerPointValues, TransparentLinesBlendTheColormapOfTheirValues) {
     FIBLET_REQUIRE_GL();
     CompressedScene compressed({straight_fiber()});
-    std::vector<float> values;
-    for (const Vec3f& p : straight_fiber()) values.push_back(p.x);
-    compressed.scene.set_point_values(values);
+    compressed.scene.set_point_values(x_values());
     const int w = 200, h = 64;
-    Camera cam;
-    cam.position = {0, 0, 60}, cam.target = {0, 0, 0}, cam.up = {0, 1, 0};
-    cam.fov_y_deg = 30, cam.aspect = float(w) / float(h), cam.near_mm = 1, cam.far_mm = 200;
-    const double half_width_mm = std::tan(15.0 * M_PI / 180.0) * cam.aspect * 60.0;
+    const auto [cam, half_width_mm] = top_view(w, h);
     viewer::Renderer renderer(*viewer_gl().programs);
     viewer::RenderTarget target(w, h);
     for (const auto mode : {viewer::TransparencyMode::sorted, viewer::TransparencyMode::unsorted}) {
@@ -315,9 +325,7 @@ TEST(ViewerPointValues, ColourBarLabelsPutTheNameBetweenTheEnds) {
 TEST(ViewerPointValues, ColourBarShowsTheMapAndItsRange) {
     FIBLET_REQUIRE_GL();
     CompressedScene compressed({straight_fiber()});
-    std::vector<float> values;
-    for (const Vec3f& p : straight_fiber()) values.push_back(p.x);
-    compressed.scene.set_point_values(values);
+    compressed.scene.set_point_values(x_values());
     const int w = 256, h = 128;
     viewer::Renderer renderer(*viewer_gl().programs);
     viewer::RenderTarget target(w, h);
