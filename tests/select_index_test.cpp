@@ -93,6 +93,20 @@ void expect_boxes_hold_points(const FftFile& file, const BlockIndex& index, cons
         }
         ASSERT_LE(d.blocks[b].sphere.radius, index.max_sphere_radius()) << "block " << b;
     }
+    // The file's bounds: the union of the blocks' boxes.
+    const std::optional<Aabb> all = index.bounds();
+    ASSERT_TRUE(all);
+    Aabb expected = index.block_box(0);
+    for (std::size_t b = 1; b < d.blocks.size(); ++b) {
+        const Aabb box = index.block_box(b);
+        expected.min = {std::min(expected.min.x, box.min.x), std::min(expected.min.y, box.min.y), std::min(expected.min.z, box.min.z)};
+        expected.max = {std::max(expected.max.x, box.max.x), std::max(expected.max.y, box.max.y), std::max(expected.max.z, box.max.z)};
+    }
+    for (const auto& [got, want] : {std::pair{all->min, expected.min}, std::pair{all->max, expected.max}}) {
+        EXPECT_EQ(got.x, want.x);
+        EXPECT_EQ(got.y, want.y);
+        EXPECT_EQ(got.z, want.z);
+    }
 }
 
 TEST_F(SelectIndex, CompressStoresAnIndexWhoseBoxesHoldEveryPoint) {
@@ -588,6 +602,7 @@ TEST_F(SelectIndex, BlocksOffTheGridAreNeverCulled) {
     const BlockIndex index = BlockIndex::load(patched);
     EXPECT_GT(index.block_box(0).max.x, 1e20f);
     EXPECT_LT(index.block_box(1).max.x, 1e3f);
+    EXPECT_FALSE(index.bounds()) << "no finite box holds block 0";
     std::vector<std::uint64_t> bits;
     index.blocks_near_sphere({-5000, 0, 0}, 1, bits);
     for (std::size_t b = 0; b < d.blocks.size(); ++b) EXPECT_EQ(bit(bits, b), b == 0) << "block " << b;

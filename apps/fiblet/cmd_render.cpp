@@ -67,6 +67,21 @@ std::string stats_json(const viewer::FrameStats& s) {
         .render();
 }
 
+// The file, the budget and what the GPU held for the image.
+std::string scene_json(const viewer::HeadlessScene& s, const viewer::HeldScene& held) {
+    return Json{}
+        .integer("file_fibers", s.file_fibers)
+        .integer("file_blocks", s.file_blocks)
+        .integer("gpu_budget_bytes", s.gpu_budget_bytes)
+        .boolean("streamed", s.streamed)
+        .num("first_scene_ms", s.first_scene_ms)
+        .integer("fibers_held", held.fibers)
+        .integer("blocks_held", held.blocks)
+        .integer("gpu_bytes", held.gpu_bytes)
+        .num("load_ms", held.load_ms)
+        .render();
+}
+
 std::string transparency_json(const viewer::TransparencyBench& t, const viewer::RenderOptions& o) {
     return Json{}
         .str("mode", viewer::transparency_mode_name(o.transparency))
@@ -194,6 +209,7 @@ void run(const RenderArgs& a) {
     job.fiber_radii_path = a.view.fiber_radii, job.fiber_opacity_source = a.view.fiber_opacity;
     job.overlays = overlay_sources;
     job.camera = a.view.camera, job.fov_y_deg = a.view.fov, job.zoom = a.view.zoom;
+    job.gpu_budget_bytes = gpu_budget_bytes(a.view);
     job.bench = a.bench, job.frames = a.frames, job.bench_views = a.bench_views;
     job.outputs = outputs, job.camera_path = path_specs;
     job.supersample = a.view.supersample, job.overwrite = a.force;
@@ -219,6 +235,7 @@ void run(const RenderArgs& a) {
                                .str("input", a.view.input)
                                .str("output", a.output)
                                .str("device", scene.device)
+                               .raw("scene", scene_json(scene, result.first_image_scene))
                                .raw("frame", stats_json(stats))
                                .render());
     } else if (!a.quiet && !a.bench) {

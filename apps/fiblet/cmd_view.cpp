@@ -12,6 +12,7 @@ void run(const ViewerArgs& a, const std::string& save_selection) {
     parse_size(a.size, o.width, o.height);
     o.render = render_options_from(a);
     o.camera = a.camera, o.fov_y_deg = a.fov, o.zoom = a.zoom;
+    o.gpu_budget_bytes = gpu_budget_bytes(a);
     o.screenshot_supersample = a.supersample;
     o.fiber_colors = fiber_color_source(a);
     o.fiber_radii_path = a.fiber_radii;

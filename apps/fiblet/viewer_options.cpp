@@ -166,6 +166,10 @@ void add_viewer_options(CLI::App* cmd, ViewerArgs& a) {
                     "Tube and capsule radius per streamline from a text file (mm, one per streamline, in file "
                     "order), instead of --radius (also --engine voxel-rt)")
         ->check(CLI::ExistingFile);
+    cmd->add_option("--gpu-memory", a.gpu_memory_mb,
+                    "GPU memory (MiB) the fibers may take; a file beyond it is held in part: the fibers the view "
+                    "sees, thinned evenly to fit (default: half of what the driver reports free, else 1024)")
+        ->check(CLI::PositiveNumber);
     cmd->add_option("--opacity", a.opacity,
                     "Opacity of every streamline, in (0, 1]; below 1 they blend, ordered by --transparency "
                     "(--engine voxel-rt: every capsule a ray enters composited in depth order)")
@@ -253,6 +257,8 @@ void parse_size(const std::string& text, int& width, int& height) {
     }
     throw Error(Errc::invalid_argument, "--size: '" + text + "' is not WIDTHxHEIGHT (1..8192 pixels a side)");
 }
+
+std::uint64_t gpu_budget_bytes(const ViewerArgs& a) { return std::uint64_t(a.gpu_memory_mb * 1048576.0); }
 
 viewer::RenderOptions render_options_from(const ViewerArgs& a) {
     viewer::RenderOptions o;

@@ -31,6 +31,7 @@ struct ViewerArgs {
     int odf_lmax = -1;
     float opacity = 1;
     std::string fiber_opacity;  // per-streamline opacities: a file or dps/NAME (fiber_opacity.hpp)
+    double gpu_memory_mb = 0;   // the scene's GPU memory budget; 0: a share of what the driver reports
     std::string transparency;  // empty: sorted (lines) / unsorted (tubes, capsules)
     // The voxel ray tracer (--engine voxel-rt).
     std::string engine = "raster";
@@ -46,6 +47,8 @@ void parse_size(const std::string& text, int& width, int& height);
 
 // The render options the arguments describe; throws fiblet::Error{invalid_argument}.
 viewer::RenderOptions render_options_from(const ViewerArgs& args);
+// --gpu-memory in bytes; 0 for the driver's share.
+std::uint64_t gpu_budget_bytes(const ViewerArgs& args);
 
 // The overlays --odf, --image and --slab ask for; throws fiblet::Error{invalid_argument}.
 viewer::OverlaySources overlay_sources_from(const ViewerArgs& args);

@@ -1,6 +1,7 @@
 #include "fiblet_viewer/headless_render.hpp"
 
 #include <algorithm>
+#include <chrono>
 
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
@@ -18,6 +19,7 @@
 #include "scene/fiber_colors.hpp"
 #include "scene/fiber_opacity.hpp"
 #include "scene/fiber_radii.hpp"
+#include "scene/fiber_streaming.hpp"
 #include "scene/gpu_programs.hpp"
 #include "scene/gpu_scene.hpp"
 #include "scene/scene_file.hpp"
@@ -26,6 +28,10 @@
 namespace fiblet::viewer {
 
 namespace {
+
+double milliseconds_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
 
 // The voxel ray tracer's one-off preprocessing, when it ran.
 std::optional<VoxelRtPreprocessing> voxel_rt_preprocessing(const Renderer& renderer, const RenderOptions& options) {
@@ -53,22 +59,43 @@ HeadlessRenderResult render_headless(const HeadlessRenderJob& job,
     RenderOptions options = job.render;
     const HeadlessContext context;
     const GpuPrograms programs;
+    const auto opened = std::chrono::steady_clock::now();
     const FftFile file = open_scene_file(job.input);
-    GpuScene scene(file, programs);
-    load_fiber_colors(job.fiber_colors, file, scene);
-    if (!job.fiber_radii_path.empty()) load_fiber_radii(job.fiber_radii_path, scene);
-    if (!job.fiber_opacity_source.empty()) load_fiber_opacities(job.fiber_opacity_source, file, scene);
+    const FiberStreaming streaming(file, job.gpu_budget_bytes ? job.gpu_budget_bytes : default_gpu_budget(),
+                                   !job.fiber_colors.point_values_path.empty());
+    // Every fiber, or the overview of a streamed file: what cameras are fitted to.
+    GpuScene first(file, programs, {}, streaming.streams() ? std::optional(streaming.overview()) : std::nullopt);
+    load_fiber_colors(job.fiber_colors, file, first);
+    if (!job.fiber_radii_path.empty()) load_fiber_radii(job.fiber_radii_path, first);
+    if (!job.fiber_opacity_source.empty()) load_fiber_opacities(job.fiber_opacity_source, file, first);
     RenderTarget target(job.width, job.height);
     Renderer renderer(programs);
     renderer.set_overlays(make_overlays(job.overlays, options));
     const float aspect = float(job.width) / float(job.height);
     auto camera_for = [&](float zoom) {
-        return camera_from_spec(job.camera, scene, aspect, job.fov_y_deg, job.zoom * zoom);
+        return camera_from_spec(job.camera, first, aspect, job.fov_y_deg, job.zoom * zoom);
     };
     HeadlessRenderResult result;
-    result.scene = {context.description(), scene.fiber_count(), scene.block_count(), scene.segment_count()};
+    result.scene = {context.description(), first.fiber_count(), first.block_count(), first.segment_count(),
+                    file.header().fibers, file.header().blocks, streaming.budget_bytes(), streaming.streams(),
+                    milliseconds_since(opened)};
+    // A streamed file holds, for each camera, the fibers it sees (beside the overview).
+    std::optional<GpuScene> part;
+    HeldScene held;
+    auto scene_seen_by = [&](const Camera& camera) -> const GpuScene& {
+        if (!streaming.streams()) return first;
+        const auto start = std::chrono::steady_clock::now();
+        FiberSubset seen = streaming.visible(camera, renderer.reach_mm(first, options));
+        if (part)
+            part->reside(file, programs, std::move(seen));
+        else
+            part.emplace(first, file, programs, std::move(seen));
+        held = {part->fiber_count(), part->block_count(), first.gpu_bytes() + part->gpu_bytes(), milliseconds_since(start)};
+        return *part;
+    };
 
     if (job.bench) {
+        const GpuScene& scene = scene_seen_by(camera_for(1));
         RenderBench bench;
         bench.cases = run_render_bench(scene, renderer, target, camera_for, options, job.frames, job.bench_views);
         if (std::find(job.bench_views.begin(), job.bench_views.end(), "decode") != job.bench_views.end())
@@ -87,17 +114,19 @@ HeadlessRenderResult render_headless(const HeadlessRenderJob& job,
     // made (and checked) before the first frame is written.
     std::vector<Camera> cameras;
     for (const std::string& spec : job.camera_path)
-        cameras.push_back(camera_from_spec(spec, scene, aspect, job.fov_y_deg, job.zoom));
+        cameras.push_back(camera_from_spec(spec, first, aspect, job.fov_y_deg, job.zoom));
     if (cameras.empty()) {
         const Camera start = camera_for(1.0f);
         for (std::size_t i = 0; i < job.outputs.size(); ++i)
-            cameras.push_back(turned_about_up(start, 360.0f * float(i) / float(job.outputs.size()), scene.bounds()));
+            cameras.push_back(turned_about_up(start, 360.0f * float(i) / float(job.outputs.size()), first.bounds()));
     }
     if (job.time_stages) options.time_stages = true;
     for (std::size_t i = 0; i < job.outputs.size(); ++i) {
+        held = {first.fiber_count(), first.block_count(), first.gpu_bytes(), 0};
+        const GpuScene& scene = scene_seen_by(cameras[i]);
         const SupersampledFrame frame =
             render_supersampled(renderer, scene, cameras[i], options, job.width, job.height, job.supersample);
-        if (i == 0) result.first_image = frame.stats;
+        if (i == 0) result.first_image = frame.stats, result.first_image_scene = held;
         write_png(job.outputs[i], frame.image, job.overwrite);
     }
     return result;

@@ -7,6 +7,7 @@
 #include "gl/shader_program.hpp"
 #include "render/shading_uniforms.hpp"
 #include "render/vec_ops.hpp"
+#include "techniques/tubes/tube_spline.hpp"
 
 namespace fiblet::viewer {
 
@@ -70,7 +71,7 @@ DrawCounters Renderer::select_blocks(const GpuScene& scene, const Camera& camera
     glProgramUniform1i(id, uniform(p, "uFrustumCulling"), o.frustum_culling ? 1 : 0);
     glProgramUniform4fv(id, uniform(p, "uPlanes"), 6, planes);
     // Spheres grow by what the style draws beyond the centre lines (a tube's radius).
-    glProgramUniform1f(id, uniform(p, "uSphereMargin"), techniques_.style(o.style).reach_mm(scene, o));
+    glProgramUniform1f(id, uniform(p, "uSphereMargin"), reach_mm(scene, o));
     const CameraBasis basis = camera_basis(camera);
     glProgramUniform1i(id, uniform(p, "uLevelOfDetail"), o.level_of_detail ? 1 : 0);
     glProgramUniform1f(id, uniform(p, "uLodPixels"), o.lod_pixels);
@@ -91,13 +92,20 @@ DrawCounters Renderer::select_blocks(const GpuScene& scene, const Camera& camera
     return c;
 }
 
+float Renderer::reach_mm(const GpuScene& scene, const RenderOptions& o) {
+    return ray_traced(o) ? tube_radius_reach(scene, o) : techniques_.style(o.style).reach_mm(scene, o);
+}
+
 voxel_rt::VoxelRayTracer& Renderer::voxel_ray_tracer() {
     if (!voxel_ray_tracer_) voxel_ray_tracer_ = std::make_unique<voxel_rt::VoxelRayTracer>(programs_);
     return *voxel_ray_tracer_;
 }
 
-FrameStats Renderer::render(const GpuScene& scene, const Camera& requested, const RenderOptions& options,
+FrameStats Renderer::render(const GpuScene& scene, const Camera& requested, const RenderOptions& file_options,
                             RenderTarget& target) {
+    // Highlighted fibers are the file's; the shaders see the scene's.
+    RenderOptions options = file_options;
+    if (!scene.holds_every_fiber()) options.highlighted_fibers = scene.scene_fibers(file_options.highlighted_fibers);
     if (ray_traced(options)) return voxel_ray_tracer().render(scene, requested, options, target);
     // Near and far planes widened to hold the overlays (overlay.hpp).
     const Camera camera = clip_planes_covering(requested, overlays_);

@@ -37,6 +37,10 @@ public:
     FrameStats render(const GpuScene& scene, const Camera& camera, const RenderOptions& options,
                       RenderTarget& target);
 
+    // How far (mm) what `options` draws reaches beyond the fibers' centre
+    // lines (a tube's radius): what views test blocks with.
+    float reach_mm(const GpuScene& scene, const RenderOptions& options);
+
     // The voxel ray tracer render() uses (made on first use; tests).
     voxel_rt::VoxelRayTracer& voxel_ray_tracer();
     const voxel_rt::VoxelRayTracer* voxel_ray_tracer_if_made() const { return voxel_ray_tracer_.get(); }

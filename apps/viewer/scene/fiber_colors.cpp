@@ -129,12 +129,12 @@ std::vector<float> read_fiber_value_source(const std::string& source, const FftF
 
 void load_fiber_colors(const FiberColorSource& source, const FftFile& file, GpuScene& scene) {
     if (!source.colors_path.empty()) {
-        scene.set_fiber_colors(read_fiber_colors(source.colors_path, scene.fiber_count()));
+        scene.set_fiber_colors(read_fiber_colors(source.colors_path, scene.file_fiber_count()));
     } else if (!source.values_path.empty()) {
         scene.set_fiber_colors(colors_from_values(read_fiber_value_source(source.values_path, file), source.value_range));
     }
     if (!source.point_values_path.empty())
-        scene.set_point_values(read_point_value_source(source.point_values_path, file, scene.fiber_point_counts()));
+        scene.set_point_values(read_point_value_source(source.point_values_path, file, scene.file_fiber_point_counts()));
 }
 
 }  // namespace fiblet::viewer

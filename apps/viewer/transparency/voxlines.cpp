@@ -41,7 +41,7 @@ std::vector<float> segment_ends(const GpuScene& scene, const GpuPrograms& progra
 }  // namespace
 
 Voxlines::Voxlines(const GpuScene& scene, const GpuPrograms& programs, GpuDecoder kind)
-    : scene_(&scene),
+    : scene_generation_(scene.generation()),
       program_(build_program({"voxline_quads.vert.glsl", "transparent_lines.frag.glsl"}, gpu_binding_defines())) {
     const std::vector<float> ends = segment_ends(scene, programs, kind);
     segments_ = std::uint32_t(ends.size() / 8);
@@ -138,7 +138,7 @@ void Voxlines::draw(const FrameInputs& in) {
 void VoxlineOrder::draw(const FrameInputs& in, const FrameBlocks& blocks, DrawTechnique& /*transparent lines*/) {
     blocks.timer.begin(Stage::draw);
     // Voxlines keep their own copy of every segment, built once per scene.
-    if (!voxlines_ || &voxlines_->scene() != &in.scene)
+    if (!voxlines_ || voxlines_->scene_generation() != in.scene.generation())
         voxlines_ = std::make_unique<Voxlines>(in.scene, programs_, blocks.kind);
     voxlines_->draw(in);
     blocks.timer.end();

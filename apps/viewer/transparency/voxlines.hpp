@@ -24,7 +24,7 @@ public:
 
     Voxlines(const GpuScene& scene, const GpuPrograms& programs, GpuDecoder kind);
 
-    const GpuScene& scene() const { return *scene_; }
+    std::uint64_t scene_generation() const { return scene_generation_; }  // built from
     std::uint64_t gpu_bytes() const { return gpu_bytes_; }
     void draw(const FrameInputs& in);
 
@@ -36,7 +36,7 @@ private:
     std::vector<std::uint32_t> back_to_front(const Camera& camera) const;  // indices into voxels_
     Vec3f voxel_center(std::uint32_t index) const;
 
-    const GpuScene* scene_;
+    std::uint64_t scene_generation_;
     Vec3f origin_;
     std::uint32_t nx_ = 1, ny_ = 1, nz_ = 1;
     std::uint32_t segments_ = 0;

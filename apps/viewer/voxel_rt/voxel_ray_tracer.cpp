@@ -18,10 +18,10 @@ VoxelRayTracer::VoxelRayTracer(const GpuPrograms& programs) : shared_(programs) 
 VoxelRayTracer::~VoxelRayTracer() = default;
 
 void VoxelRayTracer::ensure_structure(const GpuScene& scene, const RenderOptions& o) {
-    if (built_scene_ != &scene || !segments_) {
+    if (built_generation_ != scene.generation() || !segments_) {
         structure_.reset();
         segments_ = std::make_unique<SceneSegments>(scene, shared_, part_bytes_);
-        built_scene_ = &scene;
+        built_scene_ = &scene, built_generation_ = scene.generation();
     }
     const bool ao = o.ambient_occlusion;
     const bool fiber_radii = o.fiber_radii && scene.has_fiber_radii();
@@ -45,11 +45,11 @@ ResidentSegments VoxelRayTracer::segments_for(const GpuScene& scene, const Rende
 }
 
 OcclusionVolume VoxelRayTracer::chord_occlusion(const GpuScene& scene, const RenderOptions& o) {
-    if (!chords_ || chords_scene_ != &scene || chords_grid_ != o.voxel_grid || chords_radius_ != o.tube_radius_mm) {
+    if (!chords_ || chords_scene_ != scene.generation() || chords_grid_ != o.voxel_grid || chords_radius_ != o.tube_radius_mm) {
         chords_.reset();
         chords_ = std::make_unique<ChordOcclusion>(
             programs_, scene, grid_around(scene.bounds(), o.voxel_grid, o.tube_radius_mm), o.tube_radius_mm);
-        chords_scene_ = &scene, chords_grid_ = o.voxel_grid, chords_radius_ = o.tube_radius_mm;
+        chords_scene_ = scene.generation(), chords_grid_ = o.voxel_grid, chords_radius_ = o.tube_radius_mm;
     }
     return chords_->volume();
 }

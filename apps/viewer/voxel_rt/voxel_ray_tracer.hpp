@@ -66,11 +66,12 @@ private:
     std::unique_ptr<VoxelStructure> structure_;
     std::unique_ptr<VoxelCulling> culling_;  // of structure_
     const GpuScene* built_scene_ = nullptr;
+    std::uint64_t built_generation_ = 0;  // GpuScene::generation()
     int built_grid_ = 0;
     float built_radius_ = 0;
     bool built_fiber_radii_ = false;
     std::unique_ptr<ChordOcclusion> chords_;
-    const GpuScene* chords_scene_ = nullptr;
+    std::uint64_t chords_scene_ = 0;
     int chords_grid_ = 0;
     float chords_radius_ = 0;
     GlVertexArray empty_vertex_array_;

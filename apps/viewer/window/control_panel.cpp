@@ -167,6 +167,9 @@ void frame_section(const PanelFrame& f) {
                 static_cast<unsigned long long>(f.stats.coarse_blocks),
                 static_cast<unsigned long long>(f.stats.drawn_segments()));
     ImGui::Text("GPU memory: %.2f MB (scene and transparency buffers)", double(f.gpu_bytes) / 1e6);
+    if (f.fibers_held < f.file_fibers)
+        ImGui::Text("fibers held: %llu of %llu (the view's, within --gpu-memory)",
+                    static_cast<unsigned long long>(f.fibers_held), static_cast<unsigned long long>(f.file_fibers));
 }
 
 // The picked fiber and the selection.

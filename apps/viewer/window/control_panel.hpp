@@ -33,6 +33,7 @@ struct PanelFrame {
     FrameStats stats;
     double frame_ms = 0;
     std::uint64_t gpu_bytes = 0;  // the scene's buffers and the renderer's
+    std::uint64_t fibers_held = 0, file_fibers = 0;  // fewer held: a file beyond the GPU budget
     std::optional<PickedFiber> picked;
     std::size_t highlighted = 0;
     std::string message;  // the last error a change caused (e.g. a slice outside the image)

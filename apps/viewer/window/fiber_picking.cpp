@@ -24,7 +24,7 @@ std::optional<PickedFiber> pick_fiber(const RenderTarget& target, const GpuScene
             if (v == 0 || v - 1 >= scene.fiber_count() || d2 >= best || d2 > radius_px * radius_px) continue;
             best = d2;
             const std::uint64_t index = v - 1;
-            out = PickedFiber{index, scene.fiber_id(index), scene.fiber_points(index), scene.fiber_length_mm(index),
+            out = PickedFiber{scene.file_fiber(index), scene.fiber_id(index), scene.fiber_points(index), scene.fiber_length_mm(index),
                               px, py};
         }
     return out;

@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <utility>
 
 #include "overlays/overlay_sources.hpp"
 #include "scene/fiber_colors.hpp"
@@ -32,6 +33,8 @@
 #include "techniques/technique_registry.hpp"
 #include "scene/fiber_opacity.hpp"
 #include "scene/fiber_radii.hpp"
+#include "scene/fiber_streaming.hpp"
+#include "window/streamed_view.hpp"
 #include "render/supersampling.hpp"
 #include "scene/scene_file.hpp"
 #include "render/vec_ops.hpp"
@@ -289,9 +292,9 @@ PanelScene panel_scene(const FftFile& file, const GpuScene& scene) {
     p.fiber_colors = scene.has_fiber_colors();
     p.point_values = scene.has_point_values();
     p.point_value_range = scene.point_value_range();
-    p.fibers = scene.fiber_count();
+    p.fibers = scene.file_fiber_count();
     for (const StreamlineField& f : file.streamline_fields()) {
-        if (f.scope() != FieldScope::streamline || f.components != 1 || f.rows() != scene.fiber_count()) continue;
+        if (f.scope() != FieldScope::streamline || f.components != 1 || f.rows() != scene.file_fiber_count()) continue;
         std::vector<float> values(f.rows());
         for (std::uint64_t r = 0; r < f.rows(); ++r) values[r] = narrow_to_float(f.at(r, 0));
         p.fiber_values.emplace_back(f.name, std::move(values));
@@ -313,6 +316,7 @@ void save_highlighted(const WindowOptions& options, const std::vector<std::uint3
 }  // namespace
 
 void run_viewer_window(const std::string& path, const WindowOptions& options) {
+    const auto opened = std::chrono::steady_clock::now();
     const GlfwSession glfw;
     const std::string title = std::filesystem::path(path).filename().string();
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
@@ -329,7 +333,9 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
 
     const GpuPrograms programs;
     const FftFile file = open_scene_file(path);
-    GpuScene scene(file, programs);
+    const FiberStreaming streaming(file, options.gpu_budget_bytes ? options.gpu_budget_bytes : default_gpu_budget(),
+                                   !options.fiber_colors.point_values_path.empty());
+    GpuScene scene(file, programs, {}, streaming.streams() ? std::optional(streaming.overview()) : std::nullopt);
     load_fiber_colors(options.fiber_colors, file, scene);
     if (!options.fiber_radii_path.empty()) load_fiber_radii(options.fiber_radii_path, scene);
     if (!options.fiber_opacity_source.empty()) load_fiber_opacities(options.fiber_opacity_source, file, scene);
@@ -356,25 +362,34 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
     // The panel's controls, written for the window test (scripts/view_window_test.sh).
     const char* layout_file = std::getenv("FIBLET_VIEW_PANEL_LAYOUT");
     PanelLayout layout;
-    fmt::print("{}: {} fibers, {} blocks on {}\n{}", title, scene.fiber_count(), scene.block_count(),
+    fmt::print("{}: {} fibers, {} blocks on {}\n{}", title, file.header().fibers, file.header().blocks,
                current_gl_description(), window_controls_help());
+    if (streaming.streams())
+        fmt::print("beyond --gpu-memory {:.0f} MiB: an overview of {} fibers first, then the fibers each view sees\n",
+                   streaming.budget_bytes() / 1048576.0, scene.fiber_count());
     std::fflush(stdout);
+    StreamedView streamed(scene, file, programs, streaming, opened);
+    bool first_frame = true;
 
     while (!glfwWindowShouldClose(w) && !s.quit) {
         // Sleep until something happens; draw the scene again only when the
         // view changed, the panel at every event.
-        if (!s.dirty) glfwWaitEventsTimeout(0.5);
+        if (!s.dirty) glfwWaitEventsTimeout(streamed.load_pending() ? 0.1 : 0.5);
         glfwPollEvents();
         glfwGetFramebufferSize(w, &fb_width, &fb_height);
         if (fb_width < 1 || fb_height < 1) continue;  // minimized
         const Camera camera = s.orbit.camera(float(fb_width) / float(fb_height));
+        bool loaded = false;  // a streamed file's fibers for this view, after the first frame
+        const GpuScene& drawn =
+            first_frame ? scene : streamed.scene_for(camera, renderer.reach_mm(scene, s.render), loaded);
+        s.dirty = s.dirty || loaded;
         bool target_stale = false;  // a transparent frame's pick drew over it
         if (s.dirty) {
             s.dirty = false;
             target.resize(fb_width, fb_height);
             const auto t0 = std::chrono::steady_clock::now();
             try {
-                frame.stats = renderer.render(scene, camera, s.render, target);
+                frame.stats = renderer.render(drawn, camera, s.render, target);
             } catch (const Error& e) {
                 // E on a scene the voxel ray tracer refuses (its buffers): say
                 // why and keep drawing with the rasterizer.
@@ -386,7 +401,13 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
                 continue;
             }
             frame.frame_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-            frame.gpu_bytes = scene.gpu_bytes() + renderer.transparency_bytes();
+            frame.gpu_bytes = streamed.gpu_bytes() + renderer.transparency_bytes();
+            frame.fibers_held = drawn.fiber_count(), frame.file_fibers = drawn.file_fiber_count();
+            if (std::exchange(first_frame, false) || loaded)
+                fmt::print("{} frame drawn {:.2f} s after start ({} of {} fibers, {:.0f} ms)\n",
+                           loaded ? "the view's fibers'" : "first", seconds_since(opened), drawn.fiber_count(),
+                           drawn.file_fiber_count(), frame.frame_ms),
+                    std::fflush(stdout);
             glfwSetWindowTitle(w, fmt::format("{} | {:.1f} ms | {} blocks ({} coarse), {} segments | {}", title,
                                               frame.frame_ms, frame.stats.drawn_blocks(), frame.stats.coarse_blocks,
                                               frame.stats.drawn_segments(), technique_label(s.render))
@@ -395,9 +416,9 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
             // a transparent frame draws over the target.
             if (s.screenshot) {
                 s.screenshot = false;
-                take_screenshot(options, renderer, scene, camera, s.render, target);
+                take_screenshot(options, renderer, drawn, camera, s.render, target);
             }
-            if (s.pick) target_stale = pick(s, w, renderer, scene, camera, target, frame);
+            if (s.pick) target_stale = pick(s, w, renderer, drawn, camera, target, frame);
         }
         if (s.save_selection) {
             s.save_selection = false;

@@ -124,6 +124,9 @@ public:
     // Bounds of every point a block decodes to: its own box, or its group's
     // (version 2) (conservative; escaped ones are unbounded).
     Aabb block_box(std::uint64_t block) const;
+    // A box around every point of the file (the union of its boxes);
+    // nullopt when some box is unbounded or there is no block.
+    std::optional<Aabb> bounds() const;
     // Every block's view sphere (view.hpp) has a radius at most this.
     float max_sphere_radius() const { return max_sphere_radius_; }
     // A block's last point lies at most this far (mm) from the next block's

@@ -222,6 +222,16 @@ void BlockIndex::set_groups(const std::vector<Aabb>& boxes) {
     build(keyed, [&](std::uint32_t b) { return boxes[b]; });
 }
 
+std::optional<Aabb> BlockIndex::bounds() const {
+    if (sorted_boxes_.empty()) return std::nullopt;
+    Aabb all = empty_box();
+    for (const Aabb& b : sorted_boxes_) {
+        if (is_unbounded(b)) return std::nullopt;
+        grow(all, b);
+    }
+    return all;
+}
+
 template <class BoxOf>
 void BlockIndex::build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of) {
     const std::size_t n = keyed.size();

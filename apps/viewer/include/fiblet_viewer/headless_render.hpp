@@ -25,6 +25,10 @@ struct HeadlessRenderJob {
     std::string fiber_opacity_source;  // scene/fiber_opacity.hpp; render.fiber_opacity turns them on
     OverlaySources overlays;           // glyphs and slices over the fibers
     std::string camera = "oblique";    // as camera_from_spec (window/orbit_camera.hpp)
+    // GPU memory the scene may take (scene/fiber_streaming.hpp); 0: a share
+    // of what the driver reports. A file beyond it is held in part: the
+    // fibers each output's camera sees, as many as fit.
+    std::uint64_t gpu_budget_bytes = 0;
     float fov_y_deg = 35, zoom = 1;
 
     // The benchmark, run first: `frames` timed frames per case, the views
@@ -48,7 +52,17 @@ struct HeadlessRenderJob {
 // The scene as loaded, and the context that drew it.
 struct HeadlessScene {
     std::string device;  // "renderer, GL version" as the driver reports them
-    std::uint64_t fibers = 0, blocks = 0, segments = 0;
+    std::uint64_t fibers = 0, blocks = 0, segments = 0;  // held on the GPU (at first)
+    std::uint64_t file_fibers = 0, file_blocks = 0;
+    std::uint64_t gpu_budget_bytes = 0;
+    bool streamed = false;  // the file exceeds the budget: a part is held at a time
+    double first_scene_ms = 0;  // from opening the file to the first scene on the GPU
+};
+
+// What the GPU held for an image (streamed files hold the fibers its camera sees).
+struct HeldScene {
+    std::uint64_t fibers = 0, blocks = 0, gpu_bytes = 0;
+    double load_ms = 0;  // choosing and uploading them (0: the first scene served)
 };
 
 // One case of the benchmark (run_render_bench).
@@ -91,6 +105,7 @@ struct RenderBench {
 struct HeadlessRenderResult {
     HeadlessScene scene;
     FrameStats first_image;  // the first output's frame (supersampled: the enlarged frame)
+    HeldScene first_image_scene;
 };
 
 // Makes a headless OpenGL 4.5 context, opens the scene, runs the benchmark

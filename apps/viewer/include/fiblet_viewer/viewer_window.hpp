@@ -21,6 +21,10 @@ struct WindowOptions {
     OverlaySources overlays;        // glyphs and slices over the fibers
     std::string fiber_radii_path;   // fiber_radii.hpp; render.fiber_radii turns them on
     std::string fiber_opacity_source;  // fiber_opacity.hpp; render.fiber_opacity turns them on
+    // GPU memory the scene may take (scene/fiber_streaming.hpp); 0: a share
+    // of what the driver reports. A file beyond it shows a sparse overview
+    // first, then, once the view rests, the fibers it sees, as many as fit.
+    std::uint64_t gpu_budget_bytes = 0;
 };
 
 // The key and mouse bindings, for --help and the H key.
