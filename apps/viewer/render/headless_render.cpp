@@ -16,10 +16,6 @@
 #include "techniques/technique_registry.hpp"
 #include "render/supersampling.hpp"
 #include "scene/block_decoder.hpp"
-#include "scene/fiber_colors.hpp"
-#include "scene/fiber_opacity.hpp"
-#include "scene/fiber_radii.hpp"
-#include "scene/fiber_streaming.hpp"
 #include "scene/gpu_programs.hpp"
 #include "scene/gpu_scene.hpp"
 #include "scene/scene_file.hpp"
@@ -61,13 +57,10 @@ HeadlessRenderResult render_headless(const HeadlessRenderJob& job,
     const GpuPrograms programs;
     const auto opened = std::chrono::steady_clock::now();
     const FftFile file = open_scene_file(job.input);
-    const FiberStreaming streaming(file, job.gpu_budget_bytes ? job.gpu_budget_bytes : default_gpu_budget(),
-                                   !job.fiber_colors.point_values_path.empty());
+    const FiberStreaming streaming(file, job.gpu_budget_bytes, !job.fiber_colors.point_values_path.empty());
     // Every fiber, or the overview of a streamed file: what cameras are fitted to.
-    GpuScene first(file, programs, {}, streaming.streams() ? std::optional(streaming.overview()) : std::nullopt);
-    load_fiber_colors(job.fiber_colors, file, first);
-    if (!job.fiber_radii_path.empty()) load_fiber_radii(job.fiber_radii_path, first);
-    if (!job.fiber_opacity_source.empty()) load_fiber_opacities(job.fiber_opacity_source, file, first);
+    const GpuScene first =
+        first_scene(file, programs, streaming, job.fiber_colors, job.fiber_radii_path, job.fiber_opacity_source);
     RenderTarget target(job.width, job.height);
     Renderer renderer(programs);
     renderer.set_overlays(make_overlays(job.overlays, options));

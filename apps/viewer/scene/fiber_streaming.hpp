@@ -36,8 +36,8 @@ inline constexpr std::uint64_t kOverviewBlocks = 32768;
 class FiberStreaming {
 public:
     // Loads the file's block index only when the whole file exceeds the
-    // budget. Throws Error{invalid_argument} for a budget of 0,
-    // Error{fft_format} for a malformed index.
+    // budget (0: default_gpu_budget()). Throws Error{fft_format} for a
+    // malformed index.
     FiberStreaming(const FftFile& file, std::uint64_t budget_bytes, bool point_values);
 
     bool streams() const { return index_ != nullptr; }  // the whole file exceeds the budget

@@ -9,6 +9,9 @@
 #include "fiblet/compress.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/tractogram_format.hpp"
+#include "scene/fiber_colors.hpp"
+#include "scene/fiber_opacity.hpp"
+#include "scene/fiber_radii.hpp"
 
 namespace fiblet::viewer {
 
@@ -28,6 +31,15 @@ FftFile open_scene_file(const std::string& path) {
     CompressOptions options;
     compress_file(path, fft, options);
     return FftFile(fft);  // FftFile keeps its descriptor: the file may go
+}
+
+GpuScene first_scene(const FftFile& file, const GpuPrograms& programs, const FiberStreaming& streaming,
+                     const FiberColorSource& colors, const std::string& radii_path, const std::string& opacity_source) {
+    GpuScene scene(file, programs, {}, streaming.streams() ? std::optional(streaming.overview()) : std::nullopt);
+    load_fiber_colors(colors, file, scene);
+    if (!radii_path.empty()) load_fiber_radii(radii_path, scene);
+    if (!opacity_source.empty()) load_fiber_opacities(opacity_source, file, scene);
+    return scene;
 }
 
 }  // namespace fiblet::viewer

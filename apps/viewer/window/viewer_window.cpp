@@ -18,7 +18,6 @@
 #include <utility>
 
 #include "overlays/overlay_sources.hpp"
-#include "scene/fiber_colors.hpp"
 #include "window/control_panel.hpp"
 #include "window/fiber_picking.hpp"
 #include "window/fiber_selection.hpp"
@@ -31,9 +30,6 @@
 #include "render/render_target.hpp"
 #include "render/renderer.hpp"
 #include "techniques/technique_registry.hpp"
-#include "scene/fiber_opacity.hpp"
-#include "scene/fiber_radii.hpp"
-#include "scene/fiber_streaming.hpp"
 #include "window/streamed_view.hpp"
 #include "render/supersampling.hpp"
 #include "scene/scene_file.hpp"
@@ -333,12 +329,9 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
 
     const GpuPrograms programs;
     const FftFile file = open_scene_file(path);
-    const FiberStreaming streaming(file, options.gpu_budget_bytes ? options.gpu_budget_bytes : default_gpu_budget(),
-                                   !options.fiber_colors.point_values_path.empty());
-    GpuScene scene(file, programs, {}, streaming.streams() ? std::optional(streaming.overview()) : std::nullopt);
-    load_fiber_colors(options.fiber_colors, file, scene);
-    if (!options.fiber_radii_path.empty()) load_fiber_radii(options.fiber_radii_path, scene);
-    if (!options.fiber_opacity_source.empty()) load_fiber_opacities(options.fiber_opacity_source, file, scene);
+    const FiberStreaming streaming(file, options.gpu_budget_bytes, !options.fiber_colors.point_values_path.empty());
+    GpuScene scene =
+        first_scene(file, programs, streaming, options.fiber_colors, options.fiber_radii_path, options.fiber_opacity_source);
     Renderer renderer(programs);
     int fb_width = 0, fb_height = 0;
     glfwGetFramebufferSize(w, &fb_width, &fb_height);
