@@ -7,12 +7,18 @@
 #   the wheel zooms, a drag orbits, R resets (the first image again);
 #   a click on a fiber prints it and highlights it (the others dimmed);
 #   P hides the panel (a click where a button was reaches the scene);
-#   Q quits with status 0.
-#   scripts/view_window_test.sh FIBLET INPUT.fft
+#   Q quits with status 0;
+#   under --gpu-memory below the file's scene, the overview is drawn first,
+#   then a part of the fibers of the resting view, again after a zoom.
+#   scripts/view_window_test.sh FIBLET INPUT [STREAMED_INPUT]
+# (STREAMED_INPUT, default INPUT: the --gpu-memory case; a file of a few
+# hundred blocks or more, so that a part of it is more than the frames
+# every scene holds.)
 # Needs Xvfb and xdotool (scripts/setup.sh); exit 1 on the first failure.
 set -euo pipefail
 FIBLET=$(realpath "$1")
 INPUT=$(realpath "$2")
+STREAMED=$(realpath "${3:-$2}")
 for tool in Xvfb xdotool python3; do
   command -v "$tool" >/dev/null || { echo "view_window_test: needs $tool (scripts/setup.sh)" >&2; exit 1; }
 done
@@ -160,5 +166,36 @@ differ "$tubes" "$hidden" "P: the hidden panel's button still drew tubes"
 xdotool key --window "$WINDOW" q
 for _ in $(seq 100); do kill -0 "$VIEWER" 2>/dev/null || break; sleep 0.1; done
 wait "$VIEWER" || fail "fiblet view exited with status $?"
+VIEWER=""
+
+# Beyond --gpu-memory (60 % of what the file's scene takes): the overview
+# first, then the fibers of the resting view, and again after a zoom.
+whole_bytes=$("$FIBLET" render "$STREAMED" -o "$WORK/whole.png" --size 64x48 --json |
+  python3 -c 'import json, sys; print(json.load(sys.stdin)["scene"]["gpu_bytes"])')
+budget=$(python3 -c "print(0.6 * $whole_bytes / 1048576)")
+rm -f fiblet-screenshot-*.png
+"$FIBLET" view "$STREAMED" --size 640x480 --gpu-memory "$budget" >"$WORK/view.log" 2>&1 &
+VIEWER=$!
+WINDOW=$(timeout 60 xdotool search --sync --onlyvisible --name "$(basename "$STREAMED")" | head -1) ||
+  fail "no window within 60 s (--gpu-memory $budget)"
+views_drawn() { grep -c "^the view's fibers' frame drawn" view.log || true; }
+wait_views() {  # wait_views N: until the N-th view's fibers are drawn
+  for _ in $(seq 300); do [ "$(views_drawn)" -ge "$1" ] && return; sleep 0.1; done
+  fail "the view's fibers were not drawn a ${1}th time"
+}
+grep -q "^beyond --gpu-memory" view.log || fail "--gpu-memory $budget MiB: the file was not streamed"
+wait_views 1
+grep -q "^first frame drawn" view.log || fail "no first frame (the overview)"
+held=$(sed -n "s/^the view's fibers' frame drawn .* (\([0-9]*\) of \([0-9]*\) fibers.*/\1 \2/p" view.log | head -1)
+read -r n_held n_file <<<"$held"
+[ "$n_held" -gt 0 ] && [ "$n_held" -lt "$n_file" ] || fail "held $n_held of $n_file fibers"
+first_view=$(shot)
+xdotool mousemove --window "$WINDOW" 480 240 click --window "$WINDOW" 4 click --window "$WINDOW" 4
+wait_views 2
+zoomed_view=$(shot)
+differ "$first_view" "$zoomed_view" "the zoomed view's fibers"
+xdotool key --window "$WINDOW" q
+for _ in $(seq 100); do kill -0 "$VIEWER" 2>/dev/null || break; sleep 0.1; done
+wait "$VIEWER" || fail "fiblet view --gpu-memory exited with status $?"
 VIEWER=""
 echo "view_window_test: ok ($(find . -maxdepth 1 -name 'fiblet-screenshot-*.png' | wc -l) screenshots compared)"

@@ -358,7 +358,7 @@ void run_viewer_window(const std::string& path, const WindowOptions& options) {
     fmt::print("{}: {} fibers, {} blocks on {}\n{}", title, file.header().fibers, file.header().blocks,
                current_gl_description(), window_controls_help());
     if (streaming.streams())
-        fmt::print("beyond --gpu-memory {:.0f} MiB: an overview of {} fibers first, then the fibers each view sees\n",
+        fmt::print("beyond --gpu-memory {:.3g} MiB: an overview of {} fibers first, then the fibers each view sees\n",
                    streaming.budget_bytes() / 1048576.0, scene.fiber_count());
     std::fflush(stdout);
     StreamedView streamed(scene, file, programs, streaming, opened);
