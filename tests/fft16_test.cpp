@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <random>
 
 #include "fiblet/checksum.hpp"
 #include "fiblet/compare.hpp"
@@ -17,6 +18,7 @@
 #include "fiblet/fft_file.hpp"
 #include "fiblet/tck.hpp"
 #include "cli_runner.hpp"
+#include "container/packed_blocks16.hpp"
 #include "exact_error.hpp"
 #include "test_util.hpp"
 
@@ -257,6 +259,44 @@ TEST(Fft16, ChecksumGroupsHashThePackedBytes) {
         if (at == first_block + 100) {  // a code byte: verify says so, with the checksum exit status
             const test::CommandResult r = test::run_cli("verify " + dir.file("flip.fft"));
             EXPECT_EQ(r.status, 7) << r.output;
+        }
+    }
+}
+
+// Packing then expanding a block gives its codes back at every point count
+// (each tail of the eight-codes-at-a-time reader), and a code past the
+// levels is found wherever it sits.
+TEST(Fft16, PackedCodesRoundTripAndBadCodesAreFoundAnywhere) {
+    FftHeader h;
+    h.version = kFft16PackedVersion;
+    h.points_per_block = 254;
+    std::mt19937 rng(5);
+    std::uniform_int_distribution<int> code(0, 181 * 181 - 1);
+    for (std::uint32_t n = 1; n <= 254; ++n) {
+        SCOPED_TRACE(n);
+        std::vector<std::uint8_t> block(h.block_bytes(), 0);
+        const std::uint16_t flags = std::uint16_t(n);  // first and last of its fiber
+        std::memcpy(&block[kBlock16FlagsOffset], &flags, 2);
+        for (std::size_t b = 0; b < kBlock16FiberIdOffset; ++b) block[b] = std::uint8_t(rng());
+        const std::uint32_t m = n > 2 ? n - 2 : 0;
+        for (std::uint32_t k = 0; k < m; ++k) {
+            const auto c = std::uint16_t(code(rng));
+            std::memcpy(&block[kBlock16DirectionsOffset + 2 * k], &c, 2);
+        }
+        std::vector<std::uint8_t> packed;
+        detail::pack_blocks16(h, block, packed);
+        const detail::PackedBlockPlace place{n, 0, true, true};
+        std::vector<std::uint8_t> out(h.block_bytes(), 0xee);
+        ASSERT_EQ(detail::expand_block16(h, packed.data(), place, out.data()), "");
+        EXPECT_TRUE(std::equal(block.begin() + kBlock16DirectionsOffset, block.end(), out.begin() + kBlock16DirectionsOffset));
+        EXPECT_TRUE(std::equal(block.begin(), block.begin() + kBlock16FiberIdOffset, out.begin()));
+        for (std::uint32_t k = 0; k < m; k += 1 + k / 16) {  // a code past the levels at k
+            std::vector<std::uint8_t> bad = block;
+            const std::uint16_t past = std::uint16_t(181 * 181 + k % 7);
+            std::memcpy(&bad[kBlock16DirectionsOffset + 2 * k], &past, 2);
+            std::vector<std::uint8_t> bad_packed;
+            detail::pack_blocks16(h, bad, bad_packed);
+            EXPECT_NE(detail::expand_block16(h, bad_packed.data(), place, out.data()), "") << "code " << k;
         }
     }
 }

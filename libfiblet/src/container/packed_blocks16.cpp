@@ -1,5 +1,6 @@
 #include "container/packed_blocks16.hpp"
 
+#include <algorithm>
 #include <cstring>
 
 namespace fiblet::detail {
@@ -51,7 +52,27 @@ std::string expand_block16(const FftHeader& h, const std::uint8_t* packed, const
     const std::uint32_t levels = h.code_levels(), code_count = levels * levels;
     std::uint32_t bad = 0;  // OR of (code >= code_count): one test after the loops
     std::uint32_t k = 0;
-    // Code k starts at bit 15k: one unaligned 8-byte load while it stays inside the block...
+    // Eight codes from each 15 bytes (codes 8j.. start on byte 15j), read as
+    // two little-endian words while 16 bytes stay inside the block...
+    static_assert(kPacked16CodeBits == 15);
+    for (; k + 8 <= m && std::size_t(15) * (k / 8) + 16 <= code_bytes; k += 8) {
+        std::uint64_t lo, hi;
+        std::memcpy(&lo, p + 15 * (k / 8), 8);
+        std::memcpy(&hi, p + 15 * (k / 8) + 8, 8);
+        const std::uint16_t eight[8] = {std::uint16_t(lo & kCodeMask),
+                                        std::uint16_t(lo >> 15 & kCodeMask),
+                                        std::uint16_t(lo >> 30 & kCodeMask),
+                                        std::uint16_t(lo >> 45 & kCodeMask),
+                                        std::uint16_t((lo >> 60 | hi << 4) & kCodeMask),  // bits 60..74
+                                        std::uint16_t(hi >> 11 & kCodeMask),
+                                        std::uint16_t(hi >> 26 & kCodeMask),
+                                        std::uint16_t(hi >> 41 & kCodeMask)};
+        std::uint16_t largest = 0;
+        for (const std::uint16_t c : eight) largest = std::max(largest, c);
+        bad |= largest >= code_count;
+        std::memcpy(codes + 2 * k, eight, sizeof eight);
+    }
+    // ...then one unaligned 8-byte load a code while it stays inside...
     for (; k < m && std::size_t(kPacked16CodeBits) * k / 8 + 8 <= code_bytes; ++k) {
         const std::size_t bit = std::size_t(kPacked16CodeBits) * k;
         std::uint64_t w;
