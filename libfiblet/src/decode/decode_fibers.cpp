@@ -23,27 +23,32 @@ namespace {
 
 class ChunkDecoder {
 public:
-    // decode_file reuses its chunks' outputs: 4096 blocks a thread (~3 MB
-    // of points) stay in cache (DecodeOptions::chunk_blocks).
-    static constexpr std::size_t kBlocksPerThread = 4096;
+    // decode_file reuses its chunks' outputs: 4096 blocks of 60 points a
+    // thread (~3 MB of points) stay in cache (DecodeOptions::chunk_blocks);
+    // blocks of other sizes (16-bit: 254 points) as many points.
+    static constexpr std::size_t kPointsPerThread = std::size_t{4096} * 60;
     // decode_fibers and decode_fibers_into write straight into the whole
-    // output; only the chunk's blocks are reused (5 MB of 76-byte blocks).
-    // Bigger chunks join the pool less often: each chunk is two jobs, and a
-    // job's end waits for its last run and wakes a worker (docs/parallel.md:
-    // 2 threads vs 1 went from 1.4x to 1.7x on the medium file; the whole
-    // file as one chunk is slower again, its blocks fall out of cache).
-    static constexpr std::size_t kWholeOutputChunkBlocks = std::size_t{1} << 16;
+    // output; only the chunk's blocks are reused (5 MB: 65536 76-byte
+    // blocks, fewer larger ones). Bigger chunks join the pool less often:
+    // each chunk is two jobs, and a job's end waits for its last run and
+    // wakes a worker (docs/parallel.md: 2 threads vs 1 went from 1.4x to
+    // 1.7x on the medium file; the whole file as one chunk is slower again,
+    // its blocks fall out of cache).
+    static constexpr std::size_t kWholeOutputChunkBytes = (std::size_t{1} << 16) * 76;
 
-    ChunkDecoder(const FftFile& file, const DecodeOptions& options, std::size_t blocks_per_thread = kBlocksPerThread,
-                 std::size_t min_chunk_blocks = 0)
+    ChunkDecoder(const FftFile& file, const DecodeOptions& options, std::size_t min_chunk_bytes = 0)
         : file_(file),
           ctx_(file),
           decoder_(resolve_decoder(options.decoder)),
           threads_(detail::resolve_threads(options.threads)),
-          chunk_blocks_(options.chunk_blocks ? options.chunk_blocks
-                                             : std::max(blocks_per_thread * threads_, min_chunk_blocks)) {}
+          chunk_blocks_(options.chunk_blocks ? options.chunk_blocks : default_chunk_blocks(min_chunk_bytes)) {}
 
     std::size_t chunk_blocks() const { return chunk_blocks_; }
+
+    std::size_t default_chunk_blocks(std::size_t min_chunk_bytes) const {
+        const std::size_t per_thread = std::max<std::size_t>(kPointsPerThread / ctx_.header.points_per_block, 1);
+        return std::max(per_thread * threads_, min_chunk_bytes / ctx_.header.block_bytes());
+    }
 
     // End of the chunk of whole fibers starting at `f`: at least one fiber,
     // at most chunk_blocks blocks otherwise.
@@ -124,7 +129,7 @@ void check_range(const FftFile& file, std::uint64_t begin, std::uint64_t end) {
 
 Streamlines decode_fibers(const FftFile& file, std::uint64_t begin, std::uint64_t end, const DecodeOptions& options) {
     check_range(file, begin, end);
-    ChunkDecoder chunks(file, options, ChunkDecoder::kBlocksPerThread, ChunkDecoder::kWholeOutputChunkBlocks);
+    ChunkDecoder chunks(file, options, ChunkDecoder::kWholeOutputChunkBytes);
     Streamlines out;
     out.offsets.resize(end - begin + 1);
     // Reserving the most the blocks can hold maps memory without touching it.
@@ -145,7 +150,7 @@ std::uint64_t decode_fibers_into(const FftFile& file, std::uint64_t begin, std::
     if (offsets.size() < end - begin + 1)
         throw Error(Errc::invalid_argument, "decode_fibers_into: " + std::to_string(end - begin + 1) +
                                                 " offsets needed, room for " + std::to_string(offsets.size()));
-    ChunkDecoder chunks(file, options, ChunkDecoder::kBlocksPerThread, ChunkDecoder::kWholeOutputChunkBlocks);
+    ChunkDecoder chunks(file, options, ChunkDecoder::kWholeOutputChunkBytes);
     std::uint64_t done = 0;
     offsets[0] = 0;
     for (std::uint64_t f = begin; f < end;) {
