@@ -199,3 +199,37 @@ TEST(Fftz, SeekTablesClaimingHugeFramesAreRejectedBeforeAllocating) {
     test::write_file(f.dir.file("huge.fftz"), packed);
     EXPECT_THROW(FftFile{f.dir.file("huge.fftz")}, Error);
 }
+
+// A group frame followed by a stray byte that the seek table counts as its
+// own: the reader refuses it as damage (exit 7's category), whole-frame
+// decompression included.
+TEST(Fftz, BytesAfterAGroupFrameAreDamage) {
+    Files f;
+    make(f, 8, true);
+    const std::string packed = test::read_file(f.packed);
+    std::uint32_t frames;
+    std::memcpy(&frames, packed.data() + packed.size() - 9, 4);
+    const std::size_t table = packed.size() - 9 - 8 * std::size_t(frames);
+    // Frame 3: the first group of blocks (header, LUT and descriptor frames before it).
+    std::size_t at = 0;
+    for (std::uint32_t k = 0; k <= 3; ++k) {
+        std::uint32_t stored;
+        std::memcpy(&stored, &packed[table + 8 * k], 4);
+        at += stored;
+    }
+    std::string damaged = packed;
+    damaged.insert(at, 1, '\0');
+    std::uint32_t stored;
+    std::memcpy(&stored, &damaged[table + 1 + 8 * 3], 4);
+    ++stored;
+    std::memcpy(&damaged[table + 1 + 8 * 3], &stored, 4);
+    test::write_file(f.dir.file("stray.fftz"), damaged);
+    try {
+        const FftFile file(f.dir.file("stray.fftz"));
+        decode_fibers(file, 0, file.header().fibers);
+        ADD_FAILURE() << "a stray byte after a frame was read";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), Errc::checksum) << e.what();
+        EXPECT_NE(std::string(e.what()).find("after the end"), std::string::npos) << e.what();
+    }
+}

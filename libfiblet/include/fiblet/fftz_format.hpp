@@ -52,5 +52,9 @@ std::vector<std::uint8_t> transpose_block_group(std::span<const std::uint8_t> bl
                                                 std::uint32_t block_bytes);
 std::vector<std::uint8_t> untranspose_block_group(std::span<const std::uint8_t> fields, unsigned direction_bits,
                                                   std::uint32_t block_bytes);
+// The same into `blocks` (as many bytes as `fields`; throws
+// Error{invalid_argument} otherwise).
+void untranspose_block_group(std::span<const std::uint8_t> fields, unsigned direction_bits, std::uint32_t block_bytes,
+                             std::span<std::uint8_t> blocks);
 
 }  // namespace fiblet

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 #include <zstd.h>
+#include <zstd_errors.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -160,9 +161,7 @@ public:
     }
 
 private:
-    [[noreturn]] void damaged(const std::string& what) const {
-        throw Error(Errc::checksum, r_.name_ + ": damaged .fftz frame " + std::to_string(index_) + ": " + what);
-    }
+    [[noreturn]] void damaged(const std::string& what) const { r_.damaged_frame(index_, what); }
     void refill() {
         if (consumed_ == frame_.stored_size) damaged("truncated frame");
         buffer_.resize(std::size_t(std::min<std::uint64_t>(1u << 17, frame_.stored_size - consumed_)));
@@ -183,23 +182,62 @@ private:
 
 FftzReader::~FftzReader() = default;
 
+void FftzReader::FreeDCtx::operator()(ZSTD_DCtx_s* d) const { ZSTD_freeDCtx(d); }
+
+void FftzReader::damaged_frame(std::size_t index, const std::string& what) const {
+    throw Error(Errc::checksum, name_ + ": damaged .fftz frame " + std::to_string(index) + ": " + what);
+}
+
+void FftzReader::decompress_whole(std::size_t index, std::vector<std::uint8_t>& out) const {
+    const Frame& f = frames_[index];
+    stored_.resize(std::size_t(f.stored_size));
+    pread_exact(fd_, stored_.data(), stored_.size(), f.stored_at, name_);
+    const std::size_t frame = ZSTD_findFrameCompressedSize(stored_.data(), stored_.size());
+    if (ZSTD_isError(frame)) damaged_frame(index, ZSTD_getErrorName(frame));
+    if (frame != stored_.size()) damaged_frame(index, "bytes after the end of the zstd frame");
+    if (!dctx_) {
+        dctx_.reset(ZSTD_createDCtx());
+        if (!dctx_) throw std::bad_alloc();
+    }
+    out.resize(std::size_t(f.logical_size));
+    const std::size_t n = ZSTD_decompressDCtx(dctx_.get(), out.data(), out.size(), stored_.data(), stored_.size());
+    if (ZSTD_isError(n))
+        damaged_frame(index, ZSTD_getErrorCode(n) == ZSTD_error_dstSize_tooSmall
+                                 ? "content longer than its size in the seek table"
+                                 : ZSTD_getErrorName(n));
+    if (n != out.size()) damaged_frame(index, "content shorter than its size in the seek table");
+}
+
 const std::vector<std::uint8_t>& FftzReader::frame_bytes(std::size_t index) const {
     if (cached_ == index) return cache_;
     const Frame& f = frames_[index];
-    // Grown as the content really arrives: a frame that claims far more
-    // than it holds fails before the claim is allocated.
-    FrameStream stream(*this, index);
-    std::vector<std::uint8_t> out;
-    while (out.size() < f.logical_size) {
-        const std::size_t at = out.size();
-        out.resize(std::size_t(std::min<std::uint64_t>(f.logical_size, std::max<std::uint64_t>(2 * at, 1u << 16))));
-        stream.read(out.data() + at, out.size() - at);
-    }
-    stream.finish();
+    // Small frames in one call; larger ones grown as the content really
+    // arrives, beyond what is kept from the last frame: a frame that claims
+    // far more than it holds fails before the claim is allocated. The
+    // buffers are reused from frame to frame (groups are all the same size
+    // but the last).
     const bool group = layout_checked_ && index >= first_group_ && index < first_group_ + groups_;
-    if (group && descriptor_.layout == FftzLayout::transposed)
-        out = untranspose_block_group(out, direction_bits_, block_bytes_);
-    cache_ = std::move(out);
+    const bool transposed = group && descriptor_.layout == FftzLayout::transposed;
+    std::vector<std::uint8_t>& out = transposed ? fields_ : cache_;
+    cached_ = SIZE_MAX;  // until the frame is whole
+    const std::size_t at = std::size_t(f.logical_size);
+    if (f.logical_size <= kOneShotFrameBytes && f.stored_size <= ZSTD_compressBound(at)) {
+        decompress_whole(index, out);
+    } else {
+        FrameStream stream(*this, index);
+        for (std::size_t done = 0; done < at;) {
+            const std::size_t end = std::size_t(std::min<std::uint64_t>(at, std::max<std::uint64_t>(2 * done, 1u << 16)));
+            if (out.size() < end) out.resize(end);
+            stream.read(out.data() + done, end - done);
+            done = end;
+        }
+        stream.finish();
+        out.resize(at);
+    }
+    if (transposed) {
+        cache_.resize(at);
+        untranspose_block_group(fields_, direction_bits_, block_bytes_, cache_);
+    }
     cached_ = index;
     return cache_;
 }

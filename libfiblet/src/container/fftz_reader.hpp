@@ -15,9 +15,15 @@
 #include "fiblet/fft_format.hpp"
 #include "fiblet/fftz_format.hpp"
 
+struct ZSTD_DCtx_s;  // <zstd.h>
+
 namespace fiblet::detail {
 
 inline constexpr std::uint64_t kMaxCachedFrame = 64u << 20;
+// Frames up to this size are decompressed in one call straight into their
+// buffer (zstd's window is not copied out): their claimed size is allocated
+// before their content is seen, a bounded cost. Larger ones are streamed.
+inline constexpr std::uint64_t kOneShotFrameBytes = 16u << 20;
 inline constexpr std::size_t kLutFrame = 2;  // frames: descriptor, header, LUT, block groups, [trailer]
 
 class FftzReader {
@@ -50,7 +56,13 @@ private:
         std::uint64_t logical_at, logical_size;
     };
     class FrameStream;
+    struct FreeDCtx {
+        void operator()(ZSTD_DCtx_s* d) const;
+    };
     const std::vector<std::uint8_t>& frame_bytes(std::size_t index) const;  // call with mutex_ held
+    // Frame `index` (at most kOneShotFrameBytes) decompressed whole into `out`.
+    void decompress_whole(std::size_t index, std::vector<std::uint8_t>& out) const;
+    [[noreturn]] void damaged_frame(std::size_t index, const std::string& what) const;
     // Bytes [at, at + size) of a large frame, from a stream kept between calls.
     void read_streamed(std::size_t index, std::uint64_t at, std::uint8_t* out, std::uint64_t size) const;
 
@@ -68,6 +80,9 @@ private:
     mutable std::mutex mutex_;
     mutable std::size_t cached_ = SIZE_MAX;
     mutable std::vector<std::uint8_t> cache_;
+    mutable std::vector<std::uint8_t> fields_;  // a transposed group as decompressed (reused: no zeroing, no regrowth)
+    mutable std::vector<std::uint8_t> stored_;  // a frame's compressed bytes (decompress_whole)
+    mutable std::unique_ptr<ZSTD_DCtx_s, FreeDCtx> dctx_;
     mutable std::unique_ptr<FrameStream> stream_;  // read_streamed()'s, positioned where it stopped
 };
 

@@ -106,10 +106,19 @@ std::vector<std::uint8_t> transpose_block_group(std::span<const std::uint8_t> bl
 
 std::vector<std::uint8_t> untranspose_block_group(std::span<const std::uint8_t> fields, unsigned direction_bits,
                                                   std::uint32_t bb) {
+    std::vector<std::uint8_t> out(fields.size());
+    untranspose_block_group(fields, direction_bits, bb, out);
+    return out;
+}
+
+void untranspose_block_group(std::span<const std::uint8_t> fields, unsigned direction_bits, std::uint32_t bb,
+                             std::span<std::uint8_t> out) {
+    if (out.size() != fields.size())
+        throw Error(Errc::invalid_argument, "untranspose_block_group: " + std::to_string(out.size()) +
+                                                " bytes for a group of " + std::to_string(fields.size()));
     const BlockFields f = fields_of(direction_bits, bb);
     const std::size_t n = group_count(fields.size(), bb);
     const std::uint32_t mask = f.value_bytes == 3 ? 0xffffffu : 0xffffu;
-    std::vector<std::uint8_t> out(fields.size());
     const std::uint8_t* in = fields.data();
     for (std::size_t b = 0; b < n; ++b) {
         std::array<std::uint32_t, 6> q{};
@@ -133,7 +142,6 @@ std::vector<std::uint8_t> untranspose_block_group(std::span<const std::uint8_t> 
                 out[b * bb + f.head_end + 2 * w] = in[plane + b * words + w];
             }
     }
-    return out;
 }
 
 }  // namespace fiblet
