@@ -77,6 +77,12 @@ click_control() {  # click LABEL: the panel control's centre
   read -r x y < <(centre "$1")
   click "$x" "$y"
 }
+quit_viewer() {  # Q quits, with status 0
+  xdotool key --window "$WINDOW" q
+  for _ in $(seq 100); do kill -0 "$VIEWER" 2>/dev/null || break; sleep 0.1; done
+  wait "$VIEWER" || fail "fiblet view $1 exited with status $?"
+  VIEWER=""
+}
 same() { cmp -s "$1" "$2" || fail "$3: $1 and $2 differ"; }
 differ() { cmp -s "$1" "$2" && fail "$3: $1 and $2 are the same" || true; }
 
@@ -163,10 +169,7 @@ click "$x" "$y"
 hidden=$(shot)
 differ "$tubes" "$hidden" "P: the hidden panel's button still drew tubes"
 
-xdotool key --window "$WINDOW" q
-for _ in $(seq 100); do kill -0 "$VIEWER" 2>/dev/null || break; sleep 0.1; done
-wait "$VIEWER" || fail "fiblet view exited with status $?"
-VIEWER=""
+quit_viewer ""
 
 # Beyond --gpu-memory (60 % of what the file's scene takes): the overview
 # first, then the fibers of the resting view, and again after a zoom.
@@ -194,8 +197,5 @@ xdotool mousemove --window "$WINDOW" 480 240 click --window "$WINDOW" 4 click --
 wait_views 2
 zoomed_view=$(shot)
 differ "$first_view" "$zoomed_view" "the zoomed view's fibers"
-xdotool key --window "$WINDOW" q
-for _ in $(seq 100); do kill -0 "$VIEWER" 2>/dev/null || break; sleep 0.1; done
-wait "$VIEWER" || fail "fiblet view --gpu-memory exited with status $?"
-VIEWER=""
+quit_viewer "--gpu-memory"
 echo "view_window_test: ok ($(find . -maxdepth 1 -name 'fiblet-screenshot-*.png' | wc -l) screenshots compared)"
