@@ -2,9 +2,10 @@
 """Every row of the parallel-pipeline table (issue 14) from one run, with the
 machine's load: decompress and compress scaling (quiet and with a competing
 `yes > /dev/null`), the machine's own floor for 2 threads vs 1, decompress to a file against `cp`, compress speed,
-fiblet.load against numpy.fromfile of the .tck, selection of 10 % of the
-blocks against a full decode, the block index's share of the file, and the
-16-bit size and error.
+fiblet.load against numpy.fromfile of the .tck, 16-bit files against 8-bit
+ones (fiblet.load) and against `cp` (decompress, 1 thread, with the .fftz),
+selection of 10 % of the blocks against a full decode, the block index's
+share of the file, and the 16-bit size and error.
 
     /usr/bin/python3 bench/pipeline_table.py --build BUILD --tck TCK [--repeat N] [--json OUT]
 
@@ -114,7 +115,16 @@ def main():
             res["compress_busy"] = {t: timed([cli, "compress", tck, "-o", o, "-f", "-q", "-j", str(t)], R)
                                     for t in (1, 2)}
 
-        # fiblet.load vs numpy.fromfile (one Python process, both files warm).
+        # 16-bit size and error; its decompress, 1 thread (and the .fftz's) vs cp.
+        fft16 = os.path.join(work, "b16.fft")
+        c16 = json_of([cli, "compress", tck, "-o", fft16, "-f", "--json", "--bits", "16"])
+        res["bits16"] = {"ratio": tck_bytes / c16["output_bytes"], "max_error_um": c16["max_error_um"]}
+        c8 = json_of([cli, "compress", tck, "-o", os.path.join(work, "b8.fft"), "-f", "--json"])
+        res["bits8"] = {"ratio": tck_bytes / c8["output_bytes"], "max_error_um": c8["max_error_um"]}
+        res["decompress16_file"] = timed([cli, "decompress", fft16, "-o", out, "-f", "-q", "-j", "1"], R, before=rm)
+        rm()
+
+        # fiblet.load vs numpy.fromfile, and of the 16-bit file (one Python process, the files warm).
         py = f"""
 import json, os, statistics, time, numpy as np, fiblet
 def med(f, n):
@@ -122,10 +132,11 @@ def med(f, n):
     for _ in range(n):
         t0 = time.perf_counter(); r = f(); ts.append(time.perf_counter() - t0); del r
     return statistics.median(ts)
-tck, fft, n = {tck!r}, {fft!r}, {R}
-np.fromfile(tck, dtype=np.uint8); fiblet.load(fft)
+tck, fft, fft16, n = {tck!r}, {fft!r}, {fft16!r}, {R}
+np.fromfile(tck, dtype=np.uint8); fiblet.load(fft); fiblet.load(fft16)
 print(json.dumps({{"fromfile": med(lambda: np.fromfile(tck, dtype="<f4"), n),
-                  "load": med(lambda: fiblet.load(fft), n)}}))
+                  "load": med(lambda: fiblet.load(fft), n),
+                  "load16": med(lambda: fiblet.load(fft16), n)}}))
 """
         env = dict(os.environ, PYTHONPATH=os.path.join(a.build, "python"))
         res["python"] = {}
@@ -134,11 +145,6 @@ print(json.dumps({{"fromfile": med(lambda: np.fromfile(tck, dtype="<f4"), n),
             res["python"][mode] = json.loads(subprocess.run(["/usr/bin/python3", "-c", py], env=env, check=True,
                                                             capture_output=True, text=True).stdout)
 
-        # 16-bit size and error.
-        c16 = json_of([cli, "compress", tck, "-o", os.path.join(work, "b16.fft"), "-f", "--json", "--bits", "16"])
-        res["bits16"] = {"ratio": tck_bytes / c16["output_bytes"], "max_error_um": c16["max_error_um"]}
-        c8 = json_of([cli, "compress", tck, "-o", os.path.join(work, "b8.fft"), "-f", "--json"])
-        res["bits8"] = {"ratio": tck_bytes / c8["output_bytes"], "max_error_um": c8["max_error_um"]}
 
         # Selection of 10 % of the blocks vs a full decode; the index's size (select_bench.cpp).
         if not a.skip_select:
@@ -192,6 +198,13 @@ print(json.dumps({{"fromfile": med(lambda: np.fromfile(tck, dtype="<f4"), n),
                  f"**{p['huge']['load'] / p['huge']['fromfile']:.2f}×** ({f(p['huge']['load'])} s vs {f(p['huge']['fromfile'])} s; "
                  f"MAP_POPULATE instead of huge pages: {p['populate']['load'] / p['populate']['fromfile']:.2f}×)",
                  "≤ 1.0×"))
+    rows.append(("`fiblet.load` of the 16-bit `.fft` vs the 8-bit one",
+                 f"**{p['huge']['load16'] / p['huge']['load']:.2f}×** ({f(p['huge']['load16'])} s vs {f(p['huge']['load'])} s)",
+                 "≤ 1.5×"))
+    d16 = res["decompress16_file"]
+    rows.append(("decompress a 16-bit `.fft` / a `.fftz` → `.tck` file, 1 thread, vs `cp`",
+                 f"**{d16[0] / cp[0]:.2f}× / {dz[1][0] / cp[0]:.2f}×** ({f(d16[0])} s / {f(dz[1][0])} s; cp {f(cp[0])} s)",
+                 "≤ 1.5×"))
     if "select" in res:
         s = res["select"]
         rows.append(("selection of 10 % of the blocks vs a full decode (one thread, CPU)",
