@@ -223,13 +223,9 @@ void BlockIndex::set_groups(const std::vector<Aabb>& boxes) {
 }
 
 std::optional<Aabb> BlockIndex::bounds() const {
-    if (sorted_boxes_.empty()) return std::nullopt;
-    Aabb all = empty_box();
-    for (const Aabb& b : sorted_boxes_) {
-        if (is_unbounded(b)) return std::nullopt;
-        grow(all, b);
-    }
-    return all;
+    // The hierarchy's root bounds every box (an unbounded one spoils it).
+    if (sorted_boxes_.empty() || is_unbounded(levels_.back().front())) return std::nullopt;
+    return levels_.back().front();
 }
 
 template <class BoxOf>
