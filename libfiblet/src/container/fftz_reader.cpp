@@ -220,22 +220,22 @@ const std::vector<std::uint8_t>& FftzReader::frame_bytes(std::size_t index) cons
     const bool transposed = group && descriptor_.layout == FftzLayout::transposed;
     std::vector<std::uint8_t>& out = transposed ? fields_ : cache_;
     cached_ = SIZE_MAX;  // until the frame is whole
-    const std::size_t at = std::size_t(f.logical_size);
-    if (f.logical_size <= kOneShotFrameBytes && f.stored_size <= ZSTD_compressBound(at)) {
+    const std::size_t size = std::size_t(f.logical_size);
+    if (f.logical_size <= kOneShotFrameBytes && f.stored_size <= ZSTD_compressBound(size)) {
         decompress_whole(index, out);
     } else {
         FrameStream stream(*this, index);
-        for (std::size_t done = 0; done < at;) {
-            const std::size_t end = std::size_t(std::min<std::uint64_t>(at, std::max<std::uint64_t>(2 * done, 1u << 16)));
+        for (std::size_t done = 0; done < size;) {
+            const std::size_t end = std::size_t(std::min<std::uint64_t>(size, std::max<std::uint64_t>(2 * done, 1u << 16)));
             if (out.size() < end) out.resize(end);
             stream.read(out.data() + done, end - done);
             done = end;
         }
         stream.finish();
-        out.resize(at);
+        out.resize(size);
     }
     if (transposed) {
-        cache_.resize(at);
+        cache_.resize(size);
         untranspose_block_group(fields_, direction_bits_, block_bytes_, cache_);
     }
     cached_ = index;
