@@ -78,11 +78,7 @@ HeadlessRenderResult render_headless(const HeadlessRenderJob& job,
     auto scene_seen_by = [&](const Camera& camera) -> const GpuScene& {
         if (!streaming.streams()) return first;
         const auto start = std::chrono::steady_clock::now();
-        FiberSubset seen = streaming.visible(camera, renderer.reach_mm(first, options));
-        if (part)
-            part->reside(file, programs, std::move(seen));
-        else
-            part.emplace(first, file, programs, std::move(seen));
+        hold_view(part, first, file, programs, streaming, camera, renderer.reach_mm(first, options));
         held = {part->fiber_count(), part->block_count(), first.gpu_bytes() + part->gpu_bytes(), milliseconds_since(start)};
         return *part;
     };

@@ -117,4 +117,15 @@ FiberSubset FiberStreaming::visible(const Camera& camera, float margin_mm) const
     return densest_within(candidates, ~0ull, budget_ > overview_bytes_ ? budget_ - overview_bytes_ : 0);
 }
 
+const GpuScene& hold_view(std::optional<GpuScene>& part, const GpuScene& overview, const FftFile& file,
+                          const GpuPrograms& programs, const FiberStreaming& streaming, const Camera& camera,
+                          float margin_mm) {
+    FiberSubset seen = streaming.visible(camera, margin_mm);
+    if (part)
+        part->reside(file, programs, std::move(seen));
+    else
+        part.emplace(overview, file, programs, std::move(seen));
+    return *part;
+}
+
 }  // namespace fiblet::viewer

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include "fiblet/block_index.hpp"
 #include "fiblet/fft_file.hpp"
@@ -68,5 +69,12 @@ private:
     std::uint64_t block_limit_;  // what one storage buffer holds
     std::shared_ptr<const BlockIndex> index_;
 };
+
+// `part` made to hold the fibers `camera` sees (FiberStreaming::visible):
+// held again, or made the first time with `overview`'s colours, radii and
+// point values. Only when `streaming` streams.
+const GpuScene& hold_view(std::optional<GpuScene>& part, const GpuScene& overview, const FftFile& file,
+                          const GpuPrograms& programs, const FiberStreaming& streaming, const Camera& camera,
+                          float margin_mm);
 
 }  // namespace fiblet::viewer

@@ -121,23 +121,24 @@ void GpuScene::load_geometry(const FftFile& file, const GpuPrograms& programs) {
     const FftHeader& h = header_;
     const std::uint32_t bb = h.block_bytes();
     const std::uint64_t fibers = holds_every_fiber() ? h.fibers : file_fibers_.size();
+    // The held fibers' blocks: one run of consecutive fibers (the whole file) or more.
+    auto for_each_run = [&](const auto& f) {
+        if (holds_every_fiber())
+            f(file.block_end(0), file.block_end(h.fibers));
+        else
+            for_each_fiber_run(file_fibers_, [&](std::uint64_t first, std::uint64_t end) {
+                f(file.block_end(first), file.block_end(end));
+            });
+    };
     std::uint64_t block_total = 0;
-    if (holds_every_fiber())
-        block_total = h.blocks;
-    else
-        for (const std::uint64_t f : file_fibers_) block_total += file.block_count(f);
+    for_each_run([&](std::uint64_t b0, std::uint64_t b1) { block_total += b1 - b0; });
     check_fits(block_total * bb, "blocks");
     std::vector<std::uint8_t> blocks(std::size_t(block_total) * bb);
-    if (holds_every_fiber())
-        file.read_blocks(0, h.blocks, blocks.data());
-    else {
-        std::size_t at = 0;
-        for_each_fiber_run(file_fibers_, [&](std::uint64_t first, std::uint64_t end) {
-            const std::uint64_t b0 = file.first_block(first), n = file.block_end(end) - b0;
-            file.read_blocks(b0, n, &blocks[at]);
-            at += std::size_t(n) * bb;
-        });
-    }
+    std::size_t at = 0;
+    for_each_run([&](std::uint64_t b0, std::uint64_t b1) {
+        file.read_blocks(b0, b1 - b0, blocks.data() + at);
+        at += std::size_t(b1 - b0) * bb;
+    });
     const std::uint32_t block_n = std::uint32_t(block_total);
     const DecodeContext ctx(h);
     count_block_points(ctx, blocks.data(), block_n);  // validates every point count

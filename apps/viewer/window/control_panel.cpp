@@ -52,6 +52,14 @@ bool slider(const char* label, float& value, float lo, float hi, PanelLayout* la
     return changed;
 }
 
+// A slider whose value is taken when the drag ends: what it changes is
+// made again (the overlays), not just drawn again.
+bool slider_on_release(const char* label, float& value, float lo, float hi, const char* format, PanelLayout* layout) {
+    ImGui::SliderFloat(label, &value, lo, hi, format);
+    record(layout, label);
+    return ImGui::IsItemDeactivatedAfterEdit();
+}
+
 bool technique_section(RenderOptions& o, PanelLayout* layout) {
     if (!ImGui::CollapsingHeader("Technique", ImGuiTreeNodeFlags_DefaultOpen)) return false;
     bool changed = radio_row("engine", render_engines(), o.engine, render_engine_name, layout);
@@ -145,17 +153,13 @@ bool overlay_section(OverlaySources& sources, PanelLayout* layout) {
     if (!sources.odf_path.empty()) {
         ImGui::TextUnformatted("ODF glyphs");
         changed |= slice_controls("glyphs", sources.odf_slice, layout);
-        ImGui::SliderFloat("glyph scale (voxels)", &sources.odf_scale, 0.1f, 3.0f, "%.2f");
-        record(layout, "glyph scale (voxels)");
-        changed |= ImGui::IsItemDeactivatedAfterEdit();
+        changed |= slider_on_release("glyph scale (voxels)", sources.odf_scale, 0.1f, 3.0f, "%.2f", layout);
     }
     if (!sources.image_path.empty()) {
         ImGui::TextUnformatted("Background image");
         changed |= slice_controls("image", sources.image_slice, layout);
     }
-    ImGui::SliderFloat("slab (mm, 0: all)", &sources.slab_mm, 0.0f, 40.0f, "%.1f");
-    record(layout, "slab (mm, 0: all)");
-    changed |= ImGui::IsItemDeactivatedAfterEdit();
+    changed |= slider_on_release("slab (mm, 0: all)", sources.slab_mm, 0.0f, 40.0f, "%.1f", layout);
     return changed;
 }
 

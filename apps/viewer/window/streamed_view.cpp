@@ -34,11 +34,7 @@ const GpuScene& StreamedView::scene_for(const Camera& camera, float margin_mm, b
     if (seconds_since(last_change_) < kRestSeconds) return overview_;
 
     const auto start = std::chrono::steady_clock::now();
-    FiberSubset seen = streaming_.visible(camera, margin_mm);
-    if (detail_)
-        detail_->reside(file_, programs_, std::move(seen));
-    else
-        detail_.emplace(overview_, file_, programs_, std::move(seen));
+    hold_view(detail_, overview_, file_, programs_, streaming_, camera, margin_mm);
     detail_for_ = camera, pending_ = false, loaded = true;
     fmt::print("holding the view's {} of {} fibers ({} blocks, {:.1f} MB) in {:.2f} s ({:.2f} s after opening)\n",
                detail_->fiber_count(), detail_->file_fiber_count(), detail_->block_count(), detail_->gpu_bytes() / 1e6,
