@@ -85,6 +85,14 @@ IndexGrid IndexGrid::for_groups(const FftHeader& h, unsigned bits, std::uint32_t
     return g;
 }
 
+// Whether cells i..j, as readers decode them in float (bounds()), hold
+// [lo, hi]: the double arithmetic that picked them does not see float
+// rounding flatten a cell (an origin near the float range: 1.7e38 mm plus a
+// few mm is 1.7e38 mm).
+bool IndexGrid::holds_in_float(float origin_axis, std::uint32_t i, std::uint32_t j, float lo, float hi) const {
+    return origin_axis + float(i) * cell <= lo && origin_axis + float(j) * cell >= hi;
+}
+
 std::uint32_t IndexGrid::encode(const Aabb& box) const {
     std::uint32_t code = 0, scale = 1;
     const float lo[3] = {box.min.x, box.min.y, box.min.z}, hi[3] = {box.max.x, box.max.y, box.max.z};
@@ -95,7 +103,8 @@ std::uint32_t IndexGrid::encode(const Aabb& box) const {
         if (!(b >= 0 && t >= b && t < double(min_levels + extent_levels))) return unbounded_code();
         const auto i = std::uint32_t(std::floor(b));
         const auto j = std::uint32_t(std::ceil(t));
-        if (i >= min_levels || j - i >= extent_levels) return unbounded_code();
+        if (i >= min_levels || j - i >= extent_levels || !holds_in_float(o[a], i, j, lo[a], hi[a]))
+            return unbounded_code();
         code += (i * extent_levels + (j - i)) * scale;
         scale *= axis_levels();
     }
@@ -112,7 +121,8 @@ std::optional<GridBox> IndexGrid::quantize(const Aabb& box) const {
         if (!(b >= 0 && t >= b && t < double(min_levels + extent_levels))) return std::nullopt;
         const auto i = std::uint32_t(std::floor(b));
         const auto j = std::uint32_t(std::ceil(t));
-        if (i >= min_levels || j - i >= extent_levels) return std::nullopt;
+        if (i >= min_levels || j - i >= extent_levels || !holds_in_float(o[a], i, j, lo[a], hi[a]))
+            return std::nullopt;
         q.lo[a] = i, q.extent[a] = std::uint8_t(j - i);
     }
     return q;

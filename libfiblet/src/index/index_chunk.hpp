@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -50,18 +51,21 @@ struct IndexGrid {
     // slack for float rounding), or nullopt when it does not fit the grid.
     std::optional<GridBox> quantize(const Aabb& box) const;
     Aabb bounds(const GridBox& b) const;
+    bool holds_in_float(float origin_axis, std::uint32_t i, std::uint32_t j, float lo, float hi) const;
     // Version 2: the conservative code of a box (the decoded box contains
     // it, with the same slack), or unbounded_code().
     std::uint32_t encode(const Aabb& box) const;
 };
 
+// A box at least this large is unbounded (is_unbounded()).
 inline constexpr float kUnboundedExtentMm = 1e30f;
+// Every finite point: a block may lie anywhere in the float range.
 inline Aabb unbounded_box() {
-    return {{-kUnboundedExtentMm, -kUnboundedExtentMm, -kUnboundedExtentMm},
-            {kUnboundedExtentMm, kUnboundedExtentMm, kUnboundedExtentMm}};
+    const float m = std::numeric_limits<float>::max();
+    return {{-m, -m, -m}, {m, m, m}};
 }
 
-// Decodes codes into boxes (unbounded ones span +-1e30 mm) with per-axis
+// Decodes codes into boxes (unbounded ones span the float range) with per-axis
 // tables: no integer division per block.
 class IndexBoxDecoder {
 public:
