@@ -82,13 +82,15 @@ void scan_task(const FiberBatch& b, std::size_t t, ScanSlot& s) {
         const std::vector<Vec3f>& fiber = b.fibers[i];
         add_bounds(fiber, s.min, s.max);
         segment_lengths(fiber, lengths);
-        double fiber_length = 0;
+        s.lengths.add(lengths);
+        // In locals: the slot's fields would be stored and reloaded at every segment.
+        double fiber_length = 0, step_min = s.step_min, step_max = s.step_max;
         for (const double len : lengths) {
-            s.lengths.add(len);
             fiber_length += len;
-            s.step_min = std::min(s.step_min, len);
-            s.step_max = std::max(s.step_max, len);
+            step_min = std::min(step_min, len);
+            step_max = std::max(step_max, len);
         }
+        s.step_min = step_min, s.step_max = step_max;
         length_sum += fiber_length;
         s.fiber_lengths.push_back(float(fiber_length));
         s.segments += lengths.size();

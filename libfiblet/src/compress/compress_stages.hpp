@@ -70,14 +70,23 @@ bool read_fiber_batch(StreamlineSource& reader, FiberBatch& b, std::uint32_t fir
 // allocated when a length first falls in it: constant, small memory.
 class LengthHistogram {
 public:
-    void add(double len) {  // inline: once per segment of the input
-        const float f = float(len);
-        ++count_;
-        if (!(f >= kMin)) return ++below_, void();
-        const std::uint32_t i = std::min<std::uint32_t>((std::bit_cast<std::uint32_t>(f) - kMinBits) >> kShift, kBins - 1);
-        auto& block = blocks_[i >> kMantissaBits];
-        if (!block) block = std::make_unique<std::uint64_t[]>(kBlock);  // zeroed
-        ++block[i & (kBlock - 1)];
+    // A fiber's segment lengths. The counts are locals while the bins are
+    // incremented: as members they would be reloaded after every bin's
+    // store (both are uint64_t, so the compiler must assume they alias).
+    void add(std::span<const double> lengths) {
+        std::uint64_t below = 0;
+        for (const double len : lengths) {
+            const float f = float(len);
+            if (!(f >= kMin)) {
+                ++below;
+                continue;
+            }
+            const std::uint32_t i = std::min<std::uint32_t>((std::bit_cast<std::uint32_t>(f) - kMinBits) >> kShift, kBins - 1);
+            auto& block = blocks_[i >> kMantissaBits];
+            if (!block) block = std::make_unique<std::uint64_t[]>(kBlock);  // zeroed
+            ++block[i & (kBlock - 1)];
+        }
+        count_ += lengths.size(), below_ += below;
     }
     void merge(const LengthHistogram& other);
     double median() const;
