@@ -27,6 +27,7 @@
 #include <span>
 #include <vector>
 
+#include "core/points_avx2.hpp"
 #include "core/vec_math.hpp"
 
 namespace fiblet::detail {
@@ -52,21 +53,72 @@ inline constexpr unsigned kLengthFeedbackLookahead = 2;
 inline constexpr float kLengthRescueOverRetry = 1.4f;
 inline constexpr unsigned kLengthRescueBeam = 32;
 
-// The largest squared distance of a[k] from b[k], k < m (four running
-// maxima: one would wait on the last at every point; the points are finite).
-inline float max_distance2(const Vec3f* a, const Vec3f* b, std::size_t m) {
-    float worst[4] = {0, 0, 0, 0};
+#ifdef FIBLET_POINTS_AVX2
+// max_distance2's squares eight points at a time, the same float
+// operations ((dx dx + dy dy) + dz dz) on lanes holding the points
+// out of order (the maximum does not depend on it): the three registers
+// of 24 floats are blended so that lane i holds one point's x, y or z,
+// the y and z registers then rotated onto the x register's points.
+// Returns where it stopped, *worst the maximum so far.
+__attribute__((target("avx2"))) inline std::size_t max_distance2_avx2(const Vec3f* a, const Vec3f* b, std::size_t m,
+                                                                   float* worst) {
+    const float *fa = &a->x, *fb = &b->x;
+    __m256 w = _mm256_setzero_ps();
+    const __m256i rotate1 = _mm256_setr_epi32(1, 2, 3, 4, 5, 6, 7, 0), rotate2 = _mm256_setr_epi32(2, 3, 4, 5, 6, 7, 0, 1);
     std::size_t k = 0;
-    for (; k + 4 <= m; k += 4)
-        for (std::size_t i = 0; i < 4; ++i) {
-            const Vec3f d = a[k + i] - b[k + i];
-            worst[i] = std::max(worst[i], dot(d, d));
+    for (; k + 8 <= m; k += 8) {
+        __m256 r[3];
+        for (int i = 0; i < 3; ++i) {
+            const __m256 d = _mm256_sub_ps(_mm256_loadu_ps(fa + 3 * k + 8 * i), _mm256_loadu_ps(fb + 3 * k + 8 * i));
+            r[i] = _mm256_mul_ps(d, d);
         }
+        // Lanes: x0 x3 x6 x1 x4 x7 x2 x5; y5 y0 y3 y6 y1 y4 y7 y2; z2 z5 z0 z3 z6 z1 z4 z7.
+        const __m256 x = _mm256_blend_ps(_mm256_blend_ps(r[0], r[1], 0b10010010), r[2], 0b00100100);
+        const __m256 y = _mm256_blend_ps(_mm256_blend_ps(r[0], r[1], 0b00100100), r[2], 0b01001001);
+        const __m256 z = _mm256_blend_ps(_mm256_blend_ps(r[0], r[1], 0b01001001), r[2], 0b10010010);
+        const __m256 d2 = _mm256_add_ps(_mm256_add_ps(x, _mm256_permutevar8x32_ps(y, rotate1)),
+                                        _mm256_permutevar8x32_ps(z, rotate2));
+        w = _mm256_max_ps(w, d2);
+    }
+    alignas(32) float lanes[8];
+    _mm256_store_ps(lanes, w);
+    for (const float v : lanes) *worst = std::max(*worst, v);
+    return k;
+}
+#endif
+
+// The largest squared distance of a[k] from b[k], k < m (the points are
+// finite, so the maximum does not depend on the order).
+inline float max_distance2(const Vec3f* a, const Vec3f* b, std::size_t m) {
+    float worst = 0;
+    std::size_t k = 0;
+#ifdef FIBLET_POINTS_AVX2
+    if (use_avx2_loops()) k = max_distance2_avx2(a, b, m, &worst);
+#endif
     for (; k < m; ++k) {
         const Vec3f d = a[k] - b[k];
-        worst[0] = std::max(worst[0], dot(d, d));
+        worst = std::max(worst, dot(d, d));
     }
-    return std::max(std::max(worst[0], worst[1]), std::max(worst[2], worst[3]));
+    return worst;
+}
+
+// error + the sum, in order, of norm(points[k] - points[k - 1]) -
+// norm(targets[k] - targets[k - 1]) over k in [from, to): the float terms a
+// chunk at a time into a buffer (a loop without a running sum, which the
+// compiler vectorizes, square roots included), then their double sum.
+inline double add_step_errors(double error, const Vec3f* points, const Vec3f* targets, std::size_t from,
+                              std::size_t to) {
+    constexpr std::size_t kChunk = 64;
+    float terms[kChunk];
+    for (std::size_t k0 = from; k0 < to; k0 += kChunk) {
+        const std::size_t n = std::min(kChunk, to - k0);
+        for (std::size_t i = 0; i < n; ++i) {
+            const std::size_t k = k0 + i;
+            terms[i] = norm(points[k] - points[k - 1]) - norm(targets[k] - targets[k - 1]);
+        }
+        for (std::size_t i = 0; i < n; ++i) error += terms[i];
+    }
+    return error;
 }
 
 // targets[from, last] into `moved`, the last `count` of them moved along the
@@ -170,7 +222,7 @@ public:
         fiber_max2_ = max_distance2(points.data(), targets.data(), n_points);
         act_ = act_share * std::sqrt(double(fiber_max2_));
         last_b0_ = (n_points - 1) / ppb * ppb;
-        for (std::size_t k = last_b0_ + 1; k < n_points; ++k) last_block_error_ += error_of(k);
+        last_block_error_ = add_step_errors(0, points.data(), targets.data(), last_b0_ + 1, n_points);
     }
 
     // The next search to run, false once the fiber is done. adjustable(b):
@@ -211,9 +263,7 @@ private:
         b0_ += ppb_;
         const std::size_t n = std::min<std::size_t>(ppb_, points_.size() - b0);
         last_ = b0 + n - 1;
-        double error = error_;  // a local: the member would be stored at every point
-        for (std::size_t k = std::max<std::size_t>(b0, 1); k <= last_; ++k) error += error_of(k);
-        error_ = error;
+        error_ = add_step_errors(error_, points_.data(), targets_.data(), std::max<std::size_t>(b0, 1), last_ + 1);
         if (n <= 2) return;
         block_ = std::uint32_t(b0 / ppb_);
         lag_ = error_ + error_of(last_ + 1);
