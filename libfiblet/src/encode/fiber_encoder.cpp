@@ -337,7 +337,8 @@ struct FiberEncoder::Encoding {
     void store_codes16();
     void append_decoded(std::vector<Vec3f>& decoded) const;
     void append_exact16(std::vector<Vec3f>& decoded_exact);
-    void append_exact8(std::vector<Vec3f>& decoded_exact, const Vec3f* decoded);
+    double measure_blocks();
+    void append_exact8(std::vector<Vec3f>& decoded_exact, const Vec3f* decoded, double known_max);
 };
 
 // Anchors: the block's first two points; a one-point block stores the point
@@ -639,17 +640,10 @@ void FiberEncoder::Encoding::append_exact16(std::vector<Vec3f>& decoded_exact) {
     }
 }
 
-// The exact decode of 8-bit blocks; a block whose float errors plus the
-// bound on the two decoders' divergence stay below the fiber's largest
-// float error cannot raise the max error: it gets the float points (most
-// blocks), which keeps the cost of this pass small.
-void FiberEncoder::Encoding::append_exact8(std::vector<Vec3f>& decoded_exact, const Vec3f* decoded) {
-    scratch.walked.resize(points_per_block);
+// Each 8-bit block's largest float error (normalized units); returns the
+// fiber's largest.
+double FiberEncoder::Encoding::measure_blocks() {
     scratch.block_errors.resize(n_blocks);
-    const double out_slack =
-        4 * 0x1p-24 *
-        (1 + std::max({std::fabs(header.offset[0]), std::fabs(header.offset[1]), std::fabs(header.offset[2])}) /
-                 header.scaling);
     double fiber_max = 0;
     for (std::uint32_t b = 0; b < n_blocks; ++b) {
         const std::size_t i0 = std::size_t(b) * points_per_block;
@@ -657,14 +651,30 @@ void FiberEncoder::Encoding::append_exact8(std::vector<Vec3f>& decoded_exact, co
             std::sqrt(double(max_distance2(&scratch.points[i0], &scratch.targets[i0], block_points(b))));
         fiber_max = std::max(fiber_max, scratch.block_errors[b]);
     }
+    return fiber_max;
+}
+
+// The exact decode of 8-bit blocks (after measure_blocks). A block whose
+// first frame is well conditioned (not robust()) and whose float errors
+// plus the bound on the two decoders' divergence stay below `known_max`, a
+// float error of a point measured with it (the largest of the fibers
+// encoded together), cannot raise the max error, and its exact points
+// differ from the float ones by rounding only: it gets the float points
+// (nearly every block), which keeps the cost of this pass small.
+void FiberEncoder::Encoding::append_exact8(std::vector<Vec3f>& decoded_exact, const Vec3f* decoded, double known_max) {
+    scratch.walked.resize(points_per_block);
+    const double out_slack =
+        4 * 0x1p-24 *
+        (1 + std::max({std::fabs(header.offset[0]), std::fabs(header.offset[1]), std::fabs(header.offset[2])}) /
+                 header.scaling);
     decoded_exact.reserve(decoded_exact.size() + n_points);
     for (std::uint32_t b = 0; b < n_blocks; ++b) {
         const DecoderStarts& e = scratch.starts[b];
         const std::size_t i0 = std::size_t(b) * points_per_block, n = block_points(b), m = n > 2 ? n - 2 : 0;
         const double bound = e.divergence + walk_divergence(m, double(header.step)) + out_slack;
-        if (scratch.block_errors[b] + bound <= fiber_max) {
-            // Not the fiber's worst even if the exact decode is off by the
-            // bound: the float decode's points stand for it.
+        if (!robust(b) && scratch.block_errors[b] + bound <= known_max) {
+            // Not the worst even if the exact decode is off by the bound:
+            // the float decode's points stand for it.
             if (decoded) {
                 decoded_exact.insert(decoded_exact.end(), decoded + i0, decoded + i0 + n);
             } else {
@@ -705,11 +715,17 @@ void FiberEncoder::encode_fibers(std::span<const std::span<const Vec3f>> fibers,
     }
     if (!es.empty() && es.front().tails_only()) Encoding::keep_length_tails(es);
     else for (Encoding& e : es) e.keep_lengths();
+    // The largest float error of these fibers' points: the max error
+    // measured over their decoded points is at least that.
+    double group_max = 0;
+    if (decoded_exact)
+        for (Encoding& e : es)
+            if (!e.wide) group_max = std::max(group_max, e.measure_blocks());
     for (Encoding& e : es) {
         if (e.wide) e.store_codes16();
         if (decoded) e.append_decoded(*decoded);
         const Vec3f* fiber_decoded = decoded ? decoded->data() + (decoded->size() - e.n_points) : nullptr;
-        if (decoded_exact) e.wide ? e.append_exact16(*decoded_exact) : e.append_exact8(*decoded_exact, fiber_decoded);
+        if (decoded_exact) e.wide ? e.append_exact16(*decoded_exact) : e.append_exact8(*decoded_exact, fiber_decoded, group_max);
     }
 }
 
