@@ -11,8 +11,12 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <limits>
+#include <random>
 #include <string>
 
+#include "compress/compress_stages.hpp"
+#include "core/points_avx2.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/tck.hpp"
@@ -140,4 +144,43 @@ TEST(CompressPasses, TheStagesAreTimedWithinTheRunsTime) {
     o.block_index = false;
     o.overwrite = true;
     EXPECT_EQ(compress_file(dir.file("in.tck"), dir.file("out.fft"), o).timings.index, 0.0);
+}
+
+// Pass 1's bounds: the AVX2 loop and the scalar loop against a brute
+// force in double, at every length around the vector width, with NaN
+// coordinates left out and zero bounds +0 whichever zero came first.
+TEST(CompressScan, BoundsOfEveryLengthLeaveOutNaNAndGiveZeroAsPlusZero) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-50.0f, 50.0f);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (std::size_t n = 1; n <= 40; ++n) {
+        for (int trial = 0; trial < 6; ++trial) {
+            std::vector<Vec3f> fiber(n);
+            for (Vec3f& p : fiber) p = {u(rng), u(rng), u(rng)};
+            if (trial == 1) fiber[n / 2].y = nan;
+            if (trial == 2)  // zeros of both signs as the lower x and upper y bounds
+                for (std::size_t k = 0; k < n; ++k) fiber[k].x = std::fabs(fiber[k].x), fiber[k].y = -std::fabs(fiber[k].y);
+            if (trial == 2) fiber[0].x = -0.0f, fiber[n - 1].x = 0.0f, fiber[n / 3].y = -0.0f, fiber[n - 1].y = 0.0f;
+            double want_min[3], want_max[3];
+            for (int a = 0; a < 3; ++a) want_min[a] = INFINITY, want_max[a] = -INFINITY;
+            for (const Vec3f& p : fiber)
+                for (int a = 0; a < 3; ++a) {
+                    const double v = a == 0 ? p.x : a == 1 ? p.y : p.z;
+                    if (std::isnan(v)) continue;
+                    want_min[a] = std::min(want_min[a], v), want_max[a] = std::max(want_max[a], v);
+                }
+            for (bool avx2 : {true, false}) {
+                detail::avx2_loops_enabled() = avx2;
+                double min[3] = {INFINITY, INFINITY, INFINITY}, max[3] = {-INFINITY, -INFINITY, -INFINITY};
+                detail::add_bounds(fiber, min, max);
+                detail::avx2_loops_enabled() = true;
+                for (int a = 0; a < 3; ++a) {
+                    EXPECT_EQ(min[a], want_min[a]) << n << " " << trial << " " << avx2 << " axis " << a;
+                    EXPECT_EQ(max[a], want_max[a]) << n << " " << trial << " " << avx2 << " axis " << a;
+                    if (min[a] == 0) EXPECT_FALSE(std::signbit(min[a])) << n << " " << trial << " " << avx2;
+                    if (max[a] == 0) EXPECT_FALSE(std::signbit(max[a])) << n << " " << trial << " " << avx2;
+                }
+            }
+        }
+    }
 }

@@ -64,6 +64,11 @@ struct FiberBatch {
 // fibers in all: Error{unsupported} (fiber IDs are 32-bit).
 bool read_fiber_batch(StreamlineSource& reader, FiberBatch& b, std::uint32_t first_fiber);
 
+// The bounds of a fiber's points into min / max (pass 1). Float comparisons
+// (exact: the double bounds of floats are floats); NaN coordinates are left
+// out; a zero bound is +0.
+void add_bounds(std::span<const Vec3f> fiber, double* min, double* max);
+
 // Median of segment lengths from a histogram of their float32 bit patterns
 // (the top 13 mantissa bits: 1.2e-4 relative resolution between 1 um and
 // 2 m, no logarithm per segment), one block of bins per binary exponent,
