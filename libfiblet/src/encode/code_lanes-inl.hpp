@@ -25,6 +25,45 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 constexpr std::size_t kMaxLanes = 16;
 
+// out[i] = base[at + i] per lane, i < n (at: float indices). With 16
+// AVX-512 lanes, pairs of neighbouring floats come with one 64-bit gather
+// per eight lanes (with 8 lanes, per four), then a permutation per float: gathers cost per element
+// fetched (on AMD Zen 4, 6.1 ns for sixteen floats against 3.8 ns for eight
+// pairs), so this fetches a frame's nine floats in ~37 ns instead of ~55.
+// The same floats as one gather each, so the same bits at every level.
+template <class D>
+HWY_INLINE void GatherFloats(D d, const float* base, hn::Vec<hn::RebindToSigned<D>> at, hn::Vec<D>* out, int n) {
+    int i = 0;
+#if HWY_TARGET == HWY_AVX3
+    if constexpr (hn::MaxLanes(D()) == 16) {
+        const __m256i lo_at = _mm512_castsi512_si256(at.raw), hi_at = _mm512_extracti64x4_epi64(at.raw, 1);
+        const __m512i firsts = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
+        const __m512i seconds = _mm512_add_epi32(firsts, _mm512_set1_epi32(1));
+        for (; i + 2 <= n; i += 2) {
+            const __m512 lo = _mm512_castpd_ps(_mm512_i32gather_pd(lo_at, base + i, 4));
+            const __m512 hi = _mm512_castpd_ps(_mm512_i32gather_pd(hi_at, base + i, 4));
+            out[i].raw = _mm512_permutex2var_ps(lo, firsts, hi);
+            out[i + 1].raw = _mm512_permutex2var_ps(lo, seconds, hi);
+        }
+    }
+#endif
+#if HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX2
+    if constexpr (hn::MaxLanes(D()) == 8) {  // the same with four pairs a gather
+        const __m128i lo_at = _mm256_castsi256_si128(at.raw), hi_at = _mm256_extracti128_si256(at.raw, 1);
+        for (; i + 2 <= n; i += 2) {
+            const __m256 lo = _mm256_castpd_ps(_mm256_i32gather_pd(reinterpret_cast<const double*>(base + i), lo_at, 4));
+            const __m256 hi = _mm256_castpd_ps(_mm256_i32gather_pd(reinterpret_cast<const double*>(base + i), hi_at, 4));
+            // Per 128-bit half: first floats of lo's pairs, then hi's (lanes 0 1 4 5, 2 3 6 7), put in order.
+            out[i].raw = _mm256_castpd_ps(
+                _mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(lo, hi, _MM_SHUFFLE(2, 0, 2, 0))), 0b11011000));
+            out[i + 1].raw = _mm256_castpd_ps(
+                _mm256_permute4x64_pd(_mm256_castps_pd(_mm256_shuffle_ps(lo, hi, _MM_SHUFFLE(3, 1, 3, 1))), 0b11011000));
+        }
+    }
+#endif
+    for (; i < n; ++i) out[i] = hn::GatherIndex(d, base + i, at);
+}
+
 // The 8-bit code book, one code per lane. A frame is held as nine vectors,
 // f[3 * c + i] = component i of column c (column 0: the step's direction).
 template <class D>
@@ -98,14 +137,15 @@ struct CodeLanes {
     // The code's frame (its first column is its direction).
     void frame(VI code, VF* l) const {
         const VI at = frame_at(code);
-        for (int j = 0; j < 9; ++j) l[j] = hn::GatherIndex(d, code_frames + j, at);
+        GatherFloats(d, code_frames, at, l, 9);
     }
 
     // The code's direction (its frame's first column).
     void direction(VI code, VF& x, VF& y, VF& z) const {
         const VI at = frame_at(code);
-        x = hn::GatherIndex(d, code_frames, at), y = hn::GatherIndex(d, code_frames + 1, at);
-        z = hn::GatherIndex(d, code_frames + 2, at);
+        VF v[3];
+        GatherFloats(d, code_frames, at, v, 3);
+        x = v[0], y = v[1], z = v[2];
     }
 
     // compose(f, l): column c of the result is apply(f, l.c_c) =
@@ -164,8 +204,9 @@ struct BatchLanes {
 
     // The lanes' targets at `where`.
     void target(VI where, VF& x, VF& y, VF& z) const {
-        x = hn::GatherIndex(d, targets, where), y = hn::GatherIndex(d, targets + 1, where);
-        z = hn::GatherIndex(d, targets + 2, where);
+        VF v[3];
+        GatherFloats(d, targets, where, v, 3);
+        x = v[0], y = v[1], z = v[2];
     }
     VI next_at() const { return ahead_at(1); }
     // Where the targets n points ahead are (the last target past a lane's end).

@@ -118,12 +118,13 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
         const VI words[2] = {hn::GatherIndex(di, nb_words + kNbCodes, nb_at),
                              hn::GatherIndex(di, nb_words + kNbCodes + 1, nb_at)};
         const VI count = hn::GatherIndex(di, nb_words + kNbCount, nb_at);
-        VF rival_e0[8];
+        VF rival_e0[8], rx[8], ry[8], rz[8];
+        GatherFloats(d, nb_floats, nb_at, rx, 8);
+        GatherFloats(d, nb_floats + kNbY, nb_at, ry, 8);
+        GatherFloats(d, nb_floats + kNbZ, nb_at, rz, 8);
         for (int r = 0; r < 8; ++r) {
-            const VF dx = hn::GatherIndex(d, nb_floats + r, nb_at), dy = hn::GatherIndex(d, nb_floats + kNbY + r, nb_at),
-                     dz = hn::GatherIndex(d, nb_floats + kNbZ + r, nb_at);
             const auto listed = hn::And(more, hn::RebindMask(d, hn::Lt(hn::Set(di, r), count)));
-            rival_e0[r] = hn::IfThenElse(listed, error2(base, dx, dy, dz, x, y, z), inf);
+            rival_e0[r] = hn::IfThenElse(listed, error2(base, rx[r], ry[r], rz[r], x, y, z), inf);
         }
         for (int round = 0; round < 8; ++round) {
             VF e0 = rival_e0[0];
