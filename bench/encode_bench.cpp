@@ -56,12 +56,12 @@ const Input& input(unsigned bits, int effort) {
 
 // The encoder as compress runs it (its search, the length tails where
 // compress keeps lengths; fixed-step input) on fibers in memory, blocks to
-// memory, one thread: the fibers 16 at a time, as compress gives them.
+// memory, one thread: the fibers 64 at a time, as compress gives them.
 void BM_EncodeSearch(benchmark::State& state) {
     const Input& in = input(unsigned(state.range(0)), int(state.range(1)));
     const fiblet::FiberEncoder encoder =
         fiblet::FiberEncoder(in.report.header, in.report.search).with_length_feedback(in.report.lengths_kept ? 1.0f : 0.0f, true);
-    constexpr std::size_t kTogether = 16;
+    constexpr std::size_t kTogether = 64;
     std::vector<std::span<const fiblet::Vec3f>> fibers(in.fibers.begin(), in.fibers.end());
     std::vector<std::uint8_t> blocks;
     for (auto _ : state) {

@@ -30,8 +30,9 @@ namespace fiblet::detail {
 namespace {
 
 // Fixed-step fibers encoded together: enough that their next length tail
-// searches usually fill a vector's lanes.
-constexpr std::size_t kFibersTogether = 16;
+// searches usually fill a vector's lanes (a task's fibers, ~30 of 500
+// points, rather than 16 at a time: default compress 3 % faster).
+constexpr std::size_t kFibersTogether = 64;
 
 // The header's error of each point: the worse of fiblet's float decode and
 // the exact decode (when given), so it holds for every decoder. One square
