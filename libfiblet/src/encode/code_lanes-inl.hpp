@@ -222,8 +222,10 @@ struct BatchLanes {
     // which the CPU overlaps with the next step's dependency chain); on to
     // the next targets.
     void store(std::size_t k, VI code) {
-        alignas(64) float out[3][kMaxLanes];
-        alignas(64) std::int32_t out_code[kMaxLanes];
+        // Zeroed: a narrower vector stores fewer than kMaxLanes (GCC cannot
+        // tell that only those are read).
+        alignas(64) float out[3][kMaxLanes] = {};
+        alignas(64) std::int32_t out_code[kMaxLanes] = {};
         hn::Store(px, d, out[0]);
         hn::Store(py, d, out[1]);
         hn::Store(pz, d, out[2]);

@@ -69,25 +69,28 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
     VF tx, ty, tz, nx, ny, nz, ox, oy, oz;
     s.target(s.at, tx, ty, tz);
     if (kDepth == 2) s.target(s.next_at(), nx, ny, nz);
+    // Point k's target in the frame and the aimed code: from the state
+    // before it (point 0), then as the winning path found them (each path
+    // aims from its state at the next target: the same operations).
+    VF x, y, z;
+    Lanes::local(s.f, hn::Sub(tx, s.px), hn::Sub(ty, s.py), hn::Sub(tz, s.pz), x, y, z);
+    VI aimed = code.nearest(x, y, z);
     for (std::size_t k = 0; k < s.steps; ++k) {
-        // The aimed code at point k.
-        VF x, y, z;
-        Lanes::local(s.f, hn::Sub(tx, s.px), hn::Sub(ty, s.py), hn::Sub(tz, s.pz), x, y, z);
-        const VI aimed = code.nearest(x, y, z);
         const VF base = base_of(x, y, z);
         if (kDepth == 1) s.target(s.next_at(), nx, ny, nz);
         else s.target(s.ahead_at(2), ox, oy, oz);
         const auto more = s.more_after(k);                            // lanes with a point k + 1
         const auto more2 = kDepth == 2 ? s.more_after(k + 1) : more;  // and k + 2
         const bool any2 = kDepth == 2 && !hn::AllFalse(d, more2);
-        // Code c's state after point k (frame l of c given) into nf, q; returns
-        // the path's sum of squared errors, e0 (c's own) plus greedy aiming's
-        // at the points after it (added in the scalar search's order).
-        auto path = [&](const VF* l, VF e0, VF* nf, VF& qx, VF& qy, VF& qz) {
+        // Code c's state after point k (frame l of c given) into nf, q, and
+        // the next target in its frame and the code aimed at it into x1, y1,
+        // z1, c1; returns the path's sum of squared errors, e0 (c's own) plus
+        // greedy aiming's at the points after it (added in the scalar
+        // search's order).
+        auto path = [&](const VF* l, VF e0, VF* nf, VF& qx, VF& qy, VF& qz, VF& x1, VF& y1, VF& z1, VI& c1) {
             take(s.f, s.px, s.py, s.pz, l, nf, qx, qy, qz);
-            VF x1, y1, z1;
             Lanes::local(nf, hn::Sub(nx, qx), hn::Sub(ny, qy), hn::Sub(nz, qz), x1, y1, z1);
-            const VI c1 = code.nearest(x1, y1, z1);
+            c1 = code.nearest(x1, y1, z1);
             if (!any2) {
                 VF bx, by, bz;
                 code.direction(c1, bx, by, bz);
@@ -101,10 +104,11 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
             code.direction(code.nearest(x2, y2, z2), bx, by, bz);
             return hn::IfThenElse(more2, hn::Add(sum1, error2(base_of(x2, y2, z2), bx, by, bz, x2, y2, z2)), sum1);
         };
-        VF l[9], win_f[9], win_x, win_y, win_z;
+        VF l[9], win_f[9], win_x, win_y, win_z, win_x1, win_y1, win_z1;
+        VI win_c1;
         code.frame(aimed, l);
         const VF aimed_e0 = error2(base, l[0], l[1], l[2], x, y, z);
-        VF best = path(l, aimed_e0, win_f, win_x, win_y, win_z);
+        VF best = path(l, aimed_e0, win_f, win_x, win_y, win_z, win_x1, win_y1, win_z1, win_c1);
         VI win_code = aimed;
         // The rivals (the aimed code's neighbours), where a lane has a point
         // after k, in the scalar search's order: each round takes every
@@ -141,19 +145,23 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
             // Rival `which`'s code: byte (which % 4) of its word.
             const VI word = hn::IfThenElse(hn::RebindMask(di, hn::Lt(which, hn::Set(di, 4))), words[0], words[1]);
             const VI c = hn::And(word >> hn::ShiftLeft<3>(hn::And(which, hn::Set(di, 3))), code.byte);
-            VF lr[9], rf[9], qx, qy, qz;  // the rival's frame, its state after point k
+            VF lr[9], rf[9], qx, qy, qz, x1, y1, z1;  // the rival's frame, its state after point k
+            VI c1;
             code.frame(c, lr);
-            const VF total = path(lr, e0, rf, qx, qy, qz);
+            const VF total = path(lr, e0, rf, qx, qy, qz, x1, y1, z1, c1);
             const auto wins = hn::And(tries, hn::Lt(total, best));
             best = hn::IfThenElse(wins, total, best);
             win_code = hn::IfThenElse(hn::RebindMask(di, wins), c, win_code);
             for (int j = 0; j < 9; ++j) win_f[j] = hn::IfThenElse(wins, rf[j], win_f[j]);
             win_x = hn::IfThenElse(wins, qx, win_x), win_y = hn::IfThenElse(wins, qy, win_y);
             win_z = hn::IfThenElse(wins, qz, win_z);
+            win_x1 = hn::IfThenElse(wins, x1, win_x1), win_y1 = hn::IfThenElse(wins, y1, win_y1);
+            win_z1 = hn::IfThenElse(wins, z1, win_z1), win_c1 = hn::IfThenElse(hn::RebindMask(di, wins), c1, win_c1);
         }
         for (int j = 0; j < 9; ++j) s.f[j] = win_f[j];
         s.px = win_x, s.py = win_y, s.pz = win_z;
         s.store(k, win_code);
+        x = win_x1, y = win_y1, z = win_z1, aimed = win_c1;
         tx = nx, ty = ny, tz = nz;
         if (kDepth == 2) nx = ox, ny = oy, nz = oz;
     }
