@@ -177,8 +177,12 @@ TEST(CompressScan, BoundsOfEveryLengthLeaveOutNaNAndGiveZeroAsPlusZero) {
                 for (int a = 0; a < 3; ++a) {
                     EXPECT_EQ(min[a], want_min[a]) << n << " " << trial << " " << avx2 << " axis " << a;
                     EXPECT_EQ(max[a], want_max[a]) << n << " " << trial << " " << avx2 << " axis " << a;
-                    if (min[a] == 0) EXPECT_FALSE(std::signbit(min[a])) << n << " " << trial << " " << avx2;
-                    if (max[a] == 0) EXPECT_FALSE(std::signbit(max[a])) << n << " " << trial << " " << avx2;
+                    if (min[a] == 0) {
+                        EXPECT_FALSE(std::signbit(min[a])) << n << " " << trial << " " << avx2;
+                    }
+                    if (max[a] == 0) {
+                        EXPECT_FALSE(std::signbit(max[a])) << n << " " << trial << " " << avx2;
+                    }
                 }
             }
         }
