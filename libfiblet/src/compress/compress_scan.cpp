@@ -99,12 +99,12 @@ struct ResampleSlot {
 }  // namespace
 
 #ifdef FIBLET_POINTS_AVX2
+namespace {
 // add_bounds' loop eight points at a time: three registers of 24 floats,
 // whose lanes hold the same coordinate at every step (x y z x y z x y,
 // z x y ...), keep running minima and maxima (vminps / vmaxps return their
 // second operand for a NaN, as the ternaries below keep the bound);
 // returns where it stopped.
-namespace {
 __attribute__((target("avx2"))) std::size_t add_bounds_avx2(std::span<const Vec3f> fiber, float* lo, float* hi) {
     const std::size_t n = fiber.size();
     if (n < 8) return 0;
@@ -145,7 +145,6 @@ void add_bounds(std::span<const Vec3f> fiber, double* min, double* max) {
     for (int a = 0; a < 3; ++a)
         min[a] = std::min(min[a], double(lo[a]) + 0.0), max[a] = std::max(max[a], double(hi[a]) + 0.0);
 }
-
 
 void LengthHistogram::merge(const LengthHistogram& o) {
     count_ += o.count_, below_ += o.below_;

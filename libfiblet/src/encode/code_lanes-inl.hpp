@@ -25,11 +25,11 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 constexpr std::size_t kMaxLanes = 16;
 
-// out[i] = base[at + i] per lane, i < n (at: float indices). With 16
-// AVX-512 lanes, pairs of neighbouring floats come with one 64-bit gather
-// per eight lanes (with 8 lanes, per four), then a permutation per float: gathers cost per element
-// fetched (on AMD Zen 4, 6.1 ns for sixteen floats against 3.8 ns for eight
-// pairs), so this fetches a frame's nine floats in ~37 ns instead of ~55.
+// out[i] = base[at + i] per lane, i < n (at: float indices). Pairs of
+// neighbouring floats come with one 64-bit gather per eight lanes (AVX-512;
+// per four with AVX2), then a permutation per float: gathers cost per
+// element fetched (on AMD Zen 4, 6.1 ns for sixteen floats against 3.8 ns
+// for eight pairs), so a frame's nine floats take ~37 ns instead of ~55.
 // The same floats as one gather each, so the same bits at every level.
 template <class D>
 HWY_INLINE void GatherFloats(D d, const float* base, hn::Vec<hn::RebindToSigned<D>> at, hn::Vec<D>* out, int n) {
