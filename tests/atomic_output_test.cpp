@@ -210,7 +210,7 @@ TEST_P(SignalDuringSpool, LeavesNoSpoolInTmpdir) {
                      "pid=$!\n"
                      "exec 3>" + dir.file("in") + "\n"
                      "printf 'mrtrix tracks\\n' >&3\n"
-                     "for i in $(seq 100); do [ $(ls " + tmp.path() + " | wc -l) -ge 2 ] && break; sleep 0.05; done\n"
+                     "for i in $(seq 600); do [ $(ls " + tmp.path() + " | wc -l) -ge 2 ] && break; sleep 0.05; done\n"
                      "ls " + tmp.path() + " | sed 's/stdio-.*[.]/stdio-*./' | sort\n"
                      "kill -" + std::to_string(sig) + " $pid\n"
                      "wait $pid\n"
