@@ -85,12 +85,20 @@ IndexGrid IndexGrid::for_groups(const FftHeader& h, unsigned bits, std::uint32_t
     return g;
 }
 
-// Whether cells i..j, as readers decode them in float (bounds()), hold
-// [lo, hi]: the double arithmetic that picked them does not see float
-// rounding flatten a cell (an origin near the float range: 1.7e38 mm plus a
-// few mm is 1.7e38 mm).
-bool IndexGrid::holds_in_float(float origin_axis, std::uint32_t i, std::uint32_t j, float lo, float hi) const {
-    return origin_axis + float(i) * cell <= lo && origin_axis + float(j) * cell >= hi;
+// Cells i..j (first, last) of one axis (origin o) holding [lo, hi] with
+// the slack, or nullopt when they do not fit the grid. They must also hold
+// it as readers decode them, in float (bounds()): the double arithmetic
+// that picks them does not see float rounding flatten a cell (an origin
+// near the float range: 1.7e38 mm plus a few mm is 1.7e38 mm).
+std::optional<std::pair<std::uint32_t, std::uint32_t>> IndexGrid::axis_cells(float o, float lo, float hi) const {
+    const double b = (double(lo) - o) / cell - kSlackCells;
+    const double t = (double(hi) - o) / cell + kSlackCells;
+    if (!(b >= 0 && t >= b && t < double(min_levels + extent_levels))) return std::nullopt;
+    const auto i = std::uint32_t(std::floor(b));
+    const auto j = std::uint32_t(std::ceil(t));
+    if (i >= min_levels || j - i >= extent_levels) return std::nullopt;
+    if (!(o + float(i) * cell <= lo && o + float(j) * cell >= hi)) return std::nullopt;
+    return std::pair{i, j};
 }
 
 std::uint32_t IndexGrid::encode(const Aabb& box) const {
@@ -98,13 +106,9 @@ std::uint32_t IndexGrid::encode(const Aabb& box) const {
     const float lo[3] = {box.min.x, box.min.y, box.min.z}, hi[3] = {box.max.x, box.max.y, box.max.z};
     const float o[3] = {origin.x, origin.y, origin.z};
     for (int a = 0; a < 3; ++a) {
-        const double b = (double(lo[a]) - o[a]) / cell - kSlackCells;
-        const double t = (double(hi[a]) - o[a]) / cell + kSlackCells;
-        if (!(b >= 0 && t >= b && t < double(min_levels + extent_levels))) return unbounded_code();
-        const auto i = std::uint32_t(std::floor(b));
-        const auto j = std::uint32_t(std::ceil(t));
-        if (i >= min_levels || j - i >= extent_levels || !holds_in_float(o[a], i, j, lo[a], hi[a]))
-            return unbounded_code();
+        const auto cells = axis_cells(o[a], lo[a], hi[a]);
+        if (!cells) return unbounded_code();
+        const auto [i, j] = *cells;
         code += (i * extent_levels + (j - i)) * scale;
         scale *= axis_levels();
     }
@@ -116,13 +120,9 @@ std::optional<GridBox> IndexGrid::quantize(const Aabb& box) const {
     const float lo[3] = {box.min.x, box.min.y, box.min.z}, hi[3] = {box.max.x, box.max.y, box.max.z};
     const float o[3] = {origin.x, origin.y, origin.z};
     for (int a = 0; a < 3; ++a) {
-        const double b = (double(lo[a]) - o[a]) / cell - kSlackCells;
-        const double t = (double(hi[a]) - o[a]) / cell + kSlackCells;
-        if (!(b >= 0 && t >= b && t < double(min_levels + extent_levels))) return std::nullopt;
-        const auto i = std::uint32_t(std::floor(b));
-        const auto j = std::uint32_t(std::ceil(t));
-        if (i >= min_levels || j - i >= extent_levels || !holds_in_float(o[a], i, j, lo[a], hi[a]))
-            return std::nullopt;
+        const auto cells = axis_cells(o[a], lo[a], hi[a]);
+        if (!cells) return std::nullopt;
+        const auto [i, j] = *cells;
         q.lo[a] = i, q.extent[a] = std::uint8_t(j - i);
     }
     return q;

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "fiblet/fft_file.hpp"
@@ -51,7 +52,7 @@ struct IndexGrid {
     // slack for float rounding), or nullopt when it does not fit the grid.
     std::optional<GridBox> quantize(const Aabb& box) const;
     Aabb bounds(const GridBox& b) const;
-    bool holds_in_float(float origin_axis, std::uint32_t i, std::uint32_t j, float lo, float hi) const;
+    std::optional<std::pair<std::uint32_t, std::uint32_t>> axis_cells(float o, float lo, float hi) const;
     // Version 2: the conservative code of a box (the decoded box contains
     // it, with the same slack), or unbounded_code().
     std::uint32_t encode(const Aabb& box) const;
