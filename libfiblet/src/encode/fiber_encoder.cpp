@@ -556,7 +556,8 @@ void FiberEncoder::Encoding::keep_length_tails(std::span<Encoding> fibers) {
     };
     for (Encoding& e : fibers) {
         e.scratch.tails.emplace(std::span<const Vec3f>(e.scratch.targets), std::span<Vec3f>(e.scratch.points),
-                                e.points_per_block, kLengthFeedbackTail, kLengthFeedbackActShare);
+                                e.points_per_block, kLengthFeedbackTail, kLengthFeedbackActShare,
+                                kLengthFeedbackFarActShare, kLengthFeedbackNearBlocks);
         next(e);
     }
     if (fibers.empty()) return;

@@ -38,9 +38,15 @@ namespace fiblet::detail {
 inline constexpr std::uint32_t kLengthFeedbackPoints = 12;
 inline constexpr float kLengthFeedbackShares[] = {1.0f, 0.5f, 0.25f};
 // Fixed-step form: the codes searched again at a block's end, and the share
-// of the fiber's largest point error its length error may reach untouched.
+// of the fiber's largest point error its length error may reach untouched:
+// in the fiber's last kLengthFeedbackNearBlocks blocks before its last one,
+// the near share; in earlier blocks, whose lag later blocks can still take
+// back, the far share (the medium tractogram: 40 % fewer tail searches for
+// the same mean length change; docs/encode.md).
 inline constexpr std::uint32_t kLengthFeedbackTail = 24;
 inline constexpr float kLengthFeedbackActShare = 0.25f;
+inline constexpr float kLengthFeedbackFarActShare = 0.5f;
+inline constexpr std::size_t kLengthFeedbackNearBlocks = 4;
 // The tails' lookahead search looks at least this far ahead: a tail's
 // codes place the block's end, which one point of lookahead places less
 // well (small-ifod1-step0.05, lookahead 1: lengths 3.25 um over a
@@ -188,7 +194,8 @@ void feed_back_length(std::span<const Vec3f> targets, std::span<Vec3f> points, s
 // Fixed-step form. The fiber's length error after each block's bridge
 // (the fiber's last block counted with the bridge before it: its codes
 // cannot change its length) is taken back, where it exceeds `act_share`
-// of the fiber's largest point error, by moving the targets of the block's
+// of the fiber's largest point error (`far_act_share` more than `near`
+// blocks before the fiber's last block), by moving the targets of the block's
 // last `tail` points along the track (linearly more towards the end, by at
 // most that point error, in shares 1, 1/2, 1/4: the first candidate that
 // keeps the point error and shortens the lag is kept, as a smaller share
@@ -212,8 +219,8 @@ public:
     };
 
     LengthTails(std::span<const Vec3f> targets, std::span<Vec3f> points, std::uint32_t ppb, std::uint32_t tail,
-                float act_share)
-        : targets_(targets), points_(points), ppb_(ppb), tail_(tail) {
+                float act_share, float far_act_share, std::size_t near)
+        : targets_(targets), points_(points), ppb_(ppb), tail_(tail), near_(near) {
         const std::size_t n_points = points.size();
         if (n_points <= ppb) {  // one block: its length is the anchors' and the steps'
             b0_ = last_b0_ = 0;
@@ -221,6 +228,7 @@ public:
         }
         fiber_max2_ = max_distance2(points.data(), targets.data(), n_points);
         act_ = act_share * std::sqrt(double(fiber_max2_));
+        far_act_ = far_act_share * std::sqrt(double(fiber_max2_));
         last_b0_ = (n_points - 1) / ppb * ppb;
         last_block_error_ = add_step_errors(0, points.data(), targets.data(), last_b0_ + 1, n_points);
     }
@@ -269,7 +277,8 @@ private:
         lag_ = error_ + error_of(last_ + 1);
         last_chance_ = last_ + 1 == last_b0_;
         if (last_chance_) lag_ += last_block_error_;
-        if (!(std::fabs(lag_) > act_) || !adjustable(block_)) return;
+        const bool far = (last_b0_ - b0) / ppb_ > near_;
+        if (!(std::fabs(lag_) > (far ? far_act_ : act_)) || !adjustable(block_)) return;
         m_ = n - 2, first_ = b0 + 2, codes_ = std::min<std::size_t>(tail_, m_);
         best_ = std::fabs(lag_);
         const float reach = std::sqrt(fiber_max2_);
@@ -295,9 +304,9 @@ private:
 
     std::span<const Vec3f> targets_;
     std::span<Vec3f> points_;
-    std::size_t ppb_, tail_;
+    std::size_t ppb_, tail_, near_;
     float fiber_max2_ = 0;
-    double act_ = 0, last_block_error_ = 0;
+    double act_ = 0, far_act_ = 0, last_block_error_ = 0;
     std::size_t b0_ = 0, last_b0_ = 0;  // the next block's first point; the fiber's last block's
     double error_ = 0;                  // decoded minus target length, up to the current point
     // The block being tried.
