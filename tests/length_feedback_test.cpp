@@ -63,15 +63,22 @@ TEST(LengthFeedback, MaxDistanceOfEqualPointsIsZero) {
     EXPECT_EQ(max_distance2(a.data(), a.data(), a.size()), 0.0f);
 }
 
+// The same bits with the AVX2 terms (where the CPU has them) and without.
 TEST(LengthFeedback, StepErrorsAddInOrderAsTheRunningSum) {
     std::mt19937 rng(3);
-    for (std::size_t n : {2, 3, 64, 65, 66, 129, 300}) {
+    for (std::size_t n : {2, 3, 9, 10, 17, 64, 65, 66, 129, 300}) {
         const std::vector<Vec3f> points = random_points(n, 2.0f, rng), targets = random_points(n, 2.0f, rng);
-        for (std::size_t from : {std::size_t(1), n / 2}) {
+        for (std::size_t from : {std::size_t(1), std::size_t(2), n / 2}) {
+            if (from < 1 || from > n) continue;
             double running = 0.25;
             for (std::size_t k = from; k < n; ++k)
                 running += detail::norm(points[k] - points[k - 1]) - detail::norm(targets[k] - targets[k - 1]);
-            EXPECT_EQ(add_step_errors(0.25, points.data(), targets.data(), from, n), running) << n << " " << from;
+            for (const bool avx2 : {true, false}) {
+                detail::avx2_loops_enabled() = avx2;
+                EXPECT_EQ(add_step_errors(0.25, points.data(), targets.data(), from, n), running)
+                    << n << " " << from << " avx2 " << avx2;
+            }
+            detail::avx2_loops_enabled() = true;
         }
     }
 }

@@ -60,35 +60,55 @@ inline constexpr float kLengthRescueOverRetry = 1.4f;
 inline constexpr unsigned kLengthRescueBeam = 32;
 
 #ifdef FIBLET_POINTS_AVX2
-// max_distance2's squares eight points at a time, the same float
-// operations ((dx dx + dy dy) + dz dz) on lanes holding the points
-// out of order (the maximum does not depend on it): the three registers
-// of 24 floats are blended so that lane i holds one point's x, y or z,
-// the y and z registers then rotated onto the x register's points.
-// Returns where it stopped, *worst the maximum so far.
+// The squared distances |a_i - b_i|^2 of eight points i (a and b: 24
+// floats each, x y z interleaved), the scalar float operations
+// ((dx dx + dy dy) + dz dz) on lanes holding the points out of order
+// (kSquaresOrder): the three registers of 24 floats are blended so that
+// lane i holds one point's x, y or z, the y and z registers then rotated
+// onto the x register's points.
+__attribute__((target("avx2"))) inline __m256 squares8(const float* a, const float* b) {
+    const __m256i rotate1 = _mm256_setr_epi32(1, 2, 3, 4, 5, 6, 7, 0), rotate2 = _mm256_setr_epi32(2, 3, 4, 5, 6, 7, 0, 1);
+    __m256 r[3];
+    for (int i = 0; i < 3; ++i) {
+        const __m256 d = _mm256_sub_ps(_mm256_loadu_ps(a + 8 * i), _mm256_loadu_ps(b + 8 * i));
+        r[i] = _mm256_mul_ps(d, d);
+    }
+    // Lanes: x0 x3 x6 x1 x4 x7 x2 x5; y5 y0 y3 y6 y1 y4 y7 y2; z2 z5 z0 z3 z6 z1 z4 z7.
+    const __m256 x = _mm256_blend_ps(_mm256_blend_ps(r[0], r[1], 0b10010010), r[2], 0b00100100);
+    const __m256 y = _mm256_blend_ps(_mm256_blend_ps(r[0], r[1], 0b00100100), r[2], 0b01001001);
+    const __m256 z = _mm256_blend_ps(_mm256_blend_ps(r[0], r[1], 0b01001001), r[2], 0b10010010);
+    return _mm256_add_ps(_mm256_add_ps(x, _mm256_permutevar8x32_ps(y, rotate1)), _mm256_permutevar8x32_ps(z, rotate2));
+}
+// The point each lane of squares8 holds; a permutation that is its own
+// inverse, so permuting by it puts the lanes in order.
+__attribute__((target("avx2"))) inline __m256i squares_order() { return _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5); }
+
+// max_distance2 eight points at a time (the maximum does not depend on the
+// lanes' order); returns where it stopped, *worst the maximum so far.
 __attribute__((target("avx2"))) inline std::size_t max_distance2_avx2(const Vec3f* a, const Vec3f* b, std::size_t m,
                                                                    float* worst) {
     const float *fa = &a->x, *fb = &b->x;
     __m256 w = _mm256_setzero_ps();
-    const __m256i rotate1 = _mm256_setr_epi32(1, 2, 3, 4, 5, 6, 7, 0), rotate2 = _mm256_setr_epi32(2, 3, 4, 5, 6, 7, 0, 1);
     std::size_t k = 0;
-    for (; k + 8 <= m; k += 8) {
-        __m256 r[3];
-        for (int i = 0; i < 3; ++i) {
-            const __m256 d = _mm256_sub_ps(_mm256_loadu_ps(fa + 3 * k + 8 * i), _mm256_loadu_ps(fb + 3 * k + 8 * i));
-            r[i] = _mm256_mul_ps(d, d);
-        }
-        // Lanes: x0 x3 x6 x1 x4 x7 x2 x5; y5 y0 y3 y6 y1 y4 y7 y2; z2 z5 z0 z3 z6 z1 z4 z7.
-        const __m256 x = _mm256_blend_ps(_mm256_blend_ps(r[0], r[1], 0b10010010), r[2], 0b00100100);
-        const __m256 y = _mm256_blend_ps(_mm256_blend_ps(r[0], r[1], 0b00100100), r[2], 0b01001001);
-        const __m256 z = _mm256_blend_ps(_mm256_blend_ps(r[0], r[1], 0b01001001), r[2], 0b10010010);
-        const __m256 d2 = _mm256_add_ps(_mm256_add_ps(x, _mm256_permutevar8x32_ps(y, rotate1)),
-                                        _mm256_permutevar8x32_ps(z, rotate2));
-        w = _mm256_max_ps(w, d2);
-    }
+    for (; k + 8 <= m; k += 8) w = _mm256_max_ps(w, squares8(fa + 3 * k, fb + 3 * k));
     alignas(32) float lanes[8];
     _mm256_store_ps(lanes, w);
     for (const float v : lanes) *worst = std::max(*worst, v);
+    return k;
+}
+
+// add_step_errors' terms norm(p[k] - p[k - 1]) - norm(t[k] - t[k - 1]) for
+// k in [from, to), eight at a time, into terms[k - from]; returns where it
+// stopped (from >= 1).
+__attribute__((target("avx2"))) inline std::size_t step_terms_avx2(const Vec3f* points, const Vec3f* targets,
+                                                                std::size_t from, std::size_t to, float* terms) {
+    const float *fp = &points->x, *ft = &targets->x;
+    std::size_t k = from;
+    for (; k + 8 <= to; k += 8) {
+        const __m256 p = _mm256_sqrt_ps(squares8(fp + 3 * k, fp + 3 * (k - 1)));
+        const __m256 t = _mm256_sqrt_ps(squares8(ft + 3 * k, ft + 3 * (k - 1)));
+        _mm256_storeu_ps(terms + (k - from), _mm256_permutevar8x32_ps(_mm256_sub_ps(p, t), squares_order()));
+    }
     return k;
 }
 #endif
@@ -110,15 +130,19 @@ inline float max_distance2(const Vec3f* a, const Vec3f* b, std::size_t m) {
 
 // error + the sum, in order, of norm(points[k] - points[k - 1]) -
 // norm(targets[k] - targets[k - 1]) over k in [from, to): the float terms a
-// chunk at a time into a buffer (a loop without a running sum, which the
-// compiler vectorizes, square roots included), then their double sum.
+// chunk at a time into a buffer (eight at a time with AVX2), then their
+// double sum.
 inline double add_step_errors(double error, const Vec3f* points, const Vec3f* targets, std::size_t from,
                               std::size_t to) {
     constexpr std::size_t kChunk = 64;
     float terms[kChunk];
     for (std::size_t k0 = from; k0 < to; k0 += kChunk) {
         const std::size_t n = std::min(kChunk, to - k0);
-        for (std::size_t i = 0; i < n; ++i) {
+        std::size_t i = 0;
+#ifdef FIBLET_POINTS_AVX2
+        if (use_avx2_loops()) i = step_terms_avx2(points, targets, k0, k0 + n, terms) - k0;
+#endif
+        for (; i < n; ++i) {
             const std::size_t k = k0 + i;
             terms[i] = norm(points[k] - points[k - 1]) - norm(targets[k] - targets[k - 1]);
         }
