@@ -9,10 +9,10 @@
 #include <cstring>
 #include <optional>
 
-#include "fiblet/checksum.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/tck.hpp"
 #include "tractogram/tck/track_header.hpp"
+#include "core/pass_digest.hpp"
 #include "core/points_avx2.hpp"
 #include "core/streamline_label.hpp"
 #include "io/open_inputs.hpp"
@@ -83,7 +83,7 @@ struct TckReader::Impl {
     // Multi-pass readers (compress) must see the same data on every pass: the
     // file as opened, and each complete pass's bytes and counts (see check_pass).
     struct stat opened {};
-    Xxh64Stream pass_hash;
+    detail::PassDigest pass_hash;
     struct Pass {
         std::uint64_t digest, streamlines, points;
     };
