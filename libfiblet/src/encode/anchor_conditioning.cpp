@@ -80,10 +80,14 @@ DecoderStarts condition_anchors(Vec3d n0, Vec3d n1, double reach, double thresho
     if (!(best.divergence > threshold) && !fallback) return best;
     double best_cost = fallback ? INFINITY : anchor_error(best.words, n0, n1) + kDivergenceWeight * best.divergence;
     auto offer = [&](const AnchorWords& w) {
+        // The divergence only adds to the anchor error: a rounding whose
+        // anchors alone cost the best so far cannot win, and is not decoded.
+        const double error = anchor_error(w, n0, n1);
+        if (!(error < best_cost)) return;
         DecoderStarts s = decoder_starts(w);
         if (s.fallback) return;
         s.divergence = start_divergence(s, reach);
-        const double cost = anchor_error(s.words, n0, n1) + kDivergenceWeight * s.divergence;
+        const double cost = error + kDivergenceWeight * s.divergence;
         if (cost < best_cost) best_cost = cost, best = s, fallback = false;
     };
     for (unsigned mask = 0; mask < 64; ++mask) offer(words(mask, false));
