@@ -16,6 +16,7 @@
 #include "compress/batch_pipeline.hpp"
 #include "compress/compress_stages.hpp"
 #include "core/points_avx2.hpp"
+#include "core/sum_lanes.hpp"
 #include "core/streamline_label.hpp"
 #include "fiblet/error.hpp"
 #include "core/vec_math.hpp"
@@ -60,6 +61,19 @@ struct ScanSlot {
     double seconds = 0;                // in scan_task
 };
 
+// lo = min(lo, lengths), hi = max(hi, lengths), in four lanes (a loop the
+// compiler vectorizes; the lengths are not NaN, so the lanes' order does
+// not matter).
+void step_range(std::span<const double> lengths, double& lo, double& hi) {
+    double mn[4] = {lo, lo, lo, lo}, mx[4] = {hi, hi, hi, hi};
+    std::size_t i = 0;
+    for (; i + 4 <= lengths.size(); i += 4)
+        for (int j = 0; j < 4; ++j) mn[j] = std::min(mn[j], lengths[i + j]), mx[j] = std::max(mx[j], lengths[i + j]);
+    for (; i < lengths.size(); ++i) mn[0] = std::min(mn[0], lengths[i]), mx[0] = std::max(mx[0], lengths[i]);
+    lo = std::min(std::min(mn[0], mn[1]), std::min(mn[2], mn[3]));
+    hi = std::max(std::max(mx[0], mx[1]), std::max(mx[2], mx[3]));
+}
+
 void scan_task(const FiberBatch& b, std::size_t t, ScanSlot& s) {
     const StageClock clock(s.seconds);
     double length_sum = 0;  // this task's, added to the slot's once (the same sums whatever the threads)
@@ -70,14 +84,8 @@ void scan_task(const FiberBatch& b, std::size_t t, ScanSlot& s) {
         add_bounds(fiber, s.min, s.max);
         segment_lengths(fiber, lengths);
         s.lengths.add(lengths);
-        // In locals: the slot's fields would be stored and reloaded at every segment.
-        double fiber_length = 0, step_min = s.step_min, step_max = s.step_max;
-        for (const double len : lengths) {
-            fiber_length += len;
-            step_min = std::min(step_min, len);
-            step_max = std::max(step_max, len);
-        }
-        s.step_min = step_min, s.step_max = step_max;
+        const double fiber_length = sum_in_four_lanes(lengths.data(), lengths.size());
+        step_range(lengths, s.step_min, s.step_max);
         length_sum += fiber_length;
         s.fiber_lengths.push_back(float(fiber_length));
         s.segments += lengths.size();

@@ -11,6 +11,7 @@
 #endif
 
 #include "core/points_avx2.hpp"
+#include "core/sum_lanes.hpp"
 #include "core/vec_math.hpp"
 #include "stats/geometry_paths.hpp"
 
@@ -65,18 +66,6 @@ template <class T>
 T* at_least(std::vector<T>& v, std::size_t n) {
     if (v.size() < n) v.resize(n);
     return v.data();
-}
-
-// The sum of v[0, n) in four running sums (v[i] in sum i % 4), then
-// (s0 + s1) + (s2 + s3): four independent chains of additions where one
-// took a fifth of the columns' time.
-double sum4(const double* v, std::size_t n) {
-    double s[4] = {0, 0, 0, 0};
-    std::size_t i = 0;
-    for (; i + 4 <= n; i += 4)
-        for (int j = 0; j < 4; ++j) s[j] += v[i + j];
-    for (int j = 0; i < n; ++i, ++j) s[j] += v[i];
-    return (s[0] + s[1]) + (s[2] + s[3]);
 }
 
 struct Segments {
@@ -189,7 +178,7 @@ void segments_of(std::span<const Vec3f> line, Segments& out) {
     // The inverse squared lengths, and the lengths.
     inverses_and_roots(len + done, inv + done, n - done);
     out.count = n;
-    out.length = points > 1 ? sum4(len, n) : 0.0;
+    out.length = points > 1 ? detail::sum_in_four_lanes(len, n) : 0.0;
 }
 
 // Fixed-step pairs (as many points on both polylines; point k was encoded
