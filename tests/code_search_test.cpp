@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 
@@ -191,7 +192,7 @@ TEST(CodeSearch, SixteenBitSearchDecodesToWhatTheEncoderPredicted) {
 namespace {
 
 // The lookahead rule written plainly (no branch and bound, no kept
-// continuation): every code of the 3x3 around the aimed one is followed by
+// continuation): the aimed code and its four nearest codes are followed by
 // `depth` greedy steps to the block's end at most, each scored by the sum of
 // its squared errors; the aimed code stands unless a code tried after it,
 // cheapest own error first, has a smaller sum.
@@ -218,11 +219,13 @@ std::vector<std::uint8_t> brute_force_lookahead(const detail::Codebook8& cb, Fra
             }
             return e;
         };
+        // The rivals: the codes one level up or down on one grid axis.
         std::vector<std::pair<float, unsigned>> rivals;  // (own error, code), in grid order
         const int h0 = int(aimed) / 16, l0 = int(aimed) % 16;
         for (int h = std::max(h0 - 1, 0); h <= std::min(h0 + 1, 15); ++h)
             for (int l = std::max(l0 - 1, 0); l <= std::min(l0 + 1, 15); ++l)
-                if (unsigned(h * 16 + l) != aimed) rivals.emplace_back(error2(local, unsigned(h * 16 + l)), unsigned(h * 16 + l));
+                if (std::abs(h - h0) + std::abs(l - l0) == 1)
+                    rivals.emplace_back(error2(local, unsigned(h * 16 + l)), unsigned(h * 16 + l));
         std::stable_sort(rivals.begin(), rivals.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
         unsigned code = aimed;
         if (k + 1 < t.size()) {

@@ -52,6 +52,7 @@ struct Codebook8 {
     const Vec3f& direction(unsigned c) const { return table.direction(Code(c)); }
     const RowFrame& rows(unsigned c) const { return lut.rows(Code(c)); }
     const NearestCodeLut::Neighbours& neighbours(unsigned c) const { return lut.neighbours(Code(c)); }
+    const NearestCodeLut::Rivals& rivals(unsigned c) const { return lut.rivals(Code(c)); }
 };
 
 // The wide codes of 16-bit files (256 or 181 levels).
@@ -271,7 +272,7 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
 }
 
 // Greedy aiming with lookahead (a "pilot" search): at each point the aimed
-// code and the 3x3 codes around it are scored by their own squared error
+// code and its four nearest codes (NearestCodeLut::Rivals) are scored by their own squared error
 // plus the squared errors greedy aiming makes at the next `depth` points
 // from where they lead; the cheapest wins. It sees what greedy aiming
 // cannot — a code that is a little worse now but leaves the frame and the
@@ -284,9 +285,9 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
 //   (a chain of depth + 1 steps, shifted by one when the aimed code wins,
 //   replaced by the winner's own continuation otherwise), so the aimed
 //   path costs one new greedy step per point.
-// Measured on small-ifod1 at depth 2 (docs/notes/encode-history.md): 0.85
-// rivals tried and 0.55 followed a second step per point; a rival wins at
-// 16 % of the points.
+// Measured on small-ifod1 at depth 2 with the eight codes around the aimed
+// one as rivals (docs/notes/encode-history.md): 0.85 rivals tried and 0.55
+// followed a second step per point; a rival wins at 16 % of the points.
 inline constexpr std::size_t kMaxLookahead = 6;
 
 template <class Codebook>
@@ -392,20 +393,18 @@ private:
         const float e = error2(s.local, s.base, code);
         return alt_.empty() ? e : std::max(e, error2(s.alt_local, s.alt_base, code));
     }
-    // error2(s, code) of the 8 neighbours' codes (+inf past their count):
-    // the same products and sums, four lanes at a time.
-    void rival_errors(const Step& s, const NearestCodeLut::Neighbours& nb, float* out) const {
+    // error2(s, code) of the 4 rivals' codes (+inf past their count): the
+    // same products and sums, four lanes at once.
+    void rival_errors(const Step& s, const NearestCodeLut::Rivals& nb, float* out) const {
         const F4 two_step = f4_set1(two_step_), zero = f4_set1(0.0f);
-        auto lanes = [&](F4 local, float base, int i) {
-            const F4 d = f4_add(f4_add(f4_mul(f4_load(nb.x + i), f4_splat<0>(local)), f4_mul(f4_load(nb.y + i), f4_splat<1>(local))),
-                                f4_mul(f4_load(nb.z + i), f4_splat<2>(local)));
+        auto lanes = [&](F4 local, float base) {
+            const F4 d = f4_add(f4_add(f4_mul(f4_load(nb.x), f4_splat<0>(local)), f4_mul(f4_load(nb.y), f4_splat<1>(local))),
+                                f4_mul(f4_load(nb.z), f4_splat<2>(local)));
             return f4_max(zero, f4_sub(f4_set1(base), f4_mul(two_step, d)));
         };
-        for (int i = 0; i < 8; i += 4) {
-            F4 e = lanes(s.local, s.base, i);
-            if (!alt_.empty()) e = f4_max(e, lanes(s.alt_local, s.alt_base, i));
-            f4_store(out + i, f4_add(e, f4_load(nb.pad + i)));
-        }
+        F4 e = lanes(s.local, s.base);
+        if (!alt_.empty()) e = f4_max(e, lanes(s.alt_local, s.alt_base));
+        f4_store(out, f4_add(e, f4_load(nb.pad)));
     }
     // The greedy step for point j from state (f, p), without its state after.
     void aim(Step& s, std::size_t j, const RowFrame& f, F4 p) const {
@@ -447,8 +446,8 @@ private:
     static void choose_lanes(LookaheadSearch* lanes, std::size_t k, std::size_t end) {
         struct Lane {
             Step first;  // the aim's locals: copies, chain_ changes hands below
-            alignas(16) float rival_error2[8];
-            const NearestCodeLut::Neighbours* nb;
+            alignas(16) float rival_error2[4];
+            const NearestCodeLut::Rivals* nb;
             float best, e;
             bool trying, following, won;
         };
@@ -459,7 +458,7 @@ private:
             const Step& aim0 = (*l.chain_)[0];
             a.first.local = aim0.local, a.first.alt_local = aim0.alt_local;
             a.first.base = aim0.base, a.first.alt_base = aim0.alt_base;
-            a.nb = &l.cb_.neighbours(aim0.code);
+            a.nb = &l.cb_.rivals(aim0.code);
             l.rival_errors(a.first, *a.nb, a.rival_error2);
             a.best = l.chain_->sum();
             a.trying = true, a.won = false;
@@ -474,7 +473,7 @@ private:
                 a.following = false;
                 if (!a.trying) continue;
                 unsigned r = 0;
-                for (unsigned j = 1; j < 8; ++j) r = a.rival_error2[j] < a.rival_error2[r] ? j : r;
+                for (unsigned j = 1; j < 4; ++j) r = a.rival_error2[j] < a.rival_error2[r] ? j : r;
                 const float e0 = a.rival_error2[r];
                 if (!(e0 < a.best)) {
                     a.trying = false;

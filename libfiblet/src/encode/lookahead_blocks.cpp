@@ -15,6 +15,7 @@
 #endif
 
 #include <climits>
+#include <cstddef>
 #include <cmath>
 
 #include "encode/lookahead_blocks.hpp"
@@ -26,10 +27,14 @@ HWY_BEFORE_NAMESPACE();
 namespace fiblet::detail::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-// A Neighbours record as floats: x[8], y[8], z[8], pad[8], then the eight
-// codes (two 32-bit words) and the count.
-static_assert(sizeof(NearestCodeLut::Neighbours) == 36 * sizeof(float), "Neighbours are gathered as 36 words");
-constexpr int kNbY = 8, kNbZ = 16, kNbCodes = 32, kNbCount = 34;
+// A Rivals record as 32-bit words: x[4], y[4], z[4], pad[4], then the four
+// codes (one word) and the count, padded to 20 words.
+using Rivals = NearestCodeLut::Rivals;
+static_assert(offsetof(Rivals, code) == 16 * sizeof(float) && offsetof(Rivals, count) == 17 * sizeof(float) &&
+                  sizeof(Rivals) % sizeof(float) == 0,
+              "Rivals are gathered as words");
+constexpr int kRivals = 4, kRivalWords = int(sizeof(Rivals) / sizeof(float)), kRivalY = 4, kRivalZ = 8,
+              kRivalCodes = 16, kRivalCount = 17;
 
 // Blocks j0 .. j0 + active - 1 of the batch, one per lane of `d`, with
 // kDepth (1 or 2) points of lookahead.
@@ -45,7 +50,7 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
     const auto di = code.di;
     const VF stepv = hn::Set(d, step), step2 = hn::Set(d, step * step), two_step = hn::Set(d, 2.0f * step);
     const VF zero = hn::Zero(d), inf = hn::Set(d, INFINITY);
-    const float* nb_floats = cb.lut.neighbours(0).x;
+    const float* nb_floats = cb.lut.rivals(0).x;
     const auto* nb_words = reinterpret_cast<const std::int32_t*>(nb_floats);
 
     // |local|^2 + step^2 (dot_self, then the sum).
@@ -110,41 +115,39 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
         const VF aimed_e0 = error2(base, l[0], l[1], l[2], x, y, z);
         VF best = path(l, aimed_e0, win_f, win_x, win_y, win_z, win_x1, win_y1, win_z1, win_c1);
         VI win_code = aimed;
-        // The rivals (the aimed code's neighbours), where a lane has a point
-        // after k, in the scalar search's order: each round takes every
-        // lane's cheapest untried rival by own error (the first on a tie),
-        // tried while that error is below the lane's best; a rival wins with
-        // a smaller sum (the scalar search's branch and bound drops a path
-        // once its partial sum reaches the best: errors are at least 0, so
-        // such a path's whole sum does not win either). Rounds end when no
-        // lane has a rival left to try (about two a point, not eight).
-        const VI nb_at = hn::Mul(aimed, hn::Set(di, 36));
-        const VI words[2] = {hn::GatherIndex(di, nb_words + kNbCodes, nb_at),
-                             hn::GatherIndex(di, nb_words + kNbCodes + 1, nb_at)};
-        const VI count = hn::GatherIndex(di, nb_words + kNbCount, nb_at);
-        VF rival_e0[8], rx[8], ry[8], rz[8];
-        GatherFloats(d, nb_floats, nb_at, rx, 8);
-        GatherFloats(d, nb_floats + kNbY, nb_at, ry, 8);
-        GatherFloats(d, nb_floats + kNbZ, nb_at, rz, 8);
-        for (int r = 0; r < 8; ++r) {
+        // The rivals (NearestCodeLut::Rivals of the aimed code), where a
+        // lane has a point after k, in the scalar search's order: each round
+        // takes every lane's cheapest untried rival by own error (the first
+        // on a tie), tried while that error is below the lane's best; a
+        // rival wins with a smaller sum (the scalar search's branch and bound
+        // drops a path once its partial sum reaches the best: errors are at
+        // least 0, so such a path's whole sum does not win either). Rounds
+        // end when no lane has a rival left to try.
+        const VI nb_at = hn::Mul(aimed, hn::Set(di, kRivalWords));
+        const VI codes = hn::GatherIndex(di, nb_words + kRivalCodes, nb_at);
+        const VI count = hn::GatherIndex(di, nb_words + kRivalCount, nb_at);
+        VF rival_e0[kRivals], rx[kRivals], ry[kRivals], rz[kRivals];
+        GatherFloats(d, nb_floats, nb_at, rx, kRivals);
+        GatherFloats(d, nb_floats + kRivalY, nb_at, ry, kRivals);
+        GatherFloats(d, nb_floats + kRivalZ, nb_at, rz, kRivals);
+        for (int r = 0; r < kRivals; ++r) {
             const auto listed = hn::And(more, hn::RebindMask(d, hn::Lt(hn::Set(di, r), count)));
             rival_e0[r] = hn::IfThenElse(listed, error2(base, rx[r], ry[r], rz[r], x, y, z), inf);
         }
-        for (int round = 0; round < 8; ++round) {
+        for (int round = 0; round < kRivals; ++round) {
             VF e0 = rival_e0[0];
             VI which = hn::Zero(di);
-            for (int r = 1; r < 8; ++r) {
+            for (int r = 1; r < kRivals; ++r) {
                 const auto lower = hn::Lt(rival_e0[r], e0);
                 e0 = hn::IfThenElse(lower, rival_e0[r], e0);
                 which = hn::IfThenElse(hn::RebindMask(di, lower), hn::Set(di, r), which);
             }
             const auto tries = hn::Lt(e0, best);
             if (hn::AllFalse(d, tries)) break;
-            for (int r = 0; r < 8; ++r)
+            for (int r = 0; r < kRivals; ++r)
                 rival_e0[r] = hn::IfThenElse(hn::RebindMask(d, hn::Eq(which, hn::Set(di, r))), inf, rival_e0[r]);
-            // Rival `which`'s code: byte (which % 4) of its word.
-            const VI word = hn::IfThenElse(hn::RebindMask(di, hn::Lt(which, hn::Set(di, 4))), words[0], words[1]);
-            const VI c = hn::And(word >> hn::ShiftLeft<3>(hn::And(which, hn::Set(di, 3))), code.byte);
+            // Rival `which`'s code: byte `which` of the codes' word.
+            const VI c = hn::And(codes >> hn::ShiftLeft<3>(which), code.byte);
             VF lr[9], rf[9], qx, qy, qz, x1, y1, z1;  // the rival's frame, its state after point k
             VI c1;
             code.frame(c, lr);

@@ -1,3 +1,4 @@
+#include <utility>
 #include "encode/nearest_code_lut.hpp"
 
 #include <algorithm>
@@ -27,6 +28,20 @@ NearestCodeLut::NearestCodeLut(const DirectionTable& table) {
                 nb.code[nb.count++] = std::uint8_t(code);
             }
         for (unsigned i = nb.count; i < 8; ++i) nb.x[i] = nb.y[i] = nb.z[i] = 0.0f, nb.pad[i] = INFINITY, nb.code[i] = 0;
+    }
+    rivals_.resize(256);
+    for (unsigned c = 0; c < 256; ++c) {
+        Rivals& r = rivals_[c];
+        r.count = 0;
+        const int h0 = int(c >> 4), l0 = int(c & 15);
+        for (const auto [h, l] : {std::pair{h0 - 1, l0}, {h0, l0 - 1}, {h0, l0 + 1}, {h0 + 1, l0}}) {  // grid order
+            if (h < 0 || h > 15 || l < 0 || l > 15) continue;
+            const auto code = unsigned(h << 4 | l);
+            const Vec3f& d = table.direction(std::uint8_t(code));
+            r.x[r.count] = d.x, r.y[r.count] = d.y, r.z[r.count] = d.z, r.pad[r.count] = 0.0f;
+            r.code[r.count++] = std::uint8_t(code);
+        }
+        for (unsigned i = r.count; i < 4; ++i) r.x[i] = r.y[i] = r.z[i] = 0.0f, r.pad[i] = INFINITY, r.code[i] = 0;
     }
     zero_code_ = table.nearest_code({0, 0, 0});
     back_code_ = table.nearest_code({-1, 0, 0});
