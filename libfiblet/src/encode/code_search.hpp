@@ -272,9 +272,9 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
 }
 
 // Greedy aiming with lookahead (a "pilot" search): at each point the aimed
-// code and its four nearest codes (NearestCodeLut::Rivals) are scored by their own squared error
-// plus the squared errors greedy aiming makes at the next `depth` points
-// from where they lead; the cheapest wins. It sees what greedy aiming
+// code and its four nearest codes (NearestCodeLut::Rivals) are scored by
+// their own squared error plus the squared errors greedy aiming makes at
+// the next `depth` points from where they lead; the cheapest wins. It sees what greedy aiming
 // cannot — a code that is a little worse now but leaves the frame and the
 // position better placed for the next points (the zig-zag around a
 // straight path, the start of a turn) — at a few greedy steps per point:

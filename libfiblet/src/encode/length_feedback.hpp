@@ -63,7 +63,7 @@ inline constexpr unsigned kLengthRescueBeam = 32;
 // The squared distances |a_i - b_i|^2 of eight points i (a and b: 24
 // floats each, x y z interleaved), the scalar float operations
 // ((dx dx + dy dy) + dz dz) on lanes holding the points out of order
-// (kSquaresOrder): the three registers of 24 floats are blended so that
+// (squares_order()): the three registers of 24 floats are blended so that
 // lane i holds one point's x, y or z, the y and z registers then rotated
 // onto the x register's points.
 __attribute__((target("avx2"))) inline __m256 squares8(const float* a, const float* b) {

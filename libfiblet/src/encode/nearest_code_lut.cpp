@@ -1,8 +1,8 @@
-#include <utility>
 #include "encode/nearest_code_lut.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace fiblet::detail {
 
