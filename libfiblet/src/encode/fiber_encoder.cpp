@@ -107,6 +107,10 @@ void exact_decoder_targets(const DecoderStarts& s, std::span<const Vec3f> target
 }
 
 
+// The retry's first try searches a block with at least this many points of
+// lookahead before any beam (retry_with_lookahead).
+constexpr std::size_t kRetryLookahead = 2;
+
 // Blocks gathered from several fibers into one batch for the SIMD lanes
 // (greedy_blocks.hpp's layout: block j's start point, then its targets, at
 // points[j * stride]; its codes at codes[j * m]), and their results.
@@ -328,6 +332,8 @@ struct FiberEncoder::Encoding {
     void write_block_heads();
     void search_blocks();
     static void search_blocks_together(std::span<Encoding> fibers);
+    float retry_threshold2() const;
+    static void retry_with_lookahead(std::span<Encoding> fibers);
     void retry_worst_blocks();
     void search_robust_blocks();
     void keep_lengths();
@@ -423,12 +429,65 @@ void FiberEncoder::Encoding::search_blocks_together(std::span<Encoding> fibers) 
     }
 }
 
-// Blocks whose largest error exceeds the retry threshold are searched
-// again with the retry beam; the smaller max error wins.
+// The retry threshold, squared and normalized; 0 where there is no retry.
+float FiberEncoder::Encoding::retry_threshold2() const {
+    if (!(search().retry_beam_width > 0 && search().retry_error_mm > 0)) return 0;
+    const float t = float(search().retry_error_mm / header.scaling);
+    return t * t;
+}
+
+// The retry's first, cheap try where the first search was the lookahead
+// (8-bit): the blocks above the retry threshold, of all the fibers,
+// searched again with kRetryLookahead points of lookahead in SIMD lanes;
+// a block keeps the new codes where its largest error drops. On the medium
+// tractogram this takes 96 % of them below the threshold, which the beam
+// of retry_worst_blocks then leaves alone (docs/encode.md).
+void FiberEncoder::Encoding::retry_with_lookahead(std::span<Encoding> fibers) {
+    if (fibers.empty()) return;
+    const Encoding& first = fibers.front();
+    const float threshold2 = first.retry_threshold2();
+    if (first.wide || !(threshold2 > 0) || first.search().beam_width > 1 || first.search().lookahead == 0) return;
+    struct Block {
+        Encoding* e;
+        std::uint32_t b, m;
+        float worst2;
+    };
+    thread_local std::vector<Block> blocks;
+    blocks.clear();
+    for (Encoding& e : fibers)
+        for (std::uint32_t b = 0; b < e.n_blocks; ++b) {
+            const std::size_t i0 = std::size_t(b) * e.points_per_block;
+            const std::uint32_t m = e.block_points(b) > 2 ? e.block_points(b) - 2 : 0;
+            if (m == 0) continue;
+            const float worst2 = max_distance2(&e.scratch.points[i0 + 2], &e.scratch.targets[i0 + 2], m);
+            if (worst2 > threshold2) blocks.push_back({&e, b, m, worst2});
+        }
+    if (blocks.empty()) return;
+    std::stable_sort(blocks.begin(), blocks.end(), [](const Block& x, const Block& y) { return x.m > y.m; });
+    thread_local BlockBatch batch;
+    batch.reset(blocks.front().m, blocks.size());
+    for (std::size_t j = 0; j < blocks.size(); ++j) {
+        const Encoding& e = *blocks[j].e;
+        const std::size_t i0 = std::size_t(blocks[j].b) * e.points_per_block;
+        batch.set(j, e.scratch.frames[blocks[j].b], e.scratch.points[i0 + 1],
+                  std::span<const Vec3f>(&e.scratch.targets[i0 + 2], blocks[j].m));
+    }
+    const std::size_t depth = std::max<std::size_t>(first.search().lookahead, kRetryLookahead);
+    lookahead_blocks(first.codebook8(), first.header.step, depth, batch.batch());
+    for (std::size_t j = 0; j < blocks.size(); ++j) {
+        Encoding& e = *blocks[j].e;
+        const std::size_t i0 = std::size_t(blocks[j].b) * e.points_per_block;
+        if (!(max_distance2(batch.decoded_of(j), &e.scratch.targets[i0 + 2], blocks[j].m) < blocks[j].worst2)) continue;
+        std::copy_n(batch.decoded_of(j), blocks[j].m, &e.scratch.points[i0 + 2]);
+        std::copy_n(batch.codes_of(j), blocks[j].m, e.codes8_of(blocks[j].b));
+    }
+}
+
+// Blocks whose largest error (still) exceeds the retry threshold are
+// searched again with the retry beam; the smaller max error wins.
 void FiberEncoder::Encoding::retry_worst_blocks() {
-    if (!(search().retry_beam_width > 0 && search().retry_error_mm > 0)) return;
-    const float threshold2 =
-        float(search().retry_error_mm / header.scaling) * float(search().retry_error_mm / header.scaling);
+    const float threshold2 = retry_threshold2();
+    if (!(threshold2 > 0)) return;
     const SearchParams retry_params{search().retry_beam_width, search().retry_radius};
     // Fixed-step input keeping its lengths walks the sampling step, where
     // a few blocks at sharp turns stay above the retry's reach: those get
@@ -710,6 +769,7 @@ void FiberEncoder::encode_fibers(std::span<const std::span<const Vec3f>> fibers,
     for (std::size_t i = 0; i < fibers.size(); ++i) es.emplace_back(*this, fibers[i], std::uint32_t(first_id + i), out, scratch[i]);
     for (Encoding& e : es) e.write_block_heads();
     Encoding::search_blocks_together(es);
+    Encoding::retry_with_lookahead(es);
     for (Encoding& e : es) {
         e.retry_worst_blocks();
         if (!e.wide) e.search_robust_blocks();
