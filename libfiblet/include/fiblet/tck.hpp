@@ -60,7 +60,10 @@ TckHeader read_tck_header(const std::string& path);
 std::vector<std::vector<float>> read_track_scalars(const std::string& path);
 
 struct TckReadOptions {
-    std::size_t chunk_bytes = 4u << 20;  // size of each read from disk
+    // Size of each read from disk: small enough that the chunk is still in
+    // the CPU's L2 cache when it is parsed (compress of the medium
+    // tractogram 2-3 % faster than with 4 MB; 128 kB no faster again).
+    std::size_t chunk_bytes = 256u << 10;
     // A "count:" that disagrees with the data is an error unless this is set
     // (a truncated or hand-edited file would otherwise lose fibers silently).
     bool allow_count_mismatch = false;
