@@ -106,7 +106,6 @@ void exact_decoder_targets(const DecoderStarts& s, std::span<const Vec3f> target
         out[k] = to_float(a + apply(fd, apply_transposed(s.exact_frame, to_double(targets[k]) - s.exact1)));
 }
 
-
 // The retry's first try searches a block with at least this many points of
 // lookahead before any beam (retry_with_lookahead).
 constexpr std::size_t kRetryLookahead = 2;
