@@ -330,6 +330,13 @@ struct FiberEncoder::Encoding {
 
     void write_block_heads();
     void search_blocks();
+    // A block of one of several fibers searched in SIMD lanes.
+    struct LaneBlock {
+        Encoding* e;
+        std::uint32_t b, m;  // the block, its codes
+        float worst2 = 0;    // its largest squared error before the search
+    };
+    static BlockBatch& batch_of(std::vector<LaneBlock>& blocks);
     static void search_blocks_together(std::span<Encoding> fibers);
     float retry_threshold2() const;
     static void retry_with_lookahead(std::span<Encoding> fibers);
@@ -386,6 +393,21 @@ void FiberEncoder::Encoding::search_blocks() {
                          &scratch.points[std::size_t(b) * points_per_block + 2]);
 }
 
+// The blocks, longest first (the lanes of a vector then end together),
+// with their start states and targets in a batch for the SIMD lanes.
+BlockBatch& FiberEncoder::Encoding::batch_of(std::vector<LaneBlock>& blocks) {
+    std::stable_sort(blocks.begin(), blocks.end(), [](const LaneBlock& x, const LaneBlock& y) { return x.m > y.m; });
+    thread_local BlockBatch batch;
+    batch.reset(blocks.front().m, blocks.size());
+    for (std::size_t j = 0; j < blocks.size(); ++j) {
+        const Encoding& e = *blocks[j].e;
+        const std::size_t i0 = std::size_t(blocks[j].b) * e.points_per_block;
+        batch.set(j, e.scratch.frames[blocks[j].b], e.scratch.points[i0 + 1],
+                  std::span<const Vec3f>(&e.scratch.targets[i0 + 2], blocks[j].m));
+    }
+    return batch;
+}
+
 // The first search of several fibers' blocks: 8-bit greedy or lookahead
 // (greedy_blocks.hpp, lookahead_blocks.hpp) has the blocks of all the
 // fibers searched together, one per SIMD lane, the longest first (lanes
@@ -397,25 +419,13 @@ void FiberEncoder::Encoding::search_blocks_together(std::span<Encoding> fibers) 
         for (Encoding& e : fibers) e.search_blocks();
         return;
     }
-    struct Block {
-        Encoding* e;
-        std::uint32_t b, m;
-    };
-    thread_local std::vector<Block> blocks;
+    thread_local std::vector<LaneBlock> blocks;
     blocks.clear();
     for (Encoding& e : fibers)
         for (std::uint32_t b = 0; b < e.n_blocks; ++b)
             if (e.block_points(b) > 2) blocks.push_back({&e, b, e.block_points(b) - 2});
     if (blocks.empty()) return;  // fibers of at most two points a block: no codes
-    std::stable_sort(blocks.begin(), blocks.end(), [](const Block& x, const Block& y) { return x.m > y.m; });
-    thread_local BlockBatch batch;
-    batch.reset(first.points_per_block - 2, blocks.size());
-    for (std::size_t j = 0; j < blocks.size(); ++j) {
-        const Encoding& e = *blocks[j].e;
-        const std::size_t i0 = std::size_t(blocks[j].b) * e.points_per_block;
-        batch.set(j, e.scratch.frames[blocks[j].b], e.scratch.points[i0 + 1],
-                  std::span<const Vec3f>(&e.scratch.targets[i0 + 2], blocks[j].m));
-    }
+    BlockBatch& batch = batch_of(blocks);
     if (first.search().lookahead > 0)
         lookahead_blocks(first.codebook8(), first.header.step, first.search().lookahead, batch.batch());
     else
@@ -446,12 +456,7 @@ void FiberEncoder::Encoding::retry_with_lookahead(std::span<Encoding> fibers) {
     const Encoding& first = fibers.front();
     const float threshold2 = first.retry_threshold2();
     if (first.wide || !(threshold2 > 0) || first.search().beam_width > 1 || first.search().lookahead == 0) return;
-    struct Block {
-        Encoding* e;
-        std::uint32_t b, m;
-        float worst2;
-    };
-    thread_local std::vector<Block> blocks;
+    thread_local std::vector<LaneBlock> blocks;
     blocks.clear();
     for (Encoding& e : fibers)
         for (std::uint32_t b = 0; b < e.n_blocks; ++b) {
@@ -462,15 +467,7 @@ void FiberEncoder::Encoding::retry_with_lookahead(std::span<Encoding> fibers) {
             if (worst2 > threshold2) blocks.push_back({&e, b, m, worst2});
         }
     if (blocks.empty()) return;
-    std::stable_sort(blocks.begin(), blocks.end(), [](const Block& x, const Block& y) { return x.m > y.m; });
-    thread_local BlockBatch batch;
-    batch.reset(blocks.front().m, blocks.size());
-    for (std::size_t j = 0; j < blocks.size(); ++j) {
-        const Encoding& e = *blocks[j].e;
-        const std::size_t i0 = std::size_t(blocks[j].b) * e.points_per_block;
-        batch.set(j, e.scratch.frames[blocks[j].b], e.scratch.points[i0 + 1],
-                  std::span<const Vec3f>(&e.scratch.targets[i0 + 2], blocks[j].m));
-    }
+    BlockBatch& batch = batch_of(blocks);
     const std::size_t depth = std::max<std::size_t>(first.search().lookahead, kRetryLookahead);
     lookahead_blocks(first.codebook8(), first.header.step, depth, batch.batch());
     for (std::size_t j = 0; j < blocks.size(); ++j) {
