@@ -339,8 +339,9 @@ struct FiberEncoder::Encoding {
     static BlockBatch& batch_of(std::vector<LaneBlock>& blocks);
     static void search_blocks_together(std::span<Encoding> fibers);
     float retry_threshold2() const;
-    static void retry_with_lookahead(std::span<Encoding> fibers);
-    void retry_worst_blocks();
+    static void retry_worst_blocks(std::span<Encoding> fibers);
+    static void retry_with_lookahead(std::vector<LaneBlock>& blocks);
+    void retry_with_beam(std::uint32_t b, float first);
     void search_robust_blocks();
     void keep_lengths();
     static void keep_length_tails(std::span<Encoding> fibers);
@@ -445,17 +446,17 @@ float FiberEncoder::Encoding::retry_threshold2() const {
     return t * t;
 }
 
-// The retry's first, cheap try where the first search was the lookahead
-// (8-bit): the blocks above the retry threshold, of all the fibers,
-// searched again with kRetryLookahead points of lookahead in SIMD lanes;
-// a block keeps the new codes where its largest error drops. On the medium
-// tractogram this takes 96 % of them below the threshold, which the beam
-// of retry_worst_blocks then leaves alone (docs/encode.md).
-void FiberEncoder::Encoding::retry_with_lookahead(std::span<Encoding> fibers) {
+// Blocks whose largest error exceeds the retry threshold, of all the
+// fibers, are searched again; the smaller max error wins. Where the first
+// search was the lookahead (8-bit), they are searched first with
+// kRetryLookahead points of lookahead in SIMD lanes (retry_with_lookahead:
+// on the medium tractogram this takes 96 % of them below the threshold,
+// docs/encode.md); those (still) above it get the retry beam.
+void FiberEncoder::Encoding::retry_worst_blocks(std::span<Encoding> fibers) {
     if (fibers.empty()) return;
     const Encoding& first = fibers.front();
     const float threshold2 = first.retry_threshold2();
-    if (first.wide || !(threshold2 > 0) || first.search().beam_width > 1 || first.search().lookahead == 0) return;
+    if (!(threshold2 > 0)) return;
     thread_local std::vector<LaneBlock> blocks;
     blocks.clear();
     for (Encoding& e : fibers)
@@ -467,52 +468,57 @@ void FiberEncoder::Encoding::retry_with_lookahead(std::span<Encoding> fibers) {
             if (worst2 > threshold2) blocks.push_back({&e, b, m, worst2});
         }
     if (blocks.empty()) return;
+    if (!first.wide && first.search().beam_width <= 1 && first.search().lookahead > 0) retry_with_lookahead(blocks);
+    for (const LaneBlock& k : blocks)
+        if (k.worst2 > threshold2) k.e->retry_with_beam(k.b, k.worst2);
+}
+
+// The blocks searched again with the lookahead, all in SIMD lanes; a block
+// keeps the new codes (and its worst2 drops) where its largest error drops.
+void FiberEncoder::Encoding::retry_with_lookahead(std::vector<LaneBlock>& blocks) {
+    const Encoding& first = *blocks.front().e;
     BlockBatch& batch = batch_of(blocks);
     const std::size_t depth = std::max<std::size_t>(first.search().lookahead, kRetryLookahead);
     lookahead_blocks(first.codebook8(), first.header.step, depth, batch.batch());
     for (std::size_t j = 0; j < blocks.size(); ++j) {
-        Encoding& e = *blocks[j].e;
-        const std::size_t i0 = std::size_t(blocks[j].b) * e.points_per_block;
-        if (!(max_distance2(batch.decoded_of(j), &e.scratch.targets[i0 + 2], blocks[j].m) < blocks[j].worst2)) continue;
-        std::copy_n(batch.decoded_of(j), blocks[j].m, &e.scratch.points[i0 + 2]);
-        std::copy_n(batch.codes_of(j), blocks[j].m, e.codes8_of(blocks[j].b));
+        LaneBlock& k = blocks[j];
+        Encoding& e = *k.e;
+        const std::size_t i0 = std::size_t(k.b) * e.points_per_block;
+        const float now = max_distance2(batch.decoded_of(j), &e.scratch.targets[i0 + 2], k.m);
+        if (!(now < k.worst2)) continue;
+        k.worst2 = now;
+        std::copy_n(batch.decoded_of(j), k.m, &e.scratch.points[i0 + 2]);
+        std::copy_n(batch.codes_of(j), k.m, e.codes8_of(k.b));
     }
 }
 
-// Blocks whose largest error (still) exceeds the retry threshold are
-// searched again with the retry beam; the smaller max error wins.
-void FiberEncoder::Encoding::retry_worst_blocks() {
-    const float threshold2 = retry_threshold2();
-    if (!(threshold2 > 0)) return;
+// Block b (largest squared error `first`) searched again with the retry
+// beam, the smaller max error kept.
+void FiberEncoder::Encoding::retry_with_beam(std::uint32_t b, float first) {
     const SearchParams retry_params{search().retry_beam_width, search().retry_radius};
     // Fixed-step input keeping its lengths walks the sampling step, where
     // a few blocks at sharp turns stay above the retry's reach: those get
     // a wider beam still (length_feedback.hpp, kLengthRescueBeam).
     const bool rescue = enc.length_stretch_ > 0 && enc.length_tails_only_ && !wide;
-    const float rescue2 = kLengthRescueOverRetry * kLengthRescueOverRetry * threshold2;
-    for (std::uint32_t b = 0; b < n_blocks; ++b) {
-        const std::size_t i0 = std::size_t(b) * points_per_block, m = block_points(b) >= 2 ? block_points(b) - 2 : 0;
-        if (m == 0) continue;
-        float first = max_distance2(&scratch.points[i0 + 2], &scratch.targets[i0 + 2], m);
-        if (!(first > threshold2)) continue;
-        scratch.retry_points.resize(m);
-        scratch.retry_codes8.resize(m);
-        scratch.retry_codes16.resize(m);
-        for (int pass = 0; pass < 2; ++pass) {
-            const unsigned width = pass == 0 ? retry_params.beam : kLengthRescueBeam;
-            if (pass == 1 && !(rescue && first > rescue2 && width > retry_params.beam)) break;
-            search_block(b, SearchParams{width, retry_params.radius}, scratch.retry_codes8.data(),
-                         scratch.retry_codes16.data(), scratch.retry_points.data());
-            const float now = max_distance2(scratch.retry_points.data(), &scratch.targets[i0 + 2], m);
-            if (!(now < first)) continue;
-            first = now;
-            std::copy(scratch.retry_points.begin(), scratch.retry_points.end(), &scratch.points[i0 + 2]);
-            if (wide)
-                std::copy(scratch.retry_codes16.begin(), scratch.retry_codes16.end(),
-                          scratch.codes16.begin() + std::ptrdiff_t(i0));
-            else
-                std::copy(scratch.retry_codes8.begin(), scratch.retry_codes8.end(), codes8_of(b));
-        }
+    const float rescue2 = kLengthRescueOverRetry * kLengthRescueOverRetry * retry_threshold2();
+    const std::size_t i0 = std::size_t(b) * points_per_block, m = block_points(b) - 2;
+    scratch.retry_points.resize(m);
+    scratch.retry_codes8.resize(m);
+    scratch.retry_codes16.resize(m);
+    for (int pass = 0; pass < 2; ++pass) {
+        const unsigned width = pass == 0 ? retry_params.beam : kLengthRescueBeam;
+        if (pass == 1 && !(rescue && first > rescue2 && width > retry_params.beam)) break;
+        search_block(b, SearchParams{width, retry_params.radius}, scratch.retry_codes8.data(),
+                     scratch.retry_codes16.data(), scratch.retry_points.data());
+        const float now = max_distance2(scratch.retry_points.data(), &scratch.targets[i0 + 2], m);
+        if (!(now < first)) continue;
+        first = now;
+        std::copy(scratch.retry_points.begin(), scratch.retry_points.end(), &scratch.points[i0 + 2]);
+        if (wide)
+            std::copy(scratch.retry_codes16.begin(), scratch.retry_codes16.end(),
+                      scratch.codes16.begin() + std::ptrdiff_t(i0));
+        else
+            std::copy(scratch.retry_codes8.begin(), scratch.retry_codes8.end(), codes8_of(b));
     }
 }
 
@@ -765,11 +771,9 @@ void FiberEncoder::encode_fibers(std::span<const std::span<const Vec3f>> fibers,
     for (std::size_t i = 0; i < fibers.size(); ++i) es.emplace_back(*this, fibers[i], std::uint32_t(first_id + i), out, scratch[i]);
     for (Encoding& e : es) e.write_block_heads();
     Encoding::search_blocks_together(es);
-    Encoding::retry_with_lookahead(es);
-    for (Encoding& e : es) {
-        e.retry_worst_blocks();
+    Encoding::retry_worst_blocks(es);
+    for (Encoding& e : es)
         if (!e.wide) e.search_robust_blocks();
-    }
     if (!es.empty() && es.front().tails_only()) Encoding::keep_length_tails(es);
     else for (Encoding& e : es) e.keep_lengths();
     // The largest float error of these fibers' points: the max error
