@@ -79,7 +79,7 @@ struct TckReader::Impl {
     // appended to a fiber as the points it is (no zero-filled resize first;
     // runs start at multiples of 12 bytes).
     std::unique_ptr<Vec3f[]> chunk_points;
-    char* chunk = nullptr;
+    char* chunk() const { return reinterpret_cast<char*>(chunk_points.get()); }
     std::size_t chunk_cap = 0, chunk_len = 0, chunk_pos = 0;
     std::uint64_t streamlines = 0, points = 0;
     bool at_end = false;  // end marker seen (or empty data section)
@@ -133,14 +133,11 @@ struct TckReader::Impl {
     // Reads the next chunk; false when the data section is exhausted.
     bool refill() {
         if (next_read >= data_end) return false;
-        if (!chunk) {
-            chunk_points.reset(new Vec3f[(chunk_cap + sizeof(Vec3f) - 1) / sizeof(Vec3f)]);
-            chunk = reinterpret_cast<char*>(chunk_points.get());
-        }
+        if (!chunk_points) chunk_points.reset(new Vec3f[(chunk_cap + sizeof(Vec3f) - 1) / sizeof(Vec3f)]);
         const std::size_t want = std::size_t(std::min<std::uint64_t>(chunk_cap, data_end - next_read));
         std::size_t got = 0;
         while (got < want) {
-            const ssize_t n = ::pread(fd, chunk + got, want - got, off_t(next_read + got));
+            const ssize_t n = ::pread(fd, chunk() + got, want - got, off_t(next_read + got));
             if (n < 0) {
                 if (errno == EINTR) continue;
                 throw Error(Errc::io, path + ": read failed: " + std::strerror(errno));
@@ -156,7 +153,7 @@ struct TckReader::Impl {
                         " when opened");
             data_end = next_read + got;
         }
-        pass_hash.update(chunk, got);
+        pass_hash.update(chunk(), got);
         chunk_len = got;
         chunk_pos = 0;
         next_read += got;
@@ -165,7 +162,7 @@ struct TckReader::Impl {
 
     // Appends the run of finite float32le points at the cursor; stops at the first special triplet.
     void scan_float32le(std::vector<Vec3f>& out) {
-        const char* p = chunk + chunk_pos;
+        const char* p = chunk() + chunk_pos;
         const std::size_t n = (chunk_len - chunk_pos) / 12;
         std::size_t i = 0;
 #ifdef FIBLET_POINTS_AVX2
@@ -187,7 +184,7 @@ struct TckReader::Impl {
     // Classifies the triplet at the cursor; for a point, stores it in `v`.
     Kind read_triplet(Vec3f& v) {
         double d[3];
-        decode_triplet(chunk + chunk_pos, header.datatype, d);
+        decode_triplet(chunk() + chunk_pos, header.datatype, d);
         int n_nan = 0, n_inf = 0;
         for (double x : d) n_nan += std::isnan(x), n_inf += std::isinf(x);
         const Kind k = classify(n_nan, n_inf);
