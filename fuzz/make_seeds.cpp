@@ -4,7 +4,7 @@
 // (conformance files, valid and invalid, and the real bundles) and hand-made
 // edge files;
 // OUT_DIR/fft_file_fuzz: those compressed, in several layouts (8- and 16-bit
-// codes), with and without the fiblet trailer; OUT_DIR/decode_blocks_fuzz: their blocks with
+// codes, both block indexes), with and without the fiblet trailer; OUT_DIR/decode_blocks_fuzz: their blocks with
 // the parameters header of that target; OUT_DIR/streamline_source_fuzz: the
 // shared .trk files and TRX zips written from them.
 #include <cmath>
@@ -257,6 +257,13 @@ int main(int argc, char** argv) {
                 write_file(fft_dir / (stem + "-no-trailer.fft"), bytes.substr(0, f.header().file_bytes()));
                 write_file(blocks_dir / (stem + ".blocks"), blocks_seed(fft));
             }
+        }
+        // The finer block index (formats/fft-index.md: version 4, a box per
+        // block, rANS-coded).
+        {
+            CompressOptions options;
+            options.index_format = BlockIndexFormat::block_boxes;
+            if (compress_seed(e.path(), fft_dir / (stem + "-fine-index.fft"), options)) ++n_fft;
         }
         // The seekable zstd container (formats/fftz.md), small frames so a
         // seed holds several, transposed and not.

@@ -41,7 +41,7 @@ struct ExitCodeInfo {
 const std::vector<ExitCodeInfo>& exit_code_table();
 
 // --fine-index (compress, extract -o x.fft): the flag that writes the
-// block index's version 3 (a box per block) instead of the default version 2.
+// block index's version 4 (a box per block) instead of the default version 2.
 void add_fine_index_flag(CLI::App* cmd, bool& fine_index);
 inline BlockIndexFormat index_format_for(bool fine_index) {
     return fine_index ? BlockIndexFormat::block_boxes : kDefaultBlockIndexFormat;

@@ -36,7 +36,7 @@ struct ExtractArgs {
     std::string camera_position, camera_target, camera_up = "0,1,0", lod;
     float fov = 45, aspect = 16.0f / 9.0f, near_mm = 1, far_mm = 2000, lod_pixels = kDefaultLodPixels;
     bool no_cull = false, compute_index = false, force = false, quiet = false, json = false;
-    bool fine_index = false;  // a .fft output's block index: version 3
+    bool fine_index = false;  // a .fft output's block index: version 4
 };
 
 [[noreturn]] void usage(const std::string& what) { throw Error(Errc::invalid_argument, what); }

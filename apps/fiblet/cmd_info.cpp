@@ -106,7 +106,8 @@ std::uint64_t partial_last_steps(const FftFile& f) {
 // The stored block index (BIDX, formats/fft-index.md): which version, and
 // what a version holds.
 std::string block_index_text(std::uint32_t version, std::uint64_t bytes) {
-    const char* holds = version == 3   ? "a coded box per block"
+    const char* holds = version == 4   ? "an rANS-coded box per block"
+                        : version == 3 ? "a range-coded box per block"
                         : version == 2 ? "a box per group of 8 blocks"
                         : version == 1 ? "a box per block"
                                        : "unknown to this fiblet";

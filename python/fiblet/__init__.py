@@ -671,10 +671,10 @@ def save(path, streamlines, step=None, *, overwrite=False, threads=None, max_mem
         streamlines (None: half the memory the process may use, as the CLI's
         --max-memory); beyond it nothing is
         written and an error says how much was needed.
-    fine_index: for .fft/.fftz, write the finer block index (BIDX version 3,
+    fine_index: for .fft/.fftz, write the finer block index (BIDX version 4,
         a box per block, as ``fiblet compress --fine-index``): fewer candidate
-        blocks for ``roi=`` queries, but about 20x slower to load (89 ms
-        against 4 ms on a 46 M-point file); worth it for files queried many
+        blocks for ``roi=`` queries, but about 4x slower to load (26 ms
+        against 6 ms on a 46 M-point file); worth it for files queried many
         times in one session. Refused for other outputs.
 
     Points for a .fft/.fftz go through a temporary .tck file (in the default

@@ -185,7 +185,7 @@ def test_save_fft_and_fftz_compress_as_the_cli_does(tmp_path, shared, cli, dwi_s
 
 
 def test_save_fine_index_writes_what_compress_fine_index_does(tmp_path, shared, cli):
-    # fine_index=True: the block index's version 3, byte for byte as `fiblet
+    # fine_index=True: the block index's version 4, byte for byte as `fiblet
     # compress --fine-index`; the default stays `fiblet compress`'s version 2.
     tck = shared / "dwi-small64d-ifod1.tck"
     fiblet.save(tmp_path / "py.fft", tck, fine_index=True)

@@ -5,12 +5,12 @@
 // On disk it is the optional "BIDX" trailer chunk (formats/fft-index.md),
 // in one of two versions a writer chooses (BlockIndexFormat): version 2
 // (the default) stores a quantized box per group of up to 8 consecutive
-// blocks of a fiber in 28 bits; version 3 stores a box per block on a grid
-// of half a block's path, range-coded against the previous block's box
+// blocks of a fiber in 28 bits; version 4 stores a box per block on a grid
+// of half a block's path, rANS-coded against the previous block's box
 // (about 5 bits a block): fewer candidate blocks for a selection, but about
-// 20x slower to load (a serial decoder). Both add one byte per fiber (two
-// when blocks hold more than 255 points): under 1 % of a file. Version 1 (a
-// box per block, 28 bits) is still read. Files without it (e.g. from the
+// 4x slower to load. Both add one byte per fiber (two when blocks hold more
+// than 255 points): under 1 % of a file. Versions 1 (a box per block, 28
+// bits) and 3 (version 4's boxes, range-coded) are still read. Files without it (e.g. from the
 // official encoder) get an index of exact per-block boxes computed on load
 // by decoding every block once. The hierarchy is never stored: it is
 // rebuilt in memory on load.
@@ -32,16 +32,15 @@
 namespace fiblet {
 
 inline constexpr std::array<char, 4> kBlockIndexTag = {'B', 'I', 'D', 'X'};
-// Blocks under one leaf box of the in-memory hierarchy over a version-3
-// index (the leaf's blocks' boxes are tested one by one).
+// Blocks under one leaf box of the in-memory hierarchy over a version-3 or
+// version-4 index (the leaf's blocks' boxes are tested one by one).
 inline constexpr std::uint32_t kIndexLeafBlocks = 8;
 
 // Accumulates the bounds of blocks as they are written (compress, extract)
 // and serializes them as a BIDX chunk of the chosen format: version 2, a
 // box per group of 8 consecutive blocks of a fiber (4 bytes a group), or
-// version 3, a box per block (kept, 20 bytes a block, until appended or
-// finished, then range-coded; a version-3 builder that has codes takes
-// appends, never is appended). Blocks come in file order, a fiber at a
+// version 4, a box per block (kept, 13 bytes a block, until finished,
+// then coded with frequencies of their own). Blocks come in file order, a fiber at a
 // time; builders filled in parallel on consecutive fibers are joined in
 // order with append() (builders of one format).
 class IndexBuilder {
@@ -93,7 +92,7 @@ private:
 
 // The index of one file, in memory: boxes of groups of consecutive blocks
 // (a version-2 chunk's groups; one box per block from a version-1 chunk or
-// computed exactly; for a version-3 chunk, groups of kIndexLeafBlocks
+// computed exactly; for a version-3 or -4 chunk, groups of kIndexLeafBlocks
 // bounding their blocks' own boxes), per-fiber point counts, and a bounding
 // volume hierarchy (8-wide, over the groups sorted along a Morton curve) to
 // find the blocks that meet a region.
@@ -112,7 +111,7 @@ public:
     static std::optional<std::uint32_t> stored_version(const FftFile& file);
 
     Source source() const { return source_; }
-    // The stored chunk's version (1, 2 or 3; BlockIndexFormat's values for
+    // The stored chunk's version (1 to 4; BlockIndexFormat's values for
     // those fiblet writes); 0 when computed.
     std::uint32_t chunk_version() const { return chunk_version_; }
     std::uint64_t blocks() const { return blocks_; }
@@ -151,6 +150,7 @@ private:
     BlockIndex() = default;
     void set_blocks(std::vector<Aabb> boxes);  // one group per block; sorts and builds the hierarchy
     void set_groups(const std::vector<Aabb>& boxes);  // of group_first_'s groups; sorts and builds it
+    Aabb cells_union(std::uint32_t first, std::uint32_t end) const;  // of blocks first .. end - 1 (block_cells_)
     template <class BoxOf>
     void build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of);  // (Morton key << 32 | group)
     template <class Classify>
@@ -167,8 +167,12 @@ private:
     std::vector<std::uint32_t> order_;           // Morton position -> group
     std::vector<std::uint32_t> rank_;            // group -> Morton position
     std::vector<std::vector<Aabb>> levels_;      // levels_[k][j]: node j of level k (k = 0: leaves)
-    std::vector<Aabb> block_boxes_;              // version 3: per block, leaf after leaf in Morton order
-    std::vector<std::uint32_t> leaf_first_box_;  // Morton position -> its first block box; one more: blocks_
+    // Versions 3 and 4: each block's grid box, packed in 64 bits (the
+    // library's index/index_grid.hpp), in file order; boxes in mm are
+    // origin + cell number * cell.
+    std::vector<std::uint64_t> block_cells_;
+    Vec3f cells_origin_{};
+    float cell_mm_ = 0;
 };
 
 }  // namespace fiblet

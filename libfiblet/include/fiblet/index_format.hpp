@@ -9,11 +9,10 @@ namespace fiblet {
 
 // The value is the chunk's version number.
 // group_boxes (2, the default): a box per group of up to 8 blocks of a
-// fiber, loaded in a few ms (the medium file: 4 ms). block_boxes (3): a box
-// per block, range-coded: about 3x fewer candidate blocks for a small
-// region, but about 20x slower to load (89 ms, a serial decoder): for
-// viewers and long-lived sessions that load once and query often.
-enum class BlockIndexFormat : std::uint32_t { group_boxes = 2, block_boxes = 3 };
+// fiber, loaded in a few ms (the medium file: 4 ms). block_boxes (4): a box
+// per block, rANS-coded: about 3x fewer candidate blocks for a small
+// region. (Version 3, a box per block range-coded, is read, no longer written.)
+enum class BlockIndexFormat : std::uint32_t { group_boxes = 2, block_boxes = 4 };
 inline constexpr BlockIndexFormat kDefaultBlockIndexFormat = BlockIndexFormat::group_boxes;
 
 }  // namespace fiblet

@@ -28,7 +28,7 @@ public:
     explicit BlockCrossCheck(const FftFile& file) : file_(file), ctx_(file) {
         if (const TrailerChunk* c = file.find_chunk(kBlockIndexTag)) {
             index_.emplace(detail::parse_index_chunk(c->payload, file.header(), file.path()));
-            if (index_->version == 3) block_boxes_ = detail::index_block_boxes(*index_, c->payload, file);
+            if (index_->version >= detail::kIndexChunkV3Version) block_boxes_ = detail::index_block_boxes(*index_, c->payload, file);
             else boxes_.emplace(index_->grid);  // versions 1 and 2: codes
         }
     }

@@ -83,7 +83,7 @@ BlockIndex BlockIndex::load(const FftFile& file) {
     // Fiber point counts: full blocks but the last (checked against the
     // header's total); groups: G blocks at a time from each fiber's first
     // (version 3: the hierarchy's leaves, over the blocks' own boxes).
-    const bool per_block = c.version == 3;
+    const bool per_block = c.version >= detail::kIndexChunkV3Version;
     const std::uint32_t group_blocks = per_block ? kIndexLeafBlocks : c.group_blocks;
     index.fiber_points_.resize(h.fibers);
     index.group_first_.clear();
@@ -107,20 +107,12 @@ BlockIndex BlockIndex::load(const FftFile& file) {
     if (total != h.points)
         bad("its fibers hold " + std::to_string(total) + " points, the header says " + std::to_string(h.points));
     if (per_block) {
-        const std::vector<Aabb> boxes = detail::index_block_boxes(c, chunk->payload, file);
-        std::vector<Aabb> leaves(index.group_first_.size() - 1, empty_box());
+        index.block_cells_ = detail::index_block_cells(c, chunk->payload, file);
+        index.cells_origin_ = c.grid.origin, index.cell_mm_ = c.grid.cell;
+        std::vector<Aabb> leaves(index.group_first_.size() - 1);
         for (std::size_t g = 0; g < leaves.size(); ++g)
-            for (std::uint32_t b = index.group_first_[g]; b < index.group_first_[g + 1]; ++b) grow(leaves[g], boxes[b]);
+            leaves[g] = index.cells_union(index.group_first_[g], index.group_first_[g + 1]);
         index.set_groups(leaves);
-        // Block boxes in the leaves' Morton order, as a query walks them.
-        index.block_boxes_.reserve(boxes.size());
-        index.leaf_first_box_.reserve(leaves.size() + 1);
-        for (const std::uint32_t g : index.order_) {
-            index.leaf_first_box_.push_back(std::uint32_t(index.block_boxes_.size()));
-            index.block_boxes_.insert(index.block_boxes_.end(), boxes.begin() + index.group_first_[g],
-                                      boxes.begin() + index.group_first_[g + 1]);
-        }
-        index.leaf_first_box_.push_back(std::uint32_t(index.block_boxes_.size()));
         return index;
     }
     // Morton keys straight from the codes' cells, then boxes decoded in that order.
@@ -144,8 +136,20 @@ BlockIndex BlockIndex::load(const FftFile& file) {
 Aabb BlockIndex::block_box(std::uint64_t block) const {
     const auto g = std::size_t(std::upper_bound(group_first_.begin(), group_first_.end() - 1, std::uint32_t(block)) -
                                group_first_.begin()) - 1;
-    if (!block_boxes_.empty()) return block_boxes_[leaf_first_box_[rank_[g]] + (block - group_first_[g])];
+    if (!block_cells_.empty()) return detail::cells_bounds(block_cells_[block], cells_origin_, cell_mm_);
     return sorted_boxes_[rank_[g]];
+}
+
+Aabb BlockIndex::cells_union(std::uint32_t first, std::uint32_t end) const {
+    std::uint32_t lo[3] = {~0u, ~0u, ~0u}, hi[3] = {0, 0, 0};
+    for (std::uint32_t b = first; b < end; ++b) {
+        const std::uint64_t v = block_cells_[b];
+        if (v == detail::kUnboundedCells) return detail::unbounded_box();
+        for (int a = 0; a < 3; ++a)
+            lo[a] = std::min(lo[a], detail::cells_lo(v, a)), hi[a] = std::max(hi[a], detail::cells_hi(v, a));
+    }
+    // Sides grow with their cell numbers: the union of the boxes in mm.
+    return detail::cells_bounds(lo, hi, cells_origin_, cell_mm_);
 }
 
 BlockIndex BlockIndex::compute(const FftFile& file) {
@@ -269,9 +273,8 @@ void BlockIndex::collect(const Classify& classify, std::vector<std::uint64_t>& b
     // Those of its blocks whose own box meets the region.
     auto mark_blocks = [&](std::size_t pos) {
         const std::uint32_t g = order_[pos];
-        const Aabb* box = &block_boxes_[leaf_first_box_[pos]];
-        for (std::uint32_t b = group_first_[g]; b < group_first_[g + 1]; ++b, ++box) {
-            const Overlap o = classify(*box);
+        for (std::uint32_t b = group_first_[g]; b < group_first_[g + 1]; ++b) {
+            const Overlap o = classify(detail::cells_bounds(block_cells_[b], cells_origin_, cell_mm_));
             if (o != Overlap::outside) set_bit(bits, b);
             if (o == Overlap::inside && inside) set_bit(*inside, b);
         }
@@ -290,7 +293,7 @@ void BlockIndex::collect(const Classify& classify, std::vector<std::uint64_t>& b
         if (k == 0) {
             for (std::size_t pos = j * kFanout; pos < std::min(n, (j + 1) * kFanout); ++pos) {
                 const Overlap b = classify(sorted_boxes_[pos]);
-                if (b == Overlap::partial && !block_boxes_.empty()) {
+                if (b == Overlap::partial && !block_cells_.empty()) {
                     mark_blocks(pos);
                     continue;
                 }

@@ -18,7 +18,6 @@ void adapt(std::uint16_t& p, unsigned b) {
     else p = std::uint16_t(p + (((1u << kProbBits) - p) >> kAdaptShift));
 }
 
-std::uint32_t zigzag(std::int64_t d) { return std::uint32_t(d >= 0 ? 2 * d : -2 * d - 1); }
 std::int64_t unzigzag(std::uint32_t z) { return z & 1 ? -std::int64_t(z / 2) - 1 : std::int64_t(z / 2); }
 std::uint32_t sign_of(std::int64_t d) { return d < 0 ? 0 : (d == 0 ? 1 : 2); }
 
@@ -30,67 +29,6 @@ BoxModel::BoxModel(std::uint32_t levels)
         for (auto& t : a.extent_steps) t.fill(kHalf);
         for (auto& t : a.delta_steps) t.fill(kHalf);
     }
-}
-
-void BoxStreamEncoder::shift_low() {
-    if (std::uint32_t(low_) < 0xff000000u || (low_ >> 32) != 0) {
-        const auto carry = std::uint8_t(low_ >> 32);
-        std::uint8_t byte = cache_;
-        do {
-            out_.push_back(std::uint8_t(byte + carry));
-            byte = 0xff;
-        } while (--cache_size_ != 0);
-        cache_ = std::uint8_t(low_ >> 24);
-    }
-    ++cache_size_;
-    low_ = (low_ & 0x00ffffffu) << 8;
-}
-
-void BoxStreamEncoder::bit(std::uint16_t& p, unsigned b) {
-    const std::uint32_t bound = (range_ >> kProbBits) * p;
-    if (b) low_ += bound, range_ -= bound;
-    else range_ = bound;
-    adapt(p, b);
-    while (range_ < kTop) range_ <<= 8, shift_low();
-}
-
-void BoxStreamEncoder::unary(std::uint16_t* p, std::uint32_t max, std::uint32_t v) {
-    for (std::uint32_t i = 0; i < max; ++i) {
-        bit(p[i], v > i);
-        if (v == i) return;
-    }
-}
-
-void BoxStreamEncoder::direct(unsigned bits, std::uint32_t v) {
-    for (unsigned i = bits; i-- > 0;) {
-        range_ >>= 1;
-        if ((v >> i) & 1) low_ += range_;
-        while (range_ < kTop) range_ <<= 8, shift_low();
-    }
-}
-
-void BoxStreamEncoder::add(const std::optional<GridBox>& box, bool first_of_fiber) {
-    if (first_of_fiber)
-        for (Axis& a : axes_) a.sign = 3;
-    bit(bounded_, box.has_value());
-    if (!box) return;
-    for (int k = 0; k < 3; ++k) {
-        Axis& a = axes_[k];
-        const std::uint32_t e = box->extent[k];
-        unary(a.extent_context(), kMaxBoxExtent, e);
-        const std::int64_t d = std::int64_t(box->lo[k]) - std::int64_t(a.lo);
-        const std::uint32_t z = first_of_fiber ? kEscape : std::min(zigzag(d), kEscape);
-        if (!first_of_fiber) unary(a.delta_context(e), kEscape, z);
-        if (z == kEscape) direct(level_bits_, box->lo[k]);
-        a.sign = z == kEscape ? 3 : sign_of(d);
-        a.lo = box->lo[k], a.extent = e;
-    }
-}
-
-std::vector<std::uint8_t> BoxStreamEncoder::finish() const {
-    BoxStreamEncoder e = *this;
-    for (int i = 0; i < 5; ++i) e.shift_low();
-    return std::move(e.out_);
 }
 
 namespace {
@@ -120,7 +58,7 @@ public:
             }
             a.sign = z == kEscape ? 3 : sign_of(lo - std::int64_t(a.lo));
             a.lo = std::uint32_t(lo), a.extent = e;
-            b.lo[k] = a.lo, b.extent[k] = std::uint8_t(e);
+            b.lo[k] = std::uint16_t(a.lo), b.extent[k] = std::uint8_t(e);
         }
         box = b;
         return true;
@@ -174,9 +112,11 @@ DecodedBoxes decode_box_stream(const std::uint8_t* data, std::size_t size,
         return out;
     }
     BoxStreamDecoder d(data, size, levels);
-    out.boxes.resize(first_of_fiber.size());
-    for (std::size_t b = 0; b < out.boxes.size(); ++b) {
-        if (!d.next_box(out.boxes[b], first_of_fiber[b], out.error)) return out;
+    out.boxes.reserve(first_of_fiber.size());
+    for (std::size_t b = 0; b < first_of_fiber.size(); ++b) {
+        std::optional<GridBox> box;
+        if (!d.next_box(box, first_of_fiber[b], out.error)) return out;
+        out.boxes.push_back(box ? pack_cells(*box) : kUnboundedCells);
         if (d.consumed() > size) {
             out.error = "its box stream is shorter than its boxes";
             return out;

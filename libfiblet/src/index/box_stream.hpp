@@ -1,32 +1,19 @@
 // Internal: the range-coded stream of per-block grid boxes of a BIDX
-// version-3 chunk (formats/fft-index.md §2): each block's box is coded
-// against the previous block's, with adaptive binary models, so that a box
-// per block costs about 5 bits where a fixed-width code needs 28.
+// version-3 chunk (formats/fft-index.md §7): each block's box is coded
+// against the previous block's, with adaptive binary models. Read, no
+// longer written: its single serial chain of binary decisions made the
+// index slow to load (version 4, box_rans.hpp, replaced it).
 #pragma once
 
 #include <array>
 #include <cstdint>
-#include <optional>
-#include <string>
-#include <vector>
+
+#include "index/index_grid.hpp"
 
 namespace fiblet::detail {
 
-// A box on the index grid: per axis, the cells lo .. lo + extent.
-struct GridBox {
-    std::array<std::uint32_t, 3> lo{};
-    std::array<std::uint8_t, 3> extent{};
-    bool operator==(const GridBox&) const = default;
-};
-
-inline constexpr std::uint32_t kMaxBoxExtent = 15;  // extents 0..15 cells
-// lo < levels <= 1024: a cell stays above 1/1024 of the range, so that the
-// 0.001-cell slack of quantized boxes exceeds the float rounding of
-// coordinates (2^-24 of their magnitude).
-inline constexpr std::uint32_t kMaxGridLevels = 1u << 10;
-
-// The adaptive models and the previous box: what encoder and decoder
-// update identically, block after block.
+// The adaptive models and the previous box, updated block after block as
+// the encoder did.
 class BoxModel {
 public:
     explicit BoxModel(std::uint32_t levels);
@@ -57,34 +44,10 @@ protected:
     unsigned level_bits_;
 };
 
-class BoxStreamEncoder : BoxModel {
-public:
-    using BoxModel::BoxModel;
-    // The next block's box (nullopt: unbounded); a fiber's first box is
-    // coded whole, the others against the previous one.
-    void add(const std::optional<GridBox>& box, bool first_of_fiber);
-    std::vector<std::uint8_t> finish() const;     // the stream so far, flushed (the encoder stays usable)
-
-private:
-    void bit(std::uint16_t& p, unsigned b);
-    void unary(std::uint16_t* p, std::uint32_t max, std::uint32_t v);
-    void direct(unsigned bits, std::uint32_t v);
-    void shift_low();
-    std::uint64_t low_ = 0;
-    std::uint32_t range_ = 0xffffffffu;
-    std::uint8_t cache_ = 0;
-    std::uint64_t cache_size_ = 1;
-    std::vector<std::uint8_t> out_;
-};
-
 // Decodes a box per block (nullopt: unbounded), first_of_fiber[b] telling
 // where fibers start. A malformed stream (a box off the grid, a stream shorter or
 // longer than its boxes) gives an error message, which the chunk's users
 // report as an fft_format error.
-struct DecodedBoxes {
-    std::vector<std::optional<GridBox>> boxes;
-    std::string error;  // empty when well-formed
-};
 DecodedBoxes decode_box_stream(const std::uint8_t* data, std::size_t size,
                                const std::vector<bool>& first_of_fiber, std::uint32_t levels);
 

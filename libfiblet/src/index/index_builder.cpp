@@ -7,7 +7,7 @@
 
 #include "fiblet/block_index.hpp"
 #include "fiblet/error.hpp"
-#include "index/box_stream.hpp"
+#include "index/box_rans.hpp"
 #include "index/index_chunk.hpp"
 
 namespace fiblet {
@@ -86,51 +86,33 @@ struct IndexBuilder::GroupCoder final : Coder {
     std::uint32_t fill = 0;            // blocks in the open group
 };
 
-// Version 3: a box per block, range-coded against the previous one.
+// Version 4: a box per block, coded against the previous one once all are
+// known (the code's frequencies are the boxes' own).
 struct IndexBuilder::BlockCoder final : Coder {
-    explicit BlockCoder(const FftHeader& h) : grid(detail::IndexGrid::for_blocks(h)), stream(grid.min_levels) {}
+    explicit BlockCoder(const FftHeader& h) : grid(detail::IndexGrid::for_blocks(h)) {}
     std::unique_ptr<Coder> clone() const override { return std::make_unique<BlockCoder>(*this); }
-    std::unique_ptr<Coder> fresh() const override {
-        auto c = std::make_unique<BlockCoder>(*this);
-        c->pending.clear(), c->stream = detail::BoxStreamEncoder(grid.min_levels), c->coded = false,
-        c->unbounded = 0;
-        return c;
-    }
+    std::unique_ptr<Coder> fresh() const override { return std::make_unique<BlockCoder>(grid); }
     BlockIndexFormat format() const override { return BlockIndexFormat::block_boxes; }
     void add(const Aabb& b, bool first_of_fiber, bool) override {
-        const auto box = grid.quantize(b);
-        unbounded += !box;
-        pending.push_back({box, first_of_fiber});
+        boxes.push_back(grid.quantize(b));
+        unbounded += !boxes.back();
+        first.push_back(first_of_fiber);
     }
     void append(const Coder& later) override {
         const auto& o = static_cast<const BlockCoder&>(later);
-        if (o.coded) throw Error(Errc::invalid_argument, "IndexBuilder::append: the later part has coded boxes");
-        code_pending();
-        pending = o.pending;
-        code_pending();
-        coded = coded || !o.pending.empty();
+        boxes.insert(boxes.end(), o.boxes.begin(), o.boxes.end());
+        first.insert(first.end(), o.first.begin(), o.first.end());
         unbounded += o.unbounded;
     }
     std::vector<std::uint8_t> finish(detail::IndexChunk& c, const FftHeader& h) const override {
-        BlockCoder all = *this;
-        all.code_pending();
         c.version = detail::kIndexChunkVersion;
         c.grid = grid;
-        return detail::serialize_index_chunk(c, h, all.stream.finish());
+        return detail::serialize_index_chunk(c, h, detail::encode_box_rans(boxes, first, grid.min_levels));
     }
-    // Codes the pending boxes after those coded already.
-    void code_pending() {
-        for (const Pending& p : pending) stream.add(p.box, p.first_of_fiber);
-        pending.clear();
-    }
-    struct Pending {
-        std::optional<detail::GridBox> box;
-        bool first_of_fiber;
-    };
+    explicit BlockCoder(const detail::IndexGrid& g) : grid(g) {}
     detail::IndexGrid grid;
-    std::vector<Pending> pending;
-    detail::BoxStreamEncoder stream;
-    bool coded = false;  // the stream holds boxes
+    std::vector<std::optional<detail::GridBox>> boxes;
+    std::vector<bool> first;  // first block of its fiber
 };
 
 IndexBuilder::IndexBuilder() = default;
