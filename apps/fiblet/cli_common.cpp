@@ -214,7 +214,7 @@ void set_decoded_step_size(TckHeader& header, const FftFile& file) {
 void add_fine_index_flag(CLI::App* cmd, bool& fine_index) {
     cmd->add_flag("--fine-index", fine_index,
                   "Write the finer block index (BIDX version 4, a box per block): fewer candidate blocks for "
-                  "selections, but about 4x slower to load (e.g. 26 ms against 6 ms); for viewers and "
+                  "selections, but about 5x slower to load (e.g. 32 ms against 6 ms); for viewers and "
                   "long-lived sessions (formats/fft-index.md)");
 }
 

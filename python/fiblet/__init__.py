@@ -673,7 +673,7 @@ def save(path, streamlines, step=None, *, overwrite=False, threads=None, max_mem
         written and an error says how much was needed.
     fine_index: for .fft/.fftz, write the finer block index (BIDX version 4,
         a box per block, as ``fiblet compress --fine-index``): fewer candidate
-        blocks for ``roi=`` queries, but about 4x slower to load (26 ms
+        blocks for ``roi=`` queries, but about 5x slower to load (32 ms
         against 6 ms on a 46 M-point file); worth it for files queried many
         times in one session. Refused for other outputs.
 

@@ -8,7 +8,7 @@
 // blocks of a fiber in 28 bits; version 4 stores a box per block on a grid
 // of half a block's path, rANS-coded against the previous block's box
 // (about 5 bits a block): fewer candidate blocks for a selection, but about
-// 4x slower to load. Both add one byte per fiber (two when blocks hold more
+// 5x slower to load. Both add one byte per fiber (two when blocks hold more
 // than 255 points): under 1 % of a file. Versions 1 (a box per block, 28
 // bits) and 3 (version 4's boxes, range-coded) are still read. Files without it (e.g. from the
 // official encoder) get an index of exact per-block boxes computed on load
@@ -150,7 +150,8 @@ private:
     BlockIndex() = default;
     void set_blocks(std::vector<Aabb> boxes);  // one group per block; sorts and builds the hierarchy
     void set_groups(const std::vector<Aabb>& boxes);  // of group_first_'s groups; sorts and builds it
-    Aabb cells_union(std::uint32_t first, std::uint32_t end) const;  // of blocks first .. end - 1 (block_cells_)
+    Aabb cells_union(const std::uint64_t* cells, std::size_t n) const;  // of n packed grid boxes
+    void sort_block_cells(const std::vector<std::uint64_t>& cells);  // file order -> block_cells_
     template <class BoxOf>
     void build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of);  // (Morton key << 32 | group)
     template <class Classify>
@@ -168,9 +169,10 @@ private:
     std::vector<std::uint32_t> rank_;            // group -> Morton position
     std::vector<std::vector<Aabb>> levels_;      // levels_[k][j]: node j of level k (k = 0: leaves)
     // Versions 3 and 4: each block's grid box, packed in 64 bits (the
-    // library's index/index_grid.hpp), in file order; boxes in mm are
-    // origin + cell number * cell.
+    // library's index/index_grid.hpp), leaf after leaf in Morton order;
+    // boxes in mm are origin + cell number * cell.
     std::vector<std::uint64_t> block_cells_;
+    std::vector<std::uint32_t> leaf_first_cell_;  // Morton position -> its first block's cells; one more: blocks_
     Vec3f cells_origin_{};
     float cell_mm_ = 0;
 };

@@ -107,12 +107,13 @@ BlockIndex BlockIndex::load(const FftFile& file) {
     if (total != h.points)
         bad("its fibers hold " + std::to_string(total) + " points, the header says " + std::to_string(h.points));
     if (per_block) {
-        index.block_cells_ = detail::index_block_cells(c, chunk->payload, file);
+        const std::vector<std::uint64_t> cells = detail::index_block_cells(c, chunk->payload, file);
         index.cells_origin_ = c.grid.origin, index.cell_mm_ = c.grid.cell;
         std::vector<Aabb> leaves(index.group_first_.size() - 1);
         for (std::size_t g = 0; g < leaves.size(); ++g)
-            leaves[g] = index.cells_union(index.group_first_[g], index.group_first_[g + 1]);
+            leaves[g] = index.cells_union(&cells[index.group_first_[g]], index.group_first_[g + 1] - index.group_first_[g]);
         index.set_groups(leaves);
+        index.sort_block_cells(cells);
         return index;
     }
     // Morton keys straight from the codes' cells, then boxes decoded in that order.
@@ -136,20 +137,36 @@ BlockIndex BlockIndex::load(const FftFile& file) {
 Aabb BlockIndex::block_box(std::uint64_t block) const {
     const auto g = std::size_t(std::upper_bound(group_first_.begin(), group_first_.end() - 1, std::uint32_t(block)) -
                                group_first_.begin()) - 1;
-    if (!block_cells_.empty()) return detail::cells_bounds(block_cells_[block], cells_origin_, cell_mm_);
+    if (!block_cells_.empty())
+        return detail::cells_bounds(block_cells_[leaf_first_cell_[rank_[g]] + (block - group_first_[g])], cells_origin_,
+                                    cell_mm_);
     return sorted_boxes_[rank_[g]];
 }
 
-Aabb BlockIndex::cells_union(std::uint32_t first, std::uint32_t end) const {
+Aabb BlockIndex::cells_union(const std::uint64_t* cells, std::size_t n) const {
     std::uint32_t lo[3] = {~0u, ~0u, ~0u}, hi[3] = {0, 0, 0};
-    for (std::uint32_t b = first; b < end; ++b) {
-        const std::uint64_t v = block_cells_[b];
-        if (v == detail::kUnboundedCells) return detail::unbounded_box();
+    for (std::size_t i = 0; i < n; ++i) {
+        if (cells[i] == detail::kUnboundedCells) return detail::unbounded_box();
         for (int a = 0; a < 3; ++a)
-            lo[a] = std::min(lo[a], detail::cells_lo(v, a)), hi[a] = std::max(hi[a], detail::cells_hi(v, a));
+            lo[a] = std::min(lo[a], detail::cells_lo(cells[i], a)), hi[a] = std::max(hi[a], detail::cells_hi(cells[i], a));
     }
     // Sides grow with their cell numbers: the union of the boxes in mm.
     return detail::cells_bounds(lo, hi, cells_origin_, cell_mm_);
+}
+
+void BlockIndex::sort_block_cells(const std::vector<std::uint64_t>& cells) {
+    // Leaf after leaf in Morton order, as a query walks them (its partial
+    // leaves' blocks then lie side by side, not one cache miss each).
+    block_cells_.reserve(cells.size());
+    leaf_first_cell_.reserve(order_.size() + 1);
+    constexpr std::size_t kAhead = 16;  // leaves: Morton order jumps around the file
+    for (std::size_t pos = 0; pos < order_.size(); ++pos) {
+        if (pos + kAhead < order_.size()) __builtin_prefetch(&cells[group_first_[order_[pos + kAhead]]]);
+        const std::uint32_t g = order_[pos];
+        leaf_first_cell_.push_back(std::uint32_t(block_cells_.size()));
+        block_cells_.insert(block_cells_.end(), cells.begin() + group_first_[g], cells.begin() + group_first_[g + 1]);
+    }
+    leaf_first_cell_.push_back(std::uint32_t(block_cells_.size()));
 }
 
 BlockIndex BlockIndex::compute(const FftFile& file) {
@@ -273,8 +290,9 @@ void BlockIndex::collect(const Classify& classify, std::vector<std::uint64_t>& b
     // Those of its blocks whose own box meets the region.
     auto mark_blocks = [&](std::size_t pos) {
         const std::uint32_t g = order_[pos];
-        for (std::uint32_t b = group_first_[g]; b < group_first_[g + 1]; ++b) {
-            const Overlap o = classify(detail::cells_bounds(block_cells_[b], cells_origin_, cell_mm_));
+        const std::uint64_t* cells = &block_cells_[leaf_first_cell_[pos]];
+        for (std::uint32_t b = group_first_[g]; b < group_first_[g + 1]; ++b, ++cells) {
+            const Overlap o = classify(detail::cells_bounds(*cells, cells_origin_, cell_mm_));
             if (o != Overlap::outside) set_bit(bits, b);
             if (o == Overlap::inside && inside) set_bit(*inside, b);
         }
