@@ -10,9 +10,9 @@
 // (about 5 bits a block): fewer candidate blocks for a selection, but about
 // 5x slower to load. Both add one byte per fiber (two when blocks hold more
 // than 255 points): under 1 % of a file. Versions 1 (a box per block, 28
-// bits) and 3 (version 4's boxes, range-coded) are still read. Files without it (e.g. from the
-// official encoder) get an index of exact per-block boxes computed on load
-// by decoding every block once. The hierarchy is never stored: it is
+// bits) and 3 (version 4's boxes, range-coded) are still read. Files
+// without it (e.g. from the official encoder) get an index of exact
+// per-block boxes computed on load by decoding every block once. The hierarchy is never stored: it is
 // rebuilt in memory on load.
 #pragma once
 
@@ -40,9 +40,9 @@ inline constexpr std::uint32_t kIndexLeafBlocks = 8;
 // and serializes them as a BIDX chunk of the chosen format: version 2, a
 // box per group of 8 consecutive blocks of a fiber (4 bytes a group), or
 // version 4, a box per block (kept, 13 bytes a block, until finished,
-// then coded with frequencies of their own). Blocks come in file order, a fiber at a
-// time; builders filled in parallel on consecutive fibers are joined in
-// order with append() (builders of one format).
+// then coded with frequencies of their own). Blocks come in file order, a
+// fiber at a time; builders filled in parallel on consecutive fibers are
+// joined in order with append() (builders of one format).
 class IndexBuilder {
 public:
     IndexBuilder();  // unusable until assigned from a header-built one

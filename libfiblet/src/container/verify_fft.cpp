@@ -28,8 +28,10 @@ public:
     explicit BlockCrossCheck(const FftFile& file) : file_(file), ctx_(file) {
         if (const TrailerChunk* c = file.find_chunk(kBlockIndexTag)) {
             index_.emplace(detail::parse_index_chunk(c->payload, file.header(), file.path()));
-            if (index_->version >= detail::kIndexChunkV3Version) block_boxes_ = detail::index_block_boxes(*index_, c->payload, file);
-            else boxes_.emplace(index_->grid);  // versions 1 and 2: codes
+            if (index_->version >= detail::kIndexChunkV3Version)  // a box per block
+                block_boxes_ = detail::index_block_boxes(*index_, c->payload, file);
+            else
+                boxes_.emplace(index_->grid);  // versions 1 and 2: codes
         }
     }
     bool checks_index() const { return index_.has_value(); }

@@ -82,7 +82,7 @@ BlockIndex BlockIndex::load(const FftFile& file) {
     index.max_join_ = c.max_join;
     // Fiber point counts: full blocks but the last (checked against the
     // header's total); groups: G blocks at a time from each fiber's first
-    // (version 3: the hierarchy's leaves, over the blocks' own boxes).
+    // (versions 3 and 4: the hierarchy's leaves, over the blocks' own boxes).
     const bool per_block = c.version >= detail::kIndexChunkV3Version;
     const std::uint32_t group_blocks = per_block ? kIndexLeafBlocks : c.group_blocks;
     index.fiber_points_.resize(h.fibers);
@@ -110,8 +110,10 @@ BlockIndex BlockIndex::load(const FftFile& file) {
         const std::vector<std::uint64_t> cells = detail::index_block_cells(c, chunk->payload, file);
         index.cells_origin_ = c.grid.origin, index.cell_mm_ = c.grid.cell;
         std::vector<Aabb> leaves(index.group_first_.size() - 1);
-        for (std::size_t g = 0; g < leaves.size(); ++g)
-            leaves[g] = index.cells_union(&cells[index.group_first_[g]], index.group_first_[g + 1] - index.group_first_[g]);
+        for (std::size_t g = 0; g < leaves.size(); ++g) {
+            const std::uint32_t first = index.group_first_[g], end = index.group_first_[g + 1];
+            leaves[g] = index.cells_union(&cells[first], end - first);
+        }
         index.set_groups(leaves);
         index.sort_block_cells(cells);
         return index;

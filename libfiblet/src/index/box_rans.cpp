@@ -71,12 +71,10 @@ struct Step {
     std::uint16_t table, value;
 };
 
-}  // namespace
-
-std::vector<std::uint8_t> encode_box_rans(const std::vector<std::optional<GridBox>>& boxes,
-                                          const std::vector<bool>& first_of_fiber, std::uint32_t levels) {
+// The coding steps of the boxes, in decoding order.
+std::vector<Step> steps_of(const std::vector<std::optional<GridBox>>& boxes, const std::vector<bool>& first_of_fiber,
+                           std::uint32_t levels) {
     const auto level_bits = std::uint8_t(std::bit_width(levels > 1 ? levels - 1 : 1u));
-    // The symbols, in decoding order.
     std::vector<Step> steps;
     steps.reserve(boxes.size() * 3 + boxes.size() / 4);
     std::array<AxisState, 3> prev{};
@@ -100,12 +98,17 @@ std::vector<std::uint8_t> encode_box_rans(const std::vector<std::optional<GridBo
             a = {box->lo[k], box->extent[k], symbol};
         }
     }
-    // The tables: counts, normalized, stored as (count, then symbol and
-    // frequency of each symbol seen) per table.
-    std::vector<Counts> freq(kTables, Counts{}), start(kTables, Counts{});
+    return steps;
+}
+
+// Every table's frequencies (from the steps' counts) and starts; the
+// tables written to `out` as (count, then symbol and frequency of each
+// symbol seen) per table.
+void write_tables(const std::vector<Step>& steps, std::vector<Counts>& freq, std::vector<Counts>& start,
+                  std::vector<std::uint8_t>& out) {
+    freq.assign(kTables, Counts{}), start.assign(kTables, Counts{});
     for (const Step& s : steps)
         if (s.raw_bits == 0) ++freq[s.table][s.value];
-    std::vector<std::uint8_t> out;
     for (unsigned t = 0; t < kTables; ++t) {
         freq[t] = normalized(freq[t]);
         const auto used = std::count_if(freq[t].begin(), freq[t].end(), [](std::uint32_t f) { return f != 0; });
@@ -115,10 +118,15 @@ std::vector<std::uint8_t> encode_box_rans(const std::vector<std::optional<GridBo
             start[t][s] = cum, cum += freq[t][s];
             if (freq[t][s] == 0) continue;
             out.push_back(std::uint8_t(s));
-            out.push_back(std::uint8_t(freq[t][s])), out.push_back(std::uint8_t(freq[t][s] >> 8));
+            put_le(out, std::uint16_t(freq[t][s]));
         }
     }
-    // rANS runs backwards: the words come out in reverse decoding order.
+}
+
+// The rANS words of the steps, appended to `out` in decoding order (rANS
+// codes backwards: they come out in reverse), the final states first.
+void write_words(const std::vector<Step>& steps, const std::vector<Counts>& freq, const std::vector<Counts>& start,
+                 std::vector<std::uint8_t>& out) {
     std::array<std::uint64_t, 3> state{kLow, kLow, kLow};
     std::vector<std::uint32_t> words;
     for (auto it = steps.rbegin(); it != steps.rend(); ++it) {
@@ -131,6 +139,17 @@ std::vector<std::uint8_t> encode_box_rans(const std::vector<std::optional<GridBo
     }
     for (unsigned k = 3; k-- > 0;) words.push_back(std::uint32_t(state[k])), words.push_back(std::uint32_t(state[k] >> 32));
     for (auto it = words.rbegin(); it != words.rend(); ++it) put_le(out, *it);
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> encode_box_rans(const std::vector<std::optional<GridBox>>& boxes,
+                                          const std::vector<bool>& first_of_fiber, std::uint32_t levels) {
+    const std::vector<Step> steps = steps_of(boxes, first_of_fiber, levels);
+    std::vector<Counts> freq, start;
+    std::vector<std::uint8_t> out;
+    write_tables(steps, freq, start, out);
+    write_words(steps, freq, start, out);
     return out;
 }
 
@@ -177,7 +196,7 @@ const char* read_tables(const std::uint8_t* data, std::size_t size, DecodeTables
     return nullptr;
 }
 
-// The 16-bit words the three states read, in decoding order; 0 past the end.
+// The 32-bit words the three states read, in decoding order; 0 past the end.
 struct WordReader {
     const std::uint8_t* bytes;
     std::size_t count, pos = 0;
@@ -200,7 +219,7 @@ public:
         x_ |= words.next();
     }
 
-    // The axis's next box (lo(), extent()); `error` set when malformed.
+    // The axis's next box (packed()); `error` set when malformed.
     Outcome next(bool first, const char*& error) {
         const unsigned s = symbol(first ? kFirstContext : prev_.symbol);
         std::int64_t lo, extent;
@@ -249,8 +268,8 @@ private:
         return v;
     }
     // One word at most: a decoded state is at least 2^19 (2^21 after raw bits).
-    // A branch, not a select: a symbol takes about a tenth of a word, so it
-    // is well predicted, and the axes' chains do not all wait on the word
+    // A branch, not a select: a symbol takes a few bits of a 32-bit word, so
+    // it is well predicted, and the axes' chains do not all wait on the word
     // position as they would through a data dependency.
     void renormalize() {
         if (x_ < kLow) x_ = x_ << 32 | words_.next();

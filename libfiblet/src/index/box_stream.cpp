@@ -1,6 +1,6 @@
 // The BIDX version-3 box stream: an LZMA-style binary range coder (11-bit
 // probabilities, adapted by 1/32 of the error) over the symbols of
-// formats/fft-index.md §2.
+// formats/fft-index.md §7 (read only: version 4 replaced it).
 #include "index/box_stream.hpp"
 
 #include <bit>
