@@ -52,11 +52,15 @@ std::vector<std::uint64_t> packed(const Boxes& b) {
     return out;
 }
 
+std::vector<std::uint8_t> encoded(const Boxes& b, std::uint32_t levels) {
+    return encode_box_rans(packed(b), b.first, levels);
+}
+
 TEST(BoxRans, RandomBoxesComeBackExactlyOnEveryGridSize) {
     for (const std::uint32_t levels : {1u, 2u, 3u, 30u, 31u, 32u, 700u, kMaxGridLevels}) {
         for (const std::size_t blocks : {std::size_t{1}, std::size_t{7}, std::size_t{5000}}) {
             const Boxes in = random_boxes(levels, blocks, levels * 7 + std::uint32_t(blocks));
-            const std::vector<std::uint8_t> stream = encode_box_rans(in.boxes, in.first, levels);
+            const std::vector<std::uint8_t> stream = encoded(in, levels);
             const DecodedBoxes out = decode_box_rans(stream.data(), stream.size(), in.first, levels);
             ASSERT_EQ(out.error, "") << levels << " levels, " << blocks << " blocks";
             EXPECT_EQ(out.boxes, packed(in)) << levels << " levels, " << blocks << " blocks";
@@ -67,7 +71,7 @@ TEST(BoxRans, RandomBoxesComeBackExactlyOnEveryGridSize) {
 TEST(BoxRans, NoBlocksAndOnlyUnboundedBlocksRoundTrip) {
     for (const std::size_t blocks : {std::size_t{0}, std::size_t{3}}) {
         const Boxes in{std::vector<std::optional<GridBox>>(blocks), std::vector<bool>(blocks, true)};
-        const std::vector<std::uint8_t> stream = encode_box_rans(in.boxes, in.first, 30);
+        const std::vector<std::uint8_t> stream = encoded(in, 30);
         const DecodedBoxes out = decode_box_rans(stream.data(), stream.size(), in.first, 30);
         ASSERT_EQ(out.error, "");
         EXPECT_EQ(out.boxes, packed(in));
@@ -103,7 +107,7 @@ TEST(BoxRans, MovesCostNoMoreThanTheirEntropy) {
         for (const double c : axis)
             if (c > 0) entropy -= c * std::log2(c / n);
     }
-    const std::vector<std::uint8_t> stream = encode_box_rans(in.boxes, in.first, kMaxGridLevels);
+    const std::vector<std::uint8_t> stream = encoded(in, kMaxGridLevels);
     EXPECT_EQ(decode_box_rans(stream.data(), stream.size(), in.first, kMaxGridLevels).boxes, packed(in));
     // The words after the tables (87 of them: a count, then 3 bytes a
     // symbol), less the 3 final states of 8 bytes.
@@ -115,7 +119,7 @@ TEST(BoxRans, MovesCostNoMoreThanTheirEntropy) {
 
 TEST(BoxRans, TruncatedExtendedOrForeignStreamsAreRefused) {
     const Boxes in = random_boxes(30, 3000, 11);
-    const std::vector<std::uint8_t> stream = encode_box_rans(in.boxes, in.first, 30);
+    const std::vector<std::uint8_t> stream = encoded(in, 30);
     auto error = [&](const std::vector<std::uint8_t>& s, const std::vector<bool>& first) {
         return decode_box_rans(s.data(), s.size(), first, 30).error;
     };
@@ -137,7 +141,7 @@ TEST(BoxRans, TruncatedExtendedOrForeignStreamsAreRefused) {
 
 TEST(BoxRans, DamagedBytesAreRefusedOrDecodeToBoxesOnTheGrid) {
     const Boxes in = random_boxes(30, 2000, 5);
-    const std::vector<std::uint8_t> stream = encode_box_rans(in.boxes, in.first, 30);
+    const std::vector<std::uint8_t> stream = encoded(in, 30);
     std::mt19937 rng(17);
     int refused = 0;
     for (int i = 0; i < 300; ++i) {

@@ -39,7 +39,7 @@ inline constexpr std::uint32_t kIndexLeafBlocks = 8;
 // Accumulates the bounds of blocks as they are written (compress, extract)
 // and serializes them as a BIDX chunk of the chosen format: version 2, a
 // box per group of 8 consecutive blocks of a fiber (4 bytes a group), or
-// version 4, a box per block (kept, 13 bytes a block, until finished,
+// version 4, a box per block (kept, 8 bytes a block, until finished,
 // then coded with frequencies of their own). Blocks come in file order, a
 // fiber at a time; builders filled in parallel on consecutive fibers are
 // joined in order with append() (builders of one format).

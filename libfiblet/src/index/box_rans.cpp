@@ -72,7 +72,7 @@ struct Step {
 };
 
 // The coding steps of the boxes, in decoding order.
-std::vector<Step> steps_of(const std::vector<std::optional<GridBox>>& boxes, const std::vector<bool>& first_of_fiber,
+std::vector<Step> steps_of(const std::vector<std::uint64_t>& boxes, const std::vector<bool>& first_of_fiber,
                            std::uint32_t levels) {
     const auto level_bits = std::uint8_t(std::bit_width(levels > 1 ? levels - 1 : 1u));
     std::vector<Step> steps;
@@ -80,22 +80,22 @@ std::vector<Step> steps_of(const std::vector<std::optional<GridBox>>& boxes, con
     std::array<AxisState, 3> prev{};
     for (std::size_t b = 0; b < boxes.size(); ++b) {
         const bool first = first_of_fiber[b];
-        const std::optional<GridBox>& box = boxes[b];
-        if (!box) {
+        const std::uint64_t box = boxes[b];
+        if (box == kUnboundedCells) {
             steps.push_back({0, 0, std::uint16_t(table_of(0, first ? kFirstContext : prev[0].symbol)), kUnbounded});
             for (AxisState& a : prev) a.symbol = kUnbounded;
             continue;
         }
         for (std::uint8_t k = 0; k < 3; ++k) {
             AxisState& a = prev[k];
-            const unsigned symbol =
-                first || a.symbol == kUnbounded ? kWhole : move_symbol(a, box->lo[k], box->extent[k]);
+            const std::uint32_t lo = cells_lo(box, k), extent = cells_hi(box, k) - lo;
+            const unsigned symbol = first || a.symbol == kUnbounded ? kWhole : move_symbol(a, lo, extent);
             steps.push_back({k, 0, std::uint16_t(table_of(k, first ? kFirstContext : a.symbol)), std::uint16_t(symbol)});
             if (symbol == kWhole) {
-                steps.push_back({k, 0, std::uint16_t(table_of(k, kExtentTable)), box->extent[k]});
-                steps.push_back({k, level_bits, 0, std::uint16_t(box->lo[k])});
+                steps.push_back({k, 0, std::uint16_t(table_of(k, kExtentTable)), std::uint16_t(extent)});
+                steps.push_back({k, level_bits, 0, std::uint16_t(lo)});
             }
-            a = {box->lo[k], box->extent[k], symbol};
+            a = {lo, extent, symbol};
         }
     }
     return steps;
@@ -143,7 +143,7 @@ void write_words(const std::vector<Step>& steps, const std::vector<Counts>& freq
 
 }  // namespace
 
-std::vector<std::uint8_t> encode_box_rans(const std::vector<std::optional<GridBox>>& boxes,
+std::vector<std::uint8_t> encode_box_rans(const std::vector<std::uint64_t>& boxes,
                                           const std::vector<bool>& first_of_fiber, std::uint32_t levels) {
     const std::vector<Step> steps = steps_of(boxes, first_of_fiber, levels);
     std::vector<Counts> freq, start;

@@ -7,16 +7,15 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <optional>
 #include <vector>
 
 #include "index/index_grid.hpp"
 
 namespace fiblet::detail {
 
-// The stream of `boxes` (nullopt: unbounded), first_of_fiber[b] telling
-// where fibers start: its frequency tables, then its 32-bit words.
-std::vector<std::uint8_t> encode_box_rans(const std::vector<std::optional<GridBox>>& boxes,
+// The stream of `boxes` (pack_cells, or kUnboundedCells), first_of_fiber[b]
+// telling where fibers start: its frequency tables, then its 32-bit words.
+std::vector<std::uint8_t> encode_box_rans(const std::vector<std::uint64_t>& boxes,
                                           const std::vector<bool>& first_of_fiber, std::uint32_t levels);
 
 // Decodes a box per block; a malformed stream (bad tables, a box off the

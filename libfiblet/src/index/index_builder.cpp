@@ -90,12 +90,14 @@ struct IndexBuilder::GroupCoder final : Coder {
 // known (the code's frequencies are the boxes' own).
 struct IndexBuilder::BlockCoder final : Coder {
     explicit BlockCoder(const FftHeader& h) : grid(detail::IndexGrid::for_blocks(h)) {}
+    explicit BlockCoder(const detail::IndexGrid& g) : grid(g) {}
     std::unique_ptr<Coder> clone() const override { return std::make_unique<BlockCoder>(*this); }
     std::unique_ptr<Coder> fresh() const override { return std::make_unique<BlockCoder>(grid); }
     BlockIndexFormat format() const override { return BlockIndexFormat::block_boxes; }
     void add(const Aabb& b, bool first_of_fiber, bool) override {
-        boxes.push_back(grid.quantize(b));
-        unbounded += !boxes.back();
+        const std::optional<detail::GridBox> box = grid.quantize(b);
+        boxes.push_back(box ? detail::pack_cells(*box) : detail::kUnboundedCells);
+        unbounded += !box;
         first.push_back(first_of_fiber);
     }
     void append(const Coder& later) override {
@@ -109,9 +111,8 @@ struct IndexBuilder::BlockCoder final : Coder {
         c.grid = grid;
         return detail::serialize_index_chunk(c, h, detail::encode_box_rans(boxes, first, grid.min_levels));
     }
-    explicit BlockCoder(const detail::IndexGrid& g) : grid(g) {}
     detail::IndexGrid grid;
-    std::vector<std::optional<detail::GridBox>> boxes;
+    std::vector<std::uint64_t> boxes;  // packed (8 bytes a block until finished)
     std::vector<bool> first;  // first block of its fiber
 };
 
