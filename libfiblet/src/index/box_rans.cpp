@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cstring>
 
 #include "core/bytes.hpp"
@@ -74,7 +73,7 @@ struct Step {
 // The coding steps of the boxes, in decoding order.
 std::vector<Step> steps_of(const std::vector<std::uint64_t>& boxes, const std::vector<bool>& first_of_fiber,
                            std::uint32_t levels) {
-    const auto level_bits = std::uint8_t(std::bit_width(levels > 1 ? levels - 1 : 1u));
+    const auto lo_bits = std::uint8_t(level_bits(levels));
     std::vector<Step> steps;
     steps.reserve(boxes.size() * 3 + boxes.size() / 4);
     std::array<AxisState, 3> prev{};
@@ -93,7 +92,7 @@ std::vector<Step> steps_of(const std::vector<std::uint64_t>& boxes, const std::v
             steps.push_back({k, 0, std::uint16_t(table_of(k, first ? kFirstContext : a.symbol)), std::uint16_t(symbol)});
             if (symbol == kWhole) {
                 steps.push_back({k, 0, std::uint16_t(table_of(k, kExtentTable)), std::uint16_t(extent)});
-                steps.push_back({k, level_bits, 0, std::uint16_t(lo)});
+                steps.push_back({k, lo_bits, 0, std::uint16_t(lo)});
             }
             a = {lo, extent, symbol};
         }
@@ -214,7 +213,7 @@ public:
 
     AxisDecoder(const DecodeTables& tables, unsigned axis, WordReader& words, std::uint32_t levels)
         : tables_(&tables.table[axis * kTablesPerAxis]), words_(words), levels_(levels),
-          level_bits_(unsigned(std::bit_width(levels > 1 ? levels - 1 : 1u))) {
+          level_bits_(level_bits(levels)) {
         x_ = std::uint64_t(words.next()) << 32;
         x_ |= words.next();
     }

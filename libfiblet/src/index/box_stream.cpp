@@ -3,7 +3,6 @@
 // formats/fft-index.md §7 (read only: version 4 replaced it).
 #include "index/box_stream.hpp"
 
-#include <bit>
 
 namespace fiblet::detail {
 
@@ -24,7 +23,7 @@ std::uint32_t sign_of(std::int64_t d) { return d < 0 ? 0 : (d == 0 ? 1 : 2); }
 }  // namespace
 
 BoxModel::BoxModel(std::uint32_t levels)
-    : bounded_(kHalf), levels_(levels), level_bits_(unsigned(std::bit_width(levels > 1 ? levels - 1 : 1u))) {
+    : bounded_(kHalf), levels_(levels), level_bits_(detail::level_bits(levels)) {
     for (Axis& a : axes_) {
         for (auto& t : a.extent_steps) t.fill(kHalf);
         for (auto& t : a.delta_steps) t.fill(kHalf);

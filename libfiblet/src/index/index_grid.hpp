@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -27,6 +28,14 @@ inline constexpr std::uint32_t kMaxBoxExtent = 15;  // extents 0..15 cells
 // 0.001-cell slack of quantized boxes exceeds the float rounding of
 // coordinates (2^-24 of their magnitude).
 inline constexpr std::uint32_t kMaxGridLevels = 1u << 10;
+// Bits of a lo coded whole on a grid of `levels` positions (at least 1).
+inline unsigned level_bits(std::uint32_t levels) { return unsigned(std::bit_width(levels > 1 ? levels - 1 : 1u)); }
+
+// Every finite point: a block may lie anywhere in the float range.
+inline Aabb unbounded_box() {
+    const float m = std::numeric_limits<float>::max();
+    return {{-m, -m, -m}, {m, m, m}};
+}
 
 // A grid box in 64 bits, as an index keeps one per block in memory: per
 // axis a, lo in bits 14a .. 14a+9 and the extent in bits 14a+10 .. 14a+13;
@@ -49,10 +58,7 @@ inline Aabb cells_bounds(const std::uint32_t lo[3], const std::uint32_t hi[3], V
             {side(origin.x, hi[0]), side(origin.y, hi[1]), side(origin.z, hi[2])}};
 }
 inline Aabb cells_bounds(std::uint64_t packed, Vec3f origin, float cell) {
-    if (packed == kUnboundedCells) {
-        const float m = std::numeric_limits<float>::max();
-        return {{-m, -m, -m}, {m, m, m}};
-    }
+    if (packed == kUnboundedCells) return unbounded_box();
     const std::uint32_t lo[3] = {cells_lo(packed, 0), cells_lo(packed, 1), cells_lo(packed, 2)},
                         hi[3] = {cells_hi(packed, 0), cells_hi(packed, 1), cells_hi(packed, 2)};
     return cells_bounds(lo, hi, origin, cell);
@@ -92,8 +98,6 @@ struct IndexGrid {
 
 // A box at least this large is unbounded (is_unbounded()).
 inline constexpr float kUnboundedExtentMm = 1e30f;
-// Every finite point: a block may lie anywhere in the float range.
-inline Aabb unbounded_box() { return cells_bounds(kUnboundedCells, {}, 0); }
 
 // What a stream decodes to: a box per block (pack_cells, or
 // kUnboundedCells), or an error message for a malformed stream (its users
