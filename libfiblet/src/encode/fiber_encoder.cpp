@@ -335,6 +335,7 @@ struct FiberEncoder::Encoding {
         Encoding* e;
         std::uint32_t b, m;  // the block, its codes
         float worst2 = 0;    // its largest squared error before the search
+        void take(const BlockBatch& batch, std::size_t j) const;  // lane j's codes and points into the block
     };
     static BlockBatch& batch_of(std::vector<LaneBlock>& blocks);
     static void search_blocks_together(std::span<Encoding> fibers);
@@ -394,6 +395,11 @@ void FiberEncoder::Encoding::search_blocks() {
                          &scratch.points[std::size_t(b) * points_per_block + 2]);
 }
 
+void FiberEncoder::Encoding::LaneBlock::take(const BlockBatch& batch, std::size_t j) const {
+    std::copy_n(batch.decoded_of(j), m, &e->scratch.points[std::size_t(b) * e->points_per_block + 2]);
+    std::copy_n(batch.codes_of(j), m, e->codes8_of(b));
+}
+
 // The blocks, longest first (the lanes of a vector then end together),
 // with their start states and targets in a batch for the SIMD lanes.
 BlockBatch& FiberEncoder::Encoding::batch_of(std::vector<LaneBlock>& blocks) {
@@ -431,12 +437,7 @@ void FiberEncoder::Encoding::search_blocks_together(std::span<Encoding> fibers) 
         lookahead_blocks(first.codebook8(), first.header.step, first.search().lookahead, batch.batch());
     else
         greedy_blocks(first.codebook8(), first.header.step, batch.batch());
-    for (std::size_t j = 0; j < blocks.size(); ++j) {
-        Encoding& e = *blocks[j].e;
-        std::copy_n(batch.decoded_of(j), blocks[j].m,
-                    &e.scratch.points[std::size_t(blocks[j].b) * e.points_per_block + 2]);
-        std::copy_n(batch.codes_of(j), blocks[j].m, e.codes8_of(blocks[j].b));
-    }
+    for (std::size_t j = 0; j < blocks.size(); ++j) blocks[j].take(batch, j);
 }
 
 // The retry threshold, squared and normalized; 0 where there is no retry.
@@ -482,13 +483,12 @@ void FiberEncoder::Encoding::retry_with_lookahead(std::vector<LaneBlock>& blocks
     lookahead_blocks(first.codebook8(), first.header.step, depth, batch.batch());
     for (std::size_t j = 0; j < blocks.size(); ++j) {
         LaneBlock& k = blocks[j];
-        Encoding& e = *k.e;
+        const Encoding& e = *k.e;
         const std::size_t i0 = std::size_t(k.b) * e.points_per_block;
         const float now = max_distance2(batch.decoded_of(j), &e.scratch.targets[i0 + 2], k.m);
         if (!(now < k.worst2)) continue;
         k.worst2 = now;
-        std::copy_n(batch.decoded_of(j), k.m, &e.scratch.points[i0 + 2]);
-        std::copy_n(batch.codes_of(j), k.m, e.codes8_of(k.b));
+        k.take(batch, j);
     }
 }
 

@@ -2,9 +2,27 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <utility>
 
 namespace fiblet::detail {
+
+namespace {
+
+// Neighbours' and Rivals' columns: a code and its direction appended, and
+// the lanes past `count` closed (direction 0, pad +inf).
+template <class Columns>
+void add_column(Columns& r, const DirectionTable& table, unsigned code) {
+    const Vec3f& d = table.direction(std::uint8_t(code));
+    r.x[r.count] = d.x, r.y[r.count] = d.y, r.z[r.count] = d.z, r.pad[r.count] = 0.0f;
+    r.code[r.count++] = std::uint8_t(code);
+}
+template <class Columns>
+void close_columns(Columns& r) {
+    for (unsigned i = r.count; i < std::size(r.x); ++i) r.x[i] = r.y[i] = r.z[i] = 0.0f, r.pad[i] = INFINITY, r.code[i] = 0;
+}
+
+}  // namespace
 
 NearestCodeLut::NearestCodeLut(const DirectionTable& table) {
     const float ratio = table.ratio();
@@ -23,11 +41,9 @@ NearestCodeLut::NearestCodeLut(const DirectionTable& table) {
                     nb.before = nb.count;
                     continue;
                 }
-                const Vec3f& d = table.direction(std::uint8_t(code));
-                nb.x[nb.count] = d.x, nb.y[nb.count] = d.y, nb.z[nb.count] = d.z, nb.pad[nb.count] = 0.0f;
-                nb.code[nb.count++] = std::uint8_t(code);
+                add_column(nb, table, code);
             }
-        for (unsigned i = nb.count; i < 8; ++i) nb.x[i] = nb.y[i] = nb.z[i] = 0.0f, nb.pad[i] = INFINITY, nb.code[i] = 0;
+        close_columns(nb);
     }
     rivals_.resize(256);
     for (unsigned c = 0; c < 256; ++c) {
@@ -36,12 +52,9 @@ NearestCodeLut::NearestCodeLut(const DirectionTable& table) {
         const int h0 = int(c >> 4), l0 = int(c & 15);
         for (const auto [h, l] : {std::pair{h0 - 1, l0}, {h0, l0 - 1}, {h0, l0 + 1}, {h0 + 1, l0}}) {  // grid order
             if (h < 0 || h > 15 || l < 0 || l > 15) continue;
-            const auto code = unsigned(h << 4 | l);
-            const Vec3f& d = table.direction(std::uint8_t(code));
-            r.x[r.count] = d.x, r.y[r.count] = d.y, r.z[r.count] = d.z, r.pad[r.count] = 0.0f;
-            r.code[r.count++] = std::uint8_t(code);
+            add_column(r, table, unsigned(h << 4 | l));
         }
-        for (unsigned i = r.count; i < 4; ++i) r.x[i] = r.y[i] = r.z[i] = 0.0f, r.pad[i] = INFINITY, r.code[i] = 0;
+        close_columns(r);
     }
     zero_code_ = table.nearest_code({0, 0, 0});
     back_code_ = table.nearest_code({-1, 0, 0});
