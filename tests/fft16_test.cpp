@@ -20,6 +20,7 @@
 #include "cli_runner.hpp"
 #include "container/packed_blocks16.hpp"
 #include "exact_error.hpp"
+#include "scoped_avx2_loops.hpp"
 #include "test_util.hpp"
 
 using namespace fiblet;
@@ -264,9 +265,12 @@ TEST(Fft16, ChecksumGroupsHashThePackedBytes) {
 }
 
 // Packing then expanding a block gives its codes back at every point count
-// (each tail of the eight-codes-at-a-time reader), and a code past the
-// levels is found wherever it sits.
+// (each tail of the sixteen- and eight-codes-at-a-time readers), and a code
+// past the levels is found wherever it sits; with the AVX2 loop and without.
 TEST(Fft16, PackedCodesRoundTripAndBadCodesAreFoundAnywhere) {
+  for (const bool avx2 : {true, false}) {
+    SCOPED_TRACE(avx2 ? "AVX2 loop" : "scalar loops");
+    const test::ScopedAvx2Loops loops(avx2);
     FftHeader h;
     h.version = kFft16PackedVersion;
     h.points_per_block = 254;
@@ -299,4 +303,5 @@ TEST(Fft16, PackedCodesRoundTripAndBadCodesAreFoundAnywhere) {
             EXPECT_NE(detail::expand_block16(h, bad_packed.data(), place, out.data()), "") << "code " << k;
         }
     }
+  }
 }
