@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -149,6 +150,35 @@ TEST(CompressPasses, TheStagesAreTimedWithinTheRunsTime) {
 // Pass 1's bounds: the AVX2 loop and the scalar loop against a brute
 // force in double, at every length around the vector width, with NaN
 // coordinates left out and zero bounds +0 whichever zero came first.
+// The median segment length, from fibers of one repeated length (runs of
+// one bin), of scattered lengths, of lengths below the histogram's range
+// and of none, added to two histograms then merged: the bin holding the
+// sorted lengths' median, within the bins' 1.2e-4 relative width.
+TEST(CompressScan, TheMedianSegmentLengthIsTheSortedLengthsMedian) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> spread(0.01, 3.0), jitter(-1e-6, 1e-6);
+    for (int trial = 0; trial < 20; ++trial) {
+        SCOPED_TRACE(trial);
+        detail::LengthHistogram a, b;
+        std::vector<double> all;
+        for (int fiber = 0; fiber < 12; ++fiber) {
+            std::vector<double> lengths;
+            const double step = spread(rng);
+            const int kind = int(rng() % 4), n = int(rng() % 300);
+            for (int k = 0; k < n; ++k)
+                lengths.push_back(kind == 0 ? step : kind == 1 ? step * (1 + jitter(rng)) : kind == 2 ? spread(rng) : 1e-9);
+            (fiber % 2 ? a : b).add(lengths);
+            all.insert(all.end(), lengths.begin(), lengths.end());
+        }
+        a.merge(b);
+        if (all.empty()) continue;
+        std::sort(all.begin(), all.end());
+        const double median = all[(all.size() - 1) / 2], got = a.median();
+        if (float(median) < 0x1p-20f) EXPECT_EQ(got, 0.0);
+        else EXPECT_NEAR(got, median, 1.3e-4 * median) << all.size() << " lengths";
+    }
+}
+
 TEST(CompressScan, BoundsOfEveryLengthLeaveOutNaNAndGiveZeroAsPlusZero) {
     std::mt19937 rng(5);
     std::uniform_real_distribution<float> u(-50.0f, 50.0f);
