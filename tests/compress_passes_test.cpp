@@ -17,10 +17,10 @@
 #include <string>
 
 #include "compress/compress_stages.hpp"
-#include "core/points_avx2.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/tck.hpp"
+#include "scoped_simd_loops.hpp"
 #include "test_util.hpp"
 
 using namespace fiblet;
@@ -200,10 +200,11 @@ TEST(CompressScan, BoundsOfEveryLengthLeaveOutNaNAndGiveZeroAsPlusZero) {
                     want_min[a] = std::min(want_min[a], v), want_max[a] = std::max(want_max[a], v);
                 }
             for (bool avx2 : {true, false}) {
-                detail::avx2_loops_enabled() = avx2;
                 double min[3] = {INFINITY, INFINITY, INFINITY}, max[3] = {-INFINITY, -INFINITY, -INFINITY};
-                detail::add_bounds(fiber, min, max);
-                detail::avx2_loops_enabled() = true;
+                {
+                    const test::ScopedSimdLoops loops(avx2);
+                    detail::add_bounds(fiber, min, max);
+                }
                 for (int a = 0; a < 3; ++a) {
                     EXPECT_EQ(min[a], want_min[a]) << n << " " << trial << " " << avx2 << " axis " << a;
                     EXPECT_EQ(max[a], want_max[a]) << n << " " << trial << " " << avx2 << " axis " << a;

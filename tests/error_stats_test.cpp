@@ -5,8 +5,8 @@
 #include <cmath>
 #include <random>
 
-#include "core/points_avx2.hpp"
 #include "fiblet/error_stats.hpp"
+#include "scoped_simd_loops.hpp"
 
 using namespace fiblet;
 
@@ -84,9 +84,10 @@ TEST(ErrorStats, AddAllVectorsEqualScalarLoop) {
     };
     ErrorStats vectors, scalar;
     fill(vectors);
-    detail::avx2_loops_enabled() = false;
-    fill(scalar);
-    detail::avx2_loops_enabled() = true;
+    {
+        const test::ScopedSimdLoops loops(false);
+        fill(scalar);
+    }
     EXPECT_EQ(vectors.count(), scalar.count());
     EXPECT_EQ(vectors.mean_mm(), scalar.mean_mm());
     EXPECT_EQ(vectors.rms_mm(), scalar.rms_mm());

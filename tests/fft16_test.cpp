@@ -20,7 +20,7 @@
 #include "cli_runner.hpp"
 #include "container/packed_blocks16.hpp"
 #include "exact_error.hpp"
-#include "scoped_avx2_loops.hpp"
+#include "scoped_simd_loops.hpp"
 #include "test_util.hpp"
 
 using namespace fiblet;
@@ -270,7 +270,7 @@ TEST(Fft16, ChecksumGroupsHashThePackedBytes) {
 TEST(Fft16, PackedCodesRoundTripAndBadCodesAreFoundAnywhere) {
   for (const bool avx2 : {true, false}) {
     SCOPED_TRACE(avx2 ? "AVX2 loop" : "scalar loops");
-    const test::ScopedAvx2Loops loops(avx2);
+    const test::ScopedSimdLoops loops(avx2);
     FftHeader h;
     h.version = kFft16PackedVersion;
     h.points_per_block = 254;

@@ -10,8 +10,8 @@
 
 #include "fiblet/compress.hpp"
 #include "fiblet/geometry_error.hpp"
-#include "core/points_avx2.hpp"
 #include "stats/geometry_paths.hpp"
+#include "scoped_simd_loops.hpp"
 #include "test_util.hpp"
 
 namespace fiblet {
@@ -281,11 +281,8 @@ TEST(GeometryError, VectorsEqualScalarLoops) {
     for (const bool shortcut : {true, false}) {
         detail::geometry_shortcut_enabled() = shortcut;
         const GeometryError widest = measure_pairs(pairs);
-        detail::avx512_loops_enabled() = false;
-        const GeometryError avx2 = measure_pairs(pairs);
-        detail::avx2_loops_enabled() = false;
-        const GeometryError scalar = measure_pairs(pairs);
-        detail::avx2_loops_enabled() = true, detail::avx512_loops_enabled() = true;
+        const GeometryError avx2 = test::with_simd_loops(true, false, [&] { return measure_pairs(pairs); });
+        const GeometryError scalar = test::with_simd_loops(false, false, [&] { return measure_pairs(pairs); });
         expect_same_bits(widest, scalar);
         expect_same_bits(avx2, scalar);
     }
@@ -309,11 +306,10 @@ TEST(GeometryError, CompressReportsTheSameBitsWithoutAvx2Loops) {
         o.step_mm = step > 0 ? std::optional<double>(step) : std::nullopt;
         const std::string tck = test::shared_data(step > 0 ? "small-sdstream.tck" : "small-ifod1.tck");
         const CompressReport vectors = compress_file(tck, dir.file("v.fft"), o);
-        detail::avx512_loops_enabled() = false;
-        const CompressReport avx2 = compress_file(tck, dir.file("a.fft"), o);
-        detail::avx2_loops_enabled() = false;
-        const CompressReport scalar = compress_file(tck, dir.file("s.fft"), o);
-        detail::avx2_loops_enabled() = true, detail::avx512_loops_enabled() = true;
+        const CompressReport avx2 =
+            test::with_simd_loops(true, false, [&] { return compress_file(tck, dir.file("a.fft"), o); });
+        const CompressReport scalar =
+            test::with_simd_loops(false, false, [&] { return compress_file(tck, dir.file("s.fft"), o); });
         EXPECT_TRUE(test::read_file(dir.file("v.fft")) == test::read_file(dir.file("s.fft")));
         EXPECT_TRUE(test::read_file(dir.file("a.fft")) == test::read_file(dir.file("s.fft")));
         expect_same_bits(avx2.geometry, scalar.geometry);

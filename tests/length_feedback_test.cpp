@@ -8,8 +8,8 @@
 #include <random>
 #include <vector>
 
-#include "core/points_avx2.hpp"
 #include "encode/length_feedback.hpp"
+#include "scoped_simd_loops.hpp"
 
 using namespace fiblet;
 using detail::add_step_errors;
@@ -27,10 +27,7 @@ std::vector<Vec3f> random_points(std::size_t n, float scale, std::mt19937& rng) 
 
 // The scalar loop (the AVX2 loops switched off for this thread).
 float scalar_max_distance2(const Vec3f* a, const Vec3f* b, std::size_t m) {
-    detail::avx2_loops_enabled() = false;
-    const float v = max_distance2(a, b, m);
-    detail::avx2_loops_enabled() = true;
-    return v;
+    return test::with_simd_loops(false, false, [&] { return max_distance2(a, b, m); });
 }
 
 }  // namespace
@@ -74,11 +71,10 @@ TEST(LengthFeedback, StepErrorsAddInOrderAsTheRunningSum) {
             for (std::size_t k = from; k < n; ++k)
                 running += detail::norm(points[k] - points[k - 1]) - detail::norm(targets[k] - targets[k - 1]);
             for (const bool avx2 : {true, false}) {
-                detail::avx2_loops_enabled() = avx2;
+                const test::ScopedSimdLoops loops(avx2);
                 EXPECT_EQ(add_step_errors(0.25, points.data(), targets.data(), from, n), running)
                     << n << " " << from << " avx2 " << avx2;
             }
-            detail::avx2_loops_enabled() = true;
         }
     }
 }

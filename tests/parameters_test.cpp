@@ -8,7 +8,7 @@
 
 #include "compress/compress_stages.hpp"
 #include "encode/parameters.hpp"
-#include "core/points_avx2.hpp"
+#include "scoped_simd_loops.hpp"
 
 using namespace fiblet;
 using namespace fiblet::detail;
@@ -110,10 +110,11 @@ TEST(TurnStatistics, VectorLoopsEqualTheScalarLoops) {
         TurnStatistics one_vectors(1, 1), one_scalar(1, 1);  // this fiber's sharpest turn, to the bit
         vectors.add_fiber(f, lengths), one_vectors.add_fiber(f, lengths);
         roots.add_fiber(f);
-        detail::avx2_loops_enabled() = false;
-        segment_lengths(f, scalar_lengths);
-        scalar.add_fiber(f, scalar_lengths), one_scalar.add_fiber(f, scalar_lengths);
-        detail::avx2_loops_enabled() = true;
+        {
+            const test::ScopedSimdLoops loops(false);
+            segment_lengths(f, scalar_lengths);
+            scalar.add_fiber(f, scalar_lengths), one_scalar.add_fiber(f, scalar_lengths);
+        }
         ASSERT_EQ(lengths, scalar_lengths);
         EXPECT_EQ(one_vectors.min_dot(), one_scalar.min_dot()) << f.size();
         EXPECT_EQ(one_vectors.sharpest_blocks(), one_scalar.sharpest_blocks()) << f.size();
