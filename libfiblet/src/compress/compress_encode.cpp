@@ -353,13 +353,15 @@ EncodeStageResult encode_stage(StreamlineSource& reader, const EncodeStageInputs
     const IndexBuilder empty_index = index;  // the file's layout, no blocks yet
     for_each_batch(
         reader, in.threads, slots, [&](Slot& s) { s.index = empty_index; },
-        [&](const FiberBatch& b, std::size_t t, Slot& s) { encode_task(in, b, t, s); }, [](const FiberBatch&) {},
+        [&](const FiberBatch& b, std::size_t t, Slot& s) { encode_task(in, b, t, s); },
+        [](const FiberBatch&, std::size_t, std::size_t) {},
         [&](const FiberBatch& b, std::vector<Slot>& batch_slots) {
             finish_batch(in, b, batch_slots);
             write_batch(b, batch_slots, out, index, r.timings);
             if (options.progress && reader.data_bytes() > 0)
                 options.progress("encode", double(reader.bytes_consumed()) / double(reader.data_bytes()));
         },
+        in.step > 0,  // a resampled fiber's end may wait for the batch's budget (finish_batch)
         r.timings.read);
 
     for (int k = 0; k < 2; ++k)

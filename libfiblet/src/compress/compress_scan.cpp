@@ -190,8 +190,8 @@ ScanStageResult scan_stage(StreamlineSource& reader, SourceScan& scan, std::uint
     std::vector<ScanSlot> slots[2];
     for_each_batch(
         reader, threads, slots, [&](ScanSlot& s) { s.turns.emplace(points_per_block, sharp_blocks); }, scan_task,
-        [&](const FiberBatch& b) {  // in file order, on the caller's thread while the pool measures
-            for (std::size_t i = 0; i < b.count; ++i) {
+        [&](const FiberBatch& b, std::size_t first, std::size_t end) {  // in file order, on the caller's thread
+            for (std::size_t i = first; i < end; ++i) {
                 const std::vector<Vec3f>& fiber = b.fibers[i];
                 if (fiber.size() > std::numeric_limits<std::uint32_t>::max())
                     throw Error(Errc::unsupported, reader.path() + ": a streamline with more than 2^32 points");
@@ -211,7 +211,7 @@ ScanStageResult scan_stage(StreamlineSource& reader, SourceScan& scan, std::uint
             check_fiber_tables(reader, scan.fibers, options);
             report_progress(options, "scan", reader);
         },
-        timings.read);
+        false, timings.read);
     // Merged in slot order: the same sums whatever the thread count.
     scan.min = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
                 std::numeric_limits<double>::infinity()};
@@ -284,7 +284,7 @@ void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double
     };
     for_each_batch(
         reader, threads, slots, [&](ResampleSlot& s) { s.turns.emplace(points_per_block, sharp_blocks); }, task,
-        [](const FiberBatch&) {},
+        [](const FiberBatch&, std::size_t, std::size_t) {},
         [&](const FiberBatch& b, const std::vector<ResampleSlot>& batch_slots) {
             for (std::size_t t = 0; t < b.tasks(); ++t)
                 if (const ResampleSlot& s = batch_slots[t]; s.too_long)
@@ -293,7 +293,7 @@ void resample_scan_stage(StreamlineSource& reader, ResampleStep resample, double
                                                        std::to_string(step) + " mm step");
             report_progress(options, "resample-scan", reader);
         },
-        timings.read);
+        false, timings.read);
     turns = TurnStatistics(points_per_block, sharp_blocks);
     for (int k = 0; k < 2; ++k)
         for (const ResampleSlot& s : slots[k]) {

@@ -56,6 +56,8 @@ struct FiberBatch {
     std::size_t count = 0;                   // fibers in this batch
     std::uint32_t first_fiber = 0;
     std::vector<std::size_t> cuts;  // task t has fibers [cuts[t], cuts[t + 1])
+    std::size_t points = 0;         // read so far (an empty fiber counts as one)
+    bool complete = false;          // no more fibers belong to it
     std::size_t tasks() const { return cuts.empty() ? 0 : cuts.size() - 1; }
 };
 
@@ -63,6 +65,13 @@ struct FiberBatch {
 // index of its first); false at the end of the input. More than 2^32 - 1
 // fibers in all: Error{unsupported} (fiber IDs are 32-bit).
 bool read_fiber_batch(StreamlineSource& reader, FiberBatch& b, std::uint32_t first_fiber);
+// The same a task at a time: begin_fiber_batch, then read_fiber_task adds
+// the next task's fibers (true) until the batch is complete (false); the
+// batch's fibers and cuts are read_fiber_batch's.
+// With `spare`, a new fiber is read into a buffer taken from it (the most
+// recently added first).
+void begin_fiber_batch(FiberBatch& b, std::uint32_t first_fiber);
+bool read_fiber_task(StreamlineSource& reader, FiberBatch& b, std::vector<std::vector<Vec3f>>* spare = nullptr);
 
 // The bounds of a fiber's points into min / max (pass 1). Float comparisons
 // (exact: the double bounds of floats are floats); NaN coordinates are left
