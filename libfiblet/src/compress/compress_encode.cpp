@@ -217,9 +217,14 @@ void encode_resampled(const EncodeStageInputs& in, const FiberBatch& b, std::siz
 // resampled fiber that misses its length on, they wait for the batch's
 // budget (finish_batch).
 void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t, Slot& w) {
+    // The points of fibers being measured: the buffers this thread used
+    // last (in its cache), not the slot's own, last used two batches ago;
+    // handed back unless fibers wait in them for finish_batch.
+    thread_local std::vector<Vec3f> warm[3];
+    std::vector<Vec3f>* points[3] = {&w.targets, &w.decoded, &w.decoded_exact};
+    for (int k = 0; k < 3; ++k) points[k]->swap(warm[k]), points[k]->clear();
     w.blocks.clear();
     w.index.clear();
-    w.targets.clear(), w.decoded.clear(), w.decoded_exact.clear();
     w.starts.assign(1, 0), w.block_ends.clear(), w.ends.clear(), w.lengths.clear();
     w.kept_max = 0, w.ends_missing = false;
     for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1];) {
@@ -234,7 +239,9 @@ void encode_task(const EncodeStageInputs& in, const FiberBatch& b, std::size_t t
         }
         if (!w.ends_missing) measure_pending(in, b, w);
     }
-    if (!w.ends_missing) pack_task(in, w);
+    if (w.ends_missing) return;
+    pack_task(in, w);
+    for (int k = 0; k < 3; ++k) points[k]->swap(warm[k]);
 }
 
 // Stage 2's end on the caller, once a batch's tasks are done: the fibers
