@@ -106,43 +106,12 @@ struct ResampleSlot {
 
 }  // namespace
 
-#ifdef FIBLET_POINTS_AVX2
-namespace {
-// add_bounds' loop eight points at a time: three registers of 24 floats,
-// whose lanes hold the same coordinate at every step (x y z x y z x y,
-// z x y ...), keep running minima and maxima (vminps / vmaxps return their
-// second operand for a NaN, as the ternaries below keep the bound);
-// returns where it stopped.
-__attribute__((target("avx2"))) std::size_t add_bounds_avx2(std::span<const Vec3f> fiber, float* lo, float* hi) {
-    const std::size_t n = fiber.size();
-    if (n < 8) return 0;
-    const float* f = &fiber[0].x;
-    __m256 mn[3], mx[3];
-    for (int r = 0; r < 3; ++r) mn[r] = _mm256_set1_ps(lo[0]), mx[r] = _mm256_set1_ps(hi[0]);  // +-inf
-    std::size_t k = 0;
-    for (; k + 8 <= n; k += 8)
-        for (int r = 0; r < 3; ++r) {
-            const __m256 p = _mm256_loadu_ps(f + 3 * k + 8 * r);
-            mn[r] = _mm256_min_ps(p, mn[r]), mx[r] = _mm256_max_ps(p, mx[r]);
-        }
-    alignas(32) float lanes_lo[3][8], lanes_hi[3][8];
-    for (int r = 0; r < 3; ++r) _mm256_store_ps(lanes_lo[r], mn[r]), _mm256_store_ps(lanes_hi[r], mx[r]);
-    for (int r = 0; r < 3; ++r)
-        for (int i = 0; i < 8; ++i) {
-            const int c = (8 * r + i) % 3;
-            lo[c] = std::min(lo[c], lanes_lo[r][i]), hi[c] = std::max(hi[c], lanes_hi[r][i]);
-        }
-    return k;
-}
-}  // namespace
-#endif
-
 void add_bounds(std::span<const Vec3f> fiber, double* min, double* max) {
     constexpr float inf = std::numeric_limits<float>::infinity();
     float lo[3] = {inf, inf, inf}, hi[3] = {-inf, -inf, -inf};
     std::size_t k = 0;
 #ifdef FIBLET_POINTS_AVX2
-    if (use_avx2_loops()) k = add_bounds_avx2(fiber, lo, hi);
+    if (use_avx2_loops()) k = bounds_avx2(fiber.data(), fiber.size(), lo, hi);
 #endif
     for (; k < fiber.size(); ++k) {
         const Vec3f& p = fiber[k];

@@ -79,6 +79,33 @@ __attribute__((target("avx2"))) inline void deltas4(const Vec3f* p, __m256d& dx,
     dx = _mm256_sub_pd(bx, ax), dy = _mm256_sub_pd(by, ay), dz = _mm256_sub_pd(bz, az);
 }
 
+// The running bounds of points p .. p + n eight at a time into lo / hi,
+// which start at +inf / -inf: three registers of 24 floats, whose lanes
+// hold the same coordinate at every step (x y z x y z x y, z x y ...), keep
+// minima and maxima (vminps / vmaxps return their second operand for a NaN,
+// so a NaN coordinate is left out, as `p < lo ? p : lo` leaves it); returns
+// the points done, the rest for the caller's scalar loop.
+__attribute__((target("avx2"))) inline std::size_t bounds_avx2(const Vec3f* p, std::size_t n, float* lo, float* hi) {
+    if (n < 8) return 0;
+    const float* f = &p->x;
+    __m256 mn[3], mx[3];
+    for (int r = 0; r < 3; ++r) mn[r] = _mm256_set1_ps(lo[0]), mx[r] = _mm256_set1_ps(hi[0]);
+    std::size_t k = 0;
+    for (; k + 8 <= n; k += 8)
+        for (int r = 0; r < 3; ++r) {
+            const __m256 v = _mm256_loadu_ps(f + 3 * k + 8 * r);
+            mn[r] = _mm256_min_ps(v, mn[r]), mx[r] = _mm256_max_ps(v, mx[r]);
+        }
+    alignas(32) float lanes_lo[3][8], lanes_hi[3][8];
+    for (int r = 0; r < 3; ++r) _mm256_store_ps(lanes_lo[r], mn[r]), _mm256_store_ps(lanes_hi[r], mx[r]);
+    for (int r = 0; r < 3; ++r)
+        for (int i = 0; i < 8; ++i) {
+            const int c = (8 * r + i) % 3;
+            lo[c] = lanes_lo[r][i] < lo[c] ? lanes_lo[r][i] : lo[c], hi[c] = lanes_hi[r][i] > hi[c] ? lanes_hi[r][i] : hi[c];
+        }
+    return k;
+}
+
 // (dx dx + dy dy) + dz dz.
 __attribute__((target("avx2"))) inline __m256d norm2(__m256d dx, __m256d dy, __m256d dz) {
     return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)), _mm256_mul_pd(dz, dz));

@@ -8,20 +8,26 @@
 #include "fiblet/block_index.hpp"
 #include "fiblet/error.hpp"
 #include "index/box_rans.hpp"
+#include "core/points_avx2.hpp"
 #include "index/index_chunk.hpp"
 
 namespace fiblet {
 
 namespace {
 
+// A block's decoded points (finite), eight at a time where the CPU has AVX2
+// (the scan's loop; the index stage of compress -e 0 on the medium
+// tractogram 0.0755 -> 0.069 s against the scalar loop's chains of minima).
 Aabb bounds_of(const float* xyz, std::uint32_t n) {
-    Aabb b{{xyz[0], xyz[1], xyz[2]}, {xyz[0], xyz[1], xyz[2]}};
-    for (std::uint32_t k = 1; k < n; ++k) {
-        const float* p = xyz + 3 * k;
-        b.min = {std::min(b.min.x, p[0]), std::min(b.min.y, p[1]), std::min(b.min.z, p[2])};
-        b.max = {std::max(b.max.x, p[0]), std::max(b.max.y, p[1]), std::max(b.max.z, p[2])};
-    }
-    return b;
+    constexpr float inf = std::numeric_limits<float>::infinity();
+    float lo[3] = {inf, inf, inf}, hi[3] = {-inf, -inf, -inf};
+    std::size_t k = 0;
+#ifdef FIBLET_POINTS_AVX2
+    if (detail::use_avx2_loops()) k = detail::bounds_avx2(reinterpret_cast<const Vec3f*>(xyz), n, lo, hi);
+#endif
+    for (; k < n; ++k)
+        for (int c = 0; c < 3; ++c) lo[c] = std::min(lo[c], xyz[3 * k + c]), hi[c] = std::max(hi[c], xyz[3 * k + c]);
+    return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}};
 }
 
 }  // namespace
