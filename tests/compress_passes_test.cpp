@@ -147,9 +147,6 @@ TEST(CompressPasses, TheStagesAreTimedWithinTheRunsTime) {
     EXPECT_EQ(compress_file(dir.file("in.tck"), dir.file("out.fft"), o).timings.index, 0.0);
 }
 
-// Pass 1's bounds: the AVX2 loop and the scalar loop against a brute
-// force in double, at every length around the vector width, with NaN
-// coordinates left out and zero bounds +0 whichever zero came first.
 // The median segment length, from fibers of one repeated length (runs of
 // one bin), of scattered lengths, of lengths below the histogram's range
 // and of none, added to two histograms then merged: the bin holding the
@@ -179,6 +176,9 @@ TEST(CompressScan, TheMedianSegmentLengthIsTheSortedLengthsMedian) {
     }
 }
 
+// Pass 1's bounds: the AVX2 loop and the scalar loop against a brute
+// force in double, at every length around the vector width, with NaN
+// coordinates left out and zero bounds +0 whichever zero came first.
 TEST(CompressScan, BoundsOfEveryLengthLeaveOutNaNAndGiveZeroAsPlusZero) {
     std::mt19937 rng(5);
     std::uniform_real_distribution<float> u(-50.0f, 50.0f);

@@ -268,40 +268,40 @@ TEST(Fft16, ChecksumGroupsHashThePackedBytes) {
 // (each tail of the sixteen- and eight-codes-at-a-time readers), and a code
 // past the levels is found wherever it sits; with the AVX2 loop and without.
 TEST(Fft16, PackedCodesRoundTripAndBadCodesAreFoundAnywhere) {
-  for (const bool avx2 : {true, false}) {
-    SCOPED_TRACE(avx2 ? "AVX2 loop" : "scalar loops");
-    const test::ScopedSimdLoops loops(avx2);
-    FftHeader h;
-    h.version = kFft16PackedVersion;
-    h.points_per_block = 254;
-    std::mt19937 rng(5);
-    std::uniform_int_distribution<int> code(0, 181 * 181 - 1);
-    for (std::uint32_t n = 1; n <= 254; ++n) {
-        SCOPED_TRACE(n);
-        std::vector<std::uint8_t> block(h.block_bytes(), 0);
-        const std::uint16_t flags = std::uint16_t(n);  // first and last of its fiber
-        std::memcpy(&block[kBlock16FlagsOffset], &flags, 2);
-        for (std::size_t b = 0; b < kBlock16FiberIdOffset; ++b) block[b] = std::uint8_t(rng());
-        const std::uint32_t m = n > 2 ? n - 2 : 0;
-        for (std::uint32_t k = 0; k < m; ++k) {
-            const auto c = std::uint16_t(code(rng));
-            std::memcpy(&block[kBlock16DirectionsOffset + 2 * k], &c, 2);
-        }
-        std::vector<std::uint8_t> packed;
-        detail::pack_blocks16(h, block, packed);
-        const detail::PackedBlockPlace place{n, 0, true, true};
-        std::vector<std::uint8_t> out(h.block_bytes(), 0xee);
-        ASSERT_EQ(detail::expand_block16(h, packed.data(), place, out.data()), "");
-        EXPECT_TRUE(std::equal(block.begin() + kBlock16DirectionsOffset, block.end(), out.begin() + kBlock16DirectionsOffset));
-        EXPECT_TRUE(std::equal(block.begin(), block.begin() + kBlock16FiberIdOffset, out.begin()));
-        for (std::uint32_t k = 0; k < m; k += 1 + k / 16) {  // a code past the levels at k
-            std::vector<std::uint8_t> bad = block;
-            const std::uint16_t past = std::uint16_t(181 * 181 + k % 7);
-            std::memcpy(&bad[kBlock16DirectionsOffset + 2 * k], &past, 2);
-            std::vector<std::uint8_t> bad_packed;
-            detail::pack_blocks16(h, bad, bad_packed);
-            EXPECT_NE(detail::expand_block16(h, bad_packed.data(), place, out.data()), "") << "code " << k;
+    for (const bool avx2 : {true, false}) {
+        SCOPED_TRACE(avx2 ? "AVX2 loop" : "scalar loops");
+        const test::ScopedSimdLoops loops(avx2);
+        FftHeader h;
+        h.version = kFft16PackedVersion;
+        h.points_per_block = 254;
+        std::mt19937 rng(5);
+        std::uniform_int_distribution<int> code(0, 181 * 181 - 1);
+        for (std::uint32_t n = 1; n <= 254; ++n) {
+            SCOPED_TRACE(n);
+            std::vector<std::uint8_t> block(h.block_bytes(), 0);
+            const std::uint16_t flags = std::uint16_t(n);  // first and last of its fiber
+            std::memcpy(&block[kBlock16FlagsOffset], &flags, 2);
+            for (std::size_t b = 0; b < kBlock16FiberIdOffset; ++b) block[b] = std::uint8_t(rng());
+            const std::uint32_t m = n > 2 ? n - 2 : 0;
+            for (std::uint32_t k = 0; k < m; ++k) {
+                const auto c = std::uint16_t(code(rng));
+                std::memcpy(&block[kBlock16DirectionsOffset + 2 * k], &c, 2);
+            }
+            std::vector<std::uint8_t> packed;
+            detail::pack_blocks16(h, block, packed);
+            const detail::PackedBlockPlace place{n, 0, true, true};
+            std::vector<std::uint8_t> out(h.block_bytes(), 0xee);
+            ASSERT_EQ(detail::expand_block16(h, packed.data(), place, out.data()), "");
+            EXPECT_TRUE(std::equal(block.begin() + kBlock16DirectionsOffset, block.end(), out.begin() + kBlock16DirectionsOffset));
+            EXPECT_TRUE(std::equal(block.begin(), block.begin() + kBlock16FiberIdOffset, out.begin()));
+            for (std::uint32_t k = 0; k < m; k += 1 + k / 16) {  // a code past the levels at k
+                std::vector<std::uint8_t> bad = block;
+                const std::uint16_t past = std::uint16_t(181 * 181 + k % 7);
+                std::memcpy(&bad[kBlock16DirectionsOffset + 2 * k], &past, 2);
+                std::vector<std::uint8_t> bad_packed;
+                detail::pack_blocks16(h, bad, bad_packed);
+                EXPECT_NE(detail::expand_block16(h, bad_packed.data(), place, out.data()), "") << "code " << k;
+            }
         }
     }
-  }
 }

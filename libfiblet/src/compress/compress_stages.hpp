@@ -66,10 +66,9 @@ struct FiberBatch {
 // fibers in all: Error{unsupported} (fiber IDs are 32-bit).
 bool read_fiber_batch(StreamlineSource& reader, FiberBatch& b, std::uint32_t first_fiber);
 // The same a task at a time: begin_fiber_batch, then read_fiber_task adds
-// the next task's fibers (true) until the batch is complete (false); the
-// batch's fibers and cuts are read_fiber_batch's.
-// With `spare`, a new fiber is read into a buffer taken from it (the most
-// recently added first).
+// the next task's fibers (true) until the batch is complete (false), with
+// read_fiber_batch's fibers and cuts. With `spare`, each fiber is read into
+// a buffer taken from its end (the one added last).
 void begin_fiber_batch(FiberBatch& b, std::uint32_t first_fiber);
 bool read_fiber_task(StreamlineSource& reader, FiberBatch& b, std::vector<std::vector<Vec3f>>* spare = nullptr);
 
