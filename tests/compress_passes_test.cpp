@@ -39,10 +39,14 @@ void write_tck(const std::string& path) {
     w.finish();
 }
 
-// Compresses `in` to `out`, running `edit` once, during the first pass (the
-// progress callback is the hook: it runs between reads). Returns the error.
-std::string compress_editing(const std::string& in, const std::string& out, const std::function<void()>& edit) {
+// Compresses `in` to `out` on `threads` threads (1: each task in turn after
+// its reading; more: the pipeline), running `edit` once, during the first
+// pass (the progress callback is the hook: it runs between reads). Returns
+// the error.
+std::string compress_editing(const std::string& in, const std::string& out, const std::function<void()>& edit,
+                             unsigned threads) {
     CompressOptions o;
+    o.threads = threads;
     bool done = false;
     o.progress = [&](const char* phase, double) {
         if (!done && std::strcmp(phase, "scan") == 0) edit(), done = true;
@@ -74,42 +78,53 @@ void poke(const std::string& path, bool keep_mtime) {
 }  // namespace
 
 TEST(CompressPasses, AnInputEditedInPlaceIsRefused) {
-    for (bool keep_mtime : {false, true}) {
-        test::TempDir dir;
-        write_tck(dir.file("in.tck"));
-        const std::string what = compress_editing(dir.file("in.tck"), dir.file("out.fft"),
-                                                  [&] { poke(dir.file("in.tck"), keep_mtime); });
-        EXPECT_NE(what.find("changed while it was being read"), std::string::npos) << what;
-        EXPECT_NE(what.find(keep_mtime ? "other bytes" : "modification time"), std::string::npos) << what;
-        EXPECT_FALSE(fs::exists(dir.file("out.fft")));
-        EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 1);
-    }
+    for (unsigned threads : {1u, 2u})
+        for (bool keep_mtime : {false, true}) {
+            SCOPED_TRACE(threads);
+            test::TempDir dir;
+            write_tck(dir.file("in.tck"));
+            const std::string what = compress_editing(dir.file("in.tck"), dir.file("out.fft"),
+                                                      [&] { poke(dir.file("in.tck"), keep_mtime); }, threads);
+            EXPECT_NE(what.find("changed while it was being read"), std::string::npos) << what;
+            EXPECT_NE(what.find(keep_mtime ? "other bytes" : "modification time"), std::string::npos) << what;
+            EXPECT_FALSE(fs::exists(dir.file("out.fft")));
+            EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 1);
+        }
 }
 
 TEST(CompressPasses, AnInputReplacedOrGrownIsRefused) {
-    test::TempDir dir;
-    write_tck(dir.file("in.tck"));
-    test::write_three_fiber_tck(dir.file("other.tck"));
-    std::string what = compress_editing(dir.file("in.tck"), dir.file("out.fft"),
-                                        [&] { fs::rename(dir.file("other.tck"), dir.file("in.tck")); });
-    EXPECT_NE(what.find("another file now has its name"), std::string::npos) << what;
-    EXPECT_FALSE(fs::exists(dir.file("out.fft")));
+    for (unsigned threads : {1u, 2u}) {
+        SCOPED_TRACE(threads);
+        test::TempDir dir;
+        write_tck(dir.file("in.tck"));
+        test::write_three_fiber_tck(dir.file("other.tck"));
+        std::string what = compress_editing(
+            dir.file("in.tck"), dir.file("out.fft"), [&] { fs::rename(dir.file("other.tck"), dir.file("in.tck")); },
+            threads);
+        EXPECT_NE(what.find("another file now has its name"), std::string::npos) << what;
+        EXPECT_FALSE(fs::exists(dir.file("out.fft")));
 
-    write_tck(dir.file("grown.tck"));
-    what = compress_editing(dir.file("grown.tck"), dir.file("out.fft"), [&] {
-        std::FILE* f = std::fopen(dir.file("grown.tck").c_str(), "ab");
-        std::fputs("appended", f);
-        std::fclose(f);
-    });
-    EXPECT_NE(what.find("changed while it was being read"), std::string::npos) << what;
-    EXPECT_FALSE(fs::exists(dir.file("out.fft")));
+        write_tck(dir.file("grown.tck"));
+        what = compress_editing(
+            dir.file("grown.tck"), dir.file("out.fft"),
+            [&] {
+                std::FILE* f = std::fopen(dir.file("grown.tck").c_str(), "ab");
+                std::fputs("appended", f);
+                std::fclose(f);
+            },
+            threads);
+        EXPECT_NE(what.find("changed while it was being read"), std::string::npos) << what;
+        EXPECT_FALSE(fs::exists(dir.file("out.fft")));
+    }
 }
 
 TEST(CompressPasses, AnUntouchedInputCompressesAsBefore) {
-    test::TempDir dir;
-    write_tck(dir.file("in.tck"));
-    EXPECT_EQ(compress_editing(dir.file("in.tck"), dir.file("out.fft"), [] {}), "no error");
-    EXPECT_TRUE(fs::exists(dir.file("out.fft")));
+    for (unsigned threads : {1u, 2u}) {
+        test::TempDir dir;
+        write_tck(dir.file("in.tck"));
+        EXPECT_EQ(compress_editing(dir.file("in.tck"), dir.file("out.fft"), [] {}, threads), "no error") << threads;
+        EXPECT_TRUE(fs::exists(dir.file("out.fft"))) << threads;
+    }
 }
 
 TEST(CompressPasses, AnInputCutWhileReadIsNamedAsChangedNotAsTruncated) {
