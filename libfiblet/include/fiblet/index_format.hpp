@@ -11,7 +11,8 @@ namespace fiblet {
 // group_boxes (2, the default): a box per group of up to 8 blocks of a
 // fiber, loaded in a few ms (the medium file: 6 ms). block_boxes (4): a box
 // per block, rANS-coded: about 3x fewer candidate blocks for a small
-// region, about 5x slower to load (32 ms). (Version 3, a box per block range-coded, is read, no longer written.)
+// region, about 5x slower to load (32 ms). Version 3 (a box per block,
+// range-coded) is read, no longer written.
 enum class BlockIndexFormat : std::uint32_t { group_boxes = 2, block_boxes = 4 };
 inline constexpr BlockIndexFormat kDefaultBlockIndexFormat = BlockIndexFormat::group_boxes;
 

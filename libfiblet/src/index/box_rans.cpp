@@ -245,8 +245,10 @@ public:
     }
     // After an unbounded box on another axis.
     void forget_box() { prev_.symbol = kUnbounded; }
-    // The box on this axis in pack_cells' layout of the x axis.
-    std::uint64_t packed() const { return prev_.lo | prev_.extent << 10; }
+    // The box on this axis into `box`.
+    void put(GridBox& box, unsigned axis) const {
+        box.lo[axis] = std::uint16_t(prev_.lo), box.extent[axis] = std::uint8_t(prev_.extent);
+    }
     bool at_start() const { return x_ == kLow; }  // where the encoder started
 
 private:
@@ -306,7 +308,9 @@ DecodedBoxes decode_box_rans(const std::uint8_t* data, std::size_t size, const s
         }
         if (ox == Outcome::malformed || y.next(first, error) != Outcome::box || z.next(first, error) != Outcome::box)
             return out.error = error ? error : "its box stream codes an unbounded box after an axis", out;
-        out.boxes.push_back(x.packed() | y.packed() << 14 | z.packed() << 28);
+        GridBox box;
+        x.put(box, 0), y.put(box, 1), z.put(box, 2);
+        out.boxes.push_back(pack_cells(box));
     }
     if (words.pos > words.count) out.error = "its box stream is shorter than its boxes";
     else if (words.pos != words.count || !x.at_start() || !y.at_start() || !z.at_start())

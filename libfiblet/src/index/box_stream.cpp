@@ -3,7 +3,6 @@
 // formats/fft-index.md §7 (read only: version 4 replaced it).
 #include "index/box_stream.hpp"
 
-
 namespace fiblet::detail {
 
 namespace {

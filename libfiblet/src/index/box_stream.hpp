@@ -44,10 +44,10 @@ protected:
     unsigned level_bits_;
 };
 
-// Decodes a box per block (nullopt: unbounded), first_of_fiber[b] telling
-// where fibers start. A malformed stream (a box off the grid, a stream shorter or
-// longer than its boxes) gives an error message, which the chunk's users
-// report as an fft_format error.
+// Decodes a box per block (pack_cells, or kUnboundedCells), first_of_fiber[b]
+// telling where fibers start. A malformed stream (a box off the grid, a
+// stream shorter or longer than its boxes) gives an error message, which
+// the chunk's users report as an fft_format error.
 DecodedBoxes decode_box_stream(const std::uint8_t* data, std::size_t size,
                                const std::vector<bool>& first_of_fiber, std::uint32_t levels);
 

@@ -7,8 +7,8 @@
 
 #include "fiblet/block_index.hpp"
 #include "fiblet/error.hpp"
-#include "index/box_rans.hpp"
 #include "core/points_avx2.hpp"
+#include "index/box_rans.hpp"
 #include "index/index_chunk.hpp"
 
 namespace fiblet {
