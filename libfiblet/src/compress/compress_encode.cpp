@@ -37,13 +37,13 @@ constexpr std::size_t kFibersTogether = 64;
 // The header's error of each point: the worse of fiblet's float decode and
 // the exact decode (when given), so it holds for every decoder. One square
 // root per point (of the larger square: the same double as the larger of
-// the two roots), taken in a loop of its own that vectorizes.
+// the two roots), taken by the statistics' pass.
 #ifdef FIBLET_POINTS_AVX2
 // The loop of add_point_errors four points at a time: the same double
-// operations (distance2's, std::max of non-NaN squares, a correctly rounded
-// square root); returns the points left to the scalar loop.
+// operations (distance2's, std::max of non-NaN squares); returns the points
+// left to the scalar loop.
 __attribute__((target("avx2"))) std::size_t point_errors_avx2(const Vec3f* targets, const Vec3f* decoded,
-                                                              const Vec3f* decoded_exact, std::size_t n, double* e) {
+                                                              const Vec3f* decoded_exact, std::size_t n, double* e2) {
     std::size_t k = 0;
     for (; k + 4 <= n; k += 4) {
         __m256d tx, ty, tz, x, y, z;
@@ -54,7 +54,7 @@ __attribute__((target("avx2"))) std::size_t point_errors_avx2(const Vec3f* targe
             xyz4(decoded_exact + k, x, y, z);
             worst = _mm256_max_pd(norm2(_mm256_sub_pd(tx, x), _mm256_sub_pd(ty, y), _mm256_sub_pd(tz, z)), worst);
         }
-        _mm256_storeu_pd(e + k, _mm256_sqrt_pd(worst));
+        _mm256_storeu_pd(e2 + k, worst);
     }
     return k;
 }
@@ -65,18 +65,17 @@ void add_point_errors(std::span<const Vec3f> targets, std::span<const Vec3f> dec
                       ErrorStats& out) {
     const std::size_t n = targets.size();
     scratch.resize(n);
-    double* e = scratch.data();
+    double* e2 = scratch.data();
     std::size_t k = 0;
 #ifdef FIBLET_POINTS_AVX2
     if (use_avx2_loops())
-        k = point_errors_avx2(targets.data(), decoded.data(), decoded_exact.empty() ? nullptr : decoded_exact.data(), n, e);
+        k = point_errors_avx2(targets.data(), decoded.data(), decoded_exact.empty() ? nullptr : decoded_exact.data(), n, e2);
 #endif
     for (; k < n; ++k) {
-        e[k] = distance2(targets[k], decoded[k]);
-        if (!decoded_exact.empty()) e[k] = std::max(e[k], distance2(targets[k], decoded_exact[k]));
-        e[k] = std::sqrt(e[k]);
+        e2[k] = distance2(targets[k], decoded[k]);
+        if (!decoded_exact.empty()) e2[k] = std::max(e2[k], distance2(targets[k], decoded_exact[k]));
     }
-    out.add_all(e, n, fiber);
+    out.add_all_roots(e2, n, fiber);
 }
 
 // One task's outputs and scratch. Task t of every batch uses slot t of its

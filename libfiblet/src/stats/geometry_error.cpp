@@ -92,25 +92,34 @@ inline double segment_dist2(const Segments& g, double px, double py, double pz, 
 }
 
 #ifdef FIBLET_POINTS_AVX2
-FIBLET_AVX2 __m256d column(const std::vector<double>& c, std::size_t s) { return _mm256_loadu_pd(c.data() + s); }
+// A polyline's columns as plain pointers: the vector loops keep them in
+// registers (their stores may alias a std::vector's, which the compiler
+// would otherwise reload after each).
+struct ColumnPointers {
+    const double *ax, *ay, *az, *ux, *uy, *uz, *inv_uu, *len;
+    explicit ColumnPointers(const Segments& g)
+        : ax(g.ax.data()), ay(g.ay.data()), az(g.az.data()), ux(g.ux.data()), uy(g.uy.data()), uz(g.uz.data()),
+          inv_uu(g.inv_uu.data()), len(g.len.data()) {}
+};
 
 // segment_dist2 of the points (x, y, z) to segments s .. s + 3: the same
 // double operations in the same order (max(0, t) and min(1, t) return t
 // for a NaN and keep -0, as the ternaries do; no fused multiply-add:
 // -ffp-contract=off).
-FIBLET_AVX2 __m256d segment_dist2_avx2(const Segments& g, __m256d x, __m256d y, __m256d z, std::size_t s) {
-    const __m256d ux = column(g.ux, s), uy = column(g.uy, s), uz = column(g.uz, s);
-    const __m256d wx = _mm256_sub_pd(x, column(g.ax, s)), wy = _mm256_sub_pd(y, column(g.ay, s)),
-                  wz = _mm256_sub_pd(z, column(g.az, s));
+FIBLET_AVX2 __m256d segment_dist2_avx2(const ColumnPointers& g, __m256d x, __m256d y, __m256d z, std::size_t s) {
+    const __m256d ux = _mm256_loadu_pd(g.ux + s), uy = _mm256_loadu_pd(g.uy + s), uz = _mm256_loadu_pd(g.uz + s);
+    const __m256d wx = _mm256_sub_pd(x, _mm256_loadu_pd(g.ax + s)), wy = _mm256_sub_pd(y, _mm256_loadu_pd(g.ay + s)),
+                  wz = _mm256_sub_pd(z, _mm256_loadu_pd(g.az + s));
     __m256d t = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(wx, ux), _mm256_mul_pd(wy, uy)), _mm256_mul_pd(wz, uz));
-    t = _mm256_min_pd(_mm256_set1_pd(1.0), _mm256_max_pd(_mm256_setzero_pd(), _mm256_mul_pd(t, column(g.inv_uu, s))));
+    t = _mm256_min_pd(_mm256_set1_pd(1.0),
+                      _mm256_max_pd(_mm256_setzero_pd(), _mm256_mul_pd(t, _mm256_loadu_pd(g.inv_uu + s))));
     const __m256d dx = _mm256_sub_pd(wx, _mm256_mul_pd(t, ux)), dy = _mm256_sub_pd(wy, _mm256_mul_pd(t, uy)),
                   dz = _mm256_sub_pd(wz, _mm256_mul_pd(t, uz));
     return detail::norm2(dx, dy, dz);
 }
 
 // Squared distances of p to the kLanes segments from `base` into d.
-FIBLET_AVX2 void window_avx2(const Segments& g, double px, double py, double pz, std::size_t base, double* d) {
+FIBLET_AVX2 void window_avx2(const ColumnPointers& g, double px, double py, double pz, std::size_t base, double* d) {
     const __m256d x = _mm256_set1_pd(px), y = _mm256_set1_pd(py), z = _mm256_set1_pd(pz);
     for (std::size_t h = 0; h < kLanes; h += 4) _mm256_storeu_pd(d + h, segment_dist2_avx2(g, x, y, z, base + h));
 }
@@ -229,58 +238,70 @@ void own_segments_at(const Segments& g, std::span<const Vec3f> from, std::span<c
 }
 
 #ifdef FIBLET_POINTS_AVX2
-// Whether the directions of segments a .. a + 3 and b .. b + 3 are not against each other.
-FIBLET_AVX2 __m256d not_against(const Segments& g, std::size_t a, std::size_t b) {
-    const __m256d d = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(column(g.ux, a), column(g.ux, b)),
-                                                  _mm256_mul_pd(column(g.uy, a), column(g.uy, b))),
-                                    _mm256_mul_pd(column(g.uz, a), column(g.uz, b)));
-    return _mm256_cmp_pd(d, _mm256_setzero_pd(), _CMP_GE_OQ);
-}
-
 // OwnSegments::forward of every segment: each pair of segments up to three
 // apart is tested once, not once for each point it proves.
 __attribute__((target("avx2"))) void forward_avx2(const Segments& g, OwnSegments& out) {
     const std::size_t n = g.count;
-    for (std::size_t d = 0; d < 3; ++d) at_least(out.forward[d], n + 8);
+    // Pointers in locals, as in forward_avx512 (the stores may alias the
+    // vectors, and reloading them went through TLS calls: 16 % of the report).
+    double* forward[3];
+    for (std::size_t d = 0; d < 3; ++d) forward[d] = at_least(out.forward[d], n + 8);
+    const double *ux = g.ux.data(), *uy = g.uy.data(), *uz = g.uz.data();
     for (std::size_t s = 0; s < n; s += 4)  // reads up to segment n + 5: padding
-        for (std::size_t d = 0; d < 3; ++d) _mm256_storeu_pd(out.forward[d].data() + s, not_against(g, s + d + 1, s));
+        for (std::size_t d = 0; d < 3; ++d) {
+            const std::size_t a = s + d + 1;  // u_a . u_s >= 0: not against each other
+            const __m256d dot = _mm256_add_pd(
+                _mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(ux + a), _mm256_loadu_pd(ux + s)),
+                              _mm256_mul_pd(_mm256_loadu_pd(uy + a), _mm256_loadu_pd(uy + s))),
+                _mm256_mul_pd(_mm256_loadu_pd(uz + a), _mm256_loadu_pd(uz + s)));
+            _mm256_storeu_pd(forward[d] + s, _mm256_cmp_pd(dot, _mm256_setzero_pd(), _CMP_GE_OQ));
+        }
 }
 
-FIBLET_AVX2 __m256d mask(const std::vector<double>& m, std::size_t s) { return _mm256_loadu_pd(m.data() + s); }
+// The four bytes 0 or 1 of a 4-bit mask, lowest bit first.
+inline void store_mask_bytes(int mask, std::uint8_t* out) {
+    static constexpr std::uint32_t kBytes[16] = {
+        0x00000000, 0x00000001, 0x00000100, 0x00000101, 0x00010000, 0x00010001, 0x00010100, 0x00010101,
+        0x01000000, 0x01000001, 0x01000100, 0x01000101, 0x01010000, 0x01010001, 0x01010100, 0x01010101};
+    std::memcpy(out, &kBytes[mask], 4);  // little-endian: the first byte is bit 0
+}
 
 // e4 < 0.98 len^2 for lengths len .. len + 3.
-FIBLET_AVX2 __m256d within_half_step(__m256d e4, const Segments& g, std::size_t s) {
-    const __m256d len = column(g.len, s);
+FIBLET_AVX2 __m256d within_half_step(__m256d e4, const double* len4) {
+    const __m256d len = _mm256_loadu_pd(len4);
     return _mm256_cmp_pd(e4, _mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(0.98), len), len), _CMP_LT_OQ);
 }
 
 // own_segments_at for points [k0, k1) (4 <= k0, k1 <= n), four at a time,
 // the points read from both polylines' columns: the same distances bit for
 // bit, the same proof.
-__attribute__((target("avx2"))) void own_segments_avx2(const Segments& g, const Segments& from_g,
+__attribute__((target("avx2"))) void own_segments_avx2(const Segments& to_g, const Segments& from_g,
                                                        std::span<const Vec3f> from, std::span<const Vec3f> to,
                                                        std::size_t k0, std::size_t k1, double* nearest,
                                                        OwnSegments& out) {
-    const std::vector<double>* f = out.forward;
+    const ColumnPointers g(to_g), p(from_g);
+    const double *f0 = out.forward[0].data(), *f1 = out.forward[1].data(), *f2 = out.forward[2].data();
+    std::uint8_t *proven = out.proven.data(), *later_out = out.later.data();
     std::size_t k = k0;
     for (; k + 4 <= k1; k += 4) {
-        const __m256d x = column(from_g.ax, k), y = column(from_g.ay, k), z = column(from_g.az, k);
-        const __m256d ex = _mm256_sub_pd(x, column(g.ax, k)), ey = _mm256_sub_pd(y, column(g.ay, k)),
-                      ez = _mm256_sub_pd(z, column(g.az, k));
+        const __m256d x = _mm256_loadu_pd(p.ax + k), y = _mm256_loadu_pd(p.ay + k), z = _mm256_loadu_pd(p.az + k);
+        const __m256d ex = _mm256_sub_pd(x, _mm256_loadu_pd(g.ax + k)), ey = _mm256_sub_pd(y, _mm256_loadu_pd(g.ay + k)),
+                      ez = _mm256_sub_pd(z, _mm256_loadu_pd(g.az + k));
         const __m256d e4 = _mm256_mul_pd(_mm256_set1_pd(4.0), detail::norm2(ex, ey, ez));
         const __m256d before = segment_dist2_avx2(g, x, y, z, k - 1), after = segment_dist2_avx2(g, x, y, z, k);
         const __m256d later = _mm256_cmp_pd(after, before, _CMP_LT_OQ);
         _mm256_storeu_pd(nearest + k, _mm256_blendv_pd(before, after, later));  // after < before ? after : before
-        const int later_mask = _mm256_movemask_pd(later);
         // Segments k + 1 .. k + 3 not against k, and k - 4 .. k - 2 not against k - 1.
-        const __m256d ahead = _mm256_and_pd(_mm256_and_pd(mask(f[0], k), mask(f[1], k)), mask(f[2], k));
-        const __m256d behind = _mm256_and_pd(_mm256_and_pd(mask(f[0], k - 2), mask(f[1], k - 3)), mask(f[2], k - 4));
-        const __m256d ok = _mm256_and_pd(_mm256_and_pd(within_half_step(e4, g, k - 1), within_half_step(e4, g, k)),
+        const __m256d ahead =
+            _mm256_and_pd(_mm256_and_pd(_mm256_loadu_pd(f0 + k), _mm256_loadu_pd(f1 + k)), _mm256_loadu_pd(f2 + k));
+        const __m256d behind = _mm256_and_pd(_mm256_and_pd(_mm256_loadu_pd(f0 + k - 2), _mm256_loadu_pd(f1 + k - 3)),
+                                             _mm256_loadu_pd(f2 + k - 4));
+        const __m256d ok = _mm256_and_pd(_mm256_and_pd(within_half_step(e4, g.len + k - 1), within_half_step(e4, g.len + k)),
                                          _mm256_and_pd(ahead, behind));
-        const int proven_mask = _mm256_movemask_pd(ok);
-        for (int i = 0; i < 4; ++i) out.proven[k + i] = (proven_mask >> i) & 1, out.later[k + i] = (later_mask >> i) & 1;
+        store_mask_bytes(_mm256_movemask_pd(ok), proven + k);
+        store_mask_bytes(_mm256_movemask_pd(later), later_out + k);
     }
-    for (; k < k1; ++k) own_segments_at(g, from, to, k, nearest, out);
+    for (; k < k1; ++k) own_segments_at(to_g, from, to, k, nearest, out);
 }
 #undef FIBLET_AVX2
 
@@ -426,6 +447,9 @@ double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, s
     const bool same_count = from.size() == to.size() && to.size() > 1 && detail::geometry_shortcut_enabled();
     const bool paired = from.size() == to.size() && use_avx2_loops();
     alignas(32) double lanes[kLanes];
+#ifdef FIBLET_POINTS_AVX2
+    const ColumnPointers columns(g);
+#endif
     thread_local std::vector<double> nearest_buffer;  // squared distances, then distances
     double* const nearest = at_least(nearest_buffer, from.size());
     thread_local OwnSegments own;
@@ -466,7 +490,7 @@ double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, s
 #ifdef FIBLET_POINTS_AVX2
         if (paired) {
             const std::size_t base = k >= 4 ? k - 4 : 0;
-            window_avx2(g, px, py, pz, base, lanes);
+            window_avx2(columns, px, py, pz, base, lanes);
             if (lo >= base && hi <= base + kLanes) {
                 for (std::size_t s = lo; s < hi; ++s)
                     if (lanes[s - base] < best) best = lanes[s - base], hint = s;
@@ -480,10 +504,7 @@ double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, s
             if (d[j] < best) best = d[j], hint = lo + j;
         nearest[k] = best;
     }
-    // Square roots four at a time (correctly rounded, as std::sqrt), then
-    // the statistics in order.
-    sqrt_all(nearest, from.size());
-    out.add_all(nearest, from.size(), fiber);
+    out.add_all_roots(nearest, from.size(), fiber);
     return g.length;
 }
 
