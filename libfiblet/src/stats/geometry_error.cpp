@@ -450,7 +450,7 @@ double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, s
 #ifdef FIBLET_POINTS_AVX2
     const ColumnPointers columns(g);
 #endif
-    thread_local std::vector<double> nearest_buffer;  // squared distances, then distances
+    thread_local std::vector<double> nearest_buffer;  // squared distances
     double* const nearest = at_least(nearest_buffer, from.size());
     thread_local OwnSegments own;
     if (same_count) own_segments(g, from_g, from, to, nearest, own);
