@@ -53,6 +53,12 @@ if(DEFINED Python_EXECUTABLE)
   fiblet_add_pytest(ecosystem.check_skips ${PROJECT_SOURCE_DIR}/tests/test_check_skips.py 60)
 endif()
 
+# The before/after compress timing of two binaries (scripts/bench_ab.sh).
+if(DEFINED Python_EXECUTABLE)
+  fiblet_add_pytest(bench.ab_script ${PROJECT_SOURCE_DIR}/tests/test_bench_ab.py 120
+    ENVIRONMENT "FIBLET_CLI=$<TARGET_FILE:fiblet_cli>")
+endif()
+
 # The sections of bench/results.md, each replaced in place by its script.
 if(DEFINED Python_EXECUTABLE)
   fiblet_add_pytest(bench.results_sections ${PROJECT_SOURCE_DIR}/tests/test_results_sections.py 60)
