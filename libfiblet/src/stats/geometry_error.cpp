@@ -308,7 +308,7 @@ __attribute__((target("avx2"))) void own_segments_avx2(const Segments& to_g, con
 // The AVX-512 twins of forward_avx2 and own_segments_avx2: eight lanes,
 // the same double operations.
 #define FIBLET_AVX512 __attribute__((target("avx512f,avx512dq,avx512bw,avx512vl"))) inline
-FIBLET_AVX512 __m512d column8(const std::vector<double>& c, std::size_t s) { return _mm512_loadu_pd(c.data() + s); }
+FIBLET_AVX512 __m512d column8(const double* c, std::size_t s) { return _mm512_loadu_pd(c + s); }
 
 FIBLET_AVX512 __m512d norm2_8(__m512d dx, __m512d dy, __m512d dz) {
     return _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)), _mm512_mul_pd(dz, dz));
@@ -316,7 +316,7 @@ FIBLET_AVX512 __m512d norm2_8(__m512d dx, __m512d dy, __m512d dz) {
 
 // segment_dist2_avx2 for segments s .. s + 7 (vmaxpd and vminpd return
 // their second operand for a NaN, as the 256-bit ones).
-FIBLET_AVX512 __m512d segment_dist2_avx512(const Segments& g, __m512d x, __m512d y, __m512d z, std::size_t s) {
+FIBLET_AVX512 __m512d segment_dist2_avx512(const ColumnPointers& g, __m512d x, __m512d y, __m512d z, std::size_t s) {
     const __m512d ux = column8(g.ux, s), uy = column8(g.uy, s), uz = column8(g.uz, s);
     const __m512d wx = _mm512_sub_pd(x, column8(g.ax, s)), wy = _mm512_sub_pd(y, column8(g.ay, s)),
                   wz = _mm512_sub_pd(z, column8(g.az, s));
@@ -353,7 +353,7 @@ FIBLET_AVX512 __mmask8 set_lanes(const double* m, std::size_t s) {
     return _mm512_test_epi64_mask(v, v);
 }
 
-FIBLET_AVX512 __mmask8 within_half_step8(__m512d e4, const Segments& g, std::size_t s) {
+FIBLET_AVX512 __mmask8 within_half_step8(__m512d e4, const ColumnPointers& g, std::size_t s) {
     const __m512d len = column8(g.len, s);
     return _mm512_cmp_pd_mask(e4, _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(0.98), len), len), _CMP_LT_OQ);
 }
@@ -361,14 +361,15 @@ FIBLET_AVX512 __mmask8 within_half_step8(__m512d e4, const Segments& g, std::siz
 // own_segments_avx2's loop eight points at a time from k0 (>= 4) while
 // eight fit before k1; returns where it stopped.
 __attribute__((target("avx512f,avx512dq,avx512bw,avx512vl"))) std::size_t own_segments_avx512(
-    const Segments& g, const Segments& from_g, std::size_t k0, std::size_t k1, double* nearest, OwnSegments& out) {
-    // Pointers in locals, as in forward_avx512.
+    const Segments& to_g, const Segments& from_g, std::size_t k0, std::size_t k1, double* nearest, OwnSegments& out) {
+    // Pointers in locals, the columns' too, as in forward_avx512.
+    const ColumnPointers g(to_g), p(from_g);
     const double* f[3] = {out.forward[0].data(), out.forward[1].data(), out.forward[2].data()};
     std::uint8_t *proven = out.proven.data(), *later_out = out.later.data();
     const __m128i ones = _mm_set1_epi8(1);
     std::size_t k = k0;
     for (; k + 8 <= k1; k += 8) {
-        const __m512d x = column8(from_g.ax, k), y = column8(from_g.ay, k), z = column8(from_g.az, k);
+        const __m512d x = column8(p.ax, k), y = column8(p.ay, k), z = column8(p.az, k);
         const __m512d e4 = _mm512_mul_pd(_mm512_set1_pd(4.0), norm2_8(_mm512_sub_pd(x, column8(g.ax, k)),
                                                                       _mm512_sub_pd(y, column8(g.ay, k)),
                                                                       _mm512_sub_pd(z, column8(g.az, k))));
