@@ -40,7 +40,7 @@ for b in runs:
     name = b["run_name"]
     if not name.startswith("BM_SelectQuery"):
         continue
-    q = name.replace("BM_SelectQuery/", "")
+    q = name.replace("BM_SelectQueryPread/", "(pread) ").replace("BM_SelectQuery/", "")
     print(f"| {q} | {b['kept_pct']:.2f} % | {b['tested_pct']:.2f} % | {b['read_pct']:.2f} % | {b['decoded_pct']:.2f} % | "
           f"{b['cpu_time']:.2f} ms ({b['real_time']:.2f}) | {100 * b['cpu_time'] / full['cpu_time']:.1f} % |")
 load, comp = by["BM_SelectIndexLoad"], by.get("BM_SelectIndexCompute")

@@ -1,12 +1,17 @@
 // A .fft truncated by another process while it is being read (issue 12,
-// class 6): selection reads blocks with pread by default, so it fails with a
-// clear Error instead of dying of SIGBUS in a memory mapping, and an output
-// being written is cleaned up (no temporary, no output).
+// class 6): selection fails with a clear Error, whether it copies blocks out
+// of a memory mapping (the default: the copy catches the SIGBUS) or reads
+// them with pread, and an output being written is cleaned up (no temporary,
+// no output). A SIGBUS outside those copies still goes where it went before.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -53,20 +58,98 @@ struct TruncatedAfterOpen {
 
 }  // namespace
 
+void expect_unexpected_end(const std::function<void()>& read, const std::string& what) {
+    try {
+        read();
+        ADD_FAILURE() << what << ": reading a truncated file succeeded";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), Errc::fft_format) << what << ": " << e.what();
+        EXPECT_NE(std::string(e.what()).find("unexpected end of file"), std::string::npos) << what << ": " << e.what();
+    }
+}
+
 TEST(SelectTruncation, ATruncatedFileIsAnErrorNotACrash) {
+    for (const bool mapped : {true, false}) {
+        test::TempDir dir;
+        write_tractogram(dir.file("in.tck"));
+        compress_file(dir.file("in.tck"), dir.file("in.fft"), {});
+        TruncatedAfterOpen t(dir.file("in.fft"));
+        t.cut();
+        SelectOptions o;
+        o.map_file = mapped;
+        Query everything;  // reads the blocks past the cut
+        expect_unexpected_end([&] { select(t.file, t.index, everything, [](const SelectedChunk&) {}, o); },
+                              mapped ? "mapped" : "pread");
+    }
+}
+
+// The mapping made by a first query, the file cut, a second query: its
+// copies fault (SIGBUS) on the pages past the new end, and fail.
+TEST(SelectTruncation, AFileCutUnderAnExistingMappingIsAnError) {
     test::TempDir dir;
     write_tractogram(dir.file("in.tck"));
     compress_file(dir.file("in.tck"), dir.file("in.fft"), {});
     TruncatedAfterOpen t(dir.file("in.fft"));
+    std::uint64_t points = 0;
+    select(t.file, t.index, Query{}, [&](const SelectedChunk& c) { points += c.point_count(); });
+    EXPECT_EQ(points, t.file.header().points);
     t.cut();
-    Query everything;  // reads the blocks past the cut
-    try {
-        select(t.file, t.index, everything, [](const SelectedChunk&) {});
-        FAIL() << "selection over a truncated file succeeded";
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), Errc::fft_format) << e.what();
-        EXPECT_NE(std::string(e.what()).find("unexpected end of file"), std::string::npos) << e.what();
-    }
+    expect_unexpected_end([&] { select(t.file, t.index, Query{}, [](const SelectedChunk&) {}); }, "second query");
+    // The blocks before the cut still read, through the same mapping.
+    const FftFile::BlockSpan first{0, 4};
+    std::vector<std::uint8_t> blocks(4 * t.file.header().block_bytes());
+    EXPECT_TRUE(t.file.read_blocks_mapped({&first, 1}, blocks.data()));
+    EXPECT_EQ(blocks, t.file.read_blocks(0, 4));
+}
+
+// A mapped page past the end of a truncated file, read outside fiblet's
+// copies: SIGBUS as without fiblet, to the handler from before if any.
+void fault_outside_fiblet(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_RDONLY);
+    const long page = ::sysconf(_SC_PAGESIZE);
+    auto* p = static_cast<volatile const char*>(::mmap(nullptr, 4 * page, PROT_READ, MAP_SHARED, fd, 0));
+    if (p == MAP_FAILED || ::ftruncate(::open(path.c_str(), O_WRONLY), page) != 0) std::_Exit(3);
+    (void)p[3 * page];
+    std::_Exit(0);  // not reached: the read faults
+}
+
+// fiblet's SIGBUS handler, installed by a first mapped selection.
+void install_fiblet_handler(const std::string& fft) {
+    const FftFile f(fft);
+    select(f, BlockIndex::load(f), Query{}, [](const SelectedChunk&) {});
+}
+
+TEST(SelectTruncationDeathTest, AFaultOutsideACopyStillEndsTheProcess) {
+    GTEST_FLAG_SET(death_test_style, "threadsafe");  // a fresh process: no handler of an earlier test
+    test::TempDir dir;
+    write_tractogram(dir.file("in.tck"));
+    compress_file(dir.file("in.tck"), dir.file("in.fft"), {});
+    std::vector<char> page(std::size_t(4 * ::sysconf(_SC_PAGESIZE)), 1);
+    test::write_file(dir.file("victim"), std::string(page.begin(), page.end()));
+    EXPECT_EXIT(
+        {
+            install_fiblet_handler(dir.file("in.fft"));
+            fault_outside_fiblet(dir.file("victim"));
+        },
+        ::testing::KilledBySignal(SIGBUS), "");
+}
+
+TEST(SelectTruncationDeathTest, AFaultOutsideACopyGoesToTheHandlerFromBefore) {
+    GTEST_FLAG_SET(death_test_style, "threadsafe");  // a fresh process: its handler is installed before fiblet's
+    test::TempDir dir;
+    write_tractogram(dir.file("in.tck"));
+    compress_file(dir.file("in.tck"), dir.file("in.fft"), {});
+    std::vector<char> page(std::size_t(4 * ::sysconf(_SC_PAGESIZE)), 1);
+    test::write_file(dir.file("victim"), std::string(page.begin(), page.end()));
+    EXPECT_EXIT(
+        {
+            struct sigaction a {};
+            a.sa_handler = [](int) { std::_Exit(42); };
+            ::sigaction(SIGBUS, &a, nullptr);
+            install_fiblet_handler(dir.file("in.fft"));
+            fault_outside_fiblet(dir.file("victim"));
+        },
+        ::testing::ExitedWithCode(42), "");
 }
 
 TEST(SelectTruncation, ASubsetBeingWrittenIsRemoved) {

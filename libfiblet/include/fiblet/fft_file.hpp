@@ -116,14 +116,19 @@ public:
     void read_blocks(std::uint64_t first, std::uint64_t count, std::uint8_t* out) const;
     std::vector<std::uint8_t> read_blocks(std::uint64_t first, std::uint64_t count) const;
 
-    // Blocks [first, first+count) in place, in a read-only memory mapping of
-    // the file (made on the first call, kept until the FftFile goes), checked
-    // as read_blocks checks them: for reading scattered blocks without a
-    // system call and a copy each. Empty when the file cannot be mapped (use
-    // read_blocks then). The file must not shrink while mapped: a truncated
-    // file kills the process with SIGBUS (no error, no cleanup). fiblet's
-    // own readers therefore use read_blocks (SelectOptions::map_file is off).
-    std::span<const std::uint8_t> mapped_blocks(std::uint64_t first, std::uint64_t count) const;
+    // Blocks [first, first+count) of each span (ascending, not overlapping)
+    // into `out`, one span after the other, checked as read_blocks checks
+    // them, copied out of a read-only memory mapping of the file (made on
+    // the first call, kept until the FftFile goes): no system call per span
+    // and no bytes between spans. A file that shrinks meanwhile is
+    // Error{fft_format} ("unexpected end of file") as with read_blocks: the
+    // mapping is only read by a copy that catches the fault (SIGBUS).
+    // False, with nothing read, when the file cannot be mapped (a .fftz
+    // container, packed 16-bit blocks, mmap refused): use read_blocks then.
+    struct BlockSpan {
+        std::uint64_t first, count;
+    };
+    bool read_blocks_mapped(std::span<const BlockSpan> spans, std::uint8_t* out) const;
 
 private:
     struct Mapping;
@@ -136,7 +141,10 @@ private:
                               std::uint8_t* out) const;
     void open_trailer(std::span<const std::uint8_t> head, std::uint64_t lut_hash);
     void verify_open_checksums(std::span<const std::uint8_t> head, std::uint64_t lut_hash) const;
-    void check_block_structure(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const;
+    // `fiber`: the fiber holding block `first` (fiber_of_block).
+    void check_block_structure(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks,
+                               std::uint64_t fiber) const;
+    const std::uint8_t* mapped_first_block() const;
     void verify_block_groups(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const;
     void close() noexcept;
 
@@ -162,7 +170,7 @@ private:
     std::shared_ptr<const FiberEndFractions> end_fractions_;
     std::shared_ptr<const std::vector<StreamlineField>> fields_;
     std::unique_ptr<std::atomic<std::uint64_t>[]> verified_groups_;  // one bit per block group
-    std::unique_ptr<Mapping> mapping_;                                // mapped_blocks()
+    std::unique_ptr<Mapping> mapping_;                                // read_blocks_mapped()
     std::unique_ptr<detail::InputRegistration> input_;  // no output of this process may replace the file
 };
 

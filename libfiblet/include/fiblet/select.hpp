@@ -152,12 +152,12 @@ struct SelectedChunk {
 struct SelectOptions {
     bool points = true;                       // decode and output points
     std::size_t chunk_points = 1u << 18;      // points per chunk handed to the sink
-    // Read blocks through FftFile::mapped_blocks() instead of pread(). Off by
-    // default: a file truncated by another process while mapped kills the
-    // whole process with SIGBUS (no error, no cleanup), where a read fails
-    // with Error{fft_format} ("unexpected end of file"). Turn it on only for
-    // files nobody modifies (docs/select.md has the cost of each way).
-    bool map_file = false;
+    // Copy the candidate blocks out of a memory mapping of the file
+    // (FftFile::read_blocks_mapped: those blocks only, no system call per
+    // block) instead of reading spans of the file with pread(), small gaps
+    // included. A file that shrinks meanwhile is Error{fft_format} either
+    // way; off only to compare the two (docs/select.md).
+    bool map_file = true;
 };
 
 // Runs a query, handing the output to `sink` in file order, a chunk of whole

@@ -18,6 +18,7 @@
 #include "container/fft_trailer.hpp"
 #include "fiblet/tractogram_format.hpp"
 #include "container/fftz_reader.hpp"
+#include "io/mapped_copy.hpp"
 #include "io/open_inputs.hpp"
 #include "io/regular_input.hpp"
 
@@ -310,7 +311,7 @@ void FftFile::read_blocks(std::uint64_t first, std::uint64_t count, std::uint8_t
     if (count == 0) return;
     if (!header_.packed()) {
         read_at(out, count * header_.block_bytes(), header_.blocks_offset() + first * header_.block_bytes());
-        check_block_structure(first, count, out);
+        check_block_structure(first, count, out, fiber_of_block(first));
         if (verifies_checksums()) verify_block_groups(first, count, out);
         return;
     }
@@ -322,7 +323,7 @@ void FftFile::read_blocks(std::uint64_t first, std::uint64_t count, std::uint8_t
     stored.resize(stored_offset(first + count) - begin);
     read_at(stored.data(), stored.size(), header_.blocks_offset() + begin);
     expand_packed_blocks(first, count, stored.data(), out);
-    check_block_structure(first, count, out);
+    check_block_structure(first, count, out, fiber_of_block(first));
     if (verifies_checksums()) verify_block_groups(first, count, stored.data());
     if (stored.capacity() > (std::size_t{16} << 20)) std::vector<std::uint8_t>().swap(stored);  // a whole-file read: let it go
 }
@@ -364,10 +365,10 @@ void FftFile::expand_packed_blocks(std::uint64_t first, std::uint64_t count, con
     }
 }
 
-void FftFile::check_block_structure(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const {
+void FftFile::check_block_structure(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks,
+                                    std::uint64_t fiber) const {
     const std::uint32_t bb = header_.block_bytes();
-    std::uint64_t f = fiber_of_block(first);  // the fiber holding block `first`
-    std::uint64_t k = first - fiber_first_block_[f];
+    std::uint64_t f = fiber, k = first - fiber_first_block_[f];
     for (std::uint64_t b = 0; b < count; ++b, ++k) {
         while (k >= lut_[f].block_count()) ++f, k = 0;
         const BlockFlags v = block_flags(header_, blocks + b * bb);
@@ -421,26 +422,53 @@ void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, cons
     }
 }
 
-std::span<const std::uint8_t> FftFile::mapped_blocks(std::uint64_t first, std::uint64_t count) const {
-    if (first > header_.blocks || count > header_.blocks - first)
-        throw Error(Errc::invalid_argument, path_ + ": block range past the end");
-    // A container has no blocks to map, nor has a packed file (they are expanded on reading).
-    if (count == 0 || fd_ < 0 || !mapping_ || fftz_ || header_.packed()) return {};
-    const std::uint64_t bb = header_.block_bytes();
+// The first block in the file's mapping, made on the first call; null
+// when there is none to make (a container, packed blocks) or mmap fails.
+const std::uint8_t* FftFile::mapped_first_block() const {
+    if (fd_ < 0 || !mapping_ || fftz_ || header_.packed() || header_.blocks == 0) return nullptr;
     Mapping& m = *mapping_;
     std::call_once(m.once, [&] {
         const std::uint64_t page = std::uint64_t(::sysconf(_SC_PAGESIZE));
         const std::uint64_t start = header_.blocks_offset() / page * page;
         m.skip = std::size_t(header_.blocks_offset() - start);
-        m.length = std::size_t(std::uint64_t{header_.blocks} * bb + m.skip);
+        m.length = std::size_t(std::uint64_t{header_.blocks} * header_.block_bytes() + m.skip);
         void* a = ::mmap(nullptr, m.length, PROT_READ, MAP_SHARED, fd_, off_t(start));
         if (a != MAP_FAILED) m.address = a;
     });
-    if (!m.address) return {};
-    const std::uint8_t* blocks = static_cast<const std::uint8_t*>(m.address) + m.skip + first * bb;
-    check_block_structure(first, count, blocks);
-    if (verifies_checksums()) verify_block_groups(first, count, blocks);
-    return {blocks, std::size_t(count * bb)};
+    return m.address ? static_cast<const std::uint8_t*>(m.address) + m.skip : nullptr;
+}
+
+bool FftFile::read_blocks_mapped(std::span<const BlockSpan> spans, std::uint8_t* out) const {
+    for (const BlockSpan& s : spans)
+        if (s.first > header_.blocks || s.count > header_.blocks - s.first)
+            throw Error(Errc::invalid_argument, path_ + ": block range past the end");
+    const std::uint8_t* blocks = mapped_first_block();
+    if (!blocks) return false;
+    const std::uint64_t bb = header_.block_bytes();
+    thread_local std::vector<detail::MappedCopy> copies;
+    copies.clear();
+    std::uint8_t* at = out;
+    for (const BlockSpan& s : spans) copies.push_back({blocks + s.first * bb, at, s.count * bb}), at += s.count * bb;
+    if (!detail::copy_from_mapping(copies))
+        throw Error(Errc::fft_format, path_ + ": unexpected end of file (it shrank while it was read)");
+    // The spans ascend: a span's fiber is a few fibers past the last one's
+    // (a short walk), else searched for.
+    const std::uint64_t fibers = fiber_first_block_.size();
+    auto fiber_from = [&](std::uint64_t f, std::uint64_t block) {
+        for (int step = 0; step < 16; ++step, ++f)
+            if (f + 1 >= fibers || fiber_first_block_[f + 1] > block) return f;
+        return fiber_of_block(block);
+    };
+    std::uint64_t fiber = 0;
+    at = out;
+    for (const BlockSpan& s : spans) {
+        if (s.count == 0) continue;
+        fiber = fiber_from(fiber, s.first);
+        check_block_structure(s.first, s.count, at, fiber);
+        if (verifies_checksums()) verify_block_groups(s.first, s.count, at);
+        at += s.count * bb;
+    }
+    return true;
 }
 
 std::vector<std::uint8_t> FftFile::read_blocks(std::uint64_t first, std::uint64_t count) const {

@@ -1,8 +1,7 @@
-// Internal: access to a sorted set of scattered blocks, checked as
-// FftFile::read_blocks checks them. Through the file's memory mapping when
-// there is one (no copy, no system call per block); else by reads in which
-// blocks closer than a small gap share one span (the gap bytes cost less
-// than another read).
+// Internal: a sorted set of scattered blocks in memory, checked as
+// FftFile::read_blocks checks them. Copied out of the file's memory mapping
+// when it has one (just those blocks, no system call per block); else read
+// in spans where blocks closer than a small gap share one read.
 #pragma once
 
 #include <cstdint>
@@ -20,7 +19,7 @@ public:
     // and consecutive blocks lie one after the other in memory.
     void read(const std::vector<std::uint32_t>& blocks);
     const std::uint8_t* block(std::size_t i) const { return pointers_[i]; }
-    // Blocks accessed (mapped) or transferred (read, gaps included) so far.
+    // Blocks copied (mapped) or read (gaps included) so far.
     std::uint64_t blocks_read() const { return blocks_read_; }
 
 private:
@@ -28,6 +27,7 @@ private:
     bool use_mapping_;
     std::uint64_t max_gap_;
     std::uint32_t block_bytes_;
+    std::vector<FftFile::BlockSpan> spans_;
     std::vector<std::uint8_t> buffer_;
     std::vector<const std::uint8_t*> pointers_;
     std::uint64_t blocks_read_ = 0;
