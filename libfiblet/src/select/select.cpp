@@ -18,6 +18,7 @@
 #include "fiblet/error.hpp"
 #include "fiblet/fiber_regions.hpp"
 #include "fiblet/select.hpp"
+#include "core/default_init_allocator.hpp"
 #include "select/block_batch_reader.hpp"
 #include "select/block_decoder.hpp"
 #include "index/block_spheres.hpp"
@@ -107,7 +108,7 @@ private:
 // Decodes `count` consecutive blocks (contiguous in memory) into xyz, which
 // must have room; returns their point counts' sum. Validates the counts.
 std::size_t decode_into(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count,
-                        std::vector<float>& xyz, std::size_t at_point) {
+                        detail::UninitializedVector<float>& xyz, std::size_t at_point) {
     const std::size_t n = count_block_points(ctx, blocks, count);
     if (xyz.size() < 3 * (at_point + n)) xyz.resize(3 * (at_point + n));
     detail::decode_selected_blocks(ctx, blocks, count, &xyz[3 * at_point]);
@@ -242,7 +243,7 @@ public:
     }
     // The output buffer and its frontier (in points), where blocks are
     // decoded; advance() moves the frontier past them.
-    std::vector<float>& buffer() { return xyz_; }
+    detail::UninitializedVector<float>& buffer() { return xyz_; }
     std::size_t frontier() const { return frontier_; }
     void advance(std::size_t points) { frontier_ += points; }
 
@@ -330,7 +331,7 @@ private:
     const SelectOptions& options_;
     const std::function<void(const SelectedChunk&)>& sink_;
     SelectionStats& stats_;
-    std::vector<float> xyz_;  // size only grows
+    detail::UninitializedVector<float> xyz_;  // size only grows; written where it grows
     std::size_t frontier_ = 0;                // points of the buffer in use
     std::size_t run_first_ = 0, run_end_ = 0;  // the open run's points
     std::vector<std::uint64_t> first_, count_;
@@ -779,7 +780,7 @@ private:
     const bool trust_inside_;
     const bool coarse_index_;
     std::vector<std::uint8_t> keep_;
-    std::vector<float> scratch_;  // decoded points that are tested, not output
+    detail::UninitializedVector<float> scratch_;  // decoded points that are tested, not output
     std::vector<std::uint8_t> staging_;
     std::vector<std::size_t> segment_;
     std::vector<const std::uint8_t*> block_pointers_;
