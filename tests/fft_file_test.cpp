@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <random>
+#include <vector>
 
 #include "fiblet/compress.hpp"
 #include "fiblet/decode.hpp"
@@ -102,4 +104,78 @@ TEST(FftFile, MissingFileIsAnIoError) {
     } catch (const Error& e) {
         EXPECT_EQ(e.code(), Errc::io);
     }
+}
+
+namespace {
+
+// 400 curved fibers of 600 points: 4,000 blocks over four checksum groups.
+std::string compress_curves(const test::TempDir& dir, const CompressOptions& o = {}) {
+    TckWriter w(dir.file("curves.tck"), {}, true);
+    std::vector<Vec3f> f(600);
+    for (int i = 0; i < 400; ++i) {
+        for (std::size_t k = 0; k < f.size(); ++k) {
+            const float t = 0.02f * float(k);
+            f[k] = {10 * std::cos(t + float(i)), 10 * std::sin(t + float(i)), 0.1f * float(k) + 0.01f * float(i)};
+        }
+        w.write(f);
+    }
+    w.finish();
+    const std::string out = dir.file(o.zstd ? "curves.fftz" : "curves.fft");
+    compress_file(dir.file("curves.tck"), out, o);
+    return out;
+}
+
+}  // namespace
+
+// Scattered spans copied out of the mapping are the blocks read_blocks
+// reads, one span after the other, in a fresh FftFile each time (so every
+// checksum group is verified through the mapping itself).
+TEST(FftFile, ReadBlocksMappedEqualsReadBlocks) {
+    test::TempDir dir;
+    const std::string path = compress_curves(dir);
+    const std::uint64_t blocks = FftFile(path).header().blocks;
+    ASSERT_GT(blocks, 3000u);
+    std::mt19937 rng(7);
+    for (int trial = 0; trial < 20; ++trial) {
+        const FftFile mapped(path), read(path);
+        std::vector<FftFile::BlockSpan> spans;
+        std::vector<std::uint8_t> expected;
+        for (std::uint64_t b = rng() % 40; b < blocks; b += 1 + rng() % 200) {
+            const std::uint64_t count = std::min<std::uint64_t>(1 + rng() % 5, blocks - b);
+            spans.push_back({b, count});
+            const auto r = read.read_blocks(b, count);
+            expected.insert(expected.end(), r.begin(), r.end());
+            b += count;
+        }
+        std::vector<std::uint8_t> got(expected.size());
+        ASSERT_TRUE(mapped.read_blocks_mapped(spans, got.data()));
+        EXPECT_EQ(got, expected) << "trial " << trial;
+    }
+}
+
+TEST(FftFile, ReadBlocksMappedChecksWhatItCopies) {
+    test::TempDir dir;
+    const std::string path = compress_curves(dir);
+    const FftHeader h = FftFile(path).header();
+    std::vector<std::uint8_t> out(8 * h.block_bytes());
+    {  // out of range, or not ascending
+        const FftFile f(path);
+        const FftFile::BlockSpan past{h.blocks - 1, 2}, back[2] = {{10, 2}, {11, 1}};
+        EXPECT_EQ(test::error_of([&] { f.read_blocks_mapped({&past, 1}, out.data()); }), Errc::invalid_argument);
+        EXPECT_EQ(test::error_of([&] { f.read_blocks_mapped(back, out.data()); }), Errc::invalid_argument);
+    }
+    // A direction byte of block 2500 flipped: its group's checksum fails.
+    ASSERT_GT(h.blocks, 3000u);
+    std::string bytes = test::read_file(path);
+    bytes[h.blocks_offset() + 2500 * h.block_bytes() + h.block_bytes() - 1] ^= 0x10;
+    test::write_file(dir.file("flipped.fft"), bytes);
+    const FftFile flipped(dir.file("flipped.fft"));
+    const FftFile::BlockSpan around{2498, 4};
+    EXPECT_EQ(test::error_of([&] { flipped.read_blocks_mapped({&around, 1}, out.data()); }), Errc::checksum);
+    // A container has no blocks to map: nothing read, read_blocks then.
+    CompressOptions z;
+    z.zstd = ZstdOptions{};
+    const FftFile fftz(compress_curves(dir, z));
+    const FftFile::BlockSpan first{0, 2};
+    EXPECT_FALSE(fftz.read_blocks_mapped({&first, 1}, out.data()));
 }

@@ -439,9 +439,13 @@ const std::uint8_t* FftFile::mapped_first_block() const {
 }
 
 bool FftFile::read_blocks_mapped(std::span<const BlockSpan> spans, std::uint8_t* out) const {
-    for (const BlockSpan& s : spans)
+    std::uint64_t end = 0;  // of the spans so far
+    for (const BlockSpan& s : spans) {
         if (s.first > header_.blocks || s.count > header_.blocks - s.first)
             throw Error(Errc::invalid_argument, path_ + ": block range past the end");
+        if (s.first < end) throw Error(Errc::invalid_argument, path_ + ": block ranges not ascending");
+        end = s.first + s.count;
+    }
     const std::uint8_t* blocks = mapped_first_block();
     if (!blocks) return false;
     const std::uint64_t bb = header_.block_bytes();
