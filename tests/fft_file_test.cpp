@@ -108,18 +108,9 @@ TEST(FftFile, MissingFileIsAnIoError) {
 
 namespace {
 
-// 400 curved fibers of 600 points: 4,000 blocks over four checksum groups.
+// 400 helices of 600 points: 4,000 blocks over four checksum groups.
 std::string compress_curves(const test::TempDir& dir, const CompressOptions& o = {}) {
-    TckWriter w(dir.file("curves.tck"), {}, true);
-    std::vector<Vec3f> f(600);
-    for (int i = 0; i < 400; ++i) {
-        for (std::size_t k = 0; k < f.size(); ++k) {
-            const float t = 0.02f * float(k);
-            f[k] = {10 * std::cos(t + float(i)), 10 * std::sin(t + float(i)), 0.1f * float(k) + 0.01f * float(i)};
-        }
-        w.write(f);
-    }
-    w.finish();
+    test::write_helix_tck(dir.file("curves.tck"), 400, 600);
     const std::string out = dir.file(o.zstd ? "curves.fftz" : "curves.fft");
     compress_file(dir.file("curves.tck"), out, o);
     return out;

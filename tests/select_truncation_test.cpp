@@ -29,18 +29,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// 400 curved fibers of 300 points: a few thousand blocks, several checksum groups.
-void write_tractogram(const std::string& path) {
-    TckWriter w(path, {}, true);
-    std::vector<Vec3f> f(300);
-    for (int i = 0; i < 400; ++i) {
-        for (std::size_t k = 0; k < f.size(); ++k) {
-            const float t = 0.02f * float(k);
-            f[k] = {10 * std::cos(t + float(i)), 10 * std::sin(t + float(i)), 0.1f * float(k) + 0.01f * float(i)};
-        }
-        w.write(f);
-    }
-    w.finish();
+// 400 helices of 300 points: a few thousand blocks, several checksum groups.
+std::string compressed_helices(const test::TempDir& dir) {
+    test::write_helix_tck(dir.file("in.tck"), 400, 300);
+    compress_file(dir.file("in.tck"), dir.file("in.fft"), {});
+    return dir.file("in.fft");
 }
 
 // The file opened (header, LUT, index), then cut to half of its blocks by
@@ -71,9 +64,7 @@ void expect_unexpected_end(const std::function<void()>& read, const std::string&
 TEST(SelectTruncation, ATruncatedFileIsAnErrorNotACrash) {
     for (const bool mapped : {true, false}) {
         test::TempDir dir;
-        write_tractogram(dir.file("in.tck"));
-        compress_file(dir.file("in.tck"), dir.file("in.fft"), {});
-        TruncatedAfterOpen t(dir.file("in.fft"));
+        TruncatedAfterOpen t(compressed_helices(dir));
         t.cut();
         SelectOptions o;
         o.map_file = mapped;
@@ -87,9 +78,7 @@ TEST(SelectTruncation, ATruncatedFileIsAnErrorNotACrash) {
 // copies fault (SIGBUS) on the pages past the new end, and fail.
 TEST(SelectTruncation, AFileCutUnderAnExistingMappingIsAnError) {
     test::TempDir dir;
-    write_tractogram(dir.file("in.tck"));
-    compress_file(dir.file("in.tck"), dir.file("in.fft"), {});
-    TruncatedAfterOpen t(dir.file("in.fft"));
+    TruncatedAfterOpen t(compressed_helices(dir));
     std::uint64_t points = 0;
     select(t.file, t.index, Query{}, [&](const SelectedChunk& c) { points += c.point_count(); });
     EXPECT_EQ(points, t.file.header().points);
@@ -119,45 +108,42 @@ void install_fiblet_handler(const std::string& fft) {
     select(f, BlockIndex::load(f), Query{}, [](const SelectedChunk&) {});
 }
 
+// A .fft to select from and a file of four pages to fault on.
+struct FaultFiles {
+    test::TempDir dir;
+    std::string fft = compressed_helices(dir), victim = dir.file("victim");
+    FaultFiles() { test::write_file(victim, std::string(std::size_t(4 * ::sysconf(_SC_PAGESIZE)), '\1')); }
+};
+
 TEST(SelectTruncationDeathTest, AFaultOutsideACopyStillEndsTheProcess) {
     GTEST_FLAG_SET(death_test_style, "threadsafe");  // a fresh process: no handler of an earlier test
-    test::TempDir dir;
-    write_tractogram(dir.file("in.tck"));
-    compress_file(dir.file("in.tck"), dir.file("in.fft"), {});
-    std::vector<char> page(std::size_t(4 * ::sysconf(_SC_PAGESIZE)), 1);
-    test::write_file(dir.file("victim"), std::string(page.begin(), page.end()));
+    const FaultFiles files;
     EXPECT_EXIT(
         {
-            install_fiblet_handler(dir.file("in.fft"));
-            fault_outside_fiblet(dir.file("victim"));
+            install_fiblet_handler(files.fft);
+            fault_outside_fiblet(files.victim);
         },
         ::testing::KilledBySignal(SIGBUS), "");
 }
 
 TEST(SelectTruncationDeathTest, AFaultOutsideACopyGoesToTheHandlerFromBefore) {
     GTEST_FLAG_SET(death_test_style, "threadsafe");  // a fresh process: its handler is installed before fiblet's
-    test::TempDir dir;
-    write_tractogram(dir.file("in.tck"));
-    compress_file(dir.file("in.tck"), dir.file("in.fft"), {});
-    std::vector<char> page(std::size_t(4 * ::sysconf(_SC_PAGESIZE)), 1);
-    test::write_file(dir.file("victim"), std::string(page.begin(), page.end()));
+    const FaultFiles files;
     EXPECT_EXIT(
         {
             struct sigaction a {};
             a.sa_handler = [](int) { std::_Exit(42); };
             ::sigaction(SIGBUS, &a, nullptr);
-            install_fiblet_handler(dir.file("in.fft"));
-            fault_outside_fiblet(dir.file("victim"));
+            install_fiblet_handler(files.fft);
+            fault_outside_fiblet(files.victim);
         },
         ::testing::ExitedWithCode(42), "");
 }
 
 TEST(SelectTruncation, ASubsetBeingWrittenIsRemoved) {
     test::TempDir dir;
-    write_tractogram(dir.file("in.tck"));
-    compress_file(dir.file("in.tck"), dir.file("in.fft"), {});
     fs::create_directory(dir.file("out"));
-    TruncatedAfterOpen t(dir.file("in.fft"));
+    TruncatedAfterOpen t(compressed_helices(dir));
     const auto runs = select_runs(t.file, t.index, Query{});
     t.cut();
     EXPECT_THROW(write_fft_subset(t.file, runs, dir.file("out/subset.fft"), false), Error);

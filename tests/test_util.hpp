@@ -3,6 +3,7 @@
 
 #include <stdlib.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -115,6 +116,21 @@ inline void write_three_fiber_tck(const std::string& path) {
     w.write(f);
     f.resize(1);
     w.write(f);
+    w.finish();
+}
+
+// `fibers` helices of `points` points 0.1 mm apart along z, each turned by
+// its index: many blocks over several checksum groups, for reading tests.
+inline void write_helix_tck(const std::string& path, int fibers, std::size_t points) {
+    TckWriter w(path, {}, true);
+    std::vector<Vec3f> f(points);
+    for (int i = 0; i < fibers; ++i) {
+        for (std::size_t k = 0; k < f.size(); ++k) {
+            const float t = 0.02f * float(k);
+            f[k] = {10 * std::cos(t + float(i)), 10 * std::sin(t + float(i)), 0.1f * float(k) + 0.01f * float(i)};
+        }
+        w.write(f);
+    }
     w.finish();
 }
 
