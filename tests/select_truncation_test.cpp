@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "fiblet/block_index.hpp"
+#include "fiblet/checksum.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
@@ -89,6 +90,38 @@ TEST(SelectTruncation, AFileCutUnderAnExistingMappingIsAnError) {
     std::vector<std::uint8_t> blocks(4 * t.file.header().block_bytes());
     EXPECT_TRUE(t.file.read_blocks_mapped({&first, 1}, blocks.data()));
     EXPECT_EQ(blocks, t.file.read_blocks(0, 4));
+}
+
+// A block before the cut whose checksum group reaches past it: hashing the
+// group's unread part (in place in the mapping) meets the cut, read or mapped.
+TEST(SelectTruncation, AGroupHashedAcrossTheCutIsAnError) {
+    for (const bool mapped : {true, false}) {
+        test::TempDir dir;
+        TruncatedAfterOpen t(compressed_helices(dir));
+        t.cut();
+        const std::uint64_t last_kept = t.file.header().blocks / 2 - 1;
+        ASSERT_NE((last_kept + 1) % kDefaultChecksumGroupBlocks, 0u);  // its group goes on past the cut
+        std::vector<std::uint8_t> block(t.file.header().block_bytes());
+        const FftFile::BlockSpan span{last_kept, 1};
+        expect_unexpected_end(
+            [&] { mapped ? (void)t.file.read_blocks_mapped({&span, 1}, block.data()) : t.file.read_blocks(last_kept, 1, block.data()); },
+            mapped ? "mapped" : "read");
+    }
+}
+
+// The first block past the cut, on the page the cut falls in: the mapping
+// reads zeros there (no fault), which must not pass for a damaged block.
+TEST(SelectTruncation, ABlockPastACutInsideAPageIsAnError) {
+    test::TempDir dir;
+    TruncatedAfterOpen t(compressed_helices(dir));
+    t.cut();
+    const FftHeader& h = t.file.header();
+    const std::uint64_t first_cut = h.blocks / 2, page = std::uint64_t(::sysconf(_SC_PAGESIZE));
+    const std::uint64_t cut_at = h.blocks_offset() + first_cut * h.block_bytes();
+    ASSERT_LT(cut_at % page + h.block_bytes(), page);  // the block lies inside the cut page
+    std::vector<std::uint8_t> block(h.block_bytes());
+    const FftFile::BlockSpan span{first_cut, 1};
+    expect_unexpected_end([&] { t.file.read_blocks_mapped({&span, 1}, block.data()); }, "mapped");
 }
 
 // A mapped page past the end of a truncated file, read outside fiblet's

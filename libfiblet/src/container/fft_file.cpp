@@ -397,9 +397,16 @@ void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, cons
     const std::uint64_t g_blocks = c.group_blocks, end = first + count, base = stored_offset(first);
     std::vector<std::uint8_t> edge;  // the part of a group outside [first, end)
     Xxh64Stream hash;
+    // Hashed in place in the mapping when the file has one (no copy), else read.
+    const std::uint8_t* mapped = mapped_first_block();
     auto hash_from_file = [&](std::uint64_t b0, std::uint64_t b1) {
-        const std::uint64_t at = stored_offset(b0);
-        edge.resize(stored_offset(b1) - at);
+        const std::uint64_t at = stored_offset(b0), size = stored_offset(b1) - at;
+        if (mapped) {
+            if (!detail::hash_from_mapping(mapped + at, size, hash)) shrank_while_read();
+            require_size(header_.blocks_offset() + at + size);
+            return;
+        }
+        edge.resize(size);
         read_at(edge.data(), edge.size(), header_.blocks_offset() + at);
         hash.update(edge.data(), edge.size());
     };
@@ -420,6 +427,19 @@ void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, cons
                                             "): the file is corrupted");
         word.fetch_or(bit, std::memory_order_release);
     }
+}
+
+void FftFile::shrank_while_read() const {
+    throw Error(Errc::fft_format, path_ + ": unexpected end of file (it shrank while it was read)");
+}
+
+// After a read of the mapping: the file still holds `end` bytes. A cut
+// inside a page faults only past that page; before it, the mapping reads
+// zeros where the file was, which must not pass for damaged blocks.
+void FftFile::require_size(std::uint64_t end) const {
+    struct stat st {};
+    if (::fstat(fd_, &st) != 0) throw Error(Errc::io, path_ + ": cannot stat: " + std::strerror(errno));
+    if (std::uint64_t(st.st_size) < end) shrank_while_read();
 }
 
 // The first block in the file's mapping, made on the first call; null
@@ -453,8 +473,8 @@ bool FftFile::read_blocks_mapped(std::span<const BlockSpan> spans, std::uint8_t*
     copies.clear();
     std::uint8_t* at = out;
     for (const BlockSpan& s : spans) copies.push_back({blocks + s.first * bb, at, s.count * bb}), at += s.count * bb;
-    if (!detail::copy_from_mapping(copies))
-        throw Error(Errc::fft_format, path_ + ": unexpected end of file (it shrank while it was read)");
+    if (!detail::copy_from_mapping(copies)) shrank_while_read();
+    require_size(header_.blocks_offset() + end * bb);
     // The spans ascend: a span's fiber is a few fibers past the last one's
     // (a short walk), else searched for.
     const std::uint64_t fibers = fiber_first_block_.size();
