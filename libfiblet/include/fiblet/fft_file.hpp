@@ -145,6 +145,7 @@ private:
     void check_block_structure(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks,
                                std::uint64_t fiber) const;
     const std::uint8_t* mapped_first_block() const;
+    void require_block_range(std::uint64_t first, std::uint64_t count) const;  // or Error{invalid_argument}
     [[noreturn]] void shrank_while_read() const;  // a mapped read faulted
     void require_size(std::uint64_t end) const;   // or shrank_while_read()
     void verify_block_groups(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const;

@@ -305,9 +305,13 @@ FftFile& FftFile::operator=(FftFile&& o) noexcept {
     return *this;
 }
 
-void FftFile::read_blocks(std::uint64_t first, std::uint64_t count, std::uint8_t* out) const {
+void FftFile::require_block_range(std::uint64_t first, std::uint64_t count) const {
     if (first > header_.blocks || count > header_.blocks - first)
         throw Error(Errc::invalid_argument, path_ + ": block range past the end");
+}
+
+void FftFile::read_blocks(std::uint64_t first, std::uint64_t count, std::uint8_t* out) const {
+    require_block_range(first, count);
     if (count == 0) return;
     if (!header_.packed()) {
         read_at(out, count * header_.block_bytes(), header_.blocks_offset() + first * header_.block_bytes());
@@ -398,10 +402,9 @@ void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, cons
     std::vector<std::uint8_t> edge;  // the part of a group outside [first, end)
     Xxh64Stream hash;
     // Hashed in place in the mapping when the file has one (no copy), else read.
-    const std::uint8_t* mapped = mapped_first_block();
     auto hash_from_file = [&](std::uint64_t b0, std::uint64_t b1) {
         const std::uint64_t at = stored_offset(b0), size = stored_offset(b1) - at;
-        if (mapped) {
+        if (const std::uint8_t* mapped = mapped_first_block()) {
             if (!detail::hash_from_mapping(mapped + at, size, hash)) shrank_while_read();
             require_size(header_.blocks_offset() + at + size);
             return;
@@ -461,8 +464,7 @@ const std::uint8_t* FftFile::mapped_first_block() const {
 bool FftFile::read_blocks_mapped(std::span<const BlockSpan> spans, std::uint8_t* out) const {
     std::uint64_t end = 0;  // of the spans so far
     for (const BlockSpan& s : spans) {
-        if (s.first > header_.blocks || s.count > header_.blocks - s.first)
-            throw Error(Errc::invalid_argument, path_ + ": block range past the end");
+        require_block_range(s.first, s.count);
         if (s.first < end) throw Error(Errc::invalid_argument, path_ + ": block ranges not ascending");
         end = s.first + s.count;
     }

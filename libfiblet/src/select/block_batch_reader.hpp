@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/default_init_allocator.hpp"
 #include "fiblet/fft_file.hpp"
 
 namespace fiblet::detail {
@@ -28,7 +29,7 @@ private:
     std::uint64_t max_gap_;
     std::uint32_t block_bytes_;
     std::vector<FftFile::BlockSpan> spans_;
-    std::vector<std::uint8_t> buffer_;
+    UninitializedVector<std::uint8_t> buffer_;  // written right after it grows
     std::vector<const std::uint8_t*> pointers_;
     std::uint64_t blocks_read_ = 0;
 };
