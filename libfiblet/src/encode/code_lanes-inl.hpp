@@ -16,6 +16,9 @@
 
 #include <hwy/highway.h>
 
+#include <algorithm>
+#include <cstdint>
+
 #include "encode/code_search.hpp"
 #include "encode/greedy_blocks.hpp"
 
@@ -64,9 +67,83 @@ HWY_INLINE void GatherFloats(D d, const float* base, hn::Vec<hn::RebindToSigned<
     for (; i < n; ++i) out[i] = hn::GatherIndex(d, base + i, at);
 }
 
+// out[i] = base[at[i] + j] per lane, i < n, for records in a table (at:
+// float indices): with AVX2, each lane's record comes with plain 128-bit
+// loads and the rows are transposed in registers, since AMD's AVX2 gathers
+// cost per element (a frame's nine floats for eight lanes: ~13 ns by rows
+// against ~21 ns by pair gathers on this project's AVX2 EPYC VMs). The
+// same floats, so the same bits, as GatherFloats. Reads the record's floats
+// up to at[i] + 3 (n <= 4), + 7 (n <= 8) or + 8 (n == 9): the caller's
+// records must have them. Other targets and widths: GatherFloats.
+#if HWY_TARGET == HWY_AVX2
+// Rows r0..r3 in the low halves and r4..r7 in the high halves of y[0..3]:
+// column c of the 4x4 blocks into col[c] (lane i: row i's float c).
+HWY_INLINE void TransposeHalves(const __m256 y[4], __m256 col[4]) {
+    const __m256 t0 = _mm256_unpacklo_ps(y[0], y[1]), t1 = _mm256_unpackhi_ps(y[0], y[1]);
+    const __m256 t2 = _mm256_unpacklo_ps(y[2], y[3]), t3 = _mm256_unpackhi_ps(y[2], y[3]);
+    col[0] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));
+    col[1] = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
+    col[2] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
+    col[3] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
+}
+
+// Four floats of lanes i and i + 4's records, from float `from` on.
+HWY_INLINE __m256 RowPair(const float* const rec[8], int i, int from) {
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(rec[i] + from)), _mm_loadu_ps(rec[i + 4] + from), 1);
+}
+
+// Eight lanes: the records' first n floats (n <= 9) as columns.
+HWY_INLINE void LoadRecords8(const float* base, __m256i at, __m256* out, int n) {
+    const __m128i lo = _mm256_castsi256_si128(at), hi = _mm256_extracti128_si256(at, 1);
+    const std::uint64_t q[4] = {std::uint64_t(_mm_cvtsi128_si64(lo)), std::uint64_t(_mm_extract_epi64(lo, 1)),
+                                std::uint64_t(_mm_cvtsi128_si64(hi)), std::uint64_t(_mm_extract_epi64(hi, 1))};
+    const float* rec[8];
+    for (int i = 0; i < 4; ++i) rec[2 * i] = base + std::uint32_t(q[i]), rec[2 * i + 1] = base + (q[i] >> 32);
+    for (int from = 0; from < std::min(n, 8); from += 4) {
+        __m256 y[4], col[4];
+        for (int i = 0; i < 4; ++i) y[i] = RowPair(rec, i, from);
+        TransposeHalves(y, col);
+        for (int c = 0; c < 4 && from + c < n; ++c) out[from + c] = col[c];
+    }
+    if (n == 9) {  // float 8: the last of floats 5..8
+        __m256 y[4];
+        for (int i = 0; i < 4; ++i) y[i] = RowPair(rec, i, 5);
+        const __m256 t1 = _mm256_unpackhi_ps(y[0], y[1]), t3 = _mm256_unpackhi_ps(y[2], y[3]);
+        out[8] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
+    }
+}
+#endif
+
+template <class D>
+HWY_INLINE void LoadRecords(D d, const float* base, hn::Vec<hn::RebindToSigned<D>> at, hn::Vec<D>* out, int n) {
+#if HWY_TARGET == HWY_AVX2
+    if constexpr (hn::MaxLanes(D()) == 8) {
+        __m256 cols[9];
+        LoadRecords8(base, at.raw, cols, n);
+        for (int i = 0; i < n; ++i) out[i].raw = cols[i];
+        return;
+    }
+#endif
+    GatherFloats(d, base, at, out, n);
+}
+
+// Float to int32 by truncation, for lanes known to be in int range.
+HWY_INLINE __m128i TruncateInRange(__m128 v) { return _mm_cvttps_epi32(v); }
+#if HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3
+HWY_INLINE __m256i TruncateInRange(__m256 v) { return _mm256_cvttps_epi32(v); }
+#endif
+#if HWY_TARGET == HWY_AVX3
+HWY_INLINE __m512i TruncateInRange(__m512 v) { return _mm512_cvttps_epi32(v); }
+#endif
+
 // The 8-bit code book, one code per lane. A frame is held as nine vectors,
 // f[3 * c + i] = component i of column c (column 0: the step's direction).
-template <class D>
+// kByRows: frames and directions come by LoadRecords, else by GatherFloats
+// (the same bits). Which is faster depends on the kernel: greedy aiming
+// waits on each frame (rows: BM_EncodeSearch effort 0 35.4 -> 32.4 ms on
+// an AVX2 EPYC), the lookahead has other work to overlap a gather with
+// (rows: 117 -> 119.5 ms).
+template <class D, bool kByRows = false>
 struct CodeLanes {
     using DI = hn::RebindToSigned<D>;
     using VF = hn::Vec<D>;
@@ -102,7 +179,9 @@ struct CodeLanes {
     VI cell(VF u) const {
         const VF f = hn::Mul(hn::Add(u, rim_tan), cell_scale);
         const VF in_range = hn::IfThenElseZero(hn::Lt(f, int_range), f);  // NaN, >= 2^31: 0
-        return hn::ConvertTo(di, hn::Min(hn::Max(in_range, zero), last_cell));
+        VI out;  // the truncation alone: Highway's ConvertTo adds a fix-up for lanes out of int range, which the clamp rules out
+        out.raw = TruncateInRange(hn::Min(hn::Max(in_range, zero), last_cell).raw);
+        return out;
     }
 
     // NearestCodeLut::operator()(local): both the cap's and the rim's
@@ -137,14 +216,14 @@ struct CodeLanes {
     // The code's frame (its first column is its direction).
     void frame(VI code, VF* l) const {
         const VI at = frame_at(code);
-        GatherFloats(d, code_frames, at, l, 9);
+        kByRows ? LoadRecords(d, code_frames, at, l, 9) : GatherFloats(d, code_frames, at, l, 9);
     }
 
     // The code's direction (its frame's first column).
     void direction(VI code, VF& x, VF& y, VF& z) const {
         const VI at = frame_at(code);
         VF v[3];
-        GatherFloats(d, code_frames, at, v, 3);
+        kByRows ? LoadRecords(d, code_frames, at, v, 3) : GatherFloats(d, code_frames, at, v, 3);
         x = v[0], y = v[1], z = v[2];
     }
 
@@ -173,7 +252,7 @@ struct BatchLanes {
     // Lane i's target k at float index first_at[i] + 3 k (relative to block
     // j0's targets), held at its last target once its block is done (a
     // shorter last block).
-    VI at, at_end;
+    VI at, at_end, lengths;  // lengths: m_of
     const float* targets;
     std::size_t m_of[kMaxLanes], steps = 0, active;
     Vec3f* decoded[kMaxLanes];
@@ -182,7 +261,7 @@ struct BatchLanes {
     BatchLanes(const GreedyBatch& batch, std::size_t j0, std::size_t n) : targets(&batch.targets[j0 * batch.stride].x), active(std::min(n, hn::Lanes(D()))) {
         const hn::RebindToSigned<D> di;
         alignas(64) float start[12][kMaxLanes];
-        alignas(64) std::int32_t first_at[kMaxLanes], last_at[kMaxLanes];
+        alignas(64) std::int32_t first_at[kMaxLanes], last_at[kMaxLanes], length[kMaxLanes];
         for (std::size_t i = 0; i < hn::Lanes(d); ++i) {
             const std::size_t j = j0 + std::min(i, active - 1);
             const Frame& fr = batch.frames[j];
@@ -191,13 +270,14 @@ struct BatchLanes {
                 start[3 * c][i] = fr.c[c].x, start[3 * c + 1][i] = fr.c[c].y, start[3 * c + 2][i] = fr.c[c].z;
             start[9][i] = p.x, start[10][i] = p.y, start[11][i] = p.z;
             m_of[i] = batch.length(j);
+            length[i] = std::int32_t(m_of[i]);
             steps = std::max(steps, m_of[i]);
             first_at[i] = std::int32_t(3 * (j - j0) * batch.stride);
             last_at[i] = std::int32_t(3 * ((j - j0) * batch.stride + m_of[i] - 1));
         }
         for (int j = 0; j < 9; ++j) f[j] = hn::Load(d, start[j]);
         px = hn::Load(d, start[9]), py = hn::Load(d, start[10]), pz = hn::Load(d, start[11]);
-        at = hn::Load(di, first_at), at_end = hn::Load(di, last_at);
+        at = hn::Load(di, first_at), at_end = hn::Load(di, last_at), lengths = hn::Load(di, length);
         for (std::size_t i = 0; i < active; ++i)
             decoded[i] = batch.decoded + (j0 + i) * batch.stride, codes[i] = batch.codes + (j0 + i) * batch.code_stride;
     }
@@ -213,9 +293,8 @@ struct BatchLanes {
     VI ahead_at(int n) const { return hn::Min(hn::Add(at, hn::Set(hn::RebindToSigned<D>(), 3 * n)), at_end); }
     // Lanes still having a target after step k.
     hn::Mask<D> more_after(std::size_t k) const {
-        alignas(64) float more[kMaxLanes];
-        for (std::size_t i = 0; i < hn::Lanes(d); ++i) more[i] = k + 1 < m_of[i] ? 1.0f : 0.0f;
-        return hn::Gt(hn::Load(d, more), hn::Zero(d));
+        const hn::RebindToSigned<D> di;
+        return hn::RebindMask(d, hn::Lt(hn::Set(di, std::int32_t(k + 1)), lengths));
     }
 
     // Step k's point and code to each active lane's block (scalar stores,
