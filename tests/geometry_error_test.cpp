@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "fiblet/compress.hpp"
+#include "fiblet/error.hpp"
 #include "fiblet/geometry_error.hpp"
 #include "stats/geometry_paths.hpp"
 #include "scoped_simd_loops.hpp"
@@ -287,6 +288,43 @@ TEST(GeometryError, VectorsEqualScalarLoops) {
         expect_same_bits(avx2, scalar);
     }
     detail::geometry_shortcut_enabled() = true;
+}
+
+// add_fiber's pointwise squares (compress's point errors of fixed-step
+// input, taken from the report's own computation): each is the pair's
+// squared distance in double, ((dx dx + dy dy) + dz dz), whichever loops
+// and path (the shortcut's proof or the window) measured the pair; the
+// report itself does not change; a span of the wrong size is refused.
+TEST(GeometryError, PointwiseSquaresAreEachPairsDistance) {
+    std::vector<std::pair<Line, Line>> pairs = fixed_step_pairs(), folded = folded_pairs();
+    pairs.insert(pairs.end(), folded.begin(), folded.end());
+    const GeometryError plain = measure_pairs(pairs);
+    for (const bool shortcut : {true, false})
+        for (const bool avx2 : {true, false}) {
+            SCOPED_TRACE(testing::Message() << "shortcut " << shortcut << " avx2 " << avx2);
+            detail::geometry_shortcut_enabled() = shortcut;
+            const test::ScopedSimdLoops loops(avx2);
+            GeometryError g;
+            for (std::size_t i = 0; i < pairs.size(); ++i) {
+                const auto& [in, dec] = pairs[i];
+                std::vector<double> e2(in.size(), -1.0);
+                g.add_fiber(in, dec, i, e2);
+                for (std::size_t k = 0; k < in.size(); ++k) {
+                    const double dx = double(in[k].x) - double(dec[k].x), dy = double(in[k].y) - double(dec[k].y),
+                                 dz = double(in[k].z) - double(dec[k].z);
+                    ASSERT_EQ(e2[k], (dx * dx + dy * dy) + dz * dz) << "fiber " << i << " point " << k;
+                }
+            }
+            expect_same_bits(g, plain);
+        }
+    detail::geometry_shortcut_enabled() = true;
+    std::mt19937 rng(5);
+    const Line in = curve(20, 0.1, 0, rng, 0);
+    std::vector<double> wrong(in.size() - 1);
+    GeometryError g;
+    EXPECT_THROW(g.add_fiber(in, in, 0, wrong), Error);
+    Line shorter(in.begin(), in.end() - 1);
+    EXPECT_THROW(g.add_fiber(in, shorter, 0, std::span<double>(wrong.data(), in.size() - 1)), Error);
 }
 
 // The same end to end: compress's every AVX-512 and AVX2 loop over points

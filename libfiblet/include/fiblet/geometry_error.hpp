@@ -33,7 +33,12 @@ public:
     // Adds one streamline. Distances to a polyline are searched in a window
     // of segments around the nearest one so far (linear time along fibers
     // that follow each other); a result is never below the true distance.
-    void add_fiber(std::span<const Vec3f> input, std::span<const Vec3f> decoded, std::uint64_t fiber);
+    // `pointwise` (empty, or one value per point, the polylines then having
+    // as many points; else Error(invalid_argument)) receives
+    // |input[k] - decoded[k]|^2, which the report computes anyway (compress's
+    // point errors of a fixed-step input).
+    void add_fiber(std::span<const Vec3f> input, std::span<const Vec3f> decoded, std::uint64_t fiber,
+                   std::span<double> pointwise = {});
     void merge(const GeometryError& o);
 
     const ErrorStats& decoded_to_input() const { return decoded_to_input_; }

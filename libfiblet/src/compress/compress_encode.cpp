@@ -37,7 +37,11 @@ constexpr std::size_t kFibersTogether = 64;
 // The header's error of each point: the worse of fiblet's float decode and
 // the exact decode (when given), so it holds for every decoder. One square
 // root per point (of the larger square: the same double as the larger of
-// the two roots), taken by the statistics' pass.
+// the two roots), taken by the statistics' pass. e2 holds the float
+// decode's squares already where `known` (the symmetric report computed
+// them: a fixed-step input is its own targets); the exact decode's points
+// are then measured only where they differ from the float decode's (the
+// blocks append_exact8 walked in float64; a copy elsewhere).
 #ifdef FIBLET_POINTS_AVX2
 // The loop of add_point_errors four points at a time: the same double
 // operations (distance2's, std::max of non-NaN squares); returns the points
@@ -60,22 +64,32 @@ __attribute__((target("avx2"))) std::size_t point_errors_avx2(const Vec3f* targe
 }
 #endif
 
+bool same_point(const Vec3f& a, const Vec3f& b) { return std::memcmp(&a, &b, sizeof(Vec3f)) == 0; }
+
 void add_point_errors(std::span<const Vec3f> targets, std::span<const Vec3f> decoded,
-                      std::span<const Vec3f> decoded_exact, std::uint32_t fiber, std::vector<double>& scratch,
+                      std::span<const Vec3f> decoded_exact, std::uint32_t fiber, bool known, std::vector<double>& e2,
                       ErrorStats& out) {
     const std::size_t n = targets.size();
-    scratch.resize(n);
-    double* e2 = scratch.data();
+    if (known) {
+        if (!decoded_exact.empty() && std::memcmp(decoded.data(), decoded_exact.data(), n * sizeof(Vec3f)) != 0)
+            for (std::size_t k = 0; k < n; ++k)
+                if (!same_point(decoded[k], decoded_exact[k]))
+                    e2[k] = std::max(e2[k], distance2(targets[k], decoded_exact[k]));
+        out.add_all_roots(e2.data(), n, fiber);
+        return;
+    }
+    e2.resize(n);
     std::size_t k = 0;
 #ifdef FIBLET_POINTS_AVX2
     if (use_avx2_loops())
-        k = point_errors_avx2(targets.data(), decoded.data(), decoded_exact.empty() ? nullptr : decoded_exact.data(), n, e2);
+        k = point_errors_avx2(targets.data(), decoded.data(), decoded_exact.empty() ? nullptr : decoded_exact.data(), n,
+                              e2.data());
 #endif
     for (; k < n; ++k) {
         e2[k] = distance2(targets[k], decoded[k]);
         if (!decoded_exact.empty()) e2[k] = std::max(e2[k], distance2(targets[k], decoded_exact[k]));
     }
-    out.add_all_roots(e2, n, fiber);
+    out.add_all_roots(e2.data(), n, fiber);
 }
 
 // One task's outputs and scratch. Task t of every batch uses slot t of its
@@ -148,8 +162,10 @@ void measure_pending(const EncodeStageInputs& in, const FiberBatch& b, Slot& w) 
             w.index.add_fiber(decoded);
         }
         const StageClock clock(w.timings.metrics);
-        add_point_errors(points, decoded, decoded_exact, f, w.point_errors, w.error);
-        w.geometry.add_fiber(b.fibers[i], decoded, f);
+        const bool known = in.step <= 0;  // fixed-step: the targets are the input's points
+        if (known) w.point_errors.resize(n);
+        w.geometry.add_fiber(b.fibers[i], decoded, f, known ? std::span<double>(w.point_errors.data(), n) : std::span<double>());
+        add_point_errors(points, decoded, decoded_exact, f, known, w.point_errors, w.error);
     }
     w.targets.clear(), w.decoded.clear(), w.decoded_exact.clear();
     w.starts.assign(1, 0), w.block_ends.clear(), w.ends.clear(), w.lengths.clear();

@@ -1,5 +1,7 @@
 #include "fiblet/geometry_error.hpp"
 
+#include "fiblet/error.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -18,6 +20,7 @@
 namespace fiblet {
 
 using detail::distance;
+using detail::distance2;
 
 namespace {
 
@@ -214,12 +217,12 @@ struct OwnSegments {
 // Point k of own_segments (any k; the edges of the fiber and machines
 // without AVX2): its squared distance into nearest[k].
 void own_segments_at(const Segments& g, std::span<const Vec3f> from, std::span<const Vec3f> to, std::size_t k,
-                     double* nearest, OwnSegments& out) {
+                     double* nearest, double* pointwise, OwnSegments& out) {
     const std::size_t n = g.count;
     auto dot = [&](std::size_t a, std::size_t b) { return g.ux[a] * g.ux[b] + g.uy[a] * g.uy[b] + g.uz[a] * g.uz[b]; };
     const Vec3f p = from[k];
-    const double ex = double(p.x) - to[k].x, ey = double(p.y) - to[k].y, ez = double(p.z) - to[k].z;
-    const double e4 = 4 * (ex * ex + ey * ey + ez * ez);
+    const double e2 = distance2(p, to[k]), e4 = 4 * e2;
+    pointwise[k] = e2;
     bool proven = true;
     double before = std::numeric_limits<double>::infinity(), after = before;
     if (k > 0) {  // segment k - 1 and the three before it
@@ -278,7 +281,7 @@ FIBLET_AVX2 __m256d within_half_step(__m256d e4, const double* len4) {
 __attribute__((target("avx2"))) void own_segments_avx2(const Segments& to_g, const Segments& from_g,
                                                        std::span<const Vec3f> from, std::span<const Vec3f> to,
                                                        std::size_t k0, std::size_t k1, double* nearest,
-                                                       OwnSegments& out) {
+                                                       double* pointwise, OwnSegments& out) {
     const ColumnPointers g(to_g), p(from_g);
     const double *f0 = out.forward[0].data(), *f1 = out.forward[1].data(), *f2 = out.forward[2].data();
     std::uint8_t *proven = out.proven.data(), *later_out = out.later.data();
@@ -287,7 +290,8 @@ __attribute__((target("avx2"))) void own_segments_avx2(const Segments& to_g, con
         const __m256d x = _mm256_loadu_pd(p.ax + k), y = _mm256_loadu_pd(p.ay + k), z = _mm256_loadu_pd(p.az + k);
         const __m256d ex = _mm256_sub_pd(x, _mm256_loadu_pd(g.ax + k)), ey = _mm256_sub_pd(y, _mm256_loadu_pd(g.ay + k)),
                       ez = _mm256_sub_pd(z, _mm256_loadu_pd(g.az + k));
-        const __m256d e4 = _mm256_mul_pd(_mm256_set1_pd(4.0), detail::norm2(ex, ey, ez));
+        const __m256d e2 = detail::norm2(ex, ey, ez), e4 = _mm256_mul_pd(_mm256_set1_pd(4.0), e2);
+        _mm256_storeu_pd(pointwise + k, e2);
         const __m256d before = segment_dist2_avx2(g, x, y, z, k - 1), after = segment_dist2_avx2(g, x, y, z, k);
         const __m256d later = _mm256_cmp_pd(after, before, _CMP_LT_OQ);
         _mm256_storeu_pd(nearest + k, _mm256_blendv_pd(before, after, later));  // after < before ? after : before
@@ -301,7 +305,7 @@ __attribute__((target("avx2"))) void own_segments_avx2(const Segments& to_g, con
         store_mask_bytes(_mm256_movemask_pd(ok), proven + k);
         store_mask_bytes(_mm256_movemask_pd(later), later_out + k);
     }
-    for (; k < k1; ++k) own_segments_at(to_g, from, to, k, nearest, out);
+    for (; k < k1; ++k) own_segments_at(to_g, from, to, k, nearest, pointwise, out);
 }
 #undef FIBLET_AVX2
 
@@ -361,7 +365,8 @@ FIBLET_AVX512 __mmask8 within_half_step8(__m512d e4, const ColumnPointers& g, st
 // own_segments_avx2's loop eight points at a time from k0 (>= 4) while
 // eight fit before k1; returns where it stopped.
 __attribute__((target("avx512f,avx512dq,avx512bw,avx512vl"))) std::size_t own_segments_avx512(
-    const Segments& to_g, const Segments& from_g, std::size_t k0, std::size_t k1, double* nearest, OwnSegments& out) {
+    const Segments& to_g, const Segments& from_g, std::size_t k0, std::size_t k1, double* nearest, double* pointwise,
+    OwnSegments& out) {
     // Pointers in locals, the columns' too, as in forward_avx512.
     const ColumnPointers g(to_g), p(from_g);
     const double* f[3] = {out.forward[0].data(), out.forward[1].data(), out.forward[2].data()};
@@ -370,9 +375,10 @@ __attribute__((target("avx512f,avx512dq,avx512bw,avx512vl"))) std::size_t own_se
     std::size_t k = k0;
     for (; k + 8 <= k1; k += 8) {
         const __m512d x = column8(p.ax, k), y = column8(p.ay, k), z = column8(p.az, k);
-        const __m512d e4 = _mm512_mul_pd(_mm512_set1_pd(4.0), norm2_8(_mm512_sub_pd(x, column8(g.ax, k)),
-                                                                      _mm512_sub_pd(y, column8(g.ay, k)),
-                                                                      _mm512_sub_pd(z, column8(g.az, k))));
+        const __m512d e2 = norm2_8(_mm512_sub_pd(x, column8(g.ax, k)), _mm512_sub_pd(y, column8(g.ay, k)),
+                                   _mm512_sub_pd(z, column8(g.az, k)));
+        const __m512d e4 = _mm512_mul_pd(_mm512_set1_pd(4.0), e2);
+        _mm512_storeu_pd(pointwise + k, e2);
         const __m512d before = segment_dist2_avx512(g, x, y, z, k - 1), after = segment_dist2_avx512(g, x, y, z, k);
         const __mmask8 later = _mm512_cmp_pd_mask(after, before, _CMP_LT_OQ);
         _mm512_storeu_pd(nearest + k, _mm512_mask_blend_pd(later, before, after));
@@ -388,9 +394,9 @@ __attribute__((target("avx512f,avx512dq,avx512bw,avx512vl"))) std::size_t own_se
 #endif
 
 // own_segments_at for every point of a fixed-step pair (from_g: the
-// columns of `from`, g those of `to`).
+// columns of `from`, g those of `to`); pointwise[k] = |from[k] - to[k]|^2.
 void own_segments(const Segments& g, const Segments& from_g, std::span<const Vec3f> from, std::span<const Vec3f> to,
-                  double* nearest, OwnSegments& out) {
+                  double* nearest, double* pointwise, OwnSegments& out) {
     const std::size_t n = g.count, points = n + 1;  // to.size() == from.size() == n + 1
     at_least(out.later, points), at_least(out.proven, points);
     std::size_t k = 0;
@@ -399,13 +405,13 @@ void own_segments(const Segments& g, const Segments& from_g, std::span<const Vec
     if (use_avx2_loops() && n > 8) {
         const bool avx512 = use_avx512_loops();
         avx512 ? forward_avx512(g, out) : forward_avx2(g, out);
-        for (; k < 4; ++k) own_segments_at(g, from, to, k, nearest, out);
-        own_segments_avx2(g, from_g, from, to, avx512 ? own_segments_avx512(g, from_g, 4, n, nearest, out) : 4, n,
-                          nearest, out);
+        for (; k < 4; ++k) own_segments_at(g, from, to, k, nearest, pointwise, out);
+        own_segments_avx2(g, from_g, from, to, avx512 ? own_segments_avx512(g, from_g, 4, n, nearest, pointwise, out) : 4,
+                          n, nearest, pointwise, out);
         k = n;
     }
 #endif
-    for (; k < points; ++k) own_segments_at(g, from, to, k, nearest, out);
+    for (; k < points; ++k) own_segments_at(g, from, to, k, nearest, pointwise, out);
 }
 
 // The end of the run of proven points from k (bytes 0 or 1), eight at a
@@ -434,9 +440,10 @@ std::size_t proven_run_end(const std::uint8_t* proven, std::size_t k, std::size_
 // points' evaluations overlap instead of waiting on each other's nearest
 // segment); the nearest one is then chosen from the same window as always,
 // or evaluated directly where the window leaves those kLanes. The result is
-// the same, bit for bit.
+// the same, bit for bit. `pointwise` (when given, and the polylines have as
+// many points): |from[k] - to[k]|^2 for each k.
 double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, std::span<const Vec3f> to,
-                          const Segments& g, ErrorStats& out, std::uint64_t fiber) {
+                          const Segments& g, ErrorStats& out, std::uint64_t fiber, double* pointwise = nullptr) {
     if (to.empty()) return 0;
     if (from.empty()) return g.length;
     const std::size_t n = g.count;
@@ -454,7 +461,11 @@ double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, s
     thread_local std::vector<double> nearest_buffer;  // squared distances
     double* const nearest = at_least(nearest_buffer, from.size());
     thread_local OwnSegments own;
-    if (same_count) own_segments(g, from_g, from, to, nearest, own);
+    thread_local std::vector<double> pointwise_buffer;
+    if (same_count)
+        own_segments(g, from_g, from, to, nearest, pointwise ? pointwise : at_least(pointwise_buffer, from.size()), own);
+    else if (pointwise && from.size() == to.size())
+        for (std::size_t k = 0; k < from.size(); ++k) pointwise[k] = distance2(from[k], to[k]);
     const std::uint8_t *proven = own.proven.data(), *later = own.later.data();
     // Polylines of different point counts may be spaced unevenly (a sparse
     // input resampled: 0.2 mm segments, then 20 mm ones): the window reaches
@@ -536,12 +547,16 @@ double polyline_length(std::span<const Vec3f> line) {
     return len;
 }
 
-void GeometryError::add_fiber(std::span<const Vec3f> input, std::span<const Vec3f> decoded, std::uint64_t fiber) {
+void GeometryError::add_fiber(std::span<const Vec3f> input, std::span<const Vec3f> decoded, std::uint64_t fiber,
+                              std::span<double> pointwise) {
+    if (!pointwise.empty() && (pointwise.size() != input.size() || decoded.size() != input.size()))
+        throw Error(Errc::invalid_argument, "GeometryError::add_fiber: pointwise needs one value per point of both polylines");
     thread_local Segments input_segments, decoded_segments;  // each polyline's columns, once
     if (!input.empty()) segments_of(input, input_segments);
     if (!decoded.empty()) segments_of(decoded, decoded_segments);
     const double li = points_to_polyline(decoded, decoded_segments, input, input_segments, decoded_to_input_, fiber);
-    const double ld = points_to_polyline(input, input_segments, decoded, decoded_segments, input_to_decoded_, fiber);
+    const double ld = points_to_polyline(input, input_segments, decoded, decoded_segments, input_to_decoded_, fiber,
+                                         pointwise.empty() ? nullptr : pointwise.data());
     if (input.empty() || decoded.empty()) return;
     endpoint_.add(distance(input.front(), decoded.front()), fiber);
     endpoint_.add(distance(input.back(), decoded.back()), fiber);
