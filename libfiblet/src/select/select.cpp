@@ -20,6 +20,7 @@
 #include "fiblet/select.hpp"
 #include "core/default_init_allocator.hpp"
 #include "select/block_batch_reader.hpp"
+#include "select/block_bounds.hpp"
 #include "select/block_decoder.hpp"
 #include "index/block_spheres.hpp"
 #include "select/query_checks.hpp"
@@ -157,66 +158,6 @@ bool any_point_in(const std::vector<Region>& regions, const float* p, std::uint3
 }
 
 Vec3f first_point(const FftHeader& h, const std::uint8_t* block);
-
-// Where a block's points lie, from block headers alone (no decoding): a
-// capsule, the points within `radius` of the segment a-b. The block's view
-// sphere (view.hpp: a = b = its first point, radius at least the length P
-// of its path) holds them. When the next block of the fiber is at hand and
-// the index bounds the jump from a block's last point to the next block's
-// first (`join`), every point p of the block also has |p - a| + |p - b| <=
-// P + join with a, b the two first points: an ellipsoid, which lies in the
-// capsule of radius sqrt((P + join)^2 - |ab|^2) / 2 around a-b. Blocks of
-// smooth fibers are nearly straight, so that capsule is thin.
-struct BlockBound {
-    Vec3f a, b;
-    float radius;
-};
-
-// `s` is the block's view sphere, `next` the next block's (its centre is
-// that block's first point), or null.
-BlockBound block_bound(const Sphere& s, const Sphere* next, float join) {
-    BlockBound bound{s.center, s.center, s.radius};
-    if (!next || join < 0) return bound;
-    const Vec3f b = next->center;
-    const double dx = double(b.x) - s.center.x, dy = double(b.y) - s.center.y, dz = double(b.z) - s.center.z;
-    const double reach = double(s.radius) + double(join), d2 = dx * dx + dy * dy + dz * dz;
-    if (d2 >= reach * reach) return bound;  // not a path the index describes: keep the sphere
-    const double r = 0.5 * std::sqrt(reach * reach - d2) * (1 + 1e-5) + 1e-5 * reach;
-    if (r < double(s.radius)) bound = {s.center, b, float(r)};
-    return bound;
-}
-
-// Whether a block within `c` may have a point in region `r`: false only
-// when none can, so that the block need not be decoded to be tested. The
-// slack dwarfs float rounding of the points and of Region::contains.
-bool bound_may_meet(const Region& r, const BlockBound& c) {
-    const double R = double(c.radius);
-    const double slack = 1e-3 + 1e-5 * (std::abs(double(c.a.x)) + std::abs(double(c.a.y)) + std::abs(double(c.a.z)) + R);
-    const double reach = R + slack;
-    if (r.shape == Region::Shape::sphere) {
-        // Distance from the centre to the segment a-b.
-        const double ux = double(c.b.x) - c.a.x, uy = double(c.b.y) - c.a.y, uz = double(c.b.z) - c.a.z;
-        const double wx = double(r.center.x) - c.a.x, wy = double(r.center.y) - c.a.y, wz = double(r.center.z) - c.a.z;
-        const double uu = ux * ux + uy * uy + uz * uz;
-        const double t = uu > 0 ? std::clamp((wx * ux + wy * uy + wz * uz) / uu, 0.0, 1.0) : 0.0;
-        const double ex = wx - t * ux, ey = wy - t * uy, ez = wz - t * uz, far = reach + r.radius;
-        return ex * ex + ey * ey + ez * ez <= far * far;
-    }
-    // Boxes and masks: the capsule's bounding box.
-    const auto e = float(reach);
-    const Aabb b{{std::min(c.a.x, c.b.x) - e, std::min(c.a.y, c.b.y) - e, std::min(c.a.z, c.b.z) - e},
-                 {std::max(c.a.x, c.b.x) + e, std::max(c.a.y, c.b.y) + e, std::max(c.a.z, c.b.z) + e}};
-    if (r.shape == Region::Shape::box)
-        return !(b.max.x < r.box.min.x || b.min.x > r.box.max.x || b.max.y < r.box.min.y || b.min.y > r.box.max.y ||
-                 b.max.z < r.box.min.z || b.min.z > r.box.max.z);
-    return r.mask->classify(b) != ImageMask::Overlap::outside;
-}
-
-bool bound_may_meet(const std::vector<Region>& regions, const BlockBound& c) {
-    for (const Region& r : regions)
-        if (bound_may_meet(r, c)) return true;
-    return false;
-}
 
 Vec3f first_point(const FftHeader& h, const std::uint8_t* block) {
     const auto a = block_anchors_normalized(h, block);
@@ -475,11 +416,10 @@ private:
     // are coarser (quantized, or of groups of blocks).
     bool bound_meets_a_region(const RegionTests& t, std::size_t i, std::uint64_t f, std::uint64_t b) const {
         if (!coarse_index_) return true;  // exact boxes (computed) or no join bound (version 1)
-        const std::size_t next = next_at_need_[i];
-        const BlockBound c = block_bound(spheres_[at_need_[i]], next != SIZE_MAX ? &spheres_[next] : nullptr, index_.max_join());
-        if (!q_.exclude.empty() && has_bit(t.near_exclude, b) && bound_may_meet(q_.exclude, c)) return true;
+        if (!q_.exclude.empty() && has_bit(t.near_exclude, b) && bound_meets_any(q_.exclude, exclude_meets_, i))
+            return true;
         for (std::size_t k = 0; k < q_.include.size(); ++k)
-            if (t.tests(k, f, b) && bound_may_meet(q_.include[k], c)) return true;
+            if (t.tests(k, f, b) && bound_meets(q_.include[k], include_meets_[k], i)) return true;
         return false;
     }
 
@@ -494,7 +434,7 @@ private:
         while (candidates.next(batch_blocks(h_), blocks, fibers)) {
             stats_.blocks_tested += blocks.size();
             read_with_next(blocks, fibers, coarse_index_);  // the next block's first point narrows a bound
-            if (coarse_index_) spheres_of_read(need_.size());
+            if (coarse_index_) spheres_of_read(need_.size()), bounds_of_read(blocks.size());
             tested.clear();
             for (std::size_t i = 0; i < blocks.size(); ++i)
                 if (!t.excluded[fibers[i]] && bound_meets_a_region(t, i, fibers[i], blocks[i])) tested.push_back(i);
@@ -649,6 +589,7 @@ private:
         kind.assign(blocks.size(), fine);
         if (!q_.view && !pass.include_tests) return;
         spheres_of_read(need_.size());  // every header tested below, in one call (a call per block cost more)
+        if (pass.include_tests) bounds_of_read(blocks.size());
         for (std::size_t i = 0; i < blocks.size(); ++i) {
             const bool bound_test = pass.include_tests && pass.include_test(q_.include, blocks[i]);
             if (!q_.view && !bound_test) continue;
@@ -657,12 +598,9 @@ private:
                 kind[i] = dropped;
                 continue;
             }
-            if (bound_test) {
-                const std::size_t k = next_at_need_[i];
-                if (!bound_may_meet(q_.include, block_bound(s, k != SIZE_MAX ? &spheres_[k] : nullptr, index_.max_join()))) {
-                    kind[i] = dropped;
-                    continue;
-                }
+            if (bound_test && !bound_meets_any(q_.include, include_meets_, i)) {
+                kind[i] = dropped;
+                continue;
             }
             if (pass.lod && pass.lod->coarse(s.center, s.radius)) kind[i] = coarse;
         }
@@ -746,6 +684,33 @@ private:
         reader_.read(need_);
     }
 
+    // bounds_[i]: the bound of candidate i of the read batch (block_bound:
+    // its sphere, narrowed by the next block's), i < count; for each sphere
+    // region, whether each bound may meet it, in vectors (bound_meets reads
+    // them; other regions are tested where asked).
+    void bounds_of_read(std::size_t count) {
+        bounds_.compute(spheres_.data(), at_need_.data(), next_at_need_.data(), count, index_.max_join());
+        auto meets_of = [&](const std::vector<Region>& regions, std::vector<std::vector<std::uint8_t>>& meets) {
+            meets.resize(regions.size());
+            for (std::size_t k = 0; k < regions.size(); ++k)
+                if (regions[k].shape == Region::Shape::sphere) {
+                    meets[k].resize(count);
+                    bounds_.may_meet(regions[k], meets[k].data());
+                }
+        };
+        meets_of(q_.include, include_meets_);
+        meets_of(q_.exclude, exclude_meets_);
+    }
+    bool bound_meets(const Region& r, const std::vector<std::uint8_t>& sphere_meets, std::size_t i) const {
+        return r.shape == Region::Shape::sphere ? sphere_meets[i] != 0 : detail::bound_may_meet(r, bounds_[i]);
+    }
+    bool bound_meets_any(const std::vector<Region>& regions, const std::vector<std::vector<std::uint8_t>>& meets,
+                         std::size_t i) const {
+        for (std::size_t k = 0; k < regions.size(); ++k)
+            if (bound_meets(regions[k], meets[k], i)) return true;
+        return false;
+    }
+
     // spheres_[k]: the view sphere of the reader's block k, for k < count.
     void spheres_of_read(std::size_t count) {
         block_pointers_.resize(count);
@@ -785,6 +750,8 @@ private:
     std::vector<std::size_t> segment_;
     std::vector<const std::uint8_t*> block_pointers_;
     std::vector<Sphere> spheres_;  // of the blocks read, in reading order
+    detail::BlockBounds bounds_;    // of the candidates read (bounds_of_read)
+    std::vector<std::vector<std::uint8_t>> include_meets_, exclude_meets_;  // per sphere region: bound i may meet it
     std::vector<std::uint32_t> need_;                   // blocks read (read_with_next)
     std::vector<std::size_t> at_need_, next_at_need_;   // a candidate's place among them, its successor's
     SelectionStats stats_;
