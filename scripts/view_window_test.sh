@@ -194,6 +194,9 @@ wait_views() {  # wait_views N: until the N-th view's fibers are drawn
   for _ in $(seq 300); do [ "$(views_drawn)" -ge "$1" ] && return; sleep 0.1; done
   fail "the view's fibers were not drawn a ${1}th time"
 }
+# The viewer prints its streaming line before it opens the window, but the
+# log is a file (block-buffered): wait for it rather than race the flush.
+for _ in $(seq 300); do grep -q "^beyond --gpu-memory" view.log && break; sleep 0.1; done
 grep -q "^beyond --gpu-memory" view.log || fail "--gpu-memory $budget MiB: the file was not streamed"
 wait_views 1
 grep -q "^first frame drawn" view.log || fail "no first frame (the overview)"
