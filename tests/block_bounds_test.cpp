@@ -51,6 +51,14 @@ Candidates candidates(std::size_t spheres, std::size_t n, std::mt19937& rng) {
     return c;
 }
 
+// The bounds of n random candidates along `spheres`, joins of up to 2 mm.
+BlockBounds bounds_along(const std::vector<Sphere>& spheres, std::size_t n, std::mt19937& rng) {
+    const Candidates c = candidates(spheres.size(), n, rng);
+    BlockBounds bounds;
+    bounds.compute(spheres.data(), c.at.data(), c.next.data(), n, 2.0f);
+    return bounds;
+}
+
 TEST(BlockBounds, ComputeEqualsBlockBoundBitForBit) {
     std::mt19937 rng(3);
     const std::vector<Sphere> spheres = fiber_spheres(200, rng);
@@ -88,9 +96,7 @@ std::vector<Region> regions_near(const std::vector<Sphere>& spheres, std::mt1993
 TEST(BlockBounds, MayMeetEqualsBoundMayMeet) {
     std::mt19937 rng(4);
     const std::vector<Sphere> spheres = fiber_spheres(200, rng);
-    const Candidates c = candidates(spheres.size(), 39, rng);
-    BlockBounds bounds;
-    bounds.compute(spheres.data(), c.at.data(), c.next.data(), c.at.size(), 2.0f);
+    const BlockBounds bounds = bounds_along(spheres, 39, rng);
     // And regions on each capsule's axis just past either end: missed only
     // because the nearest point of the segment is clamped to its ends.
     std::vector<Region> regions = regions_near(spheres, rng);
@@ -126,10 +132,7 @@ TEST(BlockBounds, MayMeetEqualsBoundMayMeet) {
 // region is never said to miss it.
 TEST(BlockBounds, AMetRegionIsNeverMissed) {
     std::mt19937 rng(5);
-    const std::vector<Sphere> spheres = fiber_spheres(120, rng);
-    const Candidates c = candidates(spheres.size(), 64, rng);
-    BlockBounds bounds;
-    bounds.compute(spheres.data(), c.at.data(), c.next.data(), c.at.size(), 2.0f);
+    const BlockBounds bounds = bounds_along(fiber_spheres(120, rng), 64, rng);
     std::uniform_real_distribution<float> unit(-1, 1), along(0, 1);
     std::size_t checked = 0;
     for (std::size_t i = 0; i < bounds.size(); ++i) {
