@@ -44,12 +44,6 @@ bool bound_may_meet(const Region& r, const BlockBound& c) {
     return r.mask->classify(b) != ImageMask::Overlap::outside;
 }
 
-bool bound_may_meet(const std::vector<Region>& regions, const BlockBound& c) {
-    for (const Region& r : regions)
-        if (bound_may_meet(r, c)) return true;
-    return false;
-}
-
 void BlockBounds::set(std::size_t i, const BlockBound& c) {
     ax_[i] = c.a.x, ay_[i] = c.a.y, az_[i] = c.a.z, bx_[i] = c.b.x, by_[i] = c.b.y, bz_[i] = c.b.z, radius_[i] = c.radius;
 }

@@ -34,7 +34,6 @@ BlockBound block_bound(const Sphere& s, const Sphere* next, float join);
 // Whether a block within `c` may have a point in region `r`: false only
 // when none can, so that the block need not be decoded to be tested.
 bool bound_may_meet(const Region& r, const BlockBound& c);
-bool bound_may_meet(const std::vector<Region>& regions, const BlockBound& c);
 
 // The bounds of many blocks, as columns for the vector loops.
 class BlockBounds {

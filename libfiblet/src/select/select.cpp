@@ -434,7 +434,7 @@ private:
         while (candidates.next(batch_blocks(h_), blocks, fibers)) {
             stats_.blocks_tested += blocks.size();
             read_with_next(blocks, fibers, coarse_index_);  // the next block's first point narrows a bound
-            if (coarse_index_) spheres_of_read(need_.size()), bounds_of_read(blocks.size());
+            if (coarse_index_) spheres_of_read(need_.size()), bounds_of_read(blocks.size(), true);
             tested.clear();
             for (std::size_t i = 0; i < blocks.size(); ++i)
                 if (!t.excluded[fibers[i]] && bound_meets_a_region(t, i, fibers[i], blocks[i])) tested.push_back(i);
@@ -589,7 +589,7 @@ private:
         kind.assign(blocks.size(), fine);
         if (!q_.view && !pass.include_tests) return;
         spheres_of_read(need_.size());  // every header tested below, in one call (a call per block cost more)
-        if (pass.include_tests) bounds_of_read(blocks.size());
+        if (pass.include_tests) bounds_of_read(blocks.size(), false);  // exclude regions: tested on points
         for (std::size_t i = 0; i < blocks.size(); ++i) {
             const bool bound_test = pass.include_tests && pass.include_test(q_.include, blocks[i]);
             if (!q_.view && !bound_test) continue;
@@ -686,9 +686,10 @@ private:
 
     // bounds_[i]: the bound of candidate i of the read batch (block_bound:
     // its sphere, narrowed by the next block's), i < count; for each sphere
-    // region, whether each bound may meet it, in vectors (bound_meets reads
-    // them; other regions are tested where asked).
-    void bounds_of_read(std::size_t count) {
+    // include region (and exclude region, with_exclude), whether each bound
+    // may meet it, in vectors (bound_meets reads them; other regions are
+    // tested where asked).
+    void bounds_of_read(std::size_t count, bool with_exclude) {
         bounds_.compute(spheres_.data(), at_need_.data(), next_at_need_.data(), count, index_.max_join());
         auto meets_of = [&](const std::vector<Region>& regions, std::vector<std::vector<std::uint8_t>>& meets) {
             meets.resize(regions.size());
@@ -699,7 +700,7 @@ private:
                 }
         };
         meets_of(q_.include, include_meets_);
-        meets_of(q_.exclude, exclude_meets_);
+        if (with_exclude) meets_of(q_.exclude, exclude_meets_);
     }
     bool bound_meets(const Region& r, const std::vector<std::uint8_t>& sphere_meets, std::size_t i) const {
         return r.shape == Region::Shape::sphere ? sphere_meets[i] != 0 : detail::bound_may_meet(r, bounds_[i]);
