@@ -126,11 +126,15 @@ TEST(SelectTruncation, ABlockPastACutInsideAPageIsAnError) {
 
 // A mapped page past the end of a truncated file, read outside fiblet's
 // copies: SIGBUS as without fiblet, to the handler from before if any.
-void fault_outside_fiblet(const std::string& path) {
-    const int fd = ::open(path.c_str(), O_RDONLY);
+// The death test's child made `dir` (it reruns the test) and never returns:
+// it removes the directory once the file is mapped and open.
+void fault_outside_fiblet(const std::string& path, const std::string& dir) {
+    const int fd = ::open(path.c_str(), O_RDONLY), writable = ::open(path.c_str(), O_WRONLY);
     const long page = ::sysconf(_SC_PAGESIZE);
     auto* p = static_cast<volatile const char*>(::mmap(nullptr, 4 * page, PROT_READ, MAP_SHARED, fd, 0));
-    if (p == MAP_FAILED || ::ftruncate(::open(path.c_str(), O_WRONLY), page) != 0) std::_Exit(3);
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+    if (p == MAP_FAILED || ::ftruncate(writable, page) != 0) std::_Exit(3);
     (void)p[3 * page];
     std::_Exit(0);  // not reached: the read faults
 }
@@ -154,7 +158,7 @@ TEST(SelectTruncationDeathTest, AFaultOutsideACopyStillEndsTheProcess) {
     EXPECT_EXIT(
         {
             install_fiblet_handler(files.fft);
-            fault_outside_fiblet(files.victim);
+            fault_outside_fiblet(files.victim, files.dir.path());
         },
         ::testing::KilledBySignal(SIGBUS), "");
 }
@@ -168,7 +172,7 @@ TEST(SelectTruncationDeathTest, AFaultOutsideACopyGoesToTheHandlerFromBefore) {
             a.sa_handler = [](int) { std::_Exit(42); };
             ::sigaction(SIGBUS, &a, nullptr);
             install_fiblet_handler(files.fft);
-            fault_outside_fiblet(files.victim);
+            fault_outside_fiblet(files.victim, files.dir.path());
         },
         ::testing::ExitedWithCode(42), "");
 }
