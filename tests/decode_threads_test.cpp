@@ -19,28 +19,15 @@
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
+#include "sdstream_file.hpp"
 #include "test_util.hpp"
 
 using namespace fiblet;
 
 namespace {
 
-// small-sdstream.tck compressed once at 8 bits (the default gives it 16):
-// 14,000+ blocks, enough for several threads' runs of at least 2048 blocks.
-class DecodeThreads : public ::testing::Test {
+class DecodeThreads : public test::SdstreamFile {
 protected:
-    static void SetUpTestSuite() {
-        if (!test::shared_data_available()) return;
-        dir_ = std::make_unique<test::TempDir>();
-        path_ = dir_->file("sdstream.fft");
-        CompressOptions o;
-        o.direction_bits = 8;
-        compress_file(test::shared_data("small-sdstream.tck"), path_, o);
-    }
-    static void TearDownTestSuite() { dir_.reset(); }
-    void SetUp() override {
-        if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
-    }
     static DecodeOptions options(unsigned threads, std::size_t chunk_blocks = 1u << 16, const char* decoder = "auto") {
         DecodeOptions o;
         o.threads = threads;
@@ -48,11 +35,7 @@ protected:
         o.decoder = parse_decoder(decoder);
         return o;
     }
-    static std::unique_ptr<test::TempDir> dir_;
-    static std::string path_;
 };
-std::unique_ptr<test::TempDir> DecodeThreads::dir_;
-std::string DecodeThreads::path_;
 
 bool same(const Streamlines& a, const Streamlines& b) {
     return a.offsets == b.offsets && a.xyz.size() == b.xyz.size() &&

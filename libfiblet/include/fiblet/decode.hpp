@@ -124,9 +124,10 @@ struct DecodeOptions {
     // Blocks read and decoded at a time (bounds memory). 0: for decode_file,
     // 4096 per thread, so that each chunk's output (~3 MB a thread) is reused
     // in cache instead of mapping fresh pages (bench/results.md: 7x faster
-    // than 65536); for decode_fibers / decode_fibers_into, which write into
-    // the whole output, at least 65536 (fewer joins of the pool:
-    // docs/parallel.md).
+    // than 65536); for decode_fibers, which writes into the whole output, at
+    // least 65536 (fewer joins of the pool: docs/parallel.md); for
+    // decode_fibers_into, the blocks one thread reads and decodes at a time
+    // in its one pool job (4096 of 60 points, as many points of larger ones).
     std::size_t chunk_blocks = 0;
     Decoder decoder;                      // automatic: the fastest on this CPU
     unsigned threads = 0;                 // 0 = all cores; order of the output never depends on it

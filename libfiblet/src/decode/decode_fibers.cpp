@@ -1,7 +1,9 @@
 // Whole fibers out of a file: chunks of whole fibers are read and decoded
 // by `threads` threads of the library's pool, a contiguous run of the
 // chunk's blocks at a time (reading, counting and decoding all in
-// parallel), into one output in fiber order.
+// parallel), into one output in fiber order; decode_fibers_into, whose
+// caller gives the whole output, in one pool job of parts that each thread
+// reads, counts and decodes alone.
 #include <algorithm>
 #include <condition_variable>
 #include <exception>
@@ -11,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/ordered_ends.hpp"
 #include "core/thread_count.hpp"
 #include "decode/decode_kernels.hpp"
 #include "fiblet/parallel.hpp"
@@ -27,9 +30,8 @@ public:
     // thread (~3 MB of points) stay in cache (DecodeOptions::chunk_blocks);
     // blocks of other sizes (16-bit: 254 points) as many points.
     static constexpr std::size_t kPointsPerThread = std::size_t{4096} * 60;
-    // decode_fibers and decode_fibers_into write straight into the whole
-    // output; only the chunk's blocks are reused (5 MB: 65536 76-byte
-    // blocks, fewer larger ones). Bigger chunks join the pool less often:
+    // decode_fibers writes straight into the whole output; only the chunk's
+    // blocks are reused (5 MB: 65536 76-byte blocks, fewer larger ones). Bigger chunks join the pool less often:
     // each chunk is two jobs, and a job's end waits for its last run and
     // wakes a worker (docs/parallel.md: 2 threads vs 1 went from 1.4x to
     // 1.7x on the medium file; the whole file as one chunk is slower again,
@@ -120,6 +122,12 @@ private:
     std::vector<std::uint64_t> first_, points_;
 };
 
+// decode_fibers_into's parts: 16384 blocks of 60 points (1.2 MB of blocks,
+// read and decoded while in cache; as many points of larger blocks). Parts
+// of 4096 cost 10 % more on one thread, more than they balance on two
+// (docs/parallel.md).
+constexpr std::uint64_t kPartPoints = std::uint64_t{16384} * 60;
+
 void check_range(const FftFile& file, std::uint64_t begin, std::uint64_t end) {
     if (begin > end || end > file.header().fibers)
         throw Error(Errc::invalid_argument, file.path() + ": fiber range past the end");
@@ -150,20 +158,51 @@ std::uint64_t decode_fibers_into(const FftFile& file, std::uint64_t begin, std::
     if (offsets.size() < end - begin + 1)
         throw Error(Errc::invalid_argument, "decode_fibers_into: " + std::to_string(end - begin + 1) +
                                                 " offsets needed, room for " + std::to_string(offsets.size()));
-    ChunkDecoder chunks(file, options, ChunkDecoder::kWholeOutputChunkBytes);
-    std::uint64_t done = 0;
+    // One job of parts of whole fibers, each read, counted and decoded by
+    // one thread while its blocks are in cache, after the points of the
+    // parts before it (no join per chunk: docs/parallel.md).
+    const DecodeContext ctx(file);
+    const Decoder decoder = resolve_decoder(options.decoder);
+    const std::size_t bb = ctx.header.block_bytes();
+    const std::uint64_t part_blocks =
+        options.chunk_blocks ? options.chunk_blocks
+                             : std::max<std::uint64_t>(kPartPoints / ctx.header.points_per_block, 1);
+    std::vector<std::uint64_t> part_first{begin};
+    while (part_first.back() < end) {
+        const std::uint64_t f = part_first.back(), b0 = file.block_end(f);
+        std::uint64_t lo = f + 1, hi = end;  // the last fiber end within part_blocks (at least one fiber)
+        while (lo < hi) {
+            const std::uint64_t mid = lo + (hi - lo + 1) / 2;
+            if (file.block_end(mid) - b0 <= part_blocks) lo = mid;
+            else hi = mid - 1;
+        }
+        part_first.push_back(lo);
+    }
+    const std::size_t parts = part_first.size() - 1;
+    detail::OrderedEnds ends(parts);
     offsets[0] = 0;
-    for (std::uint64_t f = begin; f < end;) {
-        const std::uint64_t e = chunks.chunk_end(f, end);
-        const std::uint64_t n = chunks.load(f, e);
-        if (3 * (done + n) > xyz.size())
+    parallel_for(parts, detail::resolve_threads(options.threads), [&](std::size_t p) {
+        const detail::OrderedEnds::Guard guard{ends, p};
+        const std::uint64_t f0 = part_first[p], f1 = part_first[p + 1], b0 = file.block_end(f0);
+        const std::uint64_t blocks = file.block_end(f1) - b0;
+        thread_local std::vector<std::uint8_t> data;
+        data.resize(blocks * bb);
+        file.read_blocks(b0, blocks, data.data());
+        const std::uint64_t points = count_block_points(ctx, data.data(), blocks);
+        const std::uint64_t start = ends.publish(p, points);
+        if (start == detail::OrderedEnds::kFailed) return;  // a part before failed: its error is the one reported
+        if (3 * (start + points) > xyz.size())
             throw Error(Errc::invalid_argument, "decode_fibers_into: " + file.path() + " holds more points than the " +
                                                     std::to_string(xyz.size() / 3) + " the buffer has room for");
-        chunks.decode(xyz.data() + 3 * done, &offsets[f - begin], done);
-        done += n;
-        f = e;
-    }
-    return done;
+        std::uint64_t at = start;
+        const std::uint8_t* block = data.data();
+        for (std::uint64_t f = f0; f < f1; ++f) {
+            for (std::uint32_t k = file.block_count(f); k > 0; --k, block += bb) at += block_flags(ctx.header, block).point_count;
+            offsets[f - begin + 1] = at;
+        }
+        detail::decode_resolved(ctx, data.data(), blocks, xyz.data() + 3 * start, decoder);
+    });
+    return ends.end();
 }
 
 namespace {
