@@ -5,8 +5,11 @@
 // official encoder.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <map>
 #include <memory>
+#include <span>
+#include <string>
 
 #include "fiblet/compress.hpp"
 #include "fiblet/error.hpp"
@@ -229,13 +232,45 @@ TEST_P(SelectQuery, EndsInverseSkipAndNumberMatchBruteForce) {
     EXPECT_GE(nonempty, 6);  // random regions rarely hold a fiber's end: half of the queries keep something
 }
 
-// The regions tested on decoded fibers (FiberRegionTest: only the points of
-// the blocks the index puts near a region) keep what the brute force keeps,
-// with the stored and the computed index; and the rule picks the full
-// decode for regions over the whole file, not for a small one.
-TEST_P(SelectQuery, FiberRegionTestOnDecodedFibersMatchesBruteForce) {
+// FiberRegionTest::decode_kept_into over `candidates` gives the `expected`
+// fibers, each with the points of the whole file's decode, and writes
+// nothing past the room for the candidates' blocks.
+void expect_decoded_kept(const Subject& s, const FiberRegionTest& test, const std::vector<FiberRange>& candidates,
+                         const std::vector<std::uint64_t>& expected, unsigned threads, const std::string& what) {
+    const Streamlines& all = s.decoded.points;
+    std::uint64_t room = 0;
+    for (const FiberRange& r : candidates)
+        room += (s.file->block_end(r.last + 1) - s.file->first_block(r.first)) * s.file->header().points_per_block;
+    const float sentinel = 7777.0f;
+    std::vector<float> xyz(3 * room + 8, sentinel);
+    std::vector<std::uint64_t> offsets, fibers;
+    const std::uint64_t points =
+        test.decode_kept_into(candidates, std::span<float>(xyz.data(), 3 * room), offsets, fibers, threads);
+    ASSERT_EQ(fibers, expected) << what;
+    ASSERT_EQ(offsets.size(), fibers.size() + 1) << what;
+    EXPECT_EQ(offsets.back(), points) << what;
+    for (std::size_t i = 0; i < fibers.size(); ++i) {
+        const std::uint64_t f = fibers[i], n = all.offsets[f + 1] - all.offsets[f];
+        ASSERT_EQ(offsets[i + 1] - offsets[i], n) << what << ": fiber " << f;
+        EXPECT_EQ(std::memcmp(&xyz[3 * offsets[i]], &all.xyz[3 * all.offsets[f]], 12 * n), 0) << what << ": fiber " << f;
+    }
+    for (std::size_t i = 3 * room; i < xyz.size(); ++i) ASSERT_EQ(xyz[i], sentinel) << what;
+}
+
+// The regions tested on decoded fibers (FiberRegionTest::keeps: only the
+// points of the blocks the index puts near a region) and decided by
+// kept_fibers (the index, the blocks' anchors, the blocks that may meet a
+// region decoded alone) keep what the brute force keeps, with the stored
+// and the computed index, on one thread and two, over all fibers and over
+// ranges of them; the rule takes kept_fibers on two threads, and on one
+// for regions over the whole file, not for a small one.
+TEST_P(SelectQuery, FiberRegionTestMatchesBruteForce) {
     const Subject& s = subject();
     QueryGenerator gen(s.decoded, 41);
+    const Streamlines& all = s.decoded.points;
+    const std::uint64_t fibers = all.offsets.size() - 1;
+    // Two ranges: the first third and the last third.
+    const std::vector<FiberRange> thirds{{0, fibers / 3}, {fibers - fibers / 3, fibers - 1}};
     int kept_some = 0;
     for (int i = 0; i < 12; ++i) {
         Query q;
@@ -243,25 +278,37 @@ TEST_P(SelectQuery, FiberRegionTestOnDecodedFibersMatchesBruteForce) {
         if (i % 3 == 1) q.exclude.push_back(gen.region());
         if (i == 11) q.include.clear();
         const ReferenceSelection ref = reference_select(*s.file, s.decoded, q);
-        std::vector<std::uint64_t> expected;
-        for (const SelectedRun& r : ref.runs) expected.push_back(r.fiber);
+        std::vector<std::uint64_t> expected, expected_in_thirds;
+        for (const SelectedRun& r : ref.runs) {
+            expected.push_back(r.fiber);
+            if (r.fiber <= thirds[0].last || r.fiber >= thirds[1].first) expected_in_thirds.push_back(r.fiber);
+        }
         kept_some += !expected.empty();
         for (const BlockIndex* index : {s.stored_or_loaded.get(), s.computed.get()}) {
             const FiberRegionTest test(*s.file, *index, q);
             std::vector<std::uint64_t> got;
-            const Streamlines& all = s.decoded.points;
-            for (std::uint64_t f = 0; f + 1 < all.offsets.size(); ++f)
+            for (std::uint64_t f = 0; f < fibers; ++f)
                 if (test.keeps(f, all.xyz.data() + 3 * all.offsets[f], all.offsets[f + 1] - all.offsets[f]))
                     got.push_back(f);
             EXPECT_EQ(got, expected) << s.name << ": query " << i;
+            const std::vector<FiberRange> whole{{0, fibers - 1}};
+            for (const unsigned threads : {1u, 2u}) {
+                EXPECT_EQ(test.kept_fibers(whole, threads), expected) << s.name << ": query " << i << ", " << threads;
+                EXPECT_EQ(test.kept_fibers(thirds, threads), expected_in_thirds) << s.name << ": query " << i;
+                expect_decoded_kept(s, test, thirds, expected_in_thirds, threads, s.name + ": query " + std::to_string(i));
+            }
         }
     }
     EXPECT_GT(kept_some, 4);
     Query everything, tiny;
     everything.include.push_back(Region::sphere({0, 0, 0}, 1e6f));
     tiny.include.push_back(Region::sphere({1e4f, 1e4f, 1e4f}, 1));  // near no block
-    EXPECT_TRUE(FiberRegionTest(*s.file, *s.stored_or_loaded, everything).full_decode_is_faster());
-    EXPECT_FALSE(FiberRegionTest(*s.file, *s.stored_or_loaded, tiny).full_decode_is_faster());
+    EXPECT_TRUE(FiberRegionTest(*s.file, *s.stored_or_loaded, everything).kept_fibers_is_faster(1));
+    EXPECT_FALSE(FiberRegionTest(*s.file, *s.stored_or_loaded, tiny).kept_fibers_is_faster(1));
+    EXPECT_TRUE(FiberRegionTest(*s.file, *s.stored_or_loaded, tiny).kept_fibers_is_faster(2));
+    const std::vector<FiberRange> overlapping{{0, 2}, {2, 3}};
+    EXPECT_EQ(error_of([&] { (void)FiberRegionTest(*s.file, *s.stored_or_loaded, tiny).kept_fibers(overlapping); }),
+              Errc::invalid_argument);
 }
 
 TEST_P(SelectQuery, BlockRegionsMatchBruteForce) {

@@ -21,36 +21,39 @@ PageMode output_page_mode() {
     return PageMode::huge;
 }
 
+// Room for `blocks` full blocks, pages untouched until written.
+DecodedRange with_room_for(const FftFile& file, std::uint64_t blocks, std::uint64_t fibers) {
+    DecodedRange out;
+    out.xyz = PopulatedBuffer(blocks * file.header().points_per_block * 3 * sizeof(float), output_page_mode());
+    out.offsets.resize(fibers + 1);
+    return out;
+}
+
 }  // namespace
 
+// The library's parallel decode (decode_fibers_into) into room for every
+// block full; the rest given back after.
 DecodedRange decode_range(const FftFile& file, std::uint64_t begin, std::uint64_t end, unsigned threads) {
     if (begin > end || end > file.header().fibers)
         throw Error(Errc::invalid_argument, file.path() + ": fiber range past the end");
-    // The library's parallel decode (decode_fibers_into) into room for every
-    // block full, pages untouched until written; the rest given back after.
-    const std::uint64_t most = (file.block_end(end) - file.block_end(begin)) * file.header().points_per_block;
-    DecodedRange out;
-    out.xyz = PopulatedBuffer(most * 3 * sizeof(float), output_page_mode());
-    out.offsets.resize(end - begin + 1);
+    DecodedRange out = with_room_for(file, file.block_end(end) - file.block_end(begin), end - begin);
     DecodeOptions options;
     options.threads = threads;
-    out.points = decode_fibers_into(file, begin, end, {out.xyz.as<float>(), 3 * most}, out.offsets, options);
+    out.points = decode_fibers_into(file, begin, end, {out.xyz.as<float>(), out.xyz.bytes() / sizeof(float)}, out.offsets,
+                                    options);
     out.xyz.shrink(out.points * 3 * sizeof(float));
     return out;
 }
 
-void keep_fibers(DecodedRange& range, const std::vector<std::uint64_t>& keep) {
-    float* xyz = range.xyz.as<float>();
-    std::vector<std::uint64_t> offsets{0};
-    offsets.reserve(keep.size() + 1);
-    for (const std::uint64_t f : keep) {
-        const std::uint64_t first = range.offsets[f], n = range.offsets[f + 1] - first;
-        if (n) std::memmove(xyz + 3 * offsets.back(), xyz + 3 * first, 12 * n);  // ascending: never ahead of its source
-        offsets.push_back(offsets.back() + n);
-    }
-    range.offsets = std::move(offsets);
-    range.points = range.offsets.back();
-    range.xyz.shrink(12 * range.points);
+DecodedRange decode_kept(const FftFile& file, const FiberRegionTest& test, std::span<const FiberRange> candidates,
+                         unsigned threads, std::vector<std::uint64_t>& fibers) {
+    std::uint64_t blocks = 0;
+    for (const FiberRange& r : candidates) blocks += file.block_end(r.last + 1) - file.first_block(r.first);
+    DecodedRange out = with_room_for(file, blocks, 0);
+    out.points = test.decode_kept_into(candidates, {out.xyz.as<float>(), out.xyz.bytes() / sizeof(float)}, out.offsets,
+                                       fibers, threads);
+    out.xyz.shrink(out.points * 3 * sizeof(float));
+    return out;
 }
 
 }  // namespace fiblet::python

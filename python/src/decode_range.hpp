@@ -4,9 +4,11 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "fiblet/fft_file.hpp"
+#include "fiblet/fiber_regions.hpp"
 #include "populated_buffer.hpp"
 
 namespace fiblet::python {
@@ -21,9 +23,9 @@ struct DecodedRange {
 // those of fiblet::decode_fibers (tests compare them).
 DecodedRange decode_range(const FftFile& file, std::uint64_t begin, std::uint64_t end, unsigned threads);
 
-// Keeps only the fibers `keep` (ascending positions), moving their points to
-// the front of the same buffer and giving the rest of it back.
-void keep_fibers(DecodedRange& range, const std::vector<std::uint64_t>& keep);
-
+// The fibers among `candidates` that `test` keeps (FiberRegionTest::decode_kept_into),
+// their indices into `fibers`.
+DecodedRange decode_kept(const FftFile& file, const FiberRegionTest& test, std::span<const FiberRange> candidates,
+                         unsigned threads, std::vector<std::uint64_t>& fibers);
 
 }  // namespace fiblet::python

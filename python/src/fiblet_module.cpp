@@ -126,28 +126,6 @@ std::shared_ptr<const BlockIndex> block_index_of(const FftFile& file) {
     return index;
 }
 
-// Positions (in `s`) of the fibers the regions keep, by testing their
-// points (FiberRegionTest: only in the blocks the index puts near a region),
-// on `threads` threads (0: all cores), each a contiguous share of the
-// fibers; `fiber_of(k)` is the file's index of the k-th fiber of `s`.
-template <class FiberOf>
-std::vector<std::uint64_t> kept_by_points(const FiberRegionTest& test, FibersView s, FiberOf fiber_of, unsigned threads) {
-    std::vector<std::uint8_t> kept(s.size(), 0);
-    auto part = [&](std::uint64_t first, std::uint64_t last) {
-        for (std::uint64_t f = first; f < last; ++f)
-            kept[f] = test.keeps(fiber_of(f), s.xyz + 3 * s.offsets[f], s.offsets[f + 1] - s.offsets[f]);
-    };
-    // Parts of at least 256 fibers, up to 4 per thread, from the library's pool.
-    if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
-    const std::uint64_t n = s.size(),
-                        parts = std::clamp<std::uint64_t>(n / 256, 1, std::uint64_t(4) * threads);
-    parallel_for(parts, threads, [&](std::size_t t) { part(n * t / parts, n * (t + 1) / parts); });
-    std::vector<std::uint64_t> keep;
-    for (std::uint64_t f = 0; f < n; ++f)
-        if (kept[f]) keep.push_back(f);
-    return keep;
-}
-
 // The fibers among `candidates` that the regions of `q` keep, in file order, and
 // their IDs: the library's selection decides through the block index (only
 // the blocks near a region are decoded to test their points), then decodes
@@ -182,33 +160,28 @@ void decode_with_regions(const FftFile& file, const Regions& regions, std::uint6
                          std::optional<DecodedRange>& range, Streamlines& s, std::vector<std::uint64_t>& ids) {
     ids.clear();
     if (indices ? indices->empty() : begin >= end) return;
-    // Regions near much of the file: decoding everything on all threads,
-    // then testing the points, beats the one-thread selection (which decodes
-    // the near blocks, then the kept fibers): the library's rule.
     Query q;
     q.include = regions.include, q.exclude = regions.exclude;
-    const FiberRegionTest test(file, *block_index_of(file), q);
-    if (test.full_decode_is_faster()) {
-        if (indices) s = decode_indices(file, *indices, decode_options(threads));
-        else range = decode_range(file, begin, end, threads);
-        const FibersView view = range ? FibersView{range->xyz.as<const float>(), range->offsets} : view_of(s);
-        const std::vector<std::uint64_t> keep =
-            indices ? kept_by_points(test, view, [&](std::uint64_t k) { return (*indices)[k]; }, threads)
-                    : kept_by_points(test, view, [&](std::uint64_t k) { return begin + k; }, threads);
-        for (const std::uint64_t k : keep) ids.push_back(indices ? (*indices)[k] : begin + k);
-        if (range) keep_fibers(*range, keep);
-        else s = gather_fibers(view, keep);
-        return;
-    }
     const std::vector<FiberRange> candidates = indices ? ranges_of(*indices) : std::vector<FiberRange>{{begin, end - 1}};
-    s = select_by_regions(file, q, candidates, ids);
+    // Deciding the fibers from the index and their blocks' anchors on all
+    // threads, then decoding the kept ones, or select()'s passes on one:
+    // the library's rule.
+    const FiberRegionTest test(file, *block_index_of(file), q);
+    if (test.kept_fibers_is_faster(threads)) {
+        range = decode_kept(file, test, candidates, threads, ids);
+    } else {
+        s = select_by_regions(file, q, candidates, ids);
+    }
     if (!indices) return;
     // The kept fibers in the order (and with the repeats) asked for.
     std::vector<std::uint64_t> position(file.header().fibers, UINT64_MAX), want, order;
     for (std::size_t i = 0; i < ids.size(); ++i) position[ids[i]] = i;
     for (const std::uint64_t f : *indices)
         if (position[f] != UINT64_MAX) want.push_back(f), order.push_back(position[f]);
-    if (want != ids) s = gather_fibers(view_of(s), order);
+    if (want != ids) {
+        s = gather_fibers(range ? FibersView{range->xyz.as<const float>(), range->offsets} : view_of(s), order);
+        range.reset();
+    }
     ids = std::move(want);
 }
 

@@ -1,13 +1,18 @@
-// fiblet — fibers-mode regions (tckedit -include / -exclude) tested on
-// fibers already decoded, for callers that decode a whole range anyway (all
-// threads, the fast path) instead of select()'s index-driven passes; and
-// the rule that chooses between the two (FiberRegionTest::full_decode_is_faster).
+// fiblet — fibers-mode regions (tckedit -include / -exclude) decided on all
+// threads, for callers that want the kept fibers decoded (Python's roi=):
+// kept_fibers() decides most fibers from the index and the blocks'
+// anchors, decodes only the blocks that may still meet a region, and
+// leaves the kept fibers to decode_listed_fibers_into(); keeps() tests
+// fibers already decoded. kept_fibers_is_faster() is the rule that chooses
+// between this and select()'s index-driven passes.
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "fiblet/block_index.hpp"
+#include "fiblet/decode.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/select.hpp"
 
@@ -31,21 +36,58 @@ public:
     // without points: never).
     bool keeps(std::uint64_t fiber, const float* xyz, std::uint64_t points) const;
 
-    // Whether decoding every fiber (on all threads) and testing their points
-    // here beats select()'s passes, which decode the blocks near a region
-    // then the kept fibers on one thread: when the most selective include
-    // region (or, with none, the exclude regions) has blocks near it in more
-    // than a quarter of the file (measured on the medium tractogram:
-    // docs/ecosystem.md). From the bitmaps above: no second query of the index.
-    bool full_decode_is_faster() const;
+    // The fibers among `candidates` (ascending, disjoint ranges) that keeps()
+    // keeps, ascending, without decoding what the index and the blocks'
+    // anchors decide: an include region with no block near it drops a
+    // fiber, a block wholly inside one or an anchor in it (a block's first
+    // two points, stored exactly) meets it; of the fibers left, only the
+    // blocks whose bounds from the headers may meet a region are decoded.
+    // On `threads` threads (0: all cores). Error{invalid_argument} for
+    // ranges out of order, overlapping or past the end.
+    std::vector<std::uint64_t> kept_fibers(std::span<const FiberRange> candidates, unsigned threads = 0) const;
+
+    // kept_fibers(), with the kept fibers decoded into xyz, each as soon as
+    // it is decided (its blocks read once): fibers gets their indices,
+    // offsets[i] the first point of fibers[i] (and the number of points at
+    // the end), which is returned. xyz needs room for the points of the
+    // candidates' blocks full (points_per_block each) only where the kept
+    // fibers hold fewer: Error{invalid_argument} when it is too small,
+    // before anything is written past it.
+    std::uint64_t decode_kept_into(std::span<const FiberRange> candidates, std::span<float> xyz,
+                                   std::vector<std::uint64_t>& offsets, std::vector<std::uint64_t>& fibers,
+                                   unsigned threads = 0) const;
+
+    // Whether kept_fibers() on `threads` threads (0: all cores) beats
+    // select()'s passes, which decode the blocks near a region then the
+    // kept fibers on one thread: always with two threads or more (it is
+    // also faster on the smallest regions), on one when the most selective
+    // include region (or, with none, the exclude regions) has blocks near
+    // it in more than a fifth of the file (measured on the medium
+    // tractogram: docs/select.md). From the bitmaps above: no second query
+    // of the index.
+    bool kept_fibers_is_faster(unsigned threads) const;
 
 private:
+    enum class Fate : std::uint8_t { dropped, kept, undecided };
+    Fate fate_by_index(std::uint64_t fiber) const;
+    Fate fate_by_anchors(std::uint64_t fiber, const std::uint8_t* blocks) const;
+    bool anchor_in(const Region& r, const std::vector<std::uint64_t>& near, std::uint64_t fiber,
+                   const std::uint8_t* blocks) const;
+    bool point_in(const Region& r, const std::vector<std::uint64_t>& near, std::uint64_t fiber, const std::uint8_t* blocks,
+                  const DecodeContext& ctx) const;
+    bool keeps_by_blocks(std::uint64_t fiber, const std::uint8_t* blocks, const DecodeContext& ctx) const;
+    // Fibers [f0, f1): kept[f - f0] = 1 for those kept; `blocks` gets the
+    // blocks of the fibers the index leaves undecided (and, with read_kept,
+    // those it keeps) from f0's first block on.
+    void decide(std::uint64_t f0, std::uint64_t f1, const DecodeContext& ctx, std::uint8_t* kept, bool read_kept,
+                std::vector<std::uint8_t>& blocks) const;
     bool meets(const Region& r, const std::vector<std::uint64_t>& near, const std::vector<std::uint64_t>* inside,
                std::uint64_t fiber, const float* xyz, std::uint64_t points) const;
     const FftFile& file_;
     std::vector<Region> include_, exclude_;
     // Bitmaps of blocks: near each region, and wholly inside each include region.
     std::vector<std::vector<std::uint64_t>> near_include_, inside_include_, near_exclude_;
+    float max_join_;  // BlockIndex::max_join()
 };
 
 }  // namespace fiblet

@@ -3,11 +3,14 @@
 #include <algorithm>
 #include <bit>
 
+#include "core/thread_count.hpp"
+#include "select/block_bits.hpp"
+
 namespace fiblet {
 
-namespace {
+using detail::has_bit;
 
-bool has_bit(const std::vector<std::uint64_t>& bits, std::uint64_t i) { return (bits[i >> 6] >> (i & 63)) & 1; }
+namespace {
 
 double share_of(const std::vector<std::uint64_t>& bits, std::uint64_t blocks) {
     std::uint64_t n = 0;
@@ -15,12 +18,11 @@ double share_of(const std::vector<std::uint64_t>& bits, std::uint64_t blocks) {
     return blocks ? double(n) / double(blocks) : 0.0;
 }
 
-// Above this share of the blocks near the regions, decoding everything wins
-// (the selection's cost grows with the blocks near, the full decode's does
-// not): on the medium tractogram (index boxes of 8 blocks, 2 threads),
-// spheres whose blocks near are 22 % of the file select in 0.61x a full
-// load, 26 % in 0.99x, 38 % in 1.77x (docs/ecosystem.md).
-constexpr double kFullDecodeShare = 0.25;
+// On one thread, above this share of the blocks near the regions,
+// kept_fibers beats select()'s passes (whose cost grows with the blocks
+// near): on the medium tractogram, spheres near 16 % of the blocks select
+// in 42 ms against 57 ms, near 22 % in 103 ms against 69 ms (docs/select.md).
+constexpr double kKeptFibersShare = 0.2;
 
 }  // namespace
 
@@ -35,7 +37,7 @@ std::vector<std::uint64_t> blocks_near(const BlockIndex& index, const Region& r,
 }
 
 FiberRegionTest::FiberRegionTest(const FftFile& file, const BlockIndex& index, const Query& q)
-    : file_(file), include_(q.include), exclude_(q.exclude) {
+    : file_(file), include_(q.include), exclude_(q.exclude), max_join_(index.max_join()) {
     // A stored index says a block lies wholly inside a region only when the
     // checksums tie it to the blocks read (as select() trusts it).
     const bool trust_inside = index.source() == BlockIndex::Source::decoded || file.verifies_checksums();
@@ -74,13 +76,14 @@ bool FiberRegionTest::keeps(std::uint64_t fiber, const float* xyz, std::uint64_t
     return true;
 }
 
-bool FiberRegionTest::full_decode_is_faster() const {
+bool FiberRegionTest::kept_fibers_is_faster(unsigned threads) const {
+    if (detail::resolve_threads(threads) > 1) return true;
     const std::uint64_t blocks = file_.header().blocks;
     double share = include_.empty() ? 0.0 : 1.0;
     for (const auto& near : near_include_) share = std::min(share, share_of(near, blocks));
     if (include_.empty())
         for (const auto& near : near_exclude_) share = std::max(share, share_of(near, blocks));
-    return share > kFullDecodeShare;
+    return share > kKeptFibersShare;
 }
 
 }  // namespace fiblet

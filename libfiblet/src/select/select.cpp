@@ -19,6 +19,7 @@
 #include "fiblet/fiber_regions.hpp"
 #include "fiblet/select.hpp"
 #include "core/default_init_allocator.hpp"
+#include "select/block_bits.hpp"
 #include "select/block_batch_reader.hpp"
 #include "select/block_bounds.hpp"
 #include "select/block_decoder.hpp"
@@ -36,7 +37,7 @@ std::size_t batch_blocks(const FftHeader& h) {
     return std::clamp<std::size_t>((std::size_t{1} << 18) / h.points_per_block, 16, 4096);
 }
 
-bool has_bit(const Bits& b, std::uint64_t i) { return (b[i >> 6] >> (i & 63)) & 1; }
+using detail::has_bit;
 
 void and_bits(Bits& a, const Bits& b) {
     for (std::size_t i = 0; i < a.size(); ++i) a[i] &= b[i];
