@@ -222,6 +222,20 @@ TEST_F(SelectCli, FftOutputIsAValidSubset) {
     EXPECT_EQ(test::read_tck_fibers(c), got);
 }
 
+// Fibers-mode regions alone into a .fft (decided on all cores where the
+// library's rule says so: kept_fiber_runs) keep what the .tck output's
+// streaming selection keeps.
+TEST_F(SelectCli, FftOutputOfRegionsAloneKeepsTheTckOutputsFibers) {
+    const std::string sub = dir_->file("regions.fft"), a = dir_->file("regions-a.tck"), b = dir_->file("regions-b.tck");
+    const std::string args = " --include 0,0,0,20 --exclude 5,5,5,3";
+    ASSERT_EQ(run(cli() + " extract " + fft() + " -o " + sub + args), 0);
+    ASSERT_EQ(run(cli() + " decompress " + sub + " -o " + a), 0);
+    ASSERT_EQ(run(cli() + " extract " + fft() + " -o " + b + args), 0);
+    const auto got = test::read_tck_fibers(a);
+    EXPECT_FALSE(got.empty());
+    EXPECT_EQ(got, test::read_tck_fibers(b));
+}
+
 TEST_F(SelectCli, AddsAnIndexToOfficialEncoderFiles) {
     const std::string out = dir_->file("indexed.fft");
     ASSERT_EQ(run(cli() + " extract " + shared_data("reference/small-sdstream.fft") + " -o " + out), 0);

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <map>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -291,6 +292,17 @@ TEST_P(SelectQuery, FiberRegionTestMatchesBruteForce) {
                 if (test.keeps(f, all.xyz.data() + 3 * all.offsets[f], all.offsets[f + 1] - all.offsets[f]))
                     got.push_back(f);
             EXPECT_EQ(got, expected) << s.name << ": query " << i;
+            // The CLI's .fft output: the same runs as select_runs() (a query
+            // without regions is select_runs()'s).
+            const std::optional<std::vector<SelectedRun>> runs = kept_fiber_runs(*s.file, *index, q, 2);
+            ASSERT_EQ(runs.has_value(), !(q.include.empty() && q.exclude.empty())) << s.name << ": query " << i;
+            const std::vector<SelectedRun> reference = select_runs(*s.file, *index, q);
+            const std::vector<SelectedRun>& got_runs = runs ? *runs : reference;
+            ASSERT_EQ(got_runs.size(), reference.size()) << s.name << ": query " << i;
+            for (std::size_t r = 0; r < reference.size(); ++r)
+                EXPECT_TRUE(got_runs[r].fiber == reference[r].fiber && got_runs[r].first_block == reference[r].first_block &&
+                            got_runs[r].block_count == reference[r].block_count && got_runs[r].coarse_blocks == 0)
+                    << s.name << ": query " << i << ", run " << r;
             const std::vector<FiberRange> whole{{0, fibers - 1}};
             for (const unsigned threads : {1u, 2u}) {
                 EXPECT_EQ(test.kept_fibers(whole, threads), expected) << s.name << ": query " << i << ", " << threads;
@@ -306,6 +318,20 @@ TEST_P(SelectQuery, FiberRegionTestMatchesBruteForce) {
     EXPECT_TRUE(FiberRegionTest(*s.file, *s.stored_or_loaded, everything).kept_fibers_is_faster(1));
     EXPECT_FALSE(FiberRegionTest(*s.file, *s.stored_or_loaded, tiny).kept_fibers_is_faster(1));
     EXPECT_TRUE(FiberRegionTest(*s.file, *s.stored_or_loaded, tiny).kept_fibers_is_faster(2));
+    // kept_fiber_runs: regions alone over fiber ranges (unsorted, past the
+    // end: as select() clips them), and no other criterion.
+    Query ranged = everything;
+    ranged.fibers = {{fibers / 2, fibers + 10}, {0, 1}};
+    const auto ranged_runs = kept_fiber_runs(*s.file, *s.stored_or_loaded, ranged, 2);
+    ASSERT_TRUE(ranged_runs.has_value());
+    EXPECT_EQ(ranged_runs->size(), select_runs(*s.file, *s.stored_or_loaded, ranged).size());
+    Query with_length = everything;
+    with_length.min_length_mm = 1.0;
+    EXPECT_FALSE(kept_fiber_runs(*s.file, *s.stored_or_loaded, with_length, 2).has_value());
+    EXPECT_FALSE(kept_fiber_runs(*s.file, *s.stored_or_loaded, tiny, 1).has_value());
+    Query bad = everything;
+    bad.include.push_back(Region::sphere({0, 0, 0}, -1));
+    EXPECT_EQ(error_of([&] { (void)kept_fiber_runs(*s.file, *s.stored_or_loaded, bad, 2); }), Errc::invalid_argument);
     const std::vector<FiberRange> overlapping{{0, 2}, {2, 3}};
     EXPECT_EQ(error_of([&] { (void)FiberRegionTest(*s.file, *s.stored_or_loaded, tiny).kept_fibers(overlapping); }),
               Errc::invalid_argument);

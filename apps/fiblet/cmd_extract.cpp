@@ -174,8 +174,13 @@ void run(const ExtractArgs& a) {
         progress.done();
         bytes = std::filesystem::file_size(a.output);
     } else {
-        const auto runs = select_runs(file, index, query, &stats);
-        bytes = write_fft_subset(file, runs, a.output, a.force, index_format_for(a.fine_index)).bytes;
+        // Regions alone: decided on all cores where the library's rule says so.
+        std::optional<std::vector<SelectedRun>> runs = kept_fiber_runs(file, index, query, 0, &stats);
+        const bool on_all_cores = runs.has_value();
+        if (!runs) runs = select_runs(file, index, query, &stats);
+        const SubsetReport report = write_fft_subset(file, *runs, a.output, a.force, index_format_for(a.fine_index));
+        if (on_all_cores) stats.points = report.points;
+        bytes = report.bytes;
     }
     const auto t1 = std::chrono::steady_clock::now();
     auto secs = [](auto from, auto to) { return std::chrono::duration<double>(to - from).count(); };

@@ -1,13 +1,15 @@
 // fiblet — fibers-mode regions (tckedit -include / -exclude) decided on all
-// threads, for callers that want the kept fibers decoded (Python's roi=):
-// kept_fibers() decides most fibers from the index and the blocks'
-// anchors, decodes only the blocks that may still meet a region, and
-// leaves the kept fibers to decode_listed_fibers_into(); keeps() tests
-// fibers already decoded. kept_fibers_is_faster() is the rule that chooses
-// between this and select()'s index-driven passes.
+// threads: kept_fibers() decides most fibers from the index and the
+// blocks' anchors and decodes only the blocks that may still meet a
+// region; decode_kept_into() also decodes the kept fibers in the same job
+// (Python's roi=); kept_fiber_runs() gives the CLI's extract to .fft its
+// runs; keeps() tests fibers already decoded. kept_fibers_is_faster() is
+// the rule that chooses between these and select()'s index-driven passes.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -44,7 +46,9 @@ public:
     // blocks whose bounds from the headers may meet a region are decoded.
     // On `threads` threads (0: all cores). Error{invalid_argument} for
     // ranges out of order, overlapping or past the end.
-    std::vector<std::uint64_t> kept_fibers(std::span<const FiberRange> candidates, unsigned threads = 0) const;
+    // With `stats`: fibers, runs and blocks kept, blocks read and decoded.
+    std::vector<std::uint64_t> kept_fibers(std::span<const FiberRange> candidates, unsigned threads = 0,
+                                           SelectionStats* stats = nullptr) const;
 
     // kept_fibers(), with the kept fibers decoded into xyz, each as soon as
     // it is decided (its blocks read once): fibers gets their indices,
@@ -88,6 +92,17 @@ private:
     // Bitmaps of blocks: near each region, and wholly inside each include region.
     std::vector<std::vector<std::uint64_t>> near_include_, inside_include_, near_exclude_;
     float max_join_;  // BlockIndex::max_join()
+    // Blocks read and decoded by the calls so far (for SelectionStats).
+    mutable std::atomic<std::uint64_t> blocks_read_{0}, blocks_decoded_{0};
 };
+
+// select_runs() of a query of fibers-mode regions alone (include and
+// exclude, over its fiber ranges or every fiber: no other criterion), by
+// FiberRegionTest::kept_fibers on `threads` threads where its rule says it
+// is faster: every kept fiber one run of all its blocks. nullopt for other
+// queries and where select_runs() is faster. Error{invalid_argument} for a
+// query select() refuses.
+std::optional<std::vector<SelectedRun>> kept_fiber_runs(const FftFile& file, const BlockIndex& index, const Query& query,
+                                                        unsigned threads = 0, SelectionStats* stats = nullptr);
 
 }  // namespace fiblet

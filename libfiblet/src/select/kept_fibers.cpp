@@ -16,6 +16,7 @@
 #include "fiblet/view.hpp"
 #include "select/block_bits.hpp"
 #include "select/block_bounds.hpp"
+#include "select/query_checks.hpp"
 
 namespace fiblet {
 
@@ -112,6 +113,7 @@ bool FiberRegionTest::point_in(const Region& r, const std::vector<std::uint64_t>
         const Sphere next = with_next ? block_bounding_sphere(h, block + bb) : Sphere{};
         if (!detail::bound_may_meet(r, detail::block_bound(sphere, with_next ? &next : nullptr, max_join_))) continue;
         const std::size_t n = decode_blocks(ctx, block, 1, xyz.data());
+        blocks_decoded_.fetch_add(1, std::memory_order_relaxed);
         for (std::size_t p = 0; p < n; ++p)
             if (r.contains({xyz[3 * p], xyz[3 * p + 1], xyz[3 * p + 2]})) return true;
     }
@@ -148,8 +150,10 @@ void FiberRegionTest::decide(std::uint64_t f0, std::uint64_t f1, const DecodeCon
         if (to_read(f)) {
             while (e < f1 && to_read(e)) ++e;
             const std::uint64_t first = file_.first_block(f);
-            if (file_.block_end(e) > first)
+            if (file_.block_end(e) > first) {
                 file_.read_blocks(first, file_.block_end(e) - first, blocks.data() + (first - b0) * bb);
+                blocks_read_.fetch_add(file_.block_end(e) - first, std::memory_order_relaxed);
+            }
         }
         f = e;
     }
@@ -161,8 +165,10 @@ void FiberRegionTest::decide(std::uint64_t f0, std::uint64_t f1, const DecodeCon
     }
 }
 
-std::vector<std::uint64_t> FiberRegionTest::kept_fibers(std::span<const FiberRange> candidates, unsigned threads) const {
+std::vector<std::uint64_t> FiberRegionTest::kept_fibers(std::span<const FiberRange> candidates, unsigned threads,
+                                                        SelectionStats* stats) const {
     const Parts parts = parts_of(file_, candidates);
+    const std::uint64_t read_before = blocks_read_, decoded_before = blocks_decoded_;
     std::vector<std::uint8_t> kept(parts.flag_at.back());
     const DecodeContext ctx(file_);
     parallel_for(parts.size(), threads, [&](std::size_t p) {
@@ -173,7 +179,41 @@ std::vector<std::uint64_t> FiberRegionTest::kept_fibers(std::span<const FiberRan
     for (std::size_t p = 0; p < parts.size(); ++p)
         for (std::uint64_t f = parts.first[p]; f < parts.end[p]; ++f)
             if (kept[parts.flag_at[p] + f - parts.first[p]]) out.push_back(f);
+    if (stats) {
+        *stats = {};
+        stats->fibers = stats->runs = out.size();
+        for (const std::uint64_t f : out) stats->blocks += file_.block_count(f);
+        stats->blocks_read = blocks_read_ - read_before, stats->blocks_decoded = blocks_decoded_ - decoded_before;
+        stats->blocks_tested = stats->blocks_read;  // their anchors and bounds looked at
+    }
     return out;
+}
+
+std::optional<std::vector<SelectedRun>> kept_fiber_runs(const FftFile& file, const BlockIndex& index, const Query& q,
+                                                        unsigned threads, SelectionStats* stats) {
+    detail::check_query(q);
+    const bool regions_alone = q.roi_mode == RoiMode::fibers && !(q.include.empty() && q.exclude.empty()) &&
+                               !q.min_length_mm && !q.max_length_mm && !q.random_fraction && !q.ends_only &&
+                               !q.inverse && q.skip == 0 && !q.number && !q.view;
+    if (!regions_alone) return std::nullopt;
+    const FiberRegionTest test(file, index, q);
+    if (!test.kept_fibers_is_faster(threads)) return std::nullopt;
+    // The query's ranges within the file, sorted and merged, as select() takes them.
+    const std::uint64_t fibers = file.header().fibers;
+    std::vector<FiberRange> candidates;
+    if (q.fibers.empty() && fibers > 0) candidates.push_back({0, fibers - 1});
+    for (const FiberRange& r : q.fibers)
+        if (r.first < fibers) candidates.push_back({r.first, std::min(r.last, fibers - 1)});
+    std::sort(candidates.begin(), candidates.end(), [](const FiberRange& a, const FiberRange& b) { return a.first < b.first; });
+    std::vector<FiberRange> merged;
+    for (const FiberRange& r : candidates) {
+        if (!merged.empty() && r.first <= merged.back().last + 1) merged.back().last = std::max(merged.back().last, r.last);
+        else merged.push_back(r);
+    }
+    std::vector<SelectedRun> runs;
+    for (const std::uint64_t f : test.kept_fibers(merged, threads, stats))
+        runs.push_back({f, file.first_block(f), file.block_count(f), 0});
+    return runs;
 }
 
 std::uint64_t FiberRegionTest::decode_kept_into(std::span<const FiberRange> candidates, std::span<float> xyz,
