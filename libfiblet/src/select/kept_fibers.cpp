@@ -1,6 +1,6 @@
 // FiberRegionTest::kept_fibers and decode_kept_into: a query's regions
-// decided on all threads, one part of whole fibers (up to kPartBlocks
-// blocks) per task. A part's fibers are decided from the index's bitmaps
+// decided on all threads, one part of whole fibers (up to kPartPoints
+// points in full blocks) per task. A part's fibers are decided from the index's bitmaps
 // (no block read), then from their blocks' anchors (decoded points, stored
 // exactly), then by decoding the blocks whose bounds from the headers may
 // meet a region. decode_kept_into then decodes the part's kept fibers while
@@ -25,9 +25,10 @@ using detail::has_bit;
 
 namespace {
 
-// Blocks of whole fibers a task decides (~300 kB of 76-byte blocks, their
-// points ~3 MB: in cache from read to decode).
-constexpr std::uint64_t kPartBlocks = 4096;
+// Points of whole fibers a task decides: 4096 blocks of 60 (~300 kB of
+// 76-byte blocks, their points ~3 MB: in cache from read to decode), as
+// many points of larger blocks.
+constexpr std::uint64_t kPartPoints = std::uint64_t{4096} * 60;
 
 // Parts of whole fibers within the candidate ranges: part p is fibers
 // [first[p], end[p]), its flags from flag_at[p] on.
@@ -37,6 +38,7 @@ struct Parts {
 };
 
 Parts parts_of(const FftFile& file, std::span<const FiberRange> candidates) {
+    const std::uint64_t part_blocks = std::max<std::uint64_t>(kPartPoints / file.header().points_per_block, 1);
     Parts parts;
     for (const FiberRange& r : candidates) {
         if (r.first > r.last || r.last >= file.header().fibers || (!parts.end.empty() && r.first < parts.end.back()))
@@ -45,7 +47,7 @@ Parts parts_of(const FftFile& file, std::span<const FiberRange> candidates) {
             const std::uint64_t b0 = file.first_block(f);
             parts.first.push_back(f);
             do ++f;
-            while (f <= r.last && file.block_end(f + 1) - b0 <= kPartBlocks);
+            while (f <= r.last && file.block_end(f + 1) - b0 <= part_blocks);
             parts.end.push_back(f);
             parts.flag_at.push_back(parts.flag_at.back() + f - parts.first.back());
         }
