@@ -1,7 +1,6 @@
 #include "decode_range.hpp"
 
 #include <cstdlib>
-#include <cstring>
 #include <string_view>
 #include <exception>
 #include <string>

@@ -20,7 +20,6 @@
 #include <optional>
 #include <span>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "fiblet/block_index.hpp"
@@ -30,7 +29,6 @@
 #include "fiblet/error.hpp"
 #include "fiblet/fft_file.hpp"
 #include "fiblet/image_mask.hpp"
-#include "fiblet/parallel.hpp"
 #include "fiblet/fiber_regions.hpp"
 #include "fiblet/select.hpp"
 #include "fiblet/streamline_io.hpp"
