@@ -113,10 +113,17 @@ TEST_F(DecodeThreads, DecodeIntoFillsTheCallersBuffersExactly) {
     const float sentinel = 7777.0f;
     std::vector<float> xyz(3 * points + 16, sentinel);
     std::vector<std::uint64_t> offsets(fibers + 1, ~0ull);
-    EXPECT_EQ(decode_fibers_into(file, 0, fibers, xyz, offsets, options(2, 5000)), points);
-    EXPECT_EQ(offsets, whole.offsets);
-    EXPECT_EQ(std::memcmp(xyz.data(), whole.xyz.data(), 12 * points), 0);
-    for (std::size_t i = 3 * points; i < xyz.size(); ++i) EXPECT_EQ(xyz[i], sentinel);
+    // Any threads and parts (of 1 and 7 blocks: every part waits for the
+    // one before it to place its points).
+    for (unsigned threads : {1u, 2u, 3u})
+        for (std::size_t part : {std::size_t(1), std::size_t(7), std::size_t(5000), std::size_t(0)}) {
+            std::fill(xyz.begin(), xyz.end(), sentinel);
+            std::fill(offsets.begin(), offsets.end(), ~0ull);
+            EXPECT_EQ(decode_fibers_into(file, 0, fibers, xyz, offsets, options(threads, part)), points);
+            EXPECT_EQ(offsets, whole.offsets) << "threads " << threads << " part " << part;
+            EXPECT_EQ(std::memcmp(xyz.data(), whole.xyz.data(), 12 * points), 0) << "threads " << threads << " part " << part;
+            for (std::size_t i = 3 * points; i < xyz.size(); ++i) ASSERT_EQ(xyz[i], sentinel);
+        }
 
     // One point short: refused, and nothing written past the buffer.
     std::vector<float> small(3 * (points - 1) + 16, sentinel);
@@ -133,21 +140,28 @@ TEST_F(DecodeThreads, DecodeIntoFillsTheCallersBuffersExactly) {
 }
 
 TEST_F(DecodeThreads, ABadBlockFoundByAWorkerThreadIsReported) {
-    // Copy the file and give a block in the last thread's run a point count of 0.
-    const std::string bad = dir_->file("bad.fft");
-    std::string bytes = test::read_file(path_);
+    // Copy the file and give a block a point count of 0: in the last
+    // thread's run, and (decode_fibers_into) in the first part, which the
+    // parts after it wait for.
     const FftFile good(path_);
     const FftHeader& h = good.header();
-    const std::uint64_t block = h.blocks - 10;
-    bytes[h.blocks_offset() + block * h.block_bytes() + kBlockFlagsOffset] = char(0);
-    test::write_file(bad, bytes);
-    const FftFile file(bad);
-    for (unsigned threads : {1u, 2u, 3u}) {
-        try {
-            decode_fibers(file, 0, h.fibers, options(threads));
-            ADD_FAILURE() << "threads " << threads << ": the bad block went unnoticed";
-        } catch (const Error& e) {
-            EXPECT_EQ(e.code(), Errc::fft_format);
+    for (const std::uint64_t block : {std::uint64_t{h.blocks - 10}, std::uint64_t{10}}) {
+        const std::string bad = dir_->file("bad.fft");
+        std::string bytes = test::read_file(path_);
+        bytes[h.blocks_offset() + block * h.block_bytes() + kBlockFlagsOffset] = char(0);
+        test::write_file(bad, bytes);
+        const FftFile file(bad);
+        // Without the checksums, only the part holding the block finds it.
+        const FftFile unchecked(bad, {.verify_checksums = false});
+        std::vector<float> xyz(3 * std::uint64_t(h.blocks) * h.points_per_block);
+        std::vector<std::uint64_t> offsets(h.fibers + 1);
+        for (unsigned threads : {1u, 2u, 3u}) {
+            EXPECT_EQ(test::error_of([&] { decode_fibers(file, 0, h.fibers, options(threads)); }), Errc::fft_format)
+                << "block " << block << ", threads " << threads;
+            for (const FftFile* f : {&file, &unchecked})
+                EXPECT_EQ(test::error_of([&] { decode_fibers_into(*f, 0, h.fibers, xyz, offsets, options(threads, 1000)); }),
+                          Errc::fft_format)
+                    << "block " << block << ", threads " << threads;
         }
     }
 }
