@@ -161,6 +161,17 @@ std::size_t decode_lanes_of(const DecodeContext& ctx, const float* rows_table, f
 
         const std::uint8_t* codes = base + Blocks::kCodesOffset;
         for (int k = 0; k + 2 < max_points; ++k) {
+            // 16-bit codes: their frame rows (4 MiB) are not in cache; ask
+            // for those of a later step while this one computes. No bits
+            // change. Codes past a lane's points are still its block's bytes.
+            if constexpr (Blocks::kCodeBytes == 2) {
+                constexpr int kAhead = 6;
+                if (k + kAhead + 2 < max_points)
+                    for (int l = 0; l < W; ++l) {
+                        const std::uint8_t* c = codes + std::size_t(l) * bb + 2 * (k + kAhead);
+                        __builtin_prefetch(rows_table + 16 * std::size_t(Code16::at(c)));
+                    }
+            }
             F local[9];
             V::template lookup<typename Blocks::Code>(rows_table, codes + Blocks::kCodeBytes * k, bb, local);
             // frame = frame * local, as compose(): column j = F * local.c[j],
