@@ -77,8 +77,8 @@ private:
     Fate fate_by_anchors(std::uint64_t fiber, const std::uint8_t* blocks) const;
     bool anchor_in(const Region& r, const std::vector<std::uint64_t>& near, std::uint64_t fiber,
                    const std::uint8_t* blocks) const;
-    bool point_in(const Region& r, const std::vector<std::uint64_t>& near, std::uint64_t fiber, const std::uint8_t* blocks,
-                  const DecodeContext& ctx) const;
+    bool point_in(const Region& r, const std::vector<std::uint64_t>& near, std::uint64_t fiber,
+                  const std::uint8_t* blocks, const DecodeContext& ctx) const;
     bool keeps_by_blocks(std::uint64_t fiber, const std::uint8_t* blocks, const DecodeContext& ctx) const;
     // Fibers [f0, f1): kept[f - f0] = 1 for those kept; `blocks` gets the
     // blocks of the fibers the index leaves undecided (and, with read_kept,
@@ -102,7 +102,8 @@ private:
 // is faster: every kept fiber one run of all its blocks. nullopt for other
 // queries and where select_runs() is faster. Error{invalid_argument} for a
 // query select() refuses.
-std::optional<std::vector<SelectedRun>> kept_fiber_runs(const FftFile& file, const BlockIndex& index, const Query& query,
-                                                        unsigned threads = 0, SelectionStats* stats = nullptr);
+std::optional<std::vector<SelectedRun>> kept_fiber_runs(const FftFile& file, const BlockIndex& index,
+                                                        const Query& query, unsigned threads = 0,
+                                                        SelectionStats* stats = nullptr);
 
 }  // namespace fiblet

@@ -24,6 +24,19 @@ namespace fiblet {
 
 namespace {
 
+// The end of the whole fibers from `f` (up to `end`) within `max_blocks`
+// blocks, at least one fiber. Fibers' first blocks increase: a binary search.
+std::uint64_t fibers_end(const FftFile& file, std::uint64_t f, std::uint64_t end, std::uint64_t max_blocks) {
+    const std::uint64_t b0 = file.block_end(f);
+    std::uint64_t lo = f + 1, hi = end;
+    while (lo < hi) {
+        const std::uint64_t mid = lo + (hi - lo + 1) / 2;
+        if (file.block_end(mid) - b0 <= max_blocks) lo = mid;
+        else hi = mid - 1;
+    }
+    return lo;
+}
+
 class ChunkDecoder {
 public:
     // decode_file reuses its chunks' outputs: 4096 blocks of 60 points a
@@ -31,9 +44,9 @@ public:
     // blocks of other sizes (16-bit: 254 points) as many points.
     static constexpr std::size_t kPointsPerThread = std::size_t{4096} * 60;
     // decode_fibers writes straight into the whole output; only the chunk's
-    // blocks are reused (5 MB: 65536 76-byte blocks, fewer larger ones). Bigger chunks join the pool less often:
-    // each chunk is two jobs, and a job's end waits for its last run and
-    // wakes a worker (docs/parallel.md: 2 threads vs 1 went from 1.4x to
+    // blocks are reused (5 MB: 65536 76-byte blocks, fewer larger ones).
+    // Bigger chunks join the pool less often: each chunk is two jobs, and a
+    // job's end waits for its last run and wakes a worker (docs/parallel.md: 2 threads vs 1 went from 1.4x to
     // 1.7x on the medium file; the whole file as one chunk is slower again,
     // its blocks fall out of cache).
     static constexpr std::size_t kWholeOutputChunkBytes = (std::size_t{1} << 16) * 76;
@@ -55,15 +68,7 @@ public:
     // End of the chunk of whole fibers starting at `f`: at least one fiber,
     // at most chunk_blocks blocks otherwise.
     std::uint64_t chunk_end(std::uint64_t f, std::uint64_t end) const {
-        const std::uint64_t b0 = file_.block_end(f);
-        // Fibers' first blocks increase: binary search the last fiber that fits.
-        std::uint64_t lo = f + 1, hi = end;
-        while (lo < hi) {
-            const std::uint64_t mid = lo + (hi - lo + 1) / 2;
-            if (file_.block_end(mid) - b0 <= chunk_blocks_) lo = mid;
-            else hi = mid - 1;
-        }
-        return lo;
+        return fibers_end(file_, f, end, chunk_blocks_);
     }
 
     // Reads the blocks of fibers [f0, f1) and counts their points (validating
@@ -168,16 +173,7 @@ std::uint64_t decode_fibers_into(const FftFile& file, std::uint64_t begin, std::
         options.chunk_blocks ? options.chunk_blocks
                              : std::max<std::uint64_t>(kPartPoints / ctx.header.points_per_block, 1);
     std::vector<std::uint64_t> part_first{begin};
-    while (part_first.back() < end) {
-        const std::uint64_t f = part_first.back(), b0 = file.block_end(f);
-        std::uint64_t lo = f + 1, hi = end;  // the last fiber end within part_blocks (at least one fiber)
-        while (lo < hi) {
-            const std::uint64_t mid = lo + (hi - lo + 1) / 2;
-            if (file.block_end(mid) - b0 <= part_blocks) lo = mid;
-            else hi = mid - 1;
-        }
-        part_first.push_back(lo);
-    }
+    while (part_first.back() < end) part_first.push_back(fibers_end(file, part_first.back(), end, part_blocks));
     const std::size_t parts = part_first.size() - 1;
     detail::OrderedEnds ends(parts);
     offsets[0] = 0;
@@ -197,7 +193,8 @@ std::uint64_t decode_fibers_into(const FftFile& file, std::uint64_t begin, std::
         std::uint64_t at = start;
         const std::uint8_t* block = data.data();
         for (std::uint64_t f = f0; f < f1; ++f) {
-            for (std::uint32_t k = file.block_count(f); k > 0; --k, block += bb) at += block_flags(ctx.header, block).point_count;
+            for (std::uint32_t k = file.block_count(f); k > 0; --k, block += bb)
+                at += block_flags(ctx.header, block).point_count;
             offsets[f - begin + 1] = at;
         }
         detail::decode_resolved(ctx, data.data(), blocks, xyz.data() + 3 * start, decoder);

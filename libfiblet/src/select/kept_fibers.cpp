@@ -42,7 +42,8 @@ Parts parts_of(const FftFile& file, std::span<const FiberRange> candidates) {
     Parts parts;
     for (const FiberRange& r : candidates) {
         if (r.first > r.last || r.last >= file.header().fibers || (!parts.end.empty() && r.first < parts.end.back()))
-            throw Error(Errc::invalid_argument, file.path() + ": fiber ranges must be ascending, disjoint and in the file");
+            throw Error(Errc::invalid_argument,
+                        file.path() + ": fiber ranges must be ascending, disjoint and in the file");
         for (std::uint64_t f = r.first; f <= r.last;) {
             const std::uint64_t b0 = file.first_block(f);
             parts.first.push_back(f);
@@ -206,11 +207,14 @@ std::optional<std::vector<SelectedRun>> kept_fiber_runs(const FftFile& file, con
     if (q.fibers.empty() && fibers > 0) candidates.push_back({0, fibers - 1});
     for (const FiberRange& r : q.fibers)
         if (r.first < fibers) candidates.push_back({r.first, std::min(r.last, fibers - 1)});
-    std::sort(candidates.begin(), candidates.end(), [](const FiberRange& a, const FiberRange& b) { return a.first < b.first; });
+    std::sort(candidates.begin(), candidates.end(),
+              [](const FiberRange& a, const FiberRange& b) { return a.first < b.first; });
     std::vector<FiberRange> merged;
     for (const FiberRange& r : candidates) {
-        if (!merged.empty() && r.first <= merged.back().last + 1) merged.back().last = std::max(merged.back().last, r.last);
-        else merged.push_back(r);
+        if (!merged.empty() && r.first <= merged.back().last + 1)
+            merged.back().last = std::max(merged.back().last, r.last);
+        else
+            merged.push_back(r);
     }
     std::vector<SelectedRun> runs;
     for (const std::uint64_t f : test.kept_fibers(merged, threads, stats))
@@ -245,7 +249,8 @@ std::uint64_t FiberRegionTest::decode_kept_into(std::span<const FiberRange> cand
         const std::uint64_t base = ends.publish(p, points);
         if (base == detail::OrderedEnds::kFailed) return;  // a part before failed: its error is the one reported
         if (3 * (base + points) > xyz.size())
-            throw Error(Errc::invalid_argument, "decode_kept_into: " + file_.path() + "'s kept fibers hold more points than the " +
+            throw Error(Errc::invalid_argument, "decode_kept_into: " + file_.path() +
+                                                    "'s kept fibers hold more points than the " +
                                                     std::to_string(xyz.size() / 3) + " the buffer has room for");
         // Runs of consecutive kept fibers, each one decode.
         float* out = xyz.data() + 3 * base;
@@ -254,7 +259,8 @@ std::uint64_t FiberRegionTest::decode_kept_into(std::span<const FiberRange> cand
             if (k[f - f0]) {
                 while (e < f1 && k[e - f0]) ++e;
                 const std::uint64_t first = file_.first_block(f);
-                out += 3 * decode_blocks(ctx, blocks.data() + (first - b0) * h.block_bytes(), file_.block_end(e) - first, out);
+                out += 3 * decode_blocks(ctx, blocks.data() + (first - b0) * h.block_bytes(),
+                                         file_.block_end(e) - first, out);
             }
             f = e;
         }
