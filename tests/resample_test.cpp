@@ -296,3 +296,29 @@ TEST(Resample, PositionsSayWhereEachPointLiesOnTheInput) {
         EXPECT_EQ(back.back(), line.back());
     }
 }
+
+// Points far from the origin (x = 4e28 mm, all equal in float, as a .trk
+// whose affine translates them so) and 3 mm apart in z: every curve's walk
+// gives the points of its z extent at the step, as at the origin. The
+// cubic evaluated from its end points, not as a weighted sum of them, so
+// that their rounding (1e12 mm in double) is not in the curve (the fuzzer
+// found compress filling memory on such a file).
+TEST(Resample, CoordinatesFarLargerThanTheCurveResampleAsAtTheOrigin) {
+    // The fuzzer's fiber: 3, 3, 2.75 and 3.25 mm apart.
+    const std::vector<Vec3f> near{{0, 1.5726964e-30f, 2}, {0, 6.2908038e-30f, 5}, {0, 1.1008911e-29f, 8},
+                                  {0, 1.5727019e-29f, 10.75f}, {0, 2.0445126e-29f, 14}};
+    std::vector<Vec3f> far = near;
+    for (Vec3f& p : far) p.x = 4.1780774e28f;
+    for (const ResampleCurve curve : {ResampleCurve::polyline, ResampleCurve::cubic, ResampleCurve::cubic_keeping_length,
+                                      ResampleCurve::rounded_keeping_length}) {
+        std::vector<Vec3f> a, b;
+        resample_fixed_step(near, 0.75, a, curve);
+        resample_fixed_step(far, 0.75, b, curve);
+        ASSERT_EQ(b.size(), a.size()) << int(curve);
+        for (std::size_t i = 0; i < a.size(); ++i) {
+            EXPECT_EQ(b[i].x, far[0].x);
+            EXPECT_NEAR(b[i].z, a[i].z, 1e-5) << int(curve) << " point " << i;
+        }
+        EXPECT_GE(a.size(), 16u);  // 12 mm at 0.75 mm
+    }
+}

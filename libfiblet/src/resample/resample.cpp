@@ -93,7 +93,11 @@ public:
         if (!(qa > 0)) return;
         // While the piece's end is out of the sphere around the current
         // point, the largest t in [0, 1] with |a + t d - cur| = step is next.
-        while (dot(sub(b, cur_), sub(b, cur_)) >= r2_) {
+        // A straight piece holds at most length / step + 1 such points; more
+        // means the arithmetic no longer moves (coordinates whose rounding
+        // exceeds the step): stop rather than fill memory.
+        const double most = std::sqrt(qa / r2_) + 2;
+        for (double n = 0; dot(sub(b, cur_), sub(b, cur_)) >= r2_ && n < most; ++n) {
             const V3 f = sub(a, cur_);
             const double qb = 2 * dot(f, d), qc = dot(f, f) - r2_;
             const double disc = std::max(qb * qb - 4 * qa * qc, 0.0);
@@ -124,9 +128,12 @@ void walk_hermite(V3 p0, V3 m0, V3 p1, V3 m1, double d, std::size_t pieces, std:
     V3 from = p0;
     for (std::size_t k = 1; k <= pieces; ++k) {
         const double t = double(k) / double(pieces), t2 = t * t, t3 = t2 * t;
+        // p0 + (p1 - p0) h01 + tangent terms (h00 + h01 = 1): from p0, so
+        // that coordinates far larger than the curve (1e28 mm) do not add
+        // their rounding (1e12 mm) to it.
         const V3 to = k == pieces ? p1
-                                  : add(add(mul(p0, 2 * t3 - 3 * t2 + 1), mul(m0, d * (t3 - 2 * t2 + t))),
-                                        add(mul(p1, 3 * t2 - 2 * t3), mul(m1, d * (t3 - t2))));
+                                  : add(p0, add(add(mul(sub(p1, p0), 3 * t2 - 2 * t3), mul(m0, d * (t3 - 2 * t2 + t))),
+                                                mul(m1, d * (t3 - t2))));
         walk.piece(from, to, segment, t0 + (t1 - t0) * double(k - 1) / double(pieces), t0 + (t1 - t0) * t);
         from = to;
     }
