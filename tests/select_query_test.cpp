@@ -258,10 +258,9 @@ void expect_decoded_kept(const Subject& s, const FiberRegionTest& test, const st
     for (std::size_t i = 3 * room; i < xyz.size(); ++i) ASSERT_EQ(xyz[i], sentinel) << what;
 }
 
-// The regions tested on decoded fibers (FiberRegionTest::keeps: only the
-// points of the blocks the index puts near a region) and decided by
-// kept_fibers (the index, the blocks' anchors, the blocks that may meet a
-// region decoded alone) keep what the brute force keeps, with the stored
+// The regions decided by FiberRegionTest::kept_fibers (the index, the
+// blocks' anchors, the blocks that may meet a region decoded alone) keep
+// what the brute force keeps, with the stored
 // and the computed index, on one thread and two, over all fibers and over
 // ranges of them; the rule takes kept_fibers on two threads, and on one
 // for regions over the whole file, not for a small one.
@@ -287,11 +286,6 @@ TEST_P(SelectQuery, FiberRegionTestMatchesBruteForce) {
         kept_some += !expected.empty();
         for (const BlockIndex* index : {s.stored_or_loaded.get(), s.computed.get()}) {
             const FiberRegionTest test(*s.file, *index, q);
-            std::vector<std::uint64_t> got;
-            for (std::uint64_t f = 0; f < fibers; ++f)
-                if (test.keeps(f, all.xyz.data() + 3 * all.offsets[f], all.offsets[f + 1] - all.offsets[f]))
-                    got.push_back(f);
-            EXPECT_EQ(got, expected) << s.name << ": query " << i;
             // The CLI's .fft output: the same runs as select_runs() (a query
             // without regions is select_runs()'s).
             const std::optional<std::vector<SelectedRun>> runs = kept_fiber_runs(*s.file, *index, q, 2);

@@ -3,8 +3,8 @@
 // blocks' anchors and decodes only the blocks that may still meet a
 // region; decode_kept_into() also decodes the kept fibers in the same job
 // (Python's roi=); kept_fiber_runs() gives the CLI's extract to .fft its
-// runs; keeps() tests fibers already decoded. kept_fibers_is_faster() is
-// the rule that chooses between these and select()'s index-driven passes.
+// runs. kept_fibers_is_faster() is the rule that chooses between these and
+// select()'s index-driven passes.
 #pragma once
 
 #include <atomic>
@@ -33,13 +33,10 @@ std::vector<std::uint64_t> blocks_near(const BlockIndex& index, const Region& r,
 class FiberRegionTest {
 public:
     FiberRegionTest(const FftFile& file, const BlockIndex& index, const Query& query);
-    // Whether fiber `fiber` of the file, decoded as xyz[0, 3 * points), has a
-    // point in every include region and none in an exclude region (a fiber
-    // without points: never).
-    bool keeps(std::uint64_t fiber, const float* xyz, std::uint64_t points) const;
 
-    // The fibers among `candidates` (ascending, disjoint ranges) that keeps()
-    // keeps, ascending, without decoding what the index and the blocks'
+    // The fibers among `candidates` (ascending, disjoint ranges) with a point
+    // in every include region and none in an exclude region (a fiber without
+    // points: never), ascending, without decoding what the index and the blocks'
     // anchors decide: an include region with no block near it drops a
     // fiber, a block wholly inside one or an anchor in it (a block's first
     // two points, stored exactly) meets it; of the fibers left, only the
@@ -85,8 +82,6 @@ private:
     // those it keeps) from f0's first block on.
     void decide(std::uint64_t f0, std::uint64_t f1, const DecodeContext& ctx, std::uint8_t* kept, bool read_kept,
                 std::vector<std::uint8_t>& blocks) const;
-    bool meets(const Region& r, const std::vector<std::uint64_t>& near, const std::vector<std::uint64_t>* inside,
-               std::uint64_t fiber, const float* xyz, std::uint64_t points) const;
     const FftFile& file_;
     std::vector<Region> include_, exclude_;
     // Bitmaps of blocks: near each region, and wholly inside each include region.

@@ -46,9 +46,9 @@ public:
     // decode_fibers writes straight into the whole output; only the chunk's
     // blocks are reused (5 MB: 65536 76-byte blocks, fewer larger ones).
     // Bigger chunks join the pool less often: each chunk is two jobs, and a
-    // job's end waits for its last run and wakes a worker (docs/parallel.md: 2 threads vs 1 went from 1.4x to
-    // 1.7x on the medium file; the whole file as one chunk is slower again,
-    // its blocks fall out of cache).
+    // job's end waits for its last run and wakes a worker (docs/parallel.md:
+    // 2 threads vs 1 went from 1.4x to 1.7x on the medium file; the whole
+    // file as one chunk is slower again, its blocks fall out of cache).
     static constexpr std::size_t kWholeOutputChunkBytes = (std::size_t{1} << 16) * 76;
 
     ChunkDecoder(const FftFile& file, const DecodeOptions& options, std::size_t min_chunk_bytes = 0)

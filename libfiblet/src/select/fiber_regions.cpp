@@ -4,11 +4,8 @@
 #include <bit>
 
 #include "core/thread_count.hpp"
-#include "select/block_bits.hpp"
 
 namespace fiblet {
-
-using detail::has_bit;
 
 namespace {
 
@@ -47,33 +44,6 @@ FiberRegionTest::FiberRegionTest(const FftFile& file, const BlockIndex& index, c
         if (!trust_inside) inside_include_.back().assign(near_include_.back().size(), 0);
     }
     for (const Region& r : exclude_) near_exclude_.push_back(blocks_near(index, r));
-}
-
-bool FiberRegionTest::meets(const Region& r, const std::vector<std::uint64_t>& near,
-                            const std::vector<std::uint64_t>* inside, std::uint64_t fiber, const float* xyz,
-                            std::uint64_t points) const {
-    const std::uint64_t first = file_.first_block(fiber), count = file_.block_count(fiber);
-    const std::uint64_t ppb = file_.header().points_per_block;
-    if (inside)
-        for (std::uint64_t b = first; b < first + count; ++b)
-            if (has_bit(*inside, b)) return true;  // every point of the block is in the region
-    for (std::uint64_t b = 0; b < count; ++b) {
-        const std::uint64_t block = first + b;
-        if (!has_bit(near, block)) continue;
-        const std::uint64_t from = b * ppb, to = std::min(points, from + ppb);
-        for (std::uint64_t p = from; p < to; ++p)
-            if (r.contains({xyz[3 * p], xyz[3 * p + 1], xyz[3 * p + 2]})) return true;
-    }
-    return false;
-}
-
-bool FiberRegionTest::keeps(std::uint64_t fiber, const float* xyz, std::uint64_t points) const {
-    if (points == 0) return false;
-    for (std::size_t i = 0; i < include_.size(); ++i)
-        if (!meets(include_[i], near_include_[i], &inside_include_[i], fiber, xyz, points)) return false;
-    for (std::size_t i = 0; i < exclude_.size(); ++i)
-        if (meets(exclude_[i], near_exclude_[i], nullptr, fiber, xyz, points)) return false;
-    return true;
 }
 
 bool FiberRegionTest::kept_fibers_is_faster(unsigned threads) const {
