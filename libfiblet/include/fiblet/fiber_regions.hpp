@@ -71,7 +71,6 @@ public:
 private:
     enum class Fate : std::uint8_t { dropped, kept, undecided };
     Fate fate_by_index(std::uint64_t fiber) const;
-    Fate fate_by_anchors(std::uint64_t fiber, const std::uint8_t* blocks) const;
     bool anchor_in(const Region& r, const std::vector<std::uint64_t>& near, std::uint64_t fiber,
                    const std::uint8_t* blocks) const;
     bool point_in(const Region& r, const std::vector<std::uint64_t>& near, std::uint64_t fiber,

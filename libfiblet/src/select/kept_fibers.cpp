@@ -1,14 +1,16 @@
 // FiberRegionTest::kept_fibers and decode_kept_into: a query's regions
 // decided on all threads, one part of whole fibers (up to kPartPoints
-// points in full blocks) per task. A part's fibers are decided from the index's bitmaps
-// (no block read), then from their blocks' anchors (decoded points, stored
-// exactly), then by decoding the blocks whose bounds from the headers may
-// meet a region. decode_kept_into then decodes the part's kept fibers while
-// its blocks are in cache, after the points of the parts before it: each
-// part publishes where its points end once it knows how many it keeps.
+// points in full blocks) per task. A part's fibers are decided from the
+// index's bitmaps (no block read), then from their blocks: their anchors
+// (decoded points, stored exactly), then the blocks whose bounds from the
+// headers may meet a region, decoded. decode_kept_into then decodes the
+// part's kept fibers while its blocks are in cache, after the points of
+// the parts before it: each part publishes where its points end once it
+// knows how many it keeps.
 #include <algorithm>
 #include <string>
 
+#include "container/fiber_spans.hpp"
 #include "core/ordered_ends.hpp"
 #include "fiblet/error.hpp"
 #include "fiblet/fiber_regions.hpp"
@@ -44,13 +46,10 @@ Parts parts_of(const FftFile& file, std::span<const FiberRange> candidates) {
         if (r.first > r.last || r.last >= file.header().fibers || (!parts.end.empty() && r.first < parts.end.back()))
             throw Error(Errc::invalid_argument,
                         file.path() + ": fiber ranges must be ascending, disjoint and in the file");
-        for (std::uint64_t f = r.first; f <= r.last;) {
-            const std::uint64_t b0 = file.first_block(f);
+        for (std::uint64_t f = r.first; f <= r.last; f = parts.end.back()) {
             parts.first.push_back(f);
-            do ++f;
-            while (f <= r.last && file.block_end(f + 1) - b0 <= part_blocks);
-            parts.end.push_back(f);
-            parts.flag_at.push_back(parts.flag_at.back() + f - parts.first.back());
+            parts.end.push_back(detail::fibers_end(file, f, r.last + 1, part_blocks));
+            parts.flag_at.push_back(parts.flag_at.back() + parts.end.back() - f);
         }
     }
     return parts;
@@ -87,19 +86,6 @@ bool FiberRegionTest::anchor_in(const Region& r, const std::vector<std::uint64_t
     return false;
 }
 
-FiberRegionTest::Fate FiberRegionTest::fate_by_anchors(std::uint64_t fiber, const std::uint8_t* blocks) const {
-    const std::uint64_t first = file_.first_block(fiber), end = first + file_.block_count(fiber);
-    bool decided = true;
-    for (std::size_t i = 0; i < include_.size(); ++i)
-        if (!any_bit(inside_include_[i], first, end) && !anchor_in(include_[i], near_include_[i], fiber, blocks))
-            decided = false;
-    for (std::size_t i = 0; i < exclude_.size(); ++i) {
-        if (anchor_in(exclude_[i], near_exclude_[i], fiber, blocks)) return Fate::dropped;
-        decided = decided && !any_bit(near_exclude_[i], first, end);
-    }
-    return decided ? Fate::kept : Fate::undecided;
-}
-
 bool FiberRegionTest::point_in(const Region& r, const std::vector<std::uint64_t>& near, std::uint64_t fiber,
                                const std::uint8_t* blocks, const DecodeContext& ctx) const {
     const FftHeader& h = file_.header();
@@ -125,8 +111,13 @@ bool FiberRegionTest::point_in(const Region& r, const std::vector<std::uint64_t>
 
 bool FiberRegionTest::keeps_by_blocks(std::uint64_t fiber, const std::uint8_t* blocks, const DecodeContext& ctx) const {
     const std::uint64_t first = file_.first_block(fiber), end = first + file_.block_count(fiber);
+    // Anchors first: an exclude region one meets drops the fiber before
+    // anything is decoded.
+    for (std::size_t i = 0; i < exclude_.size(); ++i)
+        if (anchor_in(exclude_[i], near_exclude_[i], fiber, blocks)) return false;
     for (std::size_t i = 0; i < include_.size(); ++i)
-        if (!any_bit(inside_include_[i], first, end) && !point_in(include_[i], near_include_[i], fiber, blocks, ctx))
+        if (!any_bit(inside_include_[i], first, end) && !anchor_in(include_[i], near_include_[i], fiber, blocks) &&
+            !point_in(include_[i], near_include_[i], fiber, blocks, ctx))
             return false;
     for (std::size_t i = 0; i < exclude_.size(); ++i)
         if (point_in(exclude_[i], near_exclude_[i], fiber, blocks, ctx)) return false;
@@ -162,9 +153,7 @@ void FiberRegionTest::decide(std::uint64_t f0, std::uint64_t f1, const DecodeCon
     }
     for (std::uint64_t f = f0; f < f1; ++f) {
         if (fates[f - f0] != Fate::undecided) continue;
-        const std::uint8_t* own = blocks.data() + (file_.first_block(f) - b0) * bb;
-        const Fate fate = fate_by_anchors(f, own);
-        kept[f - f0] = fate == Fate::undecided ? keeps_by_blocks(f, own, ctx) : fate == Fate::kept;
+        kept[f - f0] = keeps_by_blocks(f, blocks.data() + (file_.first_block(f) - b0) * bb, ctx);
     }
 }
 
