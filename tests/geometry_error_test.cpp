@@ -86,12 +86,15 @@ void expect_matches_brute(const std::vector<std::pair<Line, Line>>& pairs) {
         g.add_fiber(pairs[i].first, pairs[i].second, i);
         brute_add(b, pairs[i].first, pairs[i].second);
     }
-    const double tol = 1e-9;
-    EXPECT_NEAR(g.decoded_to_input().max_mm(), double(b.max_di), tol);
-    EXPECT_NEAR(g.decoded_to_input().mean_mm(), double(b.sum_di / b.n_di), tol);
-    EXPECT_NEAR(g.input_to_decoded().max_mm(), double(b.max_id), tol);
-    EXPECT_NEAR(g.input_to_decoded().mean_mm(), double(b.sum_id / b.n_id), tol);
-    EXPECT_NEAR(g.hausdorff_mm(), double(std::max(b.max_di, b.max_id)), tol);
+    // Point-to-polyline distances are float arithmetic on the float points:
+    // each within a few float ulps of the segment's extent (~1e-8 mm here),
+    // far below a wrong nearest segment's error; the rest is double.
+    const double tol = 1e-9, float_tol = 1e-7;
+    EXPECT_NEAR(g.decoded_to_input().max_mm(), double(b.max_di), float_tol);
+    EXPECT_NEAR(g.decoded_to_input().mean_mm(), double(b.sum_di / b.n_di), float_tol);
+    EXPECT_NEAR(g.input_to_decoded().max_mm(), double(b.max_id), float_tol);
+    EXPECT_NEAR(g.input_to_decoded().mean_mm(), double(b.sum_id / b.n_id), float_tol);
+    EXPECT_NEAR(g.hausdorff_mm(), double(std::max(b.max_di, b.max_id)), float_tol);
     EXPECT_NEAR(g.endpoint_mm().max, double(b.end_max), tol);
     EXPECT_NEAR(g.endpoint_mm().mean(), double(b.end_sum / (2 * b.fibers)), tol);
     EXPECT_NEAR(g.length_change_mm().max, double(b.len_max), 1e-7);

@@ -43,6 +43,8 @@ public:
     // add_all of the square roots of squared errors (mm²), taken in the same
     // pass (correctly rounded, as std::sqrt): the callers measure squares.
     void add_all_roots(const double* squares_mm2, std::size_t n, std::uint64_t fiber);
+    // The same of float squares (each taken as its double value).
+    void add_all_roots(const float* squares_mm2, std::size_t n, std::uint64_t fiber);
     void merge(const ErrorStats& other);
 
     std::uint64_t count() const { return count_; }
@@ -55,8 +57,8 @@ public:
     std::uint64_t worst_fiber() const { return worst_fiber_; }
 
 private:
-    template <bool kRoots>
-    void add_each(const double* values, std::size_t n, std::uint64_t fiber);
+    template <bool kRoots, class T>
+    void add_each(const T* values, std::size_t n, std::uint64_t fiber);
     static constexpr double kBinsPerMm = 1e5;     // 0.01 µm bins
     static constexpr std::size_t kBins = 200000;  // up to 2 mm
     static constexpr std::size_t kPageBins = 2048;  // 20.48 µm per page

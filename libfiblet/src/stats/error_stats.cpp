@@ -38,15 +38,20 @@ std::size_t bin_of(double e, double bins_per_mm, std::size_t bins) {
 // Errors [0, n / 4 * 4) (kRoots: the square roots of values, else values):
 // the lane sums, the largest error and each error's bin (as bin_of), four
 // at a time; returns the errors done.
-template <bool kRoots>
-__attribute__((target("avx2"))) std::size_t sums_and_bins_avx2(const double* values, std::size_t n,
+template <bool kRoots, class T>
+__attribute__((target("avx2"))) std::size_t sums_and_bins_avx2(const T* values, std::size_t n,
                                                                double bins_per_mm, std::size_t bins, LaneSums& lanes,
                                                                double& max, std::int32_t* bin) {
     __m256d sum = _mm256_setzero_pd(), sum_sq = sum, largest = _mm256_set1_pd(max);
     const __m256d per_mm = _mm256_set1_pd(bins_per_mm), last = _mm256_set1_pd(double(bins));
     std::size_t k = 0;
     for (; k + 4 <= n; k += 4) {
-        const __m256d e = kRoots ? _mm256_sqrt_pd(_mm256_loadu_pd(values + k)) : _mm256_loadu_pd(values + k);
+        __m256d v;
+        if constexpr (sizeof(T) == sizeof(float))
+            v = _mm256_cvtps_pd(_mm_loadu_ps(values + k));
+        else
+            v = _mm256_loadu_pd(values + k);
+        const __m256d e = kRoots ? _mm256_sqrt_pd(v) : v;
         sum = _mm256_add_pd(sum, e);
         sum_sq = _mm256_add_pd(sum_sq, _mm256_mul_pd(e, e));
         largest = _mm256_max_pd(e, largest);
@@ -71,20 +76,24 @@ void ErrorStats::add_all_roots(const double* squares, std::size_t n, std::uint64
     add_each<true>(squares, n, fiber);
 }
 
-template <bool kRoots>
-void ErrorStats::add_each(const double* values, std::size_t n, std::uint64_t fiber) {
+void ErrorStats::add_all_roots(const float* squares, std::size_t n, std::uint64_t fiber) {
+    add_each<true>(squares, n, fiber);
+}
+
+template <bool kRoots, class T>
+void ErrorStats::add_each(const T* values, std::size_t n, std::uint64_t fiber) {
     if (n == 0) return;
     thread_local std::vector<std::int32_t> bins;
     if (bins.size() < n) bins.resize(n);
     LaneSums lanes;
-    double max = kRoots ? std::sqrt(values[0]) : values[0];
+    double max = kRoots ? std::sqrt(double(values[0])) : double(values[0]);
     std::size_t k = 0;
 #ifdef FIBLET_POINTS_AVX2
     if (detail::use_avx2_loops())
-        k = sums_and_bins_avx2<kRoots>(values, n, kBinsPerMm, kBins, lanes, max, bins.data());
+        k = sums_and_bins_avx2<kRoots, T>(values, n, kBinsPerMm, kBins, lanes, max, bins.data());
 #endif
     for (; k < n; ++k) {
-        const double e = kRoots ? std::sqrt(values[k]) : values[k];
+        const double e = kRoots ? std::sqrt(double(values[k])) : double(values[k]);
         lanes.sum[k % 4] += e;
         lanes.sum_sq[k % 4] += e * e;
         max = std::max(max, e);
