@@ -253,6 +253,48 @@ void expect_same_bits(const GeometryError& a, const GeometryError& b) {
     EXPECT_EQ(a.mean_length_change_mm(), b.mean_length_change_mm());
 }
 
+// Coordinates in any units: the report of a pair scaled by 2^e is the
+// report scaled by 2^e, bit for bit, far beyond float's squares (steps of
+// 1e23 mm, of 1e-31 mm: measured scaled into range, geometry_error.cpp), for
+// fixed-step pairs (the shortcut and the window) and for unevenly resampled
+// ones; and far from the origin the figures are those near it.
+TEST(GeometryError, ScaledCoordinatesScaleTheReport) {
+    std::vector<std::pair<Line, Line>> pairs = fixed_step_pairs(), folded = folded_pairs();
+    pairs.insert(pairs.end(), folded.begin(), folded.end());
+    std::mt19937 rng(29);
+    for (int k = 0; k < 6; ++k) {
+        const Line in = curve(20 + 9 * k, 0.2 * (1 + k % 3), 0, rng, 0);
+        pairs.emplace_back(in, curve(int(in.size()) * (2 + k % 3), 0.2 * (1 + k % 3) / (2 + k % 3), 0, rng, 0.004));
+    }
+    const GeometryError plain = measure_pairs(pairs);
+    for (const int e : {82, -100, 12}) {
+        SCOPED_TRACE(testing::Message() << "scale 2^" << e);
+        std::vector<std::pair<Line, Line>> scaled = pairs;
+        for (auto& [in, dec] : scaled)
+            for (Line* l : {&in, &dec})
+                for (Vec3f& p : *l) p = {std::ldexp(p.x, e), std::ldexp(p.y, e), std::ldexp(p.z, e)};
+        const GeometryError g = measure_pairs(scaled);
+        for (auto pick : {&GeometryError::decoded_to_input, &GeometryError::input_to_decoded}) {
+            const ErrorStats &x = (g.*pick)(), &y = (plain.*pick)();
+            EXPECT_EQ(x.count(), y.count());
+            EXPECT_EQ(x.max_mm(), std::ldexp(y.max_mm(), e));
+            EXPECT_EQ(x.mean_mm(), std::ldexp(y.mean_mm(), e));
+            EXPECT_EQ(x.worst_fiber(), y.worst_fiber());
+        }
+        EXPECT_EQ(g.hausdorff_mm(), std::ldexp(plain.hausdorff_mm(), e));
+        EXPECT_EQ(g.endpoint_mm().max, std::ldexp(plain.endpoint_mm().max, e));
+        EXPECT_EQ(g.length_change_mm().sum, std::ldexp(plain.length_change_mm().sum, e));
+    }
+    // Far from the origin, the same figures: every x at 2^95 mm (the
+    // fuzzer's .trk translated by 4e28 mm) against every x at 0.
+    std::vector<std::pair<Line, Line>> near = pairs, far = pairs;
+    for (auto* set : {&near, &far})
+        for (auto& [in, dec] : *set)
+            for (Line* l : {&in, &dec})
+                for (Vec3f& p : *l) p.x = set == &far ? 0x1p95f : 0.0f;
+    expect_same_bits(measure_pairs(far), measure_pairs(near));
+}
+
 // Fixed-step pairs where a point's two own segments are not provably the
 // nearest (the shortcut of geometry_error.cpp): fibers that fold back by up
 // to 178 degrees, repeated points, decoded points up to 40 % of a step off.

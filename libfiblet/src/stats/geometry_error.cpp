@@ -59,6 +59,7 @@ struct Segments {
     std::vector<double> len;  // in double, for the length
     std::size_t count = 0;  // segments (the columns hold kPadding padding segments more)
     double length = 0;
+    double max_len = 0;  // the longest segment (NaN left out)
 };
 
 // Squared distance of p to segment s (its start when it has no length): the
@@ -144,6 +145,7 @@ __attribute__((target("avx2"))) std::size_t columns_avx2(const Vec3f* p, std::si
     const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
     std::size_t s = 0;
     if (points < 12) return 0;
+    __m256d max_len = _mm256_setzero_pd();  // vmaxpd returns its second operand for a NaN: left out
     __m256d x4, y4, z4;  // points s .. s + 3 in double (each point converted once)
     detail::xyz4(p, x4, y4, z4);
     for (; s + 12 <= points; s += 8) {  // the double loads read points to s + 11
@@ -161,10 +163,15 @@ __attribute__((target("avx2"))) std::size_t columns_avx2(const Vec3f* p, std::si
             detail::xyz4(p + s + h + 4, nx4, ny4, nz4);
             const __m256d ddx = _mm256_sub_pd(next_points(x4, nx4), x4), ddy = _mm256_sub_pd(next_points(y4, ny4), y4),
                           ddz = _mm256_sub_pd(next_points(z4, nz4), z4);
-            _mm256_storeu_pd(len + s + h, _mm256_sqrt_pd(detail::norm2(ddx, ddy, ddz)));
+            const __m256d l = _mm256_sqrt_pd(detail::norm2(ddx, ddy, ddz));
+            _mm256_storeu_pd(len + s + h, l);
+            max_len = _mm256_max_pd(l, max_len);
             x4 = nx4, y4 = ny4, z4 = nz4;
         }
     }
+    alignas(32) double lanes[4];
+    _mm256_store_pd(lanes, max_len);
+    for (const double v : lanes) g.max_len = v > g.max_len ? v : g.max_len;
     return s;
 }
 #endif
@@ -176,6 +183,7 @@ void segments_of(std::span<const Vec3f> line, Segments& out) {
     double* len = at_least(out.len, n);
     // Segments [0, done) complete from the vector loop.
     std::size_t done = 0;
+    out.max_len = 0;
 #ifdef FIBLET_POINTS_AVX2
     if (use_avx2_loops()) done = columns_avx2(line.data(), points, out);
 #endif
@@ -184,10 +192,10 @@ void segments_of(std::span<const Vec3f> line, Segments& out) {
         set_segment(out, s, a, b);
         const double dx = double(b.x) - a.x, dy = double(b.y) - a.y, dz = double(b.z) - a.z;
         len[s] = std::sqrt(dx * dx + dy * dy + dz * dz);
+        out.max_len = len[s] > out.max_len ? len[s] : out.max_len;
     }
-    // Padding segments far away (their squared distance is +inf, never a
-    // nearest one), so a window of up to kLanes segments is always
-    // evaluated whole.
+    // Padding segments, so that a window of up to kLanes segments is always
+    // evaluated whole: read, never chosen (the windows end at segment n).
     for (std::size_t p = n; p < n + kPadding; ++p) {
         out.ax[p] = out.ay[p] = out.az[p] = 1e30f;
         out.ux[p] = out.uy[p] = out.uz[p] = out.inv_uu[p] = out.uu[p] = 0.0f;
@@ -361,6 +369,20 @@ std::size_t proven_run_end(const std::uint8_t* proven, std::size_t k, std::size_
     return k;
 }
 
+// The roots of n squared distances into `out`, and the pointwise squares,
+// both scaled back by unscale^2 (exact, in double) where the pair was
+// measured scaled (scale_exponent, below).
+void add_squares(ErrorStats& out, const float* squares, std::size_t n, std::uint64_t fiber, double* pointwise,
+                 double unscale) {
+    if (unscale == 1.0) return out.add_all_roots(squares, n, fiber);
+    thread_local std::vector<double> unscaled;
+    double* u = at_least(unscaled, n);
+    for (std::size_t k = 0; k < n; ++k) u[k] = double(squares[k]) * unscale * unscale;
+    out.add_all_roots(u, n, fiber);
+    if (pointwise)
+        for (std::size_t k = 0; k < n; ++k) pointwise[k] *= unscale * unscale;
+}
+
 // Every point of `from` against the polyline `to` (its columns g; from_g:
 // those of `from`, for fixed-step pairs), in order along both, so the
 // nearest segment moves forward with the point: the segments within reach
@@ -376,9 +398,10 @@ std::size_t proven_run_end(const std::uint8_t* proven, std::size_t k, std::size_
 // segment); the nearest one is then chosen from the same window as always,
 // or evaluated directly where the window leaves those kLanes. The result is
 // the same, bit for bit. `pointwise` (when given, and the polylines have as
-// many points): |from[k] - to[k]|^2 for each k.
+// many points): |from[k] - to[k]|^2 for each k. `unscale`: 2^-k for a pair
+// measured scaled by 2^k.
 double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, std::span<const Vec3f> to,
-                          const Segments& g, ErrorStats& out, std::uint64_t fiber, double* pointwise = nullptr) {
+                          const Segments& g, ErrorStats& out, std::uint64_t fiber, double* pointwise, double unscale) {
     if (to.empty()) return 0;
     if (from.empty()) return g.length;
     const std::size_t n = g.count;
@@ -449,8 +472,33 @@ double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, s
             if (d[j] < best) best = d[j], hint = lo + j;
         nearest[k] = best;
     }
-    out.add_all_roots(nearest, from.size(), fiber);
-    return g.length;
+    add_squares(out, nearest, from.size(), fiber, pointwise, unscale);
+    return g.length * unscale;
+}
+
+// The distances are float arithmetic on differences of the two polylines'
+// points (segments, errors), whatever the coordinates: their squares
+// overflow beyond ~1e19 and lose precision below ~1e-19 (turn statistics
+// and the encoder handle any units: docs/encode.md). A pair whose longest
+// segment or end error m (double) is outside [2^-40, 2^60] is measured
+// scaled by the power of two that takes m into [1, 2), which float
+// arithmetic commutes with (the same figures, scaled, as long as nothing
+// overflows or underflows), then scaled back in double. The scale is 1
+// otherwise (every tractogram in millimetres, metres or micrometres,
+// wherever its origin).
+int scale_exponent(const Segments& a, const Segments& b, std::span<const Vec3f> input, std::span<const Vec3f> decoded) {
+    const double m = std::max({a.max_len, b.max_len, distance(input.front(), decoded.front()),
+                               distance(input.back(), decoded.back())});
+    if (!(m > 0) || !std::isfinite(m) || (m >= 0x1p-40 && m <= 0x1p60)) return 0;
+    return -std::ilogb(m);
+}
+
+// `line` times 2^k into `out`.
+std::span<const Vec3f> scaled(std::span<const Vec3f> line, int k, std::vector<Vec3f>& out) {
+    out.resize(line.size());
+    for (std::size_t i = 0; i < line.size(); ++i)
+        out[i] = {std::ldexp(line[i].x, k), std::ldexp(line[i].y, k), std::ldexp(line[i].z, k)};
+    return out;
 }
 
 }  // namespace
@@ -485,11 +533,20 @@ void GeometryError::add_fiber(std::span<const Vec3f> input, std::span<const Vec3
     if (!pointwise.empty() && (pointwise.size() != input.size() || decoded.size() != input.size()))
         throw Error(Errc::invalid_argument, "GeometryError::add_fiber: pointwise needs one value per point of both polylines");
     thread_local Segments input_segments, decoded_segments;  // each polyline's columns, once
+    thread_local std::vector<Vec3f> input_scaled, decoded_scaled;
     if (!input.empty()) segments_of(input, input_segments);
     if (!decoded.empty()) segments_of(decoded, decoded_segments);
-    const double li = points_to_polyline(decoded, decoded_segments, input, input_segments, decoded_to_input_, fiber);
-    const double ld = points_to_polyline(input, input_segments, decoded, decoded_segments, input_to_decoded_, fiber,
-                                         pointwise.empty() ? nullptr : pointwise.data());
+    const int k = input.empty() || decoded.empty() ? 0 : scale_exponent(input_segments, decoded_segments, input, decoded);
+    std::span<const Vec3f> in = input, dec = decoded;
+    if (k) {  // rare: the columns again, scaled
+        in = scaled(input, k, input_scaled), dec = scaled(decoded, k, decoded_scaled);
+        if (!in.empty()) segments_of(in, input_segments);
+        if (!dec.empty()) segments_of(dec, decoded_segments);
+    }
+    const double unscale = std::ldexp(1.0, -k);
+    const double li = points_to_polyline(dec, decoded_segments, in, input_segments, decoded_to_input_, fiber, nullptr, unscale);
+    const double ld = points_to_polyline(in, input_segments, dec, decoded_segments, input_to_decoded_, fiber,
+                                         pointwise.empty() ? nullptr : pointwise.data(), unscale);
     if (input.empty() || decoded.empty()) return;
     endpoint_.add(distance(input.front(), decoded.front()), fiber);
     endpoint_.add(distance(input.back(), decoded.back()), fiber);
