@@ -480,15 +480,14 @@ double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, s
 // points (segments, errors), whatever the coordinates: their squares
 // overflow beyond ~1e19 and lose precision below ~1e-19 (turn statistics
 // and the encoder handle any units: docs/encode.md). A pair whose longest
-// segment or end error m (double) is outside [2^-40, 2^60] is measured
+// segment or end displacement m (double) is outside [2^-40, 2^60] is measured
 // scaled by the power of two that takes m into [1, 2), which float
 // arithmetic commutes with (the same figures, scaled, as long as nothing
 // overflows or underflows), then scaled back in double. The scale is 1
 // otherwise (every tractogram in millimetres, metres or micrometres,
 // wherever its origin).
-int scale_exponent(const Segments& a, const Segments& b, std::span<const Vec3f> input, std::span<const Vec3f> decoded) {
-    const double m = std::max({a.max_len, b.max_len, distance(input.front(), decoded.front()),
-                               distance(input.back(), decoded.back())});
+int scale_exponent(const Segments& a, const Segments& b, double first_end, double last_end) {
+    const double m = std::max({a.max_len, b.max_len, first_end, last_end});
     if (!(m > 0) || !std::isfinite(m) || (m >= 0x1p-40 && m <= 0x1p60)) return 0;
     return -std::ilogb(m);
 }
@@ -536,7 +535,10 @@ void GeometryError::add_fiber(std::span<const Vec3f> input, std::span<const Vec3
     thread_local std::vector<Vec3f> input_scaled, decoded_scaled;
     if (!input.empty()) segments_of(input, input_segments);
     if (!decoded.empty()) segments_of(decoded, decoded_segments);
-    const int k = input.empty() || decoded.empty() ? 0 : scale_exponent(input_segments, decoded_segments, input, decoded);
+    const bool both = !input.empty() && !decoded.empty();
+    const double first_end = both ? distance(input.front(), decoded.front()) : 0.0;
+    const double last_end = both ? distance(input.back(), decoded.back()) : 0.0;
+    const int k = both ? scale_exponent(input_segments, decoded_segments, first_end, last_end) : 0;
     std::span<const Vec3f> in = input, dec = decoded;
     if (k) {  // rare: the columns again, scaled
         in = scaled(input, k, input_scaled), dec = scaled(decoded, k, decoded_scaled);
@@ -547,9 +549,9 @@ void GeometryError::add_fiber(std::span<const Vec3f> input, std::span<const Vec3
     const double li = points_to_polyline(dec, decoded_segments, in, input_segments, decoded_to_input_, fiber, nullptr, unscale);
     const double ld = points_to_polyline(in, input_segments, dec, decoded_segments, input_to_decoded_, fiber,
                                          pointwise.empty() ? nullptr : pointwise.data(), unscale);
-    if (input.empty() || decoded.empty()) return;
-    endpoint_.add(distance(input.front(), decoded.front()), fiber);
-    endpoint_.add(distance(input.back(), decoded.back()), fiber);
+    if (!both) return;
+    endpoint_.add(first_end, fiber);
+    endpoint_.add(last_end, fiber);
     length_mm_.add(std::fabs(ld - li), fiber);
     signed_length_sum_ += ld - li;
     if (li > 0) length_pct_.add(100.0 * std::fabs(ld - li) / li, fiber);
