@@ -86,6 +86,11 @@ public:
         for (std::size_t i = 0; i + 1 < offsets.size(); ++i)
             write(xyz + 3 * offsets[i], std::size_t(offsets[i + 1] - offsets[i]));
     }
+    // Whether write() and write_chunk() refuse a non-finite coordinate
+    // (Error{invalid_input}, nothing of the call written): a .tck cannot
+    // hold one (NaN separates its streamlines). Callers that would check
+    // the points themselves can leave it to such a sink.
+    virtual bool refuses_non_finite() const { return false; }
     // Completes the file (atomically); without it no output is left.
     virtual void finish() = 0;
 };
