@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/points_avx2.hpp"
 
@@ -34,6 +35,12 @@ std::size_t bin_of(double e, double bins_per_mm, std::size_t bins) {
     return bin < double(bins) ? std::size_t(bin) : bins;
 }
 
+// The lowest and highest bin of a call's errors.
+struct BinRange {
+    std::int32_t lo = std::numeric_limits<std::int32_t>::max(), hi = 0;
+    void add(std::int32_t b) { lo = std::min(lo, b), hi = std::max(hi, b); }
+};
+
 #ifdef FIBLET_POINTS_AVX2
 // Errors [0, n / 4 * 4) (kRoots: the square roots of values, else values):
 // the lane sums, the largest error and each error's bin (as bin_of), four
@@ -41,9 +48,10 @@ std::size_t bin_of(double e, double bins_per_mm, std::size_t bins) {
 template <bool kRoots, class T>
 __attribute__((target("avx2"))) std::size_t sums_and_bins_avx2(const T* values, std::size_t n,
                                                                double bins_per_mm, std::size_t bins, LaneSums& lanes,
-                                                               double& max, std::int32_t* bin) {
+                                                               double& max, std::int32_t* bin, BinRange& range) {
     __m256d sum = _mm256_setzero_pd(), sum_sq = sum, largest = _mm256_set1_pd(max);
     const __m256d per_mm = _mm256_set1_pd(bins_per_mm), last = _mm256_set1_pd(double(bins));
+    __m128i lowest_bin = _mm_set1_epi32(range.lo), highest_bin = _mm_set1_epi32(range.hi);
     std::size_t k = 0;
     for (; k + 4 <= n; k += 4) {
         __m256d v;
@@ -57,9 +65,14 @@ __attribute__((target("avx2"))) std::size_t sums_and_bins_avx2(const T* values, 
         largest = _mm256_max_pd(e, largest);
         const __m256d b = _mm256_mul_pd(e, per_mm);
         // b < bins ? b : bins, truncated (bins fits 32 bits)
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(bin + k),
-                         _mm256_cvttpd_epi32(_mm256_blendv_pd(last, b, _mm256_cmp_pd(b, last, _CMP_LT_OQ))));
+        const __m128i b32 = _mm256_cvttpd_epi32(_mm256_blendv_pd(last, b, _mm256_cmp_pd(b, last, _CMP_LT_OQ)));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(bin + k), b32);
+        lowest_bin = _mm_min_epi32(lowest_bin, b32), highest_bin = _mm_max_epi32(highest_bin, b32);
     }
+    alignas(16) std::int32_t lo[4], hi[4];
+    _mm_store_si128(reinterpret_cast<__m128i*>(lo), lowest_bin), _mm_store_si128(reinterpret_cast<__m128i*>(hi), highest_bin);
+    range.lo = std::min(std::min(lo[0], lo[1]), std::min(lo[2], lo[3]));
+    range.hi = std::max(std::max(hi[0], hi[1]), std::max(hi[2], hi[3]));
     _mm256_storeu_pd(lanes.sum, sum), _mm256_storeu_pd(lanes.sum_sq, sum_sq);
     alignas(32) double l[4];
     _mm256_store_pd(l, largest);
@@ -86,11 +99,12 @@ void ErrorStats::add_each(const T* values, std::size_t n, std::uint64_t fiber) {
     thread_local std::vector<std::int32_t> bins;
     if (bins.size() < n) bins.resize(n);
     LaneSums lanes;
+    BinRange range;
     double max = kRoots ? std::sqrt(double(values[0])) : double(values[0]);
     std::size_t k = 0;
 #ifdef FIBLET_POINTS_AVX2
     if (detail::use_avx2_loops())
-        k = sums_and_bins_avx2<kRoots, T>(values, n, kBinsPerMm, kBins, lanes, max, bins.data());
+        k = sums_and_bins_avx2<kRoots, T>(values, n, kBinsPerMm, kBins, lanes, max, bins.data(), range);
 #endif
     for (; k < n; ++k) {
         const double e = kRoots ? std::sqrt(double(values[k])) : double(values[k]);
@@ -98,12 +112,21 @@ void ErrorStats::add_each(const T* values, std::size_t n, std::uint64_t fiber) {
         lanes.sum_sq[k % 4] += e * e;
         max = std::max(max, e);
         bins[k] = std::int32_t(bin_of(e, kBinsPerMm, kBins));
+        range.add(bins[k]);
     }
     // The fiber holds the largest error if any of its errors is above the max so far.
     if (count_ == 0 || max > max_) max_ = max, worst_fiber_ = fiber;
     count_ += n;
     sum_ += lanes.total();
     sum_sq_ += lanes.total_sq();
+    // Errors of one page (the usual: a page is 20.48 um wide): no page test a count.
+    if (std::size_t(range.lo) / kPageBins == std::size_t(range.hi) / kPageBins) {
+        const std::size_t p = std::size_t(range.hi) / kPageBins;
+        if (p != page_index_) select_page(p);
+        std::uint64_t* const counts = page_ - p * kPageBins;  // counts[bin]: the page's count of `bin`
+        for (std::size_t j = 0; j < n; ++j) ++counts[std::size_t(bins[j])];
+        return;
+    }
     // The page in locals: the counts are 64-bit words, which the compiler
     // must otherwise assume may be page_index_ and reload it after every count.
     std::uint64_t* page = page_;
