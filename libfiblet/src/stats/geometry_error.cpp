@@ -114,9 +114,12 @@ FIBLET_AVX2 void window_avx2(const ColumnPointers& g, float px, float py, float 
     _mm256_store_ps(d, segment_dist2_avx2(g, _mm256_set1_ps(px), _mm256_set1_ps(py), _mm256_set1_ps(pz), base));
 }
 
-// Lanes 1 2 3 of a and lane 0 of b: the next point of each lane.
-FIBLET_AVX2 __m256d next_points(__m256d a, __m256d b) {
-    return _mm256_shuffle_pd(a, _mm256_permute2f128_pd(a, b, 0x21), 0b0101);
+// Lanes 4 half .. 4 half + 3 of b - a in double, each side converted first
+// (exact): the double difference of the two floats.
+FIBLET_AVX2 __m256d double_diff(__m256 b, __m256 a, int half) {
+    const __m128 b4 = half ? _mm256_extractf128_ps(b, 1) : _mm256_castps256_ps128(b);
+    const __m128 a4 = half ? _mm256_extractf128_ps(a, 1) : _mm256_castps256_ps128(a);
+    return _mm256_sub_pd(_mm256_cvtps_pd(b4), _mm256_cvtps_pd(a4));
 }
 
 // Points p .. p + 7 as columns, from three loads of their 24 floats: each
@@ -136,19 +139,18 @@ FIBLET_AVX2 void xyz8(const Vec3f* p, __m256& x, __m256& y, __m256& z) {
 
 // The columns of segments [0, s) in one pass, eight at a time: set_segment's
 // float operations (vdivps rounds correctly, as /; the mask keeps +0, as the
-// ternary) and the lengths sqrt(uu) in double from the points' exact double
-// differences, as polyline_length's. Reads points up to s + 11; returns s.
+// ternary) and the lengths sqrt(uu) in double from the points' double
+// differences, as polyline_length's: the same float columns converted to
+// double (exact) and subtracted, so no shuffles of their own. Reads points
+// up to s + 8; returns s.
 __attribute__((target("avx2"))) std::size_t columns_avx2(const Vec3f* p, std::size_t points, Segments& g) {
     float *ax = g.ax.data(), *ay = g.ay.data(), *az = g.az.data(), *ux = g.ux.data(), *uy = g.uy.data(),
           *uz = g.uz.data(), *inv = g.inv_uu.data(), *uu_out = g.uu.data();
     double* len = g.len.data();
     const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
     std::size_t s = 0;
-    if (points < 12) return 0;
     __m256d max_len = _mm256_setzero_pd();  // vmaxpd returns its second operand for a NaN: left out
-    __m256d x4, y4, z4;  // points s .. s + 3 in double (each point converted once)
-    detail::xyz4(p, x4, y4, z4);
-    for (; s + 12 <= points; s += 8) {  // the double loads read points to s + 11
+    for (; s + 9 <= points; s += 8) {
         __m256 x, y, z, nx, ny, nz;
         xyz8(p + s, x, y, z);
         xyz8(p + s + 1, nx, ny, nz);
@@ -158,15 +160,11 @@ __attribute__((target("avx2"))) std::size_t columns_avx2(const Vec3f* p, std::si
         _mm256_storeu_ps(ux + s, dx), _mm256_storeu_ps(uy + s, dy), _mm256_storeu_ps(uz + s, dz);
         _mm256_storeu_ps(uu_out + s, uu);
         _mm256_storeu_ps(inv + s, _mm256_and_ps(_mm256_cmp_ps(uu, zero, _CMP_GT_OQ), _mm256_div_ps(one, uu)));
-        for (std::size_t h = 0; h < 8; h += 4) {
-            __m256d nx4, ny4, nz4;
-            detail::xyz4(p + s + h + 4, nx4, ny4, nz4);
-            const __m256d ddx = _mm256_sub_pd(next_points(x4, nx4), x4), ddy = _mm256_sub_pd(next_points(y4, ny4), y4),
-                          ddz = _mm256_sub_pd(next_points(z4, nz4), z4);
-            const __m256d l = _mm256_sqrt_pd(detail::norm2(ddx, ddy, ddz));
-            _mm256_storeu_pd(len + s + h, l);
+        for (int h = 0; h < 2; ++h) {
+            const __m256d l =
+                _mm256_sqrt_pd(detail::norm2(double_diff(nx, x, h), double_diff(ny, y, h), double_diff(nz, z, h)));
+            _mm256_storeu_pd(len + s + 4 * h, l);
             max_len = _mm256_max_pd(l, max_len);
-            x4 = nx4, y4 = ny4, z4 = nz4;
         }
     }
     alignas(32) double lanes[4];
