@@ -70,13 +70,39 @@ __attribute__((target("avx2"))) inline void xyz4(const Vec3f* p, __m256d& x, __m
                                      low_lanes(hi, _mm256_setr_epi32(0, 0, 4, 7, 0, 0, 0, 0)), 0b1100));
 }
 
-// The segments from points p .. p + 3 to the next ones (p[1] - p[0], ...),
-// in double: reads points p .. p + 4.
-__attribute__((target("avx2"))) inline void deltas4(const Vec3f* p, __m256d& dx, __m256d& dy, __m256d& dz) {
-    __m256d ax, ay, az, bx, by, bz;
-    xyz4(p, ax, ay, az);
-    xyz4(p + 1, bx, by, bz);
-    dx = _mm256_sub_pd(bx, ax), dy = _mm256_sub_pd(by, ay), dz = _mm256_sub_pd(bz, az);
+// Points p .. p + 7 as float columns, from three loads of their 24 floats:
+// each register's lanes blended from the three (x0 x3 x6 x1 x4 x7 x2 x5,
+// and likewise for y and z), then put in order.
+__attribute__((target("avx2"))) inline void xyz8(const Vec3f* p, __m256& x, __m256& y, __m256& z) {
+    static_assert(sizeof(Vec3f) == 3 * sizeof(float), "points are 3 packed floats");
+    const float* f = &p->x;
+    const __m256 m0 = _mm256_loadu_ps(f), m1 = _mm256_loadu_ps(f + 8), m2 = _mm256_loadu_ps(f + 16);
+    x = _mm256_permutevar8x32_ps(_mm256_blend_ps(_mm256_blend_ps(m0, m1, 0b10010010), m2, 0b00100100),
+                                 _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5));
+    y = _mm256_permutevar8x32_ps(_mm256_blend_ps(_mm256_blend_ps(m0, m1, 0b00100100), m2, 0b01001001),
+                                 _mm256_setr_epi32(1, 4, 7, 2, 5, 0, 3, 6));
+    z = _mm256_permutevar8x32_ps(_mm256_blend_ps(_mm256_blend_ps(m0, m1, 0b01001001), m2, 0b10010010),
+                                 _mm256_setr_epi32(2, 5, 0, 3, 6, 1, 4, 7));
+}
+
+// Lanes 4 half .. 4 half + 3 of b - a in double, each side converted first
+// (exact): the double difference of the two floats.
+__attribute__((target("avx2"))) inline __m256d double_diff(__m256 b, __m256 a, int half) {
+    const __m128 b4 = half ? _mm256_extractf128_ps(b, 1) : _mm256_castps256_ps128(b);
+    const __m128 a4 = half ? _mm256_extractf128_ps(a, 1) : _mm256_castps256_ps128(a);
+    return _mm256_sub_pd(_mm256_cvtps_pd(b4), _mm256_cvtps_pd(a4));
+}
+
+// The segments from points p .. p + 7 to the next ones (p[1] - p[0], ...)
+// in double, four a half: from the float columns of the points and of their
+// successors (a third of the lane-crossing shuffles of converting each
+// point to double first). Reads points p .. p + 8.
+__attribute__((target("avx2"))) inline void deltas8(const Vec3f* p, __m256d dx[2], __m256d dy[2], __m256d dz[2]) {
+    __m256 x, y, z, nx, ny, nz;
+    xyz8(p, x, y, z);
+    xyz8(p + 1, nx, ny, nz);
+    for (int h = 0; h < 2; ++h)
+        dx[h] = double_diff(nx, x, h), dy[h] = double_diff(ny, y, h), dz[h] = double_diff(nz, z, h);
 }
 
 // The running bounds of points p .. p + n eight at a time into lo / hi,

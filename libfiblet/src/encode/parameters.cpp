@@ -23,13 +23,13 @@ void TurnStatistics::add_fiber(std::span<const Vec3f> f) { add_turns(f, [](doubl
 #ifdef FIBLET_POINTS_AVX2
 namespace {
 
-// segment_lengths' first segments, four at a time; returns how many.
+// segment_lengths' first segments, eight at a time; returns how many.
 __attribute__((target("avx2"))) std::size_t segment_lengths_avx2(const Vec3f* f, std::size_t segments, double* out) {
     std::size_t s = 0;
-    for (; s + 4 <= segments; s += 4) {  // reads points s .. s + 4
-        __m256d dx, dy, dz;
-        deltas4(f + s, dx, dy, dz);
-        _mm256_storeu_pd(out + s, _mm256_sqrt_pd(norm2(dx, dy, dz)));
+    for (; s + 8 <= segments; s += 8) {  // reads points s .. s + 8
+        __m256d dx[2], dy[2], dz[2];
+        deltas8(f + s, dx, dy, dz);
+        for (int h = 0; h < 2; ++h) _mm256_storeu_pd(out + s + 4 * h, _mm256_sqrt_pd(norm2(dx[h], dy[h], dz[h])));
     }
     return s;
 }
@@ -45,13 +45,16 @@ __attribute__((target("avx2"))) std::size_t turn_sizes_avx2(std::span<const Vec3
     double *ux = columns.data(), *uy = ux + n, *uz = uy + n;
     const __m256d one = _mm256_set1_pd(1.0), quarter = _mm256_set1_pd(0.25);
     std::size_t s = 0;
-    for (; s + 4 <= n; s += 4) {
-        __m256d dx, dy, dz;
-        deltas4(&f[s], dx, dy, dz);
-        const __m256d inv = _mm256_div_pd(one, _mm256_loadu_pd(lengths + s));
-        _mm256_storeu_pd(ux + s, _mm256_mul_pd(dx, inv));
-        _mm256_storeu_pd(uy + s, _mm256_mul_pd(dy, inv));
-        _mm256_storeu_pd(uz + s, _mm256_mul_pd(dz, inv));
+    for (; s + 8 <= n; s += 8) {
+        __m256d dx[2], dy[2], dz[2];
+        deltas8(&f[s], dx, dy, dz);
+        for (int h = 0; h < 2; ++h) {
+            const std::size_t at = s + 4 * std::size_t(h);
+            const __m256d inv = _mm256_div_pd(one, _mm256_loadu_pd(lengths + at));
+            _mm256_storeu_pd(ux + at, _mm256_mul_pd(dx[h], inv));
+            _mm256_storeu_pd(uy + at, _mm256_mul_pd(dy[h], inv));
+            _mm256_storeu_pd(uz + at, _mm256_mul_pd(dz[h], inv));
+        }
     }
     for (; s < n; ++s) {
         const double inv = 1.0 / lengths[s];

@@ -114,29 +114,6 @@ FIBLET_AVX2 void window_avx2(const ColumnPointers& g, float px, float py, float 
     _mm256_store_ps(d, segment_dist2_avx2(g, _mm256_set1_ps(px), _mm256_set1_ps(py), _mm256_set1_ps(pz), base));
 }
 
-// Lanes 4 half .. 4 half + 3 of b - a in double, each side converted first
-// (exact): the double difference of the two floats.
-FIBLET_AVX2 __m256d double_diff(__m256 b, __m256 a, int half) {
-    const __m128 b4 = half ? _mm256_extractf128_ps(b, 1) : _mm256_castps256_ps128(b);
-    const __m128 a4 = half ? _mm256_extractf128_ps(a, 1) : _mm256_castps256_ps128(a);
-    return _mm256_sub_pd(_mm256_cvtps_pd(b4), _mm256_cvtps_pd(a4));
-}
-
-// Points p .. p + 7 as columns, from three loads of their 24 floats: each
-// register's lanes blended from the three (x0 x3 x6 x1 x4 x7 x2 x5, and
-// likewise for y and z), then put in order.
-FIBLET_AVX2 void xyz8(const Vec3f* p, __m256& x, __m256& y, __m256& z) {
-    static_assert(sizeof(Vec3f) == 3 * sizeof(float), "points are 3 packed floats");
-    const float* f = &p->x;
-    const __m256 m0 = _mm256_loadu_ps(f), m1 = _mm256_loadu_ps(f + 8), m2 = _mm256_loadu_ps(f + 16);
-    x = _mm256_permutevar8x32_ps(_mm256_blend_ps(_mm256_blend_ps(m0, m1, 0b10010010), m2, 0b00100100),
-                                 _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5));
-    y = _mm256_permutevar8x32_ps(_mm256_blend_ps(_mm256_blend_ps(m0, m1, 0b00100100), m2, 0b01001001),
-                                 _mm256_setr_epi32(1, 4, 7, 2, 5, 0, 3, 6));
-    z = _mm256_permutevar8x32_ps(_mm256_blend_ps(_mm256_blend_ps(m0, m1, 0b01001001), m2, 0b10010010),
-                                 _mm256_setr_epi32(2, 5, 0, 3, 6, 1, 4, 7));
-}
-
 // The columns of segments [0, s) in one pass, eight at a time: set_segment's
 // float operations (vdivps rounds correctly, as /; the mask keeps +0, as the
 // ternary) and the lengths sqrt(uu) in double from the points' double
@@ -152,8 +129,8 @@ __attribute__((target("avx2"))) std::size_t columns_avx2(const Vec3f* p, std::si
     __m256d max_len = _mm256_setzero_pd();  // vmaxpd returns its second operand for a NaN: left out
     for (; s + 9 <= points; s += 8) {
         __m256 x, y, z, nx, ny, nz;
-        xyz8(p + s, x, y, z);
-        xyz8(p + s + 1, nx, ny, nz);
+        detail::xyz8(p + s, x, y, z);
+        detail::xyz8(p + s + 1, nx, ny, nz);
         const __m256 dx = _mm256_sub_ps(nx, x), dy = _mm256_sub_ps(ny, y), dz = _mm256_sub_ps(nz, z);
         const __m256 uu = norm2_8(dx, dy, dz);
         _mm256_storeu_ps(ax + s, x), _mm256_storeu_ps(ay + s, y), _mm256_storeu_ps(az + s, z);
@@ -162,7 +139,7 @@ __attribute__((target("avx2"))) std::size_t columns_avx2(const Vec3f* p, std::si
         _mm256_storeu_ps(inv + s, _mm256_and_ps(_mm256_cmp_ps(uu, zero, _CMP_GT_OQ), _mm256_div_ps(one, uu)));
         for (int h = 0; h < 2; ++h) {
             const __m256d l =
-                _mm256_sqrt_pd(detail::norm2(double_diff(nx, x, h), double_diff(ny, y, h), double_diff(nz, z, h)));
+                _mm256_sqrt_pd(detail::norm2(detail::double_diff(nx, x, h), detail::double_diff(ny, y, h), detail::double_diff(nz, z, h)));
             _mm256_storeu_pd(len + s + 4 * h, l);
             max_len = _mm256_max_pd(l, max_len);
         }
