@@ -86,7 +86,7 @@ TEST(TurnStatistics, KeepsTheBlocksOfTheSharpestTurns) {
     }
 }
 
-// The scan's AVX2 loops (segment lengths, the turns of fibers with no
+// The scan's AVX2 loops (segments and their lengths, the turns of fibers with no
 // zero-length segment) against the scalar ones, bit for bit: lengths
 // against |b - a| computed here, the statistics against the same fibers
 // with the AVX2 loops switched off and against add_fiber's own square roots.
@@ -99,23 +99,27 @@ TEST(TurnStatistics, VectorLoopsEqualTheScalarLoops) {
     fibers.push_back(back);  // turns of 180 degrees: sin^2 clamped at 1
     // Blocks of one point: the kept block is where the sharpest turn is.
     TurnStatistics vectors(1, fibers.size()), scalar(1, fibers.size()), roots(1, fibers.size());
-    std::vector<double> lengths, scalar_lengths;
+    FiberSegments segments, scalar_segments;
     for (const auto& f : fibers) {
-        segment_lengths(f, lengths);
-        ASSERT_EQ(lengths.size(), f.size() - 1);
+        fiber_segments(f, segments);
+        ASSERT_EQ(segments.length.size(), f.size() - 1);
         for (std::size_t s = 0; s + 1 < f.size(); ++s) {
             const double dx = double(f[s + 1].x) - f[s].x, dy = double(f[s + 1].y) - f[s].y, dz = double(f[s + 1].z) - f[s].z;
-            ASSERT_EQ(lengths[s], std::sqrt(dx * dx + dy * dy + dz * dz)) << f.size() << " " << s;
+            ASSERT_EQ(segments.dx[s], dx);
+            ASSERT_EQ(segments.dy[s], dy);
+            ASSERT_EQ(segments.dz[s], dz);
+            ASSERT_EQ(segments.length[s], std::sqrt(dx * dx + dy * dy + dz * dz)) << f.size() << " " << s;
         }
         TurnStatistics one_vectors(1, 1), one_scalar(1, 1);  // this fiber's sharpest turn, to the bit
-        vectors.add_fiber(f, lengths), one_vectors.add_fiber(f, lengths);
+        vectors.add_fiber(f, segments), one_vectors.add_fiber(f, segments);
         roots.add_fiber(f);
         {
             const test::ScopedSimdLoops loops(false);
-            segment_lengths(f, scalar_lengths);
-            scalar.add_fiber(f, scalar_lengths), one_scalar.add_fiber(f, scalar_lengths);
+            fiber_segments(f, scalar_segments);
+            scalar.add_fiber(f, scalar_segments), one_scalar.add_fiber(f, scalar_segments);
         }
-        ASSERT_EQ(lengths, scalar_lengths);
+        ASSERT_EQ(segments.length, scalar_segments.length);
+        ASSERT_EQ(segments.dx, scalar_segments.dx);
         EXPECT_EQ(one_vectors.min_dot(), one_scalar.min_dot()) << f.size();
         EXPECT_EQ(one_vectors.sharpest_blocks(), one_scalar.sharpest_blocks()) << f.size();
     }

@@ -77,19 +77,20 @@ void step_range(std::span<const double> lengths, double& lo, double& hi) {
 void scan_task(const FiberBatch& b, std::size_t t, ScanSlot& s) {
     const StageClock clock(s.seconds);
     double length_sum = 0;  // this task's, added to the slot's once (the same sums whatever the threads)
-    thread_local std::vector<double> lengths;  // of a fiber's segments, shared with the turn statistics
+    thread_local FiberSegments segments;  // of a fiber, shared with the turn statistics
+    const std::vector<double>& lengths = segments.length;
     s.fiber_lengths.clear();
     for (std::size_t i = b.cuts[t]; i < b.cuts[t + 1]; ++i) {
         const std::vector<Vec3f>& fiber = b.fibers[i];
         add_bounds(fiber, s.min, s.max);
-        segment_lengths(fiber, lengths);
+        fiber_segments(fiber, segments);
         s.lengths.add(lengths);
         const double fiber_length = sum_in_four_lanes(lengths.data(), lengths.size());
         step_range(lengths, s.step_min, s.step_max);
         length_sum += fiber_length;
         s.fiber_lengths.push_back(float(fiber_length));
         s.segments += lengths.size();
-        s.turns->add_fiber(fiber, lengths);
+        s.turns->add_fiber(fiber, segments);
     }
     s.length_sum += length_sum;
 }

@@ -23,13 +23,18 @@ void TurnStatistics::add_fiber(std::span<const Vec3f> f) { add_turns(f, [](doubl
 #ifdef FIBLET_POINTS_AVX2
 namespace {
 
-// segment_lengths' first segments, eight at a time; returns how many.
-__attribute__((target("avx2"))) std::size_t segment_lengths_avx2(const Vec3f* f, std::size_t segments, double* out) {
+// fiber_segments' first segments, eight at a time; returns how many.
+__attribute__((target("avx2"))) std::size_t segments_avx2(const Vec3f* f, std::size_t segments, FiberSegments& out) {
+    double *dx = out.dx.data(), *dy = out.dy.data(), *dz = out.dz.data(), *length = out.length.data();
     std::size_t s = 0;
     for (; s + 8 <= segments; s += 8) {  // reads points s .. s + 8
-        __m256d dx[2], dy[2], dz[2];
-        deltas8(f + s, dx, dy, dz);
-        for (int h = 0; h < 2; ++h) _mm256_storeu_pd(out + s + 4 * h, _mm256_sqrt_pd(norm2(dx[h], dy[h], dz[h])));
+        __m256d x[2], y[2], z[2];
+        deltas8(f + s, x, y, z);
+        for (int h = 0; h < 2; ++h) {
+            const std::size_t at = s + 4 * std::size_t(h);
+            _mm256_storeu_pd(dx + at, x[h]), _mm256_storeu_pd(dy + at, y[h]), _mm256_storeu_pd(dz + at, z[h]);
+            _mm256_storeu_pd(length + at, _mm256_sqrt_pd(norm2(x[h], y[h], z[h])));
+        }
     }
     return s;
 }
@@ -38,28 +43,23 @@ __attribute__((target("avx2"))) std::size_t segment_lengths_avx2(const Vec3f* f,
 // are skipped there), four at a time: the segments' unit directions, then
 // s2[t] = sin^2 of the turn between segments t and t + 1 (at point t + 1),
 // with the same double operations. Returns the turns (segments - 1).
-__attribute__((target("avx2"))) std::size_t turn_sizes_avx2(std::span<const Vec3f> f, const double* lengths,
-                                                            std::vector<double>& columns, std::vector<double>& s2) {
-    const std::size_t n = f.size() - 1;
+__attribute__((target("avx2"))) std::size_t turn_sizes_avx2(const FiberSegments& seg, std::vector<double>& columns,
+                                                            std::vector<double>& s2) {
+    const std::size_t n = seg.length.size();
     columns.resize(3 * n), s2.resize(n - 1);
     double *ux = columns.data(), *uy = ux + n, *uz = uy + n;
+    const double *dx = seg.dx.data(), *dy = seg.dy.data(), *dz = seg.dz.data(), *lengths = seg.length.data();
     const __m256d one = _mm256_set1_pd(1.0), quarter = _mm256_set1_pd(0.25);
     std::size_t s = 0;
-    for (; s + 8 <= n; s += 8) {
-        __m256d dx[2], dy[2], dz[2];
-        deltas8(&f[s], dx, dy, dz);
-        for (int h = 0; h < 2; ++h) {
-            const std::size_t at = s + 4 * std::size_t(h);
-            const __m256d inv = _mm256_div_pd(one, _mm256_loadu_pd(lengths + at));
-            _mm256_storeu_pd(ux + at, _mm256_mul_pd(dx[h], inv));
-            _mm256_storeu_pd(uy + at, _mm256_mul_pd(dy[h], inv));
-            _mm256_storeu_pd(uz + at, _mm256_mul_pd(dz[h], inv));
-        }
+    for (; s + 4 <= n; s += 4) {
+        const __m256d inv = _mm256_div_pd(one, _mm256_loadu_pd(lengths + s));
+        _mm256_storeu_pd(ux + s, _mm256_mul_pd(_mm256_loadu_pd(dx + s), inv));
+        _mm256_storeu_pd(uy + s, _mm256_mul_pd(_mm256_loadu_pd(dy + s), inv));
+        _mm256_storeu_pd(uz + s, _mm256_mul_pd(_mm256_loadu_pd(dz + s), inv));
     }
     for (; s < n; ++s) {
         const double inv = 1.0 / lengths[s];
-        ux[s] = (double(f[s + 1].x) - f[s].x) * inv, uy[s] = (double(f[s + 1].y) - f[s].y) * inv;
-        uz[s] = (double(f[s + 1].z) - f[s].z) * inv;
+        ux[s] = dx[s] * inv, uy[s] = dy[s] * inv, uz[s] = dz[s] * inv;
     }
     std::size_t t = 0;
     for (; t + 5 <= n; t += 4) {  // std::min(v, 1.0) is (1.0 < v) ? 1.0 : v, as minpd(1.0, v)
@@ -80,24 +80,28 @@ __attribute__((target("avx2"))) std::size_t turn_sizes_avx2(std::span<const Vec3
 
 // The same double operations as distance() (a difference's square is its
 // negation's; vsqrtpd rounds correctly).
-void segment_lengths(std::span<const Vec3f> f, std::vector<double>& lengths) {
+void fiber_segments(std::span<const Vec3f> f, FiberSegments& out) {
     const std::size_t n = f.empty() ? 0 : f.size() - 1;
-    lengths.resize(n);
+    for (auto* v : {&out.dx, &out.dy, &out.dz, &out.length}) v->resize(n);
     std::size_t s = 0;
 #ifdef FIBLET_POINTS_AVX2
-    if (use_avx2_loops()) s = segment_lengths_avx2(f.data(), n, lengths.data());
+    if (use_avx2_loops()) s = segments_avx2(f.data(), n, out);
 #endif
-    for (; s < n; ++s) lengths[s] = distance(f[s], f[s + 1]);
+    for (; s < n; ++s) {
+        out.dx[s] = double(f[s + 1].x) - f[s].x, out.dy[s] = double(f[s + 1].y) - f[s].y;
+        out.dz[s] = double(f[s + 1].z) - f[s].z;
+        out.length[s] = std::sqrt(out.dx[s] * out.dx[s] + out.dy[s] * out.dy[s] + out.dz[s] * out.dz[s]);
+    }
 }
 
-void TurnStatistics::add_fiber(std::span<const Vec3f> f, std::span<const double> segment_lengths) {
+void TurnStatistics::add_fiber(std::span<const Vec3f> f, const FiberSegments& segments) {
 #ifdef FIBLET_POINTS_AVX2
     // The common case in vectors: no segment of length 0 (or NaN).
     bool positive = f.size() >= 6;
-    for (const double len : segment_lengths) positive = positive && len > 0;
+    for (const double len : segments.length) positive = positive && len > 0;
     if (positive && use_avx2_loops()) {
         thread_local std::vector<double> columns, s2;
-        const std::size_t turns = turn_sizes_avx2(f, segment_lengths.data(), columns, s2);
+        const std::size_t turns = turn_sizes_avx2(segments, columns, s2);
         double fiber_max = -1;
         std::size_t at = 0;
         for (std::size_t t = 0; t < turns; ++t) {
@@ -108,7 +112,7 @@ void TurnStatistics::add_fiber(std::span<const Vec3f> f, std::span<const double>
         return keep_sharpest(f, fiber_max, at);
     }
 #endif
-    add_turns(f, [&](double, std::size_t i) { return segment_lengths[i - 1]; });
+    add_turns(f, [&](double, std::size_t i) { return segments.length[i - 1]; });
 }
 
 template <class SegmentLength>

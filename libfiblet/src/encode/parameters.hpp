@@ -26,9 +26,13 @@ inline constexpr ResampleCurve kWrittenCurve = ResampleCurve::rounded_keeping_le
 inline std::uint16_t tension_code(double tension) { return std::uint16_t(std::lround(tension / kTensionQuantum)); }
 inline double tension_of(std::uint16_t code) { return code * kTensionQuantum; }
 
-// lengths[s] = |f[s + 1] - f[s]| in double, as distance() computes it
-// (bit for bit; four at a time with AVX2).
-void segment_lengths(std::span<const Vec3f> f, std::vector<double>& lengths);
+// A fiber's segments in double: d = f[s + 1] - f[s] per component and
+// length[s] = |d|, as distance() computes it (bit for bit; eight at a time
+// with AVX2). The scan's lengths and turns both start from them.
+struct FiberSegments {
+    std::vector<double> dx, dy, dz, length;
+};
+void fiber_segments(std::span<const Vec3f> f, FiberSegments& out);
 
 // The turning angles between consecutive unit segment directions
 // (zero-length segments carry no direction and are skipped): a histogram
@@ -39,10 +43,9 @@ class TurnStatistics {
 public:
     TurnStatistics(std::uint32_t points_per_block, std::size_t kept_blocks);
     void add_fiber(std::span<const Vec3f> fiber);
-    // The same, given the fiber's segment lengths (segment_lengths[i - 1] =
-    // |f[i] - f[i - 1]| in double, as add_fiber computes them): the scan
+    // The same, given the fiber's segments (fiber_segments): the scan
     // measures them anyway, and this saves a square root per segment.
-    void add_fiber(std::span<const Vec3f> fiber, std::span<const double> segment_lengths);
+    void add_fiber(std::span<const Vec3f> fiber, const FiberSegments& segments);
     // Adds the turns another one counted (same block size; its kept blocks
     // offered in its order): a scan split into parts merges them in order.
     void merge(const TurnStatistics& other);
