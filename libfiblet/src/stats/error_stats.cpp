@@ -121,10 +121,10 @@ void ErrorStats::add_each(const T* values, std::size_t n, std::uint64_t fiber) {
     sum_sq_ += lanes.total_sq();
     // Errors of one page (the usual: a page is 20.48 um wide): no page test a count.
     if (std::size_t(range.lo) / kPageBins == std::size_t(range.hi) / kPageBins) {
-        const std::size_t p = std::size_t(range.hi) / kPageBins;
+        const std::size_t p = std::size_t(range.hi) / kPageBins, first_bin = p * kPageBins;
         if (p != page_index_) select_page(p);
-        std::uint64_t* const counts = page_ - p * kPageBins;  // counts[bin]: the page's count of `bin`
-        for (std::size_t j = 0; j < n; ++j) ++counts[std::size_t(bins[j])];
+        std::uint64_t* const page = page_;
+        for (std::size_t j = 0; j < n; ++j) ++page[std::size_t(bins[j]) - first_bin];
         return;
     }
     // The page in locals: the counts are 64-bit words, which the compiler
