@@ -262,16 +262,10 @@ FIBLET_AVX2 void store_mask_bytes(__m256 mask, std::uint8_t* out) {
 // (eight each) in double, as distance2: the header's point errors.
 FIBLET_AVX2 void exact_squares(__m256 x, __m256 y, __m256 z, const float* gx, const float* gy, const float* gz,
                                double* out) {
-    const __m256 to[3] = {_mm256_loadu_ps(gx), _mm256_loadu_ps(gy), _mm256_loadu_ps(gz)}, from[3] = {x, y, z};
-    for (int h = 0; h < 2; ++h) {
-        __m256d d[3];
-        for (int c = 0; c < 3; ++c) {
-            const __m128 a = h ? _mm256_extractf128_ps(from[c], 1) : _mm256_castps256_ps128(from[c]);
-            const __m128 b = h ? _mm256_extractf128_ps(to[c], 1) : _mm256_castps256_ps128(to[c]);
-            d[c] = _mm256_sub_pd(_mm256_cvtps_pd(a), _mm256_cvtps_pd(b));
-        }
-        _mm256_storeu_pd(out + 4 * h, detail::norm2(d[0], d[1], d[2]));
-    }
+    const __m256 tx = _mm256_loadu_ps(gx), ty = _mm256_loadu_ps(gy), tz = _mm256_loadu_ps(gz);
+    for (int h = 0; h < 2; ++h)
+        _mm256_storeu_pd(out + 4 * h, detail::norm2(detail::double_diff(x, tx, h), detail::double_diff(y, ty, h),
+                                                    detail::double_diff(z, tz, h)));
 }
 
 // e4 < 0.98 uu for squared lengths uu .. uu + 7.
