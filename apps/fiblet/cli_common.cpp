@@ -108,8 +108,9 @@ void write_decoded_fiber(StreamlineSink& sink, const float* xyz, std::uint64_t n
     sink.write(xyz, std::size_t(n));
 }
 
-void write_decoded_chunk(StreamlineSink& sink, const Streamlines& chunk, const std::string& input,
-                         std::uint64_t first) {
+void write_decoded_chunk(StreamlineSink& sink, const Streamlines& chunk, const std::string& input, std::uint64_t first,
+                         bool proven_finite) {
+    if (proven_finite) return sink.write_finite_chunk(chunk.xyz.data(), chunk.offsets);
     auto check_each = [&] {
         for (std::size_t i = 0; i < chunk.size(); ++i)
             check_decoded_finite(&chunk.xyz[3 * chunk.offsets[i]], chunk.offsets[i + 1] - chunk.offsets[i], input,

@@ -78,8 +78,10 @@ void write_decoded_fiber(TckWriter& writer, const float* xyz, std::uint64_t n, c
 void write_decoded_fiber(StreamlineSink& sink, const float* xyz, std::uint64_t n, const std::string& input,
                          std::uint64_t fiber);
 // The same for every fiber of a decoded chunk whose first is fiber `first`,
-// written at once (StreamlineSink::write_chunk: a .tck without a copy).
-void write_decoded_chunk(StreamlineSink& sink, const Streamlines& chunk, const std::string& input, std::uint64_t first);
+// written at once (StreamlineSink::write_chunk: a .tck without a copy);
+// without the check when decodes_finite() proved the file's points finite.
+void write_decoded_chunk(StreamlineSink& sink, const Streamlines& chunk, const std::string& input, std::uint64_t first,
+                         bool proven_finite);
 
 // Minimal JSON object builder (values are numbers, strings, bools or nested
 // objects already rendered), keys in insertion order.

@@ -88,11 +88,12 @@ std::string decompress_through(const DecompressArgs& a, const std::string& input
     const std::string decoder = decoder_name(options.decoder);
     const std::string out_path = writable_path(output, ".tck", stdout_spool);
     const auto sink = open_streamline_sink(out_path, sink_header, a.force || stdout_spool);
+    const bool proven_finite = decodes_finite(h);  // then no pass over the points checks them
     Progress progress(a.quiet);
     decode_file(
         file,
         [&](std::uint64_t first, const Streamlines& chunk) {
-            write_decoded_chunk(*sink, chunk, input, first);
+            write_decoded_chunk(*sink, chunk, input, first, proven_finite);
             progress.update("decompress", h.fibers ? double(first + chunk.size()) / double(h.fibers) : 1.0);
         },
         options);

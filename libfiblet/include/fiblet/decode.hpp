@@ -99,6 +99,14 @@ std::size_t count_block_points(const DecodeContext& ctx, const std::uint8_t* blo
 std::size_t decode_blocks(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count, float* xyz,
                           Decoder decoder = {}, unsigned threads = 1);
 
+// Whether every point any decoder makes of this file's blocks is finite,
+// proven from the header and its direction table alone (docs/decode.md,
+// "Finite points": the walk's growth bounded by the frames' norms). False
+// proves nothing: such a file may still decode to finite points. A
+// consumer that must refuse NaN and Inf (a .tck writer) can skip its check
+// when it is true.
+bool decodes_finite(const FftHeader& header);
+
 // Scalar reference decoder: plain code, the reference every faster decoder
 // is tested against. Writes count_block_points() points (3 floats each) to
 // `xyz` and returns that number. Block contents must have been validated by

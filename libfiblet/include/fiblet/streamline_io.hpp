@@ -86,6 +86,11 @@ public:
         for (std::size_t i = 0; i + 1 < offsets.size(); ++i)
             write(xyz + 3 * offsets[i], std::size_t(offsets[i + 1] - offsets[i]));
     }
+    // write_chunk() for points the caller proved finite (decodes_finite()):
+    // a sink that would check them (a .tck) skips that pass.
+    virtual void write_finite_chunk(const float* xyz, std::span<const std::uint64_t> offsets) {
+        write_chunk(xyz, offsets);
+    }
     // Whether write() and write_chunk() refuse a non-finite coordinate
     // (Error{invalid_input}, nothing of the call written): a .tck cannot
     // hold one (NaN separates its streamlines). Callers that would check

@@ -124,7 +124,12 @@ public:
     // Streamlines i = 0 .. offsets.size() - 2 of a chunk: points offsets[i]
     // to offsets[i + 1] - 1 of xyz (3 floats each), handed to the kernel
     // where they lie, with their separators (no copy: writev).
+    // Refuses a non-finite coordinate (Error{invalid_input}, nothing of the
+    // chunk written).
     void write_chunk(const float* xyz, std::span<const std::uint64_t> offsets);
+    // The same for points the caller proved finite (decodes_finite()):
+    // without that pass over them.
+    void write_finite_chunk(const float* xyz, std::span<const std::uint64_t> offsets);
     void finish();
 
     std::uint64_t count() const;

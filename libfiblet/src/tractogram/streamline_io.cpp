@@ -41,6 +41,9 @@ public:
     void write_chunk(const float* xyz, std::span<const std::uint64_t> offsets) override {
         writer_.write_chunk(xyz, offsets);
     }
+    void write_finite_chunk(const float* xyz, std::span<const std::uint64_t> offsets) override {
+        writer_.write_finite_chunk(xyz, offsets);
+    }
     bool refuses_non_finite() const override { return true; }
     void finish() override { writer_.finish(); }
 

@@ -69,6 +69,46 @@ struct TckWriter::Impl {
         out.write(sep, sizeof sep);
         ++count;
     }
+
+    // Appends streamlines i = 0 .. offsets.size() - 2 of a chunk, handed to
+    // the kernel where they lie (writev), each checked for non-finite
+    // values unless the caller proved them finite.
+    void append_chunk(const float* xyz, std::span<const std::uint64_t> offsets, bool check_finite) {
+        if (offsets.size() < 2) return;
+        const std::size_t fibers = offsets.size() - 1;
+        static const float sep[3] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN(),
+                                     std::numeric_limits<float>::quiet_NaN()};
+        std::vector<const void*> data;
+        std::vector<std::size_t> sizes;
+        data.reserve(2 * fibers), sizes.reserve(2 * fibers);
+        for (std::size_t i = 0; i < fibers; ++i) {
+            check_open();
+            const float* p = xyz + 3 * offsets[i];
+            const std::uint64_t n = offsets[i + 1] - offsets[i];
+            if (check_finite && !finite_values(p, 3 * n))
+                throw Error(Errc::invalid_input, out.path() + ": cannot write a non-finite coordinate (" +
+                                                     detail::streamline_label(count + i) +
+                                                     "): a .tck cannot hold NaN or Inf");
+            if (count + i >= kMaxCount)
+                throw Error(Errc::unsupported, out.path() + ": more than " + std::to_string(kMaxCount) + " streamlines");
+            if (n > 0) data.push_back(p), sizes.push_back(std::size_t(n) * sizeof(Vec3f));
+            data.push_back(sep), sizes.push_back(sizeof sep);
+        }
+        out.write_pieces(data.data(), sizes.data(), data.size());
+        count += fibers;
+    }
+
+    // NaN and Inf have every exponent bit set: one mask and compare a value,
+    // which vectorizes (the sink thread's time is the writes').
+    static bool finite_values(const float* v, std::uint64_t n) {
+        std::uint32_t bad = 0;
+        for (std::uint64_t k = 0; k < n; ++k) {
+            std::uint32_t b;
+            std::memcpy(&b, v + k, 4);
+            bad |= std::uint32_t((b & 0x7f800000u) == 0x7f800000u);
+        }
+        return !bad;
+    }
 };
 
 TckWriter::TckWriter(const std::string& path, const std::vector<std::pair<std::string, std::string>>& properties,
@@ -129,36 +169,11 @@ void TckWriter::write(const float* xyz, std::size_t n_points) {
 }
 
 void TckWriter::write_chunk(const float* xyz, std::span<const std::uint64_t> offsets) {
-    Impl& m = *impl_;
-    if (offsets.size() < 2) return;
-    const std::size_t fibers = offsets.size() - 1;
-    static const float sep[3] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN(),
-                                 std::numeric_limits<float>::quiet_NaN()};
-    std::vector<const void*> data;
-    std::vector<std::size_t> sizes;
-    data.reserve(2 * fibers), sizes.reserve(2 * fibers);
-    for (std::size_t i = 0; i < fibers; ++i) {
-        m.check_open();
-        const float* p = xyz + 3 * offsets[i];
-        const std::uint64_t n = offsets[i + 1] - offsets[i];
-        // NaN and Inf have every exponent bit set: one mask and compare a
-        // value, which vectorizes (the sink thread's time is the writes').
-        std::uint32_t bad = 0;
-        for (std::uint64_t k = 0; k < 3 * n; ++k) {
-            std::uint32_t b;
-            std::memcpy(&b, p + k, 4);
-            bad |= std::uint32_t((b & 0x7f800000u) == 0x7f800000u);
-        }
-        if (bad)
-            throw Error(Errc::invalid_input, m.out.path() + ": cannot write a non-finite coordinate (" +
-                                                 detail::streamline_label(m.count + i) + "): a .tck cannot hold NaN or Inf");
-        if (m.count + i >= kMaxCount)
-            throw Error(Errc::unsupported, m.out.path() + ": more than " + std::to_string(kMaxCount) + " streamlines");
-        if (n > 0) data.push_back(p), sizes.push_back(std::size_t(n) * sizeof(Vec3f));
-        data.push_back(sep), sizes.push_back(sizeof sep);
-    }
-    m.out.write_pieces(data.data(), sizes.data(), data.size());
-    m.count += fibers;
+    impl_->append_chunk(xyz, offsets, true);
+}
+
+void TckWriter::write_finite_chunk(const float* xyz, std::span<const std::uint64_t> offsets) {
+    impl_->append_chunk(xyz, offsets, false);
 }
 
 void TckWriter::finish() {
