@@ -61,6 +61,7 @@ inline void block_starts(const float (&words)[6][V::W], float unorm_max, bool ax
 struct Blocks8 {
     using Code = Code8;
     static constexpr int kCodesOffset = kBlockDirectionsOffset, kCodeBytes = 1;
+    static constexpr bool kGroupByLength = false;  // 97 % of lane steps work in block order
     static int points(const std::uint8_t* b) { return int(BlockView{b}.point_count()); }
     static void anchor_words(const std::uint8_t* b, float* w) {
         const auto q = BlockView{b}.anchor_words();
@@ -70,11 +71,36 @@ struct Blocks8 {
 struct Blocks16 {
     using Code = Code16;
     static constexpr int kCodesOffset = kBlock16DirectionsOffset, kCodeBytes = 2;
+    static constexpr bool kGroupByLength = true;  // 87 % in block order (order_by_points)
     static int points(const std::uint8_t* b) { return int(BlockView16{b}.point_count()); }
     static void anchor_words(const std::uint8_t* b, float* w) {
         for (int k = 0; k < 6; ++k) w[k] = float(BlockView16{b}.anchor_word(k));  // < 2^24: exact
     }
 };
+
+// The lanes of a group walk until its longest block ends, so long blocks
+// are grouped by point count (a stable counting sort, longest first): on
+// the medium tractogram's 254-point blocks 87 % of the lane steps did work
+// in block order, ~100 % grouped (the decode 6 % faster). The points still
+// go where the block order puts them (`first_float`).
+template <class Blocks>
+void order_by_points(const std::uint8_t* blocks, std::size_t count, int bb, std::vector<std::uint32_t>& order,
+                     std::vector<std::size_t>& first_float) {
+    std::vector<std::uint32_t> start;  // per point count, longest first
+    first_float.resize(count);
+    std::size_t floats = 0;
+    for (std::size_t b = 0; b < count; ++b) {
+        const int n = Blocks::points(blocks + b * std::size_t(bb));
+        if (std::size_t(n) >= start.size()) start.resize(std::size_t(n) + 1);
+        ++start[std::size_t(n)];
+        first_float[b] = floats;
+        floats += 3 * std::size_t(n);
+    }
+    std::uint32_t at = 0;
+    for (std::size_t n = start.size(); n-- > 0;) at += std::exchange(start[n], at);
+    order.resize(count);
+    for (std::size_t b = 0; b < count; ++b) order[start[std::size_t(Blocks::points(blocks + b * std::size_t(bb)))]++] = std::uint32_t(b);
+}
 
 }  // namespace lanes
 
@@ -92,35 +118,43 @@ std::size_t decode_lanes_of(const DecodeContext& ctx, const float* rows_table, f
     const F step = V::set1(h.step), half = V::set1(0.5f), scaling = V::set1(h.scaling);
     const F offset[3] = {V::set1(h.offset[0]), V::set1(h.offset[1]), V::set1(h.offset[2])};
 
+    std::vector<std::uint32_t> order;
+    std::vector<std::size_t> first_float;
+    if constexpr (Blocks::kGroupByLength) lanes::order_by_points<Blocks>(blocks, count, bb, order, first_float);
+
     // Per lane: the six unorm16 anchor coordinates, as floats.
     alignas(64) float words[6][W];
-    // The last group's missing lanes repeat its last block (and write
-    // nothing), so every lane reads a whole block.
+    // Blocks in order are read with a stride (fewer registers in the walk):
+    // the last group's is padded.
     std::vector<std::uint8_t> padded;
     alignas(64) float rows[3 * W][W];
+    const std::uint8_t* lane_block[W];
     float* dst[W];
     int lane_floats[W];
 
-    float* out = xyz;
+    std::size_t floats = 0;
     for (std::size_t g = 0; g < count; g += W) {
+        // The last group's missing lanes repeat its last block (and write nothing).
         const int m = int(std::min<std::size_t>(W, count - g));
         const std::uint8_t* base = blocks + g * std::size_t(bb);
-        if (m < W) {
+        if (!Blocks::kGroupByLength && m < W) {
             padded.resize(std::size_t(W) * bb);
-            std::memcpy(padded.data(), base, std::size_t(m) * bb);
-            for (int l = m; l < W; ++l) std::memcpy(&padded[std::size_t(l) * bb], base + std::size_t(m - 1) * bb, bb);
+            for (int l = 0; l < W; ++l) std::memcpy(&padded[std::size_t(l) * bb], base + std::size_t(std::min(l, m - 1)) * bb, bb);
             base = padded.data();
         }
         int max_points = 0, min_floats = std::numeric_limits<int>::max();
         for (int l = 0; l < W; ++l) {
-            const std::uint8_t* block = base + std::size_t(l) * std::size_t(bb);
+            std::size_t b = g + std::size_t(std::min(l, m - 1));
+            if constexpr (Blocks::kGroupByLength) b = order[b];
+            const std::uint8_t* block = lane_block[l] =
+                Blocks::kGroupByLength ? blocks + b * std::size_t(bb) : base + std::size_t(l) * bb;
             float w[6];
             Blocks::anchor_words(block, w);
             for (int k = 0; k < 6; ++k) words[k][l] = w[k];
             const int n = l < m ? Blocks::points(block) : 0;
-            dst[l] = out;
+            dst[l] = xyz + (Blocks::kGroupByLength ? first_float[b] : floats);
             lane_floats[l] = 3 * n;
-            out += 3 * n;
+            floats += std::size_t(3 * n);
             max_points = std::max(max_points, n);
             min_floats = std::min(min_floats, 3 * n);
         }
@@ -159,7 +193,8 @@ std::size_t decode_lanes_of(const DecodeContext& ctx, const float* rows_table, f
         F p[3] = {a1.x, a1.y, a1.z};
         if (max_points >= 2) emit(1, p[0], p[1], p[2]);
 
-        const std::uint8_t* codes = base + Blocks::kCodesOffset;
+        const std::uint8_t* codes[W];
+        for (int l = 0; l < W; ++l) codes[l] = lane_block[l] + Blocks::kCodesOffset;
         for (int k = 0; k + 2 < max_points; ++k) {
             // 16-bit codes: their frame rows (4 MiB) are not in cache; ask
             // for those of a later step while this one computes. No bits
@@ -167,13 +202,15 @@ std::size_t decode_lanes_of(const DecodeContext& ctx, const float* rows_table, f
             if constexpr (Blocks::kCodeBytes == 2) {
                 constexpr int kAhead = 6;
                 if (k + kAhead + 2 < max_points)
-                    for (int l = 0; l < W; ++l) {
-                        const std::uint8_t* c = codes + std::size_t(l) * bb + 2 * (k + kAhead);
-                        __builtin_prefetch(rows_table + 16 * std::size_t(Code16::at(c)));
-                    }
+                    for (int l = 0; l < W; ++l)
+                        __builtin_prefetch(rows_table + 16 * std::size_t(Code16::at(codes[l] + 2 * (k + kAhead))));
             }
             F local[9];
-            V::template lookup<typename Blocks::Code>(rows_table, codes + Blocks::kCodeBytes * k, bb, local);
+            using Code = typename Blocks::Code;
+            if constexpr (Blocks::kGroupByLength)
+                V::template lookup<Code>(rows_table, [&](int j) { return codes[j] + Blocks::kCodeBytes * k; }, local);
+            else
+                V::template lookup<Code>(rows_table, [&](int j) { return codes[0] + j * bb + Blocks::kCodeBytes * k; }, local);
             // frame = frame * local, as compose(): column j = F * local.c[j],
             // summed left to right.
             F next[9];
@@ -186,7 +223,7 @@ std::size_t decode_lanes_of(const DecodeContext& ctx, const float* rows_table, f
             emit(k + 2, p[0], p[1], p[2]);
         }
     }
-    return std::size_t(out - xyz) / 3;
+    return floats / 3;
 }
 
 inline std::size_t decode_lanes(const DecodeContext& ctx, const std::uint8_t* blocks, std::size_t count, float* xyz) {

@@ -104,7 +104,7 @@ inline std::size_t decode_warp(const DecodeContext& ctx, const std::uint8_t* blo
         F m[9][kRegs];
         for (int reg = 0; reg < regs; ++reg) {
             F local[9];
-            V::lookup(rows_table, element_code + reg * W, 1, local);
+            V::lookup(rows_table, [&](int j) { return element_code + reg * W + j; }, local);
             for (int c = 0; c < 9; ++c) m[c][reg] = local[c];
         }
         const float f0[9] = {s.frame.c[0].x, s.frame.c[0].y, s.frame.c[0].z, s.frame.c[1].x, s.frame.c[1].y,

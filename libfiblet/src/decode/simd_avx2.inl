@@ -29,11 +29,12 @@ struct V {
 
     // Row loads and an 8 x 8 transpose (components 0..7) beat 9 gathers
     // (about 2x on Zen 4); component 8 comes from scalar loads.
-    template <class Code = Code8>
-    static void lookup(const float* rows, const std::uint8_t* code, std::ptrdiff_t stride, F (&out)[9]) {
+    // `code_at(j)`: where lane j's code is.
+    template <class Code = Code8, class CodeAt>
+    static void lookup(const float* rows, CodeAt code_at, F (&out)[9]) {
         const float* row[8];
         F r[8];
-        for (int j = 0; j < 8; ++j) row[j] = rows + 16 * Code::at(code + j * stride), r[j] = _mm256_load_ps(row[j]);
+        for (int j = 0; j < 8; ++j) row[j] = rows + 16 * Code::at(code_at(j)), r[j] = _mm256_load_ps(row[j]);
         transpose(r);
         for (int c = 0; c < 8; ++c) out[c] = r[c];
         out[8] = _mm256_setr_ps(row[0][8], row[1][8], row[2][8], row[3][8], row[4][8], row[5][8], row[6][8], row[7][8]);

@@ -25,11 +25,12 @@ struct V {
 
     // 16 row loads and the part of a 16 x 16 transpose that yields
     // components 0..8 (57 shuffles): about 1.4x faster than 9 gathers on
-    // Zen 4, where a 16-lane gather costs some 15 cycles.
-    template <class Code = Code8>
-    static void lookup(const float* rows, const std::uint8_t* code, std::ptrdiff_t stride, F (&out)[9]) {
+    // Zen 4, where a 16-lane gather costs some 15 cycles. `code_at(j)`:
+    // where lane j's code is.
+    template <class Code = Code8, class CodeAt>
+    static void lookup(const float* rows, CodeAt code_at, F (&out)[9]) {
         F r[16];
-        for (int j = 0; j < 16; ++j) r[j] = _mm512_load_ps(rows + 16 * Code::at(code + j * stride));
+        for (int j = 0; j < 16; ++j) r[j] = _mm512_load_ps(rows + 16 * Code::at(code_at(j)));
         __m512d u[16];
         unpack_4x4(r, u);
         for (int s = 0; s < 4; ++s) {

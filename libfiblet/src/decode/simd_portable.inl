@@ -68,12 +68,12 @@ struct V {
     }
     static F broadcast_last(F a) { return set1(a.v[W - 1]); }
 
-    // The local frames of W codes (lane l: code[l * stride]) from the
-    // table of padded rows (DecodeContext::frame_rows), component-major.
-    template <class Code = Code8>
-    static void lookup(const float* rows, const std::uint8_t* code, std::ptrdiff_t stride, F (&out)[9]) {
+    // The local frames of W codes (lane j's at code_at(j)) from the table
+    // of padded rows (DecodeContext::frame_rows), component-major.
+    template <class Code = Code8, class CodeAt>
+    static void lookup(const float* rows, CodeAt code_at, F (&out)[9]) {
         for (int j = 0; j < W; ++j) {
-            const float* row = rows + 16 * Code::at(code + j * stride);
+            const float* row = rows + 16 * Code::at(code_at(j));
             for (int c = 0; c < 9; ++c) out[c].v[j] = row[c];
         }
     }
