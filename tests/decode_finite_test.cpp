@@ -93,7 +93,8 @@ TEST(DecodesFinite, ProvenHeadersDecodeFinitePointsWithEveryDecoder) {
     decoders.push_back("scalar");
     int proven = 0, overflowed = 0;
     for (int trial = 0; trial < 600; ++trial) {
-        const std::uint8_t version = trial % 3 == 0 ? kFft16Version : trial % 3 == 1 ? kFft16PackedVersion : kFftVersion;
+        const std::uint8_t version =
+            trial % 3 == 0 ? kFft16Version : trial % 3 == 1 ? kFft16PackedVersion : kFftVersion;
         const std::uint32_t ppb = version == kFftVersion ? 60 : 126;
         const FftHeader h = extreme_header(rng, version, ppb);
         const DecodeContext ctx(h);  // holds a 16-bit table for decodes_finite too
@@ -102,7 +103,8 @@ TEST(DecodesFinite, ProvenHeadersDecodeFinitePointsWithEveryDecoder) {
         proven += finite;
         for (const std::string& name : decoders) {
             const bool got = all_finite(decode_with(ctx, blocks, name));
-            if (finite) EXPECT_TRUE(got) << name << ", trial " << trial << ", scaling " << h.scaling << ", step " << h.step;
+            if (finite)
+                EXPECT_TRUE(got) << name << ", trial " << trial << ", scaling " << h.scaling << ", step " << h.step;
             overflowed += !got && name == "scalar";
         }
     }

@@ -33,7 +33,8 @@ double direction_table_norm_bound(const FftHeader& h) {
     double worst = 0;
     if (h.direction_bits() == 16) {
         const auto table = make_direction_table16(h);
-        for (unsigned k = 0; k < 65536; ++k) worst = std::max(worst, spectral_norm_bound(table->frame(std::uint16_t(k))));
+        for (unsigned k = 0; k < 65536; ++k)
+            worst = std::max(worst, spectral_norm_bound(table->frame(std::uint16_t(k))));
     } else {
         const DirectionTable table(h.ratio);
         for (unsigned k = 0; k < 256; ++k) worst = std::max(worst, spectral_norm_bound(table.frame(std::uint8_t(k))));

@@ -99,7 +99,8 @@ void order_by_points(const std::uint8_t* blocks, std::size_t count, int bb, std:
     std::uint32_t at = 0;
     for (std::size_t n = start.size(); n-- > 0;) at += std::exchange(start[n], at);
     order.resize(count);
-    for (std::size_t b = 0; b < count; ++b) order[start[std::size_t(Blocks::points(blocks + b * std::size_t(bb)))]++] = std::uint32_t(b);
+    for (std::size_t b = 0; b < count; ++b)
+        order[start[std::size_t(Blocks::points(blocks + b * std::size_t(bb)))]++] = std::uint32_t(b);
 }
 
 }  // namespace lanes
@@ -139,7 +140,8 @@ std::size_t decode_lanes_of(const DecodeContext& ctx, const float* rows_table, f
         const std::uint8_t* base = blocks + g * std::size_t(bb);
         if (!Blocks::kGroupByLength && m < W) {
             padded.resize(std::size_t(W) * bb);
-            for (int l = 0; l < W; ++l) std::memcpy(&padded[std::size_t(l) * bb], base + std::size_t(std::min(l, m - 1)) * bb, bb);
+            for (int l = 0; l < W; ++l)
+                std::memcpy(&padded[std::size_t(l) * bb], base + std::size_t(std::min(l, m - 1)) * bb, bb);
             base = padded.data();
         }
         int max_points = 0, min_floats = std::numeric_limits<int>::max();
@@ -207,10 +209,11 @@ std::size_t decode_lanes_of(const DecodeContext& ctx, const float* rows_table, f
             }
             F local[9];
             using Code = typename Blocks::Code;
+            const int at = Blocks::kCodeBytes * k;
             if constexpr (Blocks::kGroupByLength)
-                V::template lookup<Code>(rows_table, [&](int j) { return codes[j] + Blocks::kCodeBytes * k; }, local);
+                V::template lookup<Code>(rows_table, [&](int j) { return codes[j] + at; }, local);
             else
-                V::template lookup<Code>(rows_table, [&](int j) { return codes[0] + j * bb + Blocks::kCodeBytes * k; }, local);
+                V::template lookup<Code>(rows_table, [&](int j) { return codes[0] + j * bb + at; }, local);
             // frame = frame * local, as compose(): column j = F * local.c[j],
             // summed left to right.
             F next[9];

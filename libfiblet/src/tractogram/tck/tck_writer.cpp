@@ -90,7 +90,8 @@ struct TckWriter::Impl {
                                                      detail::streamline_label(count + i) +
                                                      "): a .tck cannot hold NaN or Inf");
             if (count + i >= kMaxCount)
-                throw Error(Errc::unsupported, out.path() + ": more than " + std::to_string(kMaxCount) + " streamlines");
+                throw Error(Errc::unsupported,
+                            out.path() + ": more than " + std::to_string(kMaxCount) + " streamlines");
             if (n > 0) data.push_back(p), sizes.push_back(std::size_t(n) * sizeof(Vec3f));
             data.push_back(sep), sizes.push_back(sizeof sep);
         }
