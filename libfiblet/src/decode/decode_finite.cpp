@@ -28,12 +28,13 @@ double spectral_norm_bound(const Frame& f) {
     return std::sqrt(worst) * (1 + 4 * kUnit);  // the double sums' own rounding, with room
 }
 
-// The largest bound over every code a block may hold (every u16 for 16-bit files).
+// The largest bound over every code a block may hold (every u16 for 16-bit
+// files, whose codes past levels^2 repeat a frame below it).
 double direction_table_norm_bound(const FftHeader& h) {
     double worst = 0;
     if (h.direction_bits() == 16) {
         const auto table = make_direction_table16(h);
-        for (unsigned k = 0; k < 65536; ++k)
+        for (unsigned k = 0; k < table->levels() * table->levels(); ++k)
             worst = std::max(worst, spectral_norm_bound(table->frame(std::uint16_t(k))));
     } else {
         const DirectionTable table(h.ratio);

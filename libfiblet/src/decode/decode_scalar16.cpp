@@ -23,7 +23,9 @@ namespace {
 // A 16-bit file's table and its SIMD rows, shared by every DecodeContext of
 // the same ratio and levels: they take milliseconds and 6 MiB to make, and
 // a decode makes a context per thread and chunk. Held while some context
-// holds them.
+// holds them, and the last one made until another replaces it: a command
+// proves a file's points finite and then decodes it, Python loads a file
+// again, each with the table of the call before.
 struct Tables16 {
     Tables16(float ratio, unsigned levels) : table(ratio, levels) {
         for (unsigned k = 0; k < 65536; ++k) put_frame_row(table.frame(std::uint16_t(k)), &rows.rows[16 * k]);
@@ -36,12 +38,14 @@ std::shared_ptr<const Tables16> tables16(const FftHeader& header) {
     static std::mutex mutex;
     static std::map<std::pair<std::uint32_t, unsigned>, std::weak_ptr<const Tables16>> made;
     const std::pair key{std::bit_cast<std::uint32_t>(header.ratio), header.code_levels()};
+    static std::shared_ptr<const Tables16> last;
     const std::lock_guard lock(mutex);
-    if (auto t = made[key].lock()) return t;
+    if (auto t = made[key].lock()) return last = t;
+    last.reset();  // before the next is made: at most two alive here
     std::erase_if(made, [](const auto& entry) { return entry.second.expired(); });
     auto t = std::shared_ptr<const Tables16>(new Tables16(header.ratio, header.code_levels()));  // over-aligned
     made[key] = t;
-    return t;
+    return last = t;
 }
 
 }  // namespace
