@@ -54,19 +54,28 @@ struct TckWriter::Impl {
         if (finished) throw Error(Errc::invalid_argument, out.path() + ": TckWriter used after finish()");
     }
 
-    // Appends one streamline of n packed xyz float triplets and its NaN separator.
-    void append(const void* xyz, std::size_t n, bool finite) {
+    // NaN separates streamlines (so no point may hold one, nor Inf, which ends the data).
+    static constexpr float kSeparator[3] = {std::numeric_limits<float>::quiet_NaN(),
+                                            std::numeric_limits<float>::quiet_NaN(),
+                                            std::numeric_limits<float>::quiet_NaN()};
+
+    // Whether streamline `index` (its 3n floats at v) may be written: the
+    // writer open, no NaN or Inf unless the caller proved there is none,
+    // within the count's digits.
+    void check_streamline(std::uint64_t index, const float* v, std::uint64_t n, bool check_finite) const {
         check_open();
-        // A NaN or Inf would be read back as a separator or the end of the data.
-        if (!finite)
+        if (check_finite && !finite_values(v, 3 * n))
             throw Error(Errc::invalid_input, out.path() + ": cannot write a non-finite coordinate (" +
-                                                 detail::streamline_label(count) + "): a .tck cannot hold NaN or Inf");
-        if (count >= kMaxCount)
+                                                 detail::streamline_label(index) + "): a .tck cannot hold NaN or Inf");
+        if (index >= kMaxCount)
             throw Error(Errc::unsupported, out.path() + ": more than " + std::to_string(kMaxCount) + " streamlines");
+    }
+
+    // Appends one streamline of n packed xyz float triplets and its separator.
+    void append(const float* xyz, std::size_t n) {
+        check_streamline(count, xyz, n, true);
         if (n > 0) out.write(xyz, n * sizeof(Vec3f));
-        const float nan = std::numeric_limits<float>::quiet_NaN();
-        const float sep[3] = {nan, nan, nan};
-        out.write(sep, sizeof sep);
+        out.write(kSeparator, sizeof kSeparator);
         ++count;
     }
 
@@ -76,24 +85,15 @@ struct TckWriter::Impl {
     void append_chunk(const float* xyz, std::span<const std::uint64_t> offsets, bool check_finite) {
         if (offsets.size() < 2) return;
         const std::size_t fibers = offsets.size() - 1;
-        static const float sep[3] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN(),
-                                     std::numeric_limits<float>::quiet_NaN()};
         std::vector<const void*> data;
         std::vector<std::size_t> sizes;
         data.reserve(2 * fibers), sizes.reserve(2 * fibers);
         for (std::size_t i = 0; i < fibers; ++i) {
-            check_open();
             const float* p = xyz + 3 * offsets[i];
             const std::uint64_t n = offsets[i + 1] - offsets[i];
-            if (check_finite && !finite_values(p, 3 * n))
-                throw Error(Errc::invalid_input, out.path() + ": cannot write a non-finite coordinate (" +
-                                                     detail::streamline_label(count + i) +
-                                                     "): a .tck cannot hold NaN or Inf");
-            if (count + i >= kMaxCount)
-                throw Error(Errc::unsupported,
-                            out.path() + ": more than " + std::to_string(kMaxCount) + " streamlines");
+            check_streamline(count + i, p, n, check_finite);
             if (n > 0) data.push_back(p), sizes.push_back(std::size_t(n) * sizeof(Vec3f));
-            data.push_back(sep), sizes.push_back(sizeof sep);
+            data.push_back(kSeparator), sizes.push_back(sizeof kSeparator);
         }
         out.write_pieces(data.data(), sizes.data(), data.size());
         count += fibers;
@@ -158,16 +158,11 @@ TckWriter::TckWriter(const std::string& path, const std::vector<std::pair<std::s
 TckWriter::~TckWriter() = default;
 
 void TckWriter::write(std::span<const Vec3f> streamline) {
-    bool finite = true;
-    for (const Vec3f& p : streamline) finite &= std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-    impl_->append(streamline.data(), streamline.size(), finite);
+    static_assert(sizeof(Vec3f) == 3 * sizeof(float), "points are 3 packed floats");
+    impl_->append(reinterpret_cast<const float*>(streamline.data()), streamline.size());
 }
 
-void TckWriter::write(const float* xyz, std::size_t n_points) {
-    bool finite = true;
-    for (std::size_t i = 0; i < 3 * n_points; ++i) finite &= std::isfinite(xyz[i]);
-    impl_->append(xyz, n_points, finite);
-}
+void TckWriter::write(const float* xyz, std::size_t n_points) { impl_->append(xyz, n_points); }
 
 void TckWriter::write_chunk(const float* xyz, std::span<const std::uint64_t> offsets) {
     impl_->append_chunk(xyz, offsets, true);
