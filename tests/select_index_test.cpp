@@ -5,9 +5,11 @@
 // with a clear error.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <tuple>
 
 #include "fiblet/block_index.hpp"
 #include "fiblet/checksum.hpp"
@@ -389,6 +391,63 @@ TEST_F(SelectIndex, FrustumCandidatesCoverEveryBlockSphereThatMeetsTheFrustum) {
                 ASSERT_TRUE(bit(bits, b)) << "camera " << i << " block " << b;
             }
         }
+    }
+}
+
+// The hierarchy's boxes are tested eight at a time in vector lanes
+// (index/box_tests.hpp, leaf blocks unpacked from their grid cells there):
+// the candidates are exactly the blocks whose own box (block_box) meets the
+// region by the one-box tests, and `inside` those it holds: none missed, none
+// let through that its own box rules out.
+TEST_F(SelectIndex, CandidatesAreTheBlocksWhoseOwnBoxMeetsTheRegion) {
+    for (const std::string& path : {fiblet_file(), dwi_file(), v2_file(), v3_file()}) {
+        const FftFile file(path);
+        const BlockIndex index = BlockIndex::load(file);
+        const DecodedFile d = decode_everything(file);
+        QueryGenerator gen(d, 11);
+        std::size_t near_count = 0, inside_count = 0;
+        for (int i = 0; i < 30; ++i) {
+            const Frustum f = frustum_from_camera(gen.camera());
+            const float margin = gen.uniform(0, 2);
+            std::vector<std::uint64_t> bits;
+            index.blocks_near_frustum(f, margin, bits);
+            for (std::size_t b = 0; b < d.blocks.size(); ++b)
+                ASSERT_EQ(bit(bits, b), box_intersects_frustum(f, index.block_box(b), margin))
+                    << path << " camera " << i << " block " << b;
+            const Region r = gen.region();
+            std::vector<std::uint64_t> near, inside;
+            if (r.shape == Region::Shape::sphere) index.blocks_near_sphere(r.center, r.radius, near, &inside);
+            else index.blocks_near_box(r.box, near, &inside);
+            for (std::size_t b = 0; b < d.blocks.size(); ++b) {
+                const Aabb x = index.block_box(b);
+                near_count += bit(near, b), inside_count += bit(inside, b);
+                if (r.shape == Region::Shape::box) {
+                    const Aabb& q = r.box;
+                    ASSERT_EQ(bit(near, b), x.max.x >= q.min.x && x.min.x <= q.max.x && x.max.y >= q.min.y &&
+                                                x.min.y <= q.max.y && x.max.z >= q.min.z && x.min.z <= q.max.z)
+                        << path << " region " << i << " block " << b;
+                    ASSERT_EQ(bit(inside, b), x.min.x >= q.min.x && x.max.x <= q.max.x && x.min.y >= q.min.y &&
+                                                  x.max.y <= q.max.y && x.min.z >= q.min.z && x.max.z <= q.max.z)
+                        << path << " region " << i << " block " << b;
+                    continue;
+                }
+                // In double, away from the float tests' slack (1e-5 of r^2).
+                double near2 = 0, far2 = 0;
+                for (const auto [v, lo, hi] : {std::tuple{r.center.x, x.min.x, x.max.x}, std::tuple{r.center.y, x.min.y, x.max.y},
+                                               std::tuple{r.center.z, x.min.z, x.max.z}}) {
+                    const double below = double(lo) - v, above = double(v) - hi;
+                    near2 += std::pow(std::max({below, above, 0.0}), 2);
+                    far2 += std::pow(std::max(double(v) - lo, double(hi) - v), 2);
+                }
+                const double r2 = double(r.radius) * r.radius;
+                if (near2 < r2 * (1 - 1e-4)) ASSERT_TRUE(bit(near, b)) << path << " region " << i << " block " << b;
+                if (near2 > r2 * (1 + 1e-4)) ASSERT_FALSE(bit(near, b)) << path << " region " << i << " block " << b;
+                if (far2 < r2 * (1 - 1e-4)) ASSERT_TRUE(bit(inside, b)) << path << " region " << i << " block " << b;
+                if (far2 > r2) ASSERT_FALSE(bit(inside, b)) << path << " region " << i << " block " << b;
+            }
+        }
+        EXPECT_GT(near_count, inside_count) << path;  // both sides of each test visited
+        EXPECT_GT(inside_count, 0u) << path;
     }
 }
 

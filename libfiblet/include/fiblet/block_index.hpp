@@ -90,6 +90,15 @@ private:
     Vec3f last_point_{};      // of the last block added
 };
 
+namespace detail {
+// Eight boxes of the in-memory hierarchy side by side, each side and axis
+// an array (index/box_tests.hpp tests them together).
+inline constexpr std::size_t kBoxGroupSize = 8;
+struct BoxGroup {
+    float lo[3][kBoxGroupSize], hi[3][kBoxGroupSize];
+};
+}  // namespace detail
+
 // The index of one file, in memory: boxes of groups of consecutive blocks
 // (a version-2 chunk's groups; one box per block from a version-1 chunk or
 // computed exactly; for a version-3 or -4 chunk, groups of kIndexLeafBlocks
@@ -154,8 +163,9 @@ private:
     void sort_block_cells(const std::vector<std::uint64_t>& cells);  // file order -> block_cells_
     template <class BoxOf>
     void build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of);  // (Morton key << 32 | group)
-    template <class Classify>
-    void collect(const Classify& classify, std::vector<std::uint64_t>& bits, std::vector<std::uint64_t>* inside) const;
+    // Sets the blocks `test` (index/box_tests.hpp) finds near its region.
+    template <class Test>
+    void collect(const Test& test, std::vector<std::uint64_t>& bits, std::vector<std::uint64_t>* inside) const;
 
     Source source_ = Source::decoded;
     std::uint32_t chunk_version_ = 0;
@@ -164,10 +174,17 @@ private:
     float max_join_ = -1;
     std::uint64_t blocks_ = 0;
     std::vector<std::uint32_t> group_first_;     // group -> its first block; one more: blocks_
-    std::vector<Aabb> sorted_boxes_;             // groups in Morton order
     std::vector<std::uint32_t> order_;           // Morton position -> group
+    struct BlockRange {
+        std::uint32_t first, end;
+    };
+    std::vector<BlockRange> leaf_blocks_;        // Morton position -> its group's blocks (no lookup through order_)
     std::vector<std::uint32_t> rank_;            // group -> Morton position
-    std::vector<std::vector<Aabb>> levels_;      // levels_[k][j]: node j of level k (k = 0: leaves)
+    // The hierarchy, 8-wide: boxes_[k][j] holds the boxes of the children of
+    // node j of level k (k = 0: leaves' parents, whose children are the
+    // leaves in Morton order); the top level has the root alone.
+    std::vector<std::vector<detail::BoxGroup>> boxes_;
+    Aabb root_{};
     // Versions 3 and 4: each block's grid box, packed in 64 bits (the
     // library's index/index_grid.hpp), leaf after leaf in Morton order;
     // boxes in mm are origin + cell number * cell.

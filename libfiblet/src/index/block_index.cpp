@@ -11,15 +11,18 @@
 #include "fiblet/error.hpp"
 #include "select/block_decoder.hpp"
 #include "core/bytes.hpp"
+#include "index/box_tests.hpp"
 #include "index/index_chunk.hpp"
 
 namespace fiblet {
 
 namespace {
 
-constexpr std::size_t kFanout = 8;
+constexpr std::size_t kFanout = detail::kBoxLanes;  // a node's children are tested together
 
-enum class Overlap { outside, partial, inside };
+using detail::BoxLanes;
+static_assert(kIndexLeafBlocks <= kFanout, "a leaf's blocks are tested together");
+using detail::Overlap;
 
 Aabb empty_box() {
     const float inf = std::numeric_limits<float>::infinity();
@@ -142,7 +145,8 @@ Aabb BlockIndex::block_box(std::uint64_t block) const {
     if (!block_cells_.empty())
         return detail::cells_bounds(block_cells_[leaf_first_cell_[rank_[g]] + (block - group_first_[g])], cells_origin_,
                                     cell_mm_);
-    return sorted_boxes_[rank_[g]];
+    const std::uint32_t pos = rank_[g];
+    return detail::box_at(boxes_[0][pos / kFanout], pos % kFanout);
 }
 
 Aabb BlockIndex::cells_union(const std::uint64_t* cells, std::size_t n) const {
@@ -247,8 +251,8 @@ void BlockIndex::set_groups(const std::vector<Aabb>& boxes) {
 
 std::optional<Aabb> BlockIndex::bounds() const {
     // The hierarchy's root bounds every box (an unbounded one spoils it).
-    if (sorted_boxes_.empty() || is_unbounded(levels_.back().front())) return std::nullopt;
-    return levels_.back().front();
+    if (order_.empty() || is_unbounded(root_)) return std::nullopt;
+    return root_;
 }
 
 template <class BoxOf>
@@ -257,141 +261,108 @@ void BlockIndex::build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of) {
     radix_sort(keyed, 31);
     // Filled by push_back: no zeroing pass over memory written right after.
     order_.clear(), order_.reserve(n);
-    sorted_boxes_.clear(), sorted_boxes_.reserve(n);
+    leaf_blocks_.clear(), leaf_blocks_.reserve(n);
     rank_.resize(n);
+    std::vector<Aabb> boxes;  // of one level, in Morton order
+    boxes.reserve(n);
     for (std::size_t pos = 0; pos < n; ++pos) {
         const auto group = std::uint32_t(keyed[pos]);
         order_.push_back(group);
+        leaf_blocks_.push_back({group_first_[group], group_first_[group + 1]});
         rank_[group] = std::uint32_t(pos);
-        sorted_boxes_.push_back(box_of(group));
+        boxes.push_back(box_of(group));
     }
-    // Levels of the tree: each node bounds kFanout consecutive children.
-    levels_.clear();
-    const std::vector<Aabb>* below = &sorted_boxes_;
-    while (below->size() > 1 || levels_.empty()) {
-        std::vector<Aabb> level((below->size() + kFanout - 1) / kFanout, empty_box());
-        for (std::size_t i = 0; i < below->size(); ++i) grow(level[i / kFanout], (*below)[i]);
-        levels_.push_back(std::move(level));
-        below = &levels_.back();
-        if (below->empty()) break;
-    }
+    // Levels of the tree, up to the root: each node bounds kFanout
+    // consecutive children, stored side by side (a last group's missing
+    // boxes repeat its first).
+    boxes_.clear();
+    do {
+        std::vector<detail::BoxGroup> groups((boxes.size() + kFanout - 1) / kFanout);
+        std::vector<Aabb> parents(groups.size(), empty_box());
+        for (std::size_t i = 0; i < groups.size() * kFanout; ++i) {
+            const Aabb& b = boxes[i < boxes.size() ? i : i / kFanout * kFanout];
+            detail::set_box(groups[i / kFanout], i % kFanout, b);
+            grow(parents[i / kFanout], b);
+        }
+        boxes_.push_back(std::move(groups));
+        boxes.swap(parents);
+    } while (boxes.size() > 1);
+    root_ = boxes.empty() ? empty_box() : boxes[0];
 }
 
-template <class Classify>
-void BlockIndex::collect(const Classify& classify, std::vector<std::uint64_t>& bits,
-                         std::vector<std::uint64_t>* inside) const {
-    const std::size_t n = sorted_boxes_.size();
+template <class Test>
+void BlockIndex::collect(const Test& test, std::vector<std::uint64_t>& bits, std::vector<std::uint64_t>* inside) const {
+    const std::size_t n = order_.size();
     bits.resize((blocks_ + 63) / 64, 0);
     if (inside) inside->resize((blocks_ + 63) / 64, 0);
     if (n == 0) return;
-    // The blocks of the group at Morton position `pos`.
+    // The blocks of the leaf at Morton position `pos`.
     auto mark = [&](std::vector<std::uint64_t>& to, std::size_t pos) {
-        const std::uint32_t g = order_[pos];
-        for (std::uint32_t b = group_first_[g]; b < group_first_[g + 1]; ++b) set_bit(to, b);
+        for (std::uint32_t b = leaf_blocks_[pos].first; b < leaf_blocks_[pos].end; ++b) set_bit(to, b);
     };
-    // Those of its blocks whose own box meets the region.
-    auto mark_blocks = [&](std::size_t pos) {
-        const std::uint32_t g = order_[pos];
-        const std::uint64_t* cells = &block_cells_[leaf_first_cell_[pos]];
-        for (std::uint32_t b = group_first_[g]; b < group_first_[g + 1]; ++b, ++cells) {
-            const Overlap o = classify(detail::cells_bounds(*cells, cells_origin_, cell_mm_));
-            if (o != Overlap::outside) set_bit(bits, b);
-            if (o == Overlap::inside && inside) set_bit(*inside, b);
-        }
-    };
-    // Positions covered by node j of level k: [j * span, (j + 1) * span), span = 8^(k+1).
     auto mark_all = [&](std::size_t first, std::size_t last) {
         for (std::size_t pos = first; pos < std::min(last, n); ++pos) {
             mark(bits, pos);
             if (inside) mark(*inside, pos);
         }
     };
-    auto visit = [&](auto& self, std::size_t k, std::size_t j, std::size_t span) -> void {
-        const Overlap o = classify(levels_[k][j]);
-        if (o == Overlap::outside) return;
-        if (o == Overlap::inside) return mark_all(j * span, (j + 1) * span);
-        if (k == 0) {
-            for (std::size_t pos = j * kFanout; pos < std::min(n, (j + 1) * kFanout); ++pos) {
-                const Overlap b = classify(sorted_boxes_[pos]);
-                if (b == Overlap::partial && !block_cells_.empty()) {
-                    mark_blocks(pos);
-                    continue;
-                }
-                if (b != Overlap::outside) mark(bits, pos);
-                if (b == Overlap::inside && inside) mark(*inside, pos);
+    // A leaf the region meets: its blocks, or (when it meets it partly and
+    // the blocks have boxes of their own) those whose own box meets it.
+    auto leaf = [&](std::size_t pos, Overlap o) {
+        if (o == Overlap::partial && !block_cells_.empty()) {
+            const BlockRange r = leaf_blocks_[pos];
+            Overlap ob[kFanout];
+            test.classify(BoxLanes::of_cells(&block_cells_[leaf_first_cell_[pos]], r.end - r.first, cells_origin_, cell_mm_),
+                          r.end - r.first, ob);
+            for (std::uint32_t b = r.first; b < r.end; ++b) {
+                if (ob[b - r.first] != Overlap::outside) set_bit(bits, b);
+                if (ob[b - r.first] == Overlap::inside && inside) set_bit(*inside, b);
             }
             return;
         }
-        const std::size_t children = levels_[k - 1].size();
-        for (std::size_t c = j * kFanout; c < std::min(children, (j + 1) * kFanout); ++c)
-            self(self, k - 1, c, span / kFanout);
+        mark(bits, pos);
+        if (o == Overlap::inside && inside) mark(*inside, pos);
     };
-    std::size_t span = kFanout;
-    for (std::size_t k = 1; k < levels_.size(); ++k) span *= kFanout;
-    const std::size_t top = levels_.size() - 1;
-    for (std::size_t j = 0; j < levels_[top].size(); ++j) visit(visit, top, j, span);
+    // Node j of level k, which the region meets partly: its children tested
+    // together. It covers Morton positions [j * span[k], (j + 1) * span[k]),
+    // span[k] = 8^(k+1).
+    std::vector<std::size_t> span(boxes_.size());
+    for (std::size_t k = 0, s = kFanout; k < boxes_.size(); ++k, s *= kFanout) span[k] = s;
+    auto visit = [&](auto& self, std::size_t k, std::size_t j) -> void {
+        const std::size_t first = j * kFanout, count = std::min(kFanout, (k == 0 ? n : boxes_[k - 1].size()) - first);
+        Overlap o[kFanout];
+        test.classify(BoxLanes::of(boxes_[k][j]), count, o);
+        for (std::size_t i = 0; i < count; ++i) {
+            const std::size_t c = first + i;
+            if (o[i] == Overlap::outside) continue;
+            if (k == 0) leaf(c, o[i]);
+            else if (o[i] == Overlap::inside) mark_all(c * span[k - 1], (c + 1) * span[k - 1]);
+            else self(self, k - 1, c);
+        }
+    };
+    Overlap root = Overlap::partial;
+    test.classify(BoxLanes::of(root_), 1, &root);
+    if (root == Overlap::inside) mark_all(0, n);
+    else if (root == Overlap::partial) visit(visit, boxes_.size() - 1, 0);
 }
 
 void BlockIndex::blocks_near_sphere(Vec3f c, float radius, std::vector<std::uint64_t>& bits,
                                     std::vector<std::uint64_t>* inside) const {
-    // Squared distances with a relative slack, so float rounding never culls
-    // a block whose point passes Region::contains.
-    const float r2 = radius * radius * (1 + 1e-5f);
-    collect(
-        [&](const Aabb& b) {
-            auto d = [](float v, float lo, float hi) { return v < lo ? lo - v : (v > hi ? v - hi : 0.0f); };
-            const float dx = d(c.x, b.min.x, b.max.x), dy = d(c.y, b.min.y, b.max.y), dz = d(c.z, b.min.z, b.max.z);
-            if (dx * dx + dy * dy + dz * dz > r2) return Overlap::outside;
-            auto far = [](float v, float lo, float hi) { return std::max(v - lo, hi - v); };
-            const float fx = far(c.x, b.min.x, b.max.x), fy = far(c.y, b.min.y, b.max.y),
-                        fz = far(c.z, b.min.z, b.max.z);
-            return fx * fx + fy * fy + fz * fz <= radius * radius * (1 - 1e-5f) ? Overlap::inside : Overlap::partial;
-        },
-        bits, inside);
+    collect(detail::SphereTest(c, radius), bits, inside);
 }
 
 void BlockIndex::blocks_near_box(const Aabb& r, std::vector<std::uint64_t>& bits,
                                  std::vector<std::uint64_t>* inside) const {
-    collect(
-        [&](const Aabb& b) {
-            if (b.max.x < r.min.x || b.min.x > r.max.x || b.max.y < r.min.y || b.min.y > r.max.y ||
-                b.max.z < r.min.z || b.min.z > r.max.z)
-                return Overlap::outside;
-            const bool within = b.min.x >= r.min.x && b.max.x <= r.max.x && b.min.y >= r.min.y &&
-                                b.max.y <= r.max.y && b.min.z >= r.min.z && b.max.z <= r.max.z;
-            return within ? Overlap::inside : Overlap::partial;
-        },
-        bits, inside);
+    collect(detail::BoxTest{r}, bits, inside);
 }
 
 void BlockIndex::blocks_near_mask(const ImageMask& mask, std::vector<std::uint64_t>& bits,
                                   std::vector<std::uint64_t>* inside) const {
-    collect(
-        [&](const Aabb& b) {
-            switch (mask.classify(b)) {
-                case ImageMask::Overlap::outside: return Overlap::outside;
-                case ImageMask::Overlap::inside: return Overlap::inside;
-                case ImageMask::Overlap::partial: break;
-            }
-            return Overlap::partial;
-        },
-        bits, inside);
+    collect(detail::MaskTest{mask}, bits, inside);
 }
 
 void BlockIndex::blocks_near_frustum(const Frustum& f, float margin, std::vector<std::uint64_t>& bits) const {
-    collect(
-        [&](const Aabb& b) {
-            if (!box_intersects_frustum(f, b, margin)) return Overlap::outside;
-            // Inside when even the nearest corner is within the margin of every
-            // plane, with room for rounding between corners.
-            for (const Plane& p : f.planes) {
-                const Vec3f c{p.n.x >= 0 ? b.min.x : b.max.x, p.n.y >= 0 ? b.min.y : b.max.y,
-                              p.n.z >= 0 ? b.min.z : b.max.z};
-                if (p.n.x * c.x + p.n.y * c.y + p.n.z * c.z + p.d < -margin + 1e-3f) return Overlap::partial;
-            }
-            return Overlap::inside;
-        },
-        bits, nullptr);
+    collect(detail::FrustumTest{f, margin}, bits, nullptr);
 }
 
 }  // namespace fiblet
