@@ -116,6 +116,39 @@ TEST_F(ImageMaskTest, BoxTestsAreConservative) {
     EXPECT_EQ(mask->classify({{-big, -big, -big}, {big, big, big}}), ImageMask::Overlap::partial);
 }
 
+// contains_any takes four points at a time in vector lanes: it answers as
+// contains() of each point would, on points around the grid, on voxel
+// halves (where the rounding rule decides) and on non-finite points.
+TEST_F(ImageMaskTest, ContainsAnyIsContainsOfEachPoint) {
+    const SourceImage src = probe_mask();
+    src.write_mif(dir_.file("m.mif"));
+    const auto mask = ImageMask::read(dir_.file("m.mif"));
+    std::mt19937 rng(5);
+    auto on_a_half = [&] {  // one voxel coordinate at i + 0.5
+        std::array<double, 3> v{};
+        for (int a = 0; a < 3; ++a) v[a] = std::uniform_real_distribution<double>(-1.5, double(src.dims[a]) + 0.5)(rng);
+        const int a = int(rng() % 3);
+        v[a] = std::floor(v[a]) + 0.5;
+        const auto w = transform_point(src.voxel_to_world(), v);
+        return Vec3f{float(w[0]), float(w[1]), float(w[2])};
+    };
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    std::size_t yes = 0, no = 0;
+    for (int run = 0; run < 20000; ++run) {
+        std::vector<Vec3f> points(rng() % 13);
+        for (Vec3f& p : points) {
+            const unsigned kind = rng() % 16;
+            p = kind < 9 ? around_grid(src, rng) : kind < 15 ? on_a_half() : Vec3f{nan, inf, -inf};
+        }
+        bool any = false;
+        for (const Vec3f& p : points) any = any || mask->contains(p);
+        ASSERT_EQ(mask->contains_any(&points.data()->x, points.size()), any) << "run " << run;
+        (any ? yes : no) += 1;
+    }
+    EXPECT_GT(yes, 1000u);
+    EXPECT_GT(no, 1000u);
+}
+
 TEST_F(ImageMaskTest, EmptyMaskIsRefused) {
     SourceImage src;
     src.dims = {3, 3, 3};

@@ -46,6 +46,10 @@ public:
                inside_[i + std::size_t(size_[0]) * (j + std::size_t(size_[1]) * k)];
     }
 
+    // Whether any of n points (xyz triplets) is inside: contains(), four
+    // points at a time.
+    bool contains_any(const float* xyz, std::size_t n) const;
+
     enum class Overlap { outside, partial, inside };
     // outside: no point of `box` is inside the mask; inside: every point is;
     // partial otherwise (conservative both ways).

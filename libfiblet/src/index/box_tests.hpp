@@ -1,17 +1,17 @@
 // The region tests a BlockIndex walks its hierarchy with, each run over
 // eight boxes side by side: a node's eight children, or a leaf's eight
 // blocks, in one pass without branches instead of eight tests whose outcome
-// a branch predictor cannot guess. Lanes are GCC's portable vectors of four
-// floats (an SSE register on any x86-64, NEON on ARM: no dispatch), two per
-// side and axis. Every lane does the float operations of the one-box test
-// it replaces, in the same order (libfiblet builds with -ffp-contract=off):
-// the same answers bit for bit.
+// a branch predictor cannot guess, in core/float_lanes.hpp's vectors of
+// four floats, two per side and axis. Every lane does the float operations
+// of the one-box test it replaces, in the same order: the same answers bit
+// for bit.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 
+#include "core/float_lanes.hpp"
 #include "fiblet/block_index.hpp"
 #include "fiblet/image_mask.hpp"
 #include "fiblet/view.hpp"
@@ -23,11 +23,6 @@ enum class Overlap : std::uint8_t { outside, partial, inside };
 
 inline constexpr std::size_t kBoxLanes = kBoxGroupSize;
 inline constexpr std::size_t kHalves = kBoxLanes / 4;
-
-// Comparisons give -1 (true) or 0 a lane.
-using Floats = float __attribute__((vector_size(16)));
-using Ints = std::int32_t __attribute__((vector_size(16)));
-using Words = std::uint64_t __attribute__((vector_size(16)));
 
 // The i-th box of a group as stored, and back.
 inline void set_box(BoxGroup& g, std::size_t i, const Aabb& b) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/float_lanes.hpp"
 #include "fiblet/error.hpp"
 
 namespace fiblet {
@@ -79,6 +80,37 @@ std::shared_ptr<const ImageMask> ImageMask::read(const std::string& path) {
     return std::make_shared<const ImageMask>(read_mask_image(path));
 }
 
+bool ImageMask::contains_any(const float* p, std::size_t n) const {
+    using detail::Floats, detail::Ints;
+    std::size_t k = 0;
+    // Indices in 32-bit lanes: every grid of fewer than 2^31 voxels.
+    if (inside_.size() < (std::size_t{1} << 31))
+        for (; k + 4 <= n; k += 4, p += 12) {
+            const Floats x = {p[0], p[3], p[6], p[9]}, y = {p[1], p[4], p[7], p[10]}, z = {p[2], p[5], p[8], p[11]};
+            Ints ok = ~Ints{}, r[3];
+            for (int a = 0; a < 3; ++a) {
+                const auto& m = to_voxel_[a];
+                const Floats v = m[0] * x + m[1] * y + m[2] * z + m[3];
+                // voxel_index, lane by lane: in range (NaN is not), rounded
+                // halves away from zero, below the size. Out-of-range lanes
+                // convert 0 instead (no float beyond int32 converts).
+                const Ints in_range = (v > -1.0f) & (v < float(size_[a]) + 1.0f);
+                const Floats v_in = in_range ? v : Floats{};
+                const Ints t = __builtin_convertvector(v_in, Ints);  // toward zero
+                const Floats frac = v_in - __builtin_convertvector(t, Floats);
+                r[a] = t - (frac >= 0.5f) + (frac <= -0.5f);  // a true comparison is -1
+                ok &= in_range & (r[a] >= 0) & (r[a] < std::int32_t(size_[a]));
+            }
+            for (Ints& ra : r) ra &= ok;  // lanes outside the grid index voxel 0 (not read)
+            const Ints voxel = r[0] + std::int32_t(size_[0]) * (r[1] + std::int32_t(size_[1]) * r[2]);
+            for (int l = 0; l < 4; ++l)
+                if (ok[l] && inside_[std::size_t(voxel[l])]) return true;
+        }
+    for (; k < n; ++k, p += 3)
+        if (contains({p[0], p[1], p[2]})) return true;
+    return false;
+}
+
 std::int64_t ImageMask::occupied(const std::array<std::int64_t, 3>& lo, const std::array<std::int64_t, 3>& hi) const {
     const std::int64_t sx = size_[0] + 1, sy = size_[1] + 1;
     auto s = [&](std::int64_t i, std::int64_t j, std::int64_t k) {
@@ -99,14 +131,16 @@ ImageMask::Overlap ImageMask::classify(const Aabb& box) const {
     const std::array<double, 3> bmin{std::max(box.min.x, bounds_.min.x), std::max(box.min.y, bounds_.min.y),
                                      std::max(box.min.z, bounds_.min.z)},
         bmax{std::min(box.max.x, bounds_.max.x), std::min(box.max.y, bounds_.max.y), std::min(box.max.z, bounds_.max.z)};
-    // Voxel-space box of the world box's corners, grown by a margin that
-    // covers the float arithmetic of contains().
-    std::array<double, 3> vmin{HUGE_VAL, HUGE_VAL, HUGE_VAL}, vmax{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-    for (int corner = 0; corner < 8; ++corner) {
-        const std::array<double, 3> w{(corner & 1) ? bmax[0] : bmin[0], (corner & 2) ? bmax[1] : bmin[1],
-                                      (corner & 4) ? bmax[2] : bmin[2]};
-        const auto v = transform_point(to_voxel_exact_, w);
-        for (int a = 0; a < 3; ++a) vmin[a] = std::min(vmin[a], v[a]), vmax[a] = std::max(vmax[a], v[a]);
+    // Voxel-space box of the world box: its centre mapped, its half sides
+    // through |M| (the box of its eight corners, within double rounding),
+    // grown below by a margin that covers the float arithmetic of contains().
+    std::array<double, 3> centre{}, half{}, vmin{}, vmax{};
+    for (int a = 0; a < 3; ++a) centre[a] = 0.5 * (bmin[a] + bmax[a]), half[a] = 0.5 * (bmax[a] - bmin[a]);
+    const auto vc = transform_point(to_voxel_exact_, centre);
+    for (int a = 0; a < 3; ++a) {
+        const auto& m = to_voxel_exact_[a];
+        const double reach = std::abs(m[0]) * half[0] + std::abs(m[1]) * half[1] + std::abs(m[2]) * half[2];
+        vmin[a] = vc[a] - reach, vmax[a] = vc[a] + reach;
     }
     std::array<std::int64_t, 3> lo{}, hi{};
     bool whole_grid = !clamped;  // every point of the box rounds to a voxel of the grid

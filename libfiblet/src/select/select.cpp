@@ -131,12 +131,7 @@ bool any_point_in(const Region& r, const float* p, std::uint32_t n) {
             if (inside(p + 3 * k)) return true;
         return false;
     };
-    if (r.shape == Region::Shape::mask) {
-        const ImageMask& m = *r.mask;
-        for (std::uint32_t k = 0; k < n; ++k)
-            if (m.contains({p[3 * k], p[3 * k + 1], p[3 * k + 2]})) return true;
-        return false;
-    }
+    if (r.shape == Region::Shape::mask) return r.mask->contains_any(p, n);
     if (r.shape == Region::Shape::sphere) {
         const float cx = r.center.x, cy = r.center.y, cz = r.center.z, r2 = r.radius * r.radius;
         return scan([&](const float* q) {
