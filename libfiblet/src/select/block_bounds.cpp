@@ -3,10 +3,26 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/float_lanes.hpp"
 #include "core/points_avx2.hpp"
 #include "fiblet/image_mask.hpp"
 
 namespace fiblet::detail {
+
+void spheres_in_frustum(const Frustum& f, const Sphere* spheres, std::size_t n, std::uint8_t* out) {
+    std::size_t k = 0;
+    for (; k + 4 <= n; k += 4) {
+        const Sphere* s = spheres + k;
+        const Floats x = {s[0].center.x, s[1].center.x, s[2].center.x, s[3].center.x},
+                     y = {s[0].center.y, s[1].center.y, s[2].center.y, s[3].center.y},
+                     z = {s[0].center.z, s[1].center.z, s[2].center.z, s[3].center.z},
+                     below = -Floats{s[0].radius, s[1].radius, s[2].radius, s[3].radius};
+        Ints apart{};
+        for (const Plane& p : f.planes) apart |= p.n.x * x + p.n.y * y + p.n.z * z + p.d < below;
+        for (int l = 0; l < 4; ++l) out[k + std::size_t(l)] = apart[l] == 0;
+    }
+    for (; k < n; ++k) out[k] = sphere_intersects_frustum(f, spheres[k].center, spheres[k].radius);
+}
 
 BlockBound block_bound(const Sphere& s, const Sphere* next, float join) {
     BlockBound bound{s.center, s.center, s.radius};

@@ -35,6 +35,10 @@ BlockBound block_bound(const Sphere& s, const Sphere* next, float join);
 // when none can, so that the block need not be decoded to be tested.
 bool bound_may_meet(const Region& r, const BlockBound& c);
 
+// out[k] = sphere_intersects_frustum(f, spheres[k]) (0 or 1), k < n, four
+// spheres at a time: the same float operations in the same order.
+void spheres_in_frustum(const Frustum& f, const Sphere* spheres, std::size_t n, std::uint8_t* out);
+
 // The bounds of many blocks, as columns for the vector loops.
 class BlockBounds {
 public:

@@ -585,12 +585,16 @@ private:
         kind.assign(blocks.size(), fine);
         if (!q_.view && !pass.include_tests) return;
         spheres_of_read(need_.size());  // every header tested below, in one call (a call per block cost more)
+        if (pass.cull) {
+            in_frustum_.resize(need_.size());
+            detail::spheres_in_frustum(pass.frustum, spheres_.data(), need_.size(), in_frustum_.data());
+        }
         if (pass.include_tests) bounds_of_read(blocks.size(), false);  // exclude regions: tested on points
         for (std::size_t i = 0; i < blocks.size(); ++i) {
             const bool bound_test = pass.include_tests && pass.include_test(q_.include, blocks[i]);
             if (!q_.view && !bound_test) continue;
             const Sphere& s = spheres_[at_need_[i]];
-            if (pass.cull && !sphere_intersects_frustum(pass.frustum, s.center, s.radius)) {
+            if (pass.cull && !in_frustum_[at_need_[i]]) {
                 kind[i] = dropped;
                 continue;
             }
@@ -747,6 +751,7 @@ private:
     std::vector<std::size_t> segment_;
     std::vector<const std::uint8_t*> block_pointers_;
     std::vector<Sphere> spheres_;  // of the blocks read, in reading order
+    std::vector<std::uint8_t> in_frustum_;  // per block read: its sphere meets the view frustum
     detail::BlockBounds bounds_;    // of the candidates read (bounds_of_read)
     std::vector<std::vector<std::uint8_t>> include_meets_, exclude_meets_;  // per sphere region: bound i may meet it
     std::vector<std::uint32_t> need_;                   // blocks read (read_with_next)
