@@ -33,7 +33,8 @@ namespace fiblet {
 
 inline constexpr std::array<char, 4> kBlockIndexTag = {'B', 'I', 'D', 'X'};
 // Blocks under one leaf box of the in-memory hierarchy over a version-3 or
-// version-4 index (the leaf's blocks' boxes are tested one by one).
+// version-4 index (a leaf that meets a region partly has its blocks' own
+// boxes tested, all at once).
 inline constexpr std::uint32_t kIndexLeafBlocks = 8;
 
 // Accumulates the bounds of blocks as they are written (compress, extract)
