@@ -727,7 +727,8 @@ TEST_F(SelectIndex, ParallelPartsJoinToTheSameChunk) {
         EXPECT_EQ(whole.finish()->payload, file.find_chunk(kBlockIndexTag)->payload) << path;
     }
     // Parts of different formats do not join.
-    const FftHeader& h = FftFile(coarse).header();
+    const FftFile coarse_file(coarse);
+    const FftHeader& h = coarse_file.header();  // the file outlives it
     IndexBuilder v2(h, BlockIndexFormat::group_boxes);
     EXPECT_THROW(v2.append(IndexBuilder(h, BlockIndexFormat::block_boxes)), Error);
 }

@@ -142,7 +142,7 @@ TEST_F(ImageMaskTest, ContainsAnyIsContainsOfEachPoint) {
         }
         bool any = false;
         for (const Vec3f& p : points) any = any || mask->contains(p);
-        ASSERT_EQ(mask->contains_any(&points.data()->x, points.size()), any) << "run " << run;
+        ASSERT_EQ(mask->contains_any(reinterpret_cast<const float*>(points.data()), points.size()), any) << "run " << run;
         (any ? yes : no) += 1;
     }
     EXPECT_GT(yes, 1000u);
