@@ -41,13 +41,13 @@ std::vector<std::vector<Vec3f>> arcs() {
 
 StreamlineField uint32_field(const std::string& name, const std::vector<std::uint32_t>& v) {
     StreamlineField f{name, FieldType::uint32, 1, std::vector<std::uint8_t>(v.size() * 4)};
-    std::memcpy(f.bytes.data(), v.data(), f.bytes.size());
+    if (!v.empty()) std::memcpy(f.bytes.data(), v.data(), f.bytes.size());  // memcpy from null is undefined
     return f;
 }
 
 std::vector<std::uint32_t> uint32_values(const StreamlineField& f) {
     std::vector<std::uint32_t> v(f.bytes.size() / 4);
-    std::memcpy(v.data(), f.bytes.data(), f.bytes.size());
+    if (!v.empty()) std::memcpy(v.data(), f.bytes.data(), f.bytes.size());  // memcpy from null is undefined
     return v;
 }
 

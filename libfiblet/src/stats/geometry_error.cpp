@@ -114,40 +114,51 @@ FIBLET_AVX2 void window_avx2(const ColumnPointers& g, float px, float py, float 
     _mm256_store_ps(d, segment_dist2_avx2(g, _mm256_set1_ps(px), _mm256_set1_ps(py), _mm256_set1_ps(pz), base));
 }
 
-// The columns of segments [0, s) in one pass, eight at a time: set_segment's
+// The columns of segments s .. s + 7 from points s .. s + 8: set_segment's
 // float operations (vdivps rounds correctly, as /; the mask keeps +0, as the
 // ternary) and the lengths sqrt(uu) in double from the points' double
 // differences, as polyline_length's: the same float columns converted to
-// double (exact) and subtracted, so no shuffles of their own. Reads points
-// up to s + 8; returns s.
-__attribute__((target("avx2"))) std::size_t columns_avx2(const Vec3f* p, std::size_t points, Segments& g) {
-    float *ax = g.ax.data(), *ay = g.ay.data(), *az = g.az.data(), *ux = g.ux.data(), *uy = g.uy.data(),
-          *uz = g.uz.data(), *inv = g.inv_uu.data(), *uu_out = g.uu.data();
-    double* len = g.len.data();
-    const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
-    std::size_t s = 0;
-    __m256d max_len = _mm256_setzero_pd();  // vmaxpd returns its second operand for a NaN: left out
-    for (; s + 9 <= points; s += 8) {
-        __m256 x, y, z, nx, ny, nz;
-        detail::xyz8(p + s, x, y, z);
-        detail::xyz8(p + s + 1, nx, ny, nz);
-        const __m256 dx = _mm256_sub_ps(nx, x), dy = _mm256_sub_ps(ny, y), dz = _mm256_sub_ps(nz, z);
-        const __m256 uu = norm2_8(dx, dy, dz);
-        _mm256_storeu_ps(ax + s, x), _mm256_storeu_ps(ay + s, y), _mm256_storeu_ps(az + s, z);
-        _mm256_storeu_ps(ux + s, dx), _mm256_storeu_ps(uy + s, dy), _mm256_storeu_ps(uz + s, dz);
-        _mm256_storeu_ps(uu_out + s, uu);
-        _mm256_storeu_ps(inv + s, _mm256_and_ps(_mm256_cmp_ps(uu, zero, _CMP_GT_OQ), _mm256_div_ps(one, uu)));
-        for (int h = 0; h < 2; ++h) {
-            const __m256d l =
-                _mm256_sqrt_pd(detail::norm2(detail::double_diff(nx, x, h), detail::double_diff(ny, y, h), detail::double_diff(nz, z, h)));
-            _mm256_storeu_pd(len + s + 4 * h, l);
-            max_len = _mm256_max_pd(l, max_len);
-        }
+// double (exact) and subtracted, so no shuffles of their own.
+struct ColumnOutputs {  // plain pointers, as ColumnPointers
+    float *ax, *ay, *az, *ux, *uy, *uz, *inv_uu, *uu;
+    double* len;
+    explicit ColumnOutputs(Segments& g)
+        : ax(g.ax.data()), ay(g.ay.data()), az(g.az.data()), ux(g.ux.data()), uy(g.uy.data()), uz(g.uz.data()),
+          inv_uu(g.inv_uu.data()), uu(g.uu.data()), len(g.len.data()) {}
+};
+
+FIBLET_AVX2 void columns8(const Vec3f* p, std::size_t s, const ColumnOutputs& g, __m256d& max_len) {
+    __m256 x, y, z, nx, ny, nz;
+    detail::xyz8(p + s, x, y, z);
+    detail::xyz8(p + s + 1, nx, ny, nz);
+    const __m256 dx = _mm256_sub_ps(nx, x), dy = _mm256_sub_ps(ny, y), dz = _mm256_sub_ps(nz, z);
+    const __m256 uu = norm2_8(dx, dy, dz);
+    _mm256_storeu_ps(g.ax + s, x), _mm256_storeu_ps(g.ay + s, y), _mm256_storeu_ps(g.az + s, z);
+    _mm256_storeu_ps(g.ux + s, dx), _mm256_storeu_ps(g.uy + s, dy), _mm256_storeu_ps(g.uz + s, dz);
+    _mm256_storeu_ps(g.uu + s, uu);
+    _mm256_storeu_ps(g.inv_uu + s,
+                     _mm256_and_ps(_mm256_cmp_ps(uu, _mm256_setzero_ps(), _CMP_GT_OQ), _mm256_div_ps(_mm256_set1_ps(1.0f), uu)));
+    for (int h = 0; h < 2; ++h) {
+        const __m256d l =
+            _mm256_sqrt_pd(detail::norm2(detail::double_diff(nx, x, h), detail::double_diff(ny, y, h), detail::double_diff(nz, z, h)));
+        _mm256_storeu_pd(g.len + s + 4 * h, l);
+        max_len = _mm256_max_pd(l, max_len);  // vmaxpd returns its second operand for a NaN: left out
     }
+}
+
+// The columns of every segment of a polyline of at least 9 points, eight at
+// a time; the last eight overlap the ones before where the count is not a
+// multiple of 8 (the same values written again), so no segment is left for
+// the scalar loop.
+__attribute__((target("avx2"))) void columns_avx2(const Vec3f* p, std::size_t points, Segments& g) {
+    const ColumnOutputs out(g);
+    __m256d max_len = _mm256_setzero_pd();
+    const std::size_t n = points - 1;
+    for (std::size_t s = 0; s + 8 <= n; s += 8) columns8(p, s, out, max_len);
+    if (n % 8) columns8(p, n - 8, out, max_len);
     alignas(32) double lanes[4];
     _mm256_store_pd(lanes, max_len);
     for (const double v : lanes) g.max_len = v > g.max_len ? v : g.max_len;
-    return s;
 }
 #endif
 
@@ -160,7 +171,7 @@ void segments_of(std::span<const Vec3f> line, Segments& out) {
     std::size_t done = 0;
     out.max_len = 0;
 #ifdef FIBLET_POINTS_AVX2
-    if (use_avx2_loops()) done = columns_avx2(line.data(), points, out);
+    if (use_avx2_loops() && points >= 9) columns_avx2(line.data(), points, out), done = n;
 #endif
     for (std::size_t s = done; s < n; ++s) {
         const Vec3f a = line[s], b = line[std::min(s + 1, points - 1)];
@@ -273,37 +284,45 @@ FIBLET_AVX2 __m256 within_half_step(__m256 e4, const float* uu8) {
     return _mm256_cmp_ps(e4, _mm256_mul_ps(_mm256_set1_ps(0.98f), _mm256_loadu_ps(uu8)), _CMP_LT_OQ);
 }
 
-// own_segments_at for points [k0, k1) (4 <= k0, k1 <= n), eight at a time,
-// the points read from both polylines' columns: the same distances bit for
-// bit, the same proof.
-__attribute__((target("avx2"))) void own_segments_avx2(const Segments& to_g, const Segments& from_g,
-                                                       std::span<const Vec3f> from, std::span<const Vec3f> to,
-                                                       std::size_t k0, std::size_t k1, float* nearest,
+// own_segments_at for points k .. k + 7 (4 <= k, k + 8 <= n), the points
+// read from both polylines' columns: the same distances bit for bit, the
+// same proof.
+FIBLET_AVX2 void own_segments8(const ColumnPointers& g, const ColumnPointers& p, const float* const forward[3],
+                               std::size_t k, float* nearest, double* pointwise, std::uint8_t* proven,
+                               std::uint8_t* later_out) {
+    const __m256 x = _mm256_loadu_ps(p.ax + k), y = _mm256_loadu_ps(p.ay + k), z = _mm256_loadu_ps(p.az + k);
+    const __m256 e2 = norm2_8(_mm256_sub_ps(x, _mm256_loadu_ps(g.ax + k)), _mm256_sub_ps(y, _mm256_loadu_ps(g.ay + k)),
+                              _mm256_sub_ps(z, _mm256_loadu_ps(g.az + k)));
+    const __m256 e4 = _mm256_mul_ps(_mm256_set1_ps(4.0f), e2);
+    if (pointwise) exact_squares(x, y, z, g.ax + k, g.ay + k, g.az + k, pointwise + k);
+    const __m256 before = segment_dist2_avx2(g, x, y, z, k - 1), after = segment_dist2_avx2(g, x, y, z, k);
+    const __m256 later = _mm256_cmp_ps(after, before, _CMP_LT_OQ);
+    _mm256_storeu_ps(nearest + k, _mm256_blendv_ps(before, after, later));  // after < before ? after : before
+    // Segments k + 1 .. k + 3 not against k, and k - 4 .. k - 2 not against k - 1.
+    const float *f0 = forward[0], *f1 = forward[1], *f2 = forward[2];
+    const __m256 ahead =
+        _mm256_and_ps(_mm256_and_ps(_mm256_loadu_ps(f0 + k), _mm256_loadu_ps(f1 + k)), _mm256_loadu_ps(f2 + k));
+    const __m256 behind = _mm256_and_ps(_mm256_and_ps(_mm256_loadu_ps(f0 + k - 2), _mm256_loadu_ps(f1 + k - 3)),
+                                        _mm256_loadu_ps(f2 + k - 4));
+    const __m256 ok = _mm256_and_ps(_mm256_and_ps(within_half_step(e4, g.uu + k - 1), within_half_step(e4, g.uu + k)),
+                                    _mm256_and_ps(ahead, behind));
+    store_mask_bytes(ok, proven + k);
+    store_mask_bytes(later, later_out + k);
+}
+
+// own_segments_at for points [4, n) of a pair of at least 12 points, eight
+// at a time; the last eight overlap the ones before where the count is not
+// a multiple of 8 (the same values stored again), so no point is left for
+// own_segments_at.
+__attribute__((target("avx2"))) void own_segments_avx2(const Segments& to_g, const Segments& from_g, float* nearest,
                                                        double* pointwise, OwnSegments& out) {
     const ColumnPointers g(to_g), p(from_g);
-    const float *f0 = out.forward[0].data(), *f1 = out.forward[1].data(), *f2 = out.forward[2].data();
-    std::uint8_t *proven = out.proven.data(), *later_out = out.later.data();
-    std::size_t k = k0;
-    for (; k + 8 <= k1; k += 8) {
-        const __m256 x = _mm256_loadu_ps(p.ax + k), y = _mm256_loadu_ps(p.ay + k), z = _mm256_loadu_ps(p.az + k);
-        const __m256 e2 = norm2_8(_mm256_sub_ps(x, _mm256_loadu_ps(g.ax + k)), _mm256_sub_ps(y, _mm256_loadu_ps(g.ay + k)),
-                                  _mm256_sub_ps(z, _mm256_loadu_ps(g.az + k)));
-        const __m256 e4 = _mm256_mul_ps(_mm256_set1_ps(4.0f), e2);
-        if (pointwise) exact_squares(x, y, z, g.ax + k, g.ay + k, g.az + k, pointwise + k);
-        const __m256 before = segment_dist2_avx2(g, x, y, z, k - 1), after = segment_dist2_avx2(g, x, y, z, k);
-        const __m256 later = _mm256_cmp_ps(after, before, _CMP_LT_OQ);
-        _mm256_storeu_ps(nearest + k, _mm256_blendv_ps(before, after, later));  // after < before ? after : before
-        // Segments k + 1 .. k + 3 not against k, and k - 4 .. k - 2 not against k - 1.
-        const __m256 ahead =
-            _mm256_and_ps(_mm256_and_ps(_mm256_loadu_ps(f0 + k), _mm256_loadu_ps(f1 + k)), _mm256_loadu_ps(f2 + k));
-        const __m256 behind = _mm256_and_ps(_mm256_and_ps(_mm256_loadu_ps(f0 + k - 2), _mm256_loadu_ps(f1 + k - 3)),
-                                            _mm256_loadu_ps(f2 + k - 4));
-        const __m256 ok = _mm256_and_ps(_mm256_and_ps(within_half_step(e4, g.uu + k - 1), within_half_step(e4, g.uu + k)),
-                                        _mm256_and_ps(ahead, behind));
-        store_mask_bytes(ok, proven + k);
-        store_mask_bytes(later, later_out + k);
-    }
-    for (; k < k1; ++k) own_segments_at(to_g, from, to, k, nearest, pointwise, out);
+    const float* const forward[3] = {out.forward[0].data(), out.forward[1].data(), out.forward[2].data()};
+    std::uint8_t *proven = out.proven.data(), *later = out.later.data();
+    const std::size_t n = to_g.count;
+    std::size_t k = 4;
+    for (; k + 8 <= n; k += 8) own_segments8(g, p, forward, k, nearest, pointwise, proven, later);
+    if (k < n) own_segments8(g, p, forward, n - 8, nearest, pointwise, proven, later);
 }
 #undef FIBLET_AVX2
 #endif
@@ -317,10 +336,10 @@ void own_segments(const Segments& g, const Segments& from_g, std::span<const Vec
     std::size_t k = 0;
 #ifdef FIBLET_POINTS_AVX2
     // The vector loop reads segments k - 4 .. k + 7 and lengths to k + 7.
-    if (use_avx2_loops() && n > 8) {
+    if (use_avx2_loops() && n >= 12) {
         forward_avx2(g, out);
         for (; k < 4; ++k) own_segments_at(g, from, to, k, nearest, pointwise, out);
-        own_segments_avx2(g, from_g, from, to, 4, n, nearest, pointwise, out);
+        own_segments_avx2(g, from_g, nearest, pointwise, out);
         k = n;
     }
 #endif
