@@ -6,8 +6,10 @@
 # Makes the medium tractogram if missing (shared/data/make-tractograms.sh).
 #   scripts/bench_front.sh [TCK] [time_error_front.py options: --rounds N --max-effort E --baseline OLD_FIBLET]
 # Peers (built out of tree, never part of fiblet; skipped with a note when unset):
-#   FIBLET_OFFICIAL_ENCODER  the official Fiblets encoder (ENC IN.tck OUT.fft)
-#   FIBLET_QFIB              QFib's qfib program
+#   FIBLET_OFFICIAL_ENCODER  the official Fiblets encoder (ENC IN.tck OUT.fft): github.com/j-schertzer/Fiblets
+#                            at 33cf90d, a main() calling its qfib/saveload.hpp loadTckAndSaveFft(IN, OUT, 60),
+#                            built with `g++ -O3 -std=c++17 -Iqfib -Ilib/glm` (its own headers, nothing else)
+#   FIBLET_QFIB              QFib's qfib program: github.com/syrousseau/qfib, its CMake Release build
 # Environment: scripts/bench_env.sh.
 set -euo pipefail
 source "$(dirname "$0")/bench_env.sh"
