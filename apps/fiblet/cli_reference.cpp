@@ -1,5 +1,8 @@
 #include "cli_reference.hpp"
 
+#include <set>
+#include <string>
+
 namespace fiblet::cli {
 
 std::vector<CLI::App*> subcommands(CLI::App& app) {
@@ -41,8 +44,8 @@ std::string usage_line(const CLI::App* cmd) {
     return u;
 }
 
-const std::vector<CliExample>& cli_examples() {
-    static const std::vector<CliExample> examples = {
+std::vector<CliExample> cli_examples(CLI::App& app) {
+    static const CliExample all[] = {
         {"Compress a tractogram (the official .fft layout; the report names the error)",
          "fiblet compress tracks.tck -o tracks.fft"},
         {"Compress a cohort's tree into another, in parallel, as the seekable zstd container",
@@ -57,6 +60,19 @@ const std::vector<CliExample>& cli_examples() {
         {"Draw it as ray-cast tubes to a PNG, without a window", "fiblet render tracks.fft --style tubes -o tracks.png"},
         {"Explore it in a window, with the FOD glyphs of a slice", "fiblet view tracks.fft --odf fod.mif --odf-slice z:40"},
     };
+    std::set<std::string> built;
+    for (const CLI::App* cmd : subcommands(app)) built.insert(cmd->get_name());
+    // Every word after "fiblet " must be a command of this build.
+    auto runs_here = [&](const std::string& command) {
+        for (std::size_t at = 0; (at = command.find("fiblet ", at)) != std::string::npos; at += 7) {
+            const std::size_t from = at + 7;
+            if (!built.count(command.substr(from, command.find(' ', from) - from))) return false;
+        }
+        return true;
+    };
+    std::vector<CliExample> examples;
+    for (const CliExample& e : all)
+        if (runs_here(e.command)) examples.push_back(e);
     return examples;
 }
 

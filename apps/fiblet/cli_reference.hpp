@@ -24,7 +24,8 @@ struct CliExample {
     const char* what;
     const char* command;
 };
-const std::vector<CliExample>& cli_examples();
+// Those whose commands this build has (render and view need the viewer).
+std::vector<CliExample> cli_examples(CLI::App& app);
 
 std::string markdown_reference(CLI::App& app);
 std::string man_page(CLI::App& app);

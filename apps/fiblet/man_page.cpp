@@ -46,7 +46,7 @@ std::string man_page(CLI::App& app) {
     m += ".SH EXIT STATUS\n";
     for (const ExitCodeInfo& e : exit_code_table()) m += fmt::format(".TP\n.B {}\n{}\n", e.code, roff(e.meaning));
     m += ".SH EXAMPLES\n";
-    for (const CliExample& e : cli_examples()) m += ".PP\n" + roff(e.what) + ":\n.RS\n.B " + roff(e.command) + "\n.RE\n";
+    for (const CliExample& e : cli_examples(app)) m += ".PP\n" + roff(e.what) + ":\n.RS\n.B " + roff(e.command) + "\n.RE\n";
     m += ".SH SEE ALSO\n.BR tckinfo (1),\n.BR tckedit (1),\n.BR zstd (1)\n";
     return m;
 }

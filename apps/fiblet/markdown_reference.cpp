@@ -43,7 +43,7 @@ std::string markdown_reference(CLI::App& app) {
         }
     }
     md += "\n## Examples\n\n";
-    for (const CliExample& e : cli_examples()) md += fmt::format("{}:\n\n```\n{}\n```\n\n", e.what, e.command);
+    for (const CliExample& e : cli_examples(app)) md += fmt::format("{}:\n\n```\n{}\n```\n\n", e.what, e.command);
     md += "## Exit codes\n\n| code | meaning |\n|---|---|\n";
     for (const ExitCodeInfo& e : exit_code_table()) md += fmt::format("| {} | {} |\n", e.code, e.meaning);
     return md;
