@@ -34,9 +34,8 @@ inline CommandResult run_cli(const std::string& args, const std::string& env = "
 }
 
 // Starts `fiblet args...` with its output discarded; returns its pid (the
-// caller waits for it). The child's peak RSS (wait4) includes what the test
-// process had resident when it forked: memory tests measure it from a fresh
-// process (CTest runs each test in its own).
+// caller waits for it). Its peak RSS (wait4) would include what the test
+// process had resident when it forked: memory bounds use run_cli_peak.
 inline pid_t spawn_cli(const std::vector<std::string>& args) {
     const pid_t pid = ::fork();
     if (pid == 0) {
@@ -49,6 +48,29 @@ inline pid_t spawn_cli(const std::vector<std::string>& args) {
         ::_exit(127);
     }
     return pid;
+}
+
+// `fiblet args...` with its output discarded: its exit status (as
+// CommandResult's) and its peak RSS in MB, measured by fiblet_peak_rss
+// (tests/tools/peak_rss.cpp), whatever this process holds.
+struct PeakRun {
+    int status = -1;
+    double peak_mb = 0;
+};
+inline PeakRun run_cli_peak(const std::vector<std::string>& args) {
+    auto quoted = [](const std::string& s) {
+        std::string q = "'";
+        for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+        return q + "'";
+    };
+    std::string cmd = quoted(FIBLET_PEAK_RSS) + " " + quoted(FIBLET_CLI);
+    for (const std::string& a : args) cmd += " " + quoted(a);
+    const CommandResult r = run_command(cmd);
+    PeakRun out;
+    long kb = 0;
+    if (r.status != 0 || std::sscanf(r.output.c_str(), "%d %ld", &out.status, &kb) != 2) return PeakRun{};
+    out.peak_mb = double(kb) / 1024.0;
+    return out;
 }
 
 }  // namespace fiblet::test

@@ -1,12 +1,10 @@
 // Bounded memory, CI-sized (scripts/bench_memory.sh runs the >= 5 GB case):
-// the CLI's peak RSS (wait4) on a ~200 MB tractogram stays under 256 MB and
+// the CLI's peak RSS (test::run_cli_peak) on a ~200 MB tractogram stays under 256 MB and
 // grows from a ~40 MB one by no more than the per-fiber tables (12 bytes
 // per fiber) and one decode chunk, i.e. it does not grow with the size of
 // the data; and encoding threads do not multiply it.
 #include <fcntl.h>
 #include <gtest/gtest.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -32,12 +30,8 @@ constexpr double kBoundMb = 256;
 
 // Runs the CLI; returns its peak RSS in MB, or -1 if it did not exit with 0.
 double peak_rss_mb(const std::vector<std::string>& args) {
-    const pid_t pid = test::spawn_cli(args);
-    int status = 0;
-    rusage usage{};
-    ::wait4(pid, &status, 0, &usage);
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) return -1;
-    return double(usage.ru_maxrss) / 1024.0;  // kB on Linux
+    const test::PeakRun r = test::run_cli_peak(args);
+    return r.status == 0 ? r.peak_mb : -1;
 }
 
 // Smooth random walks at a fixed 0.1 mm step, 40..119 points each, until

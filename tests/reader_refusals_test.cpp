@@ -7,7 +7,6 @@
 // with no output left.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -188,11 +187,8 @@ TEST(ReaderRefusals, TrxCountsAreIntegersInRangeBeforeAnyCast) {
 
 // The CLI's exit status and peak RSS (MB) for `args`.
 std::pair<int, double> status_and_peak_rss_mb(const std::vector<std::string>& args) {
-    const pid_t pid = test::spawn_cli(args);
-    int status = 0;
-    rusage usage{};
-    ::wait4(pid, &status, 0, &usage);
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, double(usage.ru_maxrss) / 1024.0};
+    const test::PeakRun r = test::run_cli_peak(args);
+    return {r.status, r.peak_mb};
 }
 
 // Small files that claimed gigabytes were given them: memory follows what the

@@ -322,13 +322,9 @@ TEST(TrailerIntegrity, ClaimedSizesAreNotAllocatedBeforeTheyAreReal) {
     put_u64(b, header_at + 1, claimed_fibers);
     const std::string path = fx.write("claims.fftz", b);
     EXPECT_EQ(open_error(path), Errc::checksum);
-    const pid_t pid = test::spawn_cli({"verify", path});
-    int status = 0;
-    rusage usage{};
-    ::wait4(pid, &status, 0, &usage);
-    ASSERT_TRUE(WIFEXITED(status));
-    EXPECT_EQ(WEXITSTATUS(status), 7);
-    if (!kSanitized) EXPECT_LT(double(usage.ru_maxrss) / 1024.0, 64.0) << "MB peak for a file of a few kB";
+    const test::PeakRun run = test::run_cli_peak({"verify", path});
+    EXPECT_EQ(run.status, 7);
+    if (!kSanitized) EXPECT_LT(run.peak_mb, 64.0) << "MB peak for a file of a few kB";
 }
 
 // A valid .fftz of 2^21 empty fibers (a few kB): opening and verifying it
@@ -349,13 +345,9 @@ TEST(TrailerIntegrity, ManyEmptyFibersCostTheirTablesOnly) {
     compress_file(tck, fftz, o);
     ASSERT_LT(std::filesystem::file_size(fftz), 64u << 10);
     for (const char* command : {"info", "verify"}) {
-        const pid_t pid = test::spawn_cli({command, fftz});
-        int status = 0;
-        rusage usage{};
-        ::wait4(pid, &status, 0, &usage);
-        ASSERT_TRUE(WIFEXITED(status));
-        EXPECT_EQ(WEXITSTATUS(status), 0) << command;
-        const double mb = double(usage.ru_maxrss) / 1024.0, tables_mb = 12.0 * double(kFibers) / (1 << 20);
+        const test::PeakRun run = test::run_cli_peak({command, fftz});
+        EXPECT_EQ(run.status, 0) << command;
+        const double mb = run.peak_mb, tables_mb = 12.0 * double(kFibers) / (1 << 20);
         if (!kSanitized) EXPECT_LT(mb, tables_mb + 6.0 * double(kFibers) / (1 << 20) + 16) << command;
     }
 }
