@@ -60,7 +60,12 @@ def main():
     p.add_argument("--fiblet", required=True)
     p.add_argument("--tck", required=True)
     p.add_argument("--update", action="store_true", help="write the measured counts as the new budget")
+    p.add_argument("--sanitized", action="store_true",
+                   help="the binary is an AddressSanitizer build: skip (exit 77), valgrind cannot run it")
     args = p.parse_args()
+    if args.sanitized:
+        print("skipped: an AddressSanitizer build (valgrind cannot run it, and its counts are not compress's)")
+        sys.exit(77)
     with tempfile.TemporaryDirectory(prefix="fiblet-budget-") as work:
         tck = os.path.join(work, "in.tck")
         first_fibers(args.tck, FIBERS, tck)

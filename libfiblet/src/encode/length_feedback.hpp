@@ -87,7 +87,8 @@ __attribute__((target("avx2"))) inline __m256i squares_order() { return _mm256_s
 // lanes' order); returns where it stopped, *worst the maximum so far.
 __attribute__((target("avx2"))) inline std::size_t max_distance2_avx2(const Vec3f* a, const Vec3f* b, std::size_t m,
                                                                    float* worst) {
-    const float *fa = &a->x, *fb = &b->x;
+    // Cast, not &a->x: a is null for no points.
+    const auto *fa = reinterpret_cast<const float*>(a), *fb = reinterpret_cast<const float*>(b);
     __m256 w = _mm256_setzero_ps();
     std::size_t k = 0;
     for (; k + 8 <= m; k += 8) w = _mm256_max_ps(w, squares8(fa + 3 * k, fb + 3 * k));
