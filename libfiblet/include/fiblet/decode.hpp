@@ -141,8 +141,9 @@ struct DecodeOptions {
     unsigned threads = 0;                 // 0 = all cores; order of the output never depends on it
     // decode_file only: call the sink on a thread of its own, in order, while
     // the next chunk is read and decoded (a pipeline: read -> decode -> sink,
-    // e.g. format and write a .tck). The sink must then not need the
-    // caller's thread; its exceptions still reach the caller.
+    // e.g. format and write a .tck), which counts among `threads` (threads -
+    // 1 decode, at least one). The sink must then not need the caller's
+    // thread; its exceptions still reach the caller.
     bool overlap_sink = false;
 };
 

@@ -263,7 +263,12 @@ private:
 
 void decode_file(const FftFile& file, const std::function<void(std::uint64_t, const Streamlines&)>& sink,
                  const DecodeOptions& options) {
-    ChunkDecoder chunks(file, options);
+    // The sink's thread is one of the threads asked for: writing a .tck is
+    // the kernel's page copies, as long as decoding on a core of its own,
+    // and a second decoder beside them only took the sink's core away.
+    DecodeOptions decoding = options;
+    if (options.overlap_sink) decoding.threads = std::max(1u, detail::resolve_threads(options.threads) - 1);
+    ChunkDecoder chunks(file, decoding);
     const std::uint64_t fibers = file.header().fibers;
     // Two chunks: one decoded while the sink (on its own thread, with
     // overlap_sink) has the other.
