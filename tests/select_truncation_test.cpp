@@ -32,18 +32,10 @@ namespace fs = std::filesystem;
 // default (a report, then exit 1), so a fault outside fiblet's copies would
 // end in ASan's report, not in the disposition these tests check; this
 // binary leaves SIGBUS to the process, as a program without ASan has it.
-#if defined(__SANITIZE_ADDRESS__)
-#define FIBLET_TEST_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define FIBLET_TEST_ASAN 1
-#endif
-#endif
-#ifdef FIBLET_TEST_ASAN
+// Only ASan's runtime calls this; other builds never do.
 extern "C" __attribute__((used, visibility("default"))) const char* __asan_default_options() {
     return "handle_sigbus=0";
 }
-#endif
 
 namespace {
 
