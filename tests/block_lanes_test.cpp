@@ -52,12 +52,20 @@ struct Result {
     std::vector<Vec3f> decoded;
 };
 
-// Which search: greedy aiming or the lookahead of depth 1 or 2.
-enum class Search { greedy, lookahead, lookahead2 };
-const char* name_of(Search s) {
-    return s == Search::greedy ? "greedy" : s == Search::lookahead ? "lookahead" : "lookahead depth 2";
+// Which search: greedy aiming (depth 0) or the lookahead of depth 1 or 2
+// with the aim's rival or four (the first search: 1 and the aim's; the
+// length tails: 2 and the aim's; the retry: 2 and four).
+struct Search {
+    std::size_t depth = 0;
+    detail::LookaheadRivals rivals = detail::LookaheadRivals::aim;
+    bool greedy() const { return depth == 0; }
+};
+constexpr Search kSearches[] = {{0}, {1}, {2}, {1, detail::LookaheadRivals::four}, {2, detail::LookaheadRivals::four}};
+std::string name_of(Search s) {
+    if (s.greedy()) return "greedy";
+    return "lookahead depth " + std::to_string(s.depth) +
+           (s.rivals == detail::LookaheadRivals::aim ? ", the aim's rival" : ", four rivals");
 }
-std::size_t depth_of(Search s) { return s == Search::lookahead2 ? 2 : 1; }
 
 Result run_level(const detail::Codebook8& cb, float step, const Blocks& in, SimdLevel level, Search search) {
     Result r;
@@ -66,8 +74,8 @@ Result run_level(const detail::Codebook8& cb, float step, const Blocks& in, Simd
     r.decoded.assign(in.points.size(), Vec3f{-7, -7, -7});
     const detail::GreedyBatch batch{in.frames.data(), in.points.data(), in.points.data() + 1, r.decoded.data() + 1,
                                     in.stride, r.codes.data(), code_stride, in.count(), in.m, in.last_m()};
-    if (search == Search::greedy) detail::greedy_blocks(cb, step, batch, level);
-    else detail::lookahead_blocks(cb, step, depth_of(search), batch, level);
+    if (search.greedy()) detail::greedy_blocks(cb, step, batch, level);
+    else detail::lookahead_blocks(cb, step, search.depth, search.rivals, batch, level);
     return r;
 }
 
@@ -80,11 +88,11 @@ Result run_reference(const detail::Codebook8& cb, float step, const Blocks& in, 
     for (std::size_t j = 0; j < in.count(); ++j) {
         const std::size_t at = j * in.stride;
         const std::span<const Vec3f> targets(&in.points[at + 1], j + 1 == in.count() ? in.last_m() : in.m);
-        if (search == Search::greedy)
+        if (search.greedy())
             detail::search_codes(cb, detail::SearchParams{1, 1}, in.frames[j], in.points[at], step, targets,
                                  &r.codes[j * code_stride], &r.decoded[at + 1]);
         else
-            detail::LookaheadSearch<detail::Codebook8>(cb, step, depth_of(search))
+            detail::LookaheadSearch<detail::Codebook8>(cb, step, search.depth, search.rivals)
                 .run(in.frames[j], in.points[at], targets, &r.codes[j * code_stride], &r.decoded[at + 1]);
     }
     return r;
@@ -112,7 +120,7 @@ void expect_same_at_every_level(const detail::Codebook8& cb, float step, const B
 
 // Every search.
 void expect_same_at_every_level(const detail::Codebook8& cb, float step, const Blocks& in, const std::string& what) {
-    for (Search search : {Search::greedy, Search::lookahead, Search::lookahead2})
+    for (Search search : kSearches)
         expect_same_at_every_level(cb, step, in, what, search);
 }
 

@@ -113,6 +113,36 @@ TEST(NearestCodeLut, PicksACodeWithinTwoCellsOfTheNearest) {
     }
 }
 
+TEST(NearestCodeLut, RivalIsTheGridNeighbourNearestTheAim) {
+    std::mt19937 rng(6);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (float ratio : {0.01f, 0.0968f, 0.5f, 0.95f}) {
+        const DirectionTable t(ratio);
+        const detail::NearestCodeLut lut(t);
+        const double cap = std::acos(1.0 - ratio);
+        const double slack = 2 * std::sqrt(2.0) * std::tan(cap) / detail::NearestCodeLut::kGrid + 1e-6;
+        for (int i = 0; i < 20000; ++i) {
+            const double polar = cap * std::sqrt(std::fabs(u(rng))), az = M_PI * u(rng);
+            const Vec3f d{float(std::cos(polar)), float(std::sin(polar) * std::cos(az)), float(std::sin(polar) * std::sin(az))};
+            const auto a = lut.aim(d);
+            ASSERT_EQ(a.code, lut(d));
+            const int h = a.code >> 4, l = a.code & 15, rh = a.rival >> 4, rl = a.rival & 15;
+            ASSERT_EQ(std::abs(rh - h) + std::abs(rl - l), 1) << int(a.code) << " " << int(a.rival);
+            // Nearest in angle among the code's one-level neighbours, but for
+            // directions within a cell of a tie.
+            double nearest = INFINITY;
+            for (const auto& [dh, dl] : {std::pair{-1, 0}, {0, -1}, {0, 1}, {1, 0}})
+                if (h + dh >= 0 && h + dh < 16 && l + dl >= 0 && l + dl < 16)
+                    nearest = std::min(nearest, angle(t.direction(std::uint8_t((h + dh) << 4 | (l + dl))), d));
+            EXPECT_LE(angle(t.direction(a.rival), d), nearest + slack) << "ratio " << ratio;
+            // Without the table (caps of a half sphere): the nearest, to the
+            // resolution of a float dot product (~1e-7 / angle: 1e-5 rad at
+            // the smallest cap's 0.01 rad).
+            EXPECT_NEAR(angle(t.direction(lut.rival(a.code, d)), d), nearest, 2e-5);
+        }
+    }
+}
+
 TEST(NearestCodeLut, NotUsedForCapsReachingTheHalfSphere) {
     EXPECT_FALSE(detail::NearestCodeLut(DirectionTable(1.0f)).usable());
     EXPECT_FALSE(detail::NearestCodeLut(DirectionTable(1.7f)).usable());
@@ -194,10 +224,10 @@ namespace {
 // The lookahead rule written plainly (no branch and bound, no kept
 // continuation): the aimed code and its four nearest codes are followed by
 // `depth` greedy steps to the block's end at most, each scored by the sum of
-// its squared errors; the aimed code stands unless a code tried after it,
+// its squared errors; the aimed code stands unless a rival tried after it,
 // cheapest own error first, has a smaller sum.
 std::vector<std::uint8_t> brute_force_lookahead(const detail::Codebook8& cb, Frame f, Vec3f p, float step,
-                                                const std::vector<Vec3f>& t, std::size_t depth) {
+                                                const std::vector<Vec3f>& t, std::size_t depth, bool four) {
     using namespace detail;
     auto error2 = [&](Vec3f local, unsigned c) {
         return std::max(0.0f, dot(local, local) + step * step - 2.0f * step * dot(cb.direction(c), local));
@@ -219,12 +249,14 @@ std::vector<std::uint8_t> brute_force_lookahead(const detail::Codebook8& cb, Fra
             }
             return e;
         };
-        // The rivals: the codes one level up or down on one grid axis.
+        // The rivals: the codes one level up or down on one grid axis (four),
+        // or of those the one nearest the aim, as the lookup table gives it
+        // (NearestCodeLut.RivalIsTheGridNeighbourNearestTheAim).
         std::vector<std::pair<float, unsigned>> rivals;  // (own error, code), in grid order
         const int h0 = int(aimed) / 16, l0 = int(aimed) % 16;
         for (int h = std::max(h0 - 1, 0); h <= std::min(h0 + 1, 15); ++h)
             for (int l = std::max(l0 - 1, 0); l <= std::min(l0 + 1, 15); ++l)
-                if (std::abs(h - h0) + std::abs(l - l0) == 1)
+                if (std::abs(h - h0) + std::abs(l - l0) == 1 && (four || unsigned(h * 16 + l) == cb.aim(local).rival))
                     rivals.emplace_back(error2(local, unsigned(h * 16 + l)), unsigned(h * 16 + l));
         std::stable_sort(rivals.begin(), rivals.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
         unsigned code = aimed;
@@ -249,8 +281,11 @@ TEST(CodeSearch, LookaheadChoosesWhatThePlainRuleChooses) {
     const detail::NearestCodeLut lut(table);
     const detail::Codebook8 cb{table, lut};
     std::size_t points = 0, differ_from_greedy = 0;
-    for (std::size_t depth : {1u, 2u, 4u}) {
-        detail::LookaheadSearch<detail::Codebook8> search(cb, h.step, depth);
+    for (const auto& [depth, rivals] : {std::pair{1u, LookaheadRivals::aim}, {2u, LookaheadRivals::aim},
+                                        {4u, LookaheadRivals::aim}, {1u, LookaheadRivals::four},
+                                        {2u, LookaheadRivals::four}, {4u, LookaheadRivals::four}}) {
+        const bool four = rivals == LookaheadRivals::four;
+        detail::LookaheadSearch<detail::Codebook8> search(cb, h.step, depth, rivals);
         for (const auto& f : walks(20, 58, 4 + unsigned(depth))) {
             std::vector<Vec3f> t(f.size());
             for (std::size_t k = 0; k < f.size(); ++k) t[k] = {f[k].x / h.scaling + 0.5f, f[k].y / h.scaling + 0.5f, f[k].z / h.scaling + 0.5f};
@@ -259,7 +294,8 @@ TEST(CodeSearch, LookaheadChoosesWhatThePlainRuleChooses) {
             std::vector<std::uint8_t> codes(targets.size()), greedy(targets.size());
             std::vector<Vec3f> decoded(targets.size());
             search.run(f0, t[1], targets, codes.data(), decoded.data());
-            EXPECT_EQ(codes, brute_force_lookahead(cb, f0, t[1], h.step, targets, depth)) << "depth " << depth;
+            EXPECT_EQ(codes, brute_force_lookahead(cb, f0, t[1], h.step, targets, depth, four))
+                << "depth " << depth << (four ? ", four rivals" : ", the aim's rival");
             detail::search_codes(cb, {1, 1}, f0, t[1], h.step, targets, greedy.data(), decoded.data());
             for (std::size_t k = 0; k < codes.size(); ++k) differ_from_greedy += codes[k] != greedy[k];
             points += codes.size();

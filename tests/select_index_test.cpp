@@ -15,6 +15,8 @@
 #include "fiblet/checksum.hpp"
 #include "fiblet/compress.hpp"
 #include "fiblet/error.hpp"
+#include "fiblet/fft_subset.hpp"
+#include "fiblet/select.hpp"
 #include "cli_runner.hpp"
 #include "select_reference.hpp"
 #include "test_util.hpp"
@@ -222,9 +224,12 @@ TEST_F(SelectIndex, VersionTwoIndexesAreStillRead) {
 TEST_F(SelectIndex, VersionThreeIndexesAreStillRead) {
     const FftFile file(v3_file());
     const BlockIndex index = expect_stored_index_sound(file, 3);
-    // Its boxes are those version 4 stores for the same blocks: both
-    // quantize each block's bounds on the same grid.
-    const FftFile v4(dwi_file());
+    // Its boxes are those version 4 stores for the same blocks (its own,
+    // copied with a fresh index: every fiber one run): both quantize each
+    // block's bounds on the same grid.
+    const std::string copy = work_file("v3-reindexed.fft");
+    write_fft_subset(file, select_runs(file, index, Query{}), copy, true, BlockIndexFormat::block_boxes);
+    const FftFile v4(copy);
     const BlockIndex fine = BlockIndex::load(v4);
     ASSERT_EQ(fine.chunk_version(), 4u);
     ASSERT_EQ(v4.read_blocks(0, v4.header().blocks), file.read_blocks(0, file.header().blocks));

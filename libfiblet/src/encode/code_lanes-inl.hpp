@@ -155,14 +155,14 @@ struct CodeLanes {
     const float* code_frames;
     NearestCodeLut::Gnomonic g;
     VF zero, one, rim_tan, rim_tan2, cell_scale, last_cell, int_range;
-    VI zero_code, back_code, last_word, byte;
+    VI zero_word, back_word, low16, byte;
 
     explicit CodeLanes(const Codebook8& cb)
         : code_frames(&cb.table.frame(0).c[0].x), g(cb.lut.gnomonic()), zero(hn::Zero(d)), one(hn::Set(d, 1.0f)),
           rim_tan(hn::Set(d, g.rim_tan)), rim_tan2(hn::Set(d, g.rim_tan2)), cell_scale(hn::Set(d, g.cell_scale)),
           last_cell(hn::Set(d, float(NearestCodeLut::kGrid - 1))), int_range(hn::Set(d, 2147483648.0f)),
-          zero_code(hn::Set(di, g.zero_code)), back_code(hn::Set(di, g.back_code)),
-          last_word(hn::Set(di, NearestCodeLut::kGrid * NearestCodeLut::kGrid - 4)), byte(hn::Set(di, 0xff)) {}
+          zero_word(hn::Set(di, g.zero_word)), back_word(hn::Set(di, g.back_word)), low16(hn::Set(di, 0xffff)),
+          byte(hn::Set(di, 0xff)) {}
 
     // apply_transposed(f, v): dot(c_j, v) = (c_j.x v.x + c_j.y v.y) + c_j.z v.z.
     static void local(const VF* f, VF vx, VF vy, VF vz, VF& x, VF& y, VF& z) {
@@ -184,9 +184,9 @@ struct CodeLanes {
         return out;
     }
 
-    // NearestCodeLut::operator()(local): both the cap's and the rim's
-    // (u, v), then per lane the one it takes.
-    VI nearest(VF x, VF y, VF z) const {
+    // NearestCodeLut::aim(local) as its cell's word, code | rival << 8:
+    // both the cap's and the rim's (u, v), then per lane the one it takes.
+    VI aim(VF x, VF y, VF z) const {
         const VF lateral2 = hn::Add(hn::Mul(y, y), hn::Mul(z, z));
         const auto in_cap = hn::And(hn::Gt(x, zero), hn::Le(lateral2, hn::Mul(rim_tan2, hn::Mul(x, x))));
         const VF inv = hn::Div(one, x);
@@ -199,16 +199,20 @@ struct CodeLanes {
             v = hn::IfThenElse(in_cap, v, hn::Mul(z, s));
         }
         const VI index = hn::Add(hn::ShiftLeft<8>(cell(u)), cell(v));
-        // The cell's byte: a 32-bit gather at its offset, moved back from
-        // the table's last 3 bytes so that it never reads past the end.
-        const VI word_at = hn::Min(index, last_word);
-        const VI word = hn::GatherOffset(di, reinterpret_cast<const std::int32_t*>(g.cells), word_at);
-        const VI looked_up = hn::And(word >> hn::ShiftLeft<3>(hn::Sub(index, word_at)), byte);
-        // Outside the cap with no lateral direction: straight back or the zero vector's code.
+        // The cell's 16 bits: a 32-bit gather of its pair of cells (cells
+        // 2i and 2i + 1; the table's count is even), then the half it is.
+        const VI pair = hn::GatherIndex(di, reinterpret_cast<const std::int32_t*>(g.cells), hn::ShiftRight<1>(index));
+        const VI looked_up = hn::And(pair >> hn::ShiftLeft<4>(hn::And(index, hn::Set(di, 1))), low16);
+        // Outside the cap with no lateral direction: straight back or the zero vector's word.
         const auto no_lateral = hn::RebindMask(di, hn::AndNot(in_cap, hn::Not(hn::Gt(lateral2, zero))));
-        const VI behind = hn::IfThenElse(hn::RebindMask(di, hn::Lt(x, zero)), back_code, zero_code);
+        const VI behind = hn::IfThenElse(hn::RebindMask(di, hn::Lt(x, zero)), back_word, zero_word);
         return hn::IfThenElse(no_lateral, behind, looked_up);
     }
+    // NearestCodeLut::operator()(local).
+    VI nearest(VF x, VF y, VF z) const { return hn::And(aim(x, y, z), byte); }
+    // An aim word's code and rival.
+    VI code_of(VI word) const { return hn::And(word, byte); }
+    static VI rival_of(VI word) { return hn::ShiftRight<8>(word); }
 
     // Where the code's frame starts in the table, in floats: code * 9.
     static VI frame_at(VI code) { return hn::Add(hn::ShiftLeft<3>(code), code); }

@@ -53,6 +53,12 @@ struct Codebook8 {
     const RowFrame& rows(unsigned c) const { return lut.rows(Code(c)); }
     const NearestCodeLut::Neighbours& neighbours(unsigned c) const { return lut.neighbours(Code(c)); }
     const NearestCodeLut::Rivals& rivals(unsigned c) const { return lut.rivals(Code(c)); }
+    // The nearest code and its rival (NearestCodeLut::Aim).
+    NearestCodeLut::Aim aim(Vec3f local) const {
+        if (lut.usable()) return lut.aim(local);
+        const Code c = table.nearest_code(local);
+        return {c, lut.rival(c, local)};
+    }
 };
 
 // The wide codes of 16-bit files (256 or 181 levels).
@@ -272,30 +278,39 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
 }
 
 // Greedy aiming with lookahead (a "pilot" search): at each point the aimed
-// code and its four nearest codes (NearestCodeLut::Rivals) are scored by
-// their own squared error plus the squared errors greedy aiming makes at
-// the next `depth` points from where they lead; the cheapest wins. It sees what greedy aiming
-// cannot — a code that is a little worse now but leaves the frame and the
-// position better placed for the next points (the zig-zag around a
-// straight path, the start of a turn) — at a few greedy steps per point:
-// - rivals are tried in order of their own error and dropped once their
-//   partial sum reaches the best (branch and bound: the result is that of
-//   trying every rival in full);
+// code and its rival (the nearest of its four nearest codes to the aim:
+// NearestCodeLut::Aim) are scored by their own squared error plus the
+// squared errors greedy aiming makes at the next `depth` points from where
+// they lead; the cheaper wins. It sees what greedy aiming cannot — a code
+// that is a little worse now but leaves the frame and the position better
+// placed for the next points (the zig-zag around a straight path, the
+// start of a turn) — at about two greedy steps per point:
+// - the rival is followed only while its partial sum stays below the aimed
+//   path's (branch and bound: the result is that of following it in full);
 // - the aimed code's greedy continuation is kept from one point to the next
 //   (a chain of depth + 1 steps, shifted by one when the aimed code wins,
-//   replaced by the winner's own continuation otherwise), so the aimed
-//   path costs one new greedy step per point.
-// Measured on small-ifod1 at depth 2 with the eight codes around the aimed
-// one as rivals (docs/notes/encode-history.md): 0.85 rivals tried and 0.55
-// followed a second step per point; a rival wins at 16 % of the points.
+//   replaced by the rival's own continuation otherwise), so the aimed path
+//   costs one new greedy step per point.
+// History (docs/notes/encode-history.md): the four nearest codes, tried in
+// order of their own errors, and before them the eight around the aimed
+// one, measured a little more accurate for their cost.
 inline constexpr std::size_t kMaxLookahead = 6;
+
+// Which rivals a lookahead search tries besides the aimed code: `aim`, the
+// aim's one (NearestCodeLut::Aim), for the first search and the length
+// tails; `four`, the aimed code's four NearestCodeLut::Rivals in order of
+// their own errors, for the retry, which makes the max error (with one
+// rival there the sharpest turns' blocks kept larger errors and the tuning
+// chose wider caps: small-ifod1 2.03 -> 2.25 um mean). docs/encode.md.
+enum class LookaheadRivals { aim, four };
 
 template <class Codebook>
 class LookaheadSearch {
 public:
     using Code = typename Codebook::Code;
-    LookaheadSearch(const Codebook& cb, float step, std::size_t depth)
-        : cb_(cb), step_(step), step2_(step * step), two_step_(2.0f * step), depth_(std::min(depth, kMaxLookahead)) {}
+    LookaheadSearch(const Codebook& cb, float step, std::size_t depth, LookaheadRivals rivals)
+        : cb_(cb), step_(step), step2_(step * step), two_step_(2.0f * step), depth_(std::min(depth, kMaxLookahead)),
+          rivals_(rivals) {}
 
     // A block: codes[k] for targets[k] from the second anchor `p` and first
     // frame `f`. `alt_targets`, when not empty, are the second decoder's
@@ -345,7 +360,7 @@ private:
     struct Step {
         F4 local, alt_local;  // alt_local: robust search only
         float base, alt_base;
-        unsigned code;
+        unsigned code, rival;  // the code taken; the aimed code's rival (NearestCodeLut::Aim)
         float error2;
         RowFrame f;
         F4 p;
@@ -406,19 +421,34 @@ private:
         if (!alt_.empty()) e = f4_max(e, lanes(s.alt_local, s.alt_base));
         f4_store(out, f4_add(e, f4_load(nb.pad)));
     }
+    // The rivals (rivals_) of the aim in `aim0`, their own errors measured
+    // from `first`'s locals (+inf past their count).
+    void rivals_of(const Step& aim0, const Step& first, float* error2_out, std::uint8_t* codes) const {
+        if (rivals_ == LookaheadRivals::aim) {
+            error2_out[0] = error2(first, aim0.rival);
+            std::fill_n(error2_out + 1, 3, INFINITY);
+            codes[0] = std::uint8_t(aim0.rival);
+            return;
+        }
+        const NearestCodeLut::Rivals& nb = cb_.rivals(aim0.code);
+        rival_errors(first, nb, error2_out);
+        std::copy_n(nb.code, 4, codes);
+    }
     // The greedy step for point j from state (f, p), without its state after.
     void aim(Step& s, std::size_t j, const RowFrame& f, F4 p) const {
         const F4 t = f4_of(targets_[j]);
         s.local = apply_transposed(f, f4_sub(t, p));
         s.base = dot_self(s.local) + step2_;
+        NearestCodeLut::Aim a;
         if (alt_.empty()) {
-            s.code = cb_.nearest(vec3_of(s.local));
+            a = cb_.aim(vec3_of(s.local));
         } else {
             const F4 alt = f4_of(alt_[j]);
             s.alt_local = apply_transposed(f, f4_sub(alt, p));
             s.alt_base = dot_self(s.alt_local) + step2_;
-            s.code = cb_.nearest(vec3_of(apply_transposed(f, f4_sub(f4_of(midpoint(targets_[j], alt_[j])), p))));
+            a = cb_.aim(vec3_of(apply_transposed(f, f4_sub(f4_of(midpoint(targets_[j], alt_[j])), p))));
         }
+        s.code = a.code, s.rival = a.rival;
         s.error2 = error2(s, s.code);
     }
 
@@ -436,7 +466,7 @@ private:
     }
 
     // Replaces each lane's aimed path by a rival's where one is cheaper.
-    // Per lane: rivals are tried cheapest own error first, each path
+    // Per lane: rivals (LookaheadRivals) are tried cheapest own error first, each path
     // abandoned once its partial sum reaches the lane's best (branch and
     // bound), until the next rival's own error reaches the best. The lanes
     // try their rivals in rounds (round r: every lane's r-th rival, step by
@@ -447,7 +477,7 @@ private:
         struct Lane {
             Step first;  // the aim's locals: copies, chain_ changes hands below
             alignas(16) float rival_error2[4];
-            const NearestCodeLut::Rivals* nb;
+            std::uint8_t rival_code[4];
             float best, e;
             bool trying, following, won;
         };
@@ -458,8 +488,7 @@ private:
             const Step& aim0 = (*l.chain_)[0];
             a.first.local = aim0.local, a.first.alt_local = aim0.alt_local;
             a.first.base = aim0.base, a.first.alt_base = aim0.alt_base;
-            a.nb = &l.cb_.rivals(aim0.code);
-            l.rival_errors(a.first, *a.nb, a.rival_error2);
+            l.rivals_of(aim0, a.first, a.rival_error2, a.rival_code);
             a.best = l.chain_->sum();
             a.trying = true, a.won = false;
         }
@@ -485,7 +514,7 @@ private:
                 t[0].local = a.first.local, t[0].alt_local = a.first.alt_local;
                 t[0].base = a.first.base, t[0].alt_base = a.first.alt_base;
                 t[0].error2 = e0;
-                t[0].code = a.nb->code[r];
+                t[0].code = a.rival_code[r];
                 t.n = 1;
                 a.e = e0;
                 a.following = any = true;
@@ -528,6 +557,7 @@ private:
     const Codebook& cb_;
     const float step_, step2_, two_step_;
     const std::size_t depth_;
+    const LookaheadRivals rivals_;
     RowFrame f_;  // the decoder's state before point k_
     F4 p_;
     std::span<const Vec3f> targets_, alt_;

@@ -439,7 +439,8 @@ void FiberEncoder::Encoding::search_blocks_together(std::span<Encoding> fibers) 
     if (blocks.empty()) return;  // fibers of at most two points a block: no codes
     BlockBatch& batch = batch_of(blocks);
     if (first.search().lookahead > 0)
-        lookahead_blocks(first.codebook8(), first.header.step, first.search().lookahead, batch.batch());
+        lookahead_blocks(first.codebook8(), first.header.step, first.search().lookahead, LookaheadRivals::aim,
+                         batch.batch());
     else
         greedy_blocks(first.codebook8(), first.header.step, batch.batch());
     for (std::size_t j = 0; j < blocks.size(); ++j) blocks[j].take(batch, j);
@@ -485,7 +486,7 @@ void FiberEncoder::Encoding::retry_with_lookahead(std::vector<LaneBlock>& blocks
     const Encoding& first = *blocks.front().e;
     BlockBatch& batch = batch_of(blocks);
     const std::size_t depth = std::max<std::size_t>(first.search().lookahead, kRetryLookahead);
-    lookahead_blocks(first.codebook8(), first.header.step, depth, batch.batch());
+    lookahead_blocks(first.codebook8(), first.header.step, depth, LookaheadRivals::four, batch.batch());
     for (std::size_t j = 0; j < blocks.size(); ++j) {
         LaneBlock& k = blocks[j];
         const Encoding& e = *k.e;
@@ -549,7 +550,7 @@ void FiberEncoder::Encoding::search_robust_blocks() {
         for (unsigned width : {1u, robust_beam}) {
             if (width > 1 && best <= 1.21f * float_only) break;
             if (width == 1 && search().lookahead > 0)  // as the first search: greedy aiming with lookahead
-                LookaheadSearch<Codebook8>(cb, header.step, search().lookahead)
+                LookaheadSearch<Codebook8>(cb, header.step, search().lookahead, LookaheadRivals::aim)
                     .run(scratch.frames[b], scratch.points[i0 + 1], t, scratch.retry_codes8.data(),
                          scratch.retry_points.data(), std::span<const Vec3f>(scratch.alt));
             else
@@ -649,7 +650,7 @@ void FiberEncoder::Encoding::keep_length_tails(std::span<Encoding> fibers) {
             batch.set(i, f, p, group[i].search.targets);
         }
         if (lookahead)
-            lookahead_blocks(cb, first.header.step, depth, batch.batch());
+            lookahead_blocks(cb, first.header.step, depth, LookaheadRivals::aim, batch.batch());
         else
             search_codes(cb, SearchParams{search.beam_width, search.radius}, batch.frames[0], batch.points[0],
                          first.header.step, group[0].search.targets, batch.codes.data(), batch.decoded.data() + 1);

@@ -14,7 +14,6 @@
 #define FIBLET_LOOKAHEAD_ONCE 1
 #endif
 
-#include <climits>
 #include <cstddef>
 #include <cmath>
 
@@ -37,8 +36,9 @@ constexpr int kRivals = 4, kRivalWords = int(sizeof(Rivals) / sizeof(float)), kR
               kRivalCodes = 16, kRivalCount = 17;
 
 // Blocks j0 .. j0 + active - 1 of the batch, one per lane of `d`, with
-// kDepth (1 or 2) points of lookahead.
-template <int kDepth, class D>
+// kDepth (1 or 2) points of lookahead, trying the aim's rival or (kFour)
+// the aimed code's four.
+template <int kDepth, bool kFour, class D>
 void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batch, std::size_t j0, std::size_t active) {
     static_assert(kDepth == 1 || kDepth == 2, "lanes look one or two points ahead");
     using Lanes = CodeLanes<D>;
@@ -74,12 +74,13 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
     VF tx, ty, tz, nx, ny, nz, ox, oy, oz;
     s.target(s.at, tx, ty, tz);
     if (kDepth == 2) s.target(s.next_at(), nx, ny, nz);
-    // Point k's target in the frame and the aimed code: from the state
-    // before it (point 0), then as the winning path found them (each path
-    // aims from its state at the next target: the same operations).
+    // Point k's target in the frame and the aim (the aimed code and its
+    // rival: CodeLanes::aim): from the state before it (point 0), then as
+    // the winning path found them (each path aims from its state at the
+    // next target: the same operations).
     VF x, y, z;
     Lanes::local(s.f, hn::Sub(tx, s.px), hn::Sub(ty, s.py), hn::Sub(tz, s.pz), x, y, z);
-    VI aimed = code.nearest(x, y, z);
+    VI aim = code.aim(x, y, z);
     for (std::size_t k = 0; k < s.steps; ++k) {
         const VF base = base_of(x, y, z);
         if (kDepth == 1) s.target(s.next_at(), nx, ny, nz);
@@ -88,14 +89,15 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
         const auto more2 = kDepth == 2 ? s.more_after(k + 1) : more;  // and k + 2
         const bool any2 = kDepth == 2 && !hn::AllFalse(d, more2);
         // Code c's state after point k (frame l of c given) into nf, q, and
-        // the next target in its frame and the code aimed at it into x1, y1,
-        // z1, c1; returns the path's sum of squared errors, e0 (c's own) plus
+        // the next target in its frame and the aim at it into x1, y1, z1,
+        // aim1; returns the path's sum of squared errors, e0 (c's own) plus
         // greedy aiming's at the points after it (added in the scalar
         // search's order).
-        auto path = [&](const VF* l, VF e0, VF* nf, VF& qx, VF& qy, VF& qz, VF& x1, VF& y1, VF& z1, VI& c1) {
+        auto path = [&](const VF* l, VF e0, VF* nf, VF& qx, VF& qy, VF& qz, VF& x1, VF& y1, VF& z1, VI& aim1) {
             take(s.f, s.px, s.py, s.pz, l, nf, qx, qy, qz);
             Lanes::local(nf, hn::Sub(nx, qx), hn::Sub(ny, qy), hn::Sub(nz, qz), x1, y1, z1);
-            c1 = code.nearest(x1, y1, z1);
+            aim1 = code.aim(x1, y1, z1);
+            const VI c1 = code.code_of(aim1);
             if (!any2) {
                 VF bx, by, bz;
                 code.direction(c1, bx, by, bz);
@@ -110,48 +112,18 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
             return hn::IfThenElse(more2, hn::Add(sum1, error2(base_of(x2, y2, z2), bx, by, bz, x2, y2, z2)), sum1);
         };
         VF l[9], win_f[9], win_x, win_y, win_z, win_x1, win_y1, win_z1;
-        VI win_c1;
+        VI win_aim1;
+        const VI aimed = code.code_of(aim);
         code.frame(aimed, l);
         const VF aimed_e0 = error2(base, l[0], l[1], l[2], x, y, z);
-        VF best = path(l, aimed_e0, win_f, win_x, win_y, win_z, win_x1, win_y1, win_z1, win_c1);
+        VF best = path(l, aimed_e0, win_f, win_x, win_y, win_z, win_x1, win_y1, win_z1, win_aim1);
         VI win_code = aimed;
-        // The rivals (NearestCodeLut::Rivals of the aimed code), where a
-        // lane has a point after k, in the scalar search's order: each round
-        // takes every lane's cheapest untried rival by own error (the first
-        // on a tie), tried while that error is below the lane's best; a
-        // rival wins with a smaller sum (the scalar search's branch and bound
-        // drops a path once its partial sum reaches the best: errors are at
-        // least 0, so such a path's whole sum does not win either). Rounds
-        // end when no lane has a rival left to try.
-        const VI nb_at = hn::Mul(aimed, hn::Set(di, kRivalWords));
-        const VI codes = hn::GatherIndex(di, nb_words + kRivalCodes, nb_at);
-        const VI count = hn::GatherIndex(di, nb_words + kRivalCount, nb_at);
-        VF rival_e0[kRivals], rx[kRivals], ry[kRivals], rz[kRivals];
-        GatherFloats(d, nb_floats, nb_at, rx, kRivals);
-        GatherFloats(d, nb_floats + kRivalY, nb_at, ry, kRivals);
-        GatherFloats(d, nb_floats + kRivalZ, nb_at, rz, kRivals);
-        for (int r = 0; r < kRivals; ++r) {
-            const auto listed = hn::And(more, hn::RebindMask(d, hn::Lt(hn::Set(di, r), count)));
-            rival_e0[r] = hn::IfThenElse(listed, error2(base, rx[r], ry[r], rz[r], x, y, z), inf);
-        }
-        for (int round = 0; round < kRivals; ++round) {
-            VF e0 = rival_e0[0];
-            VI which = hn::Zero(di);
-            for (int r = 1; r < kRivals; ++r) {
-                const auto lower = hn::Lt(rival_e0[r], e0);
-                e0 = hn::IfThenElse(lower, rival_e0[r], e0);
-                which = hn::IfThenElse(hn::RebindMask(di, lower), hn::Set(di, r), which);
-            }
-            const auto tries = hn::Lt(e0, best);
-            if (hn::AllFalse(d, tries)) break;
-            for (int r = 0; r < kRivals; ++r)
-                rival_e0[r] = hn::IfThenElse(hn::RebindMask(d, hn::Eq(which, hn::Set(di, r))), inf, rival_e0[r]);
-            // Rival `which`'s code: byte `which` of the codes' word.
-            const VI c = hn::And(codes >> hn::ShiftLeft<3>(which), code.byte);
-            VF lr[9], rf[9], qx, qy, qz, x1, y1, z1;  // the rival's frame, its state after point k
-            VI c1;
-            code.frame(c, lr);
-            const VF total = path(lr, e0, rf, qx, qy, qz, x1, y1, z1, c1);
+        // Rival c's path (frame lr, own error e0) where lanes `tries`: it
+        // wins with a smaller sum.
+        auto try_rival = [&](VI c, const VF* lr, VF e0, hn::Mask<D> tries) {
+            VF rf[9], qx, qy, qz, x1, y1, z1;  // the rival's state after point k
+            VI aim1;
+            const VF total = path(lr, e0, rf, qx, qy, qz, x1, y1, z1, aim1);
             const auto wins = hn::And(tries, hn::Lt(total, best));
             best = hn::IfThenElse(wins, total, best);
             win_code = hn::IfThenElse(hn::RebindMask(di, wins), c, win_code);
@@ -159,22 +131,75 @@ void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batc
             win_x = hn::IfThenElse(wins, qx, win_x), win_y = hn::IfThenElse(wins, qy, win_y);
             win_z = hn::IfThenElse(wins, qz, win_z);
             win_x1 = hn::IfThenElse(wins, x1, win_x1), win_y1 = hn::IfThenElse(wins, y1, win_y1);
-            win_z1 = hn::IfThenElse(wins, z1, win_z1), win_c1 = hn::IfThenElse(hn::RebindMask(di, wins), c1, win_c1);
+            win_z1 = hn::IfThenElse(wins, z1, win_z1), win_aim1 = hn::IfThenElse(hn::RebindMask(di, wins), aim1, win_aim1);
+        };
+        // The rivals, where a lane has a point after k, each tried while its
+        // own error is below the lane's best (the scalar search's branch and
+        // bound drops a path once its partial sum reaches the best: errors
+        // are at least 0, so such a path's whole sum does not win either).
+        if constexpr (!kFour) {
+            // One: the aim's (its frame's first column is its direction).
+            const VI rival = Lanes::rival_of(aim);
+            VF lr[9];
+            code.frame(rival, lr);
+            const VF e0 = error2(base, lr[0], lr[1], lr[2], x, y, z);
+            const auto tries = hn::And(more, hn::Lt(e0, best));
+            if (!hn::AllFalse(d, tries)) try_rival(rival, lr, e0, tries);
+        } else {
+            // The four NearestCodeLut::Rivals of the aimed code, in the
+            // scalar search's order: each round takes every lane's cheapest
+            // untried rival by own error (the first on a tie); rounds end
+            // when no lane has a rival left to try.
+            const VI nb_at = hn::Mul(aimed, hn::Set(di, kRivalWords));
+            const VI codes = hn::GatherIndex(di, nb_words + kRivalCodes, nb_at);
+            const VI count = hn::GatherIndex(di, nb_words + kRivalCount, nb_at);
+            VF rival_e0[kRivals], rx[kRivals], ry[kRivals], rz[kRivals];
+            GatherFloats(d, nb_floats, nb_at, rx, kRivals);
+            GatherFloats(d, nb_floats + kRivalY, nb_at, ry, kRivals);
+            GatherFloats(d, nb_floats + kRivalZ, nb_at, rz, kRivals);
+            for (int r = 0; r < kRivals; ++r) {
+                const auto listed = hn::And(more, hn::RebindMask(d, hn::Lt(hn::Set(di, r), count)));
+                rival_e0[r] = hn::IfThenElse(listed, error2(base, rx[r], ry[r], rz[r], x, y, z), inf);
+            }
+            for (int round = 0; round < kRivals; ++round) {
+                VF e0 = rival_e0[0];
+                VI which = hn::Zero(di);
+                for (int r = 1; r < kRivals; ++r) {
+                    const auto lower = hn::Lt(rival_e0[r], e0);
+                    e0 = hn::IfThenElse(lower, rival_e0[r], e0);
+                    which = hn::IfThenElse(hn::RebindMask(di, lower), hn::Set(di, r), which);
+                }
+                const auto tries = hn::Lt(e0, best);
+                if (hn::AllFalse(d, tries)) break;
+                for (int r = 0; r < kRivals; ++r)
+                    rival_e0[r] = hn::IfThenElse(hn::RebindMask(d, hn::Eq(which, hn::Set(di, r))), inf, rival_e0[r]);
+                // Rival `which`'s code: byte `which` of the codes' word.
+                const VI c = hn::And(codes >> hn::ShiftLeft<3>(which), code.byte);
+                VF lr[9];
+                code.frame(c, lr);
+                try_rival(c, lr, e0, tries);
+            }
         }
         for (int j = 0; j < 9; ++j) s.f[j] = win_f[j];
         s.px = win_x, s.py = win_y, s.pz = win_z;
         s.store(k, win_code);
-        x = win_x1, y = win_y1, z = win_z1, aimed = win_c1;
+        x = win_x1, y = win_y1, z = win_z1, aim = win_aim1;
         tx = nx, ty = ny, tz = nz;
         if (kDepth == 2) nx = ox, ny = oy, nz = oz;
     }
 }
 
-std::size_t LookaheadVectors1(const Codebook8& cb, float step, const GreedyBatch& batch) {
-    return AllVectors(cb, step, batch, [](auto d, auto&&... args) { LookaheadVector<1>(d, args...); });
+template <int kDepth, bool kFour>
+std::size_t LookaheadVectors(const Codebook8& cb, float step, const GreedyBatch& batch) {
+    return AllVectors(cb, step, batch, [](auto d, auto&&... args) { LookaheadVector<kDepth, kFour>(d, args...); });
 }
-std::size_t LookaheadVectors2(const Codebook8& cb, float step, const GreedyBatch& batch) {
-    return AllVectors(cb, step, batch, [](auto d, auto&&... args) { LookaheadVector<2>(d, args...); });
+
+using VectorSearch = std::size_t (*)(const Codebook8&, float, const GreedyBatch&);
+
+// The lanes' search for depth 1 or 2, with four rivals or the aim's one.
+VectorSearch LookaheadVectorsFor(std::size_t depth, bool four) {
+    if (depth == 1) return four ? &LookaheadVectors<1, true> : &LookaheadVectors<1, false>;
+    return four ? &LookaheadVectors<2, true> : &LookaheadVectors<2, false>;
 }
 
 }  // namespace fiblet::detail::HWY_NAMESPACE
@@ -187,19 +212,19 @@ namespace {
 
 using VectorSearch = std::size_t (*)(const Codebook8&, float, const GreedyBatch&);
 
-// The lanes' search for this depth and level, if there is one.
-VectorSearch vector_search(SimdLevel level, std::size_t depth) {
+// The lanes' search for this depth, rivals and level, if there is one.
+VectorSearch vector_search(SimdLevel level, std::size_t depth, LookaheadRivals rivals) {
     if (depth != 1 && depth != 2) return nullptr;
-    const bool one = depth == 1;
+    const bool four = rivals == LookaheadRivals::four;
     switch (level) {
 #if FIBLET_LOOKAHEAD_HWY && (HWY_TARGETS & HWY_AVX3)
-        case SimdLevel::avx512: return one ? &N_AVX3::LookaheadVectors1 : &N_AVX3::LookaheadVectors2;
+        case SimdLevel::avx512: return N_AVX3::LookaheadVectorsFor(depth, four);
 #endif
 #if FIBLET_LOOKAHEAD_HWY && (HWY_TARGETS & HWY_AVX2)
-        case SimdLevel::avx2: return one ? &N_AVX2::LookaheadVectors1 : &N_AVX2::LookaheadVectors2;
+        case SimdLevel::avx2: return N_AVX2::LookaheadVectorsFor(depth, four);
 #endif
 #if FIBLET_LOOKAHEAD_HWY && (HWY_TARGETS & HWY_SSE4)
-        case SimdLevel::sse4: return one ? &N_SSE4::LookaheadVectors1 : &N_SSE4::LookaheadVectors2;
+        case SimdLevel::sse4: return N_SSE4::LookaheadVectorsFor(depth, four);
 #endif
         default: return nullptr;
     }
@@ -208,9 +233,11 @@ VectorSearch vector_search(SimdLevel level, std::size_t depth) {
 // LookaheadSearch for blocks [first, batch.blocks): four of the same length
 // in lockstep (their dependency chains overlap in the CPU), the others one
 // at a time.
-void scalar_blocks(const Codebook8& cb, float step, std::size_t depth, const GreedyBatch& batch, std::size_t first) {
+void scalar_blocks(const Codebook8& cb, float step, std::size_t depth, LookaheadRivals rivals, const GreedyBatch& batch,
+                   std::size_t first) {
     constexpr int kLanes = 4;
-    LookaheadSearch<Codebook8> lanes[kLanes]{{cb, step, depth}, {cb, step, depth}, {cb, step, depth}, {cb, step, depth}};
+    LookaheadSearch<Codebook8> lanes[kLanes]{
+        {cb, step, depth, rivals}, {cb, step, depth, rivals}, {cb, step, depth, rivals}, {cb, step, depth, rivals}};
     auto start = [&](LookaheadSearch<Codebook8>& lane, std::size_t j) {
         const std::size_t at = j * batch.stride;
         lane.start(batch.frames[j], batch.starts[at], std::span<const Vec3f>(batch.targets + at, batch.length(j)),
@@ -232,17 +259,19 @@ void scalar_blocks(const Codebook8& cb, float step, std::size_t depth, const Gre
 
 }  // namespace
 
-void lookahead_blocks(const Codebook8& cb, float step, std::size_t depth, const GreedyBatch& batch) {
-    lookahead_blocks(cb, step, depth, batch, simd_level());
+void lookahead_blocks(const Codebook8& cb, float step, std::size_t depth, LookaheadRivals rivals,
+                      const GreedyBatch& batch) {
+    lookahead_blocks(cb, step, depth, rivals, batch, simd_level());
 }
 
-void lookahead_blocks(const Codebook8& cb, float step, std::size_t depth, const GreedyBatch& batch, SimdLevel level) {
+void lookahead_blocks(const Codebook8& cb, float step, std::size_t depth, LookaheadRivals rivals,
+                      const GreedyBatch& batch, SimdLevel level) {
     require_simd_level(level);
     if (batch.blocks == 0) return;
     std::size_t done = 0;
-    if (const VectorSearch search = vector_search(level, depth); search && lanes_can_take(cb, batch))
+    if (const VectorSearch search = vector_search(level, depth, rivals); search && lanes_can_take(cb, batch))
         done = search(cb, step, batch);
-    scalar_blocks(cb, step, depth, batch, done);
+    scalar_blocks(cb, step, depth, rivals, batch, done);
 }
 
 }  // namespace fiblet::detail

@@ -22,7 +22,25 @@ void close_columns(Columns& r) {
     for (unsigned i = r.count; i < std::size(r.x); ++i) r.x[i] = r.y[i] = r.z[i] = 0.0f, r.pad[i] = INFINITY, r.code[i] = 0;
 }
 
+// f(c) for the codes one level up or down on one grid axis from `code`
+// (fewer at the grid's edges), in grid order: Rivals' codes.
+template <class F>
+void for_each_rival(unsigned code, F&& f) {
+    const int h0 = int(code >> 4), l0 = int(code & 15);
+    for (const auto& [h, l] : {std::pair{h0 - 1, l0}, {h0, l0 - 1}, {h0, l0 + 1}, {h0 + 1, l0}})
+        if (h >= 0 && h <= 15 && l >= 0 && l <= 15) f(unsigned(h << 4 | l));
+}
+
 }  // namespace
+
+std::uint8_t NearestCodeLut::rival(std::uint8_t code, Vec3f d) const {
+    const Rivals& r = rivals_[code];
+    unsigned best = 0;
+    float best_dot = r.x[0] * d.x + r.y[0] * d.y + r.z[0] * d.z;
+    for (unsigned i = 1; i < r.count; ++i)
+        if (const float v = r.x[i] * d.x + r.y[i] * d.y + r.z[i] * d.z; v > best_dot) best = i, best_dot = v;
+    return r.code[best];
+}
 
 NearestCodeLut::NearestCodeLut(const DirectionTable& table) {
     const float ratio = table.ratio();
@@ -49,15 +67,15 @@ NearestCodeLut::NearestCodeLut(const DirectionTable& table) {
     for (unsigned c = 0; c < 256; ++c) {
         Rivals& r = rivals_[c];
         r.count = 0;
-        const int h0 = int(c >> 4), l0 = int(c & 15);
-        for (const auto [h, l] : {std::pair{h0 - 1, l0}, {h0, l0 - 1}, {h0, l0 + 1}, {h0 + 1, l0}}) {  // grid order
-            if (h < 0 || h > 15 || l < 0 || l > 15) continue;
-            add_column(r, table, unsigned(h << 4 | l));
-        }
+        for_each_rival(c, [&](unsigned code) { add_column(r, table, code); });
         close_columns(r);
     }
-    zero_code_ = table.nearest_code({0, 0, 0});
-    back_code_ = table.nearest_code({-1, 0, 0});
+    auto aim_word = [&](unsigned code, Vec3f d) {
+        return std::uint16_t(code | unsigned(rival(std::uint8_t(code), d)) << 8);
+    };
+    const unsigned zero_code = table.nearest_code({0, 0, 0}), back_code = table.nearest_code({-1, 0, 0});
+    zero_word_ = aim_word(zero_code, {0, 0, 0});
+    back_word_ = aim_word(back_code, {-1, 0, 0});
     if (!(ratio < 1.0f)) return;  // the cap reaches the half sphere's rim: no gnomonic view of it
     const double rim_x = 1.0 - double(ratio);
     const double tan_rim = std::sqrt(std::max(1.0 - rim_x * rim_x, 0.0)) / rim_x;
@@ -92,7 +110,7 @@ NearestCodeLut::NearestCodeLut(const DirectionTable& table) {
                         }
                 }
             }
-            cells_[std::size_t(iy) * kGrid + std::size_t(iz)] = std::uint8_t(code);
+            cells_[std::size_t(iy) * kGrid + std::size_t(iz)] = aim_word(code, d);
         }
     }
 }
