@@ -271,6 +271,14 @@ struct FiberEncoder::Encoding {
         std::vector<Vec3d> walked;
         std::vector<double> block_errors;  // append_exact8: each block's largest point error
         std::optional<LengthTails> tails;  // keep_length_tails
+        // tail_start's last answer: the state before code j0 of `block`
+        // (a block's tries share it: they change its codes from j0 on).
+        struct TailStart {
+            std::uint32_t block = ~0u;
+            std::size_t j0 = 0;
+            Frame f;
+            Vec3f p;
+        } tail_start;
     };
 
     const FiberEncoder& enc;
@@ -597,13 +605,17 @@ void FiberEncoder::Encoding::keep_lengths() {
 }
 
 // The decoder's state before code t.j0 of a tail search's block, replayed
-// from the block's start.
+// from the block's start (once for the block's tries).
 std::pair<Frame, Vec3f> FiberEncoder::Encoding::tail_start(const LengthTails::Search& t) {
-    const Codebook8 cb = codebook8();
-    Frame f = scratch.frames[t.block];
-    const std::uint8_t* codes = codes8_of(t.block);
-    for (std::size_t k = 0; k < t.j0; ++k) f = compose(f, cb.frame(codes[k]));
-    return {f, scratch.points[std::size_t(t.block) * points_per_block + 1 + t.j0]};
+    Scratch::TailStart& c = scratch.tail_start;
+    if (c.block != t.block || c.j0 != t.j0) {
+        const Codebook8 cb = codebook8();
+        Frame f = scratch.frames[t.block];
+        const std::uint8_t* codes = codes8_of(t.block);
+        for (std::size_t k = 0; k < t.j0; ++k) f = compose(f, cb.frame(codes[k]));
+        c = {t.block, t.j0, f, scratch.points[std::size_t(t.block) * points_per_block + 1 + t.j0]};
+    }
+    return {c.f, c.p};
 }
 
 // The fixed-step length tails (length_feedback.hpp) of several fibers,
@@ -622,6 +634,7 @@ void FiberEncoder::Encoding::keep_length_tails(std::span<Encoding> fibers) {
         if (e.scratch.tails->next([&](std::uint32_t b) { return !e.robust(b); }, p.search)) waiting.push_back(p);
     };
     for (Encoding& e : fibers) {
+        e.scratch.tail_start = {};
         e.scratch.tails.emplace(std::span<const Vec3f>(e.scratch.targets), std::span<Vec3f>(e.scratch.points),
                                 e.points_per_block, kLengthFeedbackTail, kLengthFeedbackActShare,
                                 kLengthFeedbackFarActShare, kLengthFeedbackNearBlocks);
