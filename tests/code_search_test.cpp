@@ -13,6 +13,7 @@
 #include "fiblet/decode.hpp"
 #include "fiblet/encode.hpp"
 #include "fiblet/error.hpp"
+#include "scoped_simd_loops.hpp"
 
 using namespace fiblet;
 
@@ -146,6 +147,32 @@ TEST(NearestCodeLut, RivalIsTheGridNeighbourNearestTheAim) {
 TEST(NearestCodeLut, NotUsedForCapsReachingTheHalfSphere) {
     EXPECT_FALSE(detail::NearestCodeLut(DirectionTable(1.0f)).usable());
     EXPECT_FALSE(detail::NearestCodeLut(DirectionTable(1.7f)).usable());
+}
+
+// The encoder's AVX2 loops (the targets' normalization, the length
+// terms, the error maxima) against their scalar twins: the same blocks and
+// predicted points, greedy and at the default effort (lookahead, retry,
+// length tails), fibers of every length up to a few blocks.
+TEST(CodeSearch, EncoderWritesTheSameBlocksWithAndWithoutTheAvx2Loops) {
+    FftHeader h = header(0.0968f);
+    h.offset = {1.5f, -2.25f, 3.75f};  // each axis its own: the vector loop rotates them
+    for (const SearchOptions& search : {SearchOptions{1, 1, 0, 1, 0}, search_for_effort(1)}) {
+        const FiberEncoder e(h, search);
+        for (int points : {1, 2, 3, 4, 5, 7, 61, 62, 125, 250}) {
+            for (const auto& f : walks(3, points, unsigned(points))) {
+                std::vector<std::uint8_t> blocks[2];
+                std::vector<Vec3f> predicted[2];
+                for (int avx2 = 0; avx2 < 2; ++avx2) {
+                    const test::ScopedSimdLoops loops(avx2 == 1);
+                    e.encode(f, 3, blocks[avx2], &predicted[avx2]);
+                }
+                EXPECT_EQ(blocks[0], blocks[1]) << points << " points";
+                ASSERT_EQ(predicted[0].size(), predicted[1].size());
+                EXPECT_EQ(0, std::memcmp(predicted[0].data(), predicted[1].data(), predicted[0].size() * sizeof(Vec3f)))
+                    << points << " points";
+            }
+        }
+    }
 }
 
 TEST(CodeSearch, BeamLowersTheSquaredErrorOfGreedyAiming) {
