@@ -209,7 +209,7 @@ struct CodeLanes {
         return hn::IfThenElse(no_lateral, behind, looked_up);
     }
     // NearestCodeLut::operator()(local).
-    VI nearest(VF x, VF y, VF z) const { return hn::And(aim(x, y, z), byte); }
+    VI nearest(VF x, VF y, VF z) const { return code_of(aim(x, y, z)); }
     // An aim word's code and rival.
     VI code_of(VI word) const { return hn::And(word, byte); }
     static VI rival_of(VI word) { return hn::ShiftRight<8>(word); }

@@ -278,22 +278,22 @@ void search_codes(const Codebook& cb, const SearchParams& sp, Frame f, Vec3f p, 
 }
 
 // Greedy aiming with lookahead (a "pilot" search): at each point the aimed
-// code and its rival (the nearest of its four nearest codes to the aim:
-// NearestCodeLut::Aim) are scored by their own squared error plus the
-// squared errors greedy aiming makes at the next `depth` points from where
-// they lead; the cheaper wins. It sees what greedy aiming cannot — a code
-// that is a little worse now but leaves the frame and the position better
-// placed for the next points (the zig-zag around a straight path, the
-// start of a turn) — at about two greedy steps per point:
-// - the rival is followed only while its partial sum stays below the aimed
-//   path's (branch and bound: the result is that of following it in full);
+// code and its rivals (LookaheadRivals: the aim's one, or the aimed code's
+// four nearest) are scored by their own squared error plus the squared
+// errors greedy aiming makes at the next `depth` points from where they
+// lead; the cheapest wins. It sees what greedy aiming cannot — a code that
+// is a little worse now but leaves the frame and the position better placed
+// for the next points (the zig-zag around a straight path, the start of a
+// turn) — at a few greedy steps per point:
+// - rivals are tried in order of their own error and dropped once their
+//   partial sum reaches the best (branch and bound: the result is that of
+//   trying every rival in full);
 // - the aimed code's greedy continuation is kept from one point to the next
 //   (a chain of depth + 1 steps, shifted by one when the aimed code wins,
-//   replaced by the rival's own continuation otherwise), so the aimed path
-//   costs one new greedy step per point.
-// History (docs/notes/encode-history.md): the four nearest codes, tried in
-// order of their own errors, and before them the eight around the aimed
-// one, measured a little more accurate for their cost.
+//   replaced by the winner's own continuation otherwise), so the aimed
+//   path costs one new greedy step per point.
+// History (docs/notes/encode-history.md): eight rivals (the 3x3 around
+// the aimed code), then four, then the aim's one where it costs little.
 inline constexpr std::size_t kMaxLookahead = 6;
 
 // Which rivals a lookahead search tries besides the aimed code: `aim`, the
@@ -466,8 +466,8 @@ private:
     }
 
     // Replaces each lane's aimed path by a rival's where one is cheaper.
-    // Per lane: rivals (LookaheadRivals) are tried cheapest own error first, each path
-    // abandoned once its partial sum reaches the lane's best (branch and
+    // Per lane: rivals (LookaheadRivals) are tried cheapest own error
+    // first, each path abandoned once its partial sum reaches the lane's best (branch and
     // bound), until the next rival's own error reaches the best. The lanes
     // try their rivals in rounds (round r: every lane's r-th rival, step by
     // step). A rival path's last step is taken (its state computed) only

@@ -5,13 +5,14 @@
 // The table covers the gnomonic coordinates (y/x, z/x) of the local
 // direction, i.e. its intersection with the plane x = 1, on a G x G grid
 // over the square around the cap's rim, storing the nearest code of each
-// cell centre (and its rival, aim()): one division per lookup, no square root. Directions outside
-// the cap (or behind the half sphere) are pushed radially onto the rim,
-// where their nearest code lies. A cell is 1/256 of the cap's width, about
-// 1/10 of the code spacing, so a lookup returns the nearest code except
-// within a hair of a tie (where both codes are equally good; the encoder's
-// closed loop makes up for either). Only for caps narrower than a half
-// sphere (ratio < 1); otherwise callers use nearest_code.
+// cell centre (and its rival, aim()): one division per lookup, no square
+// root. Directions outside the cap (or behind the half sphere) are pushed
+// radially onto the rim, where their nearest code lies. A cell is 1/256 of
+// the cap's width, about 1/10 of the code spacing, so a lookup returns the
+// nearest code except within a hair of a tie (where both codes are equally
+// good; the encoder's closed loop makes up for either). Only for caps
+// narrower than a half sphere (ratio < 1); otherwise callers use
+// nearest_code.
 #pragma once
 
 #include <cstdint>
@@ -42,9 +43,9 @@ public:
         unsigned before;  // how many of them precede the code itself in grid order
     };
     const Neighbours& neighbours(std::uint8_t code) const { return neighbours_[code]; }
-    // The deeper lookahead's rivals of a code: its four nearest codes, one level
-    // up or down on one grid axis (fewer at the grid's edges), in grid
-    // order, as Neighbours' columns. The diagonal codes of the 3x3 are a
+    // The retry lookahead's rivals of a code (LookaheadRivals::four): its
+    // four nearest codes, one level up or down on one grid axis (fewer at
+    // the grid's edges), in grid order, as Neighbours' columns. The diagonal codes of the 3x3 are a
     // level farther on both axes; trying them as well made the default's
     // compress 13 % slower for a 0.3 % smaller mean error (docs/encode.md).
     struct Rivals {
