@@ -4,8 +4,6 @@
 // before they are real, and a sweep of every single-bit flip of a small
 // file finds none that verify passes while the decoded file changes.
 #include <gtest/gtest.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
 
 #include <cmath>
 #include <cstring>

@@ -76,8 +76,6 @@ HWY_AFTER_NAMESPACE();
 namespace fiblet::detail {
 namespace {
 
-using VectorSearch = std::size_t (*)(const Codebook8&, float, const GreedyBatch&);
-
 constexpr SimdLevel kLevels[] = {SimdLevel::scalar, SimdLevel::sse4, SimdLevel::avx2, SimdLevel::avx512};
 
 VectorSearch vector_search(SimdLevel level) {

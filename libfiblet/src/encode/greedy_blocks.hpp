@@ -60,6 +60,11 @@ struct GreedyBatch {
     std::size_t length(std::size_t j) const { return lengths ? lengths[j] : j + 1 == blocks ? last_m : m; }
 };
 
+// A search of a batch's blocks in SIMD lanes at one level (greedy_blocks.cpp,
+// lookahead_blocks.cpp): returns how many blocks it did, from the first;
+// the few left are the scalar search's.
+using VectorSearch = std::size_t (*)(const Codebook8&, float, const GreedyBatch&);
+
 // Whether the SIMD lanes can search this batch: the lookup table is usable,
 // the block lengths are as described above and the offsets fit 32 bits.
 bool lanes_can_take(const Codebook8& cb, const GreedyBatch& batch);

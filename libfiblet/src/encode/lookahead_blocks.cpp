@@ -194,8 +194,6 @@ std::size_t LookaheadVectors(const Codebook8& cb, float step, const GreedyBatch&
     return AllVectors(cb, step, batch, [](auto d, auto&&... args) { LookaheadVector<kDepth, kFour>(d, args...); });
 }
 
-using VectorSearch = std::size_t (*)(const Codebook8&, float, const GreedyBatch&);
-
 // The lanes' search for depth 1 or 2, with four rivals or the aim's one.
 VectorSearch LookaheadVectorsFor(std::size_t depth, bool four) {
     if (depth == 1) return four ? &LookaheadVectors<1, true> : &LookaheadVectors<1, false>;
@@ -209,8 +207,6 @@ HWY_AFTER_NAMESPACE();
 #if FIBLET_LOOKAHEAD_ONCE
 namespace fiblet::detail {
 namespace {
-
-using VectorSearch = std::size_t (*)(const Codebook8&, float, const GreedyBatch&);
 
 // The lanes' search for this depth, rivals and level, if there is one.
 VectorSearch vector_search(SimdLevel level, std::size_t depth, LookaheadRivals rivals) {
