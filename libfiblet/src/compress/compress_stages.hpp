@@ -86,8 +86,12 @@ public:
     // A fiber's segment lengths. The counts are locals while the bins are
     // incremented: as members they would be reloaded after every bin's
     // store (both are uint64_t, so the compiler must assume they alias).
+    // A fixed-step fiber's lengths all fall in one bin: counted as runs, a
+    // bin's count is stored once a run, not once a segment (each store
+    // waited on the one before: 4 % of an `-e 0` compress).
     void add(std::span<const double> lengths) {
-        std::uint64_t below = 0;
+        std::uint64_t below = 0, run = 0;
+        std::uint32_t run_bin = 0;
         for (const double len : lengths) {
             const float f = float(len);
             if (!(f >= kMin)) {
@@ -95,16 +99,22 @@ public:
                 continue;
             }
             const std::uint32_t i = std::min<std::uint32_t>((std::bit_cast<std::uint32_t>(f) - kMinBits) >> kShift, kBins - 1);
-            auto& block = blocks_[i >> kMantissaBits];
-            if (!block) block = std::make_unique<std::uint64_t[]>(kBlock);  // zeroed
-            ++block[i & (kBlock - 1)];
+            if (i != run_bin) count_run(run_bin, run), run_bin = i, run = 0;
+            ++run;
         }
+        count_run(run_bin, run);
         count_ += lengths.size(), below_ += below;
     }
     void merge(const LengthHistogram& other);
     double median() const;
 
 private:
+    void count_run(std::uint32_t bin, std::uint64_t run) {
+        if (run == 0) return;
+        auto& block = blocks_[bin >> kMantissaBits];
+        if (!block) block = std::make_unique<std::uint64_t[]>(kBlock);  // zeroed
+        block[bin & (kBlock - 1)] += run;
+    }
     static constexpr float kMin = 0x1p-20f;
     static constexpr std::uint32_t kMinBits = std::bit_cast<std::uint32_t>(kMin), kShift = 10;
     static constexpr std::uint32_t kMantissaBits = 23 - kShift, kBlock = 1u << kMantissaBits;

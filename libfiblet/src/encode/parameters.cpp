@@ -25,52 +25,50 @@ namespace {
 
 // fiber_segments' first segments, eight at a time; returns how many.
 __attribute__((target("avx2"))) std::size_t segments_avx2(const Vec3f* f, std::size_t segments, FiberSegments& out) {
-    double *dx = out.dx.data(), *dy = out.dy.data(), *dz = out.dz.data(), *length = out.length.data();
+    double *length = out.length.data(), *ux = out.ux.data(), *uy = out.uy.data(), *uz = out.uz.data();
+    const __m256d one = _mm256_set1_pd(1.0), zero = _mm256_setzero_pd();
+    __m256d positive = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
     std::size_t s = 0;
     for (; s + 8 <= segments; s += 8) {  // reads points s .. s + 8
         __m256d x[2], y[2], z[2];
         deltas8(f + s, x, y, z);
         for (int h = 0; h < 2; ++h) {
             const std::size_t at = s + 4 * std::size_t(h);
-            _mm256_storeu_pd(dx + at, x[h]), _mm256_storeu_pd(dy + at, y[h]), _mm256_storeu_pd(dz + at, z[h]);
-            _mm256_storeu_pd(length + at, _mm256_sqrt_pd(norm2(x[h], y[h], z[h])));
+            const __m256d len = _mm256_sqrt_pd(norm2(x[h], y[h], z[h])), inv = _mm256_div_pd(one, len);
+            _mm256_storeu_pd(length + at, len);
+            _mm256_storeu_pd(ux + at, _mm256_mul_pd(x[h], inv)), _mm256_storeu_pd(uy + at, _mm256_mul_pd(y[h], inv));
+            _mm256_storeu_pd(uz + at, _mm256_mul_pd(z[h], inv));
+            positive = _mm256_and_pd(positive, _mm256_cmp_pd(len, zero, _CMP_GT_OQ));  // NaN: not positive
         }
     }
+    out.positive = _mm256_movemask_pd(positive) == 0xf;
     return s;
 }
 
 // add_turns' turns of a fiber none of whose segments has length 0 (those
-// are skipped there), four at a time: the segments' unit directions, then
-// s2[t] = sin^2 of the turn between segments t and t + 1 (at point t + 1),
-// with the same double operations. Returns the turns (segments - 1).
-__attribute__((target("avx2"))) std::size_t turn_sizes_avx2(const FiberSegments& seg, std::vector<double>& columns,
-                                                            std::vector<double>& s2) {
+// are skipped there), four at a time: s2[t] = sin^2 of the turn between
+// segments t and t + 1 (at point t + 1), with the same double operations,
+// and its histogram bin. Returns the turns (segments - 1).
+__attribute__((target("avx2"))) std::size_t turn_sizes_avx2(const FiberSegments& seg, std::vector<double>& s2,
+                                                            std::vector<std::int32_t>& bin) {
     const std::size_t n = seg.length.size();
-    columns.resize(3 * n), s2.resize(n - 1);
-    double *ux = columns.data(), *uy = ux + n, *uz = uy + n;
-    const double *dx = seg.dx.data(), *dy = seg.dy.data(), *dz = seg.dz.data(), *lengths = seg.length.data();
-    const __m256d one = _mm256_set1_pd(1.0), quarter = _mm256_set1_pd(0.25);
-    std::size_t s = 0;
-    for (; s + 4 <= n; s += 4) {
-        const __m256d inv = _mm256_div_pd(one, _mm256_loadu_pd(lengths + s));
-        _mm256_storeu_pd(ux + s, _mm256_mul_pd(_mm256_loadu_pd(dx + s), inv));
-        _mm256_storeu_pd(uy + s, _mm256_mul_pd(_mm256_loadu_pd(dy + s), inv));
-        _mm256_storeu_pd(uz + s, _mm256_mul_pd(_mm256_loadu_pd(dz + s), inv));
-    }
-    for (; s < n; ++s) {
-        const double inv = 1.0 / lengths[s];
-        ux[s] = dx[s] * inv, uy[s] = dy[s] * inv, uz[s] = dz[s] * inv;
-    }
+    s2.resize(n - 1), bin.resize(n - 1);
+    const double *ux = seg.ux.data(), *uy = seg.uy.data(), *uz = seg.uz.data();
+    const __m256d one = _mm256_set1_pd(1.0), quarter = _mm256_set1_pd(0.25), bins = _mm256_set1_pd(double(kTurnBins));
     std::size_t t = 0;
     for (; t + 5 <= n; t += 4) {  // std::min(v, 1.0) is (1.0 < v) ? 1.0 : v, as minpd(1.0, v)
         const __m256d ex = _mm256_sub_pd(_mm256_loadu_pd(ux + t + 1), _mm256_loadu_pd(ux + t)),
                       ey = _mm256_sub_pd(_mm256_loadu_pd(uy + t + 1), _mm256_loadu_pd(uy + t)),
                       ez = _mm256_sub_pd(_mm256_loadu_pd(uz + t + 1), _mm256_loadu_pd(uz + t));
-        _mm256_storeu_pd(s2.data() + t, _mm256_min_pd(one, _mm256_mul_pd(quarter, norm2(ex, ey, ez))));
+        const __m256d v = _mm256_min_pd(one, _mm256_mul_pd(quarter, norm2(ex, ey, ez)));
+        _mm256_storeu_pd(s2.data() + t, v);
+        // In [0, 2^15]: the truncation of a 32-bit conversion is the size_t one.
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(bin.data() + t), _mm256_cvttpd_epi32(_mm256_mul_pd(v, bins)));
     }
     for (; t + 1 < n; ++t) {
         const double ex = ux[t + 1] - ux[t], ey = uy[t + 1] - uy[t], ez = uz[t + 1] - uz[t];
         s2[t] = std::min(0.25 * (ex * ex + ey * ey + ez * ez), 1.0);
+        bin[t] = std::int32_t(s2[t] * float(kTurnBins));
     }
     return n - 1;
 }
@@ -79,37 +77,36 @@ __attribute__((target("avx2"))) std::size_t turn_sizes_avx2(const FiberSegments&
 #endif
 
 // The same double operations as distance() (a difference's square is its
-// negation's; vsqrtpd rounds correctly).
+// negation's; vsqrtpd rounds correctly) and as add_turns' directions.
 void fiber_segments(std::span<const Vec3f> f, FiberSegments& out) {
     const std::size_t n = f.empty() ? 0 : f.size() - 1;
-    for (auto* v : {&out.dx, &out.dy, &out.dz, &out.length}) v->resize(n);
+    for (auto* v : {&out.length, &out.ux, &out.uy, &out.uz}) v->resize(n);
     std::size_t s = 0;
+    out.positive = true;
 #ifdef FIBLET_POINTS_AVX2
     if (use_avx2_loops()) s = segments_avx2(f.data(), n, out);
 #endif
     for (; s < n; ++s) {
-        out.dx[s] = double(f[s + 1].x) - f[s].x, out.dy[s] = double(f[s + 1].y) - f[s].y;
-        out.dz[s] = double(f[s + 1].z) - f[s].z;
-        out.length[s] = std::sqrt(out.dx[s] * out.dx[s] + out.dy[s] * out.dy[s] + out.dz[s] * out.dz[s]);
+        const double dx = double(f[s + 1].x) - f[s].x, dy = double(f[s + 1].y) - f[s].y, dz = double(f[s + 1].z) - f[s].z;
+        const double len = std::sqrt(dx * dx + dy * dy + dz * dz), inv = 1.0 / len;
+        out.length[s] = len;
+        out.ux[s] = dx * inv, out.uy[s] = dy * inv, out.uz[s] = dz * inv;
+        out.positive = out.positive && len > 0;
     }
 }
 
 void TurnStatistics::add_fiber(std::span<const Vec3f> f, const FiberSegments& segments) {
 #ifdef FIBLET_POINTS_AVX2
     // The common case in vectors: no segment of length 0 (or NaN).
-    bool positive = f.size() >= 6;
-    for (const double len : segments.length) positive = positive && len > 0;
-    if (positive && use_avx2_loops()) {
-        thread_local std::vector<double> columns, s2;
-        const std::size_t turns = turn_sizes_avx2(segments, columns, s2);
+    if (segments.positive && f.size() >= 6 && use_avx2_loops()) {
+        thread_local std::vector<double> s2;
+        thread_local std::vector<std::int32_t> bin;
+        const std::size_t turns = turn_sizes_avx2(segments, s2, bin);
         double fiber_max = -1;
-        std::size_t at = 0;
-        for (std::size_t t = 0; t < turns; ++t) {
-            if (s2[t] > fiber_max) fiber_max = s2[t], at = t + 1;
-            ++bins_[std::size_t(s2[t] * float(kTurnBins))];
-        }
+        for (std::size_t t = 0; t < turns; ++t) fiber_max = std::max(fiber_max, s2[t]), ++bins_[std::size_t(bin[t])];
+        const std::size_t first_max = std::size_t(std::find(s2.begin(), s2.begin() + std::ptrdiff_t(turns), fiber_max) - s2.begin());
         count_ += turns;
-        return keep_sharpest(f, fiber_max, at);
+        return keep_sharpest(f, fiber_max, first_max + 1);
     }
 #endif
     add_turns(f, [&](double, std::size_t i) { return segments.length[i - 1]; });

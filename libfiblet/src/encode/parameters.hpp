@@ -26,11 +26,14 @@ inline constexpr ResampleCurve kWrittenCurve = ResampleCurve::rounded_keeping_le
 inline std::uint16_t tension_code(double tension) { return std::uint16_t(std::lround(tension / kTensionQuantum)); }
 inline double tension_of(std::uint16_t code) { return code * kTensionQuantum; }
 
-// A fiber's segments in double: d = f[s + 1] - f[s] per component and
-// length[s] = |d|, as distance() computes it (bit for bit; eight at a time
-// with AVX2). The scan's lengths and turns both start from them.
+// A fiber's segments in double: length[s] = |d| of d = f[s + 1] - f[s], as
+// distance() computes it, and the unit direction u = d * (1 / length[s])
+// as the turn statistics compute it (bit for bit; eight at a time with
+// AVX2); `positive`: every length is > 0 (so every u is a direction). The
+// scan's lengths and turns both start from them.
 struct FiberSegments {
-    std::vector<double> dx, dy, dz, length;
+    std::vector<double> length, ux, uy, uz;
+    bool positive = true;
 };
 void fiber_segments(std::span<const Vec3f> f, FiberSegments& out);
 
