@@ -65,7 +65,9 @@ private:
     static constexpr std::size_t kNoPage = ~std::size_t(0);
     void select_page(std::size_t p);
 
-    std::vector<std::vector<std::uint64_t>> pages_;  // empty until a bin of the page is counted
+    // Empty until a bin of the page is counted; then 2 kPageBins counts, a
+    // bin's count the sum of its two halves' (add_each).
+    std::vector<std::vector<std::uint64_t>> pages_;
     std::uint64_t count_ = 0;
     double sum_ = 0, sum_sq_ = 0, max_ = 0;
     std::uint64_t worst_fiber_ = 0;
