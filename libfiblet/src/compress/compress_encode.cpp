@@ -20,6 +20,7 @@
 #include "compress/batch_pipeline.hpp"
 #include "compress/compress_stages.hpp"
 #include "encode/fiber_end_encoder.hpp"
+#include "core/append_points.hpp"
 #include "core/points_avx2.hpp"
 #include "core/vec_math.hpp"
 #include "fiblet/parallel.hpp"
@@ -207,7 +208,7 @@ void encode_resampled(const EncodeStageInputs& in, const FiberBatch& b, std::siz
         const bool short_tail = resample_cubic_keeping_end(original, in.step, tension_of((*in.tensions)[f]), w.resampled,
                                                            fields ? &w.positions : nullptr, kWrittenCurve);
         if (fields) in.point_fields->resample(f, w.positions);
-        w.targets.insert(w.targets.end(), w.resampled.begin(), w.resampled.end());
+        append_points(w.targets, w.resampled.data(), w.resampled.size());
         const std::span<const Vec3f> points(w.targets.data() + at, w.targets.size() - at);
         w.lengths.push_back(polyline_length(original));
         w.ends.push_back(encode_keeping_end(in.encoder, points, short_tail, in.step, f, w.blocks, w.decoded,

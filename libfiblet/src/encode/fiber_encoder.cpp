@@ -13,6 +13,7 @@
 #include "encode/lookahead_blocks.hpp"
 #include "encode/nearest_code_lut.hpp"
 #include "core/block_geometry.hpp"
+#include "core/append_points.hpp"
 #include "core/points_avx2.hpp"
 #include "core/vec_math.hpp"
 #include "fiblet/encode.hpp"
@@ -794,7 +795,7 @@ void FiberEncoder::Encoding::append_exact8(std::vector<Vec3f>& decoded_exact, co
             // Not the worst even if the exact decode is off by the bound:
             // the float decode's points stand for it.
             if (decoded) {
-                decoded_exact.insert(decoded_exact.end(), decoded + i0, decoded + i0 + n);
+                append_points(decoded_exact, decoded + i0, n);
             } else {
                 for (std::size_t k = 0; k < n; ++k)
                     decoded_exact.push_back(

@@ -13,6 +13,7 @@
 #include "fiblet/tck.hpp"
 #include "tractogram/tck/track_header.hpp"
 #include "core/pass_digest.hpp"
+#include "core/append_points.hpp"
 #include "core/points_avx2.hpp"
 #include "core/streamline_label.hpp"
 #include "io/open_inputs.hpp"
@@ -177,7 +178,7 @@ struct TckReader::Impl {
         }
         if (i == 0) return;
         const Vec3f* run = chunk_points.get() + chunk_pos / sizeof(Vec3f);
-        out.insert(out.end(), run, run + i);
+        detail::append_points(out, run, i);
         chunk_pos += i * 12;
     }
 
