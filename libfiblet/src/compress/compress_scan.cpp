@@ -124,6 +124,54 @@ void add_bounds(std::span<const Vec3f> fiber, double* min, double* max) {
         min[a] = std::min(min[a], double(lo[a]) + 0.0), max[a] = std::max(max[a], double(hi[a]) + 0.0);
 }
 
+#ifdef FIBLET_POINTS_AVX2
+namespace {
+// The end of the run of lengths from k on whose bin is `bin` (all at least
+// kMin as floats), four at a time: the same float conversion and bits.
+__attribute__((target("avx2"))) std::size_t run_end_avx2(const double* lengths, std::size_t k, std::size_t n,
+                                                         std::uint32_t bin, float min, std::uint32_t min_bits,
+                                                         int shift, std::uint32_t last_bin) {
+    const __m128i want = _mm_set1_epi32(std::int32_t(bin)), base = _mm_set1_epi32(std::int32_t(min_bits)),
+                  last = _mm_set1_epi32(std::int32_t(last_bin));
+    const __m128 lowest = _mm_set1_ps(min);
+    for (; k + 4 <= n; k += 4) {
+        const __m128 f = _mm256_cvtpd_ps(_mm256_loadu_pd(lengths + k));
+        const __m128i at = _mm_min_epu32(_mm_srl_epi32(_mm_sub_epi32(_mm_castps_si128(f), base), _mm_cvtsi32_si128(shift)), last);
+        const __m128i same = _mm_and_si128(_mm_castps_si128(_mm_cmpge_ps(f, lowest)), _mm_cmpeq_epi32(at, want));
+        if (_mm_movemask_epi8(same) != 0xffff) break;
+    }
+    return k;
+}
+}  // namespace
+#endif
+
+void LengthHistogram::add(std::span<const double> lengths) {
+    // The counts are locals while the bins are incremented: as members they
+    // would be reloaded after every bin's store (both are uint64_t, so the
+    // compiler must assume they alias).
+    std::uint64_t below = 0, run = 0;
+    std::uint32_t run_bin = 0;
+    const std::size_t n = lengths.size();
+    for (std::size_t k = 0; k < n; ++k) {
+        const float f = float(lengths[k]);
+        if (!(f >= kMin)) {
+            ++below;
+            continue;
+        }
+        const std::uint32_t i = bin_of(f);
+        if (i != run_bin) count_run(run_bin, run), run_bin = i, run = 0;
+        ++run;
+#ifdef FIBLET_POINTS_AVX2
+        if (use_avx2_loops()) {
+            const std::size_t end = run_end_avx2(lengths.data(), k + 1, n, run_bin, kMin, kMinBits, int(kShift), kBins - 1);
+            run += end - (k + 1), k = end - 1;
+        }
+#endif
+    }
+    count_run(run_bin, run);
+    count_ += n, below_ += below;
+}
+
 void LengthHistogram::merge(const LengthHistogram& o) {
     count_ += o.count_, below_ += o.below_;
     for (std::uint32_t e = 0; e < kExponents; ++e) {
