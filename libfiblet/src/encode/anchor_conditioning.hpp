@@ -61,4 +61,17 @@ inline double walk_divergence(std::size_t m, double step) {
 // Returns the chosen words with both decoders' starts and their divergence.
 DecoderStarts condition_anchors(Vec3d n0, Vec3d n1, double reach, double threshold);
 
+// condition_anchors in two parts, so that the first runs for several
+// blocks at once: the nearest rounding's words, then (given their start,
+// `nearest`, with its divergence) the search, if the start needs one.
+AnchorWords nearest_words(Vec3d n0, Vec3d n1);
+DecoderStarts condition_anchors(Vec3d n0, Vec3d n1, double reach, double threshold, const DecoderStarts& nearest);
+
+// decoder_starts(w[i]) with its start_divergence(.., reach[i]) for i < 4:
+// the float and double operations of both, four blocks a vector with
+// AVX2 (the same bits: the float frames from SSE lanes, the exact ones
+// from double lanes, each rounding as its scalar operation), each block's
+// long chain of square roots and divisions in step with the others'.
+void decoder_starts4(const AnchorWords w[4], const double reach[4], DecoderStarts out[4]);
+
 }  // namespace fiblet::detail

@@ -63,28 +63,27 @@ void put_le(std::uint8_t* p, std::uint32_t v, int bytes) {
 // lower the max and mean a little more for 1.7x and 4x.
 constexpr double kRobustDivergence = 0.5 / 65535.0;
 
-// Writes the anchors, fiber id and flags of block b (of n_blocks) holding n
-// points; returns where the decoders start (for 16-bit blocks, the float
-// anchors only). `reach` (normalized) is how far the block's points go from
-// its second anchor, for the choice of 8-bit anchor roundings.
-DecoderStarts write_block_head(const FftHeader& h, std::uint8_t* block, Vec3f p0, Vec3f p1, std::uint32_t fiber_id,
-                               std::uint32_t b, std::uint32_t n_blocks, std::uint32_t n, double reach) {
+// Writes the anchors, fiber id and flags of 16-bit block b (of n_blocks)
+// holding n points; returns where the decoders start (the float anchors).
+DecoderStarts write_block_head16(const FftHeader& h, std::uint8_t* block, Vec3f p0, Vec3f p1, std::uint32_t fiber_id,
+                                 std::uint32_t b, std::uint32_t n_blocks, std::uint32_t n) {
     const bool first = b == 0, last = b + 1 == n_blocks;
-    if (h.direction_bits() == 16) {
-        const Quantized q0 = quantize_point(h, p0, kUnorm24Max), q1 = quantize_point(h, p1, kUnorm24Max);
-        for (int i = 0; i < 3; ++i) put_le(block + 3 * i, q0.q[i], 3), put_le(block + 9 + 3 * i, q1.q[i], 3);
-        put_le(block + kBlock16FiberIdOffset, fiber_id, 4);
-        put_le(block + kBlock16FlagsOffset, (first ? 0u : kFlag16NotFirst) | (last ? 0u : kFlag16NotLast) | n, 2);
-        auto decoded = [](const Quantized& q) {
-            return Vec3f{unpack_unorm24(q.q[0]), unpack_unorm24(q.q[1]), unpack_unorm24(q.q[2])};
-        };
-        DecoderStarts s;
-        s.a0 = decoded(q0), s.a1 = decoded(q1);
-        return s;
-    }
-    const DecoderStarts starts =
-        condition_anchors(normalized_point(h, p0), normalized_point(h, p1), reach, kRobustDivergence);
-    const AnchorWords& w = starts.words;
+    const Quantized q0 = quantize_point(h, p0, kUnorm24Max), q1 = quantize_point(h, p1, kUnorm24Max);
+    for (int i = 0; i < 3; ++i) put_le(block + 3 * i, q0.q[i], 3), put_le(block + 9 + 3 * i, q1.q[i], 3);
+    put_le(block + kBlock16FiberIdOffset, fiber_id, 4);
+    put_le(block + kBlock16FlagsOffset, (first ? 0u : kFlag16NotFirst) | (last ? 0u : kFlag16NotLast) | n, 2);
+    auto decoded = [](const Quantized& q) {
+        return Vec3f{unpack_unorm24(q.q[0]), unpack_unorm24(q.q[1]), unpack_unorm24(q.q[2])};
+    };
+    DecoderStarts s;
+    s.a0 = decoded(q0), s.a1 = decoded(q1);
+    return s;
+}
+
+// The same for an 8-bit block whose anchor words are chosen (condition_anchors).
+void write_block_head8(std::uint8_t* block, const AnchorWords& w, std::uint32_t fiber_id, std::uint32_t b,
+                       std::uint32_t n_blocks, std::uint32_t n) {
+    const bool first = b == 0, last = b + 1 == n_blocks;
     put_word(block + 0, w.a0[0], w.a0[1]);
     put_word(block + 4, w.a0[2], w.a1[0]);
     put_word(block + 8, w.a1[1], w.a1[2]);
@@ -92,7 +91,6 @@ DecoderStarts write_block_head(const FftHeader& h, std::uint8_t* block, Vec3f p0
     block[14] = std::uint8_t(fiber_id >> 8), block[15] = std::uint8_t(fiber_id);
     block[kBlockFlagsOffset] = std::uint8_t((first ? 0 : kFlagNotFirst) | (last ? 0 : kFlagNotLast) | n);
     block[kBlockIndexOffset] = std::uint8_t(b);  // modulo 256, as the format stores it
-    return starts;
 }
 
 FrameD frame_to_double(const Frame& f) { return {{to_double(f.c[0]), to_double(f.c[1]), to_double(f.c[2])}}; }
@@ -380,6 +378,8 @@ struct FiberEncoder::Encoding {
     }
 
     void write_block_heads();
+    void write_block_heads8();
+    std::pair<Vec3f, Vec3f> anchor_points(std::uint32_t b) const;
     void search_blocks();
     // A block of one of several fibers searched in SIMD lanes.
     struct LaneBlock {
@@ -409,28 +409,57 @@ struct FiberEncoder::Encoding {
 // Anchors: the block's first two points; a one-point block stores the point
 // extrapolated from the previous segment as its second anchor (the tangent
 // a renderer needs), a one-point fiber the point itself.
+std::pair<Vec3f, Vec3f> FiberEncoder::Encoding::anchor_points(std::uint32_t b) const {
+    const std::size_t i0 = std::size_t(b) * points_per_block;
+    const Vec3f p0 = fiber[i0];
+    if (block_points(b) >= 2) return {p0, fiber[i0 + 1]};
+    if (i0 == 0) return {p0, p0};
+    return {p0, {2 * p0.x - fiber[i0 - 1].x, 2 * p0.y - fiber[i0 - 1].y, 2 * p0.z - fiber[i0 - 1].z}};
+}
+
 void FiberEncoder::Encoding::write_block_heads() {
+    if (!wide) return write_block_heads8();
     for (std::uint32_t b = 0; b < n_blocks; ++b) {
         const std::size_t i0 = std::size_t(b) * points_per_block;
         const std::uint32_t n = block_points(b);
-        const Vec3f p0 = fiber[i0];
-        Vec3f p1 = p0;
-        if (n >= 2) {
-            p1 = fiber[i0 + 1];
-        } else if (i0 > 0) {
-            p1 = {2 * p0.x - fiber[i0 - 1].x, 2 * p0.y - fiber[i0 - 1].y, 2 * p0.z - fiber[i0 - 1].z};
-        }
-        const DecoderStarts head = write_block_head(header, &out[base + std::size_t(b) * block_bytes], p0, p1, fiber_id,
-                                                    b, n_blocks, n, block_reach(n));
+        const auto [p0, p1] = anchor_points(b);
+        std::uint8_t* block = &out[base + std::size_t(b) * block_bytes];
+        const DecoderStarts head = write_block_head16(header, block, p0, p1, fiber_id, b, n_blocks, n);
         scratch.points[i0] = head.a0;
         if (n >= 2) scratch.points[i0 + 1] = head.a1;
-        const BlockView16 written{&out[base + std::size_t(b) * block_bytes]};
-        if (wide)
-            scratch.frames[b] =
-                frame_from_axis(header.packed() ? packed16_anchor_axis(written) : anchor_axis(head.a0, head.a1));
-        else
+        const BlockView16 written{block};
+        scratch.frames[b] = frame_from_axis(header.packed() ? packed16_anchor_axis(written) : anchor_axis(head.a0, head.a1));
+    }
+}
+
+// 8-bit anchors: the nearest roundings' starts four blocks at a time
+// (decoder_starts4), then each block's conditioned where its start needs it
+// (condition_anchors).
+void FiberEncoder::Encoding::write_block_heads8() {
+    for (std::uint32_t b0 = 0; b0 < n_blocks; b0 += 4) {
+        const std::uint32_t count = std::min<std::uint32_t>(4, n_blocks - b0);
+        Vec3d n0[4], n1[4];
+        AnchorWords words[4];
+        double reach[4];
+        DecoderStarts nearest[4];
+        for (std::uint32_t i = 0; i < 4; ++i) {
+            const std::uint32_t b = b0 + std::min(i, count - 1);  // lanes past the last block repeat it
+            const auto [p0, p1] = anchor_points(b);
+            n0[i] = normalized_point(header, p0), n1[i] = normalized_point(header, p1);
+            words[i] = nearest_words(n0[i], n1[i]);
+            reach[i] = block_reach(block_points(b));
+        }
+        decoder_starts4(words, reach, nearest);
+        for (std::uint32_t i = 0; i < count; ++i) {
+            const std::uint32_t b = b0 + i, n = block_points(b);
+            const DecoderStarts head = condition_anchors(n0[i], n1[i], reach[i], kRobustDivergence, nearest[i]);
+            write_block_head8(&out[base + std::size_t(b) * block_bytes], head.words, fiber_id, b, n_blocks, n);
+            const std::size_t i0 = std::size_t(b) * points_per_block;
+            scratch.points[i0] = head.a0;
+            if (n >= 2) scratch.points[i0 + 1] = head.a1;
             scratch.frames[b] = head.frame;
-        if (!wide) scratch.starts[b] = head;
+            scratch.starts[b] = head;
+        }
     }
 }
 
