@@ -398,7 +398,11 @@ struct FiberEncoder::Encoding {
     void keep_lengths();
     static void keep_length_tails(std::span<Encoding> fibers);
     bool tails_only() const { return enc.length_stretch_ > 0 && enc.length_tails_only_ && !wide; }
-    std::pair<Frame, Vec3f> tail_start(const LengthTails::Search& t);
+    struct TailSearch {
+        Encoding* e;
+        LengthTails::Search search;
+    };
+    static void tail_starts(std::span<const TailSearch> group);
     void store_codes16();
     void append_decoded(std::vector<Vec3f>& decoded) const;
     void append_exact16(std::vector<Vec3f>& decoded_exact);
@@ -671,18 +675,32 @@ void FiberEncoder::Encoding::keep_lengths() {
         });
 }
 
-// The decoder's state before code t.j0 of a tail search's block, replayed
-// from the block's start (once for the block's tries).
-std::pair<Frame, Vec3f> FiberEncoder::Encoding::tail_start(const LengthTails::Search& t) {
-    Scratch::TailStart& c = scratch.tail_start;
-    if (c.block != t.block || c.j0 != t.j0) {
-        const Codebook8 cb = codebook8();
-        Frame f = scratch.frames[t.block];
-        const std::uint8_t* codes = codes8_of(t.block);
-        for (std::size_t k = 0; k < t.j0; ++k) f = compose(f, cb.frame(codes[k]));
-        c = {t.block, t.j0, f, scratch.points[std::size_t(t.block) * points_per_block + 1 + t.j0]};
+// The decoder's states before code j0 of the group's tail searches'
+// blocks (group[i].search), replayed from each block's start (once for a
+// block's tries: the fiber's cache), the blocks' frame products in step
+// with each other (each is a chain of dependent products).
+void FiberEncoder::Encoding::tail_starts(std::span<const TailSearch> group) {
+    struct Replay {
+        Scratch::TailStart* c;
+        const std::uint8_t* codes;
+    };
+    thread_local std::vector<Replay> replays;
+    replays.clear();
+    std::size_t longest = 0;
+    for (const TailSearch& g : group) {
+        Scratch::TailStart& c = g.e->scratch.tail_start;
+        const LengthTails::Search& t = g.search;
+        if (c.block == t.block && c.j0 == t.j0) continue;
+        c = {t.block, t.j0, g.e->scratch.frames[t.block],
+             g.e->scratch.points[std::size_t(t.block) * g.e->points_per_block + 1 + t.j0]};
+        replays.push_back({&c, g.e->codes8_of(t.block)});
+        longest = std::max(longest, t.j0);
     }
-    return {c.f, c.p};
+    if (replays.empty()) return;
+    const Codebook8 cb = group.front().e->codebook8();
+    for (std::size_t k = 0; k < longest; ++k)
+        for (const Replay& r : replays)
+            if (k < r.c->j0) r.c->f = compose(r.c->f, cb.frame(r.codes[k]));
 }
 
 // The fixed-step length tails (length_feedback.hpp) of several fibers,
@@ -691,10 +709,7 @@ std::pair<Frame, Vec3f> FiberEncoder::Encoding::tail_start(const LengthTails::Se
 // searches are independent: lookahead searches of the same length run
 // together, one per SIMD lane (lookahead_blocks.hpp).
 void FiberEncoder::Encoding::keep_length_tails(std::span<Encoding> fibers) {
-    struct Pending {
-        Encoding* e;
-        LengthTails::Search search;
-    };
+    using Pending = TailSearch;
     std::vector<Pending> waiting, group;
     auto next = [&](Encoding& e) {
         Pending p{&e, {}};
@@ -725,9 +740,10 @@ void FiberEncoder::Encoding::keep_length_tails(std::span<Encoding> fibers) {
         }
         waiting.resize(kept);
         batch.reset(m, group.size());
+        tail_starts(group);
         for (std::size_t i = 0; i < group.size(); ++i) {
-            const auto [f, p] = group[i].e->tail_start(group[i].search);
-            batch.set(i, f, p, group[i].search.targets);
+            const Scratch::TailStart& start = group[i].e->scratch.tail_start;
+            batch.set(i, start.f, start.p, group[i].search.targets);
         }
         if (lookahead)
             lookahead_blocks(cb, first.header.step, depth, LookaheadRivals::aim, batch.batch());
