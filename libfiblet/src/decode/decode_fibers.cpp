@@ -5,7 +5,6 @@
 // caller gives the whole output, in one pool job of parts that each thread
 // reads, counts and decodes alone.
 #include <algorithm>
-#include <atomic>
 #include <condition_variable>
 #include <exception>
 #include <mutex>
@@ -169,7 +168,7 @@ std::uint64_t decode_fibers_into(const FftFile& file, std::uint64_t begin, std::
     detail::OrderedEnds ends(parts);
     offsets[0] = 0;
     // Part p: its blocks read, counted, placed after the parts before it and decoded.
-    auto decode_part = [&](std::size_t p) {
+    detail::parallel_parts(ends, detail::resolve_threads(options.threads), [&](std::size_t p) {
         const std::uint64_t f0 = part_first[p], f1 = part_first[p + 1], b0 = file.block_end(f0);
         const std::uint64_t blocks = file.block_end(f1) - b0;
         thread_local std::vector<std::uint8_t> data;
@@ -189,28 +188,7 @@ std::uint64_t decode_fibers_into(const FftFile& file, std::uint64_t begin, std::
             offsets[f - begin + 1] = at;
         }
         detail::decode_resolved(ctx, data.data(), blocks, xyz.data() + 3 * start, decoder);
-    };
-    // The error reported is the first part's that failed, whichever thread
-    // failed first (a damaged block fails its part's structure check and
-    // the checksum of its group, which the next part may hash too): every
-    // part before a failed one runs, the parts after it stop.
-    std::vector<std::exception_ptr> failures(parts);
-    std::atomic<std::size_t> first_failed{parts};
-    auto fail = [&](std::size_t p) {
-        failures[p] = std::current_exception();
-        for (std::size_t f = first_failed.load(); p < f && !first_failed.compare_exchange_weak(f, p);) {
-        }
-    };
-    parallel_for(parts, detail::resolve_threads(options.threads), [&](std::size_t p) {
-        const detail::OrderedEnds::Guard guard{ends, p};
-        if (p > first_failed.load()) return;
-        try {
-            decode_part(p);
-        } catch (...) {
-            fail(p);
-        }
     });
-    if (first_failed.load() < parts) std::rethrow_exception(failures[first_failed.load()]);
     return ends.end();
 }
 

@@ -220,8 +220,7 @@ std::uint64_t FiberRegionTest::decode_kept_into(std::span<const FiberRange> cand
     std::vector<std::vector<std::uint32_t>> kept_points(parts.size());  // per part, per kept fiber
     detail::OrderedEnds ends(parts.size());
     const DecodeContext ctx(file_);
-    parallel_for(parts.size(), threads, [&](std::size_t p) {
-        const detail::OrderedEnds::Guard guard{ends, p};
+    detail::parallel_parts(ends, threads, [&](std::size_t p) {
         const std::uint64_t f0 = parts.first[p], f1 = parts.end[p], b0 = file_.first_block(f0);
         std::uint8_t* k = kept.data() + parts.flag_at[p];
         thread_local std::vector<std::uint8_t> blocks;
