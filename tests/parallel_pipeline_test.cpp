@@ -1,5 +1,6 @@
 // The worker pool and the pipelines on it (fiblet/parallel.hpp): every task
-// runs exactly once whatever the thread count, errors reach the caller,
+// runs exactly once whatever the thread count, errors reach the caller (of
+// parts published in order, the first failed part's),
 // nested and overlapping jobs finish, a wait that runs the next job
 // meanwhile keeps the two jobs' errors apart; compression writes the same bytes with
 // 1 or N threads (fixed-step and resampled input, with and without zstd),
@@ -25,6 +26,7 @@
 #include "fiblet/fft_file.hpp"
 #include "fiblet/parallel.hpp"
 #include "fiblet/tck.hpp"
+#include "core/ordered_ends.hpp"
 #include "test_util.hpp"
 
 using namespace fiblet;
@@ -119,6 +121,33 @@ std::string compressed(const std::string& tck, const std::string& out, unsigned 
 }
 
 }  // namespace
+
+// Parts publishing their outputs in order (detail::parallel_parts): a
+// later part that fails first does not hide an earlier part's error, every
+// part before the first failed one runs, the parts after it do not publish.
+TEST(WorkerPool, ParallelPartsReportTheFirstFailedPartsError) {
+    for (unsigned threads : {1u, 2u, 4u}) {
+        constexpr std::size_t kParts = 12;
+        detail::OrderedEnds ends(kParts);
+        std::atomic<int> ran[kParts] = {};
+        try {
+            detail::parallel_parts(ends, threads, [&](std::size_t p) {
+                ++ran[p];
+                if (p == 7) throw std::runtime_error("part 7");  // at once
+                if (p == 3) {
+                    std::this_thread::sleep_for(std::chrono::milliseconds(30));
+                    throw std::runtime_error("part 3");  // later, but earlier in order
+                }
+                ends.publish(p, 10);
+            });
+            ADD_FAILURE() << "no error reached the caller";
+        } catch (const std::runtime_error& e) {
+            EXPECT_STREQ(e.what(), "part 3") << threads << " threads";
+        }
+        for (std::size_t p = 0; p <= 3; ++p) EXPECT_EQ(ran[p].load(), 1) << p;
+        EXPECT_EQ(ends.end(), detail::OrderedEnds::kFailed);
+    }
+}
 
 TEST(CompressThreads, TheSameBytesWithAnyThreadCount) {
     if (!test::shared_data_available()) GTEST_SKIP() << "no shared data";
