@@ -74,6 +74,13 @@ void expect_same(const DecoderStarts& got, const DecoderStarts& want, std::size_
     EXPECT_EQ(got.fallback, want.fallback) << i;
 }
 
+// A block's start from its words, the scalar way (decoder_starts, start_divergence).
+DecoderStarts started(const AnchorWords& w, double reach) {
+    DecoderStarts s = decoder_starts(w);
+    s.divergence = start_divergence(s, reach);
+    return s;
+}
+
 TEST(AnchorConditioning, FourStartsAtOnceAreTheScalarStarts) {
     const std::vector<AnchorWords> words = test_words();
     std::size_t fallbacks = 0;
@@ -84,8 +91,7 @@ TEST(AnchorConditioning, FourStartsAtOnceAreTheScalarStarts) {
             DecoderStarts four[4];
             decoder_starts4(&words[i], reach, four);
             for (std::size_t j = 0; j < 4; ++j) {
-                DecoderStarts one = decoder_starts(words[i + j]);
-                one.divergence = start_divergence(one, reach[j]);
+                const DecoderStarts one = started(words[i + j], reach[j]);
                 expect_same(four[j], one, i + j);
                 fallbacks += simd && one.fallback;
             }
@@ -94,24 +100,41 @@ TEST(AnchorConditioning, FourStartsAtOnceAreTheScalarStarts) {
     EXPECT_GT(fallbacks, 10u);  // the words near ±C reach the fallback's cone
 }
 
-// condition_anchors from a given nearest start is condition_anchors.
-TEST(AnchorConditioning, SearchFromTheNearestStartIsTheWholeSearch) {
+// condition_anchors from the nearest rounding's start: that start where it
+// needs no search; else a start whose fields are its own words' (not the
+// nearest's left over), never the fallback's, and on a rounding within a
+// few quanta of the nearest.
+TEST(AnchorConditioning, TheSearchStartsFromTheNearestRoundingsStart) {
     std::mt19937 rng(3);
     std::uniform_real_distribution<double> u(0.2, 0.8), small(-2e-3, 2e-3);
     const double helper[3] = {kFrameHelper[0], kFrameHelper[1], kFrameHelper[2]};
-    std::size_t searched = 0;
+    std::size_t searched = 0, fallbacks = 0;
     for (int i = 0; i < 300; ++i) {
         const Vec3d n0{u(rng), u(rng), u(rng)};
-        const double along_c = i % 2 ? 2e-3 : 0.0;  // every other first segment along C
-        const Vec3d n1{n0.x + along_c * helper[0] + small(rng), n0.y + along_c * helper[1] + small(rng) * (1 - i % 2),
-                       n0.z + along_c * helper[2] + small(rng) * (1 - i % 2)};
+        // Random first segments, short ones near C, and long ones along C
+        // (their rounding stays in the fallback's cone).
+        const int kind = i % 3;
+        const double along_c = kind == 0 ? 0.0 : kind == 1 ? 2e-3 : 0.1, noise = kind == 2 ? 0.0 : 1.0;
+        const Vec3d n1{n0.x + along_c * helper[0] + noise * small(rng),
+                       n0.y + along_c * helper[1] + noise * small(rng) * (kind == 0),
+                       n0.z + along_c * helper[2] + noise * small(rng) * (kind == 0)};
         const double reach = 0.01, threshold = 0.5 / 65535.0;
-        DecoderStarts nearest = decoder_starts(nearest_words(n0, n1));
-        nearest.divergence = start_divergence(nearest, reach);
-        searched += nearest.fallback || nearest.divergence > threshold;
-        expect_same(condition_anchors(n0, n1, reach, threshold, nearest), condition_anchors(n0, n1, reach, threshold), i);
+        const DecoderStarts nearest = started(nearest_words(n0, n1), reach);
+        const DecoderStarts got = condition_anchors(n0, n1, reach, threshold, nearest);
+        if (!nearest.fallback && !(nearest.divergence > threshold)) {
+            expect_same(got, nearest, i);
+            continue;
+        }
+        ++searched, fallbacks += nearest.fallback;
+        expect_same(got, started(got.words, reach), i);
+        EXPECT_FALSE(got.fallback) << i;
+        for (int k = 0; k < 3; ++k) {
+            EXPECT_LE(std::abs(std::int64_t(got.words.a0[k]) - std::int64_t(nearest.words.a0[k])), 1) << i;
+            EXPECT_LE(std::abs(std::int64_t(got.words.a1[k]) - std::int64_t(nearest.words.a1[k])), 4) << i;
+        }
     }
     EXPECT_GT(searched, 0u);
+    EXPECT_GT(fallbacks, 0u);
 }
 
 }  // namespace

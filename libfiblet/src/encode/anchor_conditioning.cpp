@@ -82,14 +82,7 @@ AnchorWords rounded_words(Vec3d n0, Vec3d n1, unsigned up_mask, bool nearest) {
 
 AnchorWords nearest_words(Vec3d n0, Vec3d n1) { return rounded_words(n0, n1, 0, true); }
 
-DecoderStarts condition_anchors(Vec3d n0, Vec3d n1, double reach, double threshold) {
-    DecoderStarts nearest = decoder_starts(nearest_words(n0, n1));
-    nearest.divergence = start_divergence(nearest, reach);
-    return condition_anchors(n0, n1, reach, threshold, nearest);
-}
-
 DecoderStarts condition_anchors(Vec3d n0, Vec3d n1, double reach, double threshold, const DecoderStarts& nearest) {
-    auto words = [&](unsigned up_mask, bool nearest_rounding) { return rounded_words(n0, n1, up_mask, nearest_rounding); };
     DecoderStarts best = nearest;
     bool fallback = best.fallback;
     if (!(best.divergence > threshold) && !fallback) return best;
@@ -105,14 +98,14 @@ DecoderStarts condition_anchors(Vec3d n0, Vec3d n1, double reach, double thresho
         const double cost = error + kDivergenceWeight * s.divergence;
         if (cost < best_cost) best_cost = cost, best = s, fallback = false;
     };
-    for (unsigned mask = 0; mask < 64; ++mask) offer(words(mask, false));
+    for (unsigned mask = 0; mask < 64; ++mask) offer(rounded_words(n0, n1, mask, false));
     // Anchors on the grid round one way only: the second one moved by a
     // quantum on each axis turns the first axis away from C (a 0.1 mm step
     // turns by 1.7 degrees a quantum of a 200 mm box, the fallback's cone is 0.06).
     for (int q = 1; fallback && q <= kFallbackQuanta; ++q)
         for (int i = 0; i < 27; ++i) {
             if (i == 13) continue;  // no move: the nearest rounding, refused above
-            AnchorWords w = words(0, true);
+            AnchorWords w = nearest.words;
             for (int a = 0, code = i; a < 3; ++a, code /= 3)
                 w.a1[a] = std::uint32_t(std::clamp<std::int64_t>(std::int64_t(w.a1[a]) + (code % 3 - 1) * q, 0, 65535));
             offer(w);

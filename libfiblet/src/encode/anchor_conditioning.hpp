@@ -46,25 +46,25 @@ inline double walk_divergence(std::size_t m, double step) {
     return k * 1.7320508 * 0x1p-25 + 5e-7 * step * k * k;
 }
 
-// The anchor words of a block whose anchors should be at n0, n1 (normalized,
-// exact): each value rounded to the nearest unorm16 — unless the decoders
-// then diverge by more than `threshold` over `reach`, which happens where
-// the first segment runs nearly along the helper vector C. Then every
-// combination of rounding each value up or down is tried (64), and the one
-// with the smallest anchor error plus a tenth of the divergence is kept: moving
-// an anchor by less than one quantum turns the first axis away from C or
-// changes its float rounding; the robust code search (code_search.hpp)
-// then splits what divergence remains between the two decoders.
-// A start whose float or exact frame would take the C' fallback (which the
-// original decoder lacks, formats/fft.md §4) is never kept: the second anchor moves
-// by up to a few quanta until the first axis leaves the fallback's cone.
-// Returns the chosen words with both decoders' starts and their divergence.
-DecoderStarts condition_anchors(Vec3d n0, Vec3d n1, double reach, double threshold);
-
-// condition_anchors in two parts, so that the first runs for several
-// blocks at once: the nearest rounding's words, then (given their start,
-// `nearest`, with its divergence) the search, if the start needs one.
+// The nearest unorm16 rounding of anchors that should be at n0, n1
+// (normalized, exact): condition_anchors' first candidate.
 AnchorWords nearest_words(Vec3d n0, Vec3d n1);
+
+// The anchor words of a block whose anchors should be at n0, n1, given
+// `nearest`, the start of nearest_words(n0, n1) (decoder_starts, with its
+// start_divergence over `reach`; decoder_starts4 makes four at once): that
+// start — unless the decoders then diverge by more than `threshold` over
+// `reach`, which happens where the first segment runs nearly along the
+// helper vector C. Then every combination of rounding each value up or
+// down is tried (64), and the one with the smallest anchor error plus a
+// tenth of the divergence is kept: moving an anchor by less than one
+// quantum turns the first axis away from C or changes its float rounding;
+// the robust code search (code_search.hpp) then splits what divergence
+// remains between the two decoders. A start whose float or exact frame
+// would take the C' fallback (which the original decoder lacks,
+// formats/fft.md §4) is never kept: the second anchor moves by up to a few
+// quanta until the first axis leaves the fallback's cone. Returns the
+// chosen words with both decoders' starts and their divergence.
 DecoderStarts condition_anchors(Vec3d n0, Vec3d n1, double reach, double threshold, const DecoderStarts& nearest);
 
 // decoder_starts(w[i]) with its start_divergence(.., reach[i]) for i < 4:
