@@ -62,10 +62,11 @@ private:
     static constexpr double kBinsPerMm = 1e5;     // 0.01 µm bins
     static constexpr std::size_t kBins = 200000;  // up to 2 mm
     static constexpr std::size_t kPageBins = 2048;  // 20.48 µm per page
+    static constexpr std::size_t kPageWords = 2 * kPageBins;  // a page's counts: two halves (add_each)
     static constexpr std::size_t kNoPage = ~std::size_t(0);
     void select_page(std::size_t p);
 
-    // Empty until a bin of the page is counted; then 2 kPageBins counts, a
+    // Empty until a bin of the page is counted; then kPageWords counts, a
     // bin's count the sum of its two halves' (add_each).
     std::vector<std::vector<std::uint64_t>> pages_;
     std::uint64_t count_ = 0;

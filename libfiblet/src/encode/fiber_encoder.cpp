@@ -709,10 +709,9 @@ void FiberEncoder::Encoding::tail_starts(std::span<const TailSearch> group) {
 // searches are independent: lookahead searches of the same length run
 // together, one per SIMD lane (lookahead_blocks.hpp).
 void FiberEncoder::Encoding::keep_length_tails(std::span<Encoding> fibers) {
-    using Pending = TailSearch;
-    std::vector<Pending> waiting, group;
+    std::vector<TailSearch> waiting, group;
     auto next = [&](Encoding& e) {
-        Pending p{&e, {}};
+        TailSearch p{&e, {}};
         if (e.scratch.tails->next([&](std::uint32_t b) { return !e.robust(b); }, p.search)) waiting.push_back(p);
     };
     for (Encoding& e : fibers) {
@@ -734,7 +733,7 @@ void FiberEncoder::Encoding::keep_length_tails(std::span<Encoding> fibers) {
         group.clear();
         const std::size_t m = waiting.front().search.targets.size();
         std::size_t kept = 0;
-        for (const Pending& p : waiting) {
+        for (const TailSearch& p : waiting) {
             if ((lookahead || group.empty()) && p.search.targets.size() == m) group.push_back(p);
             else waiting[kept++] = p;
         }

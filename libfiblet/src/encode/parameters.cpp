@@ -103,10 +103,13 @@ void TurnStatistics::add_fiber(std::span<const Vec3f> f, const FiberSegments& se
         thread_local std::vector<std::int32_t> bin;
         const std::size_t turns = turn_sizes_avx2(segments, s2, bin);
         double fiber_max = -1;
-        for (std::size_t t = 0; t < turns; ++t) fiber_max = std::max(fiber_max, s2[t]), ++bins_[std::size_t(bin[t])];
-        const std::size_t first_max = std::size_t(std::find(s2.begin(), s2.begin() + std::ptrdiff_t(turns), fiber_max) - s2.begin());
+        std::size_t at = 0;
+        for (std::size_t t = 0; t < turns; ++t) {
+            if (s2[t] > fiber_max) fiber_max = s2[t], at = t + 1;
+            ++bins_[std::size_t(bin[t])];
+        }
         count_ += turns;
-        return keep_sharpest(f, fiber_max, first_max + 1);
+        return keep_sharpest(f, fiber_max, at);
     }
 #endif
     add_turns(f, [&](double, std::size_t i) { return segments.length[i - 1]; });

@@ -16,7 +16,7 @@ ErrorStats::ErrorStats() : pages_((kBins + 1 + kPageBins - 1) / kPageBins) {}
 
 void ErrorStats::select_page(std::size_t p) {
     std::vector<std::uint64_t>& page = pages_[p];
-    if (page.empty()) page.resize(2 * kPageBins, 0);
+    if (page.empty()) page.resize(kPageWords, 0);
     page_ = page.data(), page_index_ = p;
 }
 
@@ -156,8 +156,8 @@ void ErrorStats::merge(const ErrorStats& o) {
     sum_sq_ += o.sum_sq_;
     for (std::size_t p = 0; p < pages_.size(); ++p) {
         if (o.pages_[p].empty()) continue;
-        if (pages_[p].empty()) pages_[p].resize(2 * kPageBins, 0);
-        for (std::size_t i = 0; i < 2 * kPageBins; ++i) pages_[p][i] += o.pages_[p][i];
+        if (pages_[p].empty()) pages_[p].resize(kPageWords, 0);
+        for (std::size_t i = 0; i < kPageWords; ++i) pages_[p][i] += o.pages_[p][i];
     }
 }
 
