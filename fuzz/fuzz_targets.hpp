@@ -145,7 +145,8 @@ inline double resampled_points_bound(const std::string& path);
 // content (invalid_input, unsupported), never the format.
 inline void compress_reads_back(const std::string& path, const std::vector<std::uint32_t>& sizes,
                                 bool content_refusals_only) {
-    if (resampled_points_bound(path) > 200000) return;
+    const double bound = resampled_points_bound(path);
+    if (bound > 200000) return;
     const std::string out = scratch_dir() + "/out.fft";
     CompressReport report;
     try {
@@ -164,6 +165,8 @@ inline void compress_reads_back(const std::string& path, const std::vector<std::
         const FftFile f(out);
         check(f.header().fibers == sizes.size(), "fiber count changed");
         check(f.checksums() != nullptr, "compress wrote no checksum");
+        if (report.resampled)
+            check(double(f.header().points) <= std::max(bound, 1e4), "resampled beyond resampled_points_bound (slow)");
         std::uint64_t fiber = 0;
         decode_file(f, [&](std::uint64_t first, const Streamlines& s) {
             check(first == fiber, "decode_file skipped fibers");
@@ -213,10 +216,13 @@ inline void streamline_source_target(const std::uint8_t* data, std::size_t size)
 }
 
 // An upper bound on the points compress may resample a .tck into: its
-// polyline length over a quarter of the smallest step it may pick (the
-// declared step_size or the median spacing; block_keeping_step goes down to
-// a quarter). A few points far apart can stand for millions of resampled
-// ones, which the point limit below does not see.
+// polyline length over a fifth of the smallest step it may pick (the
+// declared step_size or the median spacing, the centre of a narrow
+// histogram bin; block_keeping_step goes down to a quarter). The median is
+// LengthHistogram's: the lower median of every segment, zero-length ones
+// included (with seven repeated points among sixteen segments it is the
+// shortest non-zero one). A few points far apart can stand for millions of
+// resampled ones, which the point limit below does not see.
 inline double resampled_points_bound(const std::string& path) {
     const auto source = open_streamline_source(path, {});
     StreamlineSource& r = *source;
@@ -228,12 +234,14 @@ inline double resampled_points_bound(const std::string& path) {
             const double dx = double(f[k].x) - f[k - 1].x, dy = double(f[k].y) - f[k - 1].y, dz = double(f[k].z) - f[k - 1].z;
             const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
             length += d;
-            if (d > 0) spacing.push_back(d);
+            spacing.push_back(d);
         }
     if (spacing.empty()) return 0;
-    std::nth_element(spacing.begin(), spacing.begin() + std::ptrdiff_t(spacing.size() / 2), spacing.end());
-    const double step = std::min(spacing[spacing.size() / 2], r.step_size().value_or(INFINITY));
-    return length / (0.25 * step);
+    const auto median = spacing.begin() + std::ptrdiff_t((spacing.size() - 1) / 2);  // the first with half at or below
+    std::nth_element(spacing.begin(), median, spacing.end());
+    const double step = std::min(*median, r.step_size().value_or(INFINITY));
+    if (!(step > 0)) return 0;  // compress refuses a zero step, or has nothing to resample
+    return length / (0.2 * step);
 }
 
 // The whole compression of small valid .tck inputs, and a decode of what it
