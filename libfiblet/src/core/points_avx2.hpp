@@ -111,24 +111,30 @@ __attribute__((target("avx2"))) inline void deltas8(const Vec3f* p, __m256d dx[2
 // minima and maxima (vminps / vmaxps return their second operand for a NaN,
 // so a NaN coordinate is left out, as `p < lo ? p : lo` leaves it); returns
 // the points done, the rest for the caller's scalar loop.
+// (Six named registers: as arrays indexed in the loop, GCC kept them on the
+// stack, a store and a reload a step.)
 __attribute__((target("avx2"))) inline std::size_t bounds_avx2(const Vec3f* p, std::size_t n, float* lo, float* hi) {
     if (n < 8) return 0;
     const float* f = &p->x;
-    __m256 mn[3], mx[3];
-    for (int r = 0; r < 3; ++r) mn[r] = _mm256_set1_ps(lo[0]), mx[r] = _mm256_set1_ps(hi[0]);
+    __m256 mn0 = _mm256_set1_ps(lo[0]), mn1 = mn0, mn2 = mn0, mx0 = _mm256_set1_ps(hi[0]), mx1 = mx0, mx2 = mx0;
     std::size_t k = 0;
-    for (; k + 8 <= n; k += 8)
-        for (int r = 0; r < 3; ++r) {
-            const __m256 v = _mm256_loadu_ps(f + 3 * k + 8 * r);
-            mn[r] = _mm256_min_ps(v, mn[r]), mx[r] = _mm256_max_ps(v, mx[r]);
-        }
+    for (; k + 8 <= n; k += 8) {
+        const __m256 v0 = _mm256_loadu_ps(f + 3 * k), v1 = _mm256_loadu_ps(f + 3 * k + 8),
+                     v2 = _mm256_loadu_ps(f + 3 * k + 16);
+        mn0 = _mm256_min_ps(v0, mn0), mx0 = _mm256_max_ps(v0, mx0);
+        mn1 = _mm256_min_ps(v1, mn1), mx1 = _mm256_max_ps(v1, mx1);
+        mn2 = _mm256_min_ps(v2, mn2), mx2 = _mm256_max_ps(v2, mx2);
+    }
     alignas(32) float lanes_lo[3][8], lanes_hi[3][8];
-    for (int r = 0; r < 3; ++r) _mm256_store_ps(lanes_lo[r], mn[r]), _mm256_store_ps(lanes_hi[r], mx[r]);
-    for (int r = 0; r < 3; ++r)
-        for (int i = 0; i < 8; ++i) {
-            const int c = (8 * r + i) % 3;
-            lo[c] = lanes_lo[r][i] < lo[c] ? lanes_lo[r][i] : lo[c], hi[c] = lanes_hi[r][i] > hi[c] ? lanes_hi[r][i] : hi[c];
-        }
+    _mm256_store_ps(lanes_lo[0], mn0), _mm256_store_ps(lanes_lo[1], mn1), _mm256_store_ps(lanes_lo[2], mn2);
+    _mm256_store_ps(lanes_hi[0], mx0), _mm256_store_ps(lanes_hi[1], mx1), _mm256_store_ps(lanes_hi[2], mx2);
+    // The 24 lanes in order are coordinates x y z x y z ...: eight points.
+    const float *a = &lanes_lo[0][0], *b = &lanes_hi[0][0];
+    float l[3] = {lo[0], lo[1], lo[2]}, h[3] = {hi[0], hi[1], hi[2]};
+    for (int j = 0; j < 24; j += 3)
+        for (int c = 0; c < 3; ++c)
+            l[c] = a[j + c] < l[c] ? a[j + c] : l[c], h[c] = b[j + c] > h[c] ? b[j + c] : h[c];
+    for (int c = 0; c < 3; ++c) lo[c] = l[c], hi[c] = h[c];
     return k;
 }
 
