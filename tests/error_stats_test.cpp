@@ -97,8 +97,29 @@ TEST(ErrorStats, AddAllVectorsEqualScalarLoop) {
     for (double p : {1.0, 50.0, 99.0, 99.99, 100.0}) EXPECT_EQ(vectors.percentile_mm(p), scalar.percentile_mm(p)) << p;
 }
 
-// add_all_roots of squared errors is add_all of their square roots (std::sqrt)
-// bit for bit, with and without the vector loop, for calls of 1 to 13.
+// add_all_roots of `squares` (in calls of 1 to 13, with and without the
+// vector loop) against add_all of `roots`, bit for bit; squares[100] is
+// 6.25 (a root past the histogram).
+template <class T>
+void expect_roots_added_as(const std::vector<T>& squares, const std::vector<double>& roots) {
+    for (const bool vectors : {true, false}) {
+        const test::ScopedSimdLoops loops(vectors);
+        ErrorStats from_squares, plain;
+        for (std::size_t i = 0, n = 1; i < squares.size(); i += n, n = n % 13 + 1) {
+            from_squares.add_all_roots(&squares[i], std::min(n, squares.size() - i), i);
+            plain.add_all(&roots[i], std::min(n, squares.size() - i), i);
+        }
+        EXPECT_EQ(from_squares.count(), plain.count());
+        EXPECT_EQ(from_squares.mean_mm(), plain.mean_mm());
+        EXPECT_EQ(from_squares.rms_mm(), plain.rms_mm());
+        EXPECT_EQ(from_squares.max_mm(), 2.5);
+        EXPECT_EQ(from_squares.worst_fiber(), plain.worst_fiber());
+        for (double p : {1.0, 50.0, 99.0, 100.0}) EXPECT_EQ(from_squares.percentile_mm(p), plain.percentile_mm(p)) << p;
+    }
+}
+
+// add_all_roots of double squared errors is add_all of their square roots
+// (std::sqrt).
 TEST(ErrorStats, AddAllRootsEqualsAddAllOfTheRoots) {
     std::mt19937 rng(7);
     std::gamma_distribution<double> g(2.0, 0.004);
@@ -106,18 +127,21 @@ TEST(ErrorStats, AddAllRootsEqualsAddAllOfTheRoots) {
     for (std::size_t i = 0; i < e.size(); ++i) squares[i] = g(rng) * g(rng);
     squares[100] = 6.25, squares[2001] = 0.0;  // a root past the histogram, a zero
     for (std::size_t i = 0; i < e.size(); ++i) e[i] = std::sqrt(squares[i]);
-    for (const bool vectors : {true, false}) {
-        const test::ScopedSimdLoops loops(vectors);
-        ErrorStats roots, plain;
-        for (std::size_t i = 0, n = 1; i < e.size(); i += n, n = n % 13 + 1) {
-            roots.add_all_roots(&squares[i], std::min(n, e.size() - i), i);
-            plain.add_all(&e[i], std::min(n, e.size() - i), i);
-        }
-        EXPECT_EQ(roots.count(), plain.count());
-        EXPECT_EQ(roots.mean_mm(), plain.mean_mm());
-        EXPECT_EQ(roots.rms_mm(), plain.rms_mm());
-        EXPECT_EQ(roots.max_mm(), 2.5);
-        EXPECT_EQ(roots.worst_fiber(), plain.worst_fiber());
-        for (double p : {1.0, 50.0, 99.0, 100.0}) EXPECT_EQ(roots.percentile_mm(p), plain.percentile_mm(p)) << p;
+    expect_roots_added_as(squares, e);
+}
+
+// Float squares: each root is taken in float (std::sqrt of the float), then
+// added as a double; it stays within a float rounding of the double root.
+TEST(ErrorStats, AddAllRootsOfFloatSquaresTakesFloatRoots) {
+    std::mt19937 rng(11);
+    std::gamma_distribution<float> g(2.0f, 0.004f);
+    std::vector<float> squares(3000);
+    std::vector<double> float_roots(squares.size());
+    for (float& v : squares) v = g(rng) * g(rng);
+    squares[100] = 6.25f, squares[2001] = 0.0f;
+    for (std::size_t i = 0; i < squares.size(); ++i) {
+        float_roots[i] = double(std::sqrt(squares[i]));
+        EXPECT_NEAR(float_roots[i], std::sqrt(double(squares[i])), 1e-7 * std::sqrt(double(squares[i])));
     }
+    expect_roots_added_as(squares, float_roots);
 }

@@ -335,6 +335,70 @@ TEST(GeometryError, VectorsEqualScalarLoops) {
     detail::geometry_shortcut_enabled() = true;
 }
 
+// The vector loops skip a polyline's forward tests where every turn is
+// under 28 degrees: there, every pair of segments up to three apart has a
+// non-negative float dot product (what the tests would have found). Planar
+// curls turning the same way by 27 degrees a step are skipped, by 31 (three
+// steps: 93 degrees, a negative dot) and 50 degrees never; random 3-D turns
+// up to 10 to 60 degrees are checked against the tests themselves.
+TEST(GeometryError, ForwardTestsAreSkippedOnlyWhereTheyHold) {
+    auto planar_curl = [](double degrees, int n) {
+        Line l{{10, 20, 30}};
+        for (int i = 1; i < n; ++i) {
+            const double a = i * degrees * M_PI / 180;
+            l.push_back({float(l.back().x + 0.1 * std::cos(a)), float(l.back().y + 0.1 * std::sin(a)), l.back().z});
+        }
+        return l;
+    };
+    auto forward_tests_hold = [](const Line& l) {
+        auto u = [&](std::size_t s) {
+            return Vec3f{l[s + 1].x - l[s].x, l[s + 1].y - l[s].y, l[s + 1].z - l[s].z};
+        };
+        for (std::size_t s = 0; s + 1 < l.size(); ++s)
+            for (std::size_t t = s + 1; t <= s + 3 && t + 1 < l.size(); ++t) {
+                const Vec3f a = u(s), b = u(t);
+                if (!(a.x * b.x + a.y * b.y + a.z * b.z >= 0)) return false;
+            }
+        return true;
+    };
+    const bool vectors = detail::use_avx2_loops();
+    for (const int n : {10, 17, 64, 301}) {
+        EXPECT_EQ(detail::forward_tests_skipped(planar_curl(27, n)), vectors) << n;
+        EXPECT_FALSE(forward_tests_hold(planar_curl(31, n))) << n;
+        EXPECT_FALSE(detail::forward_tests_skipped(planar_curl(31, n))) << n;
+        EXPECT_FALSE(detail::forward_tests_skipped(planar_curl(50, n))) << n;
+    }
+    std::mt19937 rng(37);
+    int skipped = 0;
+    for (const double max_turn : {10.0, 27.0, 29.0, 45.0, 60.0})
+        for (int k = 0; k < 40; ++k) {
+            std::uniform_real_distribution<double> turn(0, max_turn * M_PI / 180);
+            std::normal_distribution<double> g(0, 1);
+            Line l{{0, 0, 0}};
+            double d[3] = {1, 0, 0};
+            for (int i = 1; i < 20 + 7 * k; ++i) {
+                // d turned by `turn` towards q, a random direction perpendicular to it.
+                double q[3] = {g(rng), g(rng), g(rng)}, along = 0, norm = 0;
+                for (int a = 0; a < 3; ++a) along += q[a] * d[a];
+                for (int a = 0; a < 3; ++a) q[a] -= along * d[a], norm += q[a] * q[a];
+                const double t = turn(rng);
+                for (int a = 0; a < 3; ++a) d[a] = std::cos(t) * d[a] + std::sin(t) * q[a] / std::sqrt(norm);
+                l.push_back({float(l.back().x + 0.1 * d[0]), float(l.back().y + 0.1 * d[1]), float(l.back().z + 0.1 * d[2])});
+            }
+            const bool skip = detail::forward_tests_skipped(l);
+            skipped += skip;
+            if (skip) {
+                EXPECT_TRUE(forward_tests_hold(l)) << max_turn << " " << k;
+            }
+            if (max_turn <= 27 && vectors) {
+                EXPECT_TRUE(skip) << max_turn << " " << k;
+            }
+        }
+    if (vectors) {
+        EXPECT_GE(skipped, 80);
+    }
+}
+
 // add_fiber's pointwise squares (compress's point errors of fixed-step
 // input, taken from the report's own computation): each is the pair's
 // squared distance in double, ((dx dx + dy dy) + dz dz), whichever loops

@@ -43,7 +43,8 @@ public:
     // add_all of the square roots of squared errors (mm²), taken in the same
     // pass (correctly rounded, as std::sqrt): the callers measure squares.
     void add_all_roots(const double* squares_mm2, std::size_t n, std::uint64_t fiber);
-    // The same of float squares (each taken as its double value).
+    // The same of float squares, each root taken in float (std::sqrt of the
+    // float, correctly rounded), then as a double.
     void add_all_roots(const float* squares_mm2, std::size_t n, std::uint64_t fiber);
     void merge(const ErrorStats& other);
 

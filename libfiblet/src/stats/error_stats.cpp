@@ -22,6 +22,14 @@ void ErrorStats::select_page(std::size_t p) {
 
 namespace {
 
+// An error from a value: the value, or the root of a squared error in the
+// squares' own precision (a float square's root in float: its distance is
+// float arithmetic already, and vsqrtps takes a fraction of vsqrtpd's time).
+template <bool kRoots, class T>
+double error_of(T v) {
+    return kRoots ? double(std::sqrt(v)) : double(v);
+}
+
 // Four running sums of errors and of squares, error k into lane k % 4:
 // the same bits whichever loop fills them.
 struct LaneSums {
@@ -54,12 +62,14 @@ __attribute__((target("avx2"))) std::size_t sums_and_bins_avx2(const T* values, 
     __m128i lowest_bin = _mm_set1_epi32(range.lo), highest_bin = _mm_set1_epi32(range.hi);
     std::size_t k = 0;
     for (; k + 4 <= n; k += 4) {
-        __m256d v;
-        if constexpr (sizeof(T) == sizeof(float))
-            v = _mm256_cvtps_pd(_mm_loadu_ps(values + k));
-        else
-            v = _mm256_loadu_pd(values + k);
-        const __m256d e = kRoots ? _mm256_sqrt_pd(v) : v;
+        __m256d e;
+        if constexpr (sizeof(T) == sizeof(float)) {
+            const __m128 v = _mm_loadu_ps(values + k);
+            e = _mm256_cvtps_pd(kRoots ? _mm_sqrt_ps(v) : v);
+        } else {
+            const __m256d v = _mm256_loadu_pd(values + k);
+            e = kRoots ? _mm256_sqrt_pd(v) : v;
+        }
         sum = _mm256_add_pd(sum, e);
         sum_sq = _mm256_add_pd(sum_sq, _mm256_mul_pd(e, e));
         largest = _mm256_max_pd(e, largest);
@@ -100,14 +110,14 @@ void ErrorStats::add_each(const T* values, std::size_t n, std::uint64_t fiber) {
     if (bins.size() < n) bins.resize(n);
     LaneSums lanes;
     BinRange range;
-    double max = kRoots ? std::sqrt(double(values[0])) : double(values[0]);
+    double max = error_of<kRoots>(values[0]);
     std::size_t k = 0;
 #ifdef FIBLET_POINTS_AVX2
     if (detail::use_avx2_loops())
         k = sums_and_bins_avx2<kRoots, T>(values, n, kBinsPerMm, kBins, lanes, max, bins.data(), range);
 #endif
     for (; k < n; ++k) {
-        const double e = kRoots ? std::sqrt(double(values[k])) : double(values[k]);
+        const double e = error_of<kRoots>(values[k]);
         lanes.sum[k % 4] += e;
         lanes.sum_sq[k % 4] += e * e;
         max = std::max(max, e);

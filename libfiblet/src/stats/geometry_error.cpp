@@ -239,6 +239,34 @@ void own_segments_at(const Segments& g, std::span<const Vec3f> from, std::span<c
 }
 
 #ifdef FIBLET_POINTS_AVX2
+// Whether every turn between consecutive segments is under 28 degrees
+// (u_s . u_(s+1) > 0 and its square above cos^2(28°) |u_s|^2 |u_(s+1)|^2):
+// then segments up to three apart turn by at most 84 degrees, the sum of the
+// turns between them, so every forward test holds (their float dot products
+// stay positive: rounding moves them by ~1e-6 of |u_a| |u_b|, cos 84° is
+// 0.10), and the proof needs no forward masks. Conservative: a zero-length
+// segment, or products that overflow or underflow, make a fiber not smooth.
+// Most tractography fibers and their decodings are smooth at their step.
+// smooth_avx2's test of the pairs (s .. s + 7, the segment after each).
+FIBLET_AVX2 __m256 smooth_pairs8(const ColumnPointers& g, std::size_t s) {
+    const __m256 dot = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_loadu_ps(g.ux + s), _mm256_loadu_ps(g.ux + s + 1)),
+                                                   _mm256_mul_ps(_mm256_loadu_ps(g.uy + s), _mm256_loadu_ps(g.uy + s + 1))),
+                                     _mm256_mul_ps(_mm256_loadu_ps(g.uz + s), _mm256_loadu_ps(g.uz + s + 1)));
+    const __m256 cos2 = _mm256_set1_ps(0.7796f);  // cos^2(28°) = 0.77960
+    const __m256 bound = _mm256_mul_ps(cos2, _mm256_mul_ps(_mm256_loadu_ps(g.uu + s), _mm256_loadu_ps(g.uu + s + 1)));
+    return _mm256_and_ps(_mm256_cmp_ps(dot, _mm256_setzero_ps(), _CMP_GT_OQ),
+                         _mm256_cmp_ps(_mm256_mul_ps(dot, dot), bound, _CMP_GT_OQ));
+}
+
+__attribute__((target("avx2"))) bool smooth_avx2(const Segments& segments) {
+    const std::size_t n = segments.count;  // pairs (s, s + 1) for s + 1 < n, eight at a time, the last eight overlapping
+    if (n < 9) return false;
+    const ColumnPointers g(segments);
+    __m256 all = smooth_pairs8(g, n - 9);
+    for (std::size_t s = 0; s + 9 <= n; s += 8) all = _mm256_and_ps(all, smooth_pairs8(g, s));
+    return _mm256_movemask_ps(all) == 0xff;
+}
+
 // OwnSegments::forward of every segment: each pair of segments up to three
 // apart is tested once, not once for each point it proves.
 __attribute__((target("avx2"))) void forward_avx2(const Segments& g, OwnSegments& out) {
@@ -286,7 +314,8 @@ FIBLET_AVX2 __m256 within_half_step(__m256 e4, const float* uu8) {
 
 // own_segments_at for points k .. k + 7 (4 <= k, k + 8 <= n), the points
 // read from both polylines' columns: the same distances bit for bit, the
-// same proof.
+// same proof (kSmooth: `to` is smooth_avx2, its forward tests all hold).
+template <bool kSmooth>
 FIBLET_AVX2 void own_segments8(const ColumnPointers& g, const ColumnPointers& p, const float* const forward[3],
                                std::size_t k, float* nearest, double* pointwise, std::uint8_t* proven,
                                std::uint8_t* later_out) {
@@ -298,14 +327,16 @@ FIBLET_AVX2 void own_segments8(const ColumnPointers& g, const ColumnPointers& p,
     const __m256 before = segment_dist2_avx2(g, x, y, z, k - 1), after = segment_dist2_avx2(g, x, y, z, k);
     const __m256 later = _mm256_cmp_ps(after, before, _CMP_LT_OQ);
     _mm256_storeu_ps(nearest + k, _mm256_blendv_ps(before, after, later));  // after < before ? after : before
-    // Segments k + 1 .. k + 3 not against k, and k - 4 .. k - 2 not against k - 1.
-    const float *f0 = forward[0], *f1 = forward[1], *f2 = forward[2];
-    const __m256 ahead =
-        _mm256_and_ps(_mm256_and_ps(_mm256_loadu_ps(f0 + k), _mm256_loadu_ps(f1 + k)), _mm256_loadu_ps(f2 + k));
-    const __m256 behind = _mm256_and_ps(_mm256_and_ps(_mm256_loadu_ps(f0 + k - 2), _mm256_loadu_ps(f1 + k - 3)),
-                                        _mm256_loadu_ps(f2 + k - 4));
-    const __m256 ok = _mm256_and_ps(_mm256_and_ps(within_half_step(e4, g.uu + k - 1), within_half_step(e4, g.uu + k)),
-                                    _mm256_and_ps(ahead, behind));
+    __m256 ok = _mm256_and_ps(within_half_step(e4, g.uu + k - 1), within_half_step(e4, g.uu + k));
+    if constexpr (!kSmooth) {
+        // Segments k + 1 .. k + 3 not against k, and k - 4 .. k - 2 not against k - 1.
+        const float *f0 = forward[0], *f1 = forward[1], *f2 = forward[2];
+        const __m256 ahead =
+            _mm256_and_ps(_mm256_and_ps(_mm256_loadu_ps(f0 + k), _mm256_loadu_ps(f1 + k)), _mm256_loadu_ps(f2 + k));
+        const __m256 behind = _mm256_and_ps(_mm256_and_ps(_mm256_loadu_ps(f0 + k - 2), _mm256_loadu_ps(f1 + k - 3)),
+                                            _mm256_loadu_ps(f2 + k - 4));
+        ok = _mm256_and_ps(ok, _mm256_and_ps(ahead, behind));
+    }
     store_mask_bytes(ok, proven + k);
     store_mask_bytes(later, later_out + k);
 }
@@ -314,6 +345,7 @@ FIBLET_AVX2 void own_segments8(const ColumnPointers& g, const ColumnPointers& p,
 // at a time; the last eight overlap the ones before where the count is not
 // a multiple of 8 (the same values stored again), so no point is left for
 // own_segments_at.
+template <bool kSmooth>
 __attribute__((target("avx2"))) void own_segments_avx2(const Segments& to_g, const Segments& from_g, float* nearest,
                                                        double* pointwise, OwnSegments& out) {
     const ColumnPointers g(to_g), p(from_g);
@@ -321,8 +353,8 @@ __attribute__((target("avx2"))) void own_segments_avx2(const Segments& to_g, con
     std::uint8_t *proven = out.proven.data(), *later = out.later.data();
     const std::size_t n = to_g.count;
     std::size_t k = 4;
-    for (; k + 8 <= n; k += 8) own_segments8(g, p, forward, k, nearest, pointwise, proven, later);
-    if (k < n) own_segments8(g, p, forward, n - 8, nearest, pointwise, proven, later);
+    for (; k + 8 <= n; k += 8) own_segments8<kSmooth>(g, p, forward, k, nearest, pointwise, proven, later);
+    if (k < n) own_segments8<kSmooth>(g, p, forward, n - 8, nearest, pointwise, proven, later);
 }
 #undef FIBLET_AVX2
 #endif
@@ -337,9 +369,13 @@ void own_segments(const Segments& g, const Segments& from_g, std::span<const Vec
 #ifdef FIBLET_POINTS_AVX2
     // The vector loop reads segments k - 4 .. k + 7 and lengths to k + 7.
     if (use_avx2_loops() && n >= 12) {
-        forward_avx2(g, out);
+        const bool smooth = smooth_avx2(g);
+        if (!smooth) forward_avx2(g, out);
         for (; k < 4; ++k) own_segments_at(g, from, to, k, nearest, pointwise, out);
-        own_segments_avx2(g, from_g, nearest, pointwise, out);
+        if (smooth)
+            own_segments_avx2<true>(g, from_g, nearest, pointwise, out);
+        else
+            own_segments_avx2<false>(g, from_g, nearest, pointwise, out);
         k = n;
     }
 #endif
@@ -358,16 +394,17 @@ std::size_t proven_run_end(const std::uint8_t* proven, std::size_t k, std::size_
     return k;
 }
 
-// The roots of n squared distances into `out`, and the pointwise squares,
-// both scaled back by unscale^2 (exact, in double) where the pair was
-// measured scaled (scale_exponent, below).
+// The roots of n squared distances into `out` (in float, as
+// add_all_roots), and the pointwise squares, the roots scaled back by
+// unscale and the squares by unscale^2 (exact, in double) where the pair
+// was measured scaled (scale_exponent, below).
 void add_squares(ErrorStats& out, const float* squares, std::size_t n, std::uint64_t fiber, double* pointwise,
                  double unscale) {
     if (unscale == 1.0) return out.add_all_roots(squares, n, fiber);
     thread_local std::vector<double> unscaled;
     double* u = at_least(unscaled, n);
-    for (std::size_t k = 0; k < n; ++k) u[k] = double(squares[k]) * unscale * unscale;
-    out.add_all_roots(u, n, fiber);
+    for (std::size_t k = 0; k < n; ++k) u[k] = double(std::sqrt(squares[k])) * unscale;
+    out.add_all(u, n, fiber);
     if (pointwise)
         for (std::size_t k = 0; k < n; ++k) pointwise[k] *= unscale * unscale;
 }
@@ -494,6 +531,18 @@ std::span<const Vec3f> scaled(std::span<const Vec3f> line, int k, std::vector<Ve
 bool& detail::geometry_shortcut_enabled() {
     thread_local bool enabled = true;
     return enabled;
+}
+
+bool detail::forward_tests_skipped(std::span<const Vec3f> line) {
+#ifdef FIBLET_POINTS_AVX2
+    if (!use_avx2_loops() || line.empty()) return false;
+    Segments g;
+    segments_of(line, g);
+    return smooth_avx2(g);
+#else
+    (void)line;
+    return false;
+#endif
 }
 
 
