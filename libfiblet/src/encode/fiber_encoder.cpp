@@ -340,13 +340,24 @@ struct FiberEncoder::Encoding {
           points_per_block(header.points_per_block), block_bytes(header.block_bytes()), n_points(f.size()),
           base(o.size()), n_blocks(e.block_count(f.size())), wide(e.tables_->table16.has_value()) {
         out.resize(base + std::size_t(n_blocks) * block_bytes, 0);
-        scratch.targets.resize(n_points);
-        scratch.points.resize(n_points);
-        scratch.frames.resize(n_blocks);
-        scratch.starts.resize(wide ? 0 : n_blocks);
+        // The scratch arrays only grow (every element the fiber uses is
+        // written before it is read): resizing one up after a shorter fiber
+        // filled its new elements for nothing.
+        grow(scratch.targets, n_points);
+        grow(scratch.points, n_points);
+        grow(scratch.frames, n_blocks);
+        if (!wide) grow(scratch.starts, n_blocks);
         if (wide) scratch.codes16.assign(n_points, 0);
         if (n_points) normalize_points(header, &fiber[0].x, &scratch.targets[0].x, n_points);
     }
+
+    template <class T>
+    static void grow(std::vector<T>& v, std::size_t n) {
+        if (v.size() < n) v.resize(n);
+    }
+    // The fiber's targets and decoded points (the scratch arrays may be longer).
+    std::span<const Vec3f> targets() const { return {scratch.targets.data(), n_points}; }
+    std::span<Vec3f> points() { return {scratch.points.data(), n_points}; }
 
     std::uint32_t block_points(std::uint32_t b) const {
         return std::uint32_t(std::min<std::size_t>(points_per_block, n_points - std::size_t(b) * points_per_block));
@@ -655,7 +666,7 @@ void FiberEncoder::Encoding::keep_lengths() {
     scratch.retry_codes8.resize(points_per_block);
     scratch.retry_codes16.resize(points_per_block);
     feed_back_length(
-        std::span<const Vec3f>(scratch.targets), std::span<Vec3f>(scratch.points), points_per_block, stretch,
+        targets(), points(), points_per_block, stretch,
         [&](std::uint32_t blk) { return wide || !robust(blk); },
         [&](std::uint32_t blk, std::span<const Vec3f> t, Vec3f* dec) {
             const std::size_t i0 = std::size_t(blk) * points_per_block;
@@ -716,8 +727,7 @@ void FiberEncoder::Encoding::keep_length_tails(std::span<Encoding> fibers) {
     };
     for (Encoding& e : fibers) {
         e.scratch.tail_start = {};
-        e.scratch.tails.emplace(std::span<const Vec3f>(e.scratch.targets), std::span<Vec3f>(e.scratch.points),
-                                e.points_per_block, kLengthFeedbackTail, kLengthFeedbackActShare,
+        e.scratch.tails.emplace(e.targets(), e.points(), e.points_per_block, kLengthFeedbackTail, kLengthFeedbackActShare,
                                 kLengthFeedbackFarActShare, kLengthFeedbackNearBlocks);
         next(e);
     }
