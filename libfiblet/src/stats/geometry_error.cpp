@@ -239,14 +239,6 @@ void own_segments_at(const Segments& g, std::span<const Vec3f> from, std::span<c
 }
 
 #ifdef FIBLET_POINTS_AVX2
-// Whether every turn between consecutive segments is under 28 degrees
-// (u_s . u_(s+1) > 0 and its square above cos^2(28°) |u_s|^2 |u_(s+1)|^2):
-// then segments up to three apart turn by at most 84 degrees, the sum of the
-// turns between them, so every forward test holds (their float dot products
-// stay positive: rounding moves them by ~1e-6 of |u_a| |u_b|, cos 84° is
-// 0.10), and the proof needs no forward masks. Conservative: a zero-length
-// segment, or products that overflow or underflow, make a fiber not smooth.
-// Most tractography fibers and their decodings are smooth at their step.
 // smooth_avx2's test of the pairs (s .. s + 7, the segment after each).
 FIBLET_AVX2 __m256 smooth_pairs8(const ColumnPointers& g, std::size_t s) {
     const __m256 dot = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_loadu_ps(g.ux + s), _mm256_loadu_ps(g.ux + s + 1)),
@@ -258,6 +250,14 @@ FIBLET_AVX2 __m256 smooth_pairs8(const ColumnPointers& g, std::size_t s) {
                          _mm256_cmp_ps(_mm256_mul_ps(dot, dot), bound, _CMP_GT_OQ));
 }
 
+// Whether every turn between consecutive segments is under 28 degrees
+// (u_s . u_(s+1) > 0 and its square above cos^2(28°) |u_s|^2 |u_(s+1)|^2):
+// then segments up to three apart turn by at most 84 degrees, the sum of the
+// turns between them, so every forward test holds (their float dot products
+// stay positive: rounding moves them by ~1e-6 of |u_a| |u_b|, cos 84° is
+// 0.10), and the proof needs no forward masks. Conservative: a zero-length
+// segment, or products that overflow or underflow, make a fiber not smooth.
+// Most tractography fibers and their decodings are smooth at their step.
 __attribute__((target("avx2"))) bool smooth_avx2(const Segments& segments) {
     const std::size_t n = segments.count;  // pairs (s, s + 1) for s + 1 < n, eight at a time, the last eight overlapping
     if (n < 9) return false;
