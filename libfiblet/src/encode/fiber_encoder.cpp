@@ -110,14 +110,21 @@ void exact_decoder_targets(const DecoderStarts& s, std::span<const Vec3f> target
 // lookahead before any beam (retry_with_lookahead).
 constexpr std::size_t kRetryLookahead = 2;
 
+// Scratch arrays reused from fiber to fiber and batch to batch are grown,
+// never shrunk: each user writes the elements it reads, and resizing one up
+// after a shrink zero-filled them for nothing (0.6 % of the default compress
+// for the batches, 0.4 % for the fibers' arrays).
+template <class T>
+void grow(std::vector<T>& v, std::size_t n) {
+    if (v.size() < n) v.resize(n);
+}
+
 // Blocks gathered from several fibers into one batch for the SIMD lanes
 // (greedy_blocks.hpp's layout: block j's start point, then its targets, at
 // points[j * stride]; its codes at codes[j * m]), and their results.
 struct BlockBatch {
     std::size_t m = 0, stride = 0, blocks = 0;
-    // Grown, never shrunk: every batch writes what it reads (resizing up
-    // and down zero-filled the points: 0.6 % of default compress).
-    std::vector<Frame> frames;
+    std::vector<Frame> frames;  // grown (grow)
     std::vector<Vec3f> points, decoded;
     std::vector<std::uint8_t> codes;
     std::vector<std::uint32_t> lengths;
@@ -125,9 +132,6 @@ struct BlockBatch {
     // Room for `count` blocks of at most m codes.
     void reset(std::size_t longest, std::size_t count) {
         m = longest, stride = m + 1, blocks = count;
-        auto grow = [](auto& v, std::size_t n) {
-            if (v.size() < n) v.resize(n);
-        };
         grow(frames, count), grow(points, count * stride), grow(decoded, count * stride);
         grow(codes, count * m), grow(lengths, count);
     }
@@ -340,10 +344,7 @@ struct FiberEncoder::Encoding {
           points_per_block(header.points_per_block), block_bytes(header.block_bytes()), n_points(f.size()),
           base(o.size()), n_blocks(e.block_count(f.size())), wide(e.tables_->table16.has_value()) {
         out.resize(base + std::size_t(n_blocks) * block_bytes, 0);
-        // The scratch arrays only grow (every element the fiber uses is
-        // written before it is read): resizing one up after a shorter fiber
-        // filled its new elements for nothing.
-        grow(scratch.targets, n_points);
+        grow(scratch.targets, n_points);  // longer than the fiber after a longer one: targets(), points()
         grow(scratch.points, n_points);
         grow(scratch.frames, n_blocks);
         if (!wide) grow(scratch.starts, n_blocks);
@@ -351,10 +352,6 @@ struct FiberEncoder::Encoding {
         if (n_points) normalize_points(header, &fiber[0].x, &scratch.targets[0].x, n_points);
     }
 
-    template <class T>
-    static void grow(std::vector<T>& v, std::size_t n) {
-        if (v.size() < n) v.resize(n);
-    }
     // The fiber's targets and decoded points (the scratch arrays may be longer).
     std::span<const Vec3f> targets() const { return {scratch.targets.data(), n_points}; }
     std::span<Vec3f> points() { return {scratch.points.data(), n_points}; }
