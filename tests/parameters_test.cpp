@@ -124,7 +124,9 @@ TEST(TurnStatistics, VectorLoopsEqualTheScalarLoops) {
         }
         ASSERT_EQ(segments.length, scalar_segments.length);
         for (std::size_t s = 0; s < segments.length.size(); ++s)  // NaN where a length is 0
-            if (segments.length[s] > 0) ASSERT_EQ(segments.ux[s], scalar_segments.ux[s]) << s;
+            if (segments.length[s] > 0) {
+                ASSERT_EQ(segments.ux[s], scalar_segments.ux[s]) << s;
+            }
         ASSERT_EQ(segments.positive, scalar_segments.positive);
         EXPECT_EQ(one_vectors.min_dot(), one_scalar.min_dot()) << f.size();
         EXPECT_EQ(one_vectors.sharpest_blocks(), one_scalar.sharpest_blocks()) << f.size();

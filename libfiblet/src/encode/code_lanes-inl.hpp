@@ -68,13 +68,14 @@ HWY_INLINE void GatherFloats(D d, const float* base, hn::Vec<hn::RebindToSigned<
 }
 
 // out[i] = base[at[i] + j] per lane, i < n, for records in a table (at:
-// float indices): with AVX2, each lane's record comes with plain 128-bit
-// loads and the rows are transposed in registers, since AMD's AVX2 gathers
-// cost per element (a frame's nine floats for eight lanes: ~13 ns by rows
-// against ~21 ns by pair gathers on this project's AVX2 EPYC VMs). The
-// same floats, so the same bits, as GatherFloats. Reads the record's floats
-// up to at[i] + 3 (n <= 4), + 7 (n <= 8) or + 8 (n == 9): the caller's
-// records must have them. Other targets and widths: GatherFloats.
+// float indices): with AVX2 (eight lanes) and AVX-512 (sixteen), each
+// lane's record comes with plain 128-bit loads and the rows are transposed
+// in registers, since AMD's gathers cost per element (a frame's nine floats
+// for eight lanes: ~13 ns by rows against ~21 ns by pair gathers on this
+// project's AVX2 EPYC VMs). The same floats, so the same bits, as
+// GatherFloats. Reads the record's floats up to at[i] + 3 (n <= 4), + 7
+// (n <= 8) or + 8 (n == 9): the caller's records must have them. Other
+// targets and widths: GatherFloats.
 #if HWY_TARGET == HWY_AVX2
 // Rows r0..r3 in the low halves and r4..r7 in the high halves of y[0..3]:
 // column c of the 4x4 blocks into col[c] (lane i: row i's float c).
@@ -92,8 +93,9 @@ HWY_INLINE __m256 RowPair(const float* const rec[8], int i, int from) {
     return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(rec[i] + from)), _mm_loadu_ps(rec[i + 4] + from), 1);
 }
 
-// Eight lanes: the records' first n floats (n <= 9) as columns.
-HWY_INLINE void LoadRecords8(const float* base, __m256i at, __m256* out, int n) {
+// Eight lanes: the records' first n floats (n <= 9) as columns (out[c].raw).
+template <class V>
+HWY_INLINE void LoadRecords8(const float* base, __m256i at, V* out, int n) {
     const __m128i lo = _mm256_castsi256_si128(at), hi = _mm256_extracti128_si256(at, 1);
     const std::uint64_t q[4] = {std::uint64_t(_mm_cvtsi128_si64(lo)), std::uint64_t(_mm_extract_epi64(lo, 1)),
                                 std::uint64_t(_mm_cvtsi128_si64(hi)), std::uint64_t(_mm_extract_epi64(hi, 1))};
@@ -103,26 +105,59 @@ HWY_INLINE void LoadRecords8(const float* base, __m256i at, __m256* out, int n) 
         __m256 y[4], col[4];
         for (int i = 0; i < 4; ++i) y[i] = RowPair(rec, i, from);
         TransposeHalves(y, col);
-        for (int c = 0; c < 4 && from + c < n; ++c) out[from + c] = col[c];
+        for (int c = 0; c < 4 && from + c < n; ++c) out[from + c].raw = col[c];
     }
     if (n == 9) {  // float 8: the last of floats 5..8
         __m256 y[4];
         for (int i = 0; i < 4; ++i) y[i] = RowPair(rec, i, 5);
         const __m256 t1 = _mm256_unpackhi_ps(y[0], y[1]), t3 = _mm256_unpackhi_ps(y[2], y[3]);
-        out[8] = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
+        out[8].raw = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
+    }
+}
+#endif
+
+#if HWY_TARGET == HWY_AVX3
+// Sixteen lanes: the records' first n floats (n <= 9) as columns. Each
+// vector takes the rows of lanes i, i + 4, i + 8 and i + 12 in its four
+// 128-bit quarters; a 4x4 transpose within the quarters puts lanes
+// 4q .. 4q + 3 in quarter q, in order.
+template <class V>
+HWY_INLINE void LoadRecords16(const float* base, __m512i at, V* out, int n) {
+    alignas(64) std::int32_t index[16];
+    _mm512_store_si512(index, at);
+    const float* rec[16];
+    for (int i = 0; i < 16; ++i) rec[i] = base + index[i];
+    auto rows = [&](int i, int from) {
+        __m512 v = _mm512_castps128_ps512(_mm_loadu_ps(rec[i] + from));
+        v = _mm512_insertf32x4(v, _mm_loadu_ps(rec[i + 4] + from), 1);
+        v = _mm512_insertf32x4(v, _mm_loadu_ps(rec[i + 8] + from), 2);
+        return _mm512_insertf32x4(v, _mm_loadu_ps(rec[i + 12] + from), 3);
+    };
+    for (int from = 0; from < std::min(n, 8); from += 4) {
+        __m512 y[4];
+        for (int i = 0; i < 4; ++i) y[i] = rows(i, from);
+        const __m512 t0 = _mm512_unpacklo_ps(y[0], y[1]), t1 = _mm512_unpackhi_ps(y[0], y[1]);
+        const __m512 t2 = _mm512_unpacklo_ps(y[2], y[3]), t3 = _mm512_unpackhi_ps(y[2], y[3]);
+        const __m512 col[4] = {_mm512_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)), _mm512_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)),
+                               _mm512_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)), _mm512_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2))};
+        for (int c = 0; c < 4 && from + c < n; ++c) out[from + c].raw = col[c];
+    }
+    if (n == 9) {  // float 8: the last of floats 5..8
+        __m512 y[4];
+        for (int i = 0; i < 4; ++i) y[i] = rows(i, 5);
+        const __m512 t1 = _mm512_unpackhi_ps(y[0], y[1]), t3 = _mm512_unpackhi_ps(y[2], y[3]);
+        out[8].raw = _mm512_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
     }
 }
 #endif
 
 template <class D>
 HWY_INLINE void LoadRecords(D d, const float* base, hn::Vec<hn::RebindToSigned<D>> at, hn::Vec<D>* out, int n) {
+#if HWY_TARGET == HWY_AVX3
+    if constexpr (hn::MaxLanes(D()) == 16) return LoadRecords16(base, at.raw, out, n);
+#endif
 #if HWY_TARGET == HWY_AVX2
-    if constexpr (hn::MaxLanes(D()) == 8) {
-        __m256 cols[9];
-        LoadRecords8(base, at.raw, cols, n);
-        for (int i = 0; i < n; ++i) out[i].raw = cols[i];
-        return;
-    }
+    if constexpr (hn::MaxLanes(D()) == 8) return LoadRecords8(base, at.raw, out, n);
 #endif
     GatherFloats(d, base, at, out, n);
 }
@@ -139,10 +174,13 @@ HWY_INLINE __m512i TruncateInRange(__m512 v) { return _mm512_cvttps_epi32(v); }
 // The 8-bit code book, one code per lane. A frame is held as nine vectors,
 // f[3 * c + i] = component i of column c (column 0: the step's direction).
 // kByRows: frames and directions come by LoadRecords, else by GatherFloats
-// (the same bits). Which is faster depends on the kernel: greedy aiming
-// waits on each frame (rows: BM_EncodeSearch effort 0 35.4 -> 32.4 ms on
-// an AVX2 EPYC), the lookahead has other work to overlap a gather with
-// (rows: 117 -> 119.5 ms).
+// (the same bits). Which is faster depends on the kernel and the width:
+// greedy aiming waits on each frame (rows: BM_EncodeSearch effort 0 35.4 ->
+// 32.4 ms on an AVX2 EPYC), the eight-lane lookahead has other work to
+// overlap a gather with (rows: 117 -> 119.5 ms), the sixteen-lane one
+// fetches twice the elements a gather (rows: its encode stage 6 % faster on
+// an AVX-512 EPYC). frame() and direction() are inlined: GCC outlined them
+// with rows, each call spilling the live vectors.
 template <class D, bool kByRows = false>
 struct CodeLanes {
     using DI = hn::RebindToSigned<D>;
@@ -218,13 +256,13 @@ struct CodeLanes {
     static VI frame_at(VI code) { return hn::Add(hn::ShiftLeft<3>(code), code); }
 
     // The code's frame (its first column is its direction).
-    void frame(VI code, VF* l) const {
+    HWY_INLINE void frame(VI code, VF* l) const {
         const VI at = frame_at(code);
         kByRows ? LoadRecords(d, code_frames, at, l, 9) : GatherFloats(d, code_frames, at, l, 9);
     }
 
     // The code's direction (its frame's first column).
-    void direction(VI code, VF& x, VF& y, VF& z) const {
+    HWY_INLINE void direction(VI code, VF& x, VF& y, VF& z) const {
         const VI at = frame_at(code);
         VF v[3];
         kByRows ? LoadRecords(d, code_frames, at, v, 3) : GatherFloats(d, code_frames, at, v, 3);
@@ -258,9 +296,10 @@ struct BatchLanes {
     // shorter last block).
     VI at, at_end, lengths;  // lengths: m_of
     const float* targets;
-    std::size_t m_of[kMaxLanes], steps = 0, active;
-    Vec3f* decoded[kMaxLanes];
-    std::uint8_t* codes[kMaxLanes];
+    // Zeroed past the vector's lanes (GCC cannot tell that store() reads only active ones).
+    std::size_t m_of[kMaxLanes] = {}, steps = 0, active;
+    Vec3f* decoded[kMaxLanes] = {};
+    std::uint8_t* codes[kMaxLanes] = {};
 
     BatchLanes(const GreedyBatch& batch, std::size_t j0, std::size_t n) : targets(&batch.targets[j0 * batch.stride].x), active(std::min(n, hn::Lanes(D()))) {
         const hn::RebindToSigned<D> di;
