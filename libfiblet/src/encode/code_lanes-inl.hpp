@@ -76,7 +76,7 @@ HWY_INLINE void GatherFloats(D d, const float* base, hn::Vec<hn::RebindToSigned<
 // GatherFloats. Reads the record's floats up to at[i] + 3 (n <= 4), + 7
 // (n <= 8) or + 8 (n == 9): the caller's records must have them. Other
 // targets and widths: GatherFloats.
-#if HWY_TARGET == HWY_AVX2
+#if HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3
 // Rows r0..r3 in the low halves and r4..r7 in the high halves of y[0..3]:
 // column c of the 4x4 blocks into col[c] (lane i: row i's float c).
 HWY_INLINE void TransposeHalves(const __m256 y[4], __m256 col[4]) {
@@ -151,14 +151,32 @@ HWY_INLINE void LoadRecords16(const float* base, __m512i at, V* out, int n) {
 }
 #endif
 
+// Four lanes: the records' first n floats (n <= 9) as columns (out[c].raw).
+template <class V>
+HWY_INLINE void LoadRecords4(const float* base, __m128i at, V* out, int n) {
+    const float* rec[4] = {base + _mm_cvtsi128_si32(at), base + _mm_extract_epi32(at, 1), base + _mm_extract_epi32(at, 2),
+                           base + _mm_extract_epi32(at, 3)};
+    auto transpose = [&](int from, int first, int count) {
+        __m128 y[4];
+        for (int i = 0; i < 4; ++i) y[i] = _mm_loadu_ps(rec[i] + from);
+        const __m128 t0 = _mm_unpacklo_ps(y[0], y[1]), t1 = _mm_unpackhi_ps(y[0], y[1]);
+        const __m128 t2 = _mm_unpacklo_ps(y[2], y[3]), t3 = _mm_unpackhi_ps(y[2], y[3]);
+        const __m128 col[4] = {_mm_movelh_ps(t0, t2), _mm_movehl_ps(t2, t0), _mm_movelh_ps(t1, t3), _mm_movehl_ps(t3, t1)};
+        for (int c = first; c < first + count; ++c) out[from + c].raw = col[c];
+    };
+    for (int from = 0; from < std::min(n, 8); from += 4) transpose(from, 0, std::min(4, n - from));
+    if (n == 9) transpose(5, 3, 1);  // float 8: the last of floats 5..8
+}
+
 template <class D>
 HWY_INLINE void LoadRecords(D d, const float* base, hn::Vec<hn::RebindToSigned<D>> at, hn::Vec<D>* out, int n) {
 #if HWY_TARGET == HWY_AVX3
     if constexpr (hn::MaxLanes(D()) == 16) return LoadRecords16(base, at.raw, out, n);
 #endif
-#if HWY_TARGET == HWY_AVX2
+#if HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3
     if constexpr (hn::MaxLanes(D()) == 8) return LoadRecords8(base, at.raw, out, n);
 #endif
+    if constexpr (hn::MaxLanes(D()) == 4) return LoadRecords4(base, at.raw, out, n);
     GatherFloats(d, base, at, out, n);
 }
 
