@@ -32,8 +32,9 @@ constexpr std::size_t kMaxLanes = 16;
 // neighbouring floats come with one 64-bit gather per eight lanes (AVX-512;
 // per four with AVX2), then a permutation per float: gathers cost per
 // element fetched (on AMD Zen 4, 6.1 ns for sixteen floats against 3.8 ns
-// for eight pairs), so a frame's nine floats take ~37 ns instead of ~55.
-// The same floats as one gather each, so the same bits at every level.
+// for eight pairs): the targets' three floats and the retry's rival
+// records (table records come by rows: LoadRecords). The same floats as one
+// gather each, so the same bits at every level.
 template <class D>
 HWY_INLINE void GatherFloats(D d, const float* base, hn::Vec<hn::RebindToSigned<D>> at, hn::Vec<D>* out, int n) {
     int i = 0;
@@ -68,14 +69,14 @@ HWY_INLINE void GatherFloats(D d, const float* base, hn::Vec<hn::RebindToSigned<
 }
 
 // out[i] = base[at[i] + j] per lane, i < n, for records in a table (at:
-// float indices): with AVX2 (eight lanes) and AVX-512 (sixteen), each
-// lane's record comes with plain 128-bit loads and the rows are transposed
-// in registers, since AMD's gathers cost per element (a frame's nine floats
-// for eight lanes: ~13 ns by rows against ~21 ns by pair gathers on this
-// project's AVX2 EPYC VMs). The same floats, so the same bits, as
-// GatherFloats. Reads the record's floats up to at[i] + 3 (n <= 4), + 7
-// (n <= 8) or + 8 (n == 9): the caller's records must have them. Other
-// targets and widths: GatherFloats.
+// float indices): in vectors of four, eight (AVX2, AVX-512) or sixteen
+// lanes (AVX-512), each lane's record comes with plain 128-bit loads and
+// the rows are transposed in registers, since AMD's gathers cost per
+// element (a frame's nine floats for eight lanes: ~13 ns by rows against
+// ~21 ns by pair gathers on this project's AVX2 EPYC VMs). The same floats,
+// so the same bits, as GatherFloats. Reads the record's floats up to
+// at[i] + 3 (n <= 4), + 7 (n <= 8) or + 8 (n == 9): the caller's records
+// must have them. Other widths: GatherFloats.
 #if HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3
 // Rows r0..r3 in the low halves and r4..r7 in the high halves of y[0..3]:
 // column c of the 4x4 blocks into col[c] (lane i: row i's float c).
@@ -191,15 +192,12 @@ HWY_INLINE __m512i TruncateInRange(__m512 v) { return _mm512_cvttps_epi32(v); }
 
 // The 8-bit code book, one code per lane. A frame is held as nine vectors,
 // f[3 * c + i] = component i of column c (column 0: the step's direction).
-// kByRows: frames and directions come by LoadRecords, else by GatherFloats
-// (the same bits). Which is faster depends on the kernel and the width:
-// greedy aiming waits on each frame (rows: BM_EncodeSearch effort 0 35.4 ->
-// 32.4 ms on an AVX2 EPYC), the eight-lane lookahead has other work to
-// overlap a gather with (rows: 117 -> 119.5 ms), the sixteen-lane one
-// fetches twice the elements a gather (rows: its encode stage 6 % faster on
-// an AVX-512 EPYC). frame() and direction() are inlined: GCC outlined them
-// with rows, each call spilling the live vectors.
-template <class D, bool kByRows = false>
+// Frames and directions come by LoadRecords (rows: the default's encode
+// stage 5-7 % faster than by pair gathers at AVX2 and AVX-512 on an AMD Zen 4
+// VM; greedy aiming's BM_EncodeSearch 35.4 -> 32.4 ms on a Zen 3 AVX2 VM).
+// frame() and direction() are inlined: GCC outlined them with rows, each
+// call spilling the live vectors (which hid the rows' gain in the lookahead).
+template <class D>
 struct CodeLanes {
     using DI = hn::RebindToSigned<D>;
     using VF = hn::Vec<D>;
@@ -276,14 +274,14 @@ struct CodeLanes {
     // The code's frame (its first column is its direction).
     HWY_INLINE void frame(VI code, VF* l) const {
         const VI at = frame_at(code);
-        kByRows ? LoadRecords(d, code_frames, at, l, 9) : GatherFloats(d, code_frames, at, l, 9);
+        LoadRecords(d, code_frames, at, l, 9);
     }
 
     // The code's direction (its frame's first column).
     HWY_INLINE void direction(VI code, VF& x, VF& y, VF& z) const {
         const VI at = frame_at(code);
         VF v[3];
-        kByRows ? LoadRecords(d, code_frames, at, v, 3) : GatherFloats(d, code_frames, at, v, 3);
+        LoadRecords(d, code_frames, at, v, 3);
         x = v[0], y = v[1], z = v[2];
     }
 

@@ -38,7 +38,7 @@ namespace hn = hwy::HWY_NAMESPACE;
 // Blocks j0 .. j0 + active - 1 of the batch, one per lane of `d`.
 template <class D>
 void GreedyVector(D, const Codebook8& cb, float step, const GreedyBatch& batch, std::size_t j0, std::size_t active) {
-    using Lanes = CodeLanes<D, true>;
+    using Lanes = CodeLanes<D>;
     using VF = typename Lanes::VF;
     const Lanes code(cb);
     BatchLanes<D> s(batch, j0, active);

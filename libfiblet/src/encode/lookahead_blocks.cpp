@@ -41,7 +41,7 @@ constexpr int kRivals = 4, kRivalWords = int(sizeof(Rivals) / sizeof(float)), kR
 template <int kDepth, bool kFour, class D>
 void LookaheadVector(D, const Codebook8& cb, float step, const GreedyBatch& batch, std::size_t j0, std::size_t active) {
     static_assert(kDepth == 1 || kDepth == 2, "lanes look one or two points ahead");
-    using Lanes = CodeLanes<D, HWY_TARGET == HWY_AVX3>;  // rows for sixteen lanes (code_lanes-inl.hpp)
+    using Lanes = CodeLanes<D>;
     using VF = typename Lanes::VF;
     using VI = typename Lanes::VI;
     const Lanes code(cb);
