@@ -23,6 +23,7 @@
 #include "select/block_batch_reader.hpp"
 #include "select/block_bounds.hpp"
 #include "select/block_decoder.hpp"
+#include "select/points_in_region.hpp"
 #include "index/block_spheres.hpp"
 #include "select/query_checks.hpp"
 
@@ -38,6 +39,7 @@ std::size_t batch_blocks(const FftHeader& h) {
 }
 
 using detail::has_bit;
+using detail::any_point_in;
 
 void and_bits(Bits& a, const Bits& b) {
     for (std::size_t i = 0; i < a.size(); ++i) a[i] &= b[i];
@@ -115,42 +117,6 @@ std::size_t decode_into(const DecodeContext& ctx, const std::uint8_t* blocks, st
     if (xyz.size() < 3 * (at_point + n)) xyz.resize(3 * (at_point + n));
     detail::decode_selected_blocks(ctx, blocks, count, &xyz[3 * at_point]);
     return n;
-}
-
-bool any_point_in(const Region& r, const float* p, std::uint32_t n) {
-    // Region::contains with the shape chosen once per block; eight points
-    // at a time without a branch (vectorizable), stopping at the first hit.
-    auto scan = [&](auto inside) {
-        std::uint32_t k = 0;
-        for (; k + 8 <= n; k += 8) {
-            bool any = false;
-            for (std::uint32_t j = k; j < k + 8; ++j) any |= inside(p + 3 * j);
-            if (any) return true;
-        }
-        for (; k < n; ++k)
-            if (inside(p + 3 * k)) return true;
-        return false;
-    };
-    if (r.shape == Region::Shape::mask) return r.mask->contains_any(p, n);
-    if (r.shape == Region::Shape::sphere) {
-        const float cx = r.center.x, cy = r.center.y, cz = r.center.z, r2 = r.radius * r.radius;
-        return scan([&](const float* q) {
-            const float dx = q[0] - cx, dy = q[1] - cy, dz = q[2] - cz;
-            return dx * dx + dy * dy + dz * dz <= r2;
-        });
-    }
-    const Aabb& b = r.box;
-    return scan([&](const float* q) {
-        return (q[0] >= b.min.x) & (q[0] <= b.max.x) & (q[1] >= b.min.y) & (q[1] <= b.max.y) & (q[2] >= b.min.z) &
-               (q[2] <= b.max.z);
-    });
-}
-
-bool any_point_in(const std::vector<Region>& regions, const float* p, std::uint32_t n) {
-    for (std::uint32_t k = 0; k < n; ++k, p += 3)
-        for (const Region& r : regions)
-            if (r.contains({p[0], p[1], p[2]})) return true;
-    return false;
 }
 
 Vec3f first_point(const FftHeader& h, const std::uint8_t* block);
