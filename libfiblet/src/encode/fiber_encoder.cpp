@@ -14,6 +14,7 @@
 #include "encode/nearest_code_lut.hpp"
 #include "core/block_geometry.hpp"
 #include "core/append_points.hpp"
+#include "core/grow.hpp"
 #include "core/points_avx2.hpp"
 #include "core/vec_math.hpp"
 #include "fiblet/encode.hpp"
@@ -110,14 +111,6 @@ void exact_decoder_targets(const DecoderStarts& s, std::span<const Vec3f> target
 // lookahead before any beam (retry_with_lookahead).
 constexpr std::size_t kRetryLookahead = 2;
 
-// Scratch arrays reused from fiber to fiber and batch to batch are grown,
-// never shrunk: each user writes the elements it reads, and resizing one up
-// after a shrink zero-filled them for nothing (0.6 % of the default compress
-// for the batches, 0.4 % for the fibers' arrays).
-template <class T>
-void grow(std::vector<T>& v, std::size_t n) {
-    if (v.size() < n) v.resize(n);
-}
 
 // Blocks gathered from several fibers into one batch for the SIMD lanes
 // (greedy_blocks.hpp's layout: block j's start point, then its targets, at

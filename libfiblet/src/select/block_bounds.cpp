@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/float_lanes.hpp"
+#include "core/grow.hpp"
 #include "core/points_avx2.hpp"
 #include "fiblet/image_mask.hpp"
 
@@ -175,8 +176,7 @@ void BlockBounds::may_meet(const Region& r, std::uint8_t* out) const {
 void BlockBounds::compute(const Sphere* spheres, const std::size_t* at, const std::size_t* next, std::size_t n,
                           float join) {
     n_ = n;
-    for (auto* c : {&ax_, &ay_, &az_, &bx_, &by_, &bz_, &radius_})
-        if (c->size() < n) c->resize(n);
+    for (auto* c : {&ax_, &ay_, &az_, &bx_, &by_, &bz_, &radius_}) grow(*c, n);
     std::size_t i = 0;
 #ifdef FIBLET_POINTS_AVX2
     if (use_avx2_loops() && join >= 0)

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/grow.hpp"
 #include "core/points_avx2.hpp"
 
 namespace fiblet {
@@ -107,7 +108,7 @@ template <bool kRoots, class T>
 void ErrorStats::add_each(const T* values, std::size_t n, std::uint64_t fiber) {
     if (n == 0) return;
     thread_local std::vector<std::int32_t> bins;
-    if (bins.size() < n) bins.resize(n);
+    detail::grow(bins, n);
     LaneSums lanes;
     BinRange range;
     double max = error_of<kRoots>(values[0]);

@@ -12,6 +12,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "core/grow.hpp"
 #include "core/points_avx2.hpp"
 #include "core/sum_lanes.hpp"
 #include "core/vec_math.hpp"
@@ -45,14 +46,8 @@ constexpr std::size_t kPadding = 16;
 
 using detail::use_avx2_loops;
 
-// The per-fiber buffers are thread_local and only ever grow: resizing a
-// vector up fills the new elements, which the code then overwrites (that
-// fill cost as much as a tenth of the metrics).
-template <class T>
-T* at_least(std::vector<T>& v, std::size_t n) {
-    if (v.size() < n) v.resize(n);
-    return v.data();
-}
+// The per-fiber buffers are thread_local and only ever grow (core/grow.hpp).
+using detail::grow;
 
 struct Segments {
     std::vector<float> ax, ay, az, ux, uy, uz, inv_uu, uu;
@@ -165,8 +160,8 @@ __attribute__((target("avx2"))) void columns_avx2(const Vec3f* p, std::size_t po
 // A non-empty polyline's columns.
 void segments_of(std::span<const Vec3f> line, Segments& out) {
     const std::size_t points = line.size(), n = points > 1 ? points - 1 : 1;  // a single point: one degenerate segment
-    for (auto* c : {&out.ax, &out.ay, &out.az, &out.ux, &out.uy, &out.uz, &out.inv_uu, &out.uu}) at_least(*c, n + kPadding);
-    double* len = at_least(out.len, n);
+    for (auto* c : {&out.ax, &out.ay, &out.az, &out.ux, &out.uy, &out.uz, &out.inv_uu, &out.uu}) grow(*c, n + kPadding);
+    double* len = grow(out.len, n);
     // Segments [0, done) complete from the vector loop.
     std::size_t done = 0;
     out.max_len = 0;
@@ -274,7 +269,7 @@ __attribute__((target("avx2"))) void forward_avx2(const Segments& g, OwnSegments
     // Pointers in locals (the stores may alias the vectors, and reloading
     // them went through TLS calls: 16 % of the report).
     float* forward[3];
-    for (std::size_t d = 0; d < 3; ++d) forward[d] = at_least(out.forward[d], n + 8);
+    for (std::size_t d = 0; d < 3; ++d) forward[d] = grow(out.forward[d], n + 8);
     const float *ux = g.ux.data(), *uy = g.uy.data(), *uz = g.uz.data();
     for (std::size_t s = 0; s < n; s += 8)  // reads up to segment n + 10: padding
         for (std::size_t d = 0; d < 3; ++d) {
@@ -364,7 +359,7 @@ __attribute__((target("avx2"))) void own_segments_avx2(const Segments& to_g, con
 void own_segments(const Segments& g, const Segments& from_g, std::span<const Vec3f> from, std::span<const Vec3f> to,
                   float* nearest, double* pointwise, OwnSegments& out) {
     const std::size_t n = g.count, points = n + 1;  // to.size() == from.size() == n + 1
-    at_least(out.later, points), at_least(out.proven, points);
+    grow(out.later, points), grow(out.proven, points);
     std::size_t k = 0;
 #ifdef FIBLET_POINTS_AVX2
     // The vector loop reads segments k - 4 .. k + 7 and lengths to k + 7.
@@ -402,7 +397,7 @@ void add_squares(ErrorStats& out, const float* squares, std::size_t n, std::uint
                  double unscale) {
     if (unscale == 1.0) return out.add_all_roots(squares, n, fiber);
     thread_local std::vector<double> unscaled;
-    double* u = at_least(unscaled, n);
+    double* u = grow(unscaled, n);
     for (std::size_t k = 0; k < n; ++k) u[k] = double(std::sqrt(squares[k])) * unscale;
     out.add_all(u, n, fiber);
     if (pointwise)
@@ -433,7 +428,7 @@ double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, s
     const std::size_t n = g.count;
     const std::size_t ahead = 2 + (to.size() + from.size() - 1) / from.size();
     thread_local std::vector<float> d2;
-    at_least(d2, ahead + 3);
+    grow(d2, ahead + 3);
     float* d = d2.data();
     std::size_t hint = 0;
     const bool same_count = from.size() == to.size() && to.size() > 1 && detail::geometry_shortcut_enabled();
@@ -443,7 +438,7 @@ double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, s
     const ColumnPointers columns(g);
 #endif
     thread_local std::vector<float> nearest_buffer;  // squared distances
-    float* const nearest = at_least(nearest_buffer, from.size());
+    float* const nearest = grow(nearest_buffer, from.size());
     thread_local OwnSegments own;
     if (same_count)
         own_segments(g, from_g, from, to, nearest, pointwise, own);
@@ -456,7 +451,7 @@ double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, s
     // moved, 2 (|p_k - p_k-1| + d_k-1), in arc length (cumulative lengths).
     const bool uneven = from.size() != to.size();
     thread_local std::vector<double> arc_buffer;
-    double* const arc = uneven ? at_least(arc_buffer, n + 1) : nullptr;
+    double* const arc = uneven ? grow(arc_buffer, n + 1) : nullptr;
     if (uneven) {
         arc[0] = 0;
         for (std::size_t s = 0; s < n; ++s) arc[s + 1] = arc[s] + g.len[s];
@@ -476,7 +471,7 @@ double points_to_polyline(std::span<const Vec3f> from, const Segments& from_g, s
         if (uneven && k > 0) {
             const double moved = 2 * (distance(from[k], from[k - 1]) + std::sqrt(double(nearest[k - 1])));
             while (hi < n && arc[hi] - arc[hint] < moved) ++hi;
-            at_least(d2, hi - hint + 3);
+            grow(d2, hi - hint + 3);
             d = d2.data();
         }
         const std::size_t lo = hint > 2 ? hint - 2 : 0, w = hi - lo;
