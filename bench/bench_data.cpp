@@ -168,9 +168,8 @@ void decode_sequential(const SequentialCoded& c, float* out) {
         std::memcpy(out, in, 12 * anchors);
         in += 12 * anchors, out += 3 * anchors;
         if (n < 3) continue;
-        Vec3f a0, p;
-        std::memcpy(&a0, out - 6, 12);
-        std::memcpy(&p, out - 3, 12);
+        const Vec3f a0{out[-6], out[-5], out[-4]};
+        Vec3f p{out[-3], out[-2], out[-1]};
         Frame frame = first_frame(a0, p);
         for (std::uint32_t k = 2; k < n; ++k) {
             frame = compose(frame, table.frame(*in++));

@@ -153,9 +153,10 @@ TEST(BoxRans, DamagedBytesAreRefusedOrDecodeToBoxesOnTheGrid) {
             continue;
         }
         ASSERT_EQ(out.boxes.size(), in.boxes.size());
-        for (const std::uint64_t v : out.boxes)
-            if (v != kUnboundedCells)
-                for (int a = 0; a < 3; ++a) ASSERT_LT(cells_lo(v, a), 30u);
+        for (const std::uint64_t v : out.boxes) {
+            if (v == kUnboundedCells) continue;
+            for (int a = 0; a < 3; ++a) ASSERT_LT(cells_lo(v, a), 30u);
+        }
     }
     // The final states must come back to where the encoder started them:
     // nearly every damaged word breaks that (a damaged table the boxes never

@@ -517,8 +517,9 @@ TEST(CliHabits, ExamplesUseOnlyRealOptions) {
             if (word == "&&") sub.clear();
             else if (word == "fiblet") continue;
             else if (sub.empty()) sub = word, help = test::run_cli(sub + " --help").output;
-            else if (word.size() > 1 && word[0] == '-' && !std::isdigit(static_cast<unsigned char>(word[1])))
+            else if (word.size() > 1 && word[0] == '-' && !std::isdigit(static_cast<unsigned char>(word[1]))) {
                 EXPECT_NE(help.find(word), std::string::npos) << sub << " has no " << word << " (" << line << ")";
+            }
         }
     }
     EXPECT_GE(examples, 6u);

@@ -154,7 +154,7 @@ TEST(CliMessages, AFlippedChecksumAlgorithmIsAnIntegrityFailure) {
         std::string damaged = bytes;
         damaged[tag + 16] = char(damaged[tag + 16] ^ bit);
         test::write_file(dir.file("bad.fft"), damaged);
-        for (const std::string& cmd : {"verify -q ", "info "}) {
+        for (const std::string cmd : {"verify -q ", "info "}) {
             const auto r = test::run_cli(cmd + dir.file("bad.fft"));
             EXPECT_EQ(r.status, 7) << cmd << int(bit) << "\n" << r.output;
         }

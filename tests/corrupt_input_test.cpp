@@ -44,7 +44,8 @@ int exit_code(Errc c) {
         case Errc::trk_format:
         case Errc::trx_format:
         case Errc::fft_format:
-        case Errc::invalid_input: return 4;
+        case Errc::invalid_input:
+        case Errc::image_format: return 4;
         case Errc::invalid_argument: return 2;
         case Errc::exists: return 5;
         case Errc::unsupported: return 6;

@@ -103,8 +103,9 @@ TEST(DecodesFinite, ProvenHeadersDecodeFinitePointsWithEveryDecoder) {
         proven += finite;
         for (const std::string& name : decoders) {
             const bool got = all_finite(decode_with(ctx, blocks, name));
-            if (finite)
+            if (finite) {
                 EXPECT_TRUE(got) << name << ", trial " << trial << ", scaling " << h.scaling << ", step " << h.step;
+            }
             overflowed += !got && name == "scalar";
         }
     }

@@ -103,13 +103,16 @@ TEST(FiberEndsSharedData, EndpointsAndLengthsMatchTheInput) {
         EXPECT_LT(len_abs_sum / double(measured), 1e-3 * mean_input + 0.2 * r.step_mm) << "mean |length change|";
         EXPECT_LT(std::fabs(len_change_sum) / double(measured), 1e-3 * mean_input + 0.15 * r.step_mm)
             << "mean length change";
-        if (!r.resampled) EXPECT_LT(len_max, 1e-3 * 250.0) << "a fixed-step fiber changed length by > 0.1 %";
+        if (!r.resampled) {
+            EXPECT_LT(len_max, 1e-3 * 250.0) << "a fixed-step fiber changed length by > 0.1 %";
+        }
         // Resampled fibers: the tension fit makes each as long as its input
         // (what stays is the codes' lag at block ends, ~0.05 step a fiber,
         // and on 0.1 mm steps the decoder's step scale, 0.03 %; with
         // Bessel's cubic alone iFOD2 was off by 0.15 step).
-        if (r.resampled)
+        if (r.resampled) {
             EXPECT_LT(len_abs_sum / double(measured), 0.1 * r.step_mm + 5e-4 * mean_input) << "mean |length change|";
+        }
         EXPECT_LE(c.error.max_mm(), recorded);
     }
 }

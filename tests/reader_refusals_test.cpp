@@ -174,7 +174,7 @@ TEST(ReaderRefusals, TrxOneArrayUnderTwoDtypes) {
 TEST(ReaderRefusals, TrxCountsAreIntegersInRangeBeforeAnyCast) {
     TempDir dir;
     // 1e30 and 2^62 + 1 overflowed (or wrapped a size product); 10.5 was cut to 10; -3 is no count.
-    for (const std::string& vertices : {"1e30", "4611686018427387905", "10.5", "-3", "\"3\""}) {
+    for (const std::string vertices : {"1e30", "4611686018427387905", "10.5", "-3", "\"3\""}) {
         SCOPED_TRACE(vertices);
         const Refusal r = refusal(trx_dir(dir, "count.trx", trx_header("1", "2", vertices)));
         EXPECT_EQ(r.code, Errc::trx_format);
@@ -337,7 +337,9 @@ TEST(ReaderRefusals, ResampledPerPointDataPeaksAtTwoCopies) {
     ASSERT_EQ(f.streamline_fields().size(), 1u);
     const double values_mb = double(f.streamline_fields()[0].bytes.size()) / (1 << 20);
     EXPECT_GT(values_mb, 80);
-    if (!test::kSanitized) EXPECT_LT(mb, 2.4 * values_mb + 40) << values_mb << " MB of values";
+    if (!test::kSanitized) {
+        EXPECT_LT(mb, 2.4 * values_mb + 40) << values_mb << " MB of values";
+    }
 }
 
 // Without --max-memory the budget is half of what the process may use: under

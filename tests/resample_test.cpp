@@ -288,8 +288,10 @@ TEST(Resample, PositionsSayWhereEachPointLiesOnTheInput) {
             ASSERT_LT(at[k].segment + 1, line.size());
             ASSERT_GE(at[k].t, 0.0);
             ASSERT_LE(at[k].t, 1.0);
-            if (k > 0) EXPECT_TRUE(at[k].segment > at[k - 1].segment ||
-                                   (at[k].segment == at[k - 1].segment && at[k].t >= at[k - 1].t));
+            if (k > 0) {
+                EXPECT_TRUE(at[k].segment > at[k - 1].segment ||
+                    (at[k].segment == at[k - 1].segment && at[k].t >= at[k - 1].t));
+            }
             const double seg = dist(line[at[k].segment], line[at[k].segment + 1]);
             EXPECT_LT(dist(back[k], out[k]), curve == ResampleCurve::polyline ? 1e-5 : 0.3 * seg + 1e-5) << k;
         }

@@ -201,7 +201,9 @@ TEST_F(SelectIndex, StoredBoxesBoundBlocksWithinACellOfTheirExactBoxes) {
 BlockIndex expect_stored_index_sound(const FftFile& file, std::uint32_t version) {
     const TrailerChunk* c = file.find_chunk(kBlockIndexTag);
     EXPECT_NE(c, nullptr);
-    if (c) EXPECT_EQ(c->payload[0], version);
+    if (c) {
+        EXPECT_EQ(c->payload[0], version);
+    }
     BlockIndex index = BlockIndex::load(file);
     EXPECT_EQ(index.source(), BlockIndex::Source::chunk);
     EXPECT_EQ(index.chunk_version(), version);
@@ -250,7 +252,9 @@ TEST_F(SelectIndex, CompressWritesVersionTwoByDefaultAndFourWithTheFineIndex) {
         const BlockIndex index = BlockIndex::load(file);
         ASSERT_EQ(index.source(), BlockIndex::Source::chunk) << path;
         EXPECT_EQ(index.chunk_version(), version) << path;
-        if (version == 2) EXPECT_EQ(index.groups(), index_groups(file, 8).size()) << path;
+        if (version == 2) {
+            EXPECT_EQ(index.groups(), index_groups(file, 8).size()) << path;
+        }
         const DecodedFile d = decode_everything(file);
         expect_boxes_hold_points(file, index, d);
         EXPECT_NO_THROW(verify_fft_file(file.path()));
@@ -344,7 +348,9 @@ TEST_F(SelectIndex, ChunkHasTheDocumentedSizeWithinOnePercentOfTheFile) {
         EXPECT_EQ(c->payload.size(), 64 + count_bytes * h.fibers + stream_bytes(c->payload)) << path;
         // The budget: 1 % of a file of long fibers (the per-fiber counts
         // make more of a file of short ones): about 6 bits a block.
-        if (path == fiblet_file()) EXPECT_LT(double(c->payload.size() + 16), 0.01 * double(file.file_size()));
+        if (path == fiblet_file()) {
+            EXPECT_LT(double(c->payload.size() + 16), 0.01 * double(file.file_size()));
+        }
         const BlockIndex index = BlockIndex::load(file);
         EXPECT_EQ(index.source(), BlockIndex::Source::chunk);
         expect_boxes_hold_points(file, index, decode_everything(file));
@@ -438,17 +444,25 @@ TEST_F(SelectIndex, CandidatesAreTheBlocksWhoseOwnBoxMeetsTheRegion) {
                 }
                 // In double, away from the float tests' slack (1e-5 of r^2).
                 double near2 = 0, far2 = 0;
-                for (const auto [v, lo, hi] : {std::tuple{r.center.x, x.min.x, x.max.x}, std::tuple{r.center.y, x.min.y, x.max.y},
+                for (const auto& [v, lo, hi] : {std::tuple{r.center.x, x.min.x, x.max.x}, std::tuple{r.center.y, x.min.y, x.max.y},
                                                std::tuple{r.center.z, x.min.z, x.max.z}}) {
                     const double below = double(lo) - v, above = double(v) - hi;
                     near2 += std::pow(std::max({below, above, 0.0}), 2);
                     far2 += std::pow(std::max(double(v) - lo, double(hi) - v), 2);
                 }
                 const double r2 = double(r.radius) * r.radius;
-                if (near2 < r2 * (1 - 1e-4)) ASSERT_TRUE(bit(near, b)) << path << " region " << i << " block " << b;
-                if (near2 > r2 * (1 + 1e-4)) ASSERT_FALSE(bit(near, b)) << path << " region " << i << " block " << b;
-                if (far2 < r2 * (1 - 1e-4)) ASSERT_TRUE(bit(inside, b)) << path << " region " << i << " block " << b;
-                if (far2 > r2) ASSERT_FALSE(bit(inside, b)) << path << " region " << i << " block " << b;
+                if (near2 < r2 * (1 - 1e-4)) {
+                    ASSERT_TRUE(bit(near, b)) << path << " region " << i << " block " << b;
+                }
+                if (near2 > r2 * (1 + 1e-4)) {
+                    ASSERT_FALSE(bit(near, b)) << path << " region " << i << " block " << b;
+                }
+                if (far2 < r2 * (1 - 1e-4)) {
+                    ASSERT_TRUE(bit(inside, b)) << path << " region " << i << " block " << b;
+                }
+                if (far2 > r2) {
+                    ASSERT_FALSE(bit(inside, b)) << path << " region " << i << " block " << b;
+                }
             }
         }
         EXPECT_GT(near_count, inside_count) << path;  // both sides of each test visited

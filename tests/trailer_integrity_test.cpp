@@ -177,8 +177,11 @@ TEST(TrailerIntegrity, DamagedTrailerIsAnIntegrityFailureNeverNoChecksum) {
             for (std::uint64_t i = original.s.offsets[f]; i < original.s.offsets[f + 1]; ++i)
                 for (int a = 0; a < 3; ++a) {
                     const float got = blocks->s.xyz[3 * i + a], want = original.s.xyz[3 * i + a];
-                    if (i + 1 < original.s.offsets[f + 1]) ASSERT_EQ(got, want) << "fiber " << f << " point " << i;
-                    else ASSERT_NEAR(got, want, 1.01 * fx.header.step * fx.header.scaling) << "fiber " << f;
+                    if (i + 1 < original.s.offsets[f + 1]) {
+                        ASSERT_EQ(got, want) << "fiber " << f << " point " << i;
+                    } else {
+                        ASSERT_NEAR(got, want, 1.01 * fx.header.step * fx.header.scaling) << "fiber " << f;
+                    }
                 }
         std::filesystem::remove(out);
     }
@@ -322,7 +325,9 @@ TEST(TrailerIntegrity, ClaimedSizesAreNotAllocatedBeforeTheyAreReal) {
     EXPECT_EQ(open_error(path), Errc::checksum);
     const test::PeakRun run = test::run_cli_peak({"verify", path});
     EXPECT_EQ(run.status, 7);
-    if (!kSanitized) EXPECT_LT(run.peak_mb, 64.0) << "MB peak for a file of a few kB";
+    if (!kSanitized) {
+        EXPECT_LT(run.peak_mb, 64.0) << "MB peak for a file of a few kB";
+    }
 }
 
 // A valid .fftz of 2^21 empty fibers (a few kB): opening and verifying it
@@ -346,7 +351,9 @@ TEST(TrailerIntegrity, ManyEmptyFibersCostTheirTablesOnly) {
         const test::PeakRun run = test::run_cli_peak({command, fftz});
         EXPECT_EQ(run.status, 0) << command;
         const double mb = run.peak_mb, tables_mb = 12.0 * double(kFibers) / (1 << 20);
-        if (!kSanitized) EXPECT_LT(mb, tables_mb + 6.0 * double(kFibers) / (1 << 20) + 16) << command;
+        if (!kSanitized) {
+            EXPECT_LT(mb, tables_mb + 6.0 * double(kFibers) / (1 << 20) + 16) << command;
+        }
     }
 }
 

@@ -159,7 +159,9 @@ TEST(TrxThroughFft, DirectoryArraysComeBackInTheirDtypes) {
     std::vector<std::string> expected = names(in);
     EXPECT_EQ(names(out), expected);  // every entry, with its dtype
     for (const auto& [name, bytes] : in) {
-        if (name.starts_with("dp") || name.starts_with("groups/")) EXPECT_EQ(out.at(name), bytes) << name;
+        if (name.starts_with("dp") || name.starts_with("groups/")) {
+            EXPECT_EQ(out.at(name), bytes) << name;
+        }
     }
     std::vector<std::uint32_t> out_offsets = values_of<std::uint32_t>(out.at("offsets.uint32"));
     ASSERT_EQ(out_offsets.size(), fibers + 1);  // with the sentinel

@@ -212,7 +212,9 @@ TEST(ViewerSixteenBit, TubePiecesInRunsDrawTheSameImage) {
             images.push_back({target.read_rgba(), target.read_fibers()});
         }
         EXPECT_EQ(images[0].rgba, images[1].rgba);
-        if (opacity == 1.0f) EXPECT_EQ(images[0].fibers, images[1].fibers);
+        if (opacity == 1.0f) {
+            EXPECT_EQ(images[0].fibers, images[1].fibers);
+        }
         EXPECT_GT(std::count_if(images[0].fibers.begin(), images[0].fibers.end(), [](std::uint32_t f) { return f != 0; }) +
                       std::count_if(images[0].rgba.begin(), images[0].rgba.end(), [](std::uint8_t c) { return c != 0; }),
                   1000);

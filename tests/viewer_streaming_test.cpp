@@ -137,7 +137,9 @@ TEST(ViewerStreaming, DenserLevelsHoldEverySparserOne) {
                                   streaming.overview().fibers.end()));
         // (Small budgets leave the overview, a quarter of them, nothing
         // beside the direction frames every scene takes.)
-        if (share >= 0.9) EXPECT_FALSE(streaming.overview().fibers.empty());
+        if (share >= 0.9) {
+            EXPECT_FALSE(streaming.overview().fibers.empty());
+        }
         sparser = level.fibers;
     }
 }

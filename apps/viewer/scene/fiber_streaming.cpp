@@ -56,8 +56,8 @@ std::uint64_t default_gpu_budget() {
 FiberStreaming::FiberStreaming(const FftFile& file, std::uint64_t budget_bytes, bool point_values)
     : file_(&file),
       budget_(budget_bytes ? budget_bytes : default_gpu_budget()),
-      point_values_(point_values),
-      constant_bytes_(scene_constant_bytes(file.header())) {
+      constant_bytes_(scene_constant_bytes(file.header())),
+      point_values_(point_values) {
     const FftHeader& h = file.header();
     const std::uint64_t per_slot = point_values ? std::max<std::uint64_t>(h.block_bytes(), 4ull * h.points_per_block)
                                                 : h.block_bytes();

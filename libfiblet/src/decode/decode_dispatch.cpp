@@ -23,7 +23,7 @@ namespace fiblet {
 namespace {
 
 // Whether the library was built with kernels of this level.
-bool compiled(SimdLevel level) {
+bool compiled([[maybe_unused]] SimdLevel level) {
 #ifdef FIBLET_HAVE_X86_KERNELS
     return true;
 #else
