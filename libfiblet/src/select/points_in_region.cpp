@@ -9,14 +9,14 @@ namespace fiblet::detail {
 namespace {
 
 // Region::contains's float operations, the shape chosen once.
-struct SphereTest {
+struct SpherePoints {
     float cx, cy, cz, r2;
     bool operator()(const float* q) const {
         const float dx = q[0] - cx, dy = q[1] - cy, dz = q[2] - cz;
         return dx * dx + dy * dy + dz * dz <= r2;
     }
 };
-struct BoxTest {
+struct BoxPoints {
     Aabb b;
     bool operator()(const float* q) const {
         return (q[0] >= b.min.x) & (q[0] <= b.max.x) & (q[1] >= b.min.y) & (q[1] <= b.max.y) & (q[2] >= b.min.z) &
@@ -27,7 +27,7 @@ struct BoxTest {
 #ifdef FIBLET_POINTS_AVX2
 // The same tests on points k .. k + 7 as float columns: the same operations
 // in the same order (-ffp-contract=off), so the same answer point by point.
-__attribute__((target("avx2"))) inline __m256 inside8(const SphereTest& s, __m256 x, __m256 y, __m256 z) {
+__attribute__((target("avx2"))) inline __m256 inside8(const SpherePoints& s, __m256 x, __m256 y, __m256 z) {
     const __m256 dx = _mm256_sub_ps(x, _mm256_set1_ps(s.cx)), dy = _mm256_sub_ps(y, _mm256_set1_ps(s.cy)),
                  dz = _mm256_sub_ps(z, _mm256_set1_ps(s.cz));
     const __m256 d2 = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)), _mm256_mul_ps(dz, dz));
@@ -36,7 +36,7 @@ __attribute__((target("avx2"))) inline __m256 inside8(const SphereTest& s, __m25
 __attribute__((target("avx2"))) inline __m256 within8(__m256 v, float lo, float hi) {
     return _mm256_and_ps(_mm256_cmp_ps(v, _mm256_set1_ps(lo), _CMP_GE_OQ), _mm256_cmp_ps(v, _mm256_set1_ps(hi), _CMP_LE_OQ));
 }
-__attribute__((target("avx2"))) inline __m256 inside8(const BoxTest& t, __m256 x, __m256 y, __m256 z) {
+__attribute__((target("avx2"))) inline __m256 inside8(const BoxPoints& t, __m256 x, __m256 y, __m256 z) {
     return _mm256_and_ps(_mm256_and_ps(within8(x, t.b.min.x, t.b.max.x), within8(y, t.b.min.y, t.b.max.y)),
                          within8(z, t.b.min.z, t.b.max.z));
 }
@@ -74,8 +74,8 @@ bool any_point_in(const Region& r, const float* p, std::uint32_t n) {
     switch (r.shape) {
         case Region::Shape::mask: return r.mask->contains_any(p, n);
         case Region::Shape::sphere:
-            return any_inside(SphereTest{r.center.x, r.center.y, r.center.z, r.radius * r.radius}, p, n);
-        case Region::Shape::box: return any_inside(BoxTest{r.box}, p, n);
+            return any_inside(SpherePoints{r.center.x, r.center.y, r.center.z, r.radius * r.radius}, p, n);
+        case Region::Shape::box: return any_inside(BoxPoints{r.box}, p, n);
     }
     return false;
 }
