@@ -78,7 +78,7 @@ HWY_INLINE void GatherFloats(D d, const float* base, hn::Vec<hn::RebindToSigned<
 // back as scalars (taking them out of the register by moves and extracts
 // measured 7 % slower for the eight- and sixteen-lane lookahead). Reads the
 // record's floats up to at[i] + 3 (n <= 4), + 7 (n <= 8) or + 8 (n == 9):
-// the caller's records must have them. Other widths: GatherFloats.
+// the caller's records must have them.
 #if HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3
 // Rows r0..r3 in the low halves and r4..r7 in the high halves of y[0..3]:
 // column c of the 4x4 blocks into col[c] (lane i: row i's float c).
@@ -172,15 +172,15 @@ HWY_INLINE void LoadRecords4(const float* base, __m128i at, V* out, int n) {
 }
 
 template <class D>
-HWY_INLINE void LoadRecords(D d, const float* base, hn::Vec<hn::RebindToSigned<D>> at, hn::Vec<D>* out, int n) {
-#if HWY_TARGET == HWY_AVX3
-    if constexpr (hn::MaxLanes(D()) == 16) return LoadRecords16(base, at.raw, out, n);
-#endif
-#if HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3
-    if constexpr (hn::MaxLanes(D()) == 8) return LoadRecords8(base, at.raw, out, n);
-#endif
+HWY_INLINE void LoadRecords(D, const float* base, hn::Vec<hn::RebindToSigned<D>> at, hn::Vec<D>* out, int n) {
     if constexpr (hn::MaxLanes(D()) == 4) return LoadRecords4(base, at.raw, out, n);
-    GatherFloats(d, base, at, out, n);
+#if HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3
+    else if constexpr (hn::MaxLanes(D()) == 8) return LoadRecords8(base, at.raw, out, n);
+#endif
+#if HWY_TARGET == HWY_AVX3
+    else if constexpr (hn::MaxLanes(D()) == 16) return LoadRecords16(base, at.raw, out, n);
+#endif
+    else static_assert(hn::MaxLanes(D()) == 4, "the lanes come in vectors of 4, 8 (AVX2, AVX-512) or 16 (AVX-512)");
 }
 
 // Float to int32 by truncation, for lanes known to be in int range.
