@@ -18,6 +18,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -218,7 +219,8 @@ inline void streamline_source_target(const std::uint8_t* data, std::size_t size)
 // An upper bound on the points compress may resample a .tck into: its
 // polyline length over a fifth of the smallest step it may pick (the
 // declared step_size or the median spacing, the centre of a narrow
-// histogram bin; block_keeping_step goes down to a quarter). The median is
+// histogram bin, the float range's end at most; block_keeping_step goes
+// down to a quarter). The median is
 // LengthHistogram's: the lower median of every segment, zero-length ones
 // included (with seven repeated points among sixteen segments it is the
 // shortest non-zero one). A few points far apart can stand for millions of
@@ -239,7 +241,8 @@ inline double resampled_points_bound(const std::string& path) {
     if (spacing.empty()) return 0;
     const auto median = spacing.begin() + std::ptrdiff_t((spacing.size() - 1) / 2);  // the first with half at or below
     std::nth_element(spacing.begin(), median, spacing.end());
-    const double step = std::min(*median, r.step_size().value_or(INFINITY));
+    // Lengths beyond the float range count as its largest in compress's median.
+    const double step = std::min({*median, r.step_size().value_or(INFINITY), double(std::numeric_limits<float>::max())});
     if (!(step > 0)) return 0;  // compress refuses a zero step, or has nothing to resample
     return length / (0.2 * step);
 }

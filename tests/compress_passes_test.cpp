@@ -165,20 +165,24 @@ TEST(CompressPasses, TheStagesAreTimedWithinTheRunsTime) {
 // The median segment length, from fibers of one repeated length (runs of
 // one bin), of scattered lengths, of lengths below the histogram's range
 // and of none, added to two histograms then merged: the bin holding the
-// sorted lengths' median, within the bins' 1.2e-4 relative width.
+// sorted lengths' median, within the bins' 1.2e-4 relative width. Odd
+// trials spread the lengths from micrometres to the float range's end
+// (a histogram that stopped at 2 m once made 100 m segments a 2 m step).
 TEST(CompressScan, TheMedianSegmentLengthIsTheSortedLengthsMedian) {
     std::mt19937 rng(11);
-    std::uniform_real_distribution<double> spread(0.01, 3.0), jitter(-1e-6, 1e-6);
-    for (int trial = 0; trial < 20; ++trial) {
+    std::uniform_real_distribution<double> spread(0.01, 3.0), jitter(-1e-6, 1e-6), exponent(-19.0, 38.5);
+    for (int trial = 0; trial < 40; ++trial) {
         SCOPED_TRACE(trial);
+        const bool wide = trial % 2;
+        auto draw = [&] { return wide ? std::min(std::pow(10.0, exponent(rng)), 3.4e38) : spread(rng); };
         detail::LengthHistogram a, b, scalar;
         std::vector<double> all;
         for (int fiber = 0; fiber < 12; ++fiber) {
             std::vector<double> lengths;
-            const double step = spread(rng);
+            const double step = draw();
             const int kind = int(rng() % 4), n = int(rng() % 300);
             for (int k = 0; k < n; ++k)
-                lengths.push_back(kind == 0 ? step : kind == 1 ? step * (1 + jitter(rng)) : kind == 2 ? spread(rng) : 1e-9);
+                lengths.push_back(kind == 0 ? step : kind == 1 ? step * (1 + jitter(rng)) : kind == 2 ? draw() : 1e-9);
             (fiber % 2 ? a : b).add(lengths);
             {
                 const test::ScopedSimdLoops loops(false);  // the AVX2 runs' check against the scalar loop's

@@ -190,7 +190,9 @@ double LengthHistogram::median() const {
             seen += blocks_[e][j];
             if (2 * seen >= count_) {
                 const std::uint32_t lo = kMinBits + ((e * kBlock + j) << kShift);
-                return 0.5 * (double(std::bit_cast<float>(lo)) + double(std::bit_cast<float>(lo + (1u << kShift))));
+                // The top bin's end is infinity: its centre, the float range's end.
+                const std::uint32_t hi = std::min(lo + (1u << kShift), std::bit_cast<std::uint32_t>(std::numeric_limits<float>::max()));
+                return 0.5 * (double(std::bit_cast<float>(lo)) + double(std::bit_cast<float>(hi)));
             }
         }
     }

@@ -14,6 +14,7 @@
 #include <bit>
 #include <chrono>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <vector>
@@ -78,9 +79,11 @@ bool read_fiber_task(StreamlineSource& reader, FiberBatch& b, std::vector<std::v
 void add_bounds(std::span<const Vec3f> fiber, double* min, double* max);
 
 // Median of segment lengths from a histogram of their float32 bit patterns
-// (the top 13 mantissa bits: 1.2e-4 relative resolution between 1 um and
-// 2 m, no logarithm per segment), one block of bins per binary exponent,
-// allocated when a length first falls in it: constant, small memory.
+// (the top 13 mantissa bits: 1.2e-4 relative resolution from 1 um up to
+// the float range, no logarithm per segment), one block of bins per binary
+// exponent, allocated when a length first falls in it: constant, small
+// memory. Lengths beyond the float range count as its largest (compress
+// refuses extents beyond it, so such a median is at most sqrt(3) times it).
 class LengthHistogram {
 public:
     // A fiber's segment lengths. A fixed-step fiber's lengths all fall in
@@ -104,7 +107,11 @@ private:
     static constexpr float kMin = 0x1p-20f;
     static constexpr std::uint32_t kMinBits = std::bit_cast<std::uint32_t>(kMin), kShift = 10;
     static constexpr std::uint32_t kMantissaBits = 23 - kShift, kBlock = 1u << kMantissaBits;
-    static constexpr std::uint32_t kExponents = 31, kBins = kExponents * kBlock;  // 2^-20 .. 2^11 mm
+    // Every exponent from kMin's to the largest finite float's: a median of
+    // metres or kilometres is that median, not a finer step of millions of points.
+    static constexpr std::uint32_t kExponents =
+        (std::bit_cast<std::uint32_t>(std::numeric_limits<float>::max()) >> 23) - (kMinBits >> 23) + 1;
+    static constexpr std::uint32_t kBins = kExponents * kBlock;  // 2^-20 mm .. FLT_MAX
     std::array<std::unique_ptr<std::uint64_t[]>, kExponents> blocks_;
     std::uint64_t count_ = 0, below_ = 0;
 };
