@@ -308,12 +308,14 @@ void BlockIndex::collect(const Test& test, std::vector<std::uint64_t>& bits, std
     };
     // A leaf the region meets: its blocks, or (when it meets it partly and
     // the blocks have boxes of their own) those whose own box meets it.
-    auto leaf = [&](std::size_t pos, Overlap o) {
+    auto leaf = [&](std::size_t pos, Overlap o, detail::Narrowing active) {
         if (o == Overlap::partial && !block_cells_.empty()) {
             const BlockRange r = leaf_blocks_[pos];
             Overlap ob[kFanout];
-            test.classify(BoxLanes::of_cells(&block_cells_[leaf_first_cell_[pos]], r.end - r.first, cells_origin_, cell_mm_),
-                          r.end - r.first, ob);
+            detail::Narrowing unused[kFanout];
+            detail::classify(test,
+                             BoxLanes::of_cells(&block_cells_[leaf_first_cell_[pos]], r.end - r.first, cells_origin_, cell_mm_),
+                             r.end - r.first, active, ob, unused);
             for (std::uint32_t b = r.first; b < r.end; ++b) {
                 if (ob[b - r.first] != Overlap::outside) set_bit(bits, b);
                 if (ob[b - r.first] == Overlap::inside && inside) set_bit(*inside, b);
@@ -323,27 +325,29 @@ void BlockIndex::collect(const Test& test, std::vector<std::uint64_t>& bits, std
         mark(bits, pos);
         if (o == Overlap::inside && inside) mark(*inside, pos);
     };
-    // Node j of level k, which the region meets partly: its children tested
-    // together. It covers Morton positions [j * span[k], (j + 1) * span[k]),
-    // span[k] = 8^(k+1).
+    // Node j of level k, which the region meets partly (`active`: what it
+    // hands its children): its children tested together. It covers Morton
+    // positions [j * span[k], (j + 1) * span[k]), span[k] = 8^(k+1).
     std::vector<std::size_t> span(boxes_.size());
     for (std::size_t k = 0, s = kFanout; k < boxes_.size(); ++k, s *= kFanout) span[k] = s;
-    auto visit = [&](auto& self, std::size_t k, std::size_t j) -> void {
+    auto visit = [&](auto& self, std::size_t k, std::size_t j, detail::Narrowing active) -> void {
         const std::size_t first = j * kFanout, count = std::min(kFanout, (k == 0 ? n : boxes_[k - 1].size()) - first);
         Overlap o[kFanout];
-        test.classify(BoxLanes::of(boxes_[k][j]), count, o);
+        detail::Narrowing narrowed[kFanout];
+        detail::classify(test, BoxLanes::of(boxes_[k][j]), count, active, o, narrowed);
         for (std::size_t i = 0; i < count; ++i) {
             const std::size_t c = first + i;
             if (o[i] == Overlap::outside) continue;
-            if (k == 0) leaf(c, o[i]);
+            if (k == 0) leaf(c, o[i], narrowed[i]);
             else if (o[i] == Overlap::inside) mark_all(c * span[k - 1], (c + 1) * span[k - 1]);
-            else self(self, k - 1, c);
+            else self(self, k - 1, c, narrowed[i]);
         }
     };
     Overlap root = Overlap::partial;
-    test.classify(BoxLanes::of(root_), 1, &root);
+    detail::Narrowing narrowed = detail::kEveryPlane;
+    detail::classify(test, BoxLanes::of(root_), 1, detail::kEveryPlane, &root, &narrowed);
     if (root == Overlap::inside) mark_all(0, n);
-    else if (root == Overlap::partial) visit(visit, boxes_.size() - 1, 0);
+    else if (root == Overlap::partial) visit(visit, boxes_.size() - 1, 0, narrowed);
 }
 
 void BlockIndex::blocks_near_sphere(Vec3f c, float radius, std::vector<std::uint64_t>& bits,

@@ -89,6 +89,11 @@ struct BoxLanes {
     }
 };
 
+// What a box hands the boxes it holds, for tests that narrow down as they
+// descend (FrustumTest: the planes it crosses); the others take none.
+using Narrowing = std::uint8_t;
+inline constexpr Narrowing kEveryPlane = 0x3f;
+
 // Per half: lanes outside (`apart`, -1) or wholly inside (`within`, -1).
 struct Verdicts {
     Ints apart[kHalves] = {}, within[kHalves] = {};
@@ -151,13 +156,23 @@ struct BoxTest {
 // along some plane's inward normal is beyond the margin
 // (box_intersects_frustum), inside when even the nearest corner is within
 // the margin of every plane, with room for rounding between corners.
+//
+// A box wholly inside a plane's side has every box it holds inside it too
+// (their nearest corners are no nearer, in float as in exact arithmetic:
+// products by the same factor and sums round monotonically), so a node
+// hands its children only the planes it crosses (`active`, bit k for plane
+// k; each lane's in `children`): deep in the hierarchy a box crosses one
+// or two of the six, and the verdicts are those of all six.
 struct FrustumTest {
     Frustum f;
     float margin;
-    void classify(const BoxLanes& b, std::size_t n, Overlap* out) const {
+    void classify(const BoxLanes& b, std::size_t n, Narrowing active, Overlap* out, Narrowing* children) const {
         Verdicts v;
+        Ints crossed[kHalves] = {};
         for (std::size_t h = 0; h < kHalves; ++h) v.within[h] = ~Ints{};
-        for (const Plane& p : f.planes) {
+        for (std::size_t k = 0; k < f.planes.size(); ++k) {
+            if (!(active >> k & 1)) continue;
+            const Plane& p = f.planes[k];
             // The corners' sides, chosen once per plane: far along n, and near.
             const bool x = p.n.x >= 0, y = p.n.y >= 0, z = p.n.z >= 0;
             for (std::size_t h = 0; h < kHalves; ++h) {
@@ -165,13 +180,23 @@ struct FrustumTest {
                                    p.n.z * (z ? b.hi : b.lo)[2][h] + p.d;
                 const Floats near = p.n.x * (x ? b.lo : b.hi)[0][h] + p.n.y * (y ? b.lo : b.hi)[1][h] +
                                     p.n.z * (z ? b.lo : b.hi)[2][h] + p.d;
+                const Ints crosses = near < -margin + 1e-3f;
                 v.apart[h] |= far < -margin;
-                v.within[h] &= ~(near < -margin + 1e-3f);
+                v.within[h] &= ~crosses;
+                crossed[h] |= crosses & (1 << k);
             }
         }
         v.store(n, out);
+        for (std::size_t i = 0; i < n; ++i) children[i] = Narrowing(crossed[i / 4][i % 4]);
     }
 };
+
+// test.classify, with what narrows it where the test takes it.
+template <class Test>
+void classify(const Test& test, const BoxLanes& b, std::size_t n, Narrowing active, Overlap* out, Narrowing* children) {
+    if constexpr (requires { test.classify(b, n, active, out, children); }) test.classify(b, n, active, out, children);
+    else test.classify(b, n, out);
+}
 
 // An image mask: ImageMask::classify, box by box.
 struct MaskTest {
