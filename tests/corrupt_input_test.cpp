@@ -147,6 +147,8 @@ std::vector<TckCase> tck_cases() {
          Errc::invalid_input},
         {"coordinates spanning more than the float range", tck(f32({-3e38f, 0, 0, 3e38f, 0, 0}) + kSep + kEnd),
          Errc::invalid_input, true},
+        {"coordinates within four spans of the float range (decoded points would overflow)",
+         tck(f32({2e38f, 0, 0, 2.5e38f, 0, 0}) + kSep + kEnd), Errc::invalid_input, true},
         {"a step lost against the extent (1e25 mm apart, 0.1 mm steps)",
          tck(f32({0, 0, 0, 0.1f, 0, 0, 0.2f, 0, 0}) + kSep + f32({1e25f, 0, 0, 1e25f, 0.1f, 0}) + kSep + kEnd),
          Errc::invalid_input, true},
