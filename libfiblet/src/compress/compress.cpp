@@ -156,13 +156,6 @@ double normalize(FftHeader& h, const SourceScan& scan, double step, const std::s
     if (!std::isfinite(h.scaling))
         throw Error(Errc::invalid_input,
                     path + ": coordinates span more than the float range (" + std::to_string(extent) + " mm)");
-    // Decoded points are (n - 0.5) * scaling - offset in float, n a walk
-    // near [0, 1] that may stray past it: room for 4 extents around the
-    // centre, or a decoder's coordinates overflow to infinity.
-    const double centre = std::max({std::fabs(h.offset[0]), std::fabs(h.offset[1]), std::fabs(h.offset[2])});
-    if (!(centre + 4.0 * double(h.scaling) <= double(std::numeric_limits<float>::max())))
-        throw Error(Errc::invalid_input, path + ": coordinates around " + fmt_g(centre) + " mm spanning " + fmt_g(extent) +
-                                             " mm: too near the float range (3.4e38) for decoded points to stay finite");
     h.step = float(step / h.scaling);
     check_step_resolvable(path, step, extent, h.step);
     return double(h.step) * double(h.scaling);
@@ -408,6 +401,12 @@ void CompressJob::encode() {
     report.error = std::move(r.error);
     report.geometry = std::move(r.geometry);
     report.timings += r.timings;
+    // The input's points are finite: a distance that is not comes from a
+    // decoded point, which a float walk can overflow near the float range.
+    const GeometryError& g = report.geometry;
+    if (!std::isfinite(g.decoded_to_input().mean_mm()) || !std::isfinite(g.input_to_decoded().mean_mm()))
+        throw Error(Errc::invalid_input, input_ + ": coordinates too near the float range (3.4e38 mm) for a float "
+                                                  "decoder: decoded points would not be finite");
 }
 
 void CompressJob::finish() {
