@@ -401,7 +401,7 @@ void CompressJob::encode() {
     report.error = std::move(r.error);
     report.geometry = std::move(r.geometry);
     report.timings += r.timings;
-    // The input's points are finite: a distance that is not comes from a
+    // The input's points are finite: a distance that is not finite comes from a
     // decoded point, which a float walk can overflow near the float range.
     const GeometryError& g = report.geometry;
     if (!std::isfinite(g.decoded_to_input().mean_mm()) || !std::isfinite(g.input_to_decoded().mean_mm()))

@@ -92,7 +92,7 @@ struct BoxLanes {
 // What a box hands the boxes it holds, for tests that narrow down as they
 // descend (FrustumTest: the planes it crosses); the others take none.
 using Narrowing = std::uint8_t;
-inline constexpr Narrowing kEveryPlane = 0x3f;
+inline constexpr Narrowing kEveryPlane = (1u << 6) - 1;  // a frustum's six planes
 
 // Per half: lanes outside (`apart`, -1) or wholly inside (`within`, -1).
 struct Verdicts {
