@@ -111,7 +111,6 @@ void exact_decoder_targets(const DecoderStarts& s, std::span<const Vec3f> target
 // lookahead before any beam (retry_with_lookahead).
 constexpr std::size_t kRetryLookahead = 2;
 
-
 // Blocks gathered from several fibers into one batch for the SIMD lanes
 // (greedy_blocks.hpp's layout: block j's start point, then its targets, at
 // points[j * stride]; its codes at codes[j * m]), and their results.
