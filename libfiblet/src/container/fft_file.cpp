@@ -400,31 +400,32 @@ void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, cons
     const FftChecksums& c = *checksums_;
     const std::uint64_t g_blocks = c.group_blocks, end = first + count, base = stored_offset(first);
     std::vector<std::uint8_t> edge;  // the part of a group outside [first, end)
-    Xxh64Stream hash;
+    std::optional<Xxh64Stream> hash;  // made for the first group not verified yet (most reads find none)
     // Hashed in place in the mapping when the file has one (no copy), else read.
     auto hash_from_file = [&](std::uint64_t b0, std::uint64_t b1) {
         const std::uint64_t at = stored_offset(b0), size = stored_offset(b1) - at;
         if (const std::uint8_t* mapped = mapped_first_block()) {
-            if (!detail::hash_from_mapping(mapped + at, size, hash)) shrank_while_read();
+            if (!detail::hash_from_mapping(mapped + at, size, *hash)) shrank_while_read();
             require_size(header_.blocks_offset() + at + size);
             return;
         }
         edge.resize(size);
         read_at(edge.data(), edge.size(), header_.blocks_offset() + at);
-        hash.update(edge.data(), edge.size());
+        hash->update(edge.data(), edge.size());
     };
     for (std::uint64_t g = first / g_blocks; g <= (end - 1) / g_blocks; ++g) {
         std::atomic<std::uint64_t>& word = verified_groups_[g / 64];
         const std::uint64_t bit = std::uint64_t{1} << (g % 64);
         if (word.load(std::memory_order_acquire) & bit) continue;  // checked by an earlier read
         const std::uint64_t g0 = g * g_blocks, g1 = std::min(g0 + g_blocks, std::uint64_t{header_.blocks});
-        hash.reset();
+        if (hash) hash->reset();
+        else hash.emplace();
         if (g0 < first) hash_from_file(g0, first);
         const std::uint64_t in0 = std::max(g0, first), in1 = std::min(g1, end);
         const std::uint64_t at0 = stored_offset(in0);
-        hash.update(blocks + (at0 - base), stored_offset(in1) - at0);
+        hash->update(blocks + (at0 - base), stored_offset(in1) - at0);
         if (g1 > end) hash_from_file(end, g1);
-        if (hash.digest() != c.group_hashes[g])
+        if (hash->digest() != c.group_hashes[g])
             throw Error(Errc::checksum, path_ + ": checksum mismatch in blocks " + std::to_string(g0) + ".." +
                                             std::to_string(g1 - 1) + " (group " + std::to_string(g) +
                                             "): the file is corrupted");

@@ -300,6 +300,7 @@ private:
         keep_.assign(n, q_.fibers.empty() ? 1 : 0);
         for (const FiberRange& r : q_.fibers)
             for (std::uint64_t f = r.first; f <= std::min(r.last, n ? n - 1 : 0) && f < n; ++f) keep_[f] = 1;
+        if (!q_.min_length_mm && !q_.max_length_mm && !q_.random_fraction) return;
         for (std::uint64_t f = 0; f < n; ++f) {
             if (!keep_[f]) continue;
             const double len = fiber_length_mm(h_, index_.fiber_points(f));
@@ -530,7 +531,7 @@ private:
         if (p.cull) {
             Bits f;
             const float margin = index_.max_sphere_radius() * (1 + 1e-5f) + 1e-3f;
-            index_.blocks_near_frustum(p.frustum, margin, f);
+            index_.blocks_starting_near_frustum(p.frustum, margin, f);
             f.resize((h_.blocks + 63) / 64, 0);
             p.only = std::move(f);
         }
