@@ -133,6 +133,12 @@ public:
     // Bounds of every point a block decodes to: its own box, or its group's
     // (version 2) (conservative; escaped ones are unbounded).
     Aabb block_box(std::uint64_t block) const;
+    // A box that holds the block's first point, the centre of its view
+    // sphere: with a box per block (versions 3 and 4) its own box narrowed
+    // to the previous block's of its fiber grown by max_join() (the fiber
+    // moves on: the two touch only where one ends and the next begins);
+    // block_box otherwise.
+    Aabb first_point_box(std::uint64_t block) const;
     // A box around every point of the file (the union of its boxes);
     // nullopt when some box is unbounded or there is no block.
     std::optional<Aabb> bounds() const;
@@ -155,6 +161,10 @@ public:
     void blocks_near_mask(const ImageMask& mask, std::vector<std::uint64_t>& bits,
                           std::vector<std::uint64_t>* inside = nullptr) const;
     void blocks_near_frustum(const Frustum& frustum, float margin, std::vector<std::uint64_t>& bits) const;
+    // Blocks whose first point may lie within `margin` of the frustum
+    // (first_point_box grown by margin meets it): with margin at least
+    // max_sphere_radius(), every block whose view sphere meets the frustum.
+    void blocks_starting_near_frustum(const Frustum& frustum, float margin, std::vector<std::uint64_t>& bits) const;
 
 private:
     BlockIndex() = default;
@@ -162,10 +172,14 @@ private:
     void set_groups(const std::vector<Aabb>& boxes);  // of group_first_'s groups; sorts and builds it
     Aabb cells_union(const std::uint64_t* cells, std::size_t n) const;  // of n packed grid boxes
     void sort_block_cells(const std::vector<std::uint64_t>& cells);  // file order -> block_cells_
+    // first_point_box's cells in quarter cells, as block_cells_ (made once).
+    const std::vector<std::uint64_t>& first_point_cells() const;
     template <class BoxOf>
     void build(std::vector<std::uint64_t>& keyed, const BoxOf& box_of);  // (Morton key << 32 | group)
+    // Which boxes of its blocks a leaf the region meets partly tests.
+    enum class LeafBoxes { own, first_point };
     // Sets the blocks `test` (index/box_tests.hpp) finds near its region.
-    template <class Test>
+    template <LeafBoxes kLeafBoxes, class Test>
     void collect(const Test& test, std::vector<std::uint64_t>& bits, std::vector<std::uint64_t>* inside) const;
 
     Source source_ = Source::decoded;
@@ -190,6 +204,8 @@ private:
     // library's index/index_grid.hpp), leaf after leaf in Morton order;
     // boxes in mm are origin + cell number * cell.
     std::vector<std::uint64_t> block_cells_;
+    struct FirstPointCells;
+    std::shared_ptr<FirstPointCells> first_points_;  // first_point_cells(), shared by copies
     std::vector<std::uint32_t> leaf_first_cell_;  // Morton position -> its first block's cells; one more: blocks_
     Vec3f cells_origin_{};
     float cell_mm_ = 0;

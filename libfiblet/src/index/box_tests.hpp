@@ -57,7 +57,9 @@ struct BoxLanes {
         return of(g);
     }
     // The boxes of n packed grid boxes (1 <= n <= kBoxLanes; cells_bounds'
-    // arithmetic), box 0 again in the lanes from n on.
+    // arithmetic, layout L on a grid of cells `cell`), box 0 again in the
+    // lanes from n on.
+    template <CellLayout L = kGridCells>
     static BoxLanes of_cells(const std::uint64_t* cells, std::size_t n, Vec3f origin, float cell) {
         std::uint64_t padded[kBoxLanes];
         if (n < kBoxLanes) {
@@ -65,6 +67,8 @@ struct BoxLanes {
             cells = padded;
         }
         const float o[3] = {origin.x, origin.y, origin.z}, m = unbounded_box().max.x;
+        const float unit = cell / float(L.subdivision);
+        constexpr std::uint64_t lo_mask = (1u << L.lo_bits) - 1, extent_mask = (1u << L.extent_bits) - 1;
         BoxLanes b;
         for (std::size_t h = 0; h < kHalves; ++h) {
             Words w0, w1;
@@ -72,11 +76,11 @@ struct BoxLanes {
             const Ints unbounded = low_halves(w0 == kUnboundedCells, w1 == kUnboundedCells);
             for (int a = 0; a < 3; ++a) {
                 // cells_lo and cells_hi
-                const int shift = 14 * a;
-                const Ints lo = low_halves((w0 >> shift) & 0x3ff, (w1 >> shift) & 0x3ff);
-                const Ints hi = lo + low_halves((w0 >> (shift + 10)) & 0xf, (w1 >> (shift + 10)) & 0xf);
-                const Floats lo_mm = o[a] + __builtin_convertvector(lo, Floats) * cell;
-                const Floats hi_mm = o[a] + __builtin_convertvector(hi, Floats) * cell;
+                const int shift = int(L.axis_bits()) * a;
+                const Ints lo = low_halves((w0 >> shift) & lo_mask, (w1 >> shift) & lo_mask);
+                const Ints hi = lo + low_halves((w0 >> (shift + L.lo_bits)) & extent_mask, (w1 >> (shift + L.lo_bits)) & extent_mask);
+                const Floats lo_mm = o[a] + __builtin_convertvector(lo, Floats) * unit;
+                const Floats hi_mm = o[a] + __builtin_convertvector(hi, Floats) * unit;
                 b.lo[a][h] = unbounded ? Floats{} - m : lo_mm;
                 b.hi[a][h] = unbounded ? Floats{} + m : hi_mm;
             }

@@ -38,30 +38,52 @@ inline Aabb unbounded_box() {
 }
 
 // A grid box in 64 bits, as an index keeps one per block in memory: per
-// axis a, lo in bits 14a .. 14a+9 and the extent in bits 14a+10 .. 14a+13;
-// all ones: unbounded.
+// axis a, lo in the low `lo_bits` of bits a * axis_bits() on and the extent
+// above it, in cells of 1 / `subdivision` of the grid's; all ones:
+// unbounded.
+struct CellLayout {
+    unsigned lo_bits, extent_bits, subdivision;
+    constexpr unsigned axis_bits() const { return lo_bits + extent_bits; }
+};
+// A block's box (GridBox: lo < 1024, extent <= 15 cells), and a box within
+// one in quarter cells (sides up to 4 * (1023 + 15), extents up to 60).
+inline constexpr CellLayout kGridCells{10, 4, 1}, kQuarterCells{13, 6, 4};
 inline constexpr std::uint64_t kUnboundedCells = ~std::uint64_t{0};
-inline std::uint64_t pack_cells(const GridBox& b) {
+
+template <CellLayout L = kGridCells>
+std::uint64_t pack_cells(const std::uint32_t lo[3], const std::uint32_t hi[3]) {
     std::uint64_t v = 0;
-    for (int a = 0; a < 3; ++a) v |= std::uint64_t(b.lo[a] | std::uint32_t(b.extent[a]) << 10) << (14 * a);
+    for (int a = 0; a < 3; ++a) v |= std::uint64_t(lo[a] | (hi[a] - lo[a]) << L.lo_bits) << (L.axis_bits() * a);
     return v;
 }
-inline std::uint32_t cells_lo(std::uint64_t v, int axis) { return std::uint32_t(v >> (14 * axis)) & 0x3ff; }
-inline std::uint32_t cells_hi(std::uint64_t v, int axis) {
-    return cells_lo(v, axis) + (std::uint32_t(v >> (14 * axis + 10)) & 0xf);
+inline std::uint64_t pack_cells(const GridBox& b) {
+    const std::uint32_t lo[3] = {b.lo[0], b.lo[1], b.lo[2]},
+                        hi[3] = {b.lo[0] + b.extent[0], b.lo[1] + b.extent[1], b.lo[2] + b.extent[2]};
+    return pack_cells(lo, hi);
 }
-// The box in mm of cells lo .. hi: sides at origin + float(i) * cell, as
-// IndexBoxDecoder computes version-2 boxes.
+template <CellLayout L = kGridCells>
+std::uint32_t cells_lo(std::uint64_t v, int axis) {
+    return std::uint32_t(v >> (L.axis_bits() * axis)) & ((1u << L.lo_bits) - 1);
+}
+template <CellLayout L = kGridCells>
+std::uint32_t cells_hi(std::uint64_t v, int axis) {
+    return cells_lo<L>(v, axis) + (std::uint32_t(v >> (L.axis_bits() * axis + L.lo_bits)) & ((1u << L.extent_bits) - 1));
+}
+// The box in mm of cells lo .. hi of size `cell`: sides at origin +
+// float(i) * cell, as IndexBoxDecoder computes version-2 boxes.
 inline Aabb cells_bounds(const std::uint32_t lo[3], const std::uint32_t hi[3], Vec3f origin, float cell) {
     auto side = [&](float o, std::uint32_t i) { return o + float(i) * cell; };
     return {{side(origin.x, lo[0]), side(origin.y, lo[1]), side(origin.z, lo[2])},
             {side(origin.x, hi[0]), side(origin.y, hi[1]), side(origin.z, hi[2])}};
 }
-inline Aabb cells_bounds(std::uint64_t packed, Vec3f origin, float cell) {
+// A packed box in mm on a grid of cells `cell` (quarter cells: sides at
+// float(4 i) * cell / 4, those of the grid's cells exactly).
+template <CellLayout L = kGridCells>
+Aabb cells_bounds(std::uint64_t packed, Vec3f origin, float cell) {
     if (packed == kUnboundedCells) return unbounded_box();
-    const std::uint32_t lo[3] = {cells_lo(packed, 0), cells_lo(packed, 1), cells_lo(packed, 2)},
-                        hi[3] = {cells_hi(packed, 0), cells_hi(packed, 1), cells_hi(packed, 2)};
-    return cells_bounds(lo, hi, origin, cell);
+    const std::uint32_t lo[3] = {cells_lo<L>(packed, 0), cells_lo<L>(packed, 1), cells_lo<L>(packed, 2)},
+                        hi[3] = {cells_hi<L>(packed, 0), cells_hi<L>(packed, 1), cells_hi<L>(packed, 2)};
+    return cells_bounds(lo, hi, origin, cell / float(L.subdivision));
 }
 
 // Boxes are stored on a cubic grid: on each axis a box is [origin + i*cell,
