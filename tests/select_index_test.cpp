@@ -18,6 +18,7 @@
 #include "fiblet/fft_subset.hpp"
 #include "fiblet/select.hpp"
 #include "cli_runner.hpp"
+#include "scoped_simd_loops.hpp"
 #include "select_reference.hpp"
 #include "test_util.hpp"
 
@@ -445,7 +446,8 @@ TEST_F(SelectIndex, FirstPointBoxHoldsTheFirstPointWithinTheBlocksBox) {
 }
 
 // The hierarchy's boxes are tested eight at a time in vector lanes
-// (index/box_tests.hpp, leaf blocks unpacked from their grid cells there):
+// (index/box_tests.hpp, leaf blocks unpacked from their grid cells there;
+// a frustum's partial leaves in AVX2 lanes, index/frustum_leaf_avx2.hpp):
 // the candidates are exactly the blocks whose own box (block_box) meets the
 // region by the one-box tests, and `inside` those it holds: none missed, none
 // let through that its own box rules out.
@@ -459,15 +461,18 @@ TEST_F(SelectIndex, CandidatesAreTheBlocksWhoseOwnBoxMeetsTheRegion) {
         for (int i = 0; i < 30; ++i) {
             const Frustum f = frustum_from_camera(gen.camera());
             const float margin = gen.uniform(0, 2);
-            std::vector<std::uint64_t> bits;
-            index.blocks_near_frustum(f, margin, bits);
-            std::vector<std::uint64_t> starting;
-            index.blocks_starting_near_frustum(f, margin, starting);
-            for (std::size_t b = 0; b < d.blocks.size(); ++b) {
-                ASSERT_EQ(bit(bits, b), box_intersects_frustum(f, index.block_box(b), margin))
-                    << path << " camera " << i << " block " << b;
-                ASSERT_EQ(bit(starting, b), box_intersects_frustum(f, index.first_point_box(b), margin))
-                    << path << " camera " << i << " block " << b << " (first point)";
+            for (const bool avx2 : {false, true}) {  // partial leaves: AVX2 lanes or four-float ones
+                const test::ScopedSimdLoops loops(avx2);
+                std::vector<std::uint64_t> bits;
+                index.blocks_near_frustum(f, margin, bits);
+                std::vector<std::uint64_t> starting;
+                index.blocks_starting_near_frustum(f, margin, starting);
+                for (std::size_t b = 0; b < d.blocks.size(); ++b) {
+                    ASSERT_EQ(bit(bits, b), box_intersects_frustum(f, index.block_box(b), margin))
+                        << path << " camera " << i << " block " << b << " AVX2 " << avx2;
+                    ASSERT_EQ(bit(starting, b), box_intersects_frustum(f, index.first_point_box(b), margin))
+                        << path << " camera " << i << " block " << b << " AVX2 " << avx2 << " (first point)";
+                }
             }
             const Region r = gen.region();
             std::vector<std::uint64_t> near, inside;

@@ -3,16 +3,19 @@
 #include "fiblet/block_index.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <mutex>
 #include <string>
+#include <type_traits>
 
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 #include "select/block_decoder.hpp"
 #include "core/bytes.hpp"
 #include "index/box_tests.hpp"
+#include "index/frustum_leaf_avx2.hpp"
 #include "index/index_chunk.hpp"
 
 namespace fiblet {
@@ -397,6 +400,17 @@ void BlockIndex::collect(const Test& test, std::vector<std::uint64_t>& bits, std
     auto leaf = [&](std::size_t pos, Overlap o, detail::Narrowing active) {
         if (o == Overlap::partial && !leaf_cells.empty()) {
             const BlockRange r = leaf_blocks_[pos];
+#ifdef FIBLET_POINTS_AVX2
+            if constexpr (std::is_same_v<Test, detail::FrustumTest>) {
+                if (!inside && detail::use_avx2_loops()) {
+                    for (unsigned kept = detail::frustum_leaf_avx2<kLeafLayout>(test, &leaf_cells[leaf_first_cell_[pos]],
+                                                                                r.end - r.first, cells_origin_, cell_mm_, active);
+                         kept; kept &= kept - 1)
+                        set_bit(bits, r.first + std::uint32_t(std::countr_zero(kept)));
+                    return;
+                }
+            }
+#endif
             Overlap ob[kFanout];
             detail::Narrowing unused[kFanout];
             detail::classify(test,

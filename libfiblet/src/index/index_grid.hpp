@@ -57,8 +57,8 @@ std::uint64_t pack_cells(const std::uint32_t lo[3], const std::uint32_t hi[3]) {
     return v;
 }
 inline std::uint64_t pack_cells(const GridBox& b) {
-    const std::uint32_t lo[3] = {b.lo[0], b.lo[1], b.lo[2]},
-                        hi[3] = {b.lo[0] + b.extent[0], b.lo[1] + b.extent[1], b.lo[2] + b.extent[2]};
+    std::uint32_t lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) lo[a] = b.lo[a], hi[a] = lo[a] + b.extent[a];
     return pack_cells(lo, hi);
 }
 template <CellLayout L = kGridCells>
