@@ -447,7 +447,7 @@ TEST_F(SelectIndex, FirstPointBoxHoldsTheFirstPointWithinTheBlocksBox) {
 
 // The hierarchy's boxes are tested eight at a time in vector lanes
 // (index/box_tests.hpp, leaf blocks unpacked from their grid cells there;
-// a frustum's partial leaves in AVX2 lanes, index/frustum_leaf_avx2.hpp):
+// partial leaves in AVX2 lanes, index/leaf_tests_avx2.hpp, where it runs):
 // the candidates are exactly the blocks whose own box (block_box) meets the
 // region by the one-box tests, and `inside` those it holds: none missed, none
 // let through that its own box rules out.
@@ -476,8 +476,18 @@ TEST_F(SelectIndex, CandidatesAreTheBlocksWhoseOwnBoxMeetsTheRegion) {
             }
             const Region r = gen.region();
             std::vector<std::uint64_t> near, inside;
-            if (r.shape == Region::Shape::sphere) index.blocks_near_sphere(r.center, r.radius, near, &inside);
-            else index.blocks_near_box(r.box, near, &inside);
+            auto walk = [&](std::vector<std::uint64_t>& n, std::vector<std::uint64_t>& in) {
+                if (r.shape == Region::Shape::sphere) index.blocks_near_sphere(r.center, r.radius, n, &in);
+                else index.blocks_near_box(r.box, n, &in);
+            };
+            walk(near, inside);
+            {  // the same blocks with the four-float lanes as with the AVX2 ones (the default)
+                const test::ScopedSimdLoops loops(false);
+                std::vector<std::uint64_t> near4, inside4;
+                walk(near4, inside4);
+                ASSERT_EQ(near4, near) << path << " region " << i;
+                ASSERT_EQ(inside4, inside) << path << " region " << i;
+            }
             for (std::size_t b = 0; b < d.blocks.size(); ++b) {
                 const Aabb x = index.block_box(b);
                 near_count += bit(near, b), inside_count += bit(inside, b);

@@ -8,14 +8,13 @@
 #include <limits>
 #include <mutex>
 #include <string>
-#include <type_traits>
 
 #include "fiblet/decode.hpp"
 #include "fiblet/error.hpp"
 #include "select/block_decoder.hpp"
 #include "core/bytes.hpp"
 #include "index/box_tests.hpp"
-#include "index/frustum_leaf_avx2.hpp"
+#include "index/leaf_tests_avx2.hpp"
 #include "index/index_chunk.hpp"
 
 namespace fiblet {
@@ -62,6 +61,10 @@ void radix_sort(std::vector<std::uint64_t>& items, unsigned key_bits) {
 }
 
 void set_bit(std::vector<std::uint64_t>& bits, std::uint32_t b) { bits[b >> 6] |= std::uint64_t{1} << (b & 63); }
+// Blocks first + i for the bits i of `mask`.
+void set_bits(std::vector<std::uint64_t>& bits, std::uint32_t first, unsigned mask) {
+    for (; mask; mask &= mask - 1) set_bit(bits, first + std::uint32_t(std::countr_zero(mask)));
+}
 
 }  // namespace
 
@@ -401,12 +404,12 @@ void BlockIndex::collect(const Test& test, std::vector<std::uint64_t>& bits, std
         if (o == Overlap::partial && !leaf_cells.empty()) {
             const BlockRange r = leaf_blocks_[pos];
 #ifdef FIBLET_POINTS_AVX2
-            if constexpr (std::is_same_v<Test, detail::FrustumTest>) {
-                if (!inside && detail::use_avx2_loops()) {
-                    for (unsigned kept = detail::frustum_leaf_avx2<kLeafLayout>(test, &leaf_cells[leaf_first_cell_[pos]],
-                                                                                r.end - r.first, cells_origin_, cell_mm_, active);
-                         kept; kept &= kept - 1)
-                        set_bit(bits, r.first + std::uint32_t(std::countr_zero(kept)));
+            if constexpr (detail::HasLeafVerdicts8<Test>) {
+                if (detail::use_avx2_loops()) {
+                    const detail::LeafVerdicts v = detail::leaf_verdicts_avx2<kLeafLayout>(
+                        test, &leaf_cells[leaf_first_cell_[pos]], r.end - r.first, cells_origin_, cell_mm_, active);
+                    set_bits(bits, r.first, v.near);
+                    if (inside) set_bits(*inside, r.first, v.inside);
                     return;
                 }
             }
