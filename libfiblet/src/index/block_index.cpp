@@ -205,21 +205,20 @@ inline std::uint64_t first_point_cells_of(std::uint64_t own, std::uint64_t previ
     if (own == detail::kUnboundedCells) return own;
     const bool narrow = reach >= 0 && previous != detail::kUnboundedCells;
     if (!narrow) previous = own, reach = 0;
-    constexpr detail::CellLayout L = detail::kQuarterCells;
-    std::uint64_t packed = 0, own_packed = 0;
+    constexpr std::uint32_t q = detail::kQuarterCells.subdivision;
+    std::uint32_t own_lo[3], own_hi[3], lo[3], hi[3];
     bool disjoint = false;
     for (int a = 0; a < 3; ++a) {
-        const auto own_lo = std::int32_t(4 * detail::cells_lo(own, a)), own_hi = std::int32_t(4 * detail::cells_hi(own, a));
-        const std::int32_t lo = std::max(own_lo, std::int32_t(4 * detail::cells_lo(previous, a)) - reach);
-        const std::int32_t hi = std::min(own_hi, std::int32_t(4 * detail::cells_hi(previous, a)) + reach);
-        disjoint |= hi < lo;
-        const unsigned shift = L.axis_bits() * unsigned(a);
-        packed |= std::uint64_t(std::uint32_t(lo) | std::uint32_t(hi - lo) << L.lo_bits) << shift;
-        own_packed |= std::uint64_t(std::uint32_t(own_lo) | std::uint32_t(own_hi - own_lo) << L.lo_bits) << shift;
+        own_lo[a] = q * detail::cells_lo(own, a), own_hi[a] = q * detail::cells_hi(own, a);
+        const auto l = std::max(std::int32_t(own_lo[a]), std::int32_t(q * detail::cells_lo(previous, a)) - reach);
+        const auto h = std::min(std::int32_t(own_hi[a]), std::int32_t(q * detail::cells_hi(previous, a)) + reach);
+        disjoint |= h < l;
+        lo[a] = std::uint32_t(l), hi[a] = std::uint32_t(h);
     }
     // Disjoint only where the index contradicts the blocks: their own box
     // then, as conservative as the rest.
-    return disjoint ? own_packed : packed;
+    return disjoint ? detail::pack_cells<detail::kQuarterCells>(own_lo, own_hi)
+                    : detail::pack_cells<detail::kQuarterCells>(lo, hi);
 }
 
 }  // namespace
@@ -247,8 +246,9 @@ const std::vector<std::uint64_t>& BlockIndex::first_point_cells() const {
         // plus 0.002 cell rounded up to whole quarters (the sides' float
         // rounding is below the 0.001-cell slack of quantized boxes:
         // index_grid.hpp).
-        const double reach_quarters = std::ceil(4.0 * double(max_join_) / double(cell_mm_) + 0.008);
-        const bool known = max_join_ >= 0 && cell_mm_ > 0 && reach_quarters < 4.0 * detail::kMaxGridLevels;
+        constexpr double q = detail::kQuarterCells.subdivision;
+        const double reach_quarters = std::ceil(q * double(max_join_) / double(cell_mm_) + q * 0.002);
+        const bool known = max_join_ >= 0 && cell_mm_ > 0 && reach_quarters < q * detail::kMaxGridLevels;
         const std::int32_t reach = known ? std::int32_t(reach_quarters) : -1;
         std::vector<std::uint64_t>& out = first_points_->cells;
         out.resize(block_cells_.size());
