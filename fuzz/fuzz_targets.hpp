@@ -379,6 +379,30 @@ inline void select_target(const FftFile& f, const Streamlines& all) {
             inside = q.include[0].contains({near.xyz[3 * k], near.xyz[3 * k + 1], near.xyz[3 * k + 2]});
         check(inside, "a fiber kept by a region query has no point inside the region");
     }
+    // A camera looking at the first point from a little away: the first
+    // block is kept exactly when its view sphere meets the frustum (the
+    // frustum walk narrows the block's box to where its first point can be),
+    // where the index is the writer's (checksums verified) or computed.
+    if (index->source() != BlockIndex::Source::decoded && !f.verifies_checksums()) return;
+    const float away = 20 * f.header().step * f.header().scaling;
+    Query view;
+    view.view = ViewSelection{};
+    Camera& camera = view.view->camera;
+    camera.target = c, camera.position = {c.x + away, c.y + 0.5f * away, c.z + away};
+    camera.near_mm = 0.5f * away, camera.far_mm = 4 * away, camera.fov_y_deg = 10, camera.aspect = 1;
+    Sphere first;
+    std::vector<SelectedRun> seen;
+    try {
+        first = block_bounding_sphere(f.header(), f.read_blocks(0, 1).data());
+        seen = select_runs(f, *index, view);
+    } catch (const Error& e) {
+        check(e.code() == Errc::invalid_argument || e.code() == Errc::fft_format || e.code() == Errc::checksum,
+              "a view query failed with an unexpected category");
+        return;
+    }
+    const bool kept = !seen.empty() && seen[0].first_block == 0;
+    check(kept == sphere_intersects_frustum(frustum_from_camera(camera), first.center, first.radius),
+          "a view query disagrees with the first block's sphere");
 }
 
 // The .fft reader and every decoder: open (checksums verified or not),
