@@ -172,6 +172,8 @@ private:
     void set_groups(const std::vector<Aabb>& boxes);  // of group_first_'s groups; sorts and builds it
     Aabb cells_union(const std::uint64_t* cells, std::size_t n) const;  // of n packed grid boxes
     void sort_block_cells(const std::vector<std::uint64_t>& cells);  // file order -> block_cells_
+    std::size_t group_of(std::uint64_t block) const;  // the group holding a block
+    std::size_t cell_of(std::uint64_t block) const;   // a block's place in block_cells_
     // first_point_box's cells in quarter cells, as block_cells_ (made once).
     const std::vector<std::uint64_t>& first_point_cells() const;
     template <class BoxOf>

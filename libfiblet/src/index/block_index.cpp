@@ -166,22 +166,25 @@ BlockIndex BlockIndex::load(const FftFile& file) {
     return index;
 }
 
+std::size_t BlockIndex::group_of(std::uint64_t block) const {
+    return std::size_t(std::upper_bound(group_first_.begin(), group_first_.end() - 1, std::uint32_t(block)) -
+                       group_first_.begin()) - 1;
+}
+
+std::size_t BlockIndex::cell_of(std::uint64_t block) const {
+    const std::size_t g = group_of(block);
+    return leaf_first_cell_[rank_[g]] + (block - group_first_[g]);
+}
+
 Aabb BlockIndex::block_box(std::uint64_t block) const {
-    const auto g = std::size_t(std::upper_bound(group_first_.begin(), group_first_.end() - 1, std::uint32_t(block)) -
-                               group_first_.begin()) - 1;
-    if (!block_cells_.empty())
-        return detail::cells_bounds(block_cells_[leaf_first_cell_[rank_[g]] + (block - group_first_[g])], cells_origin_,
-                                    cell_mm_);
-    const std::uint32_t pos = rank_[g];
+    if (!block_cells_.empty()) return detail::cells_bounds(block_cells_[cell_of(block)], cells_origin_, cell_mm_);
+    const std::uint32_t pos = rank_[group_of(block)];
     return detail::box_at(boxes_[0][pos / kFanout], pos % kFanout);
 }
 
 Aabb BlockIndex::first_point_box(std::uint64_t block) const {
     if (block_cells_.empty()) return block_box(block);
-    const auto g = std::size_t(std::upper_bound(group_first_.begin(), group_first_.end() - 1, std::uint32_t(block)) -
-                               group_first_.begin()) - 1;
-    return detail::cells_bounds<detail::kQuarterCells>(
-        first_point_cells()[leaf_first_cell_[rank_[g]] + (block - group_first_[g])], cells_origin_, cell_mm_);
+    return detail::cells_bounds<detail::kQuarterCells>(first_point_cells()[cell_of(block)], cells_origin_, cell_mm_);
 }
 
 Aabb BlockIndex::cells_union(const std::uint64_t* cells, std::size_t n) const {

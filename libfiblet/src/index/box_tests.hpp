@@ -38,6 +38,14 @@ inline Ints low_halves(Words a, Words b) {
     return __builtin_shufflevector(reinterpret_cast<Ints>(a), reinterpret_cast<Ints>(b), 0, 2, 4, 6);
 }
 
+// n (1 <= n <= kBoxLanes) packed boxes as kBoxLanes: `cells` itself, or,
+// for fewer, copied into `padded` with box 0 again past n.
+inline const std::uint64_t* eight_cells(const std::uint64_t* cells, std::size_t n, std::uint64_t (&padded)[kBoxLanes]) {
+    if (n == kBoxLanes) return cells;
+    for (std::size_t i = 0; i < kBoxLanes; ++i) padded[i] = cells[i < n ? i : 0];
+    return padded;
+}
+
 // kBoxLanes boxes in registers: [axis][half] vectors of their sides.
 struct BoxLanes {
     Floats lo[3][kHalves], hi[3][kHalves];
@@ -62,10 +70,7 @@ struct BoxLanes {
     template <CellLayout L = kGridCells>
     static BoxLanes of_cells(const std::uint64_t* cells, std::size_t n, Vec3f origin, float cell) {
         std::uint64_t padded[kBoxLanes];
-        if (n < kBoxLanes) {
-            for (std::size_t i = 0; i < kBoxLanes; ++i) padded[i] = cells[i < n ? i : 0];
-            cells = padded;
-        }
+        cells = eight_cells(cells, n, padded);
         const float o[3] = {origin.x, origin.y, origin.z}, m = unbounded_box().max.x;
         const float unit = cell / float(L.subdivision);
         constexpr std::uint64_t lo_mask = (1u << L.lo_bits) - 1, extent_mask = (1u << L.extent_bits) - 1;

@@ -40,10 +40,7 @@ FIBLET_AVX2 __m256i low_words8(__m256i a, __m256i b) {
 template <CellLayout L>
 FIBLET_AVX2 BoxLanes8 unpack_cells8(const std::uint64_t* cells, std::size_t n, Vec3f origin, float cell) {
     std::uint64_t padded[kBoxLanes];
-    if (n < kBoxLanes) {
-        for (std::size_t i = 0; i < kBoxLanes; ++i) padded[i] = cells[i < n ? i : 0];
-        cells = padded;
-    }
+    cells = eight_cells(cells, n, padded);
     const __m256i w0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(cells));
     const __m256i w1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(cells + 4));
     const __m256i all_ones = _mm256_set1_epi64x(-1);
