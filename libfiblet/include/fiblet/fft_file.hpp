@@ -149,6 +149,7 @@ private:
     [[noreturn]] void shrank_while_read() const;  // a mapped read faulted
     void require_size(std::uint64_t end) const;   // or shrank_while_read()
     void verify_block_groups(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const;
+    bool groups_verified(std::uint64_t g0, std::uint64_t g1) const;  // checksum groups [g0, g1)
     void close() noexcept;
 
     void read_at(std::uint8_t* out, std::uint64_t size, std::uint64_t offset) const;

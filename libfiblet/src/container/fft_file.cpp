@@ -395,10 +395,19 @@ void FftFile::check_block_structure(std::uint64_t first, std::uint64_t count, co
     }
 }
 
+// Whether checksum groups [g0, g1) were all verified by earlier reads.
+bool FftFile::groups_verified(std::uint64_t g0, std::uint64_t g1) const {
+    for (std::uint64_t g = g0; g < g1; ++g)
+        if (!(verified_groups_[g / 64].load(std::memory_order_acquire) >> (g % 64) & 1)) return false;
+    return true;
+}
+
 // `blocks`: blocks [first, first + count) as stored (packed for version 17).
 void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const {
     const FftChecksums& c = *checksums_;
-    const std::uint64_t g_blocks = c.group_blocks, end = first + count, base = stored_offset(first);
+    const std::uint64_t g_blocks = c.group_blocks, end = first + count;
+    if (count == 0 || groups_verified(first / g_blocks, (end - 1) / g_blocks + 1)) return;  // most reads after the first
+    const std::uint64_t base = stored_offset(first);
     std::vector<std::uint8_t> edge;  // the part of a group outside [first, end)
     std::optional<Xxh64Stream> hash;  // made for the first group not verified yet (most reads find none)
     // Hashed in place in the mapping when the file has one (no copy), else read.
