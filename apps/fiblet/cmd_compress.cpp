@@ -275,7 +275,7 @@ void add_compress(CLI::App& app) {
     cmd->add_flag("-z,--zstd", args->zstd,
                   "Write the seekable zstd container (.fftz, formats/fftz.md): smaller, still random access "
                   "(-o x.fftz implies it)");
-    cmd->add_option("--zstd-level", args->zstd_level, "zstd level (default 3; 17: 4 % smaller, the stage ~12x slower)")->check(CLI::Range(1, 22));
+    cmd->add_option("--zstd-level", args->zstd_level, "zstd level (default 1; 3: 0.8 % smaller, compress ~8 % slower; 17: 4.6 % smaller, its stage ~20x slower)")->check(CLI::Range(1, 22));
     cmd->add_option("--zstd-group", args->zstd_group, "Blocks per zstd frame, the unit of random access (default 4096)")
         ->check(CLI::Range(1u, 1u << 24));
     cmd->add_flag("--no-transpose", args->no_transpose,
