@@ -45,18 +45,22 @@ void and_bits(Bits& a, const Bits& b) {
     for (std::size_t i = 0; i < a.size(); ++i) a[i] &= b[i];
 }
 
-// The fiber of each block, for blocks visited in ascending order.
+// The fiber of each block, for blocks visited in ascending order. The
+// current fiber's end is kept: most blocks asked for lie in the fiber of the
+// one before, and the file's table would be read again after every store
+// the caller makes (the compiler cannot tell they do not change it).
 class FiberCursor {
 public:
-    explicit FiberCursor(const FftFile& file) : file_(file) {}
+    explicit FiberCursor(const FftFile& file) : file_(file), end_(file.block_end(1)) {}
     std::uint64_t fiber_of(std::uint64_t block) {
-        while (file_.block_end(fiber_ + 1) <= block) ++fiber_;
+        while (end_ <= block) end_ = file_.block_end(++fiber_ + 1);
         return fiber_;
     }
 
 private:
     const FftFile& file_;
     std::uint64_t fiber_ = 0;
+    std::uint64_t end_;  // of fiber_'s blocks
 };
 
 // The blocks of kept fibers in ascending order, restricted to a bitmap of
@@ -71,18 +75,26 @@ public:
         blocks.clear(), fibers.clear();
         const std::uint64_t nblocks = file_.header().blocks;
         if (only_) {
+            // The bitmap's position in locals: the outputs' stores might
+            // otherwise be this object's and make the compiler reload it.
+            std::size_t word = word_;
+            std::uint64_t bits = word_bits_;
+            const std::uint64_t* const words = only_->data();
+            const std::size_t word_count = only_->size();
+            const std::uint8_t* const keep = keep_.data();
             while (blocks.size() < max) {
-                if (word_bits_ == 0) {
-                    if (++word_ >= only_->size()) break;
-                    word_bits_ = (*only_)[word_];
+                if (bits == 0) {
+                    if (++word >= word_count) break;
+                    bits = words[word];
                     continue;
                 }
-                const std::uint64_t b = word_ * 64 + std::uint64_t(std::countr_zero(word_bits_));
-                word_bits_ &= word_bits_ - 1;
+                const std::uint64_t b = word * 64 + std::uint64_t(std::countr_zero(bits));
+                bits &= bits - 1;
                 if (b >= nblocks) break;
                 const std::uint64_t f = cursor_.fiber_of(b);
-                if (keep_[f]) blocks.push_back(std::uint32_t(b)), fibers.push_back(f);
+                if (keep[f]) blocks.push_back(std::uint32_t(b)), fibers.push_back(f);
             }
+            word_ = word, word_bits_ = bits;
         } else {
             const std::uint64_t nfibers = file_.header().fibers;
             while (blocks.size() < max && fiber_ < nfibers) {
