@@ -406,7 +406,9 @@ bool FftFile::groups_verified(std::uint64_t g0, std::uint64_t g1) const {
 void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, const std::uint8_t* blocks) const {
     const FftChecksums& c = *checksums_;
     const std::uint64_t g_blocks = c.group_blocks, end = first + count;
-    if (count == 0 || groups_verified(first / g_blocks, (end - 1) / g_blocks + 1)) return;  // most reads after the first
+    if (count == 0) return;
+    const std::uint64_t g_begin = first / g_blocks, g_end = (end - 1) / g_blocks + 1;  // the groups read
+    if (groups_verified(g_begin, g_end)) return;  // most reads after the first
     const std::uint64_t base = stored_offset(first);
     std::vector<std::uint8_t> edge;  // the part of a group outside [first, end)
     std::optional<Xxh64Stream> hash;  // made for the first group not verified yet (most reads find none)
@@ -422,7 +424,7 @@ void FftFile::verify_block_groups(std::uint64_t first, std::uint64_t count, cons
         read_at(edge.data(), edge.size(), header_.blocks_offset() + at);
         hash->update(edge.data(), edge.size());
     };
-    for (std::uint64_t g = first / g_blocks; g <= (end - 1) / g_blocks; ++g) {
+    for (std::uint64_t g = g_begin; g < g_end; ++g) {
         std::atomic<std::uint64_t>& word = verified_groups_[g / 64];
         const std::uint64_t bit = std::uint64_t{1} << (g % 64);
         if (word.load(std::memory_order_acquire) & bit) continue;  // checked by an earlier read
