@@ -15,10 +15,10 @@ if(BUILD_SHARED_LIBS)
   set_target_properties(fiblet PROPERTIES VERSION ${PROJECT_VERSION} SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR})
   set_target_properties(fiblet_cli PROPERTIES INSTALL_RPATH "$ORIGIN/../${CMAKE_INSTALL_LIBDIR}")
   set(FIBLET_PC_LIBS "")
-  set(FIBLET_PC_LIBS_PRIVATE "-lzstd -lzip -lnifti2 -lznz -pthread")
+  set(FIBLET_PC_LIBS_PRIVATE "-lzstd -lzip -lnifti2 -lznz -lxxhash -pthread")
 else()
   # A static archive needs its dependencies on every link line.
-  set(FIBLET_PC_LIBS "-lzstd -lzip -lnifti2 -lznz -pthread")
+  set(FIBLET_PC_LIBS "-lzstd -lzip -lnifti2 -lznz -lxxhash -pthread")
   set(FIBLET_PC_LIBS_PRIVATE "")
 endif()
 

@@ -1,6 +1,12 @@
-// Compiled inline (XXH_INLINE_ALL), as xxh64.cpp: no link-time dependency.
+#ifdef FIBLET_XXH3_DISPATCH
+// libxxhash's run-time dispatch: its widest vector code this CPU runs
+// (the same digest from every one of them).
+#define XXH_STATIC_LINKING_ONLY
+#include <xxh_x86dispatch.h>
+#else
 #define XXH_INLINE_ALL
 #include <xxhash.h>
+#endif
 
 #include "core/pass_digest.hpp"
 
