@@ -20,6 +20,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "fiblet/block_index.hpp"
 #include "fiblet/compress.hpp"
@@ -219,6 +220,38 @@ BENCHMARK_CAPTURE(BM_SelectQuery, Mask, Family::mask)->Arg(1)->Arg(10)->Arg(50)-
 BENCHMARK_CAPTURE(BM_SelectQuery, Frustum, Family::frustum)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SelectQuery, FrustumLod, Family::frustum_lod)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SelectQuery, RandomFibers, Family::random_fibers)->Arg(1)->Arg(10)->Arg(50)->Unit(benchmark::kMillisecond);
+
+// The floor of a query: decode_blocks over exactly the blocks it keeps,
+// copied together beforehand (nothing read, tested or walked), in calls of
+// 4096 blocks into one buffer, as the full decode. Beside BM_SelectQuery in
+// the same run, the difference is what selecting costs beyond decoding.
+void BM_SelectKeptDecode(benchmark::State& state, Family family) {
+    const FftFile& file = *bench_file().file;
+    const std::size_t bb = file.header().block_bytes();
+    std::vector<std::uint8_t> kept;
+    std::uint64_t blocks = 0;
+    for (const SelectedRun& r : select_runs(file, *bench_file().index, query_keeping(family, int(state.range(0))))) {
+        const std::vector<std::uint8_t> run = file.read_blocks(r.first_block, r.block_count);
+        kept.insert(kept.end(), run.begin(), run.end());
+        blocks += r.block_count;
+    }
+    constexpr std::size_t kChunk = 4096;
+    std::vector<float> xyz(3 * kChunk * file.header().points_per_block);
+    const DecodeContext ctx(file);
+    for (auto _ : state) {
+        std::size_t points = 0;
+        for (std::uint64_t b = 0; b < blocks; b += kChunk)
+            points += decode_blocks(ctx, kept.data() + b * bb, std::min<std::uint64_t>(kChunk, blocks - b), xyz.data());
+        benchmark::DoNotOptimize(points);
+    }
+    state.counters["kept_pct"] = 100.0 * double(blocks) / double(file.header().blocks);
+    state.SetLabel(bench_file().label);
+}
+BENCHMARK_CAPTURE(BM_SelectKeptDecode, RegionBlocks, Family::region_blocks)->Arg(1)->Arg(10)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SelectKeptDecode, RegionFibers, Family::region_fibers)->Arg(1)->Arg(10)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SelectKeptDecode, Mask, Family::mask)->Arg(1)->Arg(10)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SelectKeptDecode, Frustum, Family::frustum)->Arg(1)->Arg(10)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SelectKeptDecode, RandomFibers, Family::random_fibers)->Arg(1)->Arg(10)->Unit(benchmark::kMillisecond);
 
 void BM_SelectEverything(benchmark::State& state) {
     SelectionStats stats;
