@@ -239,6 +239,32 @@ TEST_F(MaskSelection, IndexSelectionEqualsReference) {
     }
 }
 
+// The index walk tests a mask eight boxes at a time (index/box_tests.hpp:
+// the mask's bounds in vector lanes, then ImageMask::classify box by box):
+// the blocks it puts near a mask, and wholly inside, are exactly those whose
+// own box classify() puts there.
+TEST_F(MaskSelection, WalkAgreesWithClassifyBlockByBlock) {
+    const FftFile file(fft());
+    const BlockIndex index = BlockIndex::load(file);
+    for (const char* name : {"ball.nii.gz", "ball2.nii", "slab.mif"}) {
+        const auto mask = ImageMask::read(dir_->file(name));
+        std::vector<std::uint64_t> near, inside;
+        index.blocks_near_mask(*mask, near, &inside);
+        near.resize((index.blocks() + 63) / 64, 0), inside.resize(near.size(), 0);
+        std::size_t near_count = 0, inside_count = 0;
+        for (std::uint64_t b = 0; b < index.blocks(); ++b) {
+            const ImageMask::Overlap o = mask->classify(index.block_box(b));
+            const bool is_near = (near[b / 64] >> (b % 64)) & 1, is_inside = (inside[b / 64] >> (b % 64)) & 1;
+            ASSERT_EQ(is_near, o != ImageMask::Overlap::outside) << name << " block " << b;
+            ASSERT_EQ(is_inside, o == ImageMask::Overlap::inside) << name << " block " << b;
+            near_count += is_near, inside_count += is_inside;
+        }
+        EXPECT_GT(near_count, 0u) << name;
+        EXPECT_LT(near_count, index.blocks()) << name;  // the mask rules some blocks out
+        if (std::string(name) == "ball.nii.gz") EXPECT_GT(inside_count, 0u) << name;
+    }
+}
+
 TEST_F(MaskSelection, ExtractEqualsTckedit) {
     const std::string full = dir_->file("full.tck");
     ASSERT_EQ(run_cli("decompress " + fft() + " -o " + full + " -f").status, 0);

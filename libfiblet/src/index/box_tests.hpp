@@ -208,14 +208,29 @@ void classify(const Test& test, const BoxLanes& b, std::size_t n, Narrowing acti
 }
 
 // An image mask: ImageMask::classify, box by box.
+// ImageMask::classify box by box, after its first test (the box misses the
+// mask's bounds) made on the eight boxes side by side with the same
+// comparisons: about half the boxes a mask query tests end there, without
+// a call or a branch each.
 struct MaskTest {
     const ImageMask& mask;
     void classify(const BoxLanes& b, std::size_t n, Overlap* out) const {
-        for (std::size_t i = 0; i < n; ++i) switch (mask.classify(b.box(i))) {
-                case ImageMask::Overlap::outside: out[i] = Overlap::outside; break;
-                case ImageMask::Overlap::inside: out[i] = Overlap::inside; break;
-                case ImageMask::Overlap::partial: out[i] = Overlap::partial; break;
-            }
+        const Aabb& m = mask.bounds();
+        const float lo[3] = {m.min.x, m.min.y, m.min.z}, hi[3] = {m.max.x, m.max.y, m.max.z};
+        for (std::size_t h = 0; h < kHalves; ++h) {
+            Ints apart{};
+            for (int a = 0; a < 3; ++a) apart |= (b.hi[a][h] < lo[a]) | (b.lo[a][h] > hi[a]);
+            for (std::size_t l = 0; l < 4 && 4 * h + l < n; ++l)
+                out[4 * h + l] = apart[l] ? Overlap::outside : of(mask.classify(b.box(4 * h + l)));
+        }
+    }
+    static Overlap of(ImageMask::Overlap o) {
+        switch (o) {
+            case ImageMask::Overlap::outside: return Overlap::outside;
+            case ImageMask::Overlap::inside: return Overlap::inside;
+            case ImageMask::Overlap::partial: break;
+        }
+        return Overlap::partial;
     }
 };
 

@@ -121,33 +121,44 @@ std::int64_t ImageMask::occupied(const std::array<std::int64_t, 3>& lo, const st
            s(x1, y0, z0) - s(x0, y0, z0);
 }
 
+namespace {
+
+// std::int64_t(std::floor(v)) for the voxel coordinates of a box clamped to
+// the mask (finite, far inside the int64 range), without a call into libm
+// (baseline x86-64 has no rounding instruction; six calls a box were a
+// tenth of a mask query's index walk).
+std::int64_t floor_to_int(double v) {
+    const auto toward_zero = std::int64_t(v);
+    return toward_zero - std::int64_t(double(toward_zero) > v);
+}
+
+}  // namespace
+
 ImageMask::Overlap ImageMask::classify(const Aabb& box) const {
-    if (box.max.x < bounds_.min.x || box.min.x > bounds_.max.x || box.max.y < bounds_.min.y ||
-        box.min.y > bounds_.max.y || box.max.z < bounds_.min.z || box.min.z > bounds_.max.z)
-        return Overlap::outside;
+    const float box_lo[3] = {box.min.x, box.min.y, box.min.z}, box_hi[3] = {box.max.x, box.max.y, box.max.z};
+    const float mask_lo[3] = {bounds_.min.x, bounds_.min.y, bounds_.min.z},
+                mask_hi[3] = {bounds_.max.x, bounds_.max.y, bounds_.max.z};
     // Clamped to the mask's bounds: finite even for an unbounded block box.
-    const bool clamped = box.min.x < bounds_.min.x || box.min.y < bounds_.min.y || box.min.z < bounds_.min.z ||
-                         box.max.x > bounds_.max.x || box.max.y > bounds_.max.y || box.max.z > bounds_.max.z;
-    const std::array<double, 3> bmin{std::max(box.min.x, bounds_.min.x), std::max(box.min.y, bounds_.min.y),
-                                     std::max(box.min.z, bounds_.min.z)},
-        bmax{std::min(box.max.x, bounds_.max.x), std::min(box.max.y, bounds_.max.y), std::min(box.max.z, bounds_.max.z)};
-    // Voxel-space box of the world box: its centre mapped, its half sides
-    // through |M| (the box of its eight corners, within double rounding),
-    // grown below by a margin that covers the float arithmetic of contains().
-    std::array<double, 3> centre{}, half{}, vmin{}, vmax{};
-    for (int a = 0; a < 3; ++a) centre[a] = 0.5 * (bmin[a] + bmax[a]), half[a] = 0.5 * (bmax[a] - bmin[a]);
-    const auto vc = transform_point(to_voxel_exact_, centre);
+    double centre[3], half[3];
+    bool whole_grid = true;  // every point of the box rounds to a voxel of the grid
+    for (int a = 0; a < 3; ++a) {
+        if (box_hi[a] < mask_lo[a] || box_lo[a] > mask_hi[a]) return Overlap::outside;
+        if (box_lo[a] < mask_lo[a] || box_hi[a] > mask_hi[a]) whole_grid = false;
+        const double lo = std::max(box_lo[a], mask_lo[a]), hi = std::min(box_hi[a], mask_hi[a]);
+        centre[a] = 0.5 * (lo + hi), half[a] = 0.5 * (hi - lo);
+    }
+    // Voxel-space box of the world box: its centre mapped (transform_point's
+    // arithmetic), its half sides through |M| (the box of its eight corners,
+    // within double rounding), grown below by a margin that covers the float
+    // arithmetic of contains().
+    std::array<std::int64_t, 3> lo{}, hi{};
     for (int a = 0; a < 3; ++a) {
         const auto& m = to_voxel_exact_[a];
+        const double vc = m[0] * centre[0] + m[1] * centre[1] + m[2] * centre[2] + m[3];
         const double reach = std::abs(m[0]) * half[0] + std::abs(m[1]) * half[1] + std::abs(m[2]) * half[2];
-        vmin[a] = vc[a] - reach, vmax[a] = vc[a] + reach;
-    }
-    std::array<std::int64_t, 3> lo{}, hi{};
-    bool whole_grid = !clamped;  // every point of the box rounds to a voxel of the grid
-    for (int a = 0; a < 3; ++a) {
-        const double margin = 1e-3 + 1e-6 * std::max(std::abs(vmin[a]), std::abs(vmax[a]));
-        const auto first = std::int64_t(std::floor(vmin[a] - margin + 0.5));
-        const auto last = std::int64_t(std::floor(vmax[a] + margin + 0.5));
+        const double vmin = vc - reach, vmax = vc + reach;
+        const double margin = 1e-3 + 1e-6 * std::max(std::abs(vmin), std::abs(vmax));
+        const std::int64_t first = floor_to_int(vmin - margin + 0.5), last = floor_to_int(vmax + margin + 0.5);
         if (first < 0 || last >= size_[a]) whole_grid = false;
         lo[a] = std::max<std::int64_t>(first, 0), hi[a] = std::min<std::int64_t>(last, size_[a] - 1);
         if (lo[a] > hi[a]) return Overlap::outside;
