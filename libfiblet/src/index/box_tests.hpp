@@ -207,11 +207,10 @@ void classify(const Test& test, const BoxLanes& b, std::size_t n, Narrowing acti
     else test.classify(b, n, out);
 }
 
-// An image mask: ImageMask::classify, box by box.
-// ImageMask::classify box by box, after its first test (the box misses the
-// mask's bounds) made on the eight boxes side by side with the same
-// comparisons: about half the boxes a mask query tests end there, without
-// a call or a branch each.
+// An image mask: ImageMask::classify box by box, after its first test
+// (the box misses the mask's bounds) made on the eight boxes side by side
+// with the same comparisons: about half the boxes a mask query tests end
+// there, without a call or a branch each.
 struct MaskTest {
     const ImageMask& mask;
     void classify(const BoxLanes& b, std::size_t n, Overlap* out) const {
