@@ -231,8 +231,8 @@ void BM_SelectKeptDecode(benchmark::State& state, Family family) {
     std::vector<std::uint8_t> kept;
     std::uint64_t blocks = 0;
     for (const SelectedRun& r : select_runs(file, *bench_file().index, query_keeping(family, int(state.range(0))))) {
-        const std::vector<std::uint8_t> run = file.read_blocks(r.first_block, r.block_count);
-        kept.insert(kept.end(), run.begin(), run.end());
+        kept.resize((blocks + r.block_count) * bb);
+        file.read_blocks(r.first_block, r.block_count, kept.data() + blocks * bb);
         blocks += r.block_count;
     }
     constexpr std::size_t kChunk = 4096;
