@@ -151,12 +151,12 @@ print(json.dumps({{"fromfile": med(lambda: np.fromfile(tck, dtype="<f4"), n),
             bj = os.path.join(work, "select.json")
             env = dict(os.environ, FIBLET_BENCH_DATA=os.path.dirname(os.path.abspath(a.tck)))
             subprocess.run([os.path.join(a.build, "bench", "fiblet_bench"),
-                            "--benchmark_filter=^BM_Select(FullDecode/0|Everything|IndexLoad|Query/(RegionBlocks|Frustum|RegionFibers)/10)$",
+                            "--benchmark_filter=^BM_Select(FullDecode/0|Everything/0|IndexLoad|Query/(RegionBlocks|Frustum|RegionFibers)/10)$",
                             "--benchmark_repetitions=3", "--benchmark_report_aggregates_only=true",
                             f"--benchmark_out={bj}", "--benchmark_out_format=json"],
                            env=env, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
             runs = {b["run_name"]: b for b in json.load(open(bj))["benchmarks"] if b.get("aggregate_name") == "median"}
-            full = min(runs["BM_SelectFullDecode/0"]["cpu_time"], runs["BM_SelectEverything"]["cpu_time"])
+            full = min(runs["BM_SelectFullDecode/0"]["cpu_time"], runs["BM_SelectEverything/0"]["cpu_time"])
             res["select"] = {k.replace("BM_SelectQuery/", ""): {"pct_of_full": 100 * v["cpu_time"] / full,
                                                                 "kept_pct": v.get("kept_pct")}
                              for k, v in runs.items() if k.startswith("BM_SelectQuery/")}

@@ -253,17 +253,23 @@ BENCHMARK_CAPTURE(BM_SelectKeptDecode, Mask, Family::mask)->Arg(1)->Arg(10)->Uni
 BENCHMARK_CAPTURE(BM_SelectKeptDecode, Frustum, Family::frustum)->Arg(1)->Arg(10)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SelectKeptDecode, RandomFibers, Family::random_fibers)->Arg(1)->Arg(10)->Unit(benchmark::kMillisecond);
 
+// select() with an empty query, in chunks of state.range(0) points (0:
+// the default, 2^15; 262144, the former default, cycles the decoder's
+// output through several MB).
 void BM_SelectEverything(benchmark::State& state) {
+    SelectOptions o;
+    if (state.range(0)) o.chunk_points = std::size_t(state.range(0));
     SelectionStats stats;
     for (auto _ : state) {
         std::uint64_t points = 0;
-        stats = select(*bench_file().file, *bench_file().index, Query{},
-                       [&](const SelectedChunk& c) { points += c.point_count(); });
+        stats = select(
+            *bench_file().file, *bench_file().index, Query{},
+            [&](const SelectedChunk& c) { points += c.point_count(); }, o);
         benchmark::DoNotOptimize(points);
     }
     report(state, stats);
 }
-BENCHMARK(BM_SelectEverything)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SelectEverything)->Arg(0)->Arg(262144)->Unit(benchmark::kMillisecond);
 
 void BM_SelectIndexLoad(benchmark::State& state) {
     const FftFile& file = *bench_file().file;

@@ -23,7 +23,7 @@ runs = [b for b in json.load(open(sys.argv[1]))["benchmarks"] if b.get("aggregat
 by = {b["run_name"]: b for b in runs}
 # The reference is the fastest way to decode everything: decode_file with
 # its default or small chunks, or a selection with an empty query.
-fulls = [b for b in runs if b["run_name"].startswith("BM_SelectFullDecode/")] + [by["BM_SelectEverything"]]
+fulls = [b for b in runs if b["run_name"].startswith(("BM_SelectFullDecode/", "BM_SelectEverything/"))]
 full = min(fulls, key=lambda b: b["cpu_time"])
 label = next(b.get("label", "") for b in fulls if b["run_name"].startswith("BM_SelectFullDecode/"))
 print(f"file, decoder: {label}; one thread; median of repetitions; CPU time (real time in brackets); "
@@ -32,8 +32,9 @@ print("| query | blocks kept | candidates (tested) | read | decoded | time | vs 
 print("|---|---|---|---|---|---|---|")
 for b in fulls:
     name = b["run_name"].replace("BM_SelectFullDecode/", "full decode, decode_file, chunks of ").replace(
-        "BM_SelectEverything", "full decode, select() with an empty query").replace(
-        "chunks of 0", "default chunks (4096 blocks)")
+        "BM_SelectEverything/", "full decode, select() with an empty query, chunks of ").replace(
+        "decode_file, chunks of 0", "decode_file, default chunks (4096 blocks)").replace(
+        "query, chunks of 0", "query, default chunks (2^15 points)")
     print(f"| {name} | 100 % | | 100 % | 100 % | {b['cpu_time']:.1f} ms ({b['real_time']:.1f}) | "
           f"{100 * b['cpu_time'] / full['cpu_time']:.1f} % |")
 for b in runs:

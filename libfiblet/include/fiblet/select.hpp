@@ -151,7 +151,11 @@ struct SelectedChunk {
 
 struct SelectOptions {
     bool points = true;                       // decode and output points
-    std::size_t chunk_points = 1u << 18;      // points per chunk handed to the sink
+    // Points per chunk handed to the sink: a chunk goes out once it holds
+    // this many, and blocks are decoded about this many points at a time.
+    // 2^15 points (384 KB) keep the decoder writing into the same 1.2 MB and
+    // the sink reading points still in cache (docs/select.md, "Chunks").
+    std::size_t chunk_points = 1u << 15;
     // Copy the candidate blocks out of a memory mapping of the file
     // (FftFile::read_blocks_mapped: those blocks only, no system call per
     // block) instead of reading spans of the file with pread(), small gaps

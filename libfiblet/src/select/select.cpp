@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <span>
 
 #include "fiblet/error.hpp"
 #include "fiblet/fiber_regions.hpp"
@@ -36,6 +37,13 @@ using Bits = std::vector<std::uint64_t>;
 // Blocks handled at a time: about 2^18 points (blocks hold 2 to 16383).
 std::size_t batch_blocks(const FftHeader& h) {
     return std::clamp<std::size_t>((std::size_t{1} << 18) / h.points_per_block, 16, 4096);
+}
+
+// Blocks decoded into the output with one call: about a chunk's points, so
+// that the output buffer stays the size of a few chunks, in cache and clear
+// of page faults (docs/select.md, "Chunks").
+std::size_t piece_blocks(const FftHeader& h, const SelectOptions& o) {
+    return std::clamp<std::size_t>(o.chunk_points / h.points_per_block, 1, batch_blocks(h));
 }
 
 using detail::has_bit;
@@ -145,11 +153,11 @@ Vec3f first_point(const FftHeader& h, const std::uint8_t* block) {
 class RunWriter {
 public:
     RunWriter(const SelectOptions& o, const std::function<void(const SelectedChunk&)>& sink, SelectionStats& stats,
-              std::size_t batch_points)
+              std::size_t piece_points)
         : options_(o), sink_(sink), stats_(stats) {
-        // Room for a full chunk and a batch decoded after it: no reallocation
+        // Room for a full chunk and a piece decoded after it: no reallocation
         // (a copy and fresh pages each time).
-        if (o.points) xyz_.reserve(3 * (o.chunk_points + 2 * batch_points));
+        if (o.points) xyz_.reserve(3 * (o.chunk_points + 2 * piece_points));
     }
 
     // Closes the open run unless `block` of `fiber` continues it.
@@ -512,7 +520,7 @@ private:
     // Pass 3: the blocks of the kept fibers.
     void blocks(const std::function<void(const SelectedChunk&)>& sink) {
         const BlockPass pass = block_pass();
-        RunWriter out(options_, sink, stats_, batch_blocks(h_) * h_.points_per_block);
+        RunWriter out(options_, sink, stats_, piece_blocks(h_, options_) * h_.points_per_block);
         CandidateBlocks candidates(file_, keep_, pass.only ? &*pass.only : nullptr);
         std::vector<std::uint32_t> blocks;
         std::vector<std::uint64_t> fibers;
@@ -613,8 +621,9 @@ private:
     }
 
     // Fine blocks from i up to the next coarse one (dropped ones left out):
-    // decoded with one call, straight into the output, then kept or dropped
-    // in place. Returns where the next coarse block (or the batch's end) is.
+    // decoded straight into the output, a piece of up to piece_blocks() at a
+    // time, then kept or dropped in place, and the chunk handed over when
+    // full. Returns where the next coarse block (or the batch's end) is.
     std::size_t write_fine_blocks(const BlockPass& pass, const std::vector<std::uint32_t>& blocks,
                                   const std::vector<std::uint64_t>& fibers, const std::vector<BlockKind>& kind,
                                   std::size_t i, RunWriter& out) {
@@ -628,21 +637,31 @@ private:
             out.maybe_flush();
             return j;
         }
-        const std::uint8_t* bytes = contiguous(blocks, segment_, [&](std::size_t k) { return reader_.block(at_need_[k]); });
-        out.break_unless_continues(fibers[i], blocks[i]);
+        const std::span<const std::size_t> all(segment_);
+        const std::size_t piece = piece_blocks(h_, options_);
+        for (std::size_t first = 0; first < all.size(); first += piece)
+            write_fine_piece(pass, blocks, fibers, all.subspan(first, std::min(piece, all.size() - first)), out);
+        return j;
+    }
+
+    // Fine blocks blocks[piece[0]], blocks[piece[1]], ... decoded with one
+    // call at the output's frontier.
+    void write_fine_piece(const BlockPass& pass, const std::vector<std::uint32_t>& blocks,
+                          const std::vector<std::uint64_t>& fibers, std::span<const std::size_t> piece, RunWriter& out) {
+        const std::uint8_t* bytes = contiguous(blocks, piece, [&](std::size_t k) { return reader_.block(at_need_[k]); });
+        out.break_unless_continues(fibers[piece[0]], blocks[piece[0]]);
         const std::size_t base = out.frontier();
-        const std::size_t decoded = decode_into(ctx_, bytes, segment_.size(), out.buffer(), base);
-        stats_.blocks_decoded += segment_.size();
+        const std::size_t decoded = decode_into(ctx_, bytes, piece.size(), out.buffer(), base);
+        stats_.blocks_decoded += piece.size();
         std::size_t at = base;
-        for (std::size_t s = 0; s < segment_.size(); ++s) {
-            const std::size_t k = segment_[s];
+        for (std::size_t s = 0; s < piece.size(); ++s) {
+            const std::size_t k = piece[s];
             const std::uint32_t n = block_flags(h_, bytes + s * h_.block_bytes()).point_count;
             if (passes_regions(pass, blocks[k], &out.buffer()[3 * at], n)) out.fine(fibers[k], blocks[k], at, n);
             at += n;
         }
         out.advance(decoded);
         out.maybe_flush();
-        return j;
     }
 
     // Reads `blocks` and, with `with_next`, the next block of each in its
@@ -703,7 +722,7 @@ private:
     // in memory: where they are when they follow each other in the file,
     // else copied into staging_ (76 bytes a block, against 720 decoded).
     template <class BlockOf>
-    const std::uint8_t* contiguous(const std::vector<std::uint32_t>& blocks, const std::vector<std::size_t>& items,
+    const std::uint8_t* contiguous(const std::vector<std::uint32_t>& blocks, std::span<const std::size_t> items,
                                    const BlockOf& block_of) {
         const std::uint32_t bb = h_.block_bytes();
         bool in_place = true;
