@@ -424,7 +424,7 @@ private:
             if (tested.empty()) continue;
             // One decode call for the whole batch (SIMD decoders fill their lanes).
             const std::uint8_t* bytes =
-                contiguous(blocks, tested, [&](std::size_t i) { return reader_.block(at_need_[i]); });
+                contiguous(tested, [&](std::size_t i) { return reader_.block(at_need_[i]); });
             decode_into(ctx_, bytes, tested.size(), scratch_, 0);
             first_point.assign(tested.size() + 1, 0);
             for (std::size_t j = 0; j < tested.size(); ++j)
@@ -464,7 +464,7 @@ private:
             reader_.read(blocks);
             all.resize(blocks.size());
             for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
-            const std::uint8_t* bytes = contiguous(blocks, all, [&](std::size_t i) { return reader_.block(i); });
+            const std::uint8_t* bytes = contiguous(all, [&](std::size_t i) { return reader_.block(i); });
             decode_into(ctx_, bytes, blocks.size(), scratch_, 0);
             stats_.blocks_decoded += blocks.size();
             std::size_t at = 0;
@@ -648,7 +648,7 @@ private:
     // call at the output's frontier.
     void write_fine_piece(const BlockPass& pass, const std::vector<std::uint32_t>& blocks,
                           const std::vector<std::uint64_t>& fibers, std::span<const std::size_t> piece, RunWriter& out) {
-        const std::uint8_t* bytes = contiguous(blocks, piece, [&](std::size_t k) { return reader_.block(at_need_[k]); });
+        const std::uint8_t* bytes = contiguous(piece, [&](std::size_t k) { return reader_.block(at_need_[k]); });
         out.break_unless_continues(fibers[piece[0]], blocks[piece[0]]);
         const std::size_t base = out.frontier();
         const std::size_t decoded = decode_into(ctx_, bytes, piece.size(), out.buffer(), base);
@@ -718,17 +718,17 @@ private:
         detail::block_spheres(h_, block_pointers_.data(), count, spheres_.data());
     }
 
-    // The blocks blocks[items[0]], blocks[items[1]], ... one after the other
-    // in memory: where they are when they follow each other in the file,
-    // else copied into staging_ (76 bytes a block, against 720 decoded).
+    // The blocks block_of(items[0]), block_of(items[1]), ... one after the
+    // other in memory: where they are when they follow each other in the
+    // reader's buffer (e.g. every block of the kept fibers), else copied into
+    // staging_ (76 bytes a block, against 720 decoded).
     template <class BlockOf>
-    const std::uint8_t* contiguous(const std::vector<std::uint32_t>& blocks, std::span<const std::size_t> items,
-                                   const BlockOf& block_of) {
+    const std::uint8_t* contiguous(std::span<const std::size_t> items, const BlockOf& block_of) {
         const std::uint32_t bb = h_.block_bytes();
+        const std::uint8_t* const first = block_of(items[0]);
         bool in_place = true;
-        for (std::size_t s = 1; s < items.size() && in_place; ++s)
-            in_place = blocks[items[s]] == blocks[items[0]] + s;
-        if (in_place) return block_of(items[0]);
+        for (std::size_t s = 1; s < items.size() && in_place; ++s) in_place = block_of(items[s]) == first + s * bb;
+        if (in_place) return first;
         staging_.resize(items.size() * bb);
         for (std::size_t s = 0; s < items.size(); ++s) std::memcpy(&staging_[s * bb], block_of(items[s]), bb);
         return staging_.data();
