@@ -17,6 +17,7 @@
 #include "fiblet/error.hpp"
 #include "fiblet/fft_subset.hpp"
 #include "fiblet/select.hpp"
+#include "select/block_bits.hpp"
 #include "cli_runner.hpp"
 #include "scoped_simd_loops.hpp"
 #include "select_reference.hpp"
@@ -67,7 +68,7 @@ protected:
     static inline std::unique_ptr<TempDir> dir_;
 };
 
-bool bit(const std::vector<std::uint64_t>& bits, std::size_t b) { return (bits[b >> 6] >> (b & 63)) & 1; }
+using detail::has_bit;
 
 // `count` random region queries (seeded), every other one in blocks mode and
 // (`with_views`) every third one with a camera, select through `index`
@@ -373,10 +374,10 @@ TEST_F(SelectIndex, CandidatesNeverMissABlockWithAPointInTheRegion) {
             else
                 index.blocks_near_box(r.box, bits);
             for (std::size_t b = 0; b < d.blocks.size(); ++b) {
-                candidates += bit(bits, b);
+                candidates += has_bit(bits, b);
                 if (any_inside(d, d.blocks[b].first_point, d.blocks[b].points, r)) {
                     ++hits;
-                    ASSERT_TRUE(bit(bits, b)) << path << ": region " << i << " misses block " << b;
+                    ASSERT_TRUE(has_bit(bits, b)) << path << ": region " << i << " misses block " << b;
                 }
             }
         }
@@ -403,11 +404,11 @@ TEST_F(SelectIndex, FrustumCandidatesCoverEveryBlockSphereThatMeetsTheFrustum) {
             index.blocks_near_frustum(f, margin, by_box);
             index.blocks_starting_near_frustum(f, margin, by_first_point);
             for (std::size_t b = 0; b < d.blocks.size(); ++b) {
-                near += bit(by_box, b), starting_near += bit(by_first_point, b);
+                near += has_bit(by_box, b), starting_near += has_bit(by_first_point, b);
                 if (sphere_intersects_frustum(f, d.blocks[b].sphere.center, d.blocks[b].sphere.radius)) {
                     ++spheres;
-                    ASSERT_TRUE(bit(by_box, b)) << path << " camera " << i << " block " << b;
-                    ASSERT_TRUE(bit(by_first_point, b)) << path << " camera " << i << " block " << b;
+                    ASSERT_TRUE(has_bit(by_box, b)) << path << " camera " << i << " block " << b;
+                    ASSERT_TRUE(has_bit(by_first_point, b)) << path << " camera " << i << " block " << b;
                 }
             }
         }
@@ -468,9 +469,9 @@ TEST_F(SelectIndex, CandidatesAreTheBlocksWhoseOwnBoxMeetsTheRegion) {
                 std::vector<std::uint64_t> starting;
                 index.blocks_starting_near_frustum(f, margin, starting);
                 for (std::size_t b = 0; b < d.blocks.size(); ++b) {
-                    ASSERT_EQ(bit(bits, b), box_intersects_frustum(f, index.block_box(b), margin))
+                    ASSERT_EQ(has_bit(bits, b), box_intersects_frustum(f, index.block_box(b), margin))
                         << path << " camera " << i << " block " << b << " AVX2 " << avx2;
-                    ASSERT_EQ(bit(starting, b), box_intersects_frustum(f, index.first_point_box(b), margin))
+                    ASSERT_EQ(has_bit(starting, b), box_intersects_frustum(f, index.first_point_box(b), margin))
                         << path << " camera " << i << " block " << b << " AVX2 " << avx2 << " (first point)";
                 }
             }
@@ -490,13 +491,13 @@ TEST_F(SelectIndex, CandidatesAreTheBlocksWhoseOwnBoxMeetsTheRegion) {
             }
             for (std::size_t b = 0; b < d.blocks.size(); ++b) {
                 const Aabb x = index.block_box(b);
-                near_count += bit(near, b), inside_count += bit(inside, b);
+                near_count += has_bit(near, b), inside_count += has_bit(inside, b);
                 if (r.shape == Region::Shape::box) {
                     const Aabb& q = r.box;
-                    ASSERT_EQ(bit(near, b), x.max.x >= q.min.x && x.min.x <= q.max.x && x.max.y >= q.min.y &&
+                    ASSERT_EQ(has_bit(near, b), x.max.x >= q.min.x && x.min.x <= q.max.x && x.max.y >= q.min.y &&
                                                 x.min.y <= q.max.y && x.max.z >= q.min.z && x.min.z <= q.max.z)
                         << path << " region " << i << " block " << b;
-                    ASSERT_EQ(bit(inside, b), x.min.x >= q.min.x && x.max.x <= q.max.x && x.min.y >= q.min.y &&
+                    ASSERT_EQ(has_bit(inside, b), x.min.x >= q.min.x && x.max.x <= q.max.x && x.min.y >= q.min.y &&
                                                   x.max.y <= q.max.y && x.min.z >= q.min.z && x.max.z <= q.max.z)
                         << path << " region " << i << " block " << b;
                     continue;
@@ -511,16 +512,16 @@ TEST_F(SelectIndex, CandidatesAreTheBlocksWhoseOwnBoxMeetsTheRegion) {
                 }
                 const double r2 = double(r.radius) * r.radius;
                 if (near2 < r2 * (1 - 1e-4)) {
-                    ASSERT_TRUE(bit(near, b)) << path << " region " << i << " block " << b;
+                    ASSERT_TRUE(has_bit(near, b)) << path << " region " << i << " block " << b;
                 }
                 if (near2 > r2 * (1 + 1e-4)) {
-                    ASSERT_FALSE(bit(near, b)) << path << " region " << i << " block " << b;
+                    ASSERT_FALSE(has_bit(near, b)) << path << " region " << i << " block " << b;
                 }
                 if (far2 < r2 * (1 - 1e-4)) {
-                    ASSERT_TRUE(bit(inside, b)) << path << " region " << i << " block " << b;
+                    ASSERT_TRUE(has_bit(inside, b)) << path << " region " << i << " block " << b;
                 }
                 if (far2 > r2) {
-                    ASSERT_FALSE(bit(inside, b)) << path << " region " << i << " block " << b;
+                    ASSERT_FALSE(has_bit(inside, b)) << path << " region " << i << " block " << b;
                 }
             }
         }
@@ -771,7 +772,7 @@ TEST_F(SelectIndex, BlocksOffTheGridAreNeverCulled) {
     EXPECT_FALSE(index.bounds()) << "no finite box holds block 0";
     std::vector<std::uint64_t> bits;
     index.blocks_near_sphere({-5000, 0, 0}, 1, bits);
-    for (std::size_t b = 0; b < d.blocks.size(); ++b) EXPECT_EQ(bit(bits, b), b == 0) << "block " << b;
+    for (std::size_t b = 0; b < d.blocks.size(); ++b) EXPECT_EQ(has_bit(bits, b), b == 0) << "block " << b;
 }
 
 TEST_F(SelectIndex, BuilderRefusesLayoutsItCannotDescribe) {

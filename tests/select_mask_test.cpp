@@ -14,6 +14,7 @@
 #include "fiblet/image_mask.hpp"
 #include "fiblet/select.hpp"
 #include "fiblet/tck.hpp"
+#include "select/block_bits.hpp"
 #include "image_source.hpp"
 #include "select_reference.hpp"
 
@@ -254,7 +255,7 @@ TEST_F(MaskSelection, WalkAgreesWithClassifyBlockByBlock) {
         std::size_t near_count = 0, inside_count = 0;
         for (std::uint64_t b = 0; b < index.blocks(); ++b) {
             const ImageMask::Overlap o = mask->classify(index.block_box(b));
-            const bool is_near = (near[b / 64] >> (b % 64)) & 1, is_inside = (inside[b / 64] >> (b % 64)) & 1;
+            const bool is_near = detail::has_bit(near, b), is_inside = detail::has_bit(inside, b);
             ASSERT_EQ(is_near, o != ImageMask::Overlap::outside) << name << " block " << b;
             ASSERT_EQ(is_inside, o == ImageMask::Overlap::inside) << name << " block " << b;
             near_count += is_near, inside_count += is_inside;
